@@ -1,0 +1,34 @@
+# Two commands do all the set-up: `make run` (the viewer on the bundled default mesh)
+# and `make test` (the test suite). Both create and fill .venv on first use.
+VENV ?= .venv
+PYTHON ?= python3
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.installed
+
+.PHONY: run test lint format bench clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e ".[dev]"
+	touch $(STAMP)
+
+run: $(STAMP)
+	$(PY) -m modalviewer
+
+test: $(STAMP)
+	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q
+	$(PY) -m ruff check modalviewer tests benchmarks
+	$(PY) -m ruff format --check modalviewer tests benchmarks
+
+lint: $(STAMP)
+	$(PY) -m ruff check modalviewer tests benchmarks
+
+format: $(STAMP)
+	$(PY) -m ruff format modalviewer tests benchmarks
+
+bench: $(STAMP)
+	$(PY) -m benchmarks.run
+
+clean:
+	rm -rf $(VENV)

@@ -1,0 +1,35 @@
+"""Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
+
+from .dirichlet import modified_dirichlet_matrix
+from .eigen import Cancelled, EigenError
+from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
+from .mesh import Mesh, MeshError, MeshReport, repair_mesh
+from .pipeline import compute_spectrum
+from .shells import normal_shells_hessian, shells_hessian
+from .signatures import SignatureTable, default_times, multiscale_distance, signature
+from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, save_spectrum
+
+__all__ = [
+    "Cancelled",
+    "EigenError",
+    "Mesh",
+    "MeshError",
+    "MeshReport",
+    "OPERATORS",
+    "SignatureTable",
+    "Spectrum",
+    "SpectrumFileError",
+    "compute_spectrum",
+    "default_times",
+    "load_spectrum",
+    "mass_matrix",
+    "modified_dirichlet_matrix",
+    "multiscale_distance",
+    "normal_shells_hessian",
+    "repair_mesh",
+    "save_spectrum",
+    "shells_hessian",
+    "signature",
+    "stiffness_matrix",
+    "vertex_normals",
+]

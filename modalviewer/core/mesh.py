@@ -1,0 +1,418 @@
+"""Triangle mesh container: validation, topology queries and load-time repair.
+
+A :class:`Mesh` holds ``vertices`` (n, 3) float64 and ``faces`` (m, 3) int64 and is
+immutable after construction.  Construction validates; it never repairs.  Repairs
+(merging duplicates, dropping degenerate faces, re-orienting) happen only in
+:func:`repair_mesh`, which returns a new mesh and a report in plain words.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections import deque
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+__all__ = ["Mesh", "MeshError", "MeshReport", "repair_mesh"]
+
+
+class MeshError(ValueError):
+    """Raised for input that cannot be a triangle surface, with a message for a user."""
+
+
+@dataclass
+class MeshReport:
+    """What loading found and repaired, as sentences a user understands."""
+
+    source: str = ""
+    messages: list[str] = field(default_factory=list)
+
+    def add(self, message: str) -> None:
+        self.messages.append(message)
+
+    def __str__(self) -> str:
+        head = f"{self.source}: " if self.source else ""
+        if not self.messages:
+            return head + "no problems found."
+        return head + " ".join(self.messages)
+
+    def __bool__(self) -> bool:  # a report is always worth showing
+        return True
+
+
+def _plural(count: int, word: str) -> str:
+    if count == 1:
+        return f"{count} {word}"
+    if word.endswith("vertex"):
+        return f"{count} {word[:-6]}vertices"
+    return f"{count} {word}s"
+
+
+class Mesh:
+    """A validated triangle mesh.
+
+    Parameters
+    ----------
+    vertices : array_like, shape (n, 3)
+        Vertex positions (any length unit); converted to float64.
+    faces : array_like, shape (m, 3)
+        Vertex indices of each triangle; converted to int64.
+
+    Raises
+    ------
+    MeshError
+        If there are no faces, coordinates are not finite, indices are out of
+        range, a face repeats a vertex or has zero area.
+    """
+
+    def __init__(self, vertices, faces, report: MeshReport | None = None):
+        try:
+            v = np.array(vertices, dtype=np.float64, copy=True)
+            f_raw = np.asarray(faces)
+        except (TypeError, ValueError) as exc:
+            raise MeshError(f"vertices and faces must be numeric arrays ({exc})") from None
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise MeshError(f"vertices must have shape (n, 3), got {v.shape}")
+        if v.shape[0] == 0:
+            raise MeshError("the mesh has no vertices")
+        if f_raw.size == 0:
+            raise MeshError(
+                "the mesh has no faces (a point cloud is not a surface); "
+                "triangulate it first, for example by surface reconstruction"
+            )
+        if f_raw.ndim != 2 or f_raw.shape[1] != 3:
+            raise MeshError(f"faces must have shape (m, 3) (triangles), got {f_raw.shape}")
+        if not np.issubdtype(f_raw.dtype, np.integer):
+            if not np.all(np.isfinite(f_raw)) or np.any(f_raw != np.round(f_raw)):
+                raise MeshError("face indices must be whole numbers")
+        f = f_raw.astype(np.int64, copy=True)
+        bad = ~np.isfinite(v).all(axis=1)
+        if bad.any():
+            first = int(np.flatnonzero(bad)[0])
+            raise MeshError(
+                f"{_plural(int(bad.sum()), 'vertex')} have NaN or infinite coordinates "
+                f"(first: vertex {first}); fix or remove them in the source file"
+            )
+        n = v.shape[0]
+        out = (f < 0) | (f >= n)
+        if out.any():
+            face = int(np.flatnonzero(out.any(axis=1))[0])
+            raise MeshError(
+                f"face {face} refers to vertex {int(f[face][out[face]][0])}, but the mesh has "
+                f"only {n} vertices (indices 0..{n - 1}); the file is corrupt or truncated"
+            )
+        repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
+        if repeated.any():
+            raise MeshError(
+                f"{_plural(int(repeated.sum()), 'face')} repeat a vertex (first: face "
+                f"{int(np.flatnonzero(repeated)[0])}); load with repair=True to drop them"
+            )
+        self._vertices = v
+        self._faces = f
+        self._vertices.setflags(write=False)
+        self._faces.setflags(write=False)
+        areas = self.face_areas
+        scale = max(self.bounding_box_diagonal, np.finfo(float).tiny)
+        degenerate = areas <= 1e-14 * scale**2
+        if degenerate.any():
+            raise MeshError(
+                f"{_plural(int(degenerate.sum()), 'face')} have zero area (first: face "
+                f"{int(np.flatnonzero(degenerate)[0])}); load with repair=True to drop them"
+            )
+        self.report = report if report is not None else MeshReport()
+
+    # ------------------------------------------------------------------ basics
+    @property
+    def vertices(self) -> np.ndarray:
+        """(n, 3) float64 vertex positions (read-only)."""
+        return self._vertices
+
+    @property
+    def faces(self) -> np.ndarray:
+        """(m, 3) int64 triangle vertex indices (read-only)."""
+        return self._faces
+
+    @property
+    def n_vertices(self) -> int:
+        return int(self._vertices.shape[0])
+
+    @property
+    def n_faces(self) -> int:
+        return int(self._faces.shape[0])
+
+    def __repr__(self) -> str:
+        return f"Mesh(n_vertices={self.n_vertices}, n_faces={self.n_faces})"
+
+    @cached_property
+    def hash(self) -> str:
+        """SHA-256 of vertices and faces: identifies the exact geometry."""
+        h = hashlib.sha256()
+        h.update(np.ascontiguousarray(self._vertices).tobytes())
+        h.update(np.ascontiguousarray(self._faces).tobytes())
+        return h.hexdigest()
+
+    @cached_property
+    def face_normals_unnormalized(self) -> np.ndarray:
+        """(m, 3) N_T = (x1 - x0) x (x2 - x0); its length is twice the face area."""
+        v, f = self._vertices, self._faces
+        return np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+
+    @cached_property
+    def face_areas(self) -> np.ndarray:
+        """(m,) triangle areas."""
+        return 0.5 * np.linalg.norm(self.face_normals_unnormalized, axis=1)
+
+    @cached_property
+    def bounding_box_diagonal(self) -> float:
+        v = self._vertices
+        return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+
+    @property
+    def total_area(self) -> float:
+        return float(self.face_areas.sum())
+
+    # ---------------------------------------------------------------- topology
+    @cached_property
+    def _edge_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Unique undirected edges (E, 2) sorted, face-edge -> edge map (m, 3), counts (E,)."""
+        f = self._faces
+        # half-edge k of face t goes from f[t, k] to f[t, (k + 1) % 3]
+        he = np.stack([f, np.roll(f, -1, axis=1)], axis=2).reshape(-1, 2)
+        key = np.sort(he, axis=1)
+        edges, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        return edges, inverse.reshape(-1, 3), counts
+
+    @property
+    def edges(self) -> np.ndarray:
+        """(E, 2) unique undirected edges, each row sorted ascending."""
+        return self._edge_data[0]
+
+    @property
+    def face_edges(self) -> np.ndarray:
+        """(m, 3) index into :attr:`edges` of face t's edge from corner k to corner k+1."""
+        return self._edge_data[1]
+
+    @property
+    def edge_face_counts(self) -> np.ndarray:
+        """(E,) number of faces incident to each edge (1 on a boundary)."""
+        return self._edge_data[2]
+
+    @cached_property
+    def n_components(self) -> int:
+        """Number of connected components (through faces)."""
+        return int(self.component_labels.max()) + 1
+
+    @cached_property
+    def component_labels(self) -> np.ndarray:
+        """(n,) connected-component label of each vertex."""
+        e = self.edges
+        n = self.n_vertices
+        adj = sp.coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
+        _, labels = connected_components(adj, directed=False)
+        return labels
+
+    @property
+    def n_boundary_edges(self) -> int:
+        return int((self.edge_face_counts == 1).sum())
+
+    @property
+    def n_nonmanifold_edges(self) -> int:
+        return int((self.edge_face_counts > 2).sum())
+
+    @property
+    def is_edge_manifold(self) -> bool:
+        """True if every edge has one or two incident faces."""
+        return self.n_nonmanifold_edges == 0
+
+    @cached_property
+    def is_consistently_oriented(self) -> bool:
+        """True if every interior edge is traversed in opposite directions by its two faces."""
+        f = self._faces
+        he = np.stack([f, np.roll(f, -1, axis=1)], axis=2).reshape(-1, 2)
+        _, counts = np.unique(he, axis=0, return_counts=True)
+        return bool(counts.max() == 1)
+
+    @property
+    def is_closed(self) -> bool:
+        return self.n_boundary_edges == 0
+
+    def shell_problem(self) -> str | None:
+        """Why the Discrete Shells and E_D^N operators cannot run here, or None."""
+        if not self.is_edge_manifold:
+            return (
+                f"the mesh has {_plural(self.n_nonmanifold_edges, 'edge')} shared by more "
+                "than two faces (non-manifold); dihedral angles and vertex normals are not "
+                "defined there. Split or remove those faces; the Laplacian still works."
+            )
+        if not self.is_consistently_oriented:
+            return (
+                "the faces are not consistently oriented (the surface may be non-orientable); "
+                "normals and dihedral angles are ambiguous. Load with repair=True to re-orient "
+                "it; the Laplacian still works."
+            )
+        return None
+
+
+# ---------------------------------------------------------------------- repair
+def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
+    if tol > 0:
+        key = np.round(v / tol).astype(np.int64)
+    else:
+        key = v
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    order = np.argsort(first)  # keep the original order of first occurrences
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    new_v = v[first[order]]
+    return new_v, rank[inverse][f], len(v) - len(new_v)
+
+
+def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
+    """Flip faces so neighbours across manifold edges agree; BFS per component.
+
+    Returns (faces, number flipped, orientable).
+    """
+    m = len(f)
+    he = np.stack([f, np.roll(f, -1, axis=1)], axis=2).reshape(-1, 2)
+    key = np.sort(he, axis=1)
+    _, inv, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.reshape(-1)
+    face_of = np.repeat(np.arange(m), 3)
+    order = np.argsort(inv, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    # neighbours only across manifold edges (exactly two faces)
+    pairs = []
+    for e in np.flatnonzero(counts == 2):
+        a, b = order[starts[e]], order[starts[e] + 1]
+        pairs.append((a, b))
+    if not pairs:
+        return f, 0, True
+    pa = np.array(pairs)
+    fa, fb = face_of[pa[:, 0]], face_of[pa[:, 1]]
+    same_dir = np.all(he[pa[:, 0]] == he[pa[:, 1]], axis=1)  # same direction: inconsistent
+    nbrs: list[list[tuple[int, bool]]] = [[] for _ in range(m)]
+    for x, y, s in zip(fa.tolist(), fb.tolist(), same_dir.tolist()):
+        nbrs[x].append((y, s))
+        nbrs[y].append((x, s))
+    flip = np.zeros(m, dtype=bool)
+    seen = np.zeros(m, dtype=bool)
+    orientable = True
+    for seed in range(m):
+        if seen[seed]:
+            continue
+        seen[seed] = True
+        queue = deque([seed])
+        while queue:
+            t = queue.popleft()
+            for u, s in nbrs[t]:
+                want = flip[t] ^ s
+                if not seen[u]:
+                    seen[u] = True
+                    flip[u] = want
+                    queue.append(u)
+                elif flip[u] != want:
+                    orientable = False
+    out = f.copy()
+    out[flip] = out[flip][:, ::-1]
+    return out, int(flip.sum()), orientable
+
+
+def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-10):
+    """Repair raw arrays into a valid :class:`Mesh` and report what was done.
+
+    Steps: check finiteness and index range (errors, not repairs), merge vertices
+    closer than ``merge_tolerance`` times the bounding-box diagonal, drop faces that
+    repeat a vertex or have (near) zero area, drop duplicate faces, drop unreferenced
+    vertices, make the orientation consistent per component where possible.
+
+    Returns
+    -------
+    Mesh
+        With ``mesh.report`` describing every change.
+    """
+    report = MeshReport(source=source)
+    try:
+        v = np.array(vertices, dtype=np.float64)
+        f = np.asarray(faces)
+    except (TypeError, ValueError) as exc:
+        raise MeshError(f"could not read vertex or face data ({exc})") from None
+    if v.ndim != 2 or v.shape[1] != 3 or len(v) == 0:
+        raise MeshError("the file contains no vertices")
+    if f.size == 0:
+        raise MeshError(
+            f"the file contains {_plural(len(v), 'vertex')} but no faces: a point cloud is "
+            "not a surface. Reconstruct a surface from it first."
+        )
+    f = f.reshape(-1, 3).astype(np.int64)
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        raise MeshError(
+            f"{_plural(int(bad.sum()), 'vertex')} have NaN or infinite coordinates (first: "
+            f"vertex {int(np.flatnonzero(bad)[0])}); the file is damaged. Fix the "
+            "coordinates in the source application and export again."
+        )
+    n = len(v)
+    out = (f < 0) | (f >= n)
+    if out.any():
+        face = int(np.flatnonzero(out.any(axis=1))[0])
+        raise MeshError(
+            f"face {face} refers to a vertex that does not exist (the file has "
+            f"{_plural(n, 'vertex')}); the file is corrupt or truncated"
+        )
+    diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    if diag == 0:
+        raise MeshError("all vertices coincide: the mesh has no extent")
+
+    v, f, merged = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
+    if merged:
+        report.add(f"Merged {_plural(merged, 'duplicate vertex')}.")
+
+    repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
+    nt = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    zero = 0.5 * np.linalg.norm(nt, axis=1) <= 1e-14 * diag**2
+    drop = repeated | zero
+    if drop.any():
+        f = f[~drop]
+        report.add(f"Removed {_plural(int(drop.sum()), 'degenerate (zero-area) face')}.")
+    if len(f):
+        _, keep = np.unique(np.sort(f, axis=1), axis=0, return_index=True)
+        if len(keep) < len(f):
+            report.add(f"Removed {_plural(len(f) - len(keep), 'duplicate face')}.")
+            f = f[np.sort(keep)]
+    if len(f) == 0:
+        raise MeshError("no faces are left after removing degenerate ones: not a surface")
+
+    used = np.zeros(len(v), dtype=bool)
+    used[f.ravel()] = True
+    if not used.all():
+        remap = np.cumsum(used) - 1
+        report.add(f"Removed {_plural(int((~used).sum()), 'unreferenced vertex')}.")
+        v, f = v[used], remap[f]
+
+    f, flipped, orientable = _orient_faces(f)
+    if flipped:
+        report.add(f"Flipped {_plural(flipped, 'face')} to make the orientation consistent.")
+    if not orientable:
+        report.add("The surface is not orientable, so some faces disagree in orientation.")
+
+    mesh = Mesh(v, f, report=report)
+    summary = (
+        f"{_plural(mesh.n_vertices, 'vertex')}, {_plural(mesh.n_faces, 'face')}, "
+        f"{_plural(mesh.n_components, 'component')}"
+    )
+    if mesh.n_boundary_edges:
+        summary += f", {_plural(mesh.n_boundary_edges, 'boundary edge')}"
+    else:
+        summary += ", closed"
+    if not mesh.is_edge_manifold:
+        summary += f", {_plural(mesh.n_nonmanifold_edges, 'non-manifold edge')}"
+    report.messages.insert(0, summary + ".")
+    problem = mesh.shell_problem()
+    if problem:
+        report.add("Shells and E_D^N cannot run: " + problem)
+    return mesh

@@ -1,0 +1,245 @@
+"""Discrete Shells energy (Grinspun et al. 2003) and its Hessian at rest (paper Lemma 1).
+
+Every term has the form ``1/2 * sum_i w_i (f_i(x) - f_i(xbar))^2`` with weights at rest:
+
+- flexural E_F over interior edges: f = signed dihedral angle, w = 3 |e|^2 / A_e;
+- stretching E_L over all edges: f = |e|, w = 1 / |e|;
+- area E_A over faces: f = A_T, w = 1 / A_T;
+
+E = bending * E_F + membrane * (E_L + E_A).  Lemma 1 gives the Hessian at rest as
+``H = sum_i w_i grad f_i grad f_i^T``; it is assembled here fully vectorised, in
+vertex-major order (dof ``3 * i + c``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .laplacian import vertex_normals
+from .mesh import Mesh, MeshError
+
+__all__ = [
+    "hinges",
+    "dihedral_angles",
+    "dihedral_angle_gradients",
+    "edge_lengths",
+    "edge_length_gradients",
+    "triangle_areas",
+    "triangle_area_gradients",
+    "shells_energy",
+    "shells_gradient",
+    "shells_hessian",
+    "normal_shells_hessian",
+    "normal_projection",
+]
+
+
+# ----------------------------------------------------------------- topology
+def hinges(mesh: Mesh) -> np.ndarray:
+    """(h, 4) interior-edge stencils ``[x0, x1, x2, x3]``.
+
+    The edge runs x0 -> x1 in the first triangle (x0, x1, x2); the second triangle is
+    (x1, x0, x3).  Requires an edge-manifold, consistently oriented mesh.
+    """
+    problem = mesh.shell_problem()
+    if problem:
+        raise MeshError("Discrete Shells cannot run: " + problem)
+    f = mesh.faces
+    m = len(f)
+    edge_of_halfedge = mesh.face_edges.ravel()  # half-edge 3t+k: f[t,k] -> f[t,k+1]
+    interior = np.flatnonzero(mesh.edge_face_counts == 2)
+    order = np.argsort(edge_of_halfedge, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(mesh.edge_face_counts)])
+    first = order[starts[interior]]
+    second = order[starts[interior] + 1]
+    t1, k1 = np.divmod(first, 3)
+    t2, k2 = np.divmod(second, 3)
+    x0 = f[t1, k1]
+    x1 = f[t1, (k1 + 1) % 3]
+    x2 = f[t1, (k1 + 2) % 3]
+    x3 = f[t2, (k2 + 2) % 3]
+    assert m == 0 or np.all(f[t2, k2] == x1)
+    return np.stack([x0, x1, x2, x3], axis=1)
+
+
+# ------------------------------------------------------- elementary quantities
+def _rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", a, b)
+
+
+def dihedral_angles(x: np.ndarray, hinge: np.ndarray) -> np.ndarray:
+    """(h,) signed dihedral angles in radians (0 for a flat hinge, via atan2).
+
+    Positive when the hinge folds towards the side the normals point to... the sign
+    convention is irrelevant for the Hessian at rest.
+    """
+    x0, x1, x2, x3 = (x[hinge[:, k]] for k in range(4))
+    e = x1 - x0
+    n1 = np.cross(e, x2 - x0)
+    n2 = np.cross(x0 - x1, x3 - x1)
+    e_hat = e / np.linalg.norm(e, axis=1, keepdims=True)
+    return np.arctan2(_rows_dot(np.cross(n1, n2), e_hat), _rows_dot(n1, n2))
+
+
+def dihedral_angle_gradients(x: np.ndarray, hinge: np.ndarray) -> np.ndarray:
+    """(h, 4, 3) gradient of :func:`dihedral_angles` w.r.t. x0, x1, x2, x3."""
+    x0, x1, x2, x3 = (x[hinge[:, k]] for k in range(4))
+    e = x1 - x0
+    length = np.linalg.norm(e, axis=1)
+    e_hat = e / length[:, None]
+    n1 = np.cross(e, x2 - x0)
+    n2 = np.cross(x0 - x1, x3 - x1)
+    a1 = n1 / _rows_dot(n1, n1)[:, None]  # n1 / |n1|^2
+    a2 = n2 / _rows_dot(n2, n2)[:, None]
+    g = np.empty((len(hinge), 4, 3))
+    g[:, 2] = -length[:, None] * a1
+    g[:, 3] = -length[:, None] * a2
+    g[:, 0] = -(_rows_dot(x2 - x1, e_hat)[:, None] * a1 + _rows_dot(x3 - x1, e_hat)[:, None] * a2)
+    g[:, 1] = _rows_dot(x2 - x0, e_hat)[:, None] * a1 + _rows_dot(x3 - x0, e_hat)[:, None] * a2
+    return g
+
+
+def edge_lengths(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(E,) edge lengths."""
+    return np.linalg.norm(x[edges[:, 1]] - x[edges[:, 0]], axis=1)
+
+
+def edge_length_gradients(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """(E, 2, 3) gradient of the edge length w.r.t. its two end points."""
+    d = x[edges[:, 1]] - x[edges[:, 0]]
+    u = d / np.linalg.norm(d, axis=1, keepdims=True)
+    return np.stack([-u, u], axis=1)
+
+
+def triangle_areas(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m,) triangle areas."""
+    n = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
+    return 0.5 * np.linalg.norm(n, axis=1)
+
+
+def triangle_area_gradients(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m, 3, 3) gradient of the area w.r.t. corner k: 1/2 n_hat x (x_{k+2} - x_{k+1})."""
+    p = [x[faces[:, k]] for k in range(3)]
+    n = np.cross(p[1] - p[0], p[2] - p[0])
+    n_hat = n / np.linalg.norm(n, axis=1, keepdims=True)
+    return np.stack(
+        [0.5 * np.cross(n_hat, p[(k + 2) % 3] - p[(k + 1) % 3]) for k in range(3)], axis=1
+    )
+
+
+# --------------------------------------------------------------- the energy
+def _terms(mesh: Mesh, bending: float, membrane: float):
+    """Yield (stencil (e, L), f(x) callable, grad callable, weights at rest (e,))."""
+    rest = mesh.vertices
+    hinge = hinges(mesh)
+    edges = mesh.edges
+    faces = mesh.faces
+    areas = mesh.face_areas
+    if bending:
+        # combined area A_e of the two triangles of each hinge
+        a_e = triangle_areas(rest, hinge[:, [0, 1, 2]]) + triangle_areas(rest, hinge[:, [1, 0, 3]])
+        len_e = edge_lengths(rest, hinge[:, :2])
+        yield hinge, dihedral_angles, dihedral_angle_gradients, bending * 3.0 * len_e**2 / a_e
+    if membrane:
+        yield edges, edge_lengths, edge_length_gradients, membrane / edge_lengths(rest, edges)
+        yield faces, triangle_areas, triangle_area_gradients, membrane / areas
+
+
+def _check_weights(bending: float, membrane: float) -> None:
+    for name, value in (("bending", bending), ("membrane", membrane)):
+        if not np.isfinite(value) or value < 0:
+            raise ValueError(f"{name} weight must be a finite number >= 0, got {value}")
+    if bending == 0 and membrane == 0:
+        raise ValueError("bending and membrane weights cannot both be zero")
+
+
+def shells_energy(mesh: Mesh, x, bending: float = 1.0, membrane: float = 1.0) -> float:
+    """Discrete Shells energy of deformed positions ``x`` (n, 3) relative to the mesh."""
+    _check_weights(bending, membrane)
+    x = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+    total = 0.0
+    for stencil, f, _, w in _terms(mesh, bending, membrane):
+        diff = f(x, stencil) - f(mesh.vertices, stencil)
+        total += 0.5 * float(np.sum(w * diff**2))
+    return total
+
+
+def shells_gradient(mesh: Mesh, x, bending: float = 1.0, membrane: float = 1.0) -> np.ndarray:
+    """(3n,) gradient of :func:`shells_energy` at ``x``, vertex-major."""
+    _check_weights(bending, membrane)
+    x = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+    grad = np.zeros((mesh.n_vertices, 3))
+    for stencil, f, df, w in _terms(mesh, bending, membrane):
+        coef = w * (f(x, stencil) - f(mesh.vertices, stencil))
+        contrib = coef[:, None, None] * df(x, stencil)
+        for c in range(3):
+            grad[:, c] += np.bincount(
+                stencil.ravel(), contrib[:, :, c].ravel(), minlength=mesh.n_vertices
+            )
+    return grad.ravel()
+
+
+def _assemble_outer_products(n: int, parts) -> sp.csr_matrix:
+    """Sum of w g g^T over elements, as a (3n, 3n) CSR built from 3x3 vertex blocks.
+
+    ``parts`` yields (stencil (e, L), gradients (e, L, 3), weights (e,)).
+    Duplicate vertex pairs are summed with one sort of int64 keys and bincounts.
+    """
+    keys_list, blocks_list = [], []
+    for stencil, g, w in parts:
+        L = stencil.shape[1]
+        a = np.repeat(stencil, L, axis=1).ravel()  # row vertex of each block
+        b = np.tile(stencil, (1, L)).ravel()  # column vertex
+        keys_list.append(a.astype(np.int64) * n + b)
+        # block (p, q) of element e: w_e g[e, p] g[e, q]^T, shape (e, L, L, 3, 3)
+        wg = g * np.sqrt(w)[:, None, None]
+        blocks_list.append(np.einsum("epi,eqj->epqij", wg, wg).reshape(-1, 9))
+    keys = np.concatenate(keys_list)
+    blocks = np.concatenate(blocks_list)
+    del keys_list, blocks_list
+    unique, inverse = np.unique(keys, return_inverse=True)
+    summed = np.empty((len(unique), 9))
+    for c in range(9):
+        summed[:, c] = np.bincount(inverse, weights=blocks[:, c], minlength=len(unique))
+    rows = unique // n
+    cols = unique - rows * n
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
+    bsr = sp.bsr_matrix(
+        (summed.reshape(-1, 3, 3), cols.astype(np.int32), indptr.astype(np.int32)),
+        shape=(3 * n, 3 * n),
+    )
+    return bsr.tocsr()
+
+
+def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
+    """Hessian of the Discrete Shells energy at rest (Lemma 1), (3n, 3n) PSD CSR.
+
+    Vertex-major dof order ``3 * i + c``.  Pair it with ``kron(M, I3)`` as mass.
+    Units: bending part ~ 1 / length^2, membrane part ~ 1 / length^1 (hence the
+    spectrum depends on the mesh's absolute size).
+    """
+    _check_weights(bending, membrane)
+    x = mesh.vertices
+    parts = (
+        (stencil, df(x, stencil), w) for stencil, _, df, w in _terms(mesh, bending, membrane)
+    )
+    return _assemble_outer_products(mesh.n_vertices, parts)
+
+
+def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_matrix:
+    """P, (3n, n): column i holds the unit normal N_i in the rows of vertex i."""
+    n = mesh.n_vertices
+    normals = vertex_normals(mesh) if normals is None else normals
+    rows = np.arange(3 * n)
+    cols = np.repeat(np.arange(n), 3)
+    return sp.csr_matrix((normals.ravel(), (rows, cols)), shape=(3 * n, n))
+
+
+def normal_shells_hessian(
+    mesh: Mesh, bending: float = 1.0, membrane: float = 1.0
+) -> sp.csr_matrix:
+    """H_N = P^T H P, (n, n): the shells Hessian restricted to normal variations."""
+    P = normal_projection(mesh)
+    H = shells_hessian(mesh, bending, membrane)
+    return (P.T @ H @ P).tocsr()

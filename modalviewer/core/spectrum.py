@@ -1,0 +1,146 @@
+"""The :class:`Spectrum` result and its ``.npz`` storage (written atomically)."""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .eigen import ZERO_MODE_RTOL
+
+__all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
+
+OPERATORS = ("laplacian", "modified_dirichlet", "shells", "shells_normal")
+FORMAT_VERSION = 1
+
+
+class SpectrumFileError(ValueError):
+    """A spectrum file is unreadable, foreign, or does not belong to the given mesh."""
+
+
+@dataclass
+class Spectrum:
+    """Lowest eigenpairs of one operator on one mesh.
+
+    Attributes
+    ----------
+    eigenvalues : (k,) ascending, units 1/time^2 for vibrations (frequency = sqrt).
+    modes : (n, k), or (n, 3, k) for ``"shells"``; Mass-orthonormal.
+    operator : one of ``OPERATORS``.
+    mass : (n,) lumped vertex masses used for orthonormality.
+    residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
+    mesh_hash : SHA-256 of the mesh geometry the spectrum belongs to.
+    parameters : bending and membrane weights, solver information.
+    """
+
+    eigenvalues: np.ndarray
+    modes: np.ndarray
+    operator: str
+    mass: np.ndarray
+    residuals: np.ndarray
+    mesh_hash: str = ""
+    parameters: dict = field(default_factory=dict)
+
+    @property
+    def k(self) -> int:
+        return int(self.eigenvalues.shape[0])
+
+    @property
+    def n_vertices(self) -> int:
+        return int(self.modes.shape[0])
+
+    @property
+    def is_vector(self) -> bool:
+        return self.modes.ndim == 3
+
+    def zero_mode_mask(self) -> np.ndarray:
+        """(k,) True for modes whose eigenvalue is below 1e-8 times the largest."""
+        lam_max = float(np.max(np.abs(self.eigenvalues)))
+        return self.eigenvalues < ZERO_MODE_RTOL * lam_max
+
+    def mode(self, j: int) -> np.ndarray:
+        """Mode j: (n,) for scalar operators, (n, 3) for ``"shells"``."""
+        return self.modes[..., j]
+
+    def squared_modes(self) -> np.ndarray:
+        """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes)."""
+        if self.is_vector:
+            return np.einsum("ick,ick->ik", self.modes, self.modes)
+        return self.modes**2
+
+
+def _atomic_write(path: Path, write) -> None:
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            write(fh)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def save_spectrum(spec: Spectrum, path) -> None:
+    """Write ``spec`` to ``path`` (.npz) atomically, with mesh hash and parameters."""
+    meta = {
+        "format": "modalviewer-spectrum",
+        "version": FORMAT_VERSION,
+        "operator": spec.operator,
+        "mesh_hash": spec.mesh_hash,
+        "parameters": spec.parameters,
+    }
+
+    def write(fh):
+        np.savez(
+            fh,
+            eigenvalues=spec.eigenvalues,
+            modes=spec.modes,
+            mass=spec.mass,
+            residuals=spec.residuals,
+            meta=np.array(json.dumps(meta)),
+        )
+
+    _atomic_write(Path(path), write)
+
+
+def load_spectrum(path, mesh_hash: str | None = None) -> Spectrum:
+    """Read a spectrum written by :func:`save_spectrum`.
+
+    If ``mesh_hash`` is given, a spectrum of another mesh raises SpectrumFileError.
+    """
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            spec = Spectrum(
+                eigenvalues=np.array(data["eigenvalues"], dtype=np.float64),
+                modes=np.array(data["modes"], dtype=np.float64),
+                operator=meta["operator"],
+                mass=np.array(data["mass"], dtype=np.float64),
+                residuals=np.array(data["residuals"], dtype=np.float64),
+                mesh_hash=meta.get("mesh_hash", ""),
+                parameters=meta.get("parameters", {}),
+            )
+    except FileNotFoundError:
+        raise
+    except Exception as exc:  # any damage: zip errors, missing keys, bad JSON
+        raise SpectrumFileError(f"{path} is not a readable spectrum file ({exc})") from None
+    if meta.get("format") != "modalviewer-spectrum" or spec.operator not in OPERATORS:
+        raise SpectrumFileError(f"{path} is not a modalviewer spectrum file")
+    k = spec.eigenvalues.shape[0]
+    n = spec.mass.shape[0]
+    expected = (n, 3, k) if spec.operator == "shells" else (n, k)
+    if spec.modes.shape != expected or spec.residuals.shape != (k,):
+        raise SpectrumFileError(f"{path} has inconsistent array shapes")
+    if not (np.all(np.isfinite(spec.eigenvalues)) and np.all(np.isfinite(spec.modes))):
+        raise SpectrumFileError(f"{path} contains NaN or infinite values")
+    if mesh_hash is not None and spec.mesh_hash != mesh_hash:
+        raise SpectrumFileError(f"{path} belongs to another mesh")
+    return spec
