@@ -21,10 +21,21 @@ SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 def _read_trimesh(path: Path):
     import trimesh
 
-    loaded = trimesh.load(str(path), process=False, force="mesh", skip_materials=True)
-    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64)
-    faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64)
-    return vertices, faces
+    loaded = trimesh.load(str(path), process=False, skip_materials=True)
+    if isinstance(loaded, trimesh.Scene):
+        geometries = list(loaded.dump()) if loaded.geometry else []
+    else:
+        geometries = [loaded]
+    vertices, faces, offset = [], [], 0
+    for geom in geometries:
+        v = np.asarray(getattr(geom, "vertices", np.zeros((0, 3))), dtype=np.float64)
+        f = np.asarray(getattr(geom, "faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
+        vertices.append(v.reshape(-1, 3))
+        faces.append(f + offset)
+        offset += len(v)
+    if not vertices:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    return np.vstack(vertices), np.vstack(faces)
 
 
 def _read_vtk(path: Path):

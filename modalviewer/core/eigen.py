@@ -190,7 +190,7 @@ def solve_lowest(
 def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol):
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
-    shift = -1e-8 * lam_max_est
+    shift = -1e-12 * lam_max_est  # far below the first non-zero mode, yet factorisable
     solver = None
     for _ in range(4):
         report("factorising", 0.05)
@@ -204,6 +204,10 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol):
             "the operator could not be factorised even with a shift below zero; "
             "it is probably not positive semi-definite (check the mesh for degenerate faces)"
         )
+    # Ask for a few more pairs than needed: single-vector Lanczos can miss a copy of a
+    # multiple eigenvalue (symmetric shapes), which the extra pairs then supply.
+    k_wanted = k
+    k = min(N - 1, k + max(8, k // 10))
     ncv = min(N, max(2 * k + 1, k + 32))
     calls = [0]
     expected = 3.0 * ncv
@@ -212,8 +216,10 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol):
         calls[0] += 1
         if calls[0] % 8 == 0:
             report("solving", 0.1 + 0.85 * (1.0 - np.exp(-calls[0] / expected)))
-        return sqrt_m * solver.solve(sqrt_m * y) if y.ndim == 1 else (
-            sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * y)
+        return (
+            sqrt_m * solver.solve(sqrt_m * y)
+            if y.ndim == 1
+            else (sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * y))
         )
 
     def c_matvec(y: np.ndarray) -> np.ndarray:
@@ -235,10 +241,15 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol):
                 "try fewer modes"
             ) from None
     # Rayleigh-Ritz in the computed subspace: orthonormal basis, exact Ritz values.
+    # One block shift-invert step on the whole subspace before Rayleigh-Ritz: damps the
+    # remaining high-frequency error of every Ritz vector by (lam_j - s)/(lam_k+1 - s).
+    report("refining", 0.93)
+    Q, _ = np.linalg.qr(Y)
+    Y = sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * Q)
     report("orthonormalising", 0.95)
     Q, _ = np.linalg.qr(Y)
     T = Q.T @ (inv_sqrt_m[:, None] * (K @ (inv_sqrt_m[:, None] * Q)))
     lam, W = np.linalg.eigh(0.5 * (T + T.T))
-    Y = Q @ W
+    Y = Q @ W[:, :k_wanted]
     X = inv_sqrt_m[:, None] * Y
-    return lam, X, shift
+    return lam[:k_wanted], X, shift

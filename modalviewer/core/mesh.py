@@ -296,19 +296,22 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
     fa, fb = face_of[pa[:, 0]], face_of[pa[:, 1]]
     same_dir = np.all(he[pa[:, 0]] == he[pa[:, 1]], axis=1)  # same direction: inconsistent
     nbrs: list[list[tuple[int, bool]]] = [[] for _ in range(m)]
-    for x, y, s in zip(fa.tolist(), fb.tolist(), same_dir.tolist()):
+    for x, y, s in zip(fa.tolist(), fb.tolist(), same_dir.tolist(), strict=True):
         nbrs[x].append((y, s))
         nbrs[y].append((x, s))
     flip = np.zeros(m, dtype=bool)
     seen = np.zeros(m, dtype=bool)
+    patch = np.zeros(m, dtype=np.int64)
     orientable = True
     for seed in range(m):
         if seen[seed]:
             continue
         seen[seed] = True
+        patch[seed] = seed
         queue = deque([seed])
         while queue:
             t = queue.popleft()
+            patch[t] = seed
             for u, s in nbrs[t]:
                 want = flip[t] ^ s
                 if not seen[u]:
@@ -317,6 +320,11 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
                     queue.append(u)
                 elif flip[u] != want:
                     orientable = False
+    # per patch, keep the majority orientation (flip the fewest faces)
+    flipped_per_patch = np.bincount(patch, flip, minlength=m)
+    size_per_patch = np.bincount(patch, minlength=m)
+    invert = flipped_per_patch > size_per_patch / 2
+    flip ^= invert[patch]
     out = f.copy()
     out[flip] = out[flip][:, ::-1]
     return out, int(flip.sum()), orientable

@@ -221,9 +221,7 @@ def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> s
     """
     _check_weights(bending, membrane)
     x = mesh.vertices
-    parts = (
-        (stencil, df(x, stencil), w) for stencil, _, df, w in _terms(mesh, bending, membrane)
-    )
+    parts = ((stencil, df(x, stencil), w) for stencil, _, df, w in _terms(mesh, bending, membrane))
     return _assemble_outer_products(mesh.n_vertices, parts)
 
 
@@ -236,9 +234,7 @@ def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_m
     return sp.csr_matrix((normals.ravel(), (rows, cols)), shape=(3 * n, n))
 
 
-def normal_shells_hessian(
-    mesh: Mesh, bending: float = 1.0, membrane: float = 1.0
-) -> sp.csr_matrix:
+def normal_shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
     """H_N = P^T H P, (n, n): the shells Hessian restricted to normal variations."""
     P = normal_projection(mesh)
     H = shells_hessian(mesh, bending, membrane)

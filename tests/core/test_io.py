@@ -1,0 +1,140 @@
+"""Loading, repair reports, clear refusals, spectrum files."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import modalviewer as mv
+from modalviewer.core.primitives import grid_plate, icosphere
+
+
+def _write_obj(path, v, f):
+    with open(path, "w") as fh:
+        for p in v:
+            fh.write(f"v {float(p[0])} {float(p[1])} {float(p[2])}\n")
+        for t in f:
+            fh.write("f " + " ".join(str(i + 1) for i in t) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("ext", [".obj", ".ply", ".stl", ".off", ".vtp", ".vtk"])
+def test_formats_round_trip(tmp_path, ext):
+    mesh = icosphere(2)
+    path = tmp_path / f"sphere{ext}"
+    if ext in (".vtp", ".vtk"):
+        import pyvista as pv
+
+        faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
+        pv.PolyData(mesh.vertices, faces).save(path)
+    else:
+        import trimesh
+
+        trimesh.Trimesh(mesh.vertices, mesh.faces, process=False).export(path)
+    loaded = mv.load_mesh(path)
+    assert loaded.n_vertices == mesh.n_vertices and loaded.n_faces == mesh.n_faces
+    assert loaded.total_area == pytest.approx(mesh.total_area, rel=1e-6)
+
+
+def test_repairs_are_made_and_reported(tmp_path):
+    plate = grid_plate(4, 4)
+    n = plate.n_vertices
+    v = np.vstack([plate.vertices, plate.vertices[:3], [[9.0, 9.0, 9.0]]])  # dups + stray
+    f = plate.faces.copy()
+    f[0] = f[0][::-1]  # inconsistent orientation
+    extra = np.array([[0, 1, 2], [n, n + 1, n + 2]])  # collinear (zero area), via duplicates
+    mesh = mv.repair_mesh(v, np.vstack([f, extra]), source="messy")
+    text = str(mesh.report)
+    assert "Merged 3 duplicate vertices" in text
+    assert "Removed 1 unreferenced vertex" in text
+    assert "degenerate" in text and "Flipped 1 face" in text
+    assert mesh.n_faces == plate.n_faces and mesh.n_vertices == plate.n_vertices
+    assert mesh.is_consistently_oriented
+    np.testing.assert_array_equal(mesh.vertices, plate.vertices)
+
+
+def test_duplicate_vertices_merged(tmp_path):
+    # two triangles that share an edge only by coordinates
+    v = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    path = _write_obj(tmp_path / "split.obj", v, [[0, 1, 2], [3, 4, 5]])
+    mesh = mv.load_mesh(path)
+    assert mesh.n_vertices == 4 and "Merged 2 duplicate vertices" in str(mesh.report)
+    raw = mv.load_mesh(path, repair=False)
+    assert raw.n_vertices == 6
+
+
+def test_quads_are_triangulated(tmp_path):
+    path = tmp_path / "quad.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
+    mesh = mv.load_mesh(path)
+    assert mesh.n_faces == 2 and mesh.total_area == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize(
+    "content,fragment",
+    [
+        ("", "empty"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no faces"),
+        ("v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n", "NaN"),
+    ],
+)
+def test_clear_errors(tmp_path, content, fragment):
+    path = tmp_path / "bad.obj"
+    path.write_text(content)
+    with pytest.raises(mv.MeshError, match=fragment):
+        mv.load_mesh(path)
+
+
+def test_direct_construction_errors():
+    with pytest.raises(mv.MeshError, match="only 3 vertices"):
+        mv.Mesh(np.eye(3), [[0, 1, 3]])
+    with pytest.raises(mv.MeshError, match="no faces"):
+        mv.Mesh(np.eye(3), np.zeros((0, 3)))
+    with pytest.raises(mv.MeshError, match="NaN"):
+        mv.Mesh([[0, 0, 0], [1, 0, 0], [0, np.inf, 0]], [[0, 1, 2]])
+    with pytest.raises(mv.MeshError, match="zero area"):
+        mv.Mesh([[0, 0, 0], [1, 0, 0], [2, 0, 0]], [[0, 1, 2]])
+    assert issubclass(mv.MeshError, ValueError)
+    with pytest.raises(mv.MeshError, match="unsupported"):
+        mv.load_mesh("mesh.xyz")
+
+
+def test_non_manifold_mesh_refuses_shells_but_not_laplacian():
+    v = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]]
+    f = [[0, 1, 2], [1, 0, 3], [0, 1, 4]]  # edge 0-1 shared by three faces
+    mesh = mv.Mesh(v, f)
+    assert not mesh.is_edge_manifold
+    for operator in ("shells", "shells_normal", "modified_dirichlet"):
+        with pytest.raises(mv.MeshError, match="non-manifold"):
+            mv.compute_spectrum(mesh, operator, k=3)
+    spec = mv.compute_spectrum(mesh, "laplacian", k=3)
+    assert np.all(np.isfinite(spec.eigenvalues))
+
+
+def test_spectrum_file_round_trip_and_hash(tmp_path, spot):
+    spec = mv.compute_spectrum(spot, "shells", k=10)
+    path = tmp_path / "s.npz"
+    mv.save_spectrum(spec, path)
+    back = mv.load_spectrum(path, mesh_hash=spot.hash)
+    assert back.operator == "shells" and back.modes.shape == spec.modes.shape
+    np.testing.assert_array_equal(back.eigenvalues, spec.eigenvalues)
+    assert back.parameters["bending"] == 1.0
+    with pytest.raises(mv.SpectrumFileError, match="another mesh"):
+        mv.load_spectrum(path, mesh_hash="0" * 64)
+    damaged = tmp_path / "damaged.npz"
+    damaged.write_bytes(path.read_bytes()[:200])
+    with pytest.raises(mv.SpectrumFileError):
+        mv.load_spectrum(damaged)
+    assert not list(tmp_path.glob("*.part"))
+
+
+def test_import_loads_no_qt_and_no_vtk():
+    code = (
+        "import sys, modalviewer as mv; mv.load_mesh; "
+        "bad = [m for m in sys.modules if m.split('.')[0] in "
+        "('qtpy', 'PySide6', 'PyQt5', 'PyQt6', 'vtk', 'vtkmodules', 'pyvista', 'pyvistaqt')]; "
+        "print(bad); sys.exit(1 if bad else 0)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
