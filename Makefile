@@ -18,11 +18,11 @@ run: $(STAMP)
 
 test: $(STAMP)
 	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q
-	$(PY) -m ruff check modalviewer tests benchmarks
-	$(PY) -m ruff format --check modalviewer tests benchmarks
+	$(PY) -m ruff check modalviewer tests benchmarks scripts
+	$(PY) -m ruff format --check modalviewer tests benchmarks scripts
 
 lint: $(STAMP)
-	$(PY) -m ruff check modalviewer tests benchmarks
+	$(PY) -m ruff check modalviewer tests benchmarks scripts
 
 format: $(STAMP)
 	$(PY) -m ruff format modalviewer tests benchmarks

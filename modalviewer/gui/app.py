@@ -1,0 +1,115 @@
+"""Start the viewer: ``modalviewer [MESH]``.
+
+Without a display (no ``DISPLAY``/``WAYLAND_DISPLAY`` on Linux) the viewer runs
+off-screen: it opens the mesh, computes a spectrum, writes a screenshot made by the
+window's own export and exits, saying so.  ``--screenshot PATH`` does the same on
+purpose, on any machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import logging
+import os
+import sys
+import traceback
+import weakref
+from pathlib import Path
+
+log = logging.getLogger("modalviewer")
+
+
+def _has_display() -> bool:
+    if sys.platform != "linux":
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="modalviewer", description="Modal shape analysis viewer.")
+    p.add_argument("mesh", nargs="?", help="mesh file to open (default: the bundled mesh)")
+    p.add_argument(
+        "--operator",
+        default=None,
+        choices=["laplacian", "modified_dirichlet", "shells", "shells_normal"],
+        help="spectrum to compute at start (headless default: modified_dirichlet)",
+    )
+    p.add_argument("--mode", type=int, default=None, help="mode to show")
+    p.add_argument("-k", type=int, default=None, help="number of modes")
+    p.add_argument("--screenshot", default=None, help="render to this PNG and exit")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
+    headless = args.screenshot is not None or not _has_display()
+    if headless and "QT_QPA_PLATFORM" not in os.environ:
+        os.environ["QT_QPA_PLATFORM"] = "offscreen"
+    if not _has_display():  # render with EGL directly instead of trying X first
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    from qtpy import QtWidgets
+
+    from .main_window import DEFAULT_MESH, SCREENSHOTS, MainWindow
+
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    app.setApplicationName("modalviewer")
+    app.setOrganizationName("modalviewer")
+    window = MainWindow()
+
+    window_ref = weakref.ref(window)
+
+    def excepthook(kind, value, tb):  # slots must never take the app down
+        details = "".join(traceback.format_exception(kind, value, tb))
+        log.error("unexpected error:\n%s", details)
+        current = window_ref()
+        if current is not None:
+            current.show_error(f"Unexpected error: {value}. The details are in the log.")
+
+    sys.excepthook = excepthook
+    if headless:
+        window.resize(1500, 900)
+    window.show()
+    app.processEvents()
+    path = Path(args.mesh) if args.mesh else DEFAULT_MESH
+    opened = window.open_mesh(path)
+    if not headless:
+        if opened and args.operator:
+            window.compute(
+                args.operator,
+                k=args.k,
+                wait=False,
+                then=lambda _s: args.mode is not None and window.show_mode(args.mode),
+            )
+        return app.exec()
+
+    if not opened:
+        print(f"error: {window.last_error}", file=sys.stderr)
+        return 1
+    operator = args.operator or "modified_dirichlet"
+    out = Path(args.screenshot) if args.screenshot else SCREENSHOTS / "headless_run.png"
+    if args.screenshot is None:
+        print(
+            "No display found: running the viewer off-screen on "
+            f"{path.name} and saving a screenshot instead."
+        )
+    try:
+        spec = window.compute(operator, k=args.k, wait=True)
+    except Exception as exc:  # ComputeError carries the user message
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    if args.mode is not None:
+        window.show_mode(args.mode)
+    app.processEvents()
+    window.export_screenshot(out)
+    nonzero = spec.eigenvalues[~spec.zero_mode_mask()][:6]
+    print(
+        f"{path.name}: {window.mesh.n_vertices} vertices; {operator}: {spec.k} modes; "
+        f"lowest non-zero eigenvalues {', '.join(f'{x:.5g}' for x in nonzero)}"
+    )
+    print(f"screenshot: {out}")
+    window.close()
+    window = None  # drop the last reference before collecting
+    gc.collect()  # release VTK objects before the interpreter shuts down
+    return 0

@@ -1,0 +1,240 @@
+"""What is drawn: the surface with a per-vertex field, isolines, a pick marker, animation.
+
+Only the GUI thread touches these VTK objects.  Updates reuse the existing
+``PolyData`` and actors (no re-adding), so switching a mode or a threshold costs
+one array copy, one contour filter and a render.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.vtkRenderingCore import vtkCellPicker
+
+from ..core.mesh import Mesh
+
+# The paper's colours: blue positive, white zero, orange negative.
+BLUE = np.array([0.16, 0.38, 0.78])
+WHITE = np.array([1.0, 1.0, 1.0])
+ORANGE = np.array([0.96, 0.55, 0.12])
+RED = np.array([0.78, 0.08, 0.08])
+SIMILAR_BLUE = np.array([0.20, 0.45, 0.85])
+
+
+def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
+    """A lookup table interpolating linearly through ``colors`` (RGB in [0, 1])."""
+    anchors = np.linspace(0.0, 1.0, len(colors))
+    x = np.linspace(0.0, 1.0, n)
+    rgb = np.column_stack([np.interp(x, anchors, [c[i] for c in colors]) for i in range(3)])
+    lut = pv.LookupTable()
+    lut.SetNumberOfTableValues(n)
+    for i, (r, g, b) in enumerate(rgb):
+        lut.SetTableValue(i, float(r), float(g), float(b), 1.0)
+    lut.Build()
+    return lut
+
+
+DIVERGING = lookup_table([ORANGE, WHITE, BLUE])  # negative -> zero -> positive
+SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
+THRESHOLD = lookup_table([SIMILAR_BLUE, WHITE], n=2)  # closer than threshold -> blue
+
+
+class MeshScene:
+    """Owns the actors of one mesh on a pyvista plotter."""
+
+    def __init__(self, plotter, mesh: Mesh, normals: np.ndarray):
+        self.plotter = plotter
+        self.mesh = mesh
+        self.normals = normals
+        faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
+        self.rest_points = np.array(mesh.vertices)
+        self.surface = pv.PolyData(self.rest_points.copy(), faces)
+        self.surface.point_data["field"] = np.zeros(mesh.n_vertices)
+        self.surface.point_data["displacement"] = np.zeros((mesh.n_vertices, 3))
+        self.surface.point_data["Normals"] = normals
+        self.surface.GetPointData().SetNormals(self.surface.GetPointData().GetArray("Normals"))
+        self.surface.set_active_scalars("field")
+        # Our own vertex normals and Phong interpolation instead of pyvista's smooth_shading,
+        # which would draw a filtered copy that our in-place updates do not reach.
+        self.surface_actor = plotter.add_mesh(
+            self.surface,
+            scalars="field",
+            show_scalar_bar=False,
+            interpolation="phong",
+            name="surface",
+            reset_camera=True,
+        )
+        self._mapper = self.surface_actor.mapper
+        self._mapper.SetInputData(self.surface)
+        self._mapper.SetScalarModeToUsePointFieldData()
+        self._mapper.SelectColorArray("field")
+        self._mapper.SetUseLookupTableScalarRange(False)
+        self.isolines = pv.PolyData()
+        self.zero_line = pv.PolyData()
+        self.iso_actor = None
+        self.zero_actor = None
+        self._iso_rest = None
+        self._iso_disp = None
+        self._zero_rest = None
+        self._zero_disp = None
+        self.marker_actor = None
+        self.picker = vtkCellPicker()
+        self.picker.SetTolerance(1e-4)
+        self.picker.PickFromListOn()
+        self.picker.AddPickList(self.surface_actor)
+        self.field_name = ""
+        self.clim = (0.0, 1.0)
+
+    # ----------------------------------------------------------------- fields
+    def show_field(
+        self,
+        values: np.ndarray,
+        kind: str = "diverging",
+        clim: tuple[float, float] | None = None,
+        isolines: int = 0,
+        displacement: np.ndarray | None = None,
+        name: str = "",
+    ) -> None:
+        """Colour the surface by ``values`` (n,).
+
+        kind: "diverging" (symmetric about zero, orange/white/blue), "sequential"
+        (white to red), "threshold" (values are 0/1: blue/white) or "plain".
+        isolines: number of isolines (the zero level drawn bold for diverging fields).
+        displacement: (n, 3) shape of the animation, carried along by the isolines.
+        """
+        values = np.asarray(values, dtype=np.float64)
+        self.surface.point_data["field"] = values
+        if displacement is not None:
+            self.surface.point_data["displacement"] = displacement
+        if kind == "diverging":
+            a = float(np.max(np.abs(values))) or 1.0
+            clim = (-a, a) if clim is None else clim
+            self._mapper.lookup_table = DIVERGING
+        elif kind == "sequential":
+            hi = float(np.max(values)) or 1.0
+            clim = (0.0, hi) if clim is None else clim
+            self._mapper.lookup_table = SEQUENTIAL
+        elif kind == "threshold":
+            clim = (0.0, 1.0)
+            self._mapper.lookup_table = THRESHOLD
+        else:
+            clim = clim or (float(values.min()), float(values.max()) or 1.0)
+            self._mapper.lookup_table = SEQUENTIAL
+        self._mapper.scalar_range = clim
+        self._mapper.ScalarVisibilityOn()
+        self.clim = clim
+        self.field_name = name
+        self.set_isolines(values, isolines if kind != "threshold" else 0, kind == "diverging")
+
+    def set_isolines(self, values: np.ndarray, count: int, emphasise_zero: bool) -> None:
+        for actor in (self.iso_actor, self.zero_actor):
+            if actor is not None:
+                self.plotter.remove_actor(actor, render=False)
+        self.iso_actor = self.zero_actor = None
+        self._iso_rest = self._zero_rest = None
+        if count <= 0:
+            return
+        lo, hi = self.clim
+        levels = np.linspace(lo, hi, count + 2)[1:-1]
+        if emphasise_zero:
+            levels = levels[np.abs(levels) > 1e-12 * max(abs(lo), abs(hi))]
+        rest = pv.PolyData(self.rest_points, self.surface.faces)
+        rest.point_data["field"] = values
+        rest.point_data["displacement"] = self.surface.point_data["displacement"]
+        if len(levels):
+            self.isolines = rest.contour(isosurfaces=list(levels), scalars="field")
+            if self.isolines.n_points:
+                self._iso_rest = np.array(self.isolines.points)
+                self._iso_disp = np.array(self.isolines.point_data["displacement"])
+                self.iso_actor = self.plotter.add_mesh(
+                    self.isolines,
+                    color="black",
+                    line_width=1.5,
+                    name="isolines",
+                    render=False,
+                    reset_camera=False,
+                    show_scalar_bar=False,
+                    scalars=None,
+                )
+        if emphasise_zero and lo < 0 < hi:
+            self.zero_line = rest.contour(isosurfaces=[0.0], scalars="field")
+            if self.zero_line.n_points:
+                self._zero_rest = np.array(self.zero_line.points)
+                self._zero_disp = np.array(self.zero_line.point_data["displacement"])
+                self.zero_actor = self.plotter.add_mesh(
+                    self.zero_line,
+                    color="black",
+                    line_width=3.5,
+                    name="zeroline",
+                    render=False,
+                    reset_camera=False,
+                    show_scalar_bar=False,
+                    scalars=None,
+                )
+
+    @property
+    def n_isoline_points(self) -> int:
+        return 0 if self._iso_rest is None else len(self._iso_rest)
+
+    # -------------------------------------------------------------- animation
+    def set_displacement_scale(self, s: float) -> None:
+        """Move the surface (and isolines) to rest + s * displacement; no render."""
+        disp = self.surface.point_data["displacement"]
+        self._move(self.surface, self.rest_points, disp, s)
+        for line, rest, d in (
+            (self.isolines, self._iso_rest, self._iso_disp),
+            (self.zero_line, self._zero_rest, self._zero_disp),
+        ):
+            if rest is not None:
+                self._move(line, rest, d, s)
+
+    @staticmethod
+    def _move(poly: pv.PolyData, rest: np.ndarray, disp: np.ndarray, s: float) -> None:
+        """In place: points = rest + s * disp, then flag the VTK points as modified."""
+        pts = np.asarray(poly.points)  # a view of the VTK array
+        np.multiply(disp, s, out=pts)
+        pts += rest
+        poly.GetPoints().Modified()
+
+    # ---------------------------------------------------------------- picking
+    def vertex_at_display(self, x: float, y: float) -> int | None:
+        """Vertex nearest to the surface point under display pixel (x, y), origin bottom left."""
+        renderer = self.plotter.renderer
+        if not self.picker.Pick(x, y, 0, renderer):
+            return None
+        cell = self.picker.GetCellId()
+        if cell < 0:
+            return None
+        hit = np.array(self.picker.GetPickPosition())
+        corners = self.mesh.faces[cell]
+        d = np.linalg.norm(self.surface.points[corners] - hit, axis=1)
+        return int(corners[np.argmin(d)])
+
+    def display_position(self, vertex: int) -> tuple[float, float, float]:
+        """(x, y, depth) display coordinates of a vertex (VTK origin: bottom left)."""
+        renderer = self.plotter.renderer
+        renderer.SetWorldPoint(*self.surface.points[vertex], 1.0)
+        renderer.WorldToDisplay()
+        return renderer.GetDisplayPoint()
+
+    def show_marker(self, vertex: int | None) -> None:
+        if self.marker_actor is not None:
+            self.plotter.remove_actor(self.marker_actor, render=False)
+            self.marker_actor = None
+        if vertex is None:
+            return
+        radius = 0.012 * self.mesh.bounding_box_diagonal
+        sphere = pv.Sphere(radius=radius, center=self.surface.points[vertex])
+        self.marker_actor = self.plotter.add_mesh(
+            sphere,
+            color=(0.9, 0.1, 0.6),
+            name="marker",
+            render=False,
+            reset_camera=False,
+            show_scalar_bar=False,
+            scalars=None,
+        )
+
+    def remove(self) -> None:
+        for name in ("surface", "isolines", "zeroline", "marker"):
+            self.plotter.remove_actor(name, render=False)

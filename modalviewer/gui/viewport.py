@@ -1,0 +1,204 @@
+"""The 3D view: pyvistaqt's ``QtInteractor`` where Qt can make an OpenGL context, else an
+off-screen pyvista plotter (EGL or OSMesa) whose frames are painted into a plain widget.
+
+Both expose the same small interface: ``plotter`` (a pyvista plotter), ``widget``
+(the QWidget to embed), ``request_render()``, and the ``clicked(x, y)`` signal with
+VTK display coordinates (origin bottom left) of a left click that did not drag.
+The off-screen variant is what runs under ``QT_QPA_PLATFORM=offscreen`` (tests, CI,
+machines without a display); it renders with the same VTK pipeline, so pixels
+checked there are real renders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from qtpy import QtCore, QtGui, QtWidgets
+
+CLICK_SLOP = 4  # pixels a press may move and still count as a click
+
+
+def qt_opengl_available() -> bool:
+    """True if Qt can create an OpenGL context on this platform."""
+    if QtGui.QGuiApplication.platformName() in ("offscreen", "minimal", "vnc", "linuxfb"):
+        return False
+    ctx = QtGui.QOpenGLContext()
+    return bool(ctx.create())
+
+
+class _ClickMixin:
+    def _init_click(self):
+        self._press_pos = None
+
+    def _press(self, x, y):
+        self._press_pos = (x, y)
+
+    def _release(self, x, y) -> bool:
+        if self._press_pos is None:
+            return False
+        dx, dy = x - self._press_pos[0], y - self._press_pos[1]
+        self._press_pos = None
+        return abs(dx) <= CLICK_SLOP and abs(dy) <= CLICK_SLOP
+
+
+class OffscreenViewport(QtWidgets.QWidget):
+    """A widget showing frames of an off-screen pyvista plotter, with mouse navigation.
+
+    Left drag rotates, right drag or wheel zooms, middle drag pans, left click picks.
+    """
+
+    clicked = QtCore.Signal(float, float)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setMinimumSize(200, 150)
+        self.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
+        self.plotter = pv.Plotter(off_screen=True, window_size=(640, 480))
+        self.plotter.set_background("white")
+        # pyvista skips render() until the first show; show once (off-screen: no window)
+        self.plotter.show(auto_close=False, interactive=False)
+        self._image: QtGui.QImage | None = None
+        self._dirty = True
+        self._press_pos = None
+        self._last = None
+        self._button = None
+        self.render_count = 0
+
+    @property
+    def widget(self) -> QtWidgets.QWidget:
+        return self
+
+    def request_render(self) -> None:
+        self._dirty = True
+        self.update()
+
+    def render_now(self) -> np.ndarray:
+        """Render synchronously and return the frame (h, w, 3) uint8."""
+        w, h = max(self.width(), 16), max(self.height(), 16)
+        if tuple(self.plotter.window_size) != (w, h):
+            self.plotter.window_size = (w, h)
+        self.plotter.render()
+        img = np.ascontiguousarray(self.plotter.screenshot(None, return_img=True)[:, :, :3])
+        self._image = QtGui.QImage(
+            img.data,
+            img.shape[1],
+            img.shape[0],
+            3 * img.shape[1],
+            QtGui.QImage.Format.Format_RGB888,
+        ).copy()
+        self._dirty = False
+        self.render_count += 1
+        return img
+
+    def paintEvent(self, event):  # noqa: N802 (Qt override)
+        if self._dirty or self._image is None:
+            self.render_now()
+        painter = QtGui.QPainter(self)
+        painter.drawImage(0, 0, self._image)
+        painter.end()
+
+    def resizeEvent(self, event):  # noqa: N802
+        self._dirty = True
+        size = event.size()
+        self.plotter.window_size = (max(size.width(), 16), max(size.height(), 16))
+        super().resizeEvent(event)
+
+    # ---------------------------------------------------------------- mouse
+    def mousePressEvent(self, event):  # noqa: N802
+        pos = event.position()
+        self._press_pos = self._last = (pos.x(), pos.y())
+        self._button = event.button()
+
+    def mouseMoveEvent(self, event):  # noqa: N802
+        if self._last is None:
+            return
+        pos = event.position()
+        dx, dy = pos.x() - self._last[0], pos.y() - self._last[1]
+        self._last = (pos.x(), pos.y())
+        cam = self.plotter.camera
+        if self._button == QtCore.Qt.MouseButton.LeftButton:
+            cam.Azimuth(-0.4 * dx)
+            cam.Elevation(0.4 * dy)
+            cam.OrthogonalizeViewUp()
+        elif self._button == QtCore.Qt.MouseButton.RightButton:
+            cam.Zoom(1.0 - 0.01 * dy)
+        elif self._button == QtCore.Qt.MouseButton.MiddleButton:
+            fp, pos3 = np.array(cam.GetFocalPoint()), np.array(cam.GetPosition())
+            scale = np.linalg.norm(pos3 - fp) / max(self.height(), 1)
+            right = np.cross(np.array(cam.GetDirectionOfProjection()), cam.GetViewUp())
+            shift = scale * (-dx * right + dy * np.array(cam.GetViewUp()))
+            cam.SetFocalPoint(*(fp + shift))
+            cam.SetPosition(*(pos3 + shift))
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.request_render()
+
+    def mouseReleaseEvent(self, event):  # noqa: N802
+        pos = event.position()
+        if (
+            self._press_pos is not None
+            and event.button() == QtCore.Qt.MouseButton.LeftButton
+            and abs(pos.x() - self._press_pos[0]) <= CLICK_SLOP
+            and abs(pos.y() - self._press_pos[1]) <= CLICK_SLOP
+        ):
+            self.clicked.emit(pos.x(), self.height() - 1 - pos.y())
+        self._press_pos = self._last = None
+
+    def wheelEvent(self, event):  # noqa: N802
+        steps = event.angleDelta().y() / 120.0
+        self.plotter.camera.Zoom(1.1**steps)
+        self.plotter.renderer.ResetCameraClippingRange()
+        self.request_render()
+
+    def close_plotter(self) -> None:
+        self.plotter.close()
+
+
+class InteractorViewport(QtCore.QObject):
+    """pyvistaqt's QtInteractor (GPU, VTK's own trackball) with click detection."""
+
+    clicked = QtCore.Signal(float, float)
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        from pyvistaqt import QtInteractor
+
+        self.plotter = QtInteractor(parent)
+        self.plotter.set_background("white")
+        self._press = None
+        iren = self.plotter.iren
+        iren.add_observer("LeftButtonPressEvent", self._on_press)
+        iren.add_observer("LeftButtonReleaseEvent", self._on_release)
+        self.render_count = 0
+
+    @property
+    def widget(self) -> QtWidgets.QWidget:
+        return self.plotter.interactor
+
+    def _on_press(self, obj, _event):
+        self._press = obj.GetEventPosition()
+
+    def _on_release(self, obj, _event):
+        pos = obj.GetEventPosition()
+        if (
+            self._press is not None
+            and max(abs(pos[0] - self._press[0]), abs(pos[1] - self._press[1])) <= CLICK_SLOP
+        ):
+            self.clicked.emit(float(pos[0]), float(pos[1]))
+        self._press = None
+
+    def request_render(self) -> None:
+        self.render_count += 1
+        self.plotter.update()
+
+    def render_now(self) -> np.ndarray:
+        self.plotter.render()
+        return np.asarray(self.plotter.screenshot(None, return_img=True))[:, :, :3]
+
+    def close_plotter(self) -> None:
+        self.plotter.close()
+
+
+def make_viewport(parent=None, force_offscreen: bool | None = None):
+    """The best viewport this platform supports."""
+    offscreen = (not qt_opengl_available()) if force_offscreen is None else force_offscreen
+    return OffscreenViewport(parent) if offscreen else InteractorViewport(parent)

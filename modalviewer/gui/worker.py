@@ -1,0 +1,76 @@
+"""Background jobs: run a function in a thread, report progress, allow cancel.
+
+Signals cross to the GUI thread through Qt's queued connections; each job carries an
+id so the window can drop results of jobs it no longer cares about.
+"""
+
+from __future__ import annotations
+
+import itertools
+import threading
+import traceback
+from collections.abc import Callable
+
+from qtpy import QtCore
+
+from ..core.eigen import Cancelled
+
+_ids = itertools.count(1)
+
+
+class Job(QtCore.QObject):
+    """One background computation: ``fn(progress, cancel)`` returns the result."""
+
+    progress = QtCore.Signal(int, str, float)
+    finished = QtCore.Signal(int, object)
+    failed = QtCore.Signal(int, str, str)  # id, message for the user, details for the log
+    cancelled = QtCore.Signal(int)
+
+    def __init__(self, fn: Callable, tag: object = None):
+        super().__init__()
+        self.id = next(_ids)
+        self.tag = tag
+        self._fn = fn
+        self._cancel = threading.Event()
+        self._thread = threading.Thread(
+            target=self._run, name=f"modalviewer-job-{self.id}", daemon=True
+        )
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def cancel(self) -> None:
+        self._cancel.set()
+
+    @property
+    def is_cancelled(self) -> bool:
+        return self._cancel.is_set()
+
+    def is_running(self) -> bool:
+        return self._thread.is_alive()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+    def _run(self) -> None:
+        try:
+            result = self._fn(
+                lambda stage, fraction: self.progress.emit(self.id, stage, float(fraction)),
+                self._cancel.is_set,
+            )
+        except Cancelled:
+            self.cancelled.emit(self.id)
+        except MemoryError:
+            self.failed.emit(
+                self.id,
+                "Not enough memory for this computation; try fewer modes or a coarser mesh.",
+                traceback.format_exc(),
+            )
+        except Exception as exc:  # reported to the user, never raised into Qt
+            self.failed.emit(self.id, str(exc) or type(exc).__name__, traceback.format_exc())
+        else:
+            if self._cancel.is_set():
+                self.cancelled.emit(self.id)
+            else:
+                self.finished.emit(self.id, result)

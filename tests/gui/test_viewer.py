@@ -1,0 +1,199 @@
+"""The real window, rendering off-screen: pixels, clicks, animation, export, cancel."""
+
+import numpy as np
+import pytest
+from PIL import Image
+from qtpy import QtCore
+
+from modalviewer.core.primitives import icosphere
+
+pytestmark = pytest.mark.gui
+
+
+def _classify(img):
+    r, g, b = (img[:, :, i].astype(int) for i in range(3))
+    blue = (b > r + 60) & (b > g + 20)
+    orange = (r > b + 80) & (g > b + 20) & (r > g + 20)
+    white = (r > 240) & (g > 240) & (b > 240)
+    black = (r < 50) & (g < 50) & (b < 50)
+    red = (r > g + 80) & (r > b + 80)
+    return {
+        "blue": blue.sum(),
+        "orange": orange.sum(),
+        "white": white.sum(),
+        "black": black.sum(),
+        "red": red.sum(),
+    }
+
+
+def _both_sides(window):
+    """Colour counts summed over the front view and the view from behind."""
+    total = _classify(window.viewport.render_now())
+    window.plotter.camera.Azimuth(180)
+    back = _classify(window.viewport.render_now())
+    window.plotter.camera.Azimuth(180)
+    return {key: total[key] + back[key] for key in total}
+
+
+def test_mode_colours_and_isolines(window, spot_path):
+    assert window.open_mesh(spot_path)
+    spec = window.compute("laplacian", k=20, wait=True)
+    assert spec.k == 20 and window.current_operator == "laplacian"
+    window.show_mode(6)
+    counts = _both_sides(window)
+    assert counts["blue"] > 2000, counts
+    assert counts["orange"] > 2000, counts
+    assert counts["black"] > 200, counts  # isolines
+    assert window.scene.n_isoline_points > 100
+    # symmetric range: white at zero
+    lo, hi = window.scene.clim
+    assert lo == pytest.approx(-hi)
+    window.iso_spin.setValue(0)
+    no_lines = _both_sides(window)
+    assert no_lines["black"] < counts["black"] / 3
+    assert "lambda_6" in window.eigen_label.text()
+
+
+def test_animation_moves_the_surface(window, spot_path, qtbot):
+    window.open_mesh(spot_path)
+    window.compute("shells", k=12, wait=True)
+    window.show_mode(8)
+    rest = np.array(window.scene.surface.points)
+    before = window.viewport.render_now()
+    window.play_button.click()
+    qtbot.wait(300)
+    assert window.anim_timer.isActive() and len(window.frame_times) > 3
+    moved = np.array(window.scene.surface.points)
+    assert np.abs(moved - rest).max() > 1e-3 * window.mesh.bounding_box_diagonal
+    assert max(window.frame_times) < 0.05
+    window.animation_frame(np.pi / 2)  # peak displacement
+    after = window.viewport.render_now()
+    assert np.mean(np.any(before != after, axis=2)) > 0.002
+    window.play_button.click()
+    assert not window.anim_timer.isActive()
+    np.testing.assert_allclose(window.scene.surface.points, rest)
+
+
+def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot):
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=20, wait=True)
+    widget = window.viewport.widget
+    h = widget.height()
+    window.viewport.render_now()
+    target = window.scene.vertex_at_display(widget.width() / 2, h / 2)
+    assert target is not None
+    x, y, _ = window.scene.display_position(target)
+    qtbot.mouseClick(
+        widget,
+        QtCore.Qt.MouseButton.LeftButton,
+        pos=QtCore.QPoint(int(round(x)), int(round(h - 1 - y))),
+    )
+    assert window.picked == target
+    # the vibration distance needs the shells spectrum: computed in the worker
+    qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
+    d = window.last_distance
+    assert d.shape == (window.mesh.n_vertices,) and d[target] == 0.0 and d.max() > 0
+    img = window.viewport.render_now()
+    assert _classify(img)["red"] > 500
+
+
+def test_threshold_display_and_slider(window, spot_path):
+    window.open_mesh(spot_path)
+    window.compute("modified_dirichlet", k=30, wait=True)
+    window.pick_vertex(100)
+    d = window.show_distance("feature", display="threshold", threshold=0.1)
+    assert d is not None
+    low = _classify(window.viewport.render_now())["blue"]
+    window.threshold_slider.setValue(700)  # what dragging the slider does
+    assert window.threshold_fraction == pytest.approx(0.7)
+    high = _classify(window.viewport.render_now())["blue"]
+    assert high > low + 1000
+    field = window.scene.surface.point_data["field"]
+    np.testing.assert_array_equal(field, (d > 0.7 * d.max()).astype(float))
+
+
+def test_export_png_size_and_transparency(window, spot_path, tmp_path):
+    window.open_mesh(spot_path)
+    w, h = window.viewport.widget.width(), window.viewport.widget.height()
+    out = window.export_screenshot(tmp_path / "fig.png", scale=2, transparent=True)
+    img = Image.open(out)
+    assert img.size == (2 * w, 2 * h) and img.mode == "RGBA"
+    alpha = np.array(img)[:, :, 3]
+    assert alpha[0, 0] == 0 and alpha[h, w] == 255
+    out2 = window.export_screenshot(tmp_path / "plain.png")
+    assert Image.open(out2).size == (w, h)
+    assert not list(tmp_path.glob(".*"))  # no temporary files left behind
+
+
+def _big_mesh_file(tmp_path):
+    import trimesh
+
+    sphere = icosphere(6)  # 40962 vertices
+    path = tmp_path / "big.ply"
+    trimesh.Trimesh(sphere.vertices, sphere.faces, process=False).export(path)
+    return path
+
+
+def test_cancel_a_running_computation(window, tmp_path, qtbot):
+    window.open_mesh(_big_mesh_file(tmp_path))
+    window.compute("shells", k=200, wait=False)
+    job = window._job
+    assert job is not None and window.cancel_button.isVisible()
+    qtbot.wait(1500)
+    window.cancel_button.click()
+    qtbot.waitUntil(lambda: not job.is_running(), timeout=30000)
+    qtbot.waitUntil(lambda: window._job is None, timeout=5000)
+    assert "shells" not in window.spectra
+    assert not window.cancel_button.isVisible()
+
+
+def test_loading_a_mesh_during_a_computation_drops_the_old_result(
+    window, tmp_path, spot_path, qtbot
+):
+    window.open_mesh(_big_mesh_file(tmp_path))
+    window.compute("laplacian", k=50, wait=False)
+    old_job = window._job
+    assert window.open_mesh(spot_path)
+    assert window.mesh.n_vertices == 2930
+    qtbot.waitUntil(lambda: not old_job.is_running(), timeout=60000)
+    qtbot.wait(100)
+    assert window.spectra == {}
+    spec = window.compute("laplacian", k=10, wait=True)
+    assert spec.n_vertices == 2930
+
+
+def test_bad_file_gives_a_message_and_keeps_the_mesh(window, spot_path, tmp_path):
+    window.open_mesh(spot_path)
+    bad = tmp_path / "broken.obj"
+    bad.write_text("")
+    assert not window.open_mesh(bad)
+    assert "empty" in window.last_error
+    assert window.mesh.n_vertices == 2930
+    junk = tmp_path / "junk.ply"
+    junk.write_bytes(np.random.default_rng(0).bytes(3000))
+    assert not window.open_mesh(junk)
+    assert "junk.ply" in window.last_error
+
+
+def test_settings_are_remembered(qtbot, spot_path):
+    from modalviewer.gui import MainWindow
+
+    first = MainWindow()
+    qtbot.addWidget(first)
+    first.iso_spin.setValue(21)
+    first.open_mesh(spot_path)
+    first.close()
+    second = MainWindow()
+    qtbot.addWidget(second)
+    assert second.iso_spin.value() == 21
+    assert str(spot_path.resolve()) in second._recent_files()
+    second.close()
+
+
+def test_cached_spectrum_reopens_instantly(window, spot_path):
+    window.open_mesh(spot_path)
+    first = window.compute("shells_normal", k=15, wait=True)
+    window.open_mesh(spot_path)
+    again = window.compute("shells_normal", k=15, wait=True)
+    assert window._job is None  # served from the disk cache, no worker job
+    np.testing.assert_array_equal(first.eigenvalues, again.eigenvalues)
