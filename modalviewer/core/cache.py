@@ -58,6 +58,18 @@ class SpectrumCache:
             return None
         return spec
 
+    def writable_path(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Path:
+        """Where a new entry should be written: the cache file, or a temporary file."""
+        try:
+            self.directory.mkdir(parents=True, exist_ok=True)
+            if os.access(self.directory, os.W_OK):
+                return self.path(mesh, operator, k, bending, membrane)
+        except OSError:
+            pass
+        import tempfile
+
+        return Path(tempfile.mkdtemp(prefix="modalviewer-")) / "spectrum.npz"
+
     def put(self, mesh, spec: Spectrum, k, bending=1.0, membrane=1.0) -> Path | None:
         """Store ``spec``; returns the path, or None if the cache folder is not writable."""
         try:

@@ -29,7 +29,7 @@ from .export import save_field_mesh, save_screenshot
 from .plots import LinePlot
 from .scene import MeshScene
 from .viewport import make_viewport
-from .worker import Job
+from .worker import Job, compute_in_process
 
 log = logging.getLogger("modalviewer")
 
@@ -48,6 +48,8 @@ DISTANCE_LABELS = {
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 DEFAULT_MESH = ASSETS / "spot.obj"
 SCREENSHOTS = Path(__file__).resolve().parents[2] / "screenshots"
+PROCESS_THRESHOLD = 20000
+"""Problems with at least this many unknowns are computed in a separate process."""
 
 
 def default_k(n_vertices: int) -> int:
@@ -533,10 +535,18 @@ class MainWindow(QtWidgets.QMainWindow):
                 then(cached)
             return cached
 
-        def work(progress, cancel):
-            spec = compute_spectrum(mesh, operator, k, bending, membrane, progress, cancel)
-            cache.put(mesh, spec, k, bending, membrane)
-            return spec
+        if mesh.n_vertices * (3 if operator == "shells" else 1) >= PROCESS_THRESHOLD:
+            target = cache.writable_path(mesh, operator, k, bending, membrane)
+
+            def work(progress, cancel):
+                return compute_in_process(mesh, operator, k, bending, membrane, target,
+                                          progress, cancel)  # fmt: skip
+        else:
+
+            def work(progress, cancel):
+                spec = compute_spectrum(mesh, operator, k, bending, membrane, progress, cancel)
+                cache.put(mesh, spec, k, bending, membrane)
+                return spec
 
         job = Job(work, tag=(self.mesh.hash, operator))
         job.progress.connect(self._on_job_progress)

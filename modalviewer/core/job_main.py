@@ -1,0 +1,54 @@
+"""A spectrum computation in a child process: ``python -m modalviewer.core.job_main JOB OUT``.
+
+JOB.npz holds ``vertices``, ``faces`` and a JSON ``params`` (operator, k, bending,
+membrane).  Progress goes to stdout as JSON lines ``{"stage": ..., "fraction": ...}``,
+the result to OUT.npz (written atomically), a failure to stdout as ``{"error": ...}``
+with exit code 1.  A separate process keeps the viewer's event loop free (sparse
+factorisations hold the GIL) and is terminated at once to cancel.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+
+def _emit(payload: dict) -> None:
+    sys.stdout.write(json.dumps(payload) + "\n")
+    sys.stdout.flush()
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    job_path, out_path = argv
+    from .mesh import Mesh
+    from .pipeline import compute_spectrum
+    from .spectrum import save_spectrum
+
+    try:
+        with np.load(job_path, allow_pickle=False) as job:
+            vertices, faces = job["vertices"], job["faces"]
+            params = json.loads(str(job["params"]))
+        spec = compute_spectrum(
+            Mesh(vertices, faces),
+            params["operator"],
+            int(params["k"]),
+            float(params["bending"]),
+            float(params["membrane"]),
+            progress=lambda stage, fraction: _emit({"stage": stage, "fraction": fraction}),
+        )
+        save_spectrum(spec, out_path)
+    except MemoryError:
+        _emit({"error": "not enough memory for this computation; try fewer modes"})
+        return 1
+    except Exception as exc:  # reported to the viewer as a message
+        _emit({"error": str(exc) or type(exc).__name__})
+        return 1
+    _emit({"done": out_path})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
