@@ -25,6 +25,7 @@ from ..core.pipeline import compute_spectrum
 from ..core.signatures import SignatureTable, signature
 from ..core.spectrum import Spectrum, save_spectrum
 from ..io import SUPPORTED_EXTENSIONS, load_mesh
+from .compare import CompareWindow
 from .export import save_field_mesh, save_screenshot
 from .plots import LinePlot
 from .scene import MeshScene
@@ -106,6 +107,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._phase = 0.0
         self._last_tick = None
         self.frame_times: list[float] = []
+        self.compare: CompareWindow | None = None
 
         self._build_docks()
         self._build_menus()
@@ -300,6 +302,21 @@ class MainWindow(QtWidgets.QMainWindow):
         self.colorbar_action = self._action(m, "Colour &bar", self._toggle_colorbar, "B")
         self.colorbar_action.setCheckable(True)
         self._action(m, "&Reset camera", self._reset_camera, "R")
+        m.addSeparator()
+        self._action(
+            m,
+            "Compare &operators (Laplacian, E_D^N, shells normal)",
+            lambda: self.open_comparison(
+                ["laplacian", "modified_dirichlet", "shells_normal"], wait=False
+            ),
+            "Ctrl+1",
+        )
+        self._action(
+            m,
+            "Compare d&istances (vibration, heat kernel)",
+            lambda: self.open_comparison(["vibration", "hks"], wait=False),
+            "Ctrl+2",
+        )
         m = bar.addMenu("&Help")
         self._action(m, "&About", self._about)
 
@@ -400,6 +417,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def closeEvent(self, event):  # noqa: N802
         self.set_animating(False)
+        if self.compare is not None:
+            self.compare.close()
         if self._job is not None:
             self._job.cancel()
             self._job.wait(5.0)
@@ -457,6 +476,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self._pending_after_compute = None
         if self.scene is not None:
             self.scene.remove()
+        if self.compare is not None:
+            self.compare.close()
         self.mesh, self.mesh_path = mesh, path
         self.compute_mesh = None
         self.spectra.clear()
@@ -539,8 +560,9 @@ class MainWindow(QtWidgets.QMainWindow):
             target = cache.writable_path(mesh, operator, k, bending, membrane)
 
             def work(progress, cancel):
-                return compute_in_process(mesh, operator, k, bending, membrane, target,
-                                          progress, cancel)  # fmt: skip
+                return compute_in_process(
+                    mesh, operator, k, bending, membrane, target, progress, cancel
+                )
         else:
 
             def work(progress, cancel):
@@ -653,7 +675,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.show_mode(first)
 
     # ================================================================ modes
-    def _mode_fields(self, spec: Spectrum, j: int):
+    def mode_fields(self, spec: Spectrum, j: int):
         """(scalar to colour, displacement (n, 3)) of mode j."""
         phi = spec.mode(j)
         if spec.is_vector:
@@ -686,7 +708,7 @@ class MainWindow(QtWidgets.QMainWindow):
         zero = " (zero mode)" if spec.zero_mode_mask()[index] else ""
         self.eigen_label.setText(f"lambda_{index} = {lam:.6g}   sqrt(lambda) = {freq:.6g}{zero}")
         self.spectrum_plot.set_highlight(index)
-        scalar, disp = self._mode_fields(spec, index)
+        scalar, disp = self.mode_fields(spec, index)
         diverging = not (spec.is_vector and self.color_combo.currentData() == "magnitude")
         self.scene.set_displacement_scale(0.0)
         self.scene.show_field(
@@ -699,6 +721,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.display = "mode"
         self._update_colorbar()
         self.viewport.request_render()
+        if self.compare is not None and not self.compare.distances:
+            self.compare.show_mode(index)
 
     def _refresh(self) -> None:
         if self.display == "mode":
@@ -824,7 +848,41 @@ class MainWindow(QtWidgets.QMainWindow):
         self.display = "distance"
         self._draw_distance()
         self._plot_signature_curve(operator)
+        if self.compare is not None and self.compare.distances:
+            self.compare.show_distance()
         return self.last_distance
+
+    def distance_map(self, kind: str) -> np.ndarray | None:
+        """Distance of ``kind`` from the picked vertex, or None if its spectrum is missing."""
+        operator = DISTANCE_OPERATOR[kind]
+        if self.picked is None or operator not in self.spectra:
+            return None
+        return self._table(operator).distance_from(self.picked)
+
+    def open_comparison(self, items: list[str], wait: bool = True) -> CompareWindow | None:
+        """Linked side-by-side views of two or three operators or distance kinds.
+
+        Missing spectra are computed first (in the worker; with ``wait`` this call
+        returns once all are ready).
+        """
+        if self.mesh is None:
+            self.show_error("Open a mesh first.")
+            return None
+        needed = [DISTANCE_OPERATOR.get(item, item) for item in items]
+        missing = [op for op in dict.fromkeys(needed) if op not in self.spectra]
+        if missing:
+            if not wait:
+                first, rest = missing[0], items
+                self.compute(first, wait=False, then=lambda _s: self.open_comparison(rest, False))
+                return None
+            for op in missing:
+                self.compute(op, wait=True)
+        if self.compare is not None:
+            self.compare.close()
+        self.compare = CompareWindow(self, items)
+        self.compare.show()
+        self.compare.refresh()
+        return self.compare
 
     def _draw_distance(self) -> None:
         d = self.last_distance

@@ -48,6 +48,7 @@ class OffscreenViewport(QtWidgets.QWidget):
     """
 
     clicked = QtCore.Signal(float, float)
+    cameraChanged = QtCore.Signal()
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -131,6 +132,7 @@ class OffscreenViewport(QtWidgets.QWidget):
             cam.SetPosition(*(pos3 + shift))
         self.plotter.renderer.ResetCameraClippingRange()
         self.request_render()
+        self.cameraChanged.emit()
 
     def mouseReleaseEvent(self, event):  # noqa: N802
         pos = event.position()
@@ -148,6 +150,7 @@ class OffscreenViewport(QtWidgets.QWidget):
         self.plotter.camera.Zoom(1.1**steps)
         self.plotter.renderer.ResetCameraClippingRange()
         self.request_render()
+        self.cameraChanged.emit()
 
     def close_plotter(self) -> None:
         self.plotter.close()
@@ -157,6 +160,7 @@ class InteractorViewport(QtCore.QObject):
     """pyvistaqt's QtInteractor (GPU, VTK's own trackball) with click detection."""
 
     clicked = QtCore.Signal(float, float)
+    cameraChanged = QtCore.Signal()
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -168,6 +172,7 @@ class InteractorViewport(QtCore.QObject):
         iren = self.plotter.iren
         iren.add_observer("LeftButtonPressEvent", self._on_press)
         iren.add_observer("LeftButtonReleaseEvent", self._on_release)
+        iren.add_observer("InteractionEvent", lambda *_: self.cameraChanged.emit())
         self.render_count = 0
 
     @property

@@ -197,3 +197,63 @@ def test_cached_spectrum_reopens_instantly(window, spot_path):
     again = window.compute("shells_normal", k=15, wait=True)
     assert window._job is None  # served from the disk cache, no worker job
     np.testing.assert_array_equal(first.eigenvalues, again.eigenvalues)
+
+
+def test_linked_comparison_of_three_operators(window, spot_path, tmp_path, qtbot):
+    window.open_mesh(spot_path)
+    for op in ("laplacian", "modified_dirichlet", "shells_normal"):
+        window.compute(op, k=12, wait=True)
+    compare = window.open_comparison(["laplacian", "modified_dirichlet", "shells_normal"])
+    cameras = {id(vp.plotter.renderer.GetActiveCamera()) for vp in compare.viewports}
+    assert len(cameras) == 1  # one shared camera
+    window.current_operator = "laplacian"
+    window.show_mode(7)
+    for op, scene in zip(compare.items, compare.scenes, strict=True):
+        np.testing.assert_allclose(
+            scene.surface.point_data["field"], window.spectra[op].mode(7), rtol=0, atol=0
+        )
+    images = compare.grab_images()
+    compare.viewports[0].plotter.camera.Azimuth(180)  # the shared camera: all views turn
+    behind = compare.grab_images()
+    compare.viewports[0].plotter.camera.Azimuth(180)
+    for img, back in zip(images, behind, strict=True):
+        counts, counts_back = _classify(img), _classify(back)
+        assert counts["blue"] + counts_back["blue"] > 200, (counts, counts_back)
+        assert counts["orange"] + counts_back["orange"] > 200, (counts, counts_back)
+    # dragging in the first view rotates the third
+    first = compare.viewports[0].widget
+    before = compare.viewports[2].render_now()
+    start = QtCore.QPoint(first.width() // 2, first.height() // 2)
+    qtbot.mousePress(first, QtCore.Qt.MouseButton.LeftButton, pos=start)
+    for step in range(1, 6):
+        qtbot.mouseMove(first, start + QtCore.QPoint(20 * step, 0))
+    qtbot.mouseRelease(first, QtCore.Qt.MouseButton.LeftButton, pos=start + QtCore.QPoint(100, 0))
+    after = compare.viewports[2].render_now()
+    assert np.mean(np.any(before != after, axis=2)) > 0.01
+    assert window.picked is None  # a drag is not a click
+    out = compare.export_screenshot(tmp_path / "compare.png")
+    assert Image.open(out).size[0] == sum(img.shape[1] for img in images)
+
+
+def test_comparison_of_distances(window, spot_path):
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=20, wait=True)
+    window.compute("shells", k=20, wait=True)
+    window.pick_vertex(500)
+    compare = window.open_comparison(["vibration", "hks"])
+    vib, hks = (np.array(s.surface.point_data["field"]) for s in compare.scenes)
+    np.testing.assert_allclose(vib, window.distance_map("vibration"))
+    np.testing.assert_allclose(hks, window.distance_map("hks"))
+    assert not np.allclose(vib / vib.max(), hks / hks.max())
+
+
+def test_export_field_as_vtp(window, spot_path, tmp_path):
+    import pyvista as pv
+
+    window.open_mesh(spot_path)
+    spec = window.compute("laplacian", k=10, wait=True)
+    window.show_mode(3)
+    out = window.export_field(tmp_path / "mode.vtp")
+    back = pv.read(out)
+    name = back.point_data.keys()[0]
+    np.testing.assert_allclose(back.point_data[name], spec.mode(3))
