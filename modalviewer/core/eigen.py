@@ -35,6 +35,9 @@ ZERO_MODE_RTOL = 1e-8
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
 
+REFINEMENT_STEPS = 1
+"""Block shift-invert steps applied to the Lanczos basis before the Rayleigh-Ritz step."""
+
 ProgressFn = Callable[[str, float], None]
 CancelFn = Callable[[], bool]
 
@@ -177,7 +180,8 @@ def solve_lowest(
         lam, X = la.eigh(K.toarray(), np.diag(mass_diag), subset_by_index=[0, k - 1])
         method, shift = "dense", 0.0
     else:
-        lam, X, shift = _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol)
+        lam_typical = float(np.median(np.abs(K.diagonal()) / mass_diag)) or lam_max_est
+        lam, X, shift = _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol)
         method = "shift-invert lanczos"
     report("checking residuals", 0.97)
     X = _fix_signs(X)
@@ -187,10 +191,12 @@ def solve_lowest(
     return EigenResult(lam, X, res, shift, method)
 
 
-def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol):
+def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol):
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
-    shift = -1e-12 * lam_max_est  # far below the first non-zero mode, yet factorisable
+    # Far below the first non-zero mode, yet factorisable.  Scaled by the typical diagonal
+    # ratio, not the largest: one sliver triangle can make the largest 1e12 times bigger.
+    shift = -1e-8 * lam_typical
     solver = None
     for _ in range(4):
         report("factorising", 0.05)
@@ -244,8 +250,9 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_max_est, report, tol):
     # One block shift-invert step on the whole subspace before Rayleigh-Ritz: damps the
     # remaining high-frequency error of every Ritz vector by (lam_j - s)/(lam_k+1 - s).
     report("refining", 0.93)
-    Q, _ = np.linalg.qr(Y)
-    Y = sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * Q)
+    for _ in range(REFINEMENT_STEPS):
+        Q, _ = np.linalg.qr(Y)
+        Y = sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * Q)
     report("orthonormalising", 0.95)
     Q, _ = np.linalg.qr(Y)
     T = Q.T @ (inv_sqrt_m[:, None] * (K @ (inv_sqrt_m[:, None] * Q)))

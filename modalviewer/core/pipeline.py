@@ -15,8 +15,13 @@ from .spectrum import OPERATORS, Spectrum
 
 __all__ = ["compute_spectrum", "operator_matrices", "RESIDUAL_LIMIT"]
 
-RESIDUAL_LIMIT = 1e-6
-"""A spectrum whose non-zero modes have a larger relative residual is rejected."""
+RESIDUAL_LIMIT = 1e-4
+"""A spectrum whose non-zero modes have a larger relative residual is rejected.
+
+On well-shaped meshes the residuals are around 1e-10 (the tests require 1e-8); sliver
+triangles make the operator ill-conditioned (largest/smallest eigenvalue ~1e13 on an
+iso-surface mesh) and put a floor of about 1e-6 under any solver's residual.  Such
+spectra are accepted and carry their residuals (the viewer shows the largest)."""
 
 
 def operator_matrices(mesh: Mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):

@@ -1,0 +1,120 @@
+"""The demo meshes of ``assets/`` (paper Figs. 1, 3, 6, 8, 10), made in code.
+
+numpy only, deterministic.  ``scripts/make_assets.py`` writes them to ``assets/``;
+the hand needs an iso-surface extraction and is built there with VTK.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .mesh import Mesh, repair_mesh
+from .primitives import grid_plate
+
+__all__ = ["plate", "folded_plate", "bumpy_plate", "voxel_surface", "double_torus",
+           "machined_part"]  # fmt: skip
+
+PLATE_N = (48, 24)  # grid cells of the Fig. 1 plate, 2 x 1
+FOLD_X = 1.0  # the fold runs along the grid line x = 1
+
+
+def plate() -> Mesh:
+    """Flat 2 x 1 plate, 49 x 25 vertices."""
+    return grid_plate(PLATE_N[0], PLATE_N[1], width=2.0, height=1.0)
+
+
+def folded_plate(angle_degrees: float = 90.0) -> Mesh:
+    """:func:`plate` folded isometrically along the mesh line x = 1 (edge lengths kept)."""
+    base = plate()
+    v = np.array(base.vertices)
+    right = v[:, 0] > FOLD_X + 1e-12
+    a = np.radians(angle_degrees)
+    d = v[right, 0] - FOLD_X
+    v[right, 0] = FOLD_X + d * np.cos(a)
+    v[right, 2] = d * np.sin(a)
+    return Mesh(v, base.faces)
+
+
+def fold_vertices(mesh: Mesh) -> np.ndarray:
+    """Indices of the plate's vertices on the fold line."""
+    return np.flatnonzero(np.abs(plate().vertices[:, 0] - FOLD_X) < 1e-12)
+
+
+def bumpy_plate(n: int = 80, seed: int = 3) -> Mesh:
+    """Unit-square plate with a dozen smooth bumps and dents of varied size (Fig. 10)."""
+    base = grid_plate(n, n)
+    v = np.array(base.vertices)
+    rng = np.random.default_rng(seed)
+    for _ in range(12):
+        cx, cy = rng.uniform(0.15, 0.85, 2)
+        r = rng.uniform(0.04, 0.12)
+        h = rng.choice([-1.0, 1.0]) * rng.uniform(0.5, 1.0) * r
+        v[:, 2] += h * np.exp(-((v[:, 0] - cx) ** 2 + (v[:, 1] - cy) ** 2) / (2 * r * r))
+    return Mesh(v, base.faces)
+
+
+def voxel_surface(solid: np.ndarray, size: float = 1.0) -> Mesh:
+    """Outward-oriented boundary of a union of cubes ``solid[i, j, k]`` (edge ``size``).
+
+    Each boundary square becomes two triangles; coinciding corners are merged.  The
+    solid must not touch itself along an edge only (that would be non-manifold).
+    """
+    solid = np.pad(np.asarray(solid, dtype=bool), 1)
+    quads = []
+    # for each axis and direction, faces where solid meets empty
+    corners = {
+        0: np.array([[0, 0, 0], [0, 1, 0], [0, 1, 1], [0, 0, 1]]),
+        1: np.array([[0, 0, 0], [0, 0, 1], [1, 0, 1], [1, 0, 0]]),
+        2: np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]),
+    }
+    for axis in range(3):
+        for direction in (1, -1):
+            neighbour = np.roll(solid, -direction, axis=axis)
+            cells = np.argwhere(solid & ~neighbour)
+            offset = np.zeros(3, dtype=int)
+            if direction == 1:
+                offset[axis] = 1
+            quad = corners[axis] + offset
+            if direction == -1:
+                quad = quad[::-1]  # reversed winding: normal along -axis
+            quads.append(cells[:, None, :] + quad[None, :, :])
+    q = np.concatenate(quads).reshape(-1, 3).astype(np.float64) - 1.0  # undo the padding
+    idx = np.arange(len(q)).reshape(-1, 4)
+    faces = np.concatenate([idx[:, [0, 1, 2]], idx[:, [0, 2, 3]]])
+    mesh = repair_mesh(q * size, faces, source="voxels")
+    return Mesh(mesh.vertices, mesh.faces)
+
+
+def double_torus(cells: int = 4) -> Mesh:
+    """A slab with two square holes: genus two, flat faces bounded by sharp edges (Fig. 3).
+
+    ``cells`` voxels per unit length; the slab is 7 x 4 x 1 units.
+    """
+    c = cells
+    solid = np.zeros((7 * c, 4 * c, 1 * c), dtype=bool)
+    solid[:, :, :] = True
+    solid[1 * c : 3 * c, 1 * c : 3 * c, :] = False
+    solid[4 * c : 6 * c, 1 * c : 3 * c, :] = False
+    return voxel_surface(solid, 1.0 / c)
+
+
+def machined_part(cells: int = 4) -> Mesh:
+    """An L-shaped bracket with a through hole and a raised boss (rocker-arm spirit, Fig. 8)."""
+    c = cells
+    solid = np.zeros((10 * c, 4 * c, 6 * c), dtype=bool)
+    solid[:, :, : 1 * c] = True  # base plate 10 x 4 x 1
+    solid[: 1 * c, :, :] = True  # upright wall 1 x 4 x 6
+    solid[6 * c : 8 * c, 1 * c : 3 * c, : 1 * c] = False  # through hole in the base
+    solid[2 * c : 4 * c, 1 * c : 3 * c, 1 * c : 2 * c] = True  # boss on the base
+    return voxel_surface(solid, 1.0 / c)
+
+
+def sharp_vertices(mesh: Mesh, angle_degrees: float = 30.0) -> np.ndarray:
+    """(n,) True at vertices on an edge whose dihedral angle exceeds ``angle_degrees``."""
+    from .shells import dihedral_angles, hinges
+
+    h = hinges(mesh)
+    theta = np.abs(dihedral_angles(mesh.vertices, h))
+    sharp = np.zeros(mesh.n_vertices, dtype=bool)
+    sharp[h[theta > np.radians(angle_degrees)][:, :2].ravel()] = True
+    return sharp
