@@ -7,6 +7,12 @@ import sys
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    from .cli import COMMANDS
+
+    if argv and argv[0] in COMMANDS:
+        from .cli import main as cli_main
+
+        return cli_main(argv)
     from .gui.app import main as gui_main
 
     return gui_main(argv)

@@ -1,0 +1,197 @@
+"""Headless commands: ``modalviewer compute | render | distance``.
+
+Bad arguments and bad files give a one-line error and exit code 2 (usage) or 1
+(input or computation), never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+COMMANDS = ("compute", "render", "distance")
+OPERATORS = ("laplacian", "modified_dirichlet", "shells", "shells_normal")
+KINDS = {"vibration": "shells", "feature": "modified_dirichlet", "hks": "laplacian"}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit code 2
+        sys.stderr.write(f"modalviewer: error: {message}\n")
+        raise SystemExit(2)
+
+
+def _progress_bar():
+    state = {"last": 0.0}
+
+    def progress(stage: str, fraction: float) -> None:
+        now = time.perf_counter()
+        if fraction < 1.0 and now - state["last"] < 0.2:
+            return
+        state["last"] = now
+        filled = int(30 * fraction)
+        sys.stderr.write(
+            f"\r[{'#' * filled}{'.' * (30 - filled)}] {100 * fraction:5.1f}% {stage:<20}"
+        )
+        if fraction >= 1.0:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+    return progress
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"size must look like 1024x768, got {text!r}") from None
+    if not (16 <= w <= 8192 and 16 <= h <= 8192):
+        raise argparse.ArgumentTypeError("width and height must be between 16 and 8192")
+    return w, h
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="modalviewer", description="Headless modal shape analysis.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    c = sub.add_parser("compute", help="compute a spectrum and save it as .npz")
+    c.add_argument("mesh")
+    c.add_argument("--operator", choices=OPERATORS, default="laplacian")
+    c.add_argument("-k", type=int, default=100)
+    c.add_argument("--bending", type=float, default=1.0)
+    c.add_argument("--membrane", type=float, default=1.0)
+    c.add_argument("-o", "--output", required=True)
+    r = sub.add_parser("render", help="render a mode to PNG")
+    r.add_argument("mesh")
+    r.add_argument("--operator", choices=OPERATORS, default="laplacian")
+    r.add_argument("--mode", type=int, required=True)
+    r.add_argument("-k", type=int, default=None)
+    r.add_argument("--isolines", type=int, default=12)
+    r.add_argument("--size", type=_size, default=(1024, 768))
+    r.add_argument("--transparent", action="store_true")
+    r.add_argument("-o", "--output", required=True)
+    d = sub.add_parser("distance", help="distance from a vertex to all vertices")
+    d.add_argument("mesh")
+    d.add_argument("--vertex", type=int, required=True)
+    d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
+    d.add_argument("-k", type=int, default=100)
+    d.add_argument(
+        "--threshold",
+        type=float,
+        default=None,
+        help="threshold map at this fraction of the largest distance (0..1)",
+    )
+    d.add_argument("--size", type=_size, default=(1024, 768))
+    d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
+    d.add_argument("--csv", default=None, help="write vertex,distance rows")
+    return p
+
+
+def _window(size):
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+    os.environ.setdefault("MODALVIEWER_NO_DIALOGS", "1")
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    from qtpy import QtWidgets
+
+    from .gui.main_window import MainWindow
+
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
+    win = MainWindow(force_offscreen=True)
+    for dock in win.findChildren(QtWidgets.QDockWidget):
+        dock.hide()
+    win.menuBar().hide()
+    win.statusBar().hide()
+    win.resize(*size)
+    win.show()
+    app.processEvents()
+    return app, win
+
+
+def _run(args) -> int:
+    import modalviewer as mv
+
+    if args.command in ("compute", "distance") or args.command == "render":
+        if args.k is not None and args.k < 1:
+            raise ValueError("-k must be at least 1")
+    if args.command == "compute":
+        mesh = mv.load_mesh(args.mesh)
+        spec = mv.compute_spectrum(
+            mesh, args.operator, args.k, args.bending, args.membrane, progress=_progress_bar()
+        )
+        mv.save_spectrum(spec, args.output)
+        worst = float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
+        print(
+            f"{Path(args.mesh).name}: {spec.k} {args.operator} modes, eigenvalues "
+            f"{spec.eigenvalues[0]:.6g} .. {spec.eigenvalues[-1]:.6g}, largest relative "
+            f"residual {worst:.1e}; saved {args.output}"
+        )
+        return 0
+    mesh = mv.load_mesh(args.mesh)
+    if args.command == "render":
+        app, win = _window(args.size)
+        win.set_mesh(mesh, Path(args.mesh))
+        win.iso_spin.setValue(args.isolines)
+        spec = win.compute(args.operator, k=args.k, wait=True)
+        if not 0 <= args.mode < spec.k:
+            raise ValueError(f"--mode must be between 0 and {spec.k - 1}")
+        win.show_mode(args.mode)
+        win.export_screenshot(args.output, transparent=args.transparent)
+        print(
+            f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}; "
+            f"saved {args.output}"
+        )
+        win.close()
+        return 0
+    # distance
+    if not 0 <= args.vertex < mesh.n_vertices:
+        raise ValueError(f"--vertex must be between 0 and {mesh.n_vertices - 1}")
+    if args.threshold is not None and not 0 < args.threshold <= 1:
+        raise ValueError("--threshold is a fraction of the largest distance, in (0, 1]")
+    spec = mv.compute_spectrum(mesh, KINDS[args.kind], args.k, progress=_progress_bar())
+    d = mv.multiscale_distance(spec, args.vertex)
+    if args.csv:
+        np.savetxt(
+            args.csv,
+            np.column_stack([np.arange(len(d)), d]),
+            delimiter=",",
+            header="vertex,distance",
+            comments="",
+            fmt=["%d", "%.10g"],
+        )
+    if args.output:
+        app, win = _window(args.size)
+        win.set_mesh(mesh, Path(args.mesh))
+        win.spectra[spec.operator] = spec
+        win.compute_mesh = mesh
+        win.pick_vertex(args.vertex)
+        display = "threshold" if args.threshold is not None else "continuous"
+        win.show_distance(args.kind, display=display, threshold=args.threshold)
+        win.export_screenshot(args.output)
+        win.close()
+    order = np.argsort(d)[1:6]
+    print(
+        f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "
+        + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
+    )
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    from .core.eigen import Cancelled
+
+    try:
+        return _run(args)
+    except KeyboardInterrupt:
+        sys.stderr.write("modalviewer: interrupted\n")
+        return 130
+    except Cancelled:
+        return 130
+    except (ValueError, OSError, RuntimeError, MemoryError) as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        sys.stderr.write(f"modalviewer: error: {message}\n")
+        return 1
