@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-COMMANDS = ("compute", "render", "distance")
+COMMANDS = ("compute", "render", "distance", "figures")
 OPERATORS = ("laplacian", "modified_dirichlet", "shells", "shells_normal")
 KINDS = {"vibration": "shells", "feature": "modified_dirichlet", "hks": "laplacian"}
 
@@ -87,6 +87,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--size", type=_size, default=(1024, 768))
     d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
     d.add_argument("--csv", default=None, help="write vertex,distance rows")
+    f = sub.add_parser("figures", help="rebuild the paper's figures on the demo meshes")
+    f.add_argument("-o", "--output", default="screenshots")
     return p
 
 
@@ -114,9 +116,15 @@ def _window(size):
 def _run(args) -> int:
     import modalviewer as mv
 
-    if args.command in ("compute", "distance") or args.command == "render":
+    if args.command in ("compute", "distance", "render"):
         if args.k is not None and args.k < 1:
             raise ValueError("-k must be at least 1")
+    if args.command == "figures":
+        from .figures import build_figures
+
+        made = build_figures(args.output)
+        print(f"{len(made)} figures written to {args.output}")
+        return 0
     if args.command == "compute":
         mesh = mv.load_mesh(args.mesh)
         spec = mv.compute_spectrum(

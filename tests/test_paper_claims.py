@@ -89,3 +89,16 @@ def test_fig6_vibration_distance_sees_the_bent_finger():
     # measured d(bent tip) / d(straight index tip): heat kernel 0.46, vibration 1.91
     assert hks[bent] / hks[straight] < 0.8  # HKS: the bent tip looks as similar as any
     assert vib[bent] / vib[straight] > 1.4  # vibration: the bent tip stands out
+
+
+def test_fig8_feature_signature_is_near_zero_on_sharp_features():
+    mesh = mv.load_mesh(ASSETS / "demo_machined_part.obj")
+    sharp = demo_shapes.sharp_vertices(mesh)  # dihedral angle above 30 degrees
+    ratios = {}
+    for operator in ("modified_dirichlet", "laplacian"):
+        _, values = mv.signature(mv.compute_spectrum(mesh, operator, k=100))
+        # mean signature on sharp vertices / elsewhere, at two default scales (samples 20, 60)
+        ratios[operator] = [values[sharp, i].mean() / values[~sharp, i].mean() for i in (20, 60)]
+    # measured: feature signature 0.028 and 0.015; heat kernel signature 1.07 and 1.04
+    assert max(ratios["modified_dirichlet"]) < 0.1
+    assert min(ratios["laplacian"]) > 0.9
