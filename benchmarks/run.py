@@ -1,0 +1,136 @@
+"""Timings of modalviewer against a plain-scipy baseline on the same matrices.
+
+    python -m benchmarks.run [--sizes 10k 50k 130k] [--k 300] [--operators laplacian shells]
+
+Meshes (reproducible): spot subdivided once (~11.7k vertices) and twice (~47k), and the
+bumpy plate on a 360 x 360 grid (~130k).  For each mesh and operator: Hessian/matrix
+assembly, the eigenproblem for k modes (modalviewer's solver and the baseline
+``eigsh(K, k, M=Mass, sigma=s)`` with scipy's default LU), the signature at all
+vertices, the ratio, the largest relative eigenvalue difference and peak memory (RSS
+high-water mark of this process).  Results go to benchmarks/results/latest.json and a
+Markdown table is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import modalviewer as mv  # noqa: E402
+from modalviewer.core.demo_shapes import bumpy_plate  # noqa: E402
+from modalviewer.core.eigen import solve_lowest  # noqa: E402
+from modalviewer.core.pipeline import operator_matrices  # noqa: E402
+
+
+def make_mesh(size: str) -> mv.Mesh:
+    import trimesh
+
+    if size == "130k":
+        return bumpy_plate(360)
+    spot = mv.load_mesh(ROOT / "assets" / "spot.obj")
+    v, f = spot.vertices, spot.faces
+    for _ in range({"10k": 1, "50k": 2}[size]):
+        v, f = trimesh.remesh.subdivide(v, f)
+    mesh = mv.repair_mesh(v, f)
+    return mv.Mesh(mesh.vertices, mesh.faces)
+
+
+def peak_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def baseline(K, mass, k, shift):
+    """Plain scipy: eigsh in shift-invert mode with its default (LU) factorisation."""
+    lam, _ = spla.eigsh(K.tocsc(), k=k, M=sp.diags(mass).tocsc(), sigma=shift, which="LM")
+    return np.sort(lam)
+
+
+def run(sizes, operators, k, with_baseline=True):
+    rows = []
+    for size in sizes:
+        mesh = make_mesh(size)
+        for operator in operators:
+            t0 = time.perf_counter()
+            K, mass = operator_matrices(mesh, operator)
+            t_assembly = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            result = solve_lowest(K, mass, k)
+            t_eigen = time.perf_counter() - t0
+            shells = operator == "shells"
+            modes = result.vectors.reshape(mesh.n_vertices, 3, k) if shells else result.vectors
+            spec = mv.Spectrum(
+                result.eigenvalues, modes, operator, mass[::3] if shells else mass, result.residuals
+            )
+            t0 = time.perf_counter()
+            mv.signature(spec)
+            t_signature = time.perf_counter() - t0
+            row = {
+                "mesh": size,
+                "vertices": mesh.n_vertices,
+                "operator": operator,
+                "unknowns": K.shape[0],
+                "k": k,
+                "assembly_s": t_assembly,
+                "eigen_s": t_eigen,
+                "signature_s": t_signature,
+                "max_residual": float(result.residuals[~spec.zero_mode_mask()].max()),
+                "peak_mb": peak_mb(),
+            }
+            if with_baseline:
+                t0 = time.perf_counter()
+                lam_base = baseline(K, mass, k, result.shift)
+                row["baseline_eigen_s"] = time.perf_counter() - t0
+                row["speedup"] = row["baseline_eigen_s"] / t_eigen
+                scale = np.maximum(np.abs(lam_base), 1e-8 * np.abs(lam_base).max())
+                row["max_rel_eig_diff"] = float(
+                    np.max(np.abs(result.eigenvalues - lam_base) / scale)
+                )
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    return rows
+
+
+def table(rows) -> str:
+    head = (
+        "| mesh | n | operator | k | assembly s | eigen s | baseline s | ratio "
+        "| signature s | max rel. diff | peak MB |"
+    )
+    lines = [head, "|" + " --- |" * 11]
+    for r in rows:
+        lines.append(
+            f"| {r['mesh']} | {r['vertices']} | {r['operator']} | {r['k']} | {r['assembly_s']:.2f} "
+            f"| {r['eigen_s']:.1f} | {r.get('baseline_eigen_s', float('nan')):.1f} "
+            f"| {r.get('speedup', float('nan')):.2f} | {r['signature_s']:.2f} "
+            f"| {r.get('max_rel_eig_diff', float('nan')):.1e} | {r['peak_mb']:.0f} |"
+        )
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--sizes", nargs="+", default=["10k", "50k", "130k"])
+    p.add_argument("--operators", nargs="+", default=["laplacian", "shells"])
+    p.add_argument("--k", type=int, default=300)
+    p.add_argument("--no-baseline", action="store_true")
+    args = p.parse_args(argv)
+    rows = run(args.sizes, args.operators, args.k, not args.no_baseline)
+    out = ROOT / "benchmarks" / "results"
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "latest.json").write_text(json.dumps(rows, indent=1) + "\n")
+    print(table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
