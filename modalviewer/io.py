@@ -38,6 +38,81 @@ def _read_trimesh(path: Path):
     return np.vstack(vertices), np.vstack(faces)
 
 
+_PLY_TYPES = {
+    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
+    "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+}  # fmt: skip
+
+
+def strips_to_triangles(strip: np.ndarray) -> np.ndarray:
+    """(m, 3) triangles of a triangle strip (-1 restarts), alternate ones flipped."""
+    tris = []
+    for run in np.split(strip, np.flatnonzero(strip < 0)):
+        run = run[run >= 0]
+        for i in range(len(run) - 2):
+            a, b, c = run[i], run[i + 1], run[i + 2]
+            tris.append((a, b, c) if i % 2 == 0 else (b, a, c))
+    return np.array(tris, dtype=np.int64).reshape(-1, 3)
+
+
+def _read_ply_tristrips(path: Path):
+    """PLY files whose faces come as ``element tristrips`` (which trimesh and VTK skip)."""
+    data = path.read_bytes()
+    end = data.find(b"end_header")
+    if end < 0:
+        raise MeshError(f"{path.name}: not a PLY file (no end_header)")
+    header = data[:end].decode("ascii", "replace").splitlines()
+    body = data[data.index(b"\n", end) + 1 :]
+    fmt = next(line.split()[1] for line in header if line.startswith("format"))
+    elements: list[list] = []
+    for line in header:
+        words = line.split()
+        if words[:1] == ["element"]:
+            elements.append([words[1], int(words[2]), []])
+        elif words[:1] == ["property"] and elements:
+            elements[-1][2].append(words[1:])
+    if fmt != "binary_little_endian" and fmt != "binary_big_endian":
+        tokens = body.split()
+        pos = 0
+    order = "<" if fmt == "binary_little_endian" else ">"
+    vertices, strips = None, []
+    offset = 0
+    for name, count, props in elements:
+        if name == "vertex":
+            names = [p[-1] for p in props]
+            if fmt.startswith("binary"):
+                dtype = np.dtype([(p[-1], order + _PLY_TYPES[p[0]]) for p in props])
+                arr = np.frombuffer(body, dtype=dtype, count=count, offset=offset)
+                offset += dtype.itemsize * count
+                vertices = np.column_stack([arr[c].astype(np.float64) for c in "xyz"])
+            else:
+                table = np.array(tokens[pos : pos + count * len(props)], dtype=np.float64)
+                pos += count * len(props)
+                table = table.reshape(count, len(props))
+                vertices = table[:, [names.index(c) for c in "xyz"]]
+        elif name == "tristrips":
+            _, count_type, index_type, _ = props[0]
+            for _ in range(count):
+                if fmt.startswith("binary"):
+                    ct = np.dtype(order + _PLY_TYPES[count_type])
+                    it = np.dtype(order + _PLY_TYPES[index_type])
+                    n = int(np.frombuffer(body, ct, 1, offset)[0])
+                    offset += ct.itemsize
+                    strips.append(np.frombuffer(body, it, n, offset).astype(np.int64))
+                    offset += it.itemsize * n
+                else:
+                    n = int(tokens[pos])
+                    strips.append(np.array(tokens[pos + 1 : pos + 1 + n], dtype=np.int64))
+                    pos += n + 1
+        else:
+            raise MeshError(f"{path.name}: PLY element '{name}' before the faces is not supported")
+    if vertices is None:
+        raise MeshError(f"{path.name}: the PLY file has no vertices")
+    faces = [strips_to_triangles(s) for s in strips]
+    return vertices, np.vstack(faces) if faces else np.zeros((0, 3), dtype=np.int64)
+
+
 def _read_vtk(path: Path):
     import pyvista as pv
 
@@ -65,7 +140,10 @@ def read_arrays(path) -> tuple[np.ndarray, np.ndarray]:
     try:
         if ext in (".vtk", ".vtp"):
             return _read_vtk(path)
-        return _read_trimesh(path)
+        vertices, faces = _read_trimesh(path)
+        if ext == ".ply" and len(faces) == 0 and b"tristrips" in path.read_bytes()[:4096]:
+            return _read_ply_tristrips(path)
+        return vertices, faces
     except MeshError:
         raise
     except Exception as exc:  # parsers raise anything on damaged files

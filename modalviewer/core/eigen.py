@@ -108,12 +108,19 @@ class EigenResult:
     method: str
 
 
-def relative_residuals(K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray) -> np.ndarray:
-    """|K x - lam M x| / |lam M x| per column; for zero modes |K x| / (lam_max |M x|)."""
+def relative_residuals(
+    K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray, lam_scale: float = 0.0
+) -> np.ndarray:
+    """|K x - lam M x| / |lam M x| per column; for zero modes |K x| / (lam_max |M x|).
+
+    Zero modes are those below 1e-8 * max(largest |lam|, ``lam_scale``); ``lam_scale``
+    (a typical eigenvalue size) keeps a spectrum of only zero modes from judging
+    itself by its own rounding noise.
+    """
     MX = mass_diag[:, None] * X
     R = K @ X - MX * lam[None, :]
     scale = np.abs(lam).copy()
-    lam_max = max(float(np.abs(lam).max()), np.finfo(float).tiny)
+    lam_max = max(float(np.abs(lam).max()), lam_scale, np.finfo(float).tiny)
     zero = scale < ZERO_MODE_RTOL * lam_max
     scale[zero] = lam_max
     return np.linalg.norm(R, axis=0) / (scale * np.linalg.norm(MX, axis=0))
@@ -185,7 +192,8 @@ def solve_lowest(
         method = "shift-invert lanczos"
     report("checking residuals", 0.97)
     X = _fix_signs(X)
-    res = relative_residuals(K, mass_diag, lam, X)
+    lam_typical = float(np.median(np.abs(K.diagonal()) / mass_diag))
+    res = relative_residuals(K, mass_diag, lam, X, lam_scale=lam_typical)
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
     return EigenResult(lam, X, res, shift, method)

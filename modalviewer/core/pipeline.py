@@ -81,7 +81,8 @@ def compute_spectrum(
     assembled = time.perf_counter()
     k = min(k, K.shape[0])
     result = solve_lowest(K, mass, k, progress=progress, cancel=cancel)
-    lam_max = float(np.max(np.abs(result.eigenvalues)))
+    lam_typical = float(np.median(np.abs(K.diagonal()) / mass))
+    lam_max = max(float(np.max(np.abs(result.eigenvalues))), lam_typical)
     nonzero = result.eigenvalues >= 1e-8 * lam_max
     worst = float(result.residuals[nonzero].max()) if nonzero.any() else 0.0
     if worst > RESIDUAL_LIMIT:
