@@ -257,3 +257,26 @@ def test_export_field_as_vtp(window, spot_path, tmp_path):
     back = pv.read(out)
     name = back.point_data.keys()[0]
     np.testing.assert_allclose(back.point_data[name], spec.mode(3))
+
+
+def test_corrupted_cache_entry_is_recomputed(window, spot_path):
+    window.open_mesh(spot_path)
+    first = window.compute("laplacian", k=9, wait=True)
+    path = window.cache.path(window.compute_mesh, "laplacian", 9, 1.0, 1.0)
+    assert path.is_file()
+    path.write_bytes(b"not a spectrum at all")
+    window.open_mesh(spot_path)
+    again = window.compute("laplacian", k=9, wait=True)  # recomputed, not trusted
+    np.testing.assert_array_equal(first.eigenvalues, again.eigenvalues)
+    import modalviewer as mv
+
+    assert mv.load_spectrum(path).k == 9  # and the entry was rewritten
+
+
+def test_export_into_an_impossible_folder_gives_a_clear_error(window, spot_path, tmp_path):
+    window.open_mesh(spot_path)
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    with pytest.raises(OSError):
+        window.export_screenshot(blocker / "fig.png")
+    assert not list(tmp_path.glob("**/*.png"))
