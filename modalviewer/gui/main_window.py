@@ -732,6 +732,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ============================================================ animation
     def set_animating(self, on: bool) -> None:
+        """Start or stop the animation of the shown mode (only modes are animated)."""
+        on = bool(on) and self.display == "mode" and self.scene is not None
         if self.play_button.isChecked() != on:
             self.play_button.blockSignals(True)
             self.play_button.setChecked(on)

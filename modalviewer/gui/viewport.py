@@ -179,11 +179,15 @@ class InteractorViewport(QtCore.QObject):
     def widget(self) -> QtWidgets.QWidget:
         return self.plotter.interactor
 
-    def _on_press(self, obj, _event):
-        self._press = obj.GetEventPosition()
+    def _event_position(self):
+        # the observer's caller may be the interaction style; ask the interactor itself
+        return self.plotter.iren.interactor.GetEventPosition()
 
-    def _on_release(self, obj, _event):
-        pos = obj.GetEventPosition()
+    def _on_press(self, _obj, _event):
+        self._press = self._event_position()
+
+    def _on_release(self, _obj, _event):
+        pos = self._event_position()
         if (
             self._press is not None
             and max(abs(pos[0] - self._press[0]), abs(pos[1] - self._press[1])) <= CLICK_SLOP
