@@ -18,9 +18,10 @@ import numpy as np
 from qtpy import QtCore, QtGui, QtWidgets
 
 from ..core.cache import SpectrumCache
+from ..core.coarse import estimate_cost, transfer_spectrum
 from ..core.curvature import total_curvature
 from ..core.laplacian import vertex_normals
-from ..core.mesh import Mesh, MeshError
+from ..core.mesh import Mesh, MeshError, repair_mesh
 from ..core.pipeline import compute_spectrum
 from ..core.signatures import SignatureTable, signature
 from ..core.spectrum import Spectrum, save_spectrum
@@ -51,6 +52,14 @@ DEFAULT_MESH = ASSETS / "spot.obj"
 SCREENSHOTS = Path(__file__).resolve().parents[2] / "screenshots"
 PROCESS_THRESHOLD = 20000
 """Problems with at least this many unknowns are computed in a separate process."""
+
+
+def _physical_memory() -> int:
+    """Bytes of physical memory, or 0 if unknown."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 0
 
 
 def default_k(n_vertices: int) -> int:
@@ -153,6 +162,11 @@ class MainWindow(QtWidgets.QMainWindow):
             "Compute on a copy scaled to total area 1. The shells spectrum depends on the "
             "absolute size; rescaling makes meshes of different sizes comparable."
         )
+        self.coarse_check = QtWidgets.QCheckBox("Coarse-to-fine (default: off)")
+        self.coarse_check.setToolTip(
+            "Compute on a copy decimated to about a fifth of the vertices and carry the modes "
+            "to this mesh by nearest vertex (paper Section 7): much faster on big meshes."
+        )
         self.compute_button = QtWidgets.QPushButton("Compute spectrum")
         self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")
         self.compute_button.clicked.connect(lambda: self.compute(wait=False))
@@ -161,6 +175,7 @@ class MainWindow(QtWidgets.QMainWindow):
         form.addRow("Bending weight", self.bending_spin)
         form.addRow("Membrane weight", self.membrane_spin)
         form.addRow(self.rescale_check)
+        form.addRow(self.coarse_check)
         form.addRow(self.compute_button)
         self.mesh_info = QtWidgets.QLabel("No mesh")
         self.mesh_info.setWordWrap(True)
@@ -548,6 +563,15 @@ class MainWindow(QtWidgets.QMainWindow):
             self._job = None
         mesh = self._mesh_for_compute()
         self.compute_mesh = mesh
+        coarse = self._coarse_copy(mesh) if self.coarse_check.isChecked() else None
+        refusal = self._too_big(coarse or mesh, operator, k)
+        if refusal:
+            self.show_error(refusal, "Computation too large")
+            if wait:
+                raise ComputeError(refusal)
+            return None
+        if coarse is not None:
+            return self._compute_coarse(mesh, coarse, operator, k, bending, membrane, wait, then)
         cache = self.cache
         cached = cache.get(mesh, operator, k, bending, membrane)
         if cached is not None:
@@ -570,6 +594,10 @@ class MainWindow(QtWidgets.QMainWindow):
                 cache.put(mesh, spec, k, bending, membrane)
                 return spec
 
+        message = f"Computing {OPERATOR_LABELS[operator]} ({k} modes)..."
+        return self._start_job(work, operator, wait, then, message)
+
+    def _start_job(self, work, operator, wait, then, message=None):
         job = Job(work, tag=(self.mesh.hash, operator))
         job.progress.connect(self._on_job_progress)
         job.finished.connect(self._on_job_finished)
@@ -579,7 +607,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self._pending_after_compute = then
         self._job_started = time.perf_counter()
         self.progress.setValue(0)
-        self.statusBar().showMessage(f"Computing {OPERATOR_LABELS[operator]} ({k} modes)...")
+        self.statusBar().showMessage(message or f"Computing {OPERATOR_LABELS[operator]}...")
         job.start()
         self._update_enabled()
         if not wait:
@@ -597,6 +625,49 @@ class MainWindow(QtWidgets.QMainWindow):
         if getattr(self, "_wait_loop", None) is not None:
             self._wait_result = result
             self._wait_loop.quit()
+
+    def _too_big(self, mesh: Mesh, operator: str, k: int) -> str | None:
+        """A message if the estimated memory exceeds 3/4 of this machine's memory."""
+        n = mesh.n_vertices * (3 if operator == "shells" else 1)
+        nnz = mesh.n_vertices * (7 if operator != "shells" else 7 * 9 * 2)
+        seconds, needed = estimate_cost(n, min(k, n), nnz)
+        available = _physical_memory()
+        if available and needed > 0.75 * available:
+            return (
+                f"{OPERATOR_LABELS[operator]} with {k} modes on {mesh.n_vertices} vertices "
+                f"needs about {needed / 2**30:.1f} GiB of memory and {seconds / 60:.0f} min; "
+                f"this machine has {available / 2**30:.1f} GiB. Compute fewer modes, or tick "
+                "Coarse-to-fine to compute on a decimated copy."
+            )
+        if seconds > 300:
+            self.statusBar().showMessage(
+                f"This will take about {seconds / 60:.0f} min (Esc cancels; Coarse-to-fine is "
+                "much faster).",
+                20000,
+            )
+        return None
+
+    def _coarse_copy(self, mesh: Mesh, fraction: float = 0.2) -> Mesh:
+        """The mesh decimated to about ``fraction`` of its vertices (VTK quadric decimation)."""
+        import pyvista as pv
+
+        faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
+        poly = pv.PolyData(np.array(mesh.vertices), faces).decimate(1.0 - fraction)
+        arrays = np.asarray(poly.points), np.asarray(poly.faces).reshape(-1, 4)[:, 1:]
+        return repair_mesh(*arrays, source="coarse copy")
+
+    def _compute_coarse(self, mesh, coarse, operator, k, bending, membrane, wait, then):
+        """Compute on ``coarse`` in the worker and carry the spectrum to ``mesh``."""
+        k = min(k, coarse.n_vertices * (3 if operator == "shells" else 1))
+
+        def work(progress, cancel):
+            spec = compute_spectrum(coarse, operator, k, bending, membrane, progress, cancel)
+            return transfer_spectrum(spec, coarse, mesh)
+
+        message = (
+            f"Computing on a coarse copy ({coarse.n_vertices} of {mesh.n_vertices} vertices)..."
+        )
+        return self._start_job(work, operator, wait, then, message)
 
     def cancel_computation(self) -> None:
         if self._job is not None:

@@ -280,3 +280,33 @@ def test_export_into_an_impossible_folder_gives_a_clear_error(window, spot_path,
     with pytest.raises(OSError):
         window.export_screenshot(blocker / "fig.png")
     assert not list(tmp_path.glob("**/*.png"))
+
+
+def test_coarse_to_fine_option(window):
+    import json
+    from pathlib import Path
+
+    import modalviewer as mv
+
+    assets = Path(__file__).resolve().parents[2] / "assets"
+    window.open_mesh(assets / "demo_hand.obj")
+    window.coarse_check.setChecked(True)
+    spec = window.compute("shells", k=60, wait=True)
+    assert spec.n_vertices == window.mesh.n_vertices
+    assert spec.parameters["coarse_vertices"] < 0.25 * window.mesh.n_vertices
+    tip = json.loads((assets / "demo_landmarks.json").read_text())["demo_hand"]["finger1"]
+    window.pick_vertex(tip)
+    coarse_d = window.last_distance
+    full = mv.compute_spectrum(window.mesh, "shells", k=60)
+    full_d = mv.multiscale_distance(full, tip)
+    assert np.corrcoef(coarse_d, full_d)[0, 1] > 0.85
+
+
+def test_too_large_computation_is_refused_up_front(window, spot_path, monkeypatch):
+    from modalviewer.gui import main_window
+
+    window.open_mesh(spot_path)
+    monkeypatch.setattr(main_window, "_physical_memory", lambda: 64 * 2**20)  # 64 MiB
+    with pytest.raises(main_window.ComputeError, match="GiB of memory"):
+        window.compute("shells", k=300, wait=True)
+    assert "Coarse-to-fine" in window.last_error and window._job is None

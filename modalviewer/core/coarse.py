@@ -1,0 +1,47 @@
+"""Coarse-to-fine (paper Section 7, Fig. 9) and cost estimates for big problems."""
+
+from __future__ import annotations
+
+from scipy.spatial import cKDTree
+
+from .laplacian import lumped_masses
+from .mesh import Mesh
+from .spectrum import Spectrum
+
+__all__ = ["transfer_spectrum", "estimate_cost"]
+
+SECONDS_PER_UNKNOWN_MODE = 4.3e-6
+"""Eigen-solve time per unknown and mode, measured on the 2-core reference machine
+(35k unknowns x 300 modes: 45.8 s; 140k x 100: 57 s)."""
+
+
+def estimate_cost(n_unknowns: int, k: int, nnz: int) -> tuple[float, float]:
+    """(seconds, bytes) a spectrum of ``k`` modes of an (N, N) operator with ``nnz`` entries
+    is expected to take on the reference machine: Lanczos basis and modes, plus factor."""
+    k_internal = k + max(8, k // 10)
+    ncv = max(2 * k_internal + 1, k_internal + 32)
+    basis = 8.0 * n_unknowns * (ncv + 2 * k_internal)
+    factor = 8.0 * 12.0 * nnz
+    return SECONDS_PER_UNKNOWN_MODE * n_unknowns * k, 1.5 * basis + factor
+
+
+def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectrum:
+    """Carry a coarse mesh's spectrum to the fine mesh by nearest-vertex lookup.
+
+    Eigenvalues are kept; each fine vertex takes the modes of the nearest coarse vertex.
+    The transferred modes are not Mass-orthonormal on the fine mesh; signatures and
+    distances computed from them approximate the fine ones (correlation 0.94 for the
+    vibration distance on the demo hand decimated to a fifth).
+    """
+    _, nearest = cKDTree(coarse.vertices).query(fine.vertices)
+    params = dict(coarse_spec.parameters)
+    params.update(transferred_from=coarse.hash, coarse_vertices=coarse.n_vertices)
+    return Spectrum(
+        eigenvalues=coarse_spec.eigenvalues.copy(),
+        modes=coarse_spec.modes[nearest].copy(),
+        operator=coarse_spec.operator,
+        mass=lumped_masses(fine),
+        residuals=coarse_spec.residuals.copy(),
+        mesh_hash=fine.hash,
+        parameters=params,
+    )
