@@ -310,3 +310,18 @@ def test_too_large_computation_is_refused_up_front(window, spot_path, monkeypatc
     with pytest.raises(main_window.ComputeError, match="GiB of memory"):
         window.compute("shells", k=300, wait=True)
     assert "Coarse-to-fine" in window.last_error and window._job is None
+
+
+def test_closing_during_a_computation_stops_it(qtbot, tmp_path):
+    from modalviewer.gui import MainWindow
+
+    win = MainWindow()
+    qtbot.addWidget(win)
+    win.show()
+    win.open_mesh(_big_mesh_file(tmp_path))
+    win.compute("shells", k=200, wait=False)
+    job = win._job
+    qtbot.wait(800)
+    win.close()  # cancels and waits for the worker
+    assert not job.is_running()
+    assert win._job is None
