@@ -52,6 +52,25 @@ def _plural(count: int, word: str) -> str:
     return f"{count} {word}s"
 
 
+def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
+    """Raise MeshError for NaN/Inf coordinates or face indices outside 0..n-1."""
+    bad = ~np.isfinite(v).all(axis=1)
+    if bad.any():
+        raise MeshError(
+            f"{_plural(int(bad.sum()), 'vertex')} have NaN or infinite coordinates (first: "
+            f"vertex {int(np.flatnonzero(bad)[0])}); fix the coordinates in the source "
+            "application and export again"
+        )
+    n = len(v)
+    out = (f < 0) | (f >= n)
+    if out.any():
+        face = int(np.flatnonzero(out.any(axis=1))[0])
+        raise MeshError(
+            f"face {face} refers to vertex {int(f[face][out[face]][0])}, which does not exist "
+            f"(the mesh has {_plural(n, 'vertex')}); the file is corrupt or truncated"
+        )
+
+
 class Mesh:
     """A validated triangle mesh.
 
@@ -90,21 +109,7 @@ class Mesh:
             if not np.all(np.isfinite(f_raw)) or np.any(f_raw != np.round(f_raw)):
                 raise MeshError("face indices must be whole numbers")
         f = f_raw.astype(np.int64, copy=True)
-        bad = ~np.isfinite(v).all(axis=1)
-        if bad.any():
-            first = int(np.flatnonzero(bad)[0])
-            raise MeshError(
-                f"{_plural(int(bad.sum()), 'vertex')} have NaN or infinite coordinates "
-                f"(first: vertex {first}); fix or remove them in the source file"
-            )
-        n = v.shape[0]
-        out = (f < 0) | (f >= n)
-        if out.any():
-            face = int(np.flatnonzero(out.any(axis=1))[0])
-            raise MeshError(
-                f"face {face} refers to vertex {int(f[face][out[face]][0])}, but the mesh has "
-                f"only {n} vertices (indices 0..{n - 1}); the file is corrupt or truncated"
-            )
+        _check_finite_and_indices(v, f)
         repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
         if repeated.any():
             raise MeshError(
@@ -357,21 +362,7 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
             "not a surface. Reconstruct a surface from it first."
         )
     f = f.reshape(-1, 3).astype(np.int64)
-    bad = ~np.isfinite(v).all(axis=1)
-    if bad.any():
-        raise MeshError(
-            f"{_plural(int(bad.sum()), 'vertex')} have NaN or infinite coordinates (first: "
-            f"vertex {int(np.flatnonzero(bad)[0])}); the file is damaged. Fix the "
-            "coordinates in the source application and export again."
-        )
-    n = len(v)
-    out = (f < 0) | (f >= n)
-    if out.any():
-        face = int(np.flatnonzero(out.any(axis=1))[0])
-        raise MeshError(
-            f"face {face} refers to a vertex that does not exist (the file has "
-            f"{_plural(n, 'vertex')}); the file is corrupt or truncated"
-        )
+    _check_finite_and_indices(v, f)
     diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     if diag == 0:
         raise MeshError("all vertices coincide: the mesh has no extent")

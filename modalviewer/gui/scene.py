@@ -142,35 +142,31 @@ class MeshScene:
         rest.point_data["field"] = values
         rest.point_data["displacement"] = self.surface.point_data["displacement"]
         if len(levels):
-            self.isolines = rest.contour(isosurfaces=list(levels), scalars="field")
-            if self.isolines.n_points:
-                self._iso_rest = np.array(self.isolines.points)
-                self._iso_disp = np.array(self.isolines.point_data["displacement"])
-                self.iso_actor = self.plotter.add_mesh(
-                    self.isolines,
-                    color="black",
-                    line_width=1.5,
-                    name="isolines",
-                    render=False,
-                    reset_camera=False,
-                    show_scalar_bar=False,
-                    scalars=None,
-                )
+            self.isolines, self._iso_rest, self._iso_disp, self.iso_actor = self._contour(
+                rest, list(levels), 1.5, "isolines"
+            )
         if emphasise_zero and lo < 0 < hi:
-            self.zero_line = rest.contour(isosurfaces=[0.0], scalars="field")
-            if self.zero_line.n_points:
-                self._zero_rest = np.array(self.zero_line.points)
-                self._zero_disp = np.array(self.zero_line.point_data["displacement"])
-                self.zero_actor = self.plotter.add_mesh(
-                    self.zero_line,
-                    color="black",
-                    line_width=3.5,
-                    name="zeroline",
-                    render=False,
-                    reset_camera=False,
-                    show_scalar_bar=False,
-                    scalars=None,
-                )
+            self.zero_line, self._zero_rest, self._zero_disp, self.zero_actor = self._contour(
+                rest, [0.0], 3.5, "zeroline"
+            )
+
+    def _contour(self, rest: pv.PolyData, levels: list[float], width: float, name: str):
+        """Black lines of ``rest``'s field at ``levels``: (lines, rest points, displacement,
+        actor), the last three None if the field never reaches the levels."""
+        lines = rest.contour(isosurfaces=levels, scalars="field")
+        if not lines.n_points:
+            return lines, None, None, None
+        actor = self.plotter.add_mesh(
+            lines,
+            color="black",
+            line_width=width,
+            name=name,
+            render=False,
+            reset_camera=False,
+            show_scalar_bar=False,
+            scalars=None,
+        )
+        return (lines, np.array(lines.points), np.array(lines.point_data["displacement"]), actor)
 
     @property
     def n_isoline_points(self) -> int:

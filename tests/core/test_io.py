@@ -87,7 +87,7 @@ def test_clear_errors(tmp_path, content, fragment):
 
 
 def test_direct_construction_errors():
-    with pytest.raises(mv.MeshError, match="only 3 vertices"):
+    with pytest.raises(mv.MeshError, match="has 3 vertices"):
         mv.Mesh(np.eye(3), [[0, 1, 3]])
     with pytest.raises(mv.MeshError, match="no faces"):
         mv.Mesh(np.eye(3), np.zeros((0, 3)))
