@@ -73,6 +73,16 @@ def build_figures(out_dir, progress=print) -> list[Path]:
     compare = win.open_comparison(["vibration", "hks"])
     save("fig6_hand_vibration_vs_hks", compare)
     compare.close()
+    # Fig. 9: vibration distance from the same fingertip, full mesh and coarse-to-fine
+    tips_straight = json.loads((ASSETS / "demo_landmarks.json").read_text())["demo_hand"]
+    for coarse in (False, True):
+        win.open_mesh(ASSETS / "demo_hand.obj")
+        win.coarse_check.setChecked(coarse)
+        win.compute("shells", k=100, wait=True)
+        win.pick_vertex(tips_straight["finger1"])
+        win.show_distance("vibration", display="continuous")
+        save(f"fig9_hand_vibration_distance_{'coarse_to_fine' if coarse else 'full'}")
+    win.coarse_check.setChecked(False)
     # Fig. 8: feature signature on the machined part at three scales, and curvature
     win.open_mesh(ASSETS / "demo_machined_part.obj")
     win.compute("modified_dirichlet", k=100, wait=True)
