@@ -32,7 +32,7 @@ def test_residuals_and_orthonormality_on_real_mesh(spot, operator):
         (spot.n_vertices, 3, 40) if operator == "shells" else (spot.n_vertices, 40)
     )
     _check_spectrum(spot, spec, operator)
-    assert spec.parameters["method"] == "shift-invert lanczos"
+    assert spec.parameters["method"].startswith("shift-invert block Krylov-Schur")
 
 
 @pytest.mark.parametrize("operator", mv.OPERATORS)
@@ -42,7 +42,7 @@ def test_sparse_solver_agrees_with_dense(operator):
     K, mass = operator_matrices(mesh, operator)
     dense = solve_lowest(K, mass, 20, dense_limit=10**6)
     sparse = solve_lowest(K, mass, 20, dense_limit=0)
-    assert dense.method == "dense" and sparse.method == "shift-invert lanczos"
+    assert dense.method == "dense" and sparse.method.startswith("shift-invert")
     scale = dense.eigenvalues.max()
     np.testing.assert_allclose(sparse.eigenvalues, dense.eigenvalues, atol=1e-9 * scale)
 

@@ -1,0 +1,116 @@
+"""The sparse factorisations and the block Krylov-Schur eigensolver on their own."""
+
+import numpy as np
+import pytest
+import scipy.linalg as la
+import scipy.sparse as sp
+
+import modalviewer as mv
+from modalviewer.core.eigen import EigenError, block_krylov_schur, solve_lowest
+from modalviewer.core.factor import SPDSolver, available_backends
+from modalviewer.core.pipeline import operator_matrices
+from modalviewer.core.primitives import grid_plate
+
+
+def _spd_matrix(n=400, seed=0):
+    rng = np.random.default_rng(seed)
+    A = sp.random(n, n, density=0.01, random_state=rng)
+    return (A @ A.T + sp.diags(rng.uniform(0.5, 2.0, n))).tocsr()
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_every_backend_solves_one_and_many_right_hand_sides(backend):
+    A = _spd_matrix()
+    solver = SPDSolver(A, backend=backend)
+    assert solver.backend == backend
+    rng = np.random.default_rng(1)
+    b = rng.standard_normal(A.shape[0])
+    B = rng.standard_normal((A.shape[0], 7))
+    x, X = solver.solve(b), solver.solve(B)
+    assert x.shape == b.shape and X.shape == B.shape
+    assert np.linalg.norm(A @ x - b) < 1e-12 * np.linalg.norm(b) * 1e3
+    np.testing.assert_allclose(A @ X, B, atol=1e-10)
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_every_backend_refuses_an_indefinite_matrix(backend):
+    A = _spd_matrix() - 50.0 * sp.eye(400)
+    with pytest.raises(np.linalg.LinAlgError):
+        SPDSolver(A, backend=backend)
+
+
+def test_unknown_backend_is_a_clear_error():
+    with pytest.raises(ValueError, match="unknown backend"):
+        SPDSolver(sp.eye(3), backend="magic")
+
+
+@pytest.mark.parametrize("block", [3, 8])
+def test_block_krylov_schur_against_dense_with_restarts_and_multiplicity(block):
+    # A symmetric operator with known spectrum: a triple eigenvalue among the wanted
+    # ones and a cluster at the border; the basis is small so the solver must restart.
+    rng = np.random.default_rng(7)
+    n = 300
+    # like a shift-inverted surface spectrum: theta_j ~ 1 / j
+    theta_all = 1.0 / (np.arange(1, n + 1) + rng.uniform(0, 0.3, n))
+    theta_all[3:6] = theta_all[4]
+    U = np.linalg.qr(rng.standard_normal((n, n)))[0]
+    A = (U * theta_all) @ U.T
+    k = 20
+    theta, Y, applied = block_krylov_schur(
+        lambda V: A @ V,
+        n,
+        k,
+        keep=k + 4,
+        block=block,
+        max_basis=k + 4 + 4 * block,
+        tol=1e-12,
+        report=lambda s, f: None,
+    )
+    np.testing.assert_allclose(theta, theta_all[:k], rtol=1e-10)
+    np.testing.assert_allclose(Y.T @ Y, np.eye(k), atol=1e-12)
+    res = np.linalg.norm(A @ Y - Y * theta, axis=0) / theta
+    assert res.max() < 1e-10
+    assert applied > k + 4 + 4 * block  # it did restart
+
+
+def test_block_krylov_schur_reports_non_convergence():
+    rng = np.random.default_rng(3)
+    n = 200
+    A = np.diag(np.linspace(1.0, 0.999, n))  # no gap at all
+    with pytest.raises(EigenError, match="did not converge"):
+        block_krylov_schur(
+            lambda V: A @ V @ np.eye(V.shape[1]) + 0 * rng.standard_normal(V.shape),
+            n,
+            10,
+            keep=12,
+            block=2,
+            max_basis=16,
+            tol=1e-14,
+            report=lambda s, f: None,
+            max_restarts=3,
+        )
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="MKL PARDISO not installed")
+def test_pardiso_and_cholmod_paths_give_the_same_spectrum(monkeypatch):
+    plate = grid_plate(40, 40)
+    v = plate.vertices.copy()
+    v[:, 2] = 0.2 * np.sin(3 * v[:, 0]) * np.cos(2 * v[:, 1])
+    mesh = mv.Mesh(v, plate.faces)
+    K, mass = operator_matrices(mesh, "shells")
+    fast = solve_lowest(K, mass, 60)
+    monkeypatch.setenv("MODALVIEWER_NO_PARDISO", "1")
+    slow = solve_lowest(K, mass, 60)
+    assert "pardiso" in fast.method and "cholmod" in slow.method
+    nonzero = fast.eigenvalues > 1e-8 * fast.eigenvalues.max()
+    assert nonzero.sum() == 54  # six rigid motions of the free plate
+    np.testing.assert_allclose(fast.eigenvalues[nonzero], slow.eigenvalues[nonzero], rtol=1e-9)
+
+
+def test_shifted_factorisation_of_a_singular_operator_against_dense():
+    # the shells Hessian is singular (rigid motions); the solver factors K - shift M
+    mesh = grid_plate(12, 12)
+    K, mass = operator_matrices(mesh, "shells")
+    sparse = solve_lowest(K, mass, 30, dense_limit=0)
+    dense = la.eigh(K.toarray(), np.diag(mass), eigvals_only=True, subset_by_index=[0, 29])
+    np.testing.assert_allclose(sparse.eigenvalues, dense, atol=1e-9 * dense.max())
