@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import threading
+import time
 import traceback
 from collections.abc import Callable
 
@@ -17,6 +18,9 @@ from qtpy import QtCore
 from ..core.eigen import Cancelled
 
 _ids = itertools.count(1)
+
+PROGRESS_INTERVAL = 0.05
+"""Seconds between two progress signals of the same stage."""
 
 
 class Job(QtCore.QObject):
@@ -33,6 +37,8 @@ class Job(QtCore.QObject):
         self.tag = tag
         self._fn = fn
         self._cancel = threading.Event()
+        self._last_stage: str | None = None
+        self._last_emit = 0.0
         self._thread = threading.Thread(
             target=self._run, name=f"modalviewer-job-{self.id}", daemon=True
         )
@@ -54,12 +60,18 @@ class Job(QtCore.QObject):
         self._thread.join(timeout)
         return not self._thread.is_alive()
 
+    def _emit_progress(self, stage: str, fraction: float) -> None:
+        """Forward progress at most every 50 ms (and on every new stage): a solver may
+        report hundreds of times a second, and each report crosses to the GUI thread."""
+        now = time.monotonic()
+        if stage == self._last_stage and now - self._last_emit < PROGRESS_INTERVAL:
+            return
+        self._last_stage, self._last_emit = stage, now
+        self.progress.emit(self.id, str(stage), float(fraction))
+
     def _run(self) -> None:
         try:
-            result = self._fn(
-                lambda stage, fraction: self.progress.emit(self.id, stage, float(fraction)),
-                self._cancel.is_set,
-            )
+            result = self._fn(self._emit_progress, self._cancel.is_set)
         except Cancelled:
             self.cancelled.emit(self.id)
         except MemoryError:

@@ -1,0 +1,176 @@
+"""Interactive costs of the real viewer window (off-screen) on a big mesh.
+
+    python -m benchmarks.interactive [--size 130k] [--operator shells] [--k 100]
+
+Drives ``modalviewer.gui.MainWindow`` as a user would and measures, separately, the
+application's own work up to the render request and the draw itself (software OpenGL on
+machines without a GPU): computing a spectrum while a 10 ms timer watches the event loop
+(longest gap), cancelling a computation, reopening the cached spectrum, switching modes
+with isolines, one animation frame, picking a vertex to a distance map (first pick builds
+the signature table), one threshold-slider step.  Results go to
+``benchmarks/results/interactive_<size>.json``; a Markdown table is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.run import make_mesh  # noqa: E402
+from modalviewer.core.cache import SpectrumCache  # noqa: E402
+
+KIND = {"shells": "vibration", "modified_dirichlet": "feature", "laplacian": "hks"}
+
+
+def _stats(values) -> dict:
+    a = 1e3 * np.asarray(values, dtype=float)
+    return {"median_ms": float(np.median(a)), "max_ms": float(a.max()), "n": int(a.size)}
+
+
+def run(size: str, operator: str, k: int) -> dict:
+    from qtpy import QtCore, QtWidgets
+
+    from modalviewer.gui import MainWindow
+
+    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
+    cache_dir = tempfile.mkdtemp(prefix="modalviewer-bench-")
+    win = MainWindow(force_offscreen=True, cache=SpectrumCache(Path(cache_dir)))
+    win.resize(1280, 900)
+    win.show()
+    app.processEvents()
+    mesh = make_mesh(size)
+    win.set_mesh(mesh)
+    app.processEvents()
+    out = {"mesh": size, "vertices": mesh.n_vertices, "operator": operator, "k": k}
+
+    # computing while a timer watches the event loop
+    gaps, last = [], [time.perf_counter()]
+
+    def tick():
+        now = time.perf_counter()
+        gaps.append(now - last[0])
+        last[0] = now
+
+    timer = QtCore.QTimer()
+    timer.setInterval(10)
+    timer.timeout.connect(tick)
+    timer.start()
+    started = time.perf_counter()
+    win.compute(operator, k=k, wait=True)
+    out["compute_s"] = time.perf_counter() - started
+    timer.stop()
+    out["longest_event_loop_gap_ms"] = 1e3 * max(gaps)
+
+    # cancel: a different k is not cached; cancel in the middle of the work
+    win.compute(operator, k=k + 1, wait=False)
+    deadline = time.perf_counter() + min(3.0, 0.4 * out["compute_s"])
+    while time.perf_counter() < deadline:
+        app.processEvents()
+        time.sleep(0.01)
+    started = time.perf_counter()
+    win.cancel_computation()
+    while win._job is not None and time.perf_counter() - started < 30:
+        app.processEvents()
+        time.sleep(0.002)
+    out["cancel_s"] = time.perf_counter() - started
+    out["cancelled_while_running"] = win.statusBar().currentMessage() == "Computation cancelled."
+
+    # reopening the cached spectrum (as a restart of the viewer would)
+    win.spectra.clear()
+    started = time.perf_counter()
+    win.compute(operator, k=k, wait=True)
+    out["cached_reopen_s"] = time.perf_counter() - started
+
+    # mode switches with isolines: the app's work, then the draw
+    app_t, draw_t = [], []
+    for j in range(6, 16):
+        t0 = time.perf_counter()
+        win.show_mode(j)
+        app_t.append(time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        win.viewport.render_now()
+        draw_t.append(time.perf_counter() - t0)
+    out["mode_switch"] = _stats(app_t)
+    out["draw"] = _stats(draw_t)
+
+    win.show_mode(8)
+    frames = [win.animation_frame(phase) for phase in np.linspace(0, 6.0, 60)]
+    out["animation_frame"] = _stats(frames)
+
+    rng = np.random.default_rng(0)
+    kind = KIND[operator]
+    win.show_distance(kind, display="threshold", threshold=0.2)
+    picks = []
+    for v in rng.integers(0, mesh.n_vertices, 11):
+        t0 = time.perf_counter()
+        win.pick_vertex(int(v))
+        picks.append(time.perf_counter() - t0)
+    out["first_pick_with_table_ms"] = 1e3 * picks[0]
+    out["pick_to_distance_map"] = _stats(picks[1:])
+    steps = [win.set_threshold(f) for f in np.linspace(0.05, 0.6, 40)]
+    out["threshold_step"] = _stats(steps)
+    win.close()
+    return out
+
+
+def table(r: dict) -> str:
+    rows = [
+        ("compute (s)", f"{r['compute_s']:.1f}"),
+        ("longest event-loop gap while computing (ms)", f"{r['longest_event_loop_gap_ms']:.0f}"),
+        ("cancel to stopped (s)", f"{r['cancel_s']:.2f}"),
+        ("reopen cached spectrum (s)", f"{r['cached_reopen_s']:.2f}"),
+        ("mode switch with isolines, app (ms, median / max)", "{median_ms:.1f} / {max_ms:.1f}"),
+        ("draw (ms, median / max)", "{median_ms:.0f} / {max_ms:.0f}"),
+        ("animation frame, app (ms)", "{median_ms:.2f} / {max_ms:.2f}"),
+        ("first pick incl. signature table (ms)", f"{r['first_pick_with_table_ms']:.0f}"),
+        ("pick to distance map, app (ms)", "{median_ms:.1f} / {max_ms:.1f}"),
+        ("threshold step, app (ms)", "{median_ms:.2f} / {max_ms:.2f}"),
+    ]
+    keys = {
+        "mode switch with isolines, app (ms, median / max)": "mode_switch",
+        "draw (ms, median / max)": "draw",
+        "animation frame, app (ms)": "animation_frame",
+        "pick to distance map, app (ms)": "pick_to_distance_map",
+        "threshold step, app (ms)": "threshold_step",
+    }
+    lines = [
+        f"{r['mesh']} ({r['vertices']} vertices), {r['operator']}, k = {r['k']}",
+        "",
+        "| measure | value |",
+        "| --- | --- |",
+    ]
+    for name, value in rows:
+        if name in keys:
+            value = value.format(**r[keys[name]])
+        lines.append(f"| {name} | {value} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--size", default="130k", choices=["10k", "50k", "130k"])
+    p.add_argument("--operator", default="shells", choices=sorted(KIND))
+    p.add_argument("--k", type=int, default=100)
+    args = p.parse_args(argv)
+    result = run(args.size, args.operator, args.k)
+    out = ROOT / "benchmarks" / "results"
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"interactive_{args.size}.json").write_text(json.dumps(result, indent=1) + "\n")
+    print(table(result))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
