@@ -31,20 +31,25 @@ def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False
     return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
 
 
-def signature(spec: Spectrum, times=None, include_zero: bool = False):
-    """Signature at every vertex and scale.
+def signature(spec: Spectrum, times=None, include_zero: bool = False, vertices=None):
+    """Signature at every vertex (or at ``vertices``) and scale.
 
     Returns
     -------
     times : (T,) the scales (default: :func:`default_times`).
-    values : (n, T) ``sum_j exp(-lambda_j t) |phi_j(v)|^2``.
+    values : (n, T), or (len(vertices), T), ``sum_j exp(-lambda_j t) |phi_j(v)|^2``.
     """
     mask = _used(spec, include_zero)
     times = default_times(spec, include_zero=include_zero) if times is None else times
     times = np.atleast_1d(np.asarray(times, dtype=np.float64))
     lam = spec.eigenvalues[mask]
     weights = np.exp(-np.outer(lam, times))  # (k, T)
-    values = spec.squared_modes()[:, mask] @ weights
+    if vertices is None:
+        squared = spec.squared_modes()
+    else:
+        rows = spec.modes[np.atleast_1d(np.asarray(vertices, dtype=np.int64))]
+        squared = np.einsum("ick,ick->ik", rows, rows) if spec.is_vector else rows**2
+    values = squared[:, mask] @ weights
     return times, values
 
 
@@ -71,11 +76,24 @@ class SignatureTable:
         z = weights.sum(axis=0)  # (T,)
         self.times = times
         self.table = (spec.squared_modes()[:, mask] @ (weights / z)) * np.sqrt(dlogt)
+        self._norms2: np.ndarray | None = None
 
     def distance_from(self, vertex: int) -> np.ndarray:
-        """(n,) distance from ``vertex`` to every vertex."""
-        d = self.table - self.table[vertex]
-        return np.sqrt(np.einsum("ij,ij->i", d, d))
+        """(n,) distance from ``vertex`` to every vertex.
+
+        ``|F[v] - F[w]|^2 = |F[v]|^2 + |F[w]|^2 - 2 F[v].F[w]``: one pass over the table
+        (a matrix-vector product) instead of three.  Where that difference cancels
+        (distance below 1e-3 of the signature norms) the entries are recomputed directly,
+        so near-zero distances keep full relative accuracy and d(v, v) = 0 exactly.
+        """
+        if self._norms2 is None:
+            self._norms2 = np.einsum("ij,ij->i", self.table, self.table)
+        row = self.table[vertex]
+        d2 = self._norms2 + self._norms2[vertex] - 2.0 * (self.table @ row)
+        close = np.flatnonzero(d2 <= 1e-6 * (self._norms2 + self._norms2[vertex]))
+        diff = self.table[close] - row
+        d2[close] = np.einsum("ij,ij->i", diff, diff)
+        return np.sqrt(np.maximum(d2, 0.0))
 
 
 def multiscale_distance(

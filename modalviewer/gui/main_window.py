@@ -994,10 +994,10 @@ class MainWindow(QtWidgets.QMainWindow):
     def _plot_signature_curve(self, operator: str) -> None:
         table = self._table(operator)
         spec = self.spectra[operator]
-        times, values = signature(spec, table.times)
+        times, values = signature(spec, table.times, vertices=[self.picked])
         self.signature_plot.set_data(
             times,
-            values[self.picked],
+            values[0],
             logx=True,
             markers=False,
             title=f"Signature of vertex {self.picked} ({spec.operator})",

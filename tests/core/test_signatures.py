@@ -84,3 +84,26 @@ def test_distance_equals_riemann_sum_of_eq31(spot):
     np.testing.assert_allclose(got, expected, rtol=1e-10, atol=1e-14)
     with pytest.raises(IndexError):
         mv.multiscale_distance(spec, spot.n_vertices)
+
+
+@pytest.mark.parametrize("operator", ["shells", "modified_dirichlet"])
+def test_fast_distance_query_matches_the_direct_difference(spot, operator):
+    from modalviewer.core.signatures import SignatureTable
+
+    spec = mv.compute_spectrum(spot, operator, k=30)
+    table = SignatureTable(spec)
+    # duplicate rows: vertices with identical signatures must be at distance exactly 0
+    table.table = np.vstack([table.table, table.table[:5]])
+    for v in (0, 3, 777):
+        fast = table.distance_from(v)
+        direct = np.linalg.norm(table.table - table.table[v], axis=1)
+        np.testing.assert_allclose(fast, direct, rtol=1e-7, atol=1e-12 * direct.max())
+        assert fast[v] == 0.0
+    assert table.distance_from(3)[spot.n_vertices + 3] == 0.0
+
+
+def test_signature_at_chosen_vertices_equals_the_full_rows(spot):
+    spec = mv.compute_spectrum(spot, "shells", k=20)
+    times, full = mv.signature(spec)
+    _, some = mv.signature(spec, times, vertices=[5, 17, 5])
+    np.testing.assert_allclose(some, full[[5, 17, 5]], rtol=1e-12)
