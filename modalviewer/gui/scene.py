@@ -69,6 +69,10 @@ class MeshScene:
         self._mapper.SetScalarModeToUsePointFieldData()
         self._mapper.SelectColorArray("field")
         self._mapper.SetUseLookupTableScalarRange(False)
+        # the rest shape with the shown field, contoured for the isolines
+        self._rest = pv.PolyData(self.rest_points, faces)
+        self._rest.point_data["field"] = np.zeros(mesh.n_vertices)
+        self._rest.point_data["displacement"] = np.zeros((mesh.n_vertices, 3))
         self.isolines = pv.PolyData()
         self.zero_line = pv.PolyData()
         self.iso_actor = None
@@ -127,46 +131,47 @@ class MeshScene:
         self.set_isolines(values, isolines if kind != "threshold" else 0, kind == "diverging")
 
     def set_isolines(self, values: np.ndarray, count: int, emphasise_zero: bool) -> None:
-        for actor in (self.iso_actor, self.zero_actor):
-            if actor is not None:
-                self.plotter.remove_actor(actor, render=False)
-        self.iso_actor = self.zero_actor = None
-        self._iso_rest = self._zero_rest = None
-        if count <= 0:
-            return
+        """Contour the rest shape (so the lines can follow the animation) at ``count``
+        levels; the line actors are created once and their data replaced in place."""
         lo, hi = self.clim
-        levels = np.linspace(lo, hi, count + 2)[1:-1]
+        levels = np.linspace(lo, hi, count + 2)[1:-1] if count > 0 else np.zeros(0)
         if emphasise_zero:
             levels = levels[np.abs(levels) > 1e-12 * max(abs(lo), abs(hi))]
-        rest = pv.PolyData(self.rest_points, self.surface.faces)
-        rest.point_data["field"] = values
-        rest.point_data["displacement"] = self.surface.point_data["displacement"]
-        if len(levels):
-            self.isolines, self._iso_rest, self._iso_disp, self.iso_actor = self._contour(
-                rest, list(levels), 1.5, "isolines"
-            )
-        if emphasise_zero and lo < 0 < hi:
-            self.zero_line, self._zero_rest, self._zero_disp, self.zero_actor = self._contour(
-                rest, [0.0], 3.5, "zeroline"
-            )
-
-    def _contour(self, rest: pv.PolyData, levels: list[float], width: float, name: str):
-        """Black lines of ``rest``'s field at ``levels``: (lines, rest points, displacement,
-        actor), the last three None if the field never reaches the levels."""
-        lines = rest.contour(isosurfaces=levels, scalars="field")
-        if not lines.n_points:
-            return lines, None, None, None
-        actor = self.plotter.add_mesh(
-            lines,
-            color="black",
-            line_width=width,
-            name=name,
-            render=False,
-            reset_camera=False,
-            show_scalar_bar=False,
-            scalars=None,
+        want_zero = count > 0 and emphasise_zero and lo < 0 < hi
+        if len(levels) or want_zero:
+            self._rest.point_data["field"] = values
+            self._rest.point_data["displacement"] = self.surface.point_data["displacement"]
+        self._iso_rest, self._iso_disp = self._contour(
+            self.isolines, list(levels), 1.5, "iso_actor"
         )
-        return (lines, np.array(lines.points), np.array(lines.point_data["displacement"]), actor)
+        self._zero_rest, self._zero_disp = self._contour(
+            self.zero_line, [0.0] if want_zero else [], 3.5, "zero_actor"
+        )
+
+    def _contour(self, lines: pv.PolyData, levels: list[float], width: float, attr: str):
+        """Replace ``lines`` by the black contour of the rest field at ``levels`` (none:
+        hide it); returns (rest points, displacement) of the lines, or (None, None)."""
+        actor = getattr(self, attr)
+        contour = self._rest.contour(isosurfaces=levels, scalars="field") if levels else None
+        if contour is None or not contour.n_points:
+            if actor is not None:
+                actor.SetVisibility(False)
+            return None, None
+        lines.copy_from(contour, deep=False)
+        if actor is None:
+            actor = self.plotter.add_mesh(
+                lines,
+                color="black",
+                line_width=width,
+                name=attr,
+                render=False,
+                reset_camera=False,
+                show_scalar_bar=False,
+                scalars=None,
+            )
+            setattr(self, attr, actor)
+        actor.SetVisibility(True)
+        return np.array(lines.points), np.array(lines.point_data["displacement"])
 
     @property
     def n_isoline_points(self) -> int:
@@ -232,5 +237,5 @@ class MeshScene:
         )
 
     def remove(self) -> None:
-        for name in ("surface", "isolines", "zeroline", "marker"):
+        for name in ("surface", "iso_actor", "zero_actor", "marker"):
             self.plotter.remove_actor(name, render=False)
