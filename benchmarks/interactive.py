@@ -52,6 +52,7 @@ def run(size: str, operator: str, k: int) -> dict:
     app.processEvents()
     mesh = make_mesh(size)
     win.set_mesh(mesh)
+    win.viewport.render_now()  # the first draw of a new mesh is slow in software
     app.processEvents()
     out = {"mesh": size, "vertices": mesh.n_vertices, "operator": operator, "k": k}
 

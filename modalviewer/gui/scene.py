@@ -39,6 +39,57 @@ SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
 THRESHOLD = lookup_table([SIMILAR_BLUE, WHITE], n=2)  # closer than threshold -> blue
 
 
+def isoline_segments(
+    points: np.ndarray,
+    faces: np.ndarray,
+    values: np.ndarray,
+    levels,
+    displacement: np.ndarray | None = None,
+) -> pv.PolyData:
+    """Isolines of a piecewise-linear field as line segments, one per crossed triangle
+    and level (vectorised; about 10 times faster than VTK's contour filter at 130k).
+
+    points (n, 3), faces (m, 3), values (n,), levels (L,); ``displacement`` (n, 3) is
+    interpolated onto the line points as point data.  A vertex exactly at a level counts
+    as above it, so every crossed triangle yields exactly one segment.
+    """
+    levels = np.sort(np.asarray(levels, dtype=np.float64))
+    # levels crossed by each triangle: those in (min, max] of its corner values
+    level = np.searchsorted(levels, values, side="right").astype(np.int32)
+    l0, l1, l2 = level[faces[:, 0]], level[faces[:, 1]], level[faces[:, 2]]
+    lo = np.minimum(np.minimum(l0, l1), l2)  # (m,); faster than min(axis=1)
+    hi = np.maximum(np.maximum(l0, l1), l2)
+    tri = np.flatnonzero(hi > lo)
+    if tri.size == 0:
+        return pv.PolyData()
+    counts = hi[tri] - lo[tri]
+    tri_rep = np.repeat(tri, counts)
+    first = np.repeat(lo[tri], counts)
+    offsets = np.arange(tri_rep.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    c = levels[first + offsets]  # (s,) the level of each segment
+    fv = values[faces[tri_rep]]  # (s, 3)
+    above = fv >= c[:, None]
+    a_idx = np.array([0, 1, 2])
+    b_idx = np.array([1, 2, 0])
+    crosses = above[:, a_idx] != above[:, b_idx]  # (s, 3), exactly two True per row
+    order = np.argsort(~crosses, axis=1, kind="stable")[:, :2]  # the two crossed edges
+    rows = np.arange(tri_rep.size)[:, None]
+    va = faces[tri_rep][rows, a_idx[order]]  # (s, 2) edge start vertices
+    vb = faces[tri_rep][rows, b_idx[order]]
+    fa, fb = values[va], values[vb]
+    t = ((c[:, None] - fa) / (fb - fa))[..., None]  # (s, 2, 1)
+    seg = points[va] * (1 - t) + points[vb] * t  # (s, 2, 3)
+    n = seg.shape[0]
+    poly = pv.PolyData()
+    poly.points = seg.reshape(-1, 3)
+    cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
+    poly.lines = cells.ravel()
+    if displacement is not None:
+        d = displacement[va] * (1 - t) + displacement[vb] * t
+        poly.point_data["displacement"] = d.reshape(-1, 3)
+    return poly
+
+
 class MeshScene:
     """Owns the actors of one mesh on a pyvista plotter."""
 
@@ -152,7 +203,17 @@ class MeshScene:
         """Replace ``lines`` by the black contour of the rest field at ``levels`` (none:
         hide it); returns (rest points, displacement) of the lines, or (None, None)."""
         actor = getattr(self, attr)
-        contour = self._rest.contour(isosurfaces=levels, scalars="field") if levels else None
+        contour = (
+            isoline_segments(
+                self.rest_points,
+                self.mesh.faces,
+                self._rest.point_data["field"],
+                levels,
+                self._rest.point_data["displacement"],
+            )
+            if levels
+            else None
+        )
         if contour is None or not contour.n_points:
             if actor is not None:
                 actor.SetVisibility(False)

@@ -325,3 +325,34 @@ def test_closing_during_a_computation_stops_it(qtbot, tmp_path):
     win.close()  # cancels and waits for the worker
     assert not job.is_running()
     assert win._job is None
+
+
+def test_isolines_match_vtk_contour_filter():
+    import pyvista as pv
+
+    from modalviewer.core.primitives import icosphere
+    from modalviewer.gui.scene import isoline_segments
+
+    mesh = icosphere(4)
+    v, f = mesh.vertices, mesh.faces
+    values = np.sin(3 * v[:, 0]) * np.cos(2 * v[:, 1]) + 0.5 * v[:, 2]
+    levels = np.linspace(values.min(), values.max(), 14)[1:-1]
+    ours = isoline_segments(v, f, values, levels, displacement=2.0 * v)
+    poly = pv.PolyData(v, np.hstack([np.full((len(f), 1), 3), f]).ravel())
+    poly.point_data["field"] = values
+    ref = poly.contour(isosurfaces=list(levels), scalars="field")
+
+    def total_length(lines: pv.PolyData) -> float:
+        total, i, cells, pts = 0.0, 0, lines.lines, lines.points
+        while i < len(cells):
+            ids = cells[i + 1 : i + 1 + cells[i]]
+            total += np.linalg.norm(np.diff(pts[ids], axis=0), axis=1).sum()
+            i += cells[i] + 1
+        return total
+
+    assert ours.n_lines > 500
+    np.testing.assert_allclose(total_length(ours), total_length(ref), rtol=1e-9)
+    # every line point lies on the sphere's surface and carries its interpolated value
+    r = np.linalg.norm(ours.points, axis=1)
+    assert r.max() <= 1.0 + 1e-12
+    np.testing.assert_allclose(ours.point_data["displacement"], 2.0 * ours.points, atol=1e-12)
