@@ -13,7 +13,7 @@ from .mesh import Mesh
 from .shells import normal_shells_hessian, shells_hessian
 from .spectrum import OPERATORS, Spectrum
 
-__all__ = ["compute_spectrum", "operator_matrices", "RESIDUAL_LIMIT"]
+__all__ = ["compute_spectrum", "operator_matrices", "sliver_report", "RESIDUAL_LIMIT"]
 
 RESIDUAL_LIMIT = 1e-4
 """A spectrum whose non-zero modes have a larger relative residual is rejected.
@@ -22,6 +22,24 @@ On well-shaped meshes the residuals are around 1e-10 (the tests require 1e-8); s
 triangles make the operator ill-conditioned (largest/smallest eigenvalue ~1e13 on an
 iso-surface mesh) and put a floor of about 1e-6 under any solver's residual.  Such
 spectra are accepted and carry their residuals (the viewer shows the largest)."""
+
+
+def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
+    """Words on nearly degenerate triangles (quality 4 sqrt(3) area / sum of squared edge
+    lengths below ``threshold``; 1 is equilateral), or "" if there are none."""
+    v, f = mesh.vertices, mesh.faces
+    e0, e1, e2 = v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 1]], v[f[:, 0]] - v[f[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(e0, -e2), axis=1)
+    sq = (e0**2).sum(1) + (e1**2).sum(1) + (e2**2).sum(1)
+    quality = 4.0 * np.sqrt(3.0) * area / np.maximum(sq, np.finfo(float).tiny)
+    bad = np.flatnonzero(quality < threshold)
+    if bad.size == 0:
+        return ""
+    worst = int(bad[np.argmin(quality[bad])])
+    return (
+        f"{bad.size} nearly degenerate triangles (quality below {threshold:g}; the worst, "
+        f"face {worst}, {quality[worst]:.1e})"
+    )
 
 
 def operator_matrices(mesh: Mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):
@@ -86,9 +104,16 @@ def compute_spectrum(
     nonzero = result.eigenvalues >= 1e-8 * lam_max
     worst = float(result.residuals[nonzero].max()) if nonzero.any() else 0.0
     if worst > RESIDUAL_LIMIT:
+        slivers = sliver_report(mesh)
+        hint = (
+            f"; the mesh has {slivers}, which make the operator numerically indefinite: "
+            "remesh it (or clean those triangles) and try again"
+            if slivers
+            else " (try fewer modes)"
+        )
         raise EigenError(
             f"the eigensolver's residual {worst:.1e} is above {RESIDUAL_LIMIT:.0e}; "
-            "the result is not trustworthy (try fewer modes)"
+            f"the result is not trustworthy{hint}"
         )
     n = mesh.n_vertices
     modes = result.vectors
