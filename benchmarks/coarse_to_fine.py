@@ -5,9 +5,9 @@
 Decimates the benchmark mesh to a fifth of its vertices (VTK progressive decimation with
 topology preserved, as the viewer's Coarse-to-fine option does), computes the spectrum
 there, carries it to the full mesh by nearest vertex and compares with the full
-computation: time of both, relative
-error of the eigenvalues (non-zero modes), and the Pearson correlation of the multi-scale
-distance from 20 random vertices (the distance the viewer shows).  Results go to
+computation: time of both, relative error of the eigenvalues (non-zero modes), and the
+Pearson correlation of the multi-scale distance from 20 random vertices (the distance the
+viewer shows).  Results go to
 ``benchmarks/results/coarse_to_fine_<size>.json``.
 """
 

@@ -46,7 +46,7 @@ ZERO_MODE_RTOL = 1e-8
 BASIS_EXTRA = 0.6
 """The Krylov basis holds (1 + BASIS_EXTRA) times the working number of pairs: more
 converges in fewer operator applications but costs memory (at 130k vertices, shells,
-300 modes: 1.6 GB for the basis) and orthogonalisation time; 0.6 measured best."""
+300 modes: 1.7 GB for the basis) and orthogonalisation time; 0.6 measured best."""
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
 
@@ -204,7 +204,9 @@ def _cholqr(W: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     return W, Rn
 
 
-def _orthonormal_block(W: np.ndarray, Q: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+def _orthonormal_block(
+    W: np.ndarray, Q: np.ndarray, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Orthonormalise W (N, b) against the orthonormal columns of Q and among itself.
 
     Block classical Gram-Schmidt with a second pass where the first lost more than half
@@ -237,6 +239,15 @@ def _orthonormal_block(W: np.ndarray, Q: np.ndarray, rng: np.random.Generator) -
     return V, h, Rn
 
 
+def _rotate_in_place(Q: np.ndarray, j: int, S: np.ndarray, rows: int = 32768) -> None:
+    """``Q[:, :p] = Q[:, :j] @ S`` (S is (j, p), p <= j) a block of rows at a time, so no
+    (N, p) temporary is needed (1 GB for 300 shells modes at 130k vertices)."""
+    p = S.shape[1]
+    for start in range(0, Q.shape[0], rows):
+        block = Q[start : start + rows]
+        block[:, :p] = block[:, :j] @ S
+
+
 def block_krylov_schur(
     apply_op: Callable[[np.ndarray], np.ndarray],
     N: int,
@@ -266,7 +277,8 @@ def block_krylov_schur(
 
     Returns
     -------
-    theta (k,) descending, Y (N, k) orthonormal Ritz vectors, number of operator columns.
+    theta (k,) descending, Y (N, k) orthonormal Ritz vectors (a view into the basis
+    array), number of operator columns applied.
     """
     rng = np.random.default_rng(seed)
     b = block
@@ -306,7 +318,8 @@ def block_krylov_schur(
         done = int(np.argmin(converged)) if not converged.all() else k
         report("solving", 0.05 + 0.85 * done / k)
         if done == k:
-            return theta[:k], Q[:, :j] @ S[:, :k], applied
+            _rotate_in_place(Q, j, S[:, :k])
+            return theta[:k], Q[:, :k], applied
         if not full:
             continue
         if restarts == max_restarts:
@@ -318,7 +331,7 @@ def block_krylov_schur(
         # thick restart: keep the best Ritz vectors, continue from the open block
         restarts += 1
         p = min(keep, j - b)
-        Q[:, :p] = Q[:, :j] @ S[:, :p]
+        _rotate_in_place(Q, j, S[:, :p])
         Q[:, p : p + b] = Q[:, j : j + b]
         T[:] = 0.0
         T[np.arange(p), np.arange(p)] = theta[:p]
@@ -363,6 +376,8 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     for start in range(0, Y.shape[1], 4 * block):
         Y[:, start : start + 4 * block] = apply_op(Y[:, start : start + 4 * block])
         report("refining", 0.9 + 0.05 * start / Y.shape[1])
+    backend = solver.backend
+    solver = None  # free the factor (apply_op's closure holds it) before the last step
     report("orthonormalising", 0.95)
     fast = _cholqr(Y)
     Q = fast[0] if fast is not None else np.linalg.qr(Y)[0]
@@ -370,8 +385,8 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     Q *= inv_sqrt_m[:, None]  # now Mass-orthonormal in the original variables
     G = Q.T @ (K @ Q)
     lam, W = np.linalg.eigh(0.5 * (G + G.T))
-    X = Q @ W[:, :k]
-    return lam[:k], X, shift, solver.backend
+    _rotate_in_place(Q, Q.shape[1], W[:, :k])
+    return lam[:k], Q[:, :k], shift, backend
 
 
 class _TooSmall(Exception):
