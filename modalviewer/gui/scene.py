@@ -120,6 +120,10 @@ class MeshScene:
         self._mapper.SetScalarModeToUsePointFieldData()
         self._mapper.SelectColorArray("field")
         self._mapper.SetUseLookupTableScalarRange(False)
+        # Push the surface slightly back in depth so the isolines lying on it are not
+        # half hidden by depth fighting (they looked dotted on fine meshes).
+        self._mapper.SetResolveCoincidentTopologyToPolygonOffset()
+        self._mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 4.0)
         # the rest shape with the shown field, contoured for the isolines
         self._rest = pv.PolyData(self.rest_points, faces)
         self._rest.point_data["field"] = np.zeros(mesh.n_vertices)
