@@ -343,16 +343,16 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2``."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
-    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report)
     # A few more pairs than requested: the last requested pairs then converge as fast
     # as the others (the gap to the unwanted part of the spectrum is larger).
-    k_work = min(N // 2, k + max(8, k // 10))
+    k_work = max(k, min(N // 2, k + max(8, k // 10)))
     if block is None:
         block = int(np.clip(k_work // 16, 4, 16))
     max_basis = k_work + max(2 * block, int(BASIS_EXTRA * k_work))
     max_basis = ((max_basis + block - 1) // block) * block
     if max_basis + block > N:
-        raise _TooSmall()
+        raise _TooSmall()  # the basis would not fit: the dense solver is the right tool
+    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report)
 
     def apply_op(V: np.ndarray) -> np.ndarray:
         return sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * V)

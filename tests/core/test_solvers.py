@@ -114,3 +114,17 @@ def test_shifted_factorisation_of_a_singular_operator_against_dense():
     sparse = solve_lowest(K, mass, 30, dense_limit=0)
     dense = la.eigh(K.toarray(), np.diag(mass), eigvals_only=True, subset_by_index=[0, 29])
     np.testing.assert_allclose(sparse.eigenvalues, dense, atol=1e-9 * dense.max())
+
+
+def test_more_than_half_of_the_spectrum():
+    # 1681 unknowns: 1000 modes still fit a Krylov basis (more than N / 2 wanted), 1300
+    # do not and the dense solver takes over; both agree with a dense reference
+    mesh = grid_plate(40, 40)
+    K, mass = operator_matrices(mesh, "laplacian")
+    dense = la.eigh(K.toarray(), np.diag(mass), eigvals_only=True, subset_by_index=[0, 1299])
+    krylov = solve_lowest(K, mass, 1000)
+    assert krylov.method.startswith("shift-invert")
+    np.testing.assert_allclose(krylov.eigenvalues, dense[:1000], atol=1e-9 * dense.max())
+    fallback = solve_lowest(K, mass, 1300)
+    assert fallback.method == "dense"
+    np.testing.assert_allclose(fallback.eigenvalues, dense, atol=1e-9 * dense.max())
