@@ -144,11 +144,11 @@ def solve_lowest(
             progress(stage, float(min(max(fraction, 0.0), 1.0)))
 
     inv_sqrt_m = 1.0 / np.sqrt(mass_diag)
-    lam_max_est = _gershgorin_max(K, mass_diag)
+    median_ratio = float(np.median(np.abs(K.diagonal()) / mass_diag))
 
     lam = None
     if N > dense_limit:
-        lam_typical = float(np.median(np.abs(K.diagonal()) / mass_diag)) or lam_max_est
+        lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
         try:
             lam, X, shift, backend = _shift_invert(
                 K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block
@@ -162,8 +162,7 @@ def solve_lowest(
         method, shift = "dense", 0.0
     report("checking residuals", 0.97)
     X = _fix_signs(X)
-    lam_typical = float(np.median(np.abs(K.diagonal()) / mass_diag))
-    res = relative_residuals(K, mass_diag, lam, X, lam_scale=lam_typical)
+    res = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
     return EigenResult(lam, X, res, shift, method)
@@ -307,7 +306,7 @@ def block_krylov_schur(
         # matrix costs about as much as orthogonalising 64 vectors).
         blocks_since_check = (blocks_since_check + 1) % check_every
         if (j < k or blocks_since_check) and not full:
-            report("solving", 0.05 + 0.85 * done / k * 0.5)
+            report("solving", 0.05 + 0.85 * done / k)
             continue
         theta, S = np.linalg.eigh(0.5 * (T[:j, :j] + T[:j, :j].T))
         theta, S = theta[::-1], S[:, ::-1]

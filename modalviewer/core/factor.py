@@ -90,14 +90,12 @@ class _Pardiso:
         ip[0] = 1  # no solver defaults: the values below
         ip[1] = 3  # parallel nested dissection (METIS)
         ip[7] = 0  # no iterative refinement: the eigensolver checks its own residuals
-        ip[9] = 13  # pivot perturbation 1e-13 (not used for SPD matrices)
-        ip[17] = -1  # report the number of non-zeros in the factor
         ip[23] = 1  # two-level parallel factorisation
         ip[24] = 1  # parallel forward/backward substitution
         ip[34] = 1  # zero-based indices
         self._iparm = ip
         self._alive = True
-        error = self._call(12, np.zeros((self.n, 1), order="F"))
+        error, _ = self._call(12, np.zeros((self.n, 1), order="F"))
         if error == -4:
             self.release()
             raise np.linalg.LinAlgError("matrix is not positive definite")
@@ -105,18 +103,14 @@ class _Pardiso:
             self.release()
             raise np.linalg.LinAlgError(f"PARDISO factorisation failed (error {error})")
 
-    @property
-    def factor_nnz(self) -> int:
-        return int(self._iparm[17])
-
-    def _call(self, phase: int, b: np.ndarray, x: np.ndarray | None = None) -> int:
+    def _call(self, phase: int, b: np.ndarray) -> tuple[int, np.ndarray]:
+        """Run PARDISO ``phase`` on the Fortran-ordered (n, r) ``b``: (error code, x)."""
         i32 = ctypes.c_int32
 
         def ptr(a, t):
             return a.ctypes.data_as(ctypes.POINTER(t))
 
-        if x is None:
-            x = np.zeros_like(b, order="F")
+        x = np.zeros_like(b, order="F")
         err = i32(0)
         self._lib.pardiso(
             ptr(self._pt, ctypes.c_int64),
@@ -136,17 +130,14 @@ class _Pardiso:
             ptr(x, ctypes.c_double),
             ctypes.byref(err),
         )
-        self._x = x
-        return int(err.value)
+        return int(err.value), x
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         one = b.ndim == 1
         B = np.asfortranarray(b.reshape(self.n, -1), dtype=np.float64)
-        error = self._call(33, B)
+        error, X = self._call(33, B)
         if error != 0:
             raise np.linalg.LinAlgError(f"PARDISO solve failed (error {error})")
-        X = self._x
-        self._x = None
         return X[:, 0].copy() if one else X
 
     def release(self) -> None:

@@ -28,10 +28,8 @@ def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
     """Words on nearly degenerate triangles (quality 4 sqrt(3) area / sum of squared edge
     lengths below ``threshold``; 1 is equilateral), or "" if there are none."""
     v, f = mesh.vertices, mesh.faces
-    e0, e1, e2 = v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 1]], v[f[:, 0]] - v[f[:, 2]]
-    area = 0.5 * np.linalg.norm(np.cross(e0, -e2), axis=1)
-    sq = (e0**2).sum(1) + (e1**2).sum(1) + (e2**2).sum(1)
-    quality = 4.0 * np.sqrt(3.0) * area / np.maximum(sq, np.finfo(float).tiny)
+    sq = sum(((v[f[:, (c + 1) % 3]] - v[f[:, c]]) ** 2).sum(axis=1) for c in range(3))
+    quality = 4.0 * np.sqrt(3.0) * mesh.face_areas / np.maximum(sq, np.finfo(float).tiny)
     bad = np.flatnonzero(quality < threshold)
     if bad.size == 0:
         return ""

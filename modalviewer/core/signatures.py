@@ -44,12 +44,7 @@ def signature(spec: Spectrum, times=None, include_zero: bool = False, vertices=N
     times = np.atleast_1d(np.asarray(times, dtype=np.float64))
     lam = spec.eigenvalues[mask]
     weights = np.exp(-np.outer(lam, times))  # (k, T)
-    if vertices is None:
-        squared = spec.squared_modes()
-    else:
-        rows = spec.modes[np.atleast_1d(np.asarray(vertices, dtype=np.int64))]
-        squared = np.einsum("ick,ick->ik", rows, rows) if spec.is_vector else rows**2
-    values = squared[:, mask] @ weights
+    values = spec.squared_modes(vertices)[:, mask] @ weights
     return times, values
 
 

@@ -66,11 +66,13 @@ class Spectrum:
         """Mode j: (n,) for scalar operators, (n, 3) for ``"shells"``."""
         return self.modes[..., j]
 
-    def squared_modes(self) -> np.ndarray:
-        """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes)."""
+    def squared_modes(self, vertices=None) -> np.ndarray:
+        """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes); only the rows of
+        ``vertices`` (a sequence of indices) if given."""
+        modes = self.modes if vertices is None else self.modes[np.asarray(vertices, dtype=int)]
         if self.is_vector:
-            return np.einsum("ick,ick->ik", self.modes, self.modes)
-        return self.modes**2
+            return np.einsum("ick,ick->ik", modes, modes)
+        return modes**2
 
 
 def _atomic_write(path: Path, write) -> None:
