@@ -124,10 +124,6 @@ class MeshScene:
         # half hidden by depth fighting (they looked dotted on fine meshes).
         self._mapper.SetResolveCoincidentTopologyToPolygonOffset()
         self._mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 4.0)
-        # the rest shape with the shown field, contoured for the isolines
-        self._rest = pv.PolyData(self.rest_points, faces)
-        self._rest.point_data["field"] = np.zeros(mesh.n_vertices)
-        self._rest.point_data["displacement"] = np.zeros((mesh.n_vertices, 3))
         self.isolines = pv.PolyData()
         self.zero_line = pv.PolyData()
         self.iso_actor = None
@@ -193,27 +189,27 @@ class MeshScene:
         if emphasise_zero:
             levels = levels[np.abs(levels) > 1e-12 * max(abs(lo), abs(hi))]
         want_zero = count > 0 and emphasise_zero and lo < 0 < hi
-        if len(levels) or want_zero:
-            self._rest.point_data["field"] = values
-            self._rest.point_data["displacement"] = self.surface.point_data["displacement"]
         self._iso_rest, self._iso_disp = self._contour(
-            self.isolines, list(levels), 1.5, "iso_actor"
+            self.isolines, values, list(levels), 1.5, "iso_actor"
         )
         self._zero_rest, self._zero_disp = self._contour(
-            self.zero_line, [0.0] if want_zero else [], 3.5, "zero_actor"
+            self.zero_line, values, [0.0] if want_zero else [], 3.5, "zero_actor"
         )
 
-    def _contour(self, lines: pv.PolyData, levels: list[float], width: float, attr: str):
-        """Replace ``lines`` by the black contour of the rest field at ``levels`` (none:
-        hide it); returns (rest points, displacement) of the lines, or (None, None)."""
+    def _contour(
+        self, lines: pv.PolyData, values: np.ndarray, levels: list[float], width: float, attr: str
+    ):
+        """Replace ``lines`` by the black contour of ``values`` on the rest shape at
+        ``levels`` (none: hide it); returns (rest points, displacement) of the lines, or
+        (None, None)."""
         actor = getattr(self, attr)
         contour = (
             isoline_segments(
                 self.rest_points,
                 self.mesh.faces,
-                self._rest.point_data["field"],
+                values,
                 levels,
-                self._rest.point_data["displacement"],
+                self.surface.point_data["displacement"],
             )
             if levels
             else None
