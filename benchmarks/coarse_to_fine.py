@@ -25,23 +25,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import modalviewer as mv  # noqa: E402
-from benchmarks.run import make_mesh  # noqa: E402
+from benchmarks.run import make_mesh, save_result  # noqa: E402
+from modalviewer.coarsen import decimated_copy  # noqa: E402
 from modalviewer.core.coarse import transfer_spectrum  # noqa: E402
-
-
-def decimate(mesh: mv.Mesh, fraction: float = 0.2) -> mv.Mesh:
-    import pyvista as pv
-
-    faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
-    poly = pv.PolyData(np.array(mesh.vertices), faces).decimate_pro(
-        1.0 - fraction, preserve_topology=True
-    )
-    return mv.repair_mesh(np.asarray(poly.points), np.asarray(poly.faces).reshape(-1, 4)[:, 1:])
 
 
 def run(size: str, operator: str, k: int) -> dict:
     fine = make_mesh(size)
-    coarse = decimate(fine)
+    coarse = decimated_copy(fine)
     t0 = time.perf_counter()
     full = mv.compute_spectrum(fine, operator, k=k)
     t_full = time.perf_counter() - t0
@@ -81,9 +72,7 @@ def main(argv=None) -> int:
     p.add_argument("--k", type=int, default=100)
     args = p.parse_args(argv)
     result = run(args.size, args.operator, args.k)
-    out = ROOT / "benchmarks" / "results"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / f"coarse_to_fine_{args.size}.json").write_text(json.dumps(result, indent=1) + "\n")
+    save_result(f"coarse_to_fine_{args.size}", result)
     print(json.dumps(result, indent=1))
     return 0
 

@@ -14,7 +14,6 @@ the signature table), one threshold-slider step.  Results go to
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 import tempfile
@@ -28,7 +27,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.run import make_mesh  # noqa: E402
+from benchmarks.run import make_mesh, save_result  # noqa: E402
 from modalviewer.core.cache import SpectrumCache  # noqa: E402
 
 KIND = {"shells": "vibration", "modified_dirichlet": "feature", "laplacian": "hks"}
@@ -166,9 +165,7 @@ def main(argv=None) -> int:
     p.add_argument("--k", type=int, default=100)
     args = p.parse_args(argv)
     result = run(args.size, args.operator, args.k)
-    out = ROOT / "benchmarks" / "results"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / f"interactive_{args.size}.json").write_text(json.dumps(result, indent=1) + "\n")
+    save_result(f"interactive_{args.size}", result)
     print(table(result))
     return 0
 

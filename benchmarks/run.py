@@ -46,6 +46,13 @@ def make_mesh(size: str) -> mv.Mesh:
     return mv.Mesh(mesh.vertices, mesh.faces)
 
 
+def save_result(name: str, data) -> None:
+    """Write ``data`` as ``benchmarks/results/<name>.json``."""
+    out = ROOT / "benchmarks" / "results"
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{name}.json").write_text(json.dumps(data, indent=1) + "\n")
+
+
 def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
@@ -169,9 +176,7 @@ def main(argv=None) -> int:
     )
     args = p.parse_args(argv)
     rows = run(args.sizes, args.operators, args.k, not args.no_baseline, args.baseline_max_unknowns)
-    out = ROOT / "benchmarks" / "results"
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "latest.json").write_text(json.dumps(rows, indent=1) + "\n")
+    save_result("latest", rows)
     print(table(rows))
     return 0
 

@@ -17,11 +17,12 @@ from pathlib import Path
 import numpy as np
 from qtpy import QtCore, QtGui, QtWidgets
 
+from ..coarsen import decimated_copy
 from ..core.cache import SpectrumCache
 from ..core.coarse import estimate_cost, transfer_spectrum
 from ..core.curvature import total_curvature
 from ..core.laplacian import vertex_normals
-from ..core.mesh import Mesh, MeshError, repair_mesh
+from ..core.mesh import Mesh, MeshError
 from ..core.pipeline import compute_spectrum
 from ..core.signatures import SignatureTable, signature
 from ..core.spectrum import Spectrum, save_spectrum
@@ -563,7 +564,7 @@ class MainWindow(QtWidgets.QMainWindow):
             self._job = None
         mesh = self._mesh_for_compute()
         self.compute_mesh = mesh
-        coarse = self._coarse_copy(mesh) if self.coarse_check.isChecked() else None
+        coarse = decimated_copy(mesh) if self.coarse_check.isChecked() else None
         refusal = self._too_big(coarse or mesh, operator, k)
         if refusal:
             self.show_error(refusal, "Computation too large")
@@ -646,21 +647,6 @@ class MainWindow(QtWidgets.QMainWindow):
                 20000,
             )
         return None
-
-    def _coarse_copy(self, mesh: Mesh, fraction: float = 0.2) -> Mesh:
-        """The mesh decimated to about ``fraction`` of its vertices.
-
-        VTK's progressive decimation with topology preserved: quadric decimation left
-        slivers (triangle quality 7e-7) on flat regions of subdivided meshes, which make
-        the shells Hessian numerically indefinite."""
-        import pyvista as pv
-
-        faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
-        poly = pv.PolyData(np.array(mesh.vertices), faces).decimate_pro(
-            1.0 - fraction, preserve_topology=True
-        )
-        arrays = np.asarray(poly.points), np.asarray(poly.faces).reshape(-1, 4)[:, 1:]
-        return repair_mesh(*arrays, source="coarse copy")
 
     def _compute_coarse(self, mesh, coarse, operator, k, bending, membrane, wait, then):
         """Compute on ``coarse`` in the worker and carry the spectrum to ``mesh``."""
