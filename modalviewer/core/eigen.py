@@ -203,6 +203,11 @@ def _cholqr(W: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     return W, Rn
 
 
+_SWEEP_ROWS = 1024
+"""Rows of the basis per step of the fused orthogonalisation sweep (1024 x 544 doubles:
+4.5 MB, inside the L3 cache)."""
+
+
 def _orthonormal_block(
     W: np.ndarray, Q: np.ndarray, rng: np.random.Generator
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -213,11 +218,20 @@ def _orthonormal_block(
     is invariant) are replaced by random directions orthogonal to Q.
     Returns (V, h, Rn) with W_in = Q h + V Rn.
     """
+    W = np.array(W, dtype=np.float64, order="F")  # own copy; Q.T @ W is faster in F order
     before = np.linalg.norm(W, axis=0)
     h = Q.T @ W
-    W = W - Q @ h
-    if np.any(np.linalg.norm(W, axis=0) < 0.5 * before):
-        h2 = Q.T @ W
+    # The update of the first pass and the products of the second share one sweep over
+    # Q, a block of rows at a time that stays in cache: three sweeps instead of four
+    # (the basis is 0.5 to 1.7 GB and these products are memory-bound).
+    h2 = np.zeros_like(h)
+    after_sq = np.zeros(W.shape[1])
+    for start in range(0, Q.shape[0], _SWEEP_ROWS):
+        Qc, Wc = Q[start : start + _SWEEP_ROWS], W[start : start + _SWEEP_ROWS]
+        Wc -= Qc @ h
+        h2 += Qc.T @ Wc
+        after_sq += np.einsum("ij,ij->j", Wc, Wc)
+    if np.any(np.sqrt(after_sq) < 0.5 * before):
         W -= Q @ h2
         h += h2
     fast = _cholqr(W)
