@@ -80,21 +80,27 @@ def relative_residuals(
     (a typical eigenvalue size) keeps a spectrum of only zero modes from judging
     itself by its own rounding noise.
     """
-    MX = mass_diag[:, None] * X
-    R = K @ X - MX * lam[None, :]
     scale = np.abs(lam).copy()
     lam_max = max(float(np.abs(lam).max()), lam_scale, np.finfo(float).tiny)
     zero = scale < ZERO_MODE_RTOL * lam_max
     scale[zero] = lam_max
-    return np.linalg.norm(R, axis=0) / (scale * np.linalg.norm(MX, axis=0))
+    out = np.empty(X.shape[1])
+    for start in range(0, X.shape[1], 32):  # (N, 32) temporaries, not three (N, k) ones
+        cols = slice(start, start + 32)
+        MX = mass_diag[:, None] * X[:, cols]
+        R = K @ X[:, cols] - MX * lam[None, cols]
+        out[cols] = np.linalg.norm(R, axis=0) / (scale[cols] * np.linalg.norm(MX, axis=0))
+    return out
 
 
 def _fix_signs(X: np.ndarray) -> np.ndarray:
-    """Deterministic sign: the entry of largest magnitude of each mode is positive."""
+    """Deterministic sign: the entry of largest magnitude of each mode is positive
+    (changes and returns X)."""
     idx = np.argmax(np.abs(X), axis=0)
     signs = np.sign(X[idx, np.arange(X.shape[1])])
     signs[signs == 0] = 1.0
-    return X * signs
+    X *= signs  # in place: X is up to 1 GB
+    return X
 
 
 def _gershgorin_max(K: sp.csr_matrix, mass_diag: np.ndarray) -> float:
@@ -201,6 +207,23 @@ def _cholqr(W: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         W = W @ la.solve_triangular(C, np.eye(W.shape[1]), lower=False)
         Rn = C @ Rn
     return W, Rn
+
+
+def _cholqr_in_place(Y: np.ndarray) -> bool:
+    """Orthonormalise the columns of Y in place by two Cholesky-QR passes (BLAS-3, no
+    (N, k) temporary); False if Y is numerically rank deficient (Y then still spans
+    the same space, and Householder QR takes over)."""
+    for _ in range(2):
+        G = Y.T @ Y
+        try:
+            C = la.cholesky(0.5 * (G + G.T), lower=False)
+        except la.LinAlgError:
+            return False
+        d = np.abs(np.diag(C))
+        if d.min() <= 1e-7 * d.max():
+            return False
+        _rotate_in_place(Y, Y.shape[1], la.solve_triangular(C, np.eye(Y.shape[1])))
+    return True
 
 
 _SWEEP_ROWS = 1024
@@ -386,20 +409,24 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     # eigenvalue (1e10 times the lowest on fine meshes); one application of OP damps the
     # noise by the same factor, so |K x - lam M x| / |lam M x| reaches 1e-10.
     report("refining", 0.9)
-    for start in range(0, Y.shape[1], 4 * block):
-        Y[:, start : start + 4 * block] = apply_op(Y[:, start : start + 4 * block])
+    step = 2 * block  # each step has four (N, step) temporaries
+    for start in range(0, Y.shape[1], step):
+        Y[:, start : start + step] = apply_op(Y[:, start : start + step])
         report("refining", 0.9 + 0.05 * start / Y.shape[1])
     backend = solver.backend
     solver = None  # free the factor (apply_op's closure holds it) before the last step
+    # Everything below works in place on Y, a view into the Krylov basis, or on (N, 32)
+    # pieces: at 130k vertices (shells, 300 modes) one (N, k) temporary is 0.9 GB.
     report("orthonormalising", 0.95)
-    fast = _cholqr(Y)
-    Q = fast[0] if fast is not None else np.linalg.qr(Y)[0]
-    del Y, fast
-    Q *= inv_sqrt_m[:, None]  # now Mass-orthonormal in the original variables
-    G = Q.T @ (K @ Q)
+    if not _cholqr_in_place(Y):
+        Y[:] = np.linalg.qr(Y)[0]
+    Y *= inv_sqrt_m[:, None]  # now Mass-orthonormal in the original variables
+    G = np.empty((Y.shape[1], Y.shape[1]))
+    for start in range(0, Y.shape[1], 32):
+        G[:, start : start + 32] = Y.T @ (K @ Y[:, start : start + 32])
     lam, W = np.linalg.eigh(0.5 * (G + G.T))
-    _rotate_in_place(Q, Q.shape[1], W[:, :k])
-    return lam[:k], Q[:, :k], shift, backend
+    _rotate_in_place(Y, Y.shape[1], W[:, :k])
+    return lam[:k], np.ascontiguousarray(Y[:, :k]), shift, backend
 
 
 class _TooSmall(Exception):

@@ -71,7 +71,16 @@ class SignatureTable:
         z = weights.sum(axis=0)  # (T,)
         self.times = times
         self.table = (spec.squared_modes()[:, mask] @ (weights / z)) * np.sqrt(dlogt)
-        self._norms2: np.ndarray | None = None
+
+    @property
+    def table(self) -> np.ndarray:
+        """(n, T) normalised signatures."""
+        return self._table
+
+    @table.setter
+    def table(self, value: np.ndarray) -> None:
+        self._table = value
+        self._norms2 = np.einsum("ij,ij->i", value, value)  # (n,) squared row norms
 
     def distance_from(self, vertex: int) -> np.ndarray:
         """(n,) distance from ``vertex`` to every vertex.
@@ -81,8 +90,6 @@ class SignatureTable:
         (distance below 1e-3 of the signature norms) the entries are recomputed directly,
         so near-zero distances keep full relative accuracy and d(v, v) = 0 exactly.
         """
-        if self._norms2 is None:
-            self._norms2 = np.einsum("ij,ij->i", self.table, self.table)
         row = self.table[vertex]
         d2 = self._norms2 + self._norms2[vertex] - 2.0 * (self.table @ row)
         close = np.flatnonzero(d2 <= 1e-6 * (self._norms2 + self._norms2[vertex]))
