@@ -6,10 +6,13 @@ import numpy as np
 
 from .core.mesh import Mesh, repair_mesh
 
-__all__ = ["decimated_copy"]
+__all__ = ["COARSE_FRACTION", "decimated_copy"]
+
+COARSE_FRACTION = 0.2
+"""Default share of the vertices kept by :func:`decimated_copy`."""
 
 
-def decimated_copy(mesh: Mesh, fraction: float = 0.2) -> Mesh:
+def decimated_copy(mesh: Mesh, fraction: float = COARSE_FRACTION) -> Mesh:
     """The mesh decimated to about ``fraction`` of its vertices, repaired and reported.
 
     VTK's progressive decimation with topology preserved: quadric decimation left slivers

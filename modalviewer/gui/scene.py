@@ -67,15 +67,16 @@ def isoline_segments(
     first = np.repeat(lo[tri], counts)
     offsets = np.arange(tri_rep.size) - np.repeat(np.cumsum(counts) - counts, counts)
     c = levels[first + offsets]  # (s,) the level of each segment
-    fv = values[faces[tri_rep]]  # (s, 3)
-    above = fv >= c[:, None]
-    a_idx = np.array([0, 1, 2])
-    b_idx = np.array([1, 2, 0])
-    crosses = above[:, a_idx] != above[:, b_idx]  # (s, 3), exactly two True per row
-    order = np.argsort(~crosses, axis=1, kind="stable")[:, :2]  # the two crossed edges
-    rows = np.arange(tri_rep.size)[:, None]
-    va = faces[tri_rep][rows, a_idx[order]]  # (s, 2) edge start vertices
-    vb = faces[tri_rep][rows, b_idx[order]]
+    ft = faces[tri_rep]  # (s, 3)
+    fv = values[ft]
+    a0, a1, a2 = (fv[:, i] >= c for i in range(3))
+    # The level separates one corner (the odd one out) from the other two; the segment
+    # joins the points where it crosses the two edges at that corner.
+    odd = np.where(a0 == a1, 2, np.where(a0 == a2, 1, 0))
+    rows = np.arange(tri_rep.size)
+    v_odd = ft[rows, odd]
+    va = np.column_stack([v_odd, v_odd])  # (s, 2) edge start vertices
+    vb = np.column_stack([ft[rows, (odd + 1) % 3], ft[rows, (odd + 2) % 3]])
     fa, fb = values[va], values[vb]
     t = ((c[:, None] - fa) / (fb - fa))[..., None]  # (s, 2, 1)
     seg = points[va] * (1 - t) + points[vb] * t  # (s, 2, 3)

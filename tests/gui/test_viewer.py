@@ -356,3 +356,20 @@ def test_isolines_match_vtk_contour_filter():
     r = np.linalg.norm(ours.points, axis=1)
     assert r.max() <= 1.0 + 1e-12
     np.testing.assert_allclose(ours.point_data["displacement"], 2.0 * ours.points, atol=1e-12)
+
+
+def test_shells_on_an_inconsistently_oriented_mesh_fail_with_a_message(window):
+    """The manifold and orientation checks run in the worker; the message reaches the user."""
+    from modalviewer.core.mesh import Mesh
+    from modalviewer.core.primitives import grid_plate
+    from modalviewer.gui import main_window
+
+    plate = grid_plate(6, 6)
+    v = np.vstack([plate.vertices, [[0.5, 0.5, 1.0]]])
+    fin = [[0, 1, plate.n_vertices]]  # a fin on the boundary edge (0, 1), against its face
+    window.set_mesh(Mesh(v, np.vstack([plate.faces, fin])))
+    with pytest.raises(main_window.ComputeError, match="not consistently oriented"):
+        window.compute("shells", k=6, wait=True)
+    assert "cannot run" in window.last_error and window._job is None
+    spec = window.compute("laplacian", k=6, wait=True)  # the Laplacian still works
+    assert spec.k == 6 and window.display == "mode"
