@@ -128,3 +128,22 @@ def test_more_than_half_of_the_spectrum():
     fallback = solve_lowest(K, mass, 1300)
     assert fallback.method == "dense"
     np.testing.assert_allclose(fallback.eigenvalues, dense, atol=1e-9 * dense.max())
+
+
+@pytest.mark.parametrize("local", [0, 40])
+def test_orthonormal_block_against_the_basis(local):
+    """W = Q h + V Rn with V orthonormal and orthogonal to Q, also when the first pass
+    only covers the columns from ``local`` on and W has rounding-size components along
+    the others (as in the Lanczos recurrence)."""
+    from modalviewer.core.eigen import _orthonormal_block
+
+    rng = np.random.default_rng(7)
+    N, m, b = 3000, 56, 8
+    Q = np.linalg.qr(rng.standard_normal((N, m)))[0]
+    coupling = rng.standard_normal((m, b)) * 1e3
+    coupling[:local] *= 1e-13  # nearly orthogonal to the leading columns
+    W = Q @ coupling + 1e-3 * rng.standard_normal((N, b))
+    V, h, Rn = _orthonormal_block(W.copy(), Q, rng, local)
+    assert np.abs(Q @ h + V @ Rn - W).max() < 1e-10 * np.abs(W).max()
+    assert np.abs(Q.T @ V).max() < 1e-13
+    assert np.abs(V.T @ V - np.eye(b)).max() < 1e-13
