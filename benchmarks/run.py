@@ -151,13 +151,17 @@ def table(rows) -> str:
         "| signature s | max rel. diff | max residual | peak MB | baseline peak MB |"
     )
     lines = [head, "|" + " --- |" * 13]
+
+    def opt(r, key, fmt):  # "-" where the baseline was not run
+        return format(r[key], fmt) if key in r else "-"
+
     for r in rows:
         lines.append(
             f"| {r['mesh']} | {r['vertices']} | {r['operator']} | {r['k']} | {r['assembly_s']:.2f} "
-            f"| {r['eigen_s']:.1f} | {r.get('baseline_eigen_s', float('nan')):.1f} "
-            f"| {r.get('speedup', float('nan')):.2f} | {r['signature_s']:.2f} "
-            f"| {r.get('max_rel_eig_diff', float('nan')):.1e} | {r['max_residual']:.1e} "
-            f"| {r['peak_mb']:.0f} | {r.get('baseline_peak_mb', float('nan')):.0f} |"
+            f"| {r['eigen_s']:.1f} | {opt(r, 'baseline_eigen_s', '.1f')} "
+            f"| {opt(r, 'speedup', '.2f')} | {r['signature_s']:.2f} "
+            f"| {opt(r, 'max_rel_eig_diff', '.1e')} | {r['max_residual']:.1e} "
+            f"| {r['peak_mb']:.0f} | {opt(r, 'baseline_peak_mb', '.0f')} |"
         )
     return "\n".join(lines)
 

@@ -10,20 +10,21 @@ from .spectrum import Spectrum
 
 __all__ = ["transfer_spectrum", "estimate_cost"]
 
-SECONDS_PER_UNKNOWN_MODE = 2.0e-6
+SECONDS_PER_UNKNOWN_MODE = 1.6e-6
 """Eigen-solve time per unknown and mode on the 2-core reference machine with the block
-Krylov-Schur solver and PARDISO (``make bench`` on 2026-11-23, shells, 300 modes: 35k
-unknowns 26 s, 141k 83 s, 391k 232 s)."""
+Krylov-Schur solver and PARDISO (``make bench`` on 2026-11-23, second run, shells, 300
+modes: 35k unknowns 15.1 s, 141k 69.0 s, 391k 172.9 s)."""
 
 
 def estimate_cost(n_unknowns: int, k: int, nnz: int) -> tuple[float, float]:
     """(seconds, bytes) a spectrum of ``k`` modes of an (N, N) operator with ``nnz`` entries
-    is expected to take on the reference machine: Krylov basis, polishing arrays, factor."""
+    is expected to take on the reference machine: the Krylov basis with the factor while
+    iterating, then with the compact copy of the modes (the factor is freed by then)."""
     k_work = k + max(8, k // 10)
     basis = 8.0 * n_unknowns * (1.6 * k_work + 32)
-    polish = 8.0 * n_unknowns * 3 * k
+    modes = 8.0 * n_unknowns * k
     factor = 8.0 * 12.0 * nnz
-    return SECONDS_PER_UNKNOWN_MODE * n_unknowns * k, max(basis, polish) + factor
+    return SECONDS_PER_UNKNOWN_MODE * n_unknowns * k, basis + max(factor, modes)
 
 
 def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectrum:
