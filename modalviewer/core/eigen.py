@@ -415,11 +415,15 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     def apply_op(V: np.ndarray) -> np.ndarray:
         return sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * V)
 
+    # At a restart the basis keeps the working pairs and the best third of the unwanted
+    # Ritz vectors next to them, which carry the part of the spectrum the last wanted
+    # pairs must be told apart from.  10k Laplacian, 300 modes: 1152 operator columns
+    # when keeping only the working pairs, 1024 with the third (50k: 14.9 s -> 13.6 s).
     theta, Y, _ = block_krylov_schur(
         apply_op,
         N,
         k,
-        keep=k_work,
+        keep=k_work + (max_basis - k_work) // 3,
         block=block,
         max_basis=max_basis,
         tol=tol,
