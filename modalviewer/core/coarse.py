@@ -10,10 +10,10 @@ from .spectrum import Spectrum
 
 __all__ = ["transfer_spectrum", "estimate_cost"]
 
-SECONDS_PER_UNKNOWN_MODE = 1.6e-6
+SECONDS_PER_UNKNOWN_MODE = 1.5e-6
 """Eigen-solve time per unknown and mode on the 2-core reference machine with the block
-Krylov-Schur solver and PARDISO (``make bench`` on 2026-11-23, second run, shells, 300
-modes: 35k unknowns 15.1 s, 141k 69.0 s, 391k 172.9 s)."""
+Krylov-Schur solver and PARDISO (``make bench`` on 2026-11-23, third run, shells, 300
+modes: 35k unknowns 14.1 s, 141k 59.5 s, 391k 177.8 s)."""
 
 
 def estimate_cost(n_unknowns: int, k: int, nnz: int) -> tuple[float, float]:
