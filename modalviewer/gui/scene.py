@@ -53,6 +53,26 @@ def isoline_segments(
     interpolated onto the line points as point data.  A vertex exactly at a level counts
     as above it, so every crossed triangle yields exactly one segment.
     """
+    seg, disp, _ = _segments(points, faces, values, levels, displacement)
+    return _line_polydata(seg, disp)
+
+
+def _line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
+    """PolyData of (s, 2, 3) segments, with (s, 2, 3) ``disp`` as point data."""
+    poly = pv.PolyData()
+    n = seg.shape[0]
+    if n == 0:
+        return poly
+    poly.points = seg.reshape(-1, 3)
+    cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
+    poly.lines = cells.ravel()
+    if disp is not None:
+        poly.point_data["displacement"] = disp.reshape(-1, 3)
+    return poly
+
+
+def _segments(points, faces, values, levels, displacement=None):
+    """(segments (s, 2, 3), their displacement (s, 2, 3) or None, level of each (s,))."""
     levels = np.sort(np.asarray(levels, dtype=np.float64))
     # levels crossed by each triangle: those in (min, max] of its corner values
     level = np.searchsorted(levels, values, side="right").astype(np.int32)
@@ -61,7 +81,8 @@ def isoline_segments(
     hi = np.maximum(np.maximum(l0, l1), l2)
     tri = np.flatnonzero(hi > lo)
     if tri.size == 0:
-        return pv.PolyData()
+        empty = np.zeros((0, 2, 3))
+        return empty, (empty if displacement is not None else None), np.zeros(0)
     counts = hi[tri] - lo[tri]
     tri_rep = np.repeat(tri, counts)
     first = np.repeat(lo[tri], counts)
@@ -80,15 +101,10 @@ def isoline_segments(
     fa, fb = values[va], values[vb]
     t = ((c[:, None] - fa) / (fb - fa))[..., None]  # (s, 2, 1)
     seg = points[va] * (1 - t) + points[vb] * t  # (s, 2, 3)
-    n = seg.shape[0]
-    poly = pv.PolyData()
-    poly.points = seg.reshape(-1, 3)
-    cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
-    poly.lines = cells.ravel()
+    disp = None
     if displacement is not None:
-        d = displacement[va] * (1 - t) + displacement[vb] * t
-        poly.point_data["displacement"] = d.reshape(-1, 3)
-    return poly
+        disp = displacement[va] * (1 - t) + displacement[vb] * t
+    return seg, disp, c
 
 
 class MeshScene:
@@ -190,36 +206,34 @@ class MeshScene:
         if emphasise_zero:
             levels = levels[np.abs(levels) > 1e-12 * max(abs(lo), abs(hi))]
         want_zero = count > 0 and emphasise_zero and lo < 0 < hi
-        self._iso_rest, self._iso_disp = self._contour(
-            self.isolines, values, list(levels), 1.5, "iso_actor"
+        # one pass over the triangles for all levels, the zero line split off after
+        everything = list(levels) + ([0.0] if want_zero else [])
+        seg, disp, level = _segments(
+            self.rest_points,
+            self.mesh.faces,
+            values,
+            everything,
+            self.surface.point_data["displacement"],
         )
-        self._zero_rest, self._zero_disp = self._contour(
-            self.zero_line, values, [0.0] if want_zero else [], 3.5, "zero_actor"
+        zero = level == 0.0 if want_zero else np.zeros(len(level), dtype=bool)
+        self._iso_rest, self._iso_disp = self._show_lines(
+            self.isolines, seg[~zero], disp[~zero], 1.5, "iso_actor"
+        )
+        self._zero_rest, self._zero_disp = self._show_lines(
+            self.zero_line, seg[zero], disp[zero], 3.5, "zero_actor"
         )
 
-    def _contour(
-        self, lines: pv.PolyData, values: np.ndarray, levels: list[float], width: float, attr: str
+    def _show_lines(
+        self, lines: pv.PolyData, seg: np.ndarray, disp: np.ndarray, width: float, attr: str
     ):
-        """Replace ``lines`` by the black contour of ``values`` on the rest shape at
-        ``levels`` (none: hide it); returns (rest points, displacement) of the lines, or
-        (None, None)."""
+        """Replace ``lines`` by the black segments ``seg`` (s, 2, 3) on the rest shape (none:
+        hide the actor); returns (rest points, displacement) of the lines, or (None, None)."""
         actor = getattr(self, attr)
-        contour = (
-            isoline_segments(
-                self.rest_points,
-                self.mesh.faces,
-                values,
-                levels,
-                self.surface.point_data["displacement"],
-            )
-            if levels
-            else None
-        )
-        if contour is None or not contour.n_points:
+        if len(seg) == 0:
             if actor is not None:
                 actor.SetVisibility(False)
             return None, None
-        lines.copy_from(contour, deep=False)
+        lines.copy_from(_line_polydata(seg, disp), deep=False)
         if actor is None:
             actor = self.plotter.add_mesh(
                 lines,
@@ -233,7 +247,8 @@ class MeshScene:
             )
             setattr(self, attr, actor)
         actor.SetVisibility(True)
-        return np.array(lines.points), np.array(lines.point_data["displacement"])
+        # copies: the animation writes into the line points in place
+        return seg.reshape(-1, 3).copy(), disp.reshape(-1, 3).copy()
 
     @property
     def n_isoline_points(self) -> int:
