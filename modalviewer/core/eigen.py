@@ -191,18 +191,25 @@ def _factor_below_spectrum(K, mass_diag, lam_typical, report) -> tuple[SPDSolver
     )
 
 
+def _gram_cholesky(W: np.ndarray) -> np.ndarray | None:
+    """Upper Cholesky factor C of ``W.T @ W`` (so ``W @ inv(C)`` has orthonormal columns),
+    or None if W is numerically rank deficient (C's diagonal spans more than 1e7)."""
+    G = W.T @ W
+    try:
+        C = la.cholesky(0.5 * (G + G.T), lower=False)
+    except la.LinAlgError:
+        return None
+    d = np.abs(np.diag(C))
+    return None if d.min() <= 1e-7 * d.max() else C
+
+
 def _cholqr(W: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """W = V Rn with orthonormal V by two Cholesky-QR passes (BLAS-3), or None if W is
     numerically rank deficient (then Householder QR takes over)."""
     Rn = np.eye(W.shape[1])
     for _ in range(2):
-        G = W.T @ W
-        try:
-            C = la.cholesky(0.5 * (G + G.T), lower=False)
-        except la.LinAlgError:
-            return None
-        d = np.abs(np.diag(C))
-        if d.min() <= 1e-7 * d.max():
+        C = _gram_cholesky(W)
+        if C is None:
             return None
         W = W @ la.solve_triangular(C, np.eye(W.shape[1]), lower=False)
         Rn = C @ Rn
@@ -214,13 +221,8 @@ def _cholqr_in_place(Y: np.ndarray) -> bool:
     (N, k) temporary); False if Y is numerically rank deficient (Y then still spans
     the same space, and Householder QR takes over)."""
     for _ in range(2):
-        G = Y.T @ Y
-        try:
-            C = la.cholesky(0.5 * (G + G.T), lower=False)
-        except la.LinAlgError:
-            return False
-        d = np.abs(np.diag(C))
-        if d.min() <= 1e-7 * d.max():
+        C = _gram_cholesky(Y)
+        if C is None:
             return False
         _rotate_in_place(Y, Y.shape[1], la.solve_triangular(C, np.eye(Y.shape[1])))
     return True
