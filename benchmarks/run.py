@@ -8,7 +8,9 @@ assembly, the eigenproblem for k modes (modalviewer's solver and the baseline
 ``eigsh(K, k, M=Mass, sigma=s)`` with scipy's default LU), the signature at all
 vertices, the ratio, the largest relative eigenvalue difference (non-zero modes) and peak
 memory (RSS high-water mark of the process that ran it: every measurement runs in a fresh
-process).  Results go to benchmarks/results/latest.json and a Markdown table is printed.
+process), and where the solver's time went (factorisation, solves, orthogonalisation,
+restarts, projected eigenproblems, refinement; ``EigenResult.stage_seconds``).  Results go
+to benchmarks/results/latest.json and two Markdown tables are printed.
 """
 
 from __future__ import annotations
@@ -88,6 +90,8 @@ def _ours(size: str, operator: str, k: int) -> dict:
         "k": k,
         "assembly_s": t_assembly,
         "eigen_s": t_eigen,
+        "stage_s": result.stage_seconds,
+        "operator_columns": result.operator_columns,
         "signature_s": t_signature,
         "method": result.method,
         "max_residual": float(result.residuals[~spec.zero_mode_mask()].max()),
@@ -166,6 +170,33 @@ def table(rows) -> str:
     return "\n".join(lines)
 
 
+STAGES = (
+    "factorisation",
+    "solves",
+    "orthogonalisation",
+    "restarts",
+    "ritz",
+    "refinement",
+    "rayleigh_ritz",
+    "residuals",
+)
+
+
+def stage_table(rows) -> str:
+    """Where the solver's time went, per row: seconds per stage and operator columns."""
+    head = "| mesh | operator | unknowns | columns | " + " | ".join(STAGES) + " | other | eigen s |"
+    lines = [head, "|" + " --- |" * (len(STAGES) + 6)]
+    for r in rows:
+        stages = r.get("stage_s", {})
+        cells = [f"{stages.get(name, 0.0):.1f}" for name in STAGES]
+        other = r["eigen_s"] - sum(stages.get(name, 0.0) for name in STAGES)
+        lines.append(
+            f"| {r['mesh']} | {r['operator']} | {r['unknowns']} | {r.get('operator_columns', '-')} "
+            f"| " + " | ".join(cells) + f" | {other:.1f} | {r['eigen_s']:.1f} |"
+        )
+    return "\n".join(lines)
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sizes", nargs="+", default=["10k", "50k", "130k"])
@@ -182,6 +213,8 @@ def main(argv=None) -> int:
     rows = run(args.sizes, args.operators, args.k, not args.no_baseline, args.baseline_max_unknowns)
     save_result("latest", rows)
     print(table(rows))
+    print()
+    print(stage_table(rows))
     return 0
 
 

@@ -21,8 +21,10 @@ Every run is deterministic (fixed start block); every result carries its residua
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as la
@@ -62,6 +64,22 @@ class EigenError(RuntimeError):
     """The eigensolver failed (no convergence, factorisation breakdown, bad residuals)."""
 
 
+class StageTimer:
+    """Wall-clock seconds spent per stage of a solve (accumulated over calls)."""
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+
+    @contextmanager
+    def __call__(self, stage: str) -> Iterator[None]:
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            elapsed = time.perf_counter() - start
+            self.seconds[stage] = self.seconds.get(stage, 0.0) + elapsed
+
+
 @dataclass
 class EigenResult:
     eigenvalues: np.ndarray  # (k,) ascending
@@ -69,6 +87,12 @@ class EigenResult:
     residuals: np.ndarray  # (k,) relative residuals (absolute, scaled, for zero modes)
     shift: float
     method: str
+    stage_seconds: dict[str, float] = field(default_factory=dict)
+    """Where the time went: "factorisation", "solves" (the Krylov iteration's), "orthogonalisation",
+    "ritz" (projected eigenproblems), "restarts" (basis rotations), "refinement" (the last
+    block of solves), "rayleigh_ritz" (with K itself), "residuals", "dense"."""
+    operator_columns: int = 0
+    """Columns the shift-invert operator was applied to, refinement included."""
 
 
 def relative_residuals(
@@ -152,29 +176,33 @@ def solve_lowest(
     inv_sqrt_m = 1.0 / np.sqrt(mass_diag)
     median_ratio = float(np.median(np.abs(K.diagonal()) / mass_diag))
 
+    timer = StageTimer()
     lam = None
+    columns = 0
     if N > dense_limit:
         lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
         try:
-            lam, X, shift, backend = _shift_invert(
-                K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block
+            lam, X, shift, backend, columns = _shift_invert(
+                K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer
             )
             method = f"shift-invert block Krylov-Schur ({backend})"
         except _TooSmall:
             lam = None
     if lam is None:
         report("solving (dense)", 0.1)
-        lam, X = la.eigh(K.toarray(), np.diag(mass_diag), subset_by_index=[0, k - 1])
+        with timer("dense"):
+            lam, X = la.eigh(K.toarray(), np.diag(mass_diag), subset_by_index=[0, k - 1])
         method, shift = "dense", 0.0
     report("checking residuals", 0.97)
-    X = _fix_signs(X)
-    res = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
+    with timer("residuals"):
+        X = _fix_signs(X)
+        res = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
-    return EigenResult(lam, X, res, shift, method)
+    return EigenResult(lam, X, res, shift, method, timer.seconds, columns)
 
 
-def _factor_below_spectrum(K, mass_diag, lam_typical, report) -> tuple[SPDSolver, float]:
+def _factor_below_spectrum(K, mass_diag, lam_typical, report, timer) -> tuple[SPDSolver, float]:
     """Factor ``K - shift * M`` with a shift just below zero (K may be singular)."""
     # Far below the first non-zero mode, yet factorisable.  Scaled by the typical diagonal
     # ratio, not the largest: one sliver triangle can make the largest 1e12 times bigger.
@@ -182,7 +210,8 @@ def _factor_below_spectrum(K, mass_diag, lam_typical, report) -> tuple[SPDSolver
     for _ in range(4):
         report("factorising", 0.02)
         try:
-            return SPDSolver(K - shift * sp.diags(mass_diag)), shift
+            with timer("factorisation"):
+                return SPDSolver(K - shift * sp.diags(mass_diag)), shift
         except np.linalg.LinAlgError:
             shift *= 100.0  # move further below the spectrum and try again
     raise EigenError(
@@ -315,6 +344,7 @@ def block_krylov_schur(
     report: ProgressFn,
     max_restarts: int = 60,
     seed: int = 12345,
+    timer: StageTimer | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """The k largest eigenpairs of a symmetric positive definite operator.
 
@@ -329,6 +359,7 @@ def block_krylov_schur(
     apply_op : maps an (N, b) array to OP times it.
     k : wanted eigenpairs; ``k <= keep``, ``keep + block <= max_basis <= N - block``.
     tol : a pair counts as converged when ``|OP y - theta y| <= tol * theta``.
+    timer : accumulates the seconds of "solves", "orthogonalisation", "ritz", "restarts".
 
     Returns
     -------
@@ -336,6 +367,7 @@ def block_krylov_schur(
     array), number of operator columns applied.
     """
     rng = np.random.default_rng(seed)
+    timer = timer or StageTimer()
     b = block
     Q = np.empty((N, max_basis + b))
     T = np.zeros((max_basis, max_basis))
@@ -349,15 +381,17 @@ def block_krylov_schur(
     check_every = max(1, 64 // b)
     blocks_since_check = 0
     while True:
-        W = apply_op(Q[:, j : j + b])
+        with timer("solves"):
+            W = apply_op(Q[:, j : j + b])
         applied += b
         # OP times the open block couples (in exact arithmetic) only to the previous
         # block, except right after a (re)start, where it couples to all kept vectors.
         local = j - b if j > sequence_start else 0
-        V, h, Rn = _orthonormal_block(W, Q[:, : j + b], rng, local)
+        with timer("orthogonalisation"):
+            V, h, Rn = _orthonormal_block(W, Q[:, : j + b], rng, local)
+            Q[:, j + b : j + 2 * b] = V
         T[: j + b, j : j + b] = h
         T[j : j + b, : j + b] = h.T
-        Q[:, j + b : j + 2 * b] = V
         j += b
         R = np.zeros((b, j))
         R[:, j - b :] = Rn
@@ -368,16 +402,18 @@ def block_krylov_schur(
         if (j < k or blocks_since_check) and not full:
             report("solving", 0.05 + 0.85 * done / k)
             continue
-        theta, S = np.linalg.eigh(0.5 * (T[:j, :j] + T[:j, :j].T))
-        theta, S = theta[::-1], S[:, ::-1]
-        estimates = np.linalg.norm(R @ S[:, :keep], axis=0)
+        with timer("ritz"):
+            theta, S = np.linalg.eigh(0.5 * (T[:j, :j] + T[:j, :j].T))
+            theta, S = theta[::-1], S[:, ::-1]
+            estimates = np.linalg.norm(R @ S[:, :keep], axis=0)
         # rounding floor: zero modes make theta[0] up to 1e6 times theta[k]
         floor = 16 * np.finfo(float).eps * abs(theta[0])
         converged = estimates[:k] <= np.maximum(tol * np.abs(theta[:k]), floor)
         done = int(np.argmin(converged)) if not converged.all() else k
         report("solving", 0.05 + 0.85 * done / k)
         if done == k:
-            _rotate_in_place(Q, j, S[:, :k])
+            with timer("restarts"):
+                _rotate_in_place(Q, j, S[:, :k])
             return theta[:k], Q[:, :k], applied
         if not full:
             continue
@@ -390,8 +426,9 @@ def block_krylov_schur(
         # thick restart: keep the best Ritz vectors, continue from the open block
         restarts += 1
         p = min(keep, j - b)
-        _rotate_in_place(Q, j, S[:, :p])
-        Q[:, p : p + b] = Q[:, j : j + b]
+        with timer("restarts"):
+            _rotate_in_place(Q, j, S[:, :p])
+            Q[:, p : p + b] = Q[:, j : j + b]
         T[:] = 0.0
         T[np.arange(p), np.arange(p)] = theta[:p]
         R = R @ S[:, :p]
@@ -399,8 +436,9 @@ def block_krylov_schur(
         sequence_start = p
 
 
-def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=None):
-    """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2``."""
+def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer):
+    """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2``:
+    (eigenvalues, vectors, shift, backend name, operator columns)."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
     # A few more pairs than requested: the last requested pairs then converge as fast
@@ -412,7 +450,7 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     max_basis = ((max_basis + block - 1) // block) * block
     if max_basis + block > N:
         raise _TooSmall()  # the basis would not fit: the dense solver is the right tool
-    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report)
+    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report, timer)
 
     def apply_op(V: np.ndarray) -> np.ndarray:
         return sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * V)
@@ -421,7 +459,7 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     # Ritz vectors next to them, which carry the part of the spectrum the last wanted
     # pairs must be told apart from.  10k Laplacian, 300 modes: 1152 operator columns
     # when keeping only the working pairs, 1024 with the third (50k: 14.9 s -> 13.6 s).
-    theta, Y, _ = block_krylov_schur(
+    theta, Y, columns = block_krylov_schur(
         apply_op,
         N,
         k,
@@ -430,6 +468,7 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
         max_basis=max_basis,
         tol=tol,
         report=report,
+        timer=timer,
     )
     # One block step of inverse iteration on the converged subspace, then Rayleigh-Ritz
     # with the operator itself.  Rounding in the Gram-Schmidt steps leaves noise of
@@ -439,22 +478,26 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block=N
     report("refining", 0.9)
     step = 2 * block  # each step has four (N, step) temporaries
     for start in range(0, Y.shape[1], step):
-        Y[:, start : start + step] = apply_op(Y[:, start : start + step])
+        with timer("refinement"):
+            Y[:, start : start + step] = apply_op(Y[:, start : start + step])
         report("refining", 0.9 + 0.05 * start / Y.shape[1])
+    columns += Y.shape[1]
     backend = solver.backend
     solver = None  # free the factor (apply_op's closure holds it) before the last step
     # Everything below works in place on Y, a view into the Krylov basis, or on (N, 32)
     # pieces: at 130k vertices (shells, 300 modes) one (N, k) temporary is 0.9 GB.
     report("orthonormalising", 0.95)
-    if not _cholqr_in_place(Y):
-        Y[:] = np.linalg.qr(Y)[0]
-    Y *= inv_sqrt_m[:, None]  # now Mass-orthonormal in the original variables
-    G = np.empty((Y.shape[1], Y.shape[1]))
-    for start in range(0, Y.shape[1], 32):
-        G[:, start : start + 32] = Y.T @ (K @ Y[:, start : start + 32])
-    lam, W = np.linalg.eigh(0.5 * (G + G.T))
-    _rotate_in_place(Y, Y.shape[1], W[:, :k])
-    return lam[:k], np.ascontiguousarray(Y[:, :k]), shift, backend
+    with timer("rayleigh_ritz"):
+        if not _cholqr_in_place(Y):
+            Y[:] = np.linalg.qr(Y)[0]
+        Y *= inv_sqrt_m[:, None]  # now Mass-orthonormal in the original variables
+        G = np.empty((Y.shape[1], Y.shape[1]))
+        for start in range(0, Y.shape[1], 32):
+            G[:, start : start + 32] = Y.T @ (K @ Y[:, start : start + 32])
+        lam, W = np.linalg.eigh(0.5 * (G + G.T))
+        _rotate_in_place(Y, Y.shape[1], W[:, :k])
+        X = np.ascontiguousarray(Y[:, :k])
+    return lam[:k], X, shift, backend, columns
 
 
 class _TooSmall(Exception):

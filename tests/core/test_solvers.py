@@ -147,3 +147,28 @@ def test_orthonormal_block_against_the_basis(local):
     assert np.abs(Q @ h + V @ Rn - W).max() < 1e-10 * np.abs(W).max()
     assert np.abs(Q.T @ V).max() < 1e-13
     assert np.abs(V.T @ V - np.eye(b)).max() < 1e-13
+
+
+def test_solver_accounts_for_its_time_and_operator_columns(monkeypatch):
+    import time
+
+    plate = grid_plate(40, 40)
+    K, mass = operator_matrices(plate, "laplacian")
+    calls = []
+    original = SPDSolver.solve
+
+    def counting_solve(self, b):
+        calls.append(b.shape[1] if b.ndim == 2 else 1)
+        return original(self, b)
+
+    monkeypatch.setattr(SPDSolver, "solve", counting_solve)
+    start = time.perf_counter()
+    result = solve_lowest(K, mass, 40)
+    wall = time.perf_counter() - start
+    stages = result.stage_seconds
+    for name in ("factorisation", "solves", "orthogonalisation", "ritz", "refinement"):
+        assert stages[name] > 0.0
+    assert sum(stages.values()) <= wall
+    # every column the factor solved for is counted, the refinement's 40 included
+    assert result.operator_columns == sum(calls)
+    assert result.operator_columns >= 2 * 40
