@@ -172,3 +172,35 @@ def test_solver_accounts_for_its_time_and_operator_columns(monkeypatch):
     # every column the factor solved for is counted, the refinement's 40 included
     assert result.operator_columns == sum(calls)
     assert result.operator_columns >= 2 * 40
+
+
+@pytest.mark.parametrize("mixing", ["scaled", "ill-conditioned"])
+def test_final_rayleigh_ritz_in_a_non_orthonormal_basis(mixing, monkeypatch):
+    # the span of 12 exact eigenvectors (standard form), given as scaled columns (what
+    # inverse iteration produces) or mixed with condition number 1e6 (the fallback that
+    # orthonormalises first): exact eigenvalues and Mass-orthonormal vectors either way
+    from modalviewer.core import eigen
+    from modalviewer.core.eigen import _rayleigh_ritz_in_place
+
+    orthonormalised = []
+    original = eigen._cholqr_in_place
+    monkeypatch.setattr(
+        eigen, "_cholqr_in_place", lambda Y: orthonormalised.append(1) or original(Y)
+    )
+    rng = np.random.default_rng(5)
+    K = _spd_matrix(200, seed=4)
+    mass = rng.uniform(0.5, 2.0, 200)
+    lam, X = la.eigh(K.toarray(), np.diag(mass))
+    Y = np.sqrt(mass)[:, None] * X[:, :12]
+    if mixing == "scaled":
+        Y = Y * np.logspace(0, 6, 12)
+    else:
+        U = np.linalg.qr(rng.standard_normal((12, 12)))[0]
+        Y = Y @ (U * np.logspace(0, -6, 12)) @ U.T
+    Y = np.asfortranarray(Y)
+    ritz = _rayleigh_ritz_in_place(K, 1.0 / np.sqrt(mass), Y)
+    assert bool(orthonormalised) == (mixing == "ill-conditioned")
+    np.testing.assert_allclose(ritz, lam[:12], rtol=1e-9)
+    np.testing.assert_allclose((Y * mass[:, None]).T @ Y, np.eye(12), atol=1e-9)
+    res = np.linalg.norm(K @ Y - (mass[:, None] * Y) * ritz, axis=0) / ritz
+    assert res.max() < 1e-9
