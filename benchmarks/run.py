@@ -179,6 +179,7 @@ STAGES = (
     "refinement",
     "rayleigh_ritz",
     "residuals",
+    "copy",
 )
 
 

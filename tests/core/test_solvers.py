@@ -204,3 +204,15 @@ def test_final_rayleigh_ritz_in_a_non_orthonormal_basis(mixing, monkeypatch):
     np.testing.assert_allclose((Y * mass[:, None]).T @ Y, np.eye(12), atol=1e-9)
     res = np.linalg.norm(K @ Y - (mass[:, None] * Y) * ritz, axis=0) / ritz
     assert res.max() < 1e-9
+
+
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_sign_convention_largest_entry_positive(order):
+    from modalviewer.core.eigen import _fix_signs
+
+    rng = np.random.default_rng(2)
+    X = np.asarray(rng.standard_normal((5000, 40)), order=order)
+    expected = X * np.sign(X[np.abs(X).argmax(axis=0), np.arange(40)])
+    fixed = _fix_signs(X.copy(order=order), rows=700)  # blocks of rows, the last one short
+    np.testing.assert_array_equal(fixed, expected)
+    assert np.all(fixed[np.abs(fixed).argmax(axis=0), np.arange(40)] > 0)
