@@ -380,8 +380,9 @@ def block_krylov_schur(
     Block Krylov-Schur (thick-restart block Lanczos) with full re-orthogonalisation in
     BLAS-3 blocks: the operator is applied to ``block`` vectors at a time, so a sparse
     factorisation solves many right-hand sides per pass over its factor.  The Ritz
-    pairs are checked after every block, so the iteration stops as soon as the wanted
-    pairs have converged; a full basis is restarted with its ``keep`` best Ritz vectors.
+    pairs are checked every 64 new vectors (and when the basis is full), so the iteration
+    stops soon after the wanted pairs have converged; a full basis is restarted with its
+    ``keep`` best Ritz vectors.
 
     Parameters
     ----------
