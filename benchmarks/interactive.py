@@ -8,7 +8,7 @@ machines without a GPU): computing a spectrum while a 10 ms timer watches the ev
 (longest gap), cancelling a computation, reopening the cached spectrum, switching modes
 with isolines, one animation frame, picking a vertex to a distance map (first pick builds
 the signature table), one threshold-slider step.  Results go to
-``benchmarks/results/interactive_<size>.json``; a Markdown table is printed.
+``benchmarks/results/interactive_<size>_<operator>.json``; a Markdown table is printed.
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def main(argv=None) -> int:
     p.add_argument("--k", type=int, default=100)
     args = p.parse_args(argv)
     result = run(args.size, args.operator, args.k)
-    save_result(f"interactive_{args.size}", result)
+    save_result(f"interactive_{args.size}_{args.operator}", result)
     print(table(result))
     return 0
 

@@ -137,6 +137,14 @@ def _run(args) -> int:
             f"{spec.eigenvalues[0]:.6g} .. {spec.eigenvalues[-1]:.6g}, largest relative "
             f"residual {worst:.1e}; saved {args.output}"
         )
+        stages = spec.parameters.get("seconds_by_stage", {})
+        if stages:
+            busiest = sorted(stages.items(), key=lambda item: -item[1])[:4]
+            print(
+                f"{spec.parameters['seconds_total']:.1f} s in all; solver: "
+                + ", ".join(f"{name} {seconds:.1f} s" for name, seconds in busiest)
+                + f" ({spec.parameters['operator_columns']} operator columns)"
+            )
         return 0
     mesh = mv.load_mesh(args.mesh)
     if args.command == "render":

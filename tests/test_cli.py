@@ -38,6 +38,7 @@ def test_compute_writes_a_spectrum(tmp_path):
     spec = mv.load_spectrum(out)
     assert spec.operator == "modified_dirichlet" and spec.k == 12
     assert "Traceback" not in r.stderr
+    assert "solver:" in r.stdout and f"({spec.parameters['operator_columns']} operator" in r.stdout
 
 
 def test_render_and_distance_images(tmp_path):

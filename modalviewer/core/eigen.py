@@ -41,6 +41,7 @@ __all__ = [
     "SPDSolver",
     "solve_lowest",
     "relative_residuals",
+    "zero_modes",
     "ZERO_MODE_RTOL",
 ]
 
@@ -115,18 +116,26 @@ def _sparse_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice,
                 yield slice(start, start + width), KY
 
 
+def zero_modes(lam: np.ndarray, lam_scale: float = 0.0) -> np.ndarray:
+    """Boolean mask (k,) of the zero modes: ``lam < ZERO_MODE_RTOL * lam_max`` (rounding
+    can make them slightly negative) with ``lam_max = max(largest |lam|, lam_scale)``;
+    ``lam_scale`` (a typical eigenvalue size) keeps a spectrum of only zero modes from
+    judging itself by its own rounding noise."""
+    lam = np.asarray(lam, dtype=np.float64)
+    lam_max = max(float(np.abs(lam).max(initial=0.0)), lam_scale, np.finfo(float).tiny)
+    return lam < ZERO_MODE_RTOL * lam_max
+
+
 def relative_residuals(
     K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray, lam_scale: float = 0.0
 ) -> np.ndarray:
     """|K x - lam M x| / |lam M x| per column; for zero modes |K x| / (lam_max |M x|).
 
-    Zero modes are those below 1e-8 * max(largest |lam|, ``lam_scale``); ``lam_scale``
-    (a typical eigenvalue size) keeps a spectrum of only zero modes from judging
-    itself by its own rounding noise.
+    Zero modes are those of :func:`zero_modes` (``lam_scale`` is passed on).
     """
     scale = np.abs(lam).copy()
     lam_max = max(float(np.abs(lam).max()), lam_scale, np.finfo(float).tiny)
-    zero = scale < ZERO_MODE_RTOL * lam_max
+    zero = zero_modes(lam, lam_scale)
     scale[zero] = lam_max
     out = np.empty(X.shape[1])
     for cols, KX in _sparse_products(K, X):  # (N, 32) temporaries, not three (N, k) ones

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .eigen import ZERO_MODE_RTOL
+from .eigen import zero_modes
 
 __all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
 
@@ -59,8 +59,7 @@ class Spectrum:
 
     def zero_mode_mask(self) -> np.ndarray:
         """(k,) True for modes whose eigenvalue is below 1e-8 times the largest."""
-        lam_max = float(np.max(np.abs(self.eigenvalues)))
-        return self.eigenvalues < ZERO_MODE_RTOL * lam_max
+        return zero_modes(self.eigenvalues)
 
     def mode(self, j: int) -> np.ndarray:
         """Mode j: (n,) for scalar operators, (n, 3) for ``"shells"``."""

@@ -110,3 +110,15 @@ def test_bad_arguments(spot):
         mv.compute_spectrum(spot, "laplacian", k=0)
     with pytest.raises(ValueError, match="bending"):
         mv.compute_spectrum(spot, "shells", bending=-1.0)
+
+
+def test_zero_mode_rule_is_relative_to_the_largest_or_typical_eigenvalue():
+    from modalviewer.core.eigen import zero_modes
+
+    lam = np.array([-3e-9, 2e-9, 5e-7, 1.0, 100.0])
+    # below 1e-8 * 100 = 1e-6: the first three (the slightly negative one too)
+    np.testing.assert_array_equal(zero_modes(lam), [True, True, True, False, False])
+    # only rounding noise: judged against a typical eigenvalue size, all are zero modes
+    noise = np.array([1e-14, 3e-14])
+    np.testing.assert_array_equal(zero_modes(noise), [False, False])
+    np.testing.assert_array_equal(zero_modes(noise, lam_scale=1.0), [True, True])

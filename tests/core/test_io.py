@@ -120,6 +120,11 @@ def test_spectrum_file_round_trip_and_hash(tmp_path, spot):
     assert back.operator == "shells" and back.modes.shape == spec.modes.shape
     np.testing.assert_array_equal(back.eigenvalues, spec.eigenvalues)
     assert back.parameters["bending"] == 1.0
+    # the solver's stage clock travels with the spectrum (`modalviewer compute` prints it)
+    stages = back.parameters["seconds_by_stage"]
+    assert stages == spec.parameters["seconds_by_stage"] and stages["solves"] > 0
+    assert sum(stages.values()) <= back.parameters["seconds_total"] + 1e-3
+    assert back.parameters["operator_columns"] >= 10
     with pytest.raises(mv.SpectrumFileError, match="another mesh"):
         mv.load_spectrum(path, mesh_hash="0" * 64)
     damaged = tmp_path / "damaged.npz"
