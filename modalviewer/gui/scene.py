@@ -138,7 +138,7 @@ class MeshScene:
         self._mapper.SelectColorArray("field")
         self._mapper.SetUseLookupTableScalarRange(False)
         # Push the surface slightly back in depth so the isolines lying on it are not
-        # half hidden by depth fighting (they looked dotted on fine meshes).
+        # half hidden by depth fighting.
         self._mapper.SetResolveCoincidentTopologyToPolygonOffset()
         self._mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 4.0)
         self.isolines = pv.PolyData()
@@ -239,6 +239,9 @@ class MeshScene:
                 lines,
                 color="black",
                 line_width=width,
+                # drawn as screen-space tubes: plain wide lines leave gaps between the
+                # sub-pixel segments of fine meshes (isolines looked dotted at 130k)
+                render_lines_as_tubes=True,
                 name=attr,
                 render=False,
                 reset_camera=False,
