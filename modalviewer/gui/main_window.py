@@ -80,6 +80,17 @@ class ComputeError(RuntimeError):
     """A computation started from the scripting API failed; the message is for users."""
 
 
+def _combo() -> QtWidgets.QComboBox:
+    """A combo box as wide as 14 characters, not as its longest item (which made the
+    Compute dock wider than its 340-pixel limit, so its right edge was cut off)."""
+    combo = QtWidgets.QComboBox()
+    combo.setSizeAdjustPolicy(
+        QtWidgets.QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon
+    )
+    combo.setMinimumContentsLength(14)
+    return combo
+
+
 class MainWindow(QtWidgets.QMainWindow):
     """The modalviewer main window."""
 
@@ -146,7 +157,7 @@ class MainWindow(QtWidgets.QMainWindow):
         # --- compute
         box = QtWidgets.QWidget()
         form = QtWidgets.QFormLayout(box)
-        self.operator_combo = QtWidgets.QComboBox()
+        self.operator_combo = _combo()
         for key, label in OPERATOR_LABELS.items():
             self.operator_combo.addItem(label, key)
         self.operator_combo.currentIndexChanged.connect(self._on_operator_changed)
@@ -204,7 +215,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.spectrum_plot.sampleClicked.connect(self.mode_spin.setValue)
         lay.addWidget(self.spectrum_plot)
         form = QtWidgets.QFormLayout()
-        self.color_combo = QtWidgets.QComboBox()
+        self.color_combo = _combo()
         self.color_combo.addItem("Normal component", "normal")
         self.color_combo.addItem("Magnitude", "magnitude")
         self.color_combo.setToolTip("Scalar shown for 3D vibration modes")
@@ -234,10 +245,10 @@ class MainWindow(QtWidgets.QMainWindow):
         # --- distances
         box = QtWidgets.QWidget()
         form = QtWidgets.QFormLayout(box)
-        self.kind_combo = QtWidgets.QComboBox()
+        self.kind_combo = _combo()
         for key, label in DISTANCE_LABELS.items():
             self.kind_combo.addItem(label, key)
-        self.display_combo = QtWidgets.QComboBox()
+        self.display_combo = _combo()
         self.display_combo.addItem("Continuous (white to red)", "continuous")
         self.display_combo.addItem("Threshold (blue = similar)", "threshold")
         self.threshold_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
@@ -280,6 +291,10 @@ class MainWindow(QtWidgets.QMainWindow):
         scroll = QtWidgets.QScrollArea()
         scroll.setWidgetResizable(True)
         scroll.setWidget(widget)
+        # wide enough for its contents (no sideways scrolling; labels wrap)
+        scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        needed = widget.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width()
+        scroll.setMinimumWidth(min(340, needed + 4))
         dock.setWidget(scroll)
         self.addDockWidget(area, dock)
         return dock

@@ -137,6 +137,10 @@ class MeshScene:
         self._mapper.SetScalarModeToUsePointFieldData()
         self._mapper.SelectColorArray("field")
         self._mapper.SetUseLookupTableScalarRange(False)
+        # plain light grey until a field is shown (the all-zero field would take the
+        # bottom colour of pyvista's default colour map, a dark purple)
+        self._mapper.ScalarVisibilityOff()
+        self.surface_actor.prop.color = (0.86, 0.86, 0.86)
         # Push the surface slightly back in depth so the isolines lying on it are not
         # half hidden by depth fighting.
         self._mapper.SetResolveCoincidentTopologyToPolygonOffset()

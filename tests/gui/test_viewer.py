@@ -54,6 +54,30 @@ def test_mode_colours_and_isolines(window, spot_path):
     assert "lambda_6" in window.eigen_label.text()
 
 
+def test_a_freshly_opened_mesh_is_plain_grey(window, spot_path):
+    assert window.open_mesh(spot_path)
+    img = window.viewport.render_now().astype(int)
+    r, g, b = img[:, :, 0], img[:, :, 1], img[:, :, 2]
+    surface = (r < 235) | (g < 235) | (b < 235)  # not the white background
+    assert surface.sum() > 5000
+    # shaded grey: the channels agree (the default colour map's dark purple did not)
+    spread = np.max([r, g, b], axis=0) - np.min([r, g, b], axis=0)
+    assert np.median(spread[surface]) < 12, np.median(spread[surface])
+    assert np.median(g[surface]) > 90
+
+
+def test_every_dock_fits_its_contents_without_sideways_scrolling(window, spot_path):
+    from qtpy import QtWidgets
+
+    window.open_mesh(spot_path)
+    window.show()
+    QtWidgets.QApplication.processEvents()
+    for dock in window.findChildren(QtWidgets.QDockWidget):
+        scroll = dock.widget()
+        inner = scroll.widget()
+        assert inner.minimumSizeHint().width() <= scroll.viewport().width(), dock.windowTitle()
+
+
 def test_animation_moves_the_surface(window, spot_path, qtbot):
     window.open_mesh(spot_path)
     window.compute("shells", k=12, wait=True)
