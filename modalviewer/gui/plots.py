@@ -36,11 +36,14 @@ class LinePlot(QtWidgets.QWidget):
         self.update()
 
     def _transform(self):
-        rect = self.rect().adjusted(46, 20, -10, -28)
         x = np.log10(self.x) if self.logx else self.x
         y = self.y
         x0, x1 = float(x.min()), float(x.max())
         y0, y1 = float(y.min()), float(y.max())
+        # room for the longer of the two axis labels (e.g. "-4.75e-08" for a zero mode)
+        metrics = self.fontMetrics()
+        left = 8 + max(metrics.horizontalAdvance(f"{v:.3g}") for v in (y0, y1))
+        rect = self.rect().adjusted(max(46, left), 20, -10, -28)
         if x1 == x0:
             x1 = x0 + 1
         if y1 == y0:

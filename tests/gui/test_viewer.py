@@ -397,3 +397,12 @@ def test_shells_on_an_inconsistently_oriented_mesh_fail_with_a_message(window):
     assert "cannot run" in window.last_error and window._job is None
     spec = window.compute("laplacian", k=6, wait=True)  # the Laplacian still works
     assert spec.k == 6 and window.display == "mode"
+
+
+def test_spectrum_plot_leaves_room_for_its_axis_labels(window):
+    plot = window.spectrum_plot
+    plot.resize(300, 140)
+    plot.set_data(np.arange(5), [-4.75e-8, 1.0, 2.0, 3.0, 5470.0])
+    rect = plot._transform()[0]
+    widest = plot.fontMetrics().horizontalAdvance("-4.75e-08")
+    assert rect.left() >= widest + 4  # the label is drawn from x = 2
