@@ -406,3 +406,21 @@ def test_spectrum_plot_leaves_room_for_its_axis_labels(window):
     rect = plot._transform()[0]
     widest = plot.fontMetrics().horizontalAdvance("-4.75e-08")
     assert rect.left() >= widest + 4  # the label is drawn from x = 2
+
+
+def test_an_idle_window_does_not_render(window, spot_path, qtbot):
+    # pyvistaqt's QtInteractor re-renders five times a second by default (auto_update),
+    # which cost a full core in software OpenGL; the viewer renders only on change.
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=8, wait=True)
+    window.show_mode(3)
+    window.viewport.render_now()
+    qtbot.wait(300)  # let the paint events already queued by these changes arrive
+    renders = []
+    tag = window.plotter.ren_win.AddObserver("StartEvent", lambda *_: renders.append(1))
+    qtbot.wait(1500)
+    window.plotter.ren_win.RemoveObserver(tag)
+    assert len(renders) == 0
+    window.show_mode(4)  # a change does render
+    window.viewport.render_now()
+    assert window.scene.n_isoline_points > 0
