@@ -1,6 +1,6 @@
 """Interactive costs of the real viewer window (off-screen) on a big mesh.
 
-    python -m benchmarks.interactive [--size 130k] [--operator shells] [--k 100]
+    python -m benchmarks.interactive [--size 130k] [--operator shells] [--k 100] [--desktop]
 
 Drives ``modalviewer.gui.MainWindow`` as a user would and measures, separately, the
 application's own work up to the render request and the draw itself (software OpenGL on
@@ -8,7 +8,9 @@ machines without a GPU): computing a spectrum while a 10 ms timer watches the ev
 (longest gap), cancelling a computation, reopening the cached spectrum, switching modes
 with isolines, one animation frame, picking a vertex to a distance map (first pick builds
 the signature table), one threshold-slider step.  Results go to
-``benchmarks/results/interactive_<size>_<operator>.json``; a Markdown table is printed.
+``benchmarks/results/interactive_<size>_<operator>[_desktop].json``; a Markdown table is
+printed.  ``--desktop`` measures the desktop view (pyvistaqt's QtInteractor) instead, on
+the X server in ``$DISPLAY`` with ``QT_QPA_PLATFORM=xcb`` (Xvfb will do).
 """
 
 from __future__ import annotations
@@ -38,14 +40,16 @@ def _stats(values) -> dict:
     return {"median_ms": float(np.median(a)), "max_ms": float(a.max()), "n": int(a.size)}
 
 
-def run(size: str, operator: str, k: int) -> dict:
+def run(size: str, operator: str, k: int, desktop: bool = False) -> dict:
     from qtpy import QtCore, QtWidgets
 
     from modalviewer.gui import MainWindow
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
     cache_dir = tempfile.mkdtemp(prefix="modalviewer-bench-")
-    win = MainWindow(force_offscreen=True, cache=SpectrumCache(Path(cache_dir)))
+    win = MainWindow(
+        force_offscreen=None if desktop else True, cache=SpectrumCache(Path(cache_dir))
+    )
     win.resize(1280, 900)
     win.show()
     app.processEvents()
@@ -54,6 +58,7 @@ def run(size: str, operator: str, k: int) -> dict:
     win.viewport.render_now()  # the first draw of a new mesh is slow in software
     app.processEvents()
     out = {"mesh": size, "vertices": mesh.n_vertices, "operator": operator, "k": k}
+    out["view"] = type(win.viewport).__name__
 
     # computing while a timer watches the event loop
     gaps, ends, last = [], [], [time.perf_counter()]
@@ -173,9 +178,16 @@ def main(argv=None) -> int:
     p.add_argument("--size", default="130k", choices=["10k", "50k", "130k"])
     p.add_argument("--operator", default="shells", choices=sorted(KIND))
     p.add_argument("--k", type=int, default=100)
+    p.add_argument(
+        "--desktop",
+        action="store_true",
+        help="the desktop view (pyvistaqt's QtInteractor) on $DISPLAY, with "
+        "QT_QPA_PLATFORM=xcb, instead of the off-screen view",
+    )
     args = p.parse_args(argv)
-    result = run(args.size, args.operator, args.k)
-    save_result(f"interactive_{args.size}_{args.operator}", result)
+    result = run(args.size, args.operator, args.k, args.desktop)
+    suffix = "_desktop" if args.desktop else ""
+    save_result(f"interactive_{args.size}_{args.operator}{suffix}", result)
     print(table(result))
     return 0
 
