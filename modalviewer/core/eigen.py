@@ -122,8 +122,12 @@ def zero_modes(lam: np.ndarray, lam_scale: float = 0.0) -> np.ndarray:
     ``lam_scale`` (a typical eigenvalue size) keeps a spectrum of only zero modes from
     judging itself by its own rounding noise."""
     lam = np.asarray(lam, dtype=np.float64)
-    lam_max = max(float(np.abs(lam).max(initial=0.0)), lam_scale, np.finfo(float).tiny)
-    return lam < ZERO_MODE_RTOL * lam_max
+    return lam < ZERO_MODE_RTOL * _lam_max(lam, lam_scale)
+
+
+def _lam_max(lam: np.ndarray, lam_scale: float) -> float:
+    """The eigenvalue size zero modes are judged against: max(largest |lam|, lam_scale)."""
+    return max(float(np.abs(lam).max(initial=0.0)), lam_scale, np.finfo(float).tiny)
 
 
 def relative_residuals(
@@ -134,9 +138,7 @@ def relative_residuals(
     Zero modes are those of :func:`zero_modes` (``lam_scale`` is passed on).
     """
     scale = np.abs(lam).copy()
-    lam_max = max(float(np.abs(lam).max()), lam_scale, np.finfo(float).tiny)
-    zero = zero_modes(lam, lam_scale)
-    scale[zero] = lam_max
+    scale[zero_modes(lam, lam_scale)] = _lam_max(lam, lam_scale)
     out = np.empty(X.shape[1])
     for cols, KX in _sparse_products(K, X):  # (N, 32) temporaries, not three (N, k) ones
         MX = mass_diag[:, None] * X[:, cols]
