@@ -1,0 +1,260 @@
+"""Computations as job objects: each its own progress, cancel, result or error (no Qt).
+
+Policy: one job runs at a time (a spectrum computation already uses every core), the
+others wait in a first-in first-out queue.  A request identical to a queued or running
+job (same ``key``) joins that job instead of starting another.  Nothing is cancelled
+except by :meth:`Job.cancel` (the user's Cancel, or the viewer when the mesh a job
+belongs to is replaced), and a cancelled or failed job reports so to whoever waits for
+it: a new request never swallows another one.
+
+Threads: the job's function runs in a worker thread; every state change of a job is
+handed to ``dispatch`` (a callable that runs a function on the owner's thread: Qt's
+event loop in the viewer, :class:`ManualDispatcher` in scripts and tests), so the
+``events`` are always emitted on the owner's thread.
+"""
+
+from __future__ import annotations
+
+import itertools
+import queue
+import threading
+import time
+import traceback
+from collections.abc import Callable, Hashable
+
+from psygnal import Signal, SignalGroup
+
+from ..core.eigen import Cancelled
+
+_ids = itertools.count(1)
+
+PROGRESS_INTERVAL = 0.05
+"""Seconds between two progress reports of the same stage (each crosses threads)."""
+
+QUEUED, RUNNING, DONE, FAILED, CANCELLED = "queued", "running", "done", "failed", "cancelled"
+
+
+class Job:
+    """One computation: ``fn(progress, cancel)`` returns the result.
+
+    Attributes set on the owner's thread: ``status``, ``stage``, ``fraction``,
+    ``result``, ``error`` (a message for users), ``details`` (a traceback for the log),
+    ``seconds`` (run time).
+    """
+
+    def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None):
+        self.id = next(_ids)
+        self.key = key
+        self.owner = owner
+        self.description = description
+        self.status = QUEUED
+        self.stage = "queued"
+        self.fraction = 0.0
+        self.result = None
+        self.error: str | None = None
+        self.details = ""
+        self.seconds = 0.0
+        self.callbacks: list[Callable[[Job], None]] = []
+        self._fn = fn
+        self._cancel = threading.Event()
+        self._done = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def __repr__(self) -> str:
+        return f"<Job {self.id} {self.description!r} {self.status}>"
+
+    @property
+    def done(self) -> bool:
+        return self.status in (DONE, FAILED, CANCELLED)
+
+    @property
+    def cancel_requested(self) -> bool:
+        return self._cancel.is_set()
+
+    def cancel(self) -> None:
+        """Ask the job to stop; a queued job is dropped when its turn comes."""
+        self._cancel.set()
+
+    @classmethod
+    def ended(cls, result, key: Hashable, description: str, owner: Hashable = None) -> Job:
+        """A job that has ended already with ``result`` (a request answered at once)."""
+        job = cls(None, key, description, owner)
+        job.status, job.stage, job.fraction, job.result = DONE, "done", 1.0, result
+        job._done.set()
+        return job
+
+    def then(self, callback: Callable[[Job], None]) -> Job:
+        """Call ``callback(job)`` on the owner's thread once the job has ended (at once
+        if it has)."""
+        if self.done:
+            callback(self)
+        else:
+            self.callbacks.append(callback)
+        return self
+
+    def join(self, timeout: float | None = None) -> bool:
+        """Block until the worker thread has finished (not until callbacks ran)."""
+        return self._done.wait(timeout)
+
+
+class JobEvents(SignalGroup):
+    changed = Signal(object)  # a job was queued, started, progressed or ended
+    finished = Signal(object)  # a job ended (done, failed or cancelled)
+
+
+class ManualDispatcher:
+    """Collects functions from worker threads; :meth:`process` runs them here."""
+
+    def __init__(self) -> None:
+        self._queue: queue.Queue = queue.Queue()
+
+    def __call__(self, fn: Callable[[], None]) -> None:
+        self._queue.put(fn)
+
+    def process(self, timeout: float = 0.0) -> int:
+        """Run the pending functions (waiting up to ``timeout`` s for the first)."""
+        count = 0
+        try:
+            fn = self._queue.get(timeout=timeout) if timeout > 0 else self._queue.get_nowait()
+        except queue.Empty:
+            return 0
+        while True:
+            fn()
+            count += 1
+            try:
+                fn = self._queue.get_nowait()
+            except queue.Empty:
+                return count
+
+
+class JobQueue:
+    """Runs jobs one at a time in worker threads; see the module docstring."""
+
+    def __init__(self, dispatch: Callable[[Callable[[], None]], None] | None = None):
+        self.dispatch = dispatch or ManualDispatcher()
+        self.events = JobEvents()
+        self.jobs: list[Job] = []  # queued and running, in order
+
+    # -------------------------------------------------------------- public
+    def submit(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None) -> Job:
+        """Queue ``fn``; an identical queued or running request is returned instead."""
+        for job in self.jobs:
+            if job.key == key and not job.cancel_requested:
+                return job
+        job = Job(fn, key, description, owner)
+        self.jobs.append(job)
+        self.events.changed.emit(job)
+        self._start_next()
+        return job
+
+    @property
+    def running(self) -> Job | None:
+        return next((job for job in self.jobs if job.status == RUNNING), None)
+
+    @property
+    def busy(self) -> bool:
+        return bool(self.jobs)
+
+    def cancel(self, job: Job) -> None:
+        """Cancel ``job``: a queued one ends at once, a running one at its next check."""
+        job.cancel()
+        if job.status == QUEUED:
+            self._end(job, CANCELLED, error="cancelled")
+            self._start_next()
+
+    def cancel_all(self, owner: Hashable = None, reason: str = "cancelled") -> None:
+        """Cancel every job (of ``owner`` only, if given)."""
+        for job in list(self.jobs):
+            if owner is None or job.owner == owner:
+                job.cancel()
+                if job.status == QUEUED:
+                    self._end(job, CANCELLED, error=reason)
+                else:
+                    job.error = reason
+        self._start_next()
+
+    def wait(self, job: Job, timeout: float | None = None) -> Job:
+        """Wait for ``job`` here, running dispatched functions (scripts and tests)."""
+        if not isinstance(self.dispatch, ManualDispatcher):
+            raise RuntimeError("this queue's events run in an event loop: wait there")
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while not job.done:
+            if deadline is not None and time.monotonic() > deadline:
+                raise TimeoutError(f"{job.description} did not end within {timeout} s")
+            self.dispatch.process(timeout=0.05)
+        return job
+
+    def shutdown(self, timeout: float = 5.0) -> None:
+        """Cancel everything and wait for the running worker (window closing)."""
+        running = self.running
+        self.cancel_all(reason="the window was closed")
+        if running is not None:
+            running.join(timeout)
+
+    # ------------------------------------------------------------ internal
+    def _start_next(self) -> None:
+        if self.running is not None:
+            return
+        job = next((j for j in self.jobs if j.status == QUEUED), None)
+        if job is None:
+            return
+        job.status, job.stage = RUNNING, "starting"
+        job._thread = threading.Thread(target=self._run, args=(job,), daemon=True)
+        job._started = time.perf_counter()
+        self.events.changed.emit(job)
+        job._thread.start()
+
+    def _run(self, job: Job) -> None:
+        last = {"stage": None, "time": 0.0}
+
+        def progress(stage: str, fraction: float) -> None:
+            now = time.monotonic()
+            if stage == last["stage"] and now - last["time"] < PROGRESS_INTERVAL:
+                return
+            last.update(stage=stage, time=now)
+            self.dispatch(lambda: self._progress(job, str(stage), float(fraction)))
+
+        try:
+            result = job._fn(progress, job._cancel.is_set)
+        except Cancelled:
+            outcome = (CANCELLED, None, job.error or "cancelled", "")
+        except MemoryError:
+            outcome = (
+                FAILED,
+                None,
+                "Not enough memory for this computation; compute fewer modes or use "
+                "Coarse-to-fine.",
+                traceback.format_exc(),
+            )
+        except Exception as exc:  # reported to the user, never raised into the event loop
+            outcome = (FAILED, None, str(exc) or type(exc).__name__, traceback.format_exc())
+        else:
+            if job._cancel.is_set():
+                outcome = (CANCELLED, None, job.error or "cancelled", "")
+            else:
+                outcome = (DONE, result, None, "")
+        job.seconds = time.perf_counter() - job._started
+        job._done.set()
+        self.dispatch(lambda: self._finish(job, *outcome))
+
+    def _progress(self, job: Job, stage: str, fraction: float) -> None:
+        if job.status != RUNNING:
+            return
+        job.stage, job.fraction = stage, fraction
+        self.events.changed.emit(job)
+
+    def _finish(self, job: Job, status, result, error, details) -> None:
+        job.result, job.details = result, details
+        self._end(job, status, error)
+        self._start_next()
+
+    def _end(self, job: Job, status: str, error: str | None) -> None:
+        if job.done:
+            return
+        job.status, job.error = status, error
+        if job in self.jobs:
+            self.jobs.remove(job)
+        self.events.changed.emit(job)
+        self.events.finished.emit(job)
+        for callback in job.callbacks:
+            callback(job)

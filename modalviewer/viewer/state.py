@@ -1,0 +1,604 @@
+"""The viewer's state: what is loaded, computed, displayed and picked (no Qt, no VTK).
+
+:class:`ViewerState` is the single source of truth of the viewer.  The 3D scene, every
+panel, the status bar and the plots observe its events and redraw from it; they keep
+no state of their own.  Input (a click, a slider, a script, the CLI) goes through its
+setters, which validate, store and emit.  Everything shown can be derived from it:
+:meth:`ViewerState.field` is the per-vertex picture, :meth:`ViewerState.legend` its
+legend and :meth:`ViewerState.summary` the status line.
+
+Events (``state.events.<name>.connect(callback)``), all emitted on the thread that
+changed the state (the GUI thread in the viewer):
+
+- ``mesh()``: a new mesh (or none) is loaded; spectra, pick and display were reset.
+- ``spectra(operator)``: a spectrum of ``operator`` was added or replaced.
+- ``display()``: what is drawn changed (:class:`Display`), including the threshold.
+- ``style()``: isolines, colouring of 3D modes, colour bar, render style.
+- ``pick()``: the picked vertex changed.
+- ``compute_settings()``: operator, k, weights or options of the next computation.
+- ``scale_range()``: the distance scale range (t1, t2) changed.
+- ``animation()``: playing, amplitude or speed changed.
+- ``camera()``: a camera was set through the state (a preset, a restored session).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+from psygnal import Signal, SignalGroup
+
+from ..core.curvature import total_curvature
+from ..core.laplacian import vertex_normals
+from ..core.mesh import Mesh
+from ..core.operators import (
+    DISTANCE_KINDS,
+    OPERATOR_INFO,
+    operator_for_distance,
+    operator_info,
+)
+from ..core.signatures import SignatureTable, signature
+from ..core.spectrum import Spectrum
+
+DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature")
+DISTANCE_DISPLAYS = ("continuous", "threshold")
+SHELL_COLORINGS = ("normal", "magnitude")
+
+
+def default_k(n_vertices: int) -> int:
+    """A mode count suited to the mesh: 100 for most meshes, fewer for tiny ones."""
+    return int(max(2, min(100, n_vertices // 4)))
+
+
+@dataclass(frozen=True)
+class ComputeSettings:
+    """What the next computation computes (the Compute panel's fields)."""
+
+    operator: str = "modified_dirichlet"
+    k: int = 100
+    bending: float = 1.0
+    membrane: float = 1.0
+    rescale: bool = False
+    coarse: bool = False
+
+    def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
+        op = operator or self.operator
+        weights = operator_info(op).has_weights
+        return SpectrumKey(
+            operator=op,
+            k=int(k if k is not None else self.k),
+            bending=float(self.bending) if weights else 1.0,
+            membrane=float(self.membrane) if weights else 1.0,
+            rescale=bool(self.rescale),
+            coarse=bool(self.coarse),
+        )
+
+
+@dataclass(frozen=True)
+class SpectrumKey:
+    """Identifies one computed spectrum of the loaded mesh."""
+
+    operator: str
+    k: int
+    bending: float = 1.0
+    membrane: float = 1.0
+    rescale: bool = False
+    coarse: bool = False
+
+    def describe(self) -> str:
+        info = operator_info(self.operator)
+        extra = []
+        if info.has_weights and (self.bending, self.membrane) != (1.0, 1.0):
+            extra.append(f"bending {self.bending:g}, membrane {self.membrane:g}")
+        if self.rescale:
+            extra.append("unit area")
+        if self.coarse:
+            extra.append("coarse-to-fine")
+        tail = f" ({'; '.join(extra)})" if extra else ""
+        return f"{info.label}, {self.k} modes{tail}"
+
+
+@dataclass(frozen=True)
+class Display:
+    """What the surface shows.
+
+    kind : "none" | "mode" | "distance" | "signature" | "curvature".
+    operator : the spectrum a mode belongs to.
+    mode : index of the mode shown.
+    distance_kind : "vibration" | "feature" | "hks" (also picks the signature's spectrum).
+    distance_display : "continuous" | "threshold".
+    threshold : threshold as a fraction of the largest distance (0..1].
+    signature_sample : index of the scale a signature is shown at (0..99).
+    """
+
+    kind: str = "none"
+    operator: str | None = None
+    mode: int = 0
+    distance_kind: str = "vibration"
+    distance_display: str = "continuous"
+    threshold: float = 0.2
+    signature_sample: int = 50
+
+
+@dataclass
+class Field:
+    """A per-vertex picture derived from the state, ready for the scene to draw.
+
+    colormap : "diverging" (blue / white / orange), "sequential" (white to red),
+    "threshold" (blue = similar) or "plain" (no field: the grey surface).
+    """
+
+    values: np.ndarray
+    colormap: str
+    isolines: int = 0
+    displacement: np.ndarray | None = None
+    clim: tuple[float, float] | None = None
+    title: str = ""
+    legend: str = ""
+    share_similar: float | None = None
+
+
+class ViewerEvents(SignalGroup):
+    mesh = Signal()
+    spectra = Signal(str)
+    display = Signal()
+    style = Signal()
+    pick = Signal()
+    compute_settings = Signal()
+    scale_range = Signal()
+    animation = Signal()
+    camera = Signal()
+
+
+@dataclass
+class _Style:
+    isolines: int = 12
+    shell_coloring: str = "normal"
+    colorbar: bool = False
+
+
+@dataclass
+class Animation:
+    playing: bool = False
+    amplitude: int = 8  # percent of a quarter of the bounding-box diagonal
+    speed: int = 30  # tenths of a radian per second
+
+
+@dataclass
+class _Derived:
+    """Values computed from the state and kept until it changes (not part of it)."""
+
+    normals: np.ndarray | None = None
+    tables: dict = field(default_factory=dict)
+    distance: dict = field(default_factory=dict)
+    curvature: np.ndarray | None = None
+
+
+class ViewerState:
+    """The viewer's state; see the module docstring for its events."""
+
+    def __init__(self) -> None:
+        self.events = ViewerEvents()
+        self.mesh: Mesh | None = None
+        self.mesh_path: Path | None = None
+        self.compute_settings = ComputeSettings()
+        self.spectra: dict[SpectrumKey, Spectrum] = {}
+        self._latest: dict[str, SpectrumKey] = {}
+        self.display = Display()
+        self.picked: int | None = None
+        self.t_range: tuple[float, float] | None = None
+        self.style = _Style()
+        self.animation = Animation()
+        self.camera: dict | None = None
+        self._derived = _Derived()
+
+    # ------------------------------------------------------------- mesh
+    def set_mesh(self, mesh: Mesh | None, path: Path | str | None = None) -> None:
+        """Load ``mesh``: spectra, pick and display of the previous mesh are dropped."""
+        self.mesh = mesh
+        self.mesh_path = Path(path) if path is not None else None
+        self.spectra.clear()
+        self._latest.clear()
+        self._derived = _Derived()
+        if mesh is not None:
+            self._derived.normals = vertex_normals(mesh)
+            self.compute_settings = replace(self.compute_settings, k=default_k(mesh.n_vertices))
+        self.picked = None
+        self.animation.playing = False
+        self.display = replace(self.display, kind="none", operator=None, mode=0)
+        self.camera = None
+        self.events.mesh.emit()
+
+    @property
+    def normals(self) -> np.ndarray | None:
+        return self._derived.normals
+
+    def compute_mesh(self, key: SpectrumKey | None = None) -> Mesh:
+        """The mesh a spectrum is computed on: the loaded one, or a copy of unit area."""
+        if self.mesh is None:
+            raise ValueError("no mesh is loaded")
+        rescale = key.rescale if key is not None else self.compute_settings.rescale
+        if not rescale:
+            return self.mesh
+        factor = 1.0 / np.sqrt(self.mesh.total_area)
+        return Mesh(self.mesh.vertices * factor, self.mesh.faces, report=self.mesh.report)
+
+    # ---------------------------------------------------------- spectra
+    def add_spectrum(self, key: SpectrumKey, spec: Spectrum, table=None) -> None:
+        """Store a computed spectrum (and its signature table, if already built)."""
+        if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
+            raise ValueError("the spectrum does not belong to the loaded mesh")
+        self.spectra[key] = spec
+        self._latest[key.operator] = key
+        stale = [k for k in self._derived.tables if k[0] == key.operator]
+        for k in stale:
+            del self._derived.tables[k]
+        self._derived.distance.clear()
+        if table is not None:
+            self._derived.tables[(key.operator, id(spec), table_range(table))] = table
+        self.events.spectra.emit(key.operator)
+        if self.display.kind in ("mode", "distance", "signature"):
+            if self.display_operator() == key.operator:
+                self.events.display.emit()
+
+    def spectrum(self, operator: str | None) -> Spectrum | None:
+        """The most recent spectrum of ``operator``, or None."""
+        key = self._latest.get(operator) if operator else None
+        return self.spectra.get(key) if key is not None else None
+
+    def spectrum_key(self, operator: str) -> SpectrumKey | None:
+        return self._latest.get(operator)
+
+    def operators_computed(self) -> list[str]:
+        return [op for op in OPERATOR_INFO if op in self._latest]
+
+    def has_spectrum(self, key: SpectrumKey) -> bool:
+        return key in self.spectra
+
+    # --------------------------------------------------------- settings
+    def set_compute_settings(self, **changes) -> None:
+        """Change fields of :class:`ComputeSettings` (operator, k, bending, ...)."""
+        if "operator" in changes:
+            operator_info(changes["operator"])
+        if "k" in changes:
+            changes["k"] = int(changes["k"])
+            if changes["k"] < 1:
+                raise ValueError("the number of modes must be at least 1")
+        new = replace(self.compute_settings, **changes)
+        if new != self.compute_settings:
+            self.compute_settings = new
+            self.events.compute_settings.emit()
+
+    def set_isolines(self, count: int) -> None:
+        count = int(np.clip(count, 0, 60))
+        if count != self.style.isolines:
+            self.style.isolines = count
+            self.events.style.emit()
+
+    def set_shell_coloring(self, coloring: str) -> None:
+        if coloring not in SHELL_COLORINGS:
+            raise ValueError(f"colouring must be one of {SHELL_COLORINGS}")
+        if coloring != self.style.shell_coloring:
+            self.style.shell_coloring = coloring
+            self.events.style.emit()
+
+    def set_colorbar(self, on: bool) -> None:
+        if bool(on) != self.style.colorbar:
+            self.style.colorbar = bool(on)
+            self.events.style.emit()
+
+    def set_animation(self, **changes) -> None:
+        """playing (only a mode can play), amplitude (0..100), speed (1..100)."""
+        anim = self.animation
+        new = Animation(
+            playing=bool(changes.get("playing", anim.playing)) and self.display.kind == "mode",
+            amplitude=int(np.clip(changes.get("amplitude", anim.amplitude), 0, 100)),
+            speed=int(np.clip(changes.get("speed", anim.speed), 1, 100)),
+        )
+        if new != anim:
+            self.animation = new
+            self.events.animation.emit()
+
+    def set_scale_range(self, t_range: tuple[float, float] | None) -> None:
+        """The scale range (t1, t2) of signatures and distances; None for the default."""
+        if t_range is not None:
+            t1, t2 = (float(t) for t in t_range)
+            if not 0 < t1 < t2:
+                raise ValueError("the scale range needs 0 < t1 < t2")
+            t_range = (t1, t2)
+        if t_range != self.t_range:
+            self.t_range = t_range
+            self._derived.distance.clear()
+            self.events.scale_range.emit()
+            if self.display.kind in ("distance", "signature"):
+                self.events.display.emit()
+
+    def set_camera(self, camera: dict | None) -> None:
+        """Set the camera (position, focal_point, view_up, parallel_scale); the scene
+        applies it.  The scene also stores the user's camera here before a session is
+        saved."""
+        self.camera = camera
+        self.events.camera.emit()
+
+    # ---------------------------------------------------------- display
+    def set_display(self, **changes) -> None:
+        """Change what is shown; fields of :class:`Display`.  Validated before storing."""
+        new = replace(self.display, **changes)
+        if new.kind not in DISPLAY_KINDS:
+            raise ValueError(f"display kind must be one of {DISPLAY_KINDS}")
+        if new.distance_kind not in DISTANCE_KINDS:
+            raise ValueError(f"distance kind must be one of {tuple(DISTANCE_KINDS)}")
+        if new.distance_display not in DISTANCE_DISPLAYS:
+            raise ValueError(f"distance display must be one of {DISTANCE_DISPLAYS}")
+        if new.kind == "mode":
+            spec = self.spectrum(new.operator)
+            if spec is None:
+                raise ValueError(f"no spectrum of {new.operator!r} has been computed")
+            new = replace(new, mode=int(np.clip(new.mode, 0, spec.k - 1)))
+        new = replace(
+            new,
+            threshold=float(np.clip(new.threshold, 1e-4, 1.0)),
+            signature_sample=int(np.clip(new.signature_sample, 0, 99)),
+        )
+        if new == self.display:
+            return
+        self.display = new
+        if new.kind != "mode" and self.animation.playing:
+            self.animation = replace(self.animation, playing=False)
+            self.events.animation.emit()
+        self.events.display.emit()
+
+    def show_mode(self, index: int, operator: str | None = None) -> None:
+        op = operator or self.display.operator or self._first_computed()
+        self.set_display(kind="mode", operator=op, mode=index)
+
+    def first_nonzero_mode(self, operator: str) -> int:
+        spec = self.spectrum(operator)
+        if spec is None:
+            return 0
+        nonzero = ~spec.zero_mode_mask()
+        return int(np.argmax(nonzero)) if nonzero.any() else 0
+
+    def _first_computed(self) -> str | None:
+        ops = self.operators_computed()
+        return ops[0] if ops else None
+
+    def set_pick(self, vertex: int | None) -> None:
+        if vertex is not None:
+            if self.mesh is None:
+                raise ValueError("no mesh is loaded")
+            vertex = int(vertex)
+            if not 0 <= vertex < self.mesh.n_vertices:
+                raise ValueError(f"Vertex {vertex} does not exist (0..{self.mesh.n_vertices - 1}).")
+        if vertex != self.picked:
+            self.picked = vertex
+            self.events.pick.emit()
+            if self.display.kind == "distance":
+                self.events.display.emit()
+
+    def display_operator(self) -> str | None:
+        """The operator whose spectrum the current display is made of."""
+        d = self.display
+        if d.kind == "mode":
+            return d.operator
+        if d.kind in ("distance", "signature"):
+            return operator_for_distance(d.distance_kind)
+        return None
+
+    # ---------------------------------------------------- derived values
+    def table(self, operator: str) -> SignatureTable:
+        """The signature table of ``operator``'s spectrum over the current scale range."""
+        spec = self.spectrum(operator)
+        if spec is None:
+            raise ValueError(f"no spectrum of {operator!r} has been computed")
+        key = (operator, id(spec), self.t_range)
+        table = self._derived.tables.get(key)
+        if table is None:
+            table = SignatureTable(spec, t_range=self.t_range)
+            self._derived.tables[key] = table
+        return table
+
+    def keep_table(self, operator: str, spec: Spectrum, table: SignatureTable) -> None:
+        """Keep a table built elsewhere (in a worker) if it is still the current one."""
+        if self.spectrum(operator) is spec:
+            self._derived.tables.setdefault((operator, id(spec), table_range(table)), table)
+
+    def distance_map(self, kind: str | None = None) -> np.ndarray | None:
+        """Distance of ``kind`` from the picked vertex, or None if a spectrum is missing."""
+        kind = kind or self.display.distance_kind
+        operator = operator_for_distance(kind)
+        if self.picked is None or self.spectrum(operator) is None:
+            return None
+        key = (kind, self.picked, self.t_range, id(self.spectrum(operator)))
+        d = self._derived.distance.get(key)
+        if d is None:
+            d = self.table(operator).distance_from(self.picked)
+            self._derived.distance = {key: d}
+        return d
+
+    def threshold_value(self, d: np.ndarray | None = None) -> float | None:
+        """The absolute threshold of the display's distance (fraction x largest)."""
+        d = self.distance_map() if d is None else d
+        if d is None:
+            return None
+        return self.display.threshold * float(d.max())
+
+    def threshold_for_share(self, share: float, d: np.ndarray | None = None) -> float:
+        """The threshold fraction that marks ``share`` (0..1) of the vertices similar."""
+        d = self.distance_map() if d is None else d
+        if d is None or d.max() <= 0:
+            return float(share)
+        value = float(np.quantile(d, float(np.clip(share, 0.0, 1.0))))
+        return float(np.clip(value / float(d.max()), 1e-4, 1.0))
+
+    def mode_fields(self, spec: Spectrum, j: int) -> tuple[np.ndarray, np.ndarray]:
+        """(scalar to colour (n,), displacement (n, 3) scaled to a peak of 1) of mode j."""
+        phi = spec.mode(j)
+        normals = self.normals
+        if spec.is_vector:
+            if self.style.shell_coloring == "normal":
+                scalar = np.einsum("ij,ij->i", phi, normals)
+            else:
+                scalar = np.linalg.norm(phi, axis=1)
+            disp = phi
+        else:
+            scalar = phi
+            disp = phi[:, None] * normals
+        peak = float(np.max(np.linalg.norm(disp, axis=1))) or 1.0
+        return scalar, disp / peak
+
+    def curvature(self) -> np.ndarray:
+        if self._derived.curvature is None:
+            self._derived.curvature = total_curvature(self.mesh)
+        return self._derived.curvature
+
+    def field(self) -> Field | None:
+        """The picture the display asks for, or None if it cannot be drawn (yet)."""
+        if self.mesh is None:
+            return None
+        d = self.display
+        n = self.mesh.n_vertices
+        plain = Field(np.zeros(n), "plain")
+        if d.kind == "mode":
+            spec = self.spectrum(d.operator)
+            if spec is None:
+                return plain
+            j = int(np.clip(d.mode, 0, spec.k - 1))
+            scalar, disp = self.mode_fields(spec, j)
+            magnitude = spec.is_vector and self.style.shell_coloring == "magnitude"
+            return Field(
+                scalar,
+                "sequential" if magnitude else "diverging",
+                isolines=self.style.isolines,
+                displacement=disp,
+                title=f"{operator_info(d.operator).short_label} mode {j}",
+                legend=self.legend(),
+            )
+        if d.kind == "distance":
+            dist = self.distance_map()
+            if dist is None:
+                return plain
+            name = DISTANCE_KINDS[d.distance_kind]
+            if d.distance_display == "threshold":
+                thr = self.threshold_value(dist)
+                return Field(
+                    (dist > thr).astype(np.float64),
+                    "threshold",
+                    title=f"{name} < {thr:.3g}",
+                    legend=self.legend(),
+                    share_similar=float(np.mean(dist <= thr)),
+                )
+            return Field(dist, "sequential", title=name, legend=self.legend())
+        if d.kind == "signature":
+            operator = operator_for_distance(d.distance_kind)
+            spec = self.spectrum(operator)
+            if spec is None:
+                return plain
+            t = self.signature_time()
+            _, values = signature(spec, [t])
+            return Field(
+                values[:, 0],
+                "sequential",
+                isolines=self.style.isolines,
+                title=f"signature t = {t:.3g}",
+                legend=self.legend(),
+            )
+        if d.kind == "curvature":
+            curvature = self.curvature()
+            hi = float(np.percentile(curvature, 98)) or 1.0
+            return Field(
+                curvature,
+                "sequential",
+                clim=(0.0, hi),
+                title="curvature",
+                legend=self.legend(),
+            )
+        return plain
+
+    def signature_time(self) -> float:
+        table = self.table(operator_for_distance(self.display.distance_kind))
+        return float(
+            table.times[int(np.clip(self.display.signature_sample, 0, len(table.times) - 1))]
+        )
+
+    # ------------------------------------------------------------- words
+    def legend(self) -> str:
+        """One or two lines naming what the surface shows, with its numbers."""
+        d = self.display
+        if self.mesh is None or d.kind == "none":
+            return ""
+        if d.kind == "mode":
+            spec = self.spectrum(d.operator)
+            if spec is None:
+                return ""
+            j = int(np.clip(d.mode, 0, spec.k - 1))
+            lam = float(spec.eigenvalues[j])
+            zero = spec.zero_mode_mask()[j]
+            value = "0 (zero mode)" if zero else f"{lam:.4g}"
+            colours = "blue +, white 0, orange -"
+            if spec.is_vector and self.style.shell_coloring == "magnitude":
+                colours = "white 0 to red: displacement magnitude"
+            elif spec.is_vector:
+                colours += " (normal component)"
+            return f"{operator_info(d.operator).label}, mode {j}: lambda = {value}\n{colours}"
+        if d.kind == "distance":
+            name = DISTANCE_KINDS[d.distance_kind]
+            dist = self.distance_map()
+            if dist is None:
+                return f"{name}: pick a vertex"
+            if d.distance_display == "threshold":
+                thr = self.threshold_value(dist)
+                share = 100.0 * float(np.mean(dist <= thr))
+                return (
+                    f"blue: {name.lower()} < {thr:.3g}, {share:.1f} % of the surface\n"
+                    f"from vertex {self.picked}"
+                )
+            t1, t2 = self.scale_limits()
+            return (
+                f"{name} from vertex {self.picked}: white 0 to red {float(dist.max()):.3g}\n"
+                f"scales t = {t1:.3g} .. {t2:.3g}"
+            )
+        if d.kind == "signature":
+            operator = operator_for_distance(d.distance_kind)
+            if self.spectrum(operator) is None:
+                return ""
+            word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
+            return f"{word[d.distance_kind]} signature at t = {self.signature_time():.3g}"
+        if d.kind == "curvature":
+            return "Curvature sqrt(k1^2 + k2^2), white 0 to red (98th percentile)"
+        return ""
+
+    def scale_limits(self) -> tuple[float, float]:
+        """(t1, t2) the distances and signatures use: the chosen range or the default."""
+        table = self.table(operator_for_distance(self.display.distance_kind))
+        return float(table.times[0]), float(table.times[-1])
+
+    def summary(self) -> str:
+        """The status line: the current display's live numbers, on one line."""
+        if self.mesh is None:
+            return "Open a mesh to begin (File > Open, Ctrl+O)."
+        text = self.legend().replace("\n", "; ")
+        if not text:
+            text = f"{self.mesh.n_vertices} vertices, {self.mesh.n_faces} faces"
+            if not self.spectra:
+                text += "; compute a spectrum (Ctrl+R) or click the surface"
+        return text
+
+    def snapshot(self) -> dict:
+        """The display-related state as plain data (for sessions and tests)."""
+        return {
+            "display": asdict(self.display),
+            "picked": self.picked,
+            "t_range": list(self.t_range) if self.t_range else None,
+            "isolines": self.style.isolines,
+            "shell_coloring": self.style.shell_coloring,
+            "colorbar": self.style.colorbar,
+            "animation": asdict(self.animation),
+            "compute_settings": asdict(self.compute_settings),
+        }
+
+
+def table_range(table: SignatureTable) -> tuple[float, float] | None:
+    """The t_range a table was built for (None when built over the default range)."""
+    return getattr(table, "requested_range", None)
