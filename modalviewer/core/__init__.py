@@ -1,5 +1,16 @@
 """Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
 
+from .cross import (
+    CrossTables,
+    Matches,
+    ScaleWarning,
+    best_match,
+    common_times,
+    cross_distance,
+    distance_ranks,
+    mutual_best_matches,
+    rescale_to_area,
+)
 from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
 from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
@@ -10,6 +21,15 @@ from .signatures import SignatureTable, default_times, multiscale_distance, sign
 from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, save_spectrum
 
 __all__ = [
+    "CrossTables",
+    "Matches",
+    "ScaleWarning",
+    "best_match",
+    "common_times",
+    "cross_distance",
+    "distance_ranks",
+    "mutual_best_matches",
+    "rescale_to_area",
     "Cancelled",
     "EigenError",
     "Mesh",

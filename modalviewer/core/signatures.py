@@ -90,9 +90,20 @@ class SignatureTable:
         (distance below 1e-3 of the signature norms) the entries are recomputed directly,
         so near-zero distances keep full relative accuracy and d(v, v) = 0 exactly.
         """
-        row = self.table[vertex]
-        d2 = self._norms2 + self._norms2[vertex] - 2.0 * (self.table @ row)
-        close = np.flatnonzero(d2 <= 1e-6 * (self._norms2 + self._norms2[vertex]))
+        return self.distance_to(self.table[vertex])
+
+    def distance_to(self, row: np.ndarray) -> np.ndarray:
+        """(n,) distance from a normalised signature ``row`` (T,) to every vertex.
+
+        ``row`` must be sampled at the same :attr:`times`, for example a row of another
+        mesh's table (the distance between shapes of :mod:`modalviewer.core.cross`).
+        """
+        row = np.asarray(row, dtype=np.float64)
+        if row.shape != (self.table.shape[1],):
+            raise ValueError(f"row must have shape ({self.table.shape[1]},), got {row.shape}")
+        norm2 = float(row @ row)
+        d2 = self._norms2 + norm2 - 2.0 * (self.table @ row)
+        close = np.flatnonzero(d2 <= 1e-6 * (self._norms2 + norm2))
         diff = self.table[close] - row
         d2[close] = np.einsum("ij,ij->i", diff, diff)
         return np.sqrt(np.maximum(d2, 0.0))
