@@ -73,7 +73,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--size", type=_size, default=(1024, 768))
     r.add_argument("--transparent", action="store_true")
     r.add_argument("-o", "--output", required=True)
-    d = sub.add_parser("distance", help="distance from a vertex to all vertices")
+    d = sub.add_parser(
+        "distance", help="distance from a vertex to all vertices (of a second mesh with --to)"
+    )
     d.add_argument("mesh")
     d.add_argument("--vertex", type=int, required=True)
     d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
@@ -87,6 +89,17 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--size", type=_size, default=(1024, 768))
     d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
     d.add_argument("--csv", default=None, help="write vertex,distance rows")
+    d.add_argument(
+        "--to",
+        default=None,
+        metavar="MESH_B",
+        help="distance to every vertex of this second mesh instead (vertex of MESH_B, distance)",
+    )
+    d.add_argument(
+        "--rescale",
+        action="store_true",
+        help="with --to: scale both meshes to unit area before computing",
+    )
     f = sub.add_parser("figures", help="rebuild the paper's figures on the demo meshes")
     f.add_argument("-o", "--output", default="screenshots")
     return p
@@ -167,17 +180,14 @@ def _run(args) -> int:
         raise ValueError(f"--vertex must be between 0 and {mesh.n_vertices - 1}")
     if args.threshold is not None and not 0 < args.threshold <= 1:
         raise ValueError("--threshold is a fraction of the largest distance, in (0, 1]")
+    if args.to is not None:
+        return _distance_to(args, mesh)
+    if args.rescale:
+        raise ValueError("--rescale applies to two meshes (with --to)")
     spec = mv.compute_spectrum(mesh, KINDS[args.kind], args.k, progress=_progress_bar())
     d = mv.multiscale_distance(spec, args.vertex)
     if args.csv:
-        np.savetxt(
-            args.csv,
-            np.column_stack([np.arange(len(d)), d]),
-            delimiter=",",
-            header="vertex,distance",
-            comments="",
-            fmt=["%d", "%.10g"],
-        )
+        _write_csv(args.csv, d)
     if args.output:
         app, win = _window(args.size)
         win.set_mesh(mesh, Path(args.mesh))
@@ -191,6 +201,69 @@ def _run(args) -> int:
     order = np.argsort(d)[1:6]
     print(
         f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "
+        + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
+    )
+    return 0
+
+
+def _write_csv(path, d: np.ndarray) -> None:
+    np.savetxt(
+        path,
+        np.column_stack([np.arange(len(d)), d]),
+        delimiter=",",
+        header="vertex,distance",
+        comments="",
+        fmt=["%d", "%.10g"],
+    )
+
+
+def _distance_to(args, mesh_a) -> int:
+    """``distance A --vertex V --to B``: from vertex V of A to every vertex of B."""
+    import warnings
+
+    import modalviewer as mv
+
+    mesh_b = mv.load_mesh(args.to)
+    if args.rescale:
+        mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
+    operator = KINDS[args.kind]
+    spec_a = mv.compute_spectrum(mesh_a, operator, args.k, progress=_progress_bar())
+    spec_b = mv.compute_spectrum(mesh_b, operator, args.k, progress=_progress_bar())
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", mv.ScaleWarning)
+        tables = mv.CrossTables(spec_a, spec_b)
+    for warning in caught:
+        sys.stderr.write(f"modalviewer: warning: {warning.message} (or pass --rescale)\n")
+    d = tables.a_to_b(args.vertex)
+    best = int(np.argmin(d))
+    back = int(np.argmin(tables.b_to_a(best)))
+    if args.csv:
+        _write_csv(args.csv, d)
+    if args.output:
+        from .cross_figure import Panel, render_panels
+
+        label = {"vibration": "vibration", "feature": "feature", "hks": "heat kernel"}[args.kind]
+        display = "threshold" if args.threshold is not None else "continuous"
+        panels = [
+            Panel(mesh_a, f"{Path(args.mesh).name}: vertex {args.vertex}", args.vertex),
+            Panel(
+                mesh_b,
+                f"{Path(args.to).name}: {label} distance, best match {best}",
+                best,
+                d,
+                args.kind,
+                display,
+                args.threshold if args.threshold is not None else 0.2,
+            ),
+        ]
+        render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))
+    order = np.argsort(d, kind="stable")[:5]
+    print(
+        f"{args.kind} distance from vertex {args.vertex} of {Path(args.mesh).name} to "
+        f"{Path(args.to).name} (scales {tables.times[0]:.4g} .. {tables.times[-1]:.4g}): "
+        f"max {d.max():.6g}; best match {best} ({d[best]:.3g}), "
+        + ("mutual" if back == args.vertex else f"not mutual (its best match on A is {back})")
+        + "; nearest "
         + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
     )
     return 0
