@@ -1,16 +1,36 @@
-"""On-disk cache of computed spectra, keyed by mesh hash, operator and parameters."""
+"""On-disk cache of computed spectra, keyed by mesh hash, operator and parameters.
+
+The cache is a folder of ``.npz`` files, one per spectrum, with a size limit: when the
+files add up to more than ``max_bytes``, the least recently used ones are deleted first.
+A file's modification time is its last use: :meth:`SpectrumCache.get` touches the file
+it serves, and a new file is written (atomically, through a temporary file and a rename)
+with the current time.  Every entry is checked when it is read (zip member checksums,
+format, shapes, finite values, mesh hash); a damaged or foreign one is deleted with a
+warning in the ``modalviewer.cache`` log and counts as a miss.
+"""
 
 from __future__ import annotations
 
 import hashlib
 import json
+import logging
 import os
+import time
+from dataclasses import dataclass
 from pathlib import Path
 
 from .mesh import Mesh
-from .spectrum import Spectrum, SpectrumFileError, load_spectrum, save_spectrum
+from .spectrum import Spectrum, load_spectrum, save_spectrum
 
-__all__ = ["SpectrumCache", "default_cache_dir"]
+__all__ = ["CacheEntry", "SpectrumCache", "default_cache_dir", "default_cache_limit"]
+
+log = logging.getLogger("modalviewer.cache")
+
+DEFAULT_LIMIT_MB = 2048
+"""Default size limit in megabytes (2 GiB): about fifteen 120-mode shells spectra of a
+48k-vertex mesh (140 MB each), or two 300-mode shells spectra of a 130k-vertex mesh."""
+
+_STALE_PART_SECONDS = 3600.0  # a temporary file this old belongs to a killed writer
 
 
 def default_cache_dir() -> Path:
@@ -22,12 +42,57 @@ def default_cache_dir() -> Path:
     return Path(base) / "modalviewer"
 
 
+def default_cache_limit() -> int:
+    """The size limit in bytes: ``$MODALVIEWER_CACHE_MAX_MB`` megabytes (a number; 0 keeps
+    nothing), else :data:`DEFAULT_LIMIT_MB`.  A value that is not a number is ignored with
+    a warning."""
+    env = os.environ.get("MODALVIEWER_CACHE_MAX_MB", "").strip()
+    if env:
+        try:
+            mb = float(env)
+            if mb >= 0 and mb != float("inf"):
+                return int(mb * 2**20)
+        except ValueError:
+            pass
+        log.warning(
+            "MODALVIEWER_CACHE_MAX_MB=%r is not a non-negative number of megabytes; "
+            "using the default of %d MB",
+            env,
+            DEFAULT_LIMIT_MB,
+        )
+    return DEFAULT_LIMIT_MB * 2**20
+
+
+@dataclass(frozen=True)
+class CacheEntry:
+    """One cached spectrum file: its path, size in bytes and last use (seconds since the
+    epoch)."""
+
+    path: Path
+    size: int
+    last_used: float
+
+
 class SpectrumCache:
-    """Spectra stored as ``.npz`` files; a damaged or foreign entry is ignored and replaced."""
+    """Spectra stored as ``.npz`` files in ``directory``, at most ``max_bytes`` in all.
 
-    def __init__(self, directory: Path | None = None):
+    Parameters
+    ----------
+    directory : the cache folder; default :func:`default_cache_dir`.
+    max_bytes : the size limit; default :func:`default_cache_limit` (2 GiB, or
+        ``$MODALVIEWER_CACHE_MAX_MB``).  The least recently used entries are deleted
+        when the limit is exceeded; the entry just written or read is always kept, even
+        if it alone is larger.  0 stores nothing.
+    """
+
+    def __init__(self, directory: Path | None = None, max_bytes: int | None = None):
         self.directory = Path(directory) if directory else default_cache_dir()
+        if max_bytes is not None and max_bytes < 0:
+            raise ValueError(f"max_bytes must be at least 0, got {max_bytes}")
+        self.max_bytes = int(max_bytes) if max_bytes is not None else default_cache_limit()
+        self._last_stamp = 0
 
+    # ---------------------------------------------------------------- keys
     def key(self, mesh: Mesh, operator: str, k: int, bending: float, membrane: float) -> str:
         params = {"op": operator, "k": int(k)}
         if operator in ("shells", "shells_normal"):
@@ -38,31 +103,75 @@ class SpectrumCache:
     def path(self, *args) -> Path:
         return self.directory / f"{self.key(*args)}.npz"
 
+    # ---------------------------------------------------------- inspection
+    def entries(self) -> list[CacheEntry]:
+        """The cached spectra, most recently used first."""
+        out = []
+        try:
+            candidates = list(self.directory.glob("*.npz"))
+        except OSError:
+            return []
+        for p in candidates:
+            try:
+                st = p.stat()
+            except OSError:  # deleted meanwhile
+                continue
+            out.append(CacheEntry(p, int(st.st_size), st.st_mtime_ns / 1e9))
+        out.sort(key=lambda e: e.last_used, reverse=True)
+        return out
+
+    def size_bytes(self) -> int:
+        """Total size of the cached spectra in bytes."""
+        return sum(e.size for e in self.entries())
+
+    def clear(self) -> int:
+        """Delete every cached spectrum (and temporary files left by killed writers);
+        returns the number of bytes freed."""
+        freed = 0
+        for e in self.entries():
+            try:
+                e.path.unlink()
+                freed += e.size
+            except OSError:
+                pass
+        self._remove_stale_parts(max_age=_STALE_PART_SECONDS)
+        return freed
+
+    # ------------------------------------------------------------- use
     def get(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Spectrum | None:
+        """The cached spectrum, or None.  A hit counts as a use (for the eviction order);
+        an entry that cannot be read is deleted with a warning."""
         path = self.path(mesh, operator, k, bending, membrane)
         if not path.is_file():
             return None
         try:
             spec = load_spectrum(path, mesh_hash=mesh.hash)
-        except (SpectrumFileError, OSError):
-            try:
-                path.unlink()
-            except OSError:
-                pass
+        except FileNotFoundError:  # evicted by another process meanwhile
+            return None
+        except Exception as exc:  # damaged, truncated, foreign: never a crash
+            log.warning("dropped a damaged cache entry %s: %s", path.name, exc)
+            self._unlink(path)
             return None
         if (
             spec.operator != operator
             or spec.k != min(k, spec.k)
             or spec.n_vertices != mesh.n_vertices
         ):
+            log.warning("dropped a cache entry that does not match its key: %s", path.name)
+            self._unlink(path)
             return None
+        self._touch(path)
+        self.enforce_limit(keep=path)
         return spec
 
     def writable_path(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Path:
-        """Where a new entry should be written: the cache file, or a temporary file."""
+        """Where a new entry should be written: the cache file, or a temporary file.
+
+        Makes room first, so that the limit holds once the entry is written."""
         try:
             self.directory.mkdir(parents=True, exist_ok=True)
-            if os.access(self.directory, os.W_OK):
+            if os.access(self.directory, os.W_OK) and self.max_bytes > 0:
+                self.enforce_limit()
                 return self.path(mesh, operator, k, bending, membrane)
         except OSError:
             pass
@@ -71,11 +180,68 @@ class SpectrumCache:
         return Path(tempfile.mkdtemp(prefix="modalviewer-")) / "spectrum.npz"
 
     def put(self, mesh, spec: Spectrum, k, bending=1.0, membrane=1.0) -> Path | None:
-        """Store ``spec``; returns the path, or None if the cache folder is not writable."""
+        """Store ``spec`` (atomically) and evict least recently used entries beyond the
+        limit; returns the path, or None if nothing was stored (folder not writable, or a
+        limit of 0)."""
+        if self.max_bytes <= 0:
+            return None
         try:
             self.directory.mkdir(parents=True, exist_ok=True)
             path = self.path(mesh, spec.operator, k, bending, membrane)
             save_spectrum(spec, path)
-            return path
-        except OSError:
+            self._touch(path)
+        except OSError as exc:
+            log.warning("could not write a cache entry in %s: %s", self.directory, exc)
             return None
+        self.enforce_limit(keep=path)
+        return path
+
+    def enforce_limit(self, keep: Path | None = None) -> list[Path]:
+        """Delete least recently used entries until the total is within ``max_bytes``
+        (never ``keep``); returns the deleted paths."""
+        entries = self.entries()
+        total = sum(e.size for e in entries)
+        evicted = []
+        for e in reversed(entries):  # least recently used first
+            if total <= self.max_bytes:
+                break
+            if keep is not None and e.path == Path(keep):
+                continue
+            if self._unlink(e.path):
+                total -= e.size
+                evicted.append(e.path)
+        if evicted:
+            log.info("cache over its limit: evicted %d least recently used", len(evicted))
+        return evicted
+
+    # ------------------------------------------------------------ helpers
+    def _touch(self, path: Path) -> None:
+        now = max(time.time_ns(), self._last_stamp + 1)  # strictly increasing here
+        self._last_stamp = now
+        try:
+            os.utime(path, ns=(now, now))
+        except OSError:
+            pass
+
+    @staticmethod
+    def _unlink(path: Path) -> bool:
+        try:
+            path.unlink()
+            return True
+        except FileNotFoundError:
+            return True
+        except OSError:
+            return False
+
+    def _remove_stale_parts(self, max_age: float) -> None:
+        now = time.time()
+        try:
+            parts = list(self.directory.glob("*.part"))
+        except OSError:
+            return
+        for p in parts:
+            try:
+                if now - p.stat().st_mtime > max_age:
+                    p.unlink()
+            except OSError:
+                pass
