@@ -163,7 +163,7 @@ def _run(args) -> int:
     if args.command == "render":
         app, win = _window(args.size)
         win.set_mesh(mesh, Path(args.mesh))
-        win.iso_spin.setValue(args.isolines)
+        win.state.set_isolines(args.isolines)
         spec = win.compute(args.operator, k=args.k, wait=True)
         if not 0 <= args.mode < spec.k:
             raise ValueError(f"--mode must be between 0 and {spec.k - 1}")
@@ -191,8 +191,7 @@ def _run(args) -> int:
     if args.output:
         app, win = _window(args.size)
         win.set_mesh(mesh, Path(args.mesh))
-        win.spectra[spec.operator] = spec
-        win.compute_mesh = mesh
+        win.state.add_spectrum(win.state.compute_settings.key(spec.operator, spec.k), spec)
         win.pick_vertex(args.vertex)
         display = "threshold" if args.threshold is not None else "continuous"
         win.show_distance(args.kind, display=display, threshold=args.threshold)
@@ -249,11 +248,10 @@ def _distance_to(args, mesh_a) -> int:
             Panel(
                 mesh_b,
                 f"{Path(args.to).name}: {label} distance, best match {best}",
-                best,
-                d,
-                args.kind,
-                display,
-                args.threshold if args.threshold is not None else 0.2,
+                marker=best,
+                distances=d,
+                display=display,
+                threshold=args.threshold if args.threshold is not None else 0.2,
             ),
         ]
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))

@@ -1,10 +1,11 @@
 """Images of a distance between two shapes, rendered by the viewer's own scene.
 
 Panels side by side in one PNG: mesh A with the picked vertex, then mesh B coloured by
-a distance from that vertex with its best match marked.  Each panel is drawn by the
-off-screen main window (the same scene, colours, marker and colour bar as the viewer's
-distance display) and captioned.  Used by ``modalviewer distance A --to B -o fig.png``
-and ``scripts/hand_correspondence.py``.
+a distance from that vertex with its best match marked.  Each panel is drawn off-screen
+by the viewer's :class:`~modalviewer.gui.scene.MeshScene` (the same surface, colour
+maps and marker as the viewer's distance display: white = similar, red = the largest
+distance; or blue where the distance is below the threshold) and captioned.  Used by
+``modalviewer distance A --to B -o fig.png`` and ``scripts/hand_correspondence.py``.
 """
 
 from __future__ import annotations
@@ -23,14 +24,13 @@ class Panel:
     seen from the viewer's default direction turned by ``azimuth`` and ``elevation``.
 
     display: "continuous" or "threshold" (blue where the distance is at most
-    ``threshold`` times its largest value); kind: "vibration" | "feature" | "hks".
+    ``threshold`` times its largest value).
     """
 
     mesh: object
     title: str
     marker: int | None = None
     distances: np.ndarray | None = None
-    kind: str = "vibration"
     display: str = "continuous"
     threshold: float = 0.2
     azimuth: float = 0.0  # degrees, added to the viewer's default view
@@ -51,40 +51,53 @@ def _caption(img: np.ndarray, text: str) -> np.ndarray:
     return np.vstack([np.asarray(band), img[:, :, :3]])
 
 
-def render_panels(panels: list[Panel], path, size=(640, 560), window=None) -> Path:
-    """Render ``panels`` left to right into one PNG at ``path`` (written atomically).
+def _plotter(size):
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
 
-    ``window``: an off-screen main window to reuse (``cli._window``); made if None.
-    """
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    plotter.set_background("white")
+    return plotter
+
+
+def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
+    """(h, w, 3) image of one panel, captioned."""
+    from .core.laplacian import vertex_normals
+    from .gui.scene import MeshScene
+
+    plotter = _plotter(size)
+    try:
+        scene = MeshScene(plotter, panel.mesh, vertex_normals(panel.mesh))
+        if panel.distances is not None:
+            d = np.asarray(panel.distances, dtype=np.float64)
+            if d.shape != (panel.mesh.n_vertices,):
+                raise ValueError("a panel's distances must have one value per vertex")
+            if panel.display == "threshold":
+                thr = panel.threshold * float(d.max())
+                scene.show_field((d > thr).astype(np.float64), "threshold", name="threshold")
+            else:
+                scene.show_field(d, "sequential", isolines=0, name="distance")
+        scene.show_marker(panel.marker)
+        # the viewer's first view: looking down -z, y up, turned a little
+        plotter.view_xy()
+        plotter.camera.Azimuth(25 + panel.azimuth)
+        plotter.camera.Elevation(15 + panel.elevation)
+        plotter.camera.OrthogonalizeViewUp()
+        plotter.reset_camera()
+        plotter.render()
+        image = np.asarray(plotter.screenshot(None, return_img=True))[:, :, :3]
+    finally:
+        plotter.close()
+    return _caption(image, panel.title)
+
+
+def render_panels(panels: list[Panel], path, size=(640, 560)) -> Path:
+    """Render ``panels`` left to right, each ``size`` pixels, into one PNG at ``path``
+    (written atomically)."""
     from PIL import Image
 
-    from .cli import _window
-
-    win = window if window is not None else _window(size)[1]
-    images = []
-    try:
-        for panel in panels:
-            win.set_mesh(panel.mesh)
-            if panel.azimuth or panel.elevation:
-                win.plotter.camera.Azimuth(panel.azimuth)
-                win.plotter.camera.Elevation(panel.elevation)
-                win.plotter.camera.OrthogonalizeViewUp()
-                win.plotter.reset_camera()
-            if panel.distances is not None:
-                d = np.asarray(panel.distances, dtype=np.float64)
-                if d.shape != (panel.mesh.n_vertices,):
-                    raise ValueError("a panel's distances must have one value per vertex")
-                win.last_distance = d
-                win.distance_kind = panel.kind
-                win.distance_display = panel.display
-                win.threshold_fraction = float(panel.threshold)
-                win.display = "distance"
-                win._draw_distance()  # the viewer's own distance display, colour bar included
-            win.scene.show_marker(panel.marker)
-            images.append(_caption(win.viewport.render_now(), panel.title))
-    finally:
-        if window is None:
-            win.close()
+    images = [render_panel(panel, size) for panel in panels]
     height = max(img.shape[0] for img in images)
     canvas = np.full((height, sum(img.shape[1] for img in images), 3), 255, np.uint8)
     x = 0
