@@ -1,20 +1,15 @@
-"""Writing screenshots and per-vertex fields atomically (temporary file, then rename)."""
+"""Writing screenshots and per-vertex fields atomically (temporary file, then rename),
+with the permissions of the user's umask."""
 
 from __future__ import annotations
 
 import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..core.files import atomic_write
 from ..core.mesh import Mesh
-
-
-def _temp_beside(path: Path) -> Path:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    return Path(tmp)
 
 
 def _check_folder(path: Path) -> None:
@@ -25,9 +20,24 @@ def _check_folder(path: Path) -> None:
         raise OSError(f"the folder {folder} is not writable; choose another one")
 
 
-def save_screenshot(viewport, path: Path, scale: int = 1, transparent: bool = False) -> Path:
-    """Render the viewport's plotter to a PNG at ``scale`` times its size."""
+def save_screenshot(
+    viewport,
+    path: Path,
+    scale: int = 1,
+    transparent: bool = False,
+    legend: bool = True,
+    colorbar: bool | None = None,
+    scene=None,
+) -> Path:
+    """Render the viewport's plotter to a PNG at ``scale`` times its size.
+
+    The scene's legend (if ``legend`` and the scene has one) and colour bar (as shown on
+    screen when ``colorbar`` is None, else forced on or off; a two-swatch legend for
+    threshold maps) are drawn onto the image at the same scale, also on a transparent
+    background.  ``scene`` defaults to the scene drawn on the viewport's plotter."""
     from PIL import Image
+
+    from .overlay import draw_overlay
 
     path = Path(path)
     if path.suffix.lower() != ".png":
@@ -35,16 +45,27 @@ def save_screenshot(viewport, path: Path, scale: int = 1, transparent: bool = Fa
     _check_folder(path)
     plotter = viewport.plotter
     scale = int(max(1, scale))
-    plotter.render()  # pyvista's screenshot reads the last frame; make it the current scene
-    img = plotter.screenshot(None, transparent_background=transparent, return_img=True, scale=scale)
-    img = np.ascontiguousarray(img)
-    tmp = _temp_beside(path)
+    if scene is None:
+        scene = getattr(plotter, "_modalviewer_scene", None)
+    overlay = scene.overlay(legend=legend, colorbar=colorbar) if scene is not None else None
+    # the scene's own 2D actors are replaced by the overlay drawn at the export's scale
+    hidden = [a for a in scene.overlay_actors() if a.GetVisibility()] if scene else []
+    for actor in hidden:
+        actor.SetVisibility(False)
     try:
-        Image.fromarray(img).save(tmp, format="PNG")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+        plotter.render()  # pyvista's screenshot reads the last frame: the current scene
+        img = plotter.screenshot(
+            None, transparent_background=transparent, return_img=True, scale=scale
+        )
+    finally:
+        for actor in hidden:
+            actor.SetVisibility(True)
+        if hidden:
+            plotter.render()
+    img = np.ascontiguousarray(img)
+    if overlay:
+        img = draw_overlay(img, overlay, scale)
+    atomic_write(path, lambda tmp: Image.fromarray(img).save(tmp, format="PNG"))
     return path
 
 
@@ -60,11 +81,4 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
     poly = pv.PolyData(np.array(mesh.vertices), faces)
     for name, values in fields.items():
         poly.point_data[name] = np.asarray(values)
-    tmp = _temp_beside(path)
-    try:
-        poly.save(tmp, binary=True)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    return path
+    return atomic_write(path, lambda tmp: poly.save(tmp, binary=True))

@@ -6,6 +6,25 @@ import numpy as np
 from qtpy import QtCore, QtGui, QtWidgets
 
 
+def axis_label(value: float, scale: float) -> str:
+    """A tick label with 3 significant digits; values below 1e-8 times ``scale`` (the
+    axis' largest magnitude), round-off around a zero eigenvalue, read "0"."""
+    if abs(value) <= 1e-8 * scale:
+        return "0"
+    return f"{value:.3g}"
+
+
+def nice_ticks(lo: float, hi: float, count: int = 5) -> np.ndarray:
+    """About ``count`` round tick positions (1, 2 or 5 times a power of ten) in [lo, hi]."""
+    if not np.isfinite(lo) or not np.isfinite(hi) or hi <= lo:
+        return np.array([lo])
+    raw = (hi - lo) / max(count - 1, 1)
+    power = 10.0 ** np.floor(np.log10(raw))
+    step = next(m * power for m in (1, 2, 5, 10) if m * power >= raw)
+    first = np.ceil(lo / step - 1e-9) * step
+    return np.arange(first, hi + 1e-9 * step, step)
+
+
 class LinePlot(QtWidgets.QWidget):
     """Plots y against x with an optional highlighted sample; click selects a sample."""
 
@@ -21,9 +40,15 @@ class LinePlot(QtWidgets.QWidget):
         self.markers = True
         self.setMinimumHeight(140)
 
-    def set_data(self, x, y, highlight=None, logx=False, markers=True, title=None) -> None:
+    def set_data(
+        self, x, y, highlight=None, logx=False, markers=True, title=None, zero_mask=None
+    ) -> None:
+        """``zero_mask`` (len(y),) bool: samples plotted and labelled as exactly 0 (a
+        spectrum's zero modes, whose computed eigenvalues are round-off)."""
         self.x = np.asarray(x, dtype=float)
         self.y = np.asarray(y, dtype=float)
+        if zero_mask is not None and self.y.size:
+            self.y = np.where(np.asarray(zero_mask, dtype=bool), 0.0, self.y)
         self.highlight = highlight
         self.logx = logx
         self.markers = markers
@@ -42,8 +67,9 @@ class LinePlot(QtWidgets.QWidget):
         y0, y1 = float(y.min()), float(y.max())
         # room for the longer of the two axis labels (e.g. "-4.75e-08" for a zero mode)
         metrics = self.fontMetrics()
-        left = 8 + max(metrics.horizontalAdvance(f"{v:.3g}") for v in (y0, y1))
-        rect = self.rect().adjusted(max(46, left), 20, -10, -28)
+        scale = max(abs(y0), abs(y1))
+        left = 8 + max(metrics.horizontalAdvance(axis_label(v, scale)) for v in (y0, y1))
+        rect = self.rect().adjusted(max(46, left), 20, -10, -34)
         if x1 == x0:
             x1 = x0 + 1
         if y1 == y0:
@@ -51,6 +77,32 @@ class LinePlot(QtWidgets.QWidget):
         px = rect.left() + (x - x0) / (x1 - x0) * rect.width()
         py = rect.bottom() - (y - y0) / (y1 - y0) * rect.height()
         return rect, px, py, (y0, y1)
+
+    def x_ticks(self, rect=None) -> list[tuple[float, float]]:
+        """(value, pixel x) of the tick labels along the bottom: round numbers (integers
+        for integer samples such as mode indices), powers of ten on a log axis."""
+        if self.x.size == 0:
+            return []
+        if rect is None:
+            rect = self._transform()[0]
+        x = np.log10(self.x) if self.logx else self.x
+        x0, x1 = float(x.min()), float(x.max())
+        span = (x1 - x0) or 1.0
+        count = max(2, min(6, rect.width() // 60))
+        if self.logx:
+            ticks = np.arange(np.ceil(x0 - 1e-9), np.floor(x1 + 1e-9) + 1)
+            if ticks.size > count:
+                ticks = ticks[:: int(np.ceil(ticks.size / count))]
+            values = 10.0**ticks
+        else:
+            ticks = nice_ticks(x0, x1, count)
+            if np.allclose(self.x, np.round(self.x)):
+                ticks = np.unique(np.round(ticks))
+            values = ticks
+        return [
+            (float(v), rect.left() + (t - x0) / span * rect.width())
+            for v, t in zip(values, ticks, strict=True)
+        ]
 
     def paintEvent(self, event):  # noqa: N802
         p = QtGui.QPainter(self)
@@ -66,9 +118,21 @@ class LinePlot(QtWidgets.QWidget):
         p.setPen(QtGui.QColor(150, 150, 150))
         p.drawRect(rect)
         p.setPen(QtGui.QColor("black"))
-        p.drawText(2, rect.top() + 10, f"{y1:.3g}")
-        p.drawText(2, rect.bottom(), f"{y0:.3g}")
-        p.drawText(rect.left(), rect.bottom() + 16, self.xlabel)
+        scale = max(abs(y0), abs(y1))
+        p.drawText(2, rect.top() + 10, axis_label(y1, scale))
+        p.drawText(2, rect.bottom(), axis_label(y0, scale))
+        metrics = self.fontMetrics()
+        for value, xpos in self.x_ticks(rect):
+            text = f"1e{round(np.log10(value))}" if self.logx else axis_label(value, 1.0)
+            w = metrics.horizontalAdvance(text)
+            xpos_text = min(max(xpos - w / 2, rect.left() - 4), self.width() - w - 2)
+            p.setPen(QtGui.QColor(150, 150, 150))
+            p.drawLine(QtCore.QPointF(xpos, rect.bottom()), QtCore.QPointF(xpos, rect.bottom() + 3))
+            p.setPen(QtGui.QColor("black"))
+            p.drawText(QtCore.QPointF(xpos_text, rect.bottom() + 15), text)
+        p.drawText(
+            rect.right() - metrics.horizontalAdvance(self.xlabel), rect.bottom() + 30, self.xlabel
+        )
         p.setPen(QtGui.QPen(QtGui.QColor(40, 90, 180), 1.5))
         path = QtGui.QPainterPath(QtCore.QPointF(px[0], py[0]))
         for a, b in zip(px[1:], py[1:], strict=True):

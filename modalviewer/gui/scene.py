@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-from vtkmodules.vtkRenderingCore import vtkCellPicker
+from vtkmodules.vtkRenderingAnnotation import vtkLegendBoxActor, vtkScalarBarActor
+from vtkmodules.vtkRenderingCore import vtkCellPicker, vtkTextActor
 
 from ..core.mesh import Mesh
+from ..viewer import camera as cameras
+from .overlay import FONT_PX, ColorBar, Overlay
 
 # The paper's colours: blue positive, white zero, orange negative.
 BLUE = np.array([0.16, 0.38, 0.78])
@@ -34,6 +37,36 @@ def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
     return lut
 
 
+# Rendering styles: the light set-up and the surface's ambient/diffuse/specular balance.
+# "paper": one headlight (the light sits at the camera, like a matcap the brightness
+# depends only on the angle between the normal and the view direction) over a high
+# ambient term: brightness min(1, ambient + diffuse * cos) reaches 1 for surfaces within
+# about 39 degrees of facing the viewer and stays above 225/255 up to about 49 degrees,
+# so white stays white and blue/orange keep their full saturation where the surface faces
+# the viewer, while the shading falls to 0.3 toward silhouettes and sharp edges show as
+# steps in brightness.  No specular term (a highlight would wash the colours out).
+# Polyscope reaches its look with a matcap (an image of a lit sphere indexed by the
+# view-space normal); a headlight gives the same view-locked shading with VTK's own
+# lighting, on screen and off screen alike.
+# "shaded": pyvista's default light kit (key, fill and back lights) with plain diffuse
+# shading: more relief, colours darker (white renders grey).
+STYLES = {
+    "paper": {"ambient": 0.3, "diffuse": 0.9, "specular": 0.0, "lights": "headlight"},
+    "shaded": {"ambient": 0.0, "diffuse": 1.0, "specular": 0.0, "lights": "light kit"},
+}
+DEFAULT_STYLE = "paper"
+# The bold zero line is drawn only where the mode is meaningfully non-zero nearby: in a
+# triangle whose corner values or whose change over ZERO_LINE_LENGTH (a fraction of the
+# bounding-box diagonal, along the gradient) reach ZERO_LINE_FRACTION of max |field|.
+ZERO_LINE_FRACTION = 0.01
+ZERO_LINE_LENGTH = 0.01
+
+COLORMAPS = {  # colours from the low to the high end of each colour map
+    "diverging": [ORANGE, WHITE, BLUE],
+    "sequential": [WHITE, RED],
+    "plain": [WHITE, RED],
+    "threshold": [SIMILAR_BLUE, WHITE],
+}
 DIVERGING = lookup_table([ORANGE, WHITE, BLUE])  # negative -> zero -> positive
 SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
 THRESHOLD = lookup_table([SIMILAR_BLUE, WHITE], n=2)  # closer than threshold -> blue
@@ -71,8 +104,9 @@ def _line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
     return poly
 
 
-def _segments(points, faces, values, levels, displacement=None):
-    """(segments (s, 2, 3), their displacement (s, 2, 3) or None, level of each (s,))."""
+def _segments(points, faces, values, levels, displacement=None, with_triangles=False):
+    """(segments (s, 2, 3), their displacement (s, 2, 3) or None, level of each (s,)),
+    and with ``with_triangles`` the triangle of each segment (s,) as a fourth item."""
     levels = np.sort(np.asarray(levels, dtype=np.float64))
     # levels crossed by each triangle: those in (min, max] of its corner values
     level = np.searchsorted(levels, values, side="right").astype(np.int32)
@@ -82,7 +116,8 @@ def _segments(points, faces, values, levels, displacement=None):
     tri = np.flatnonzero(hi > lo)
     if tri.size == 0:
         empty = np.zeros((0, 2, 3))
-        return empty, (empty if displacement is not None else None), np.zeros(0)
+        out = (empty, (empty if displacement is not None else None), np.zeros(0))
+        return (*out, np.zeros(0, dtype=np.int64)) if with_triangles else out
     counts = hi[tri] - lo[tri]
     tri_rep = np.repeat(tri, counts)
     first = np.repeat(lo[tri], counts)
@@ -104,13 +139,13 @@ def _segments(points, faces, values, levels, displacement=None):
     disp = None
     if displacement is not None:
         disp = displacement[va] * (1 - t) + displacement[vb] * t
-    return seg, disp, c
+    return (seg, disp, c, tri_rep) if with_triangles else (seg, disp, c)
 
 
 class MeshScene:
     """Owns the actors of one mesh on a pyvista plotter."""
 
-    def __init__(self, plotter, mesh: Mesh, normals: np.ndarray):
+    def __init__(self, plotter, mesh: Mesh, normals: np.ndarray, style: str = DEFAULT_STYLE):
         self.plotter = plotter
         self.mesh = mesh
         self.normals = normals
@@ -160,6 +195,37 @@ class MeshScene:
         self.picker.AddPickList(self.surface_actor)
         self.field_name = ""
         self.clim = (0.0, 1.0)
+        self.kind = "plain"
+        self.style = ""
+        self.set_style(style)
+        # legend and colour bar: what the caller asked for, and their on-screen actors
+        self.legend_text: str | None = None
+        self.colorbar_title: str | None = None
+        self.colorbar_labels: list[str] | None = None
+        self.legend_actor = None
+        self.colorbar_actor = None
+        # canonical first view of this mesh; the scene keeps a reference on the plotter so
+        # an export of the plotter finds the scene's legend and colour bar
+        self.up_axis: str | None = None
+        plotter._modalviewer_scene = self
+
+    # ------------------------------------------------------------------ style
+    def set_style(self, style: str) -> None:
+        """Switch the rendering style: "paper" (white zero, saturated colours, headlight)
+        or "shaded" (pyvista's light kit, plain diffuse); see ``STYLES``.  No render."""
+        if style not in STYLES:
+            raise ValueError(f"unknown style {style!r}; choose one of {', '.join(STYLES)}")
+        params = STYLES[style]
+        self.plotter.remove_all_lights()
+        if params["lights"] == "headlight":
+            self.plotter.add_light(pv.Light(light_type="headlight", intensity=1.0))
+        else:
+            self.plotter.enable_lightkit()
+        prop = self.surface_actor.prop
+        prop.ambient = params["ambient"]
+        prop.diffuse = params["diffuse"]
+        prop.specular = params["specular"]
+        self.style = style
 
     # ----------------------------------------------------------------- fields
     def show_field(
@@ -199,7 +265,9 @@ class MeshScene:
         self._mapper.scalar_range = clim
         self._mapper.ScalarVisibilityOn()
         self.clim = clim
+        self.kind = kind
         self.field_name = name
+        self._update_colorbar_actor()
         self.set_isolines(values, isolines if kind != "threshold" else 0, kind == "diverging")
 
     def set_isolines(self, values: np.ndarray, count: int, emphasise_zero: bool) -> None:
@@ -212,20 +280,55 @@ class MeshScene:
         want_zero = count > 0 and emphasise_zero and lo < 0 < hi
         # one pass over the triangles for all levels, the zero line split off after
         everything = list(levels) + ([0.0] if want_zero else [])
-        seg, disp, level = _segments(
+        seg, disp, level, tri = _segments(
             self.rest_points,
             self.mesh.faces,
             values,
             everything,
             self.surface.point_data["displacement"],
+            with_triangles=True,
         )
         zero = level == 0.0 if want_zero else np.zeros(len(level), dtype=bool)
+        if want_zero:
+            keep = self.meaningful_zero(values, tri[zero])
+            drop = np.flatnonzero(zero)[~keep]
+            seg, disp, zero = (np.delete(x, drop, axis=0) for x in (seg, disp, zero))
         self._iso_rest, self._iso_disp = self._show_lines(
             self.isolines, seg[~zero], disp[~zero], 1.5, "iso_actor"
         )
         self._zero_rest, self._zero_disp = self._show_lines(
             self.zero_line, seg[zero], disp[zero], 3.5, "zero_actor"
         )
+
+    def meaningful_zero(self, values: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+        """(len(triangles),) bool: True where the field is meaningfully non-zero near the
+        triangle, so a zero crossing there is a real nodal line.  A triangle qualifies if a
+        corner value, or the change of the field along its gradient over
+        ``ZERO_LINE_LENGTH`` times the bounding-box diagonal, reaches ``ZERO_LINE_FRACTION``
+        of max |values|.  The gradient term keeps the zero line of low modes on fine meshes,
+        whose corner values next to the line are tiny; regions where a mode is zero up to
+        round-off (values and their changes both far below the fraction) are dropped."""
+        a = float(np.max(np.abs(values)))
+        if triangles.size == 0 or a == 0.0:
+            return np.zeros(triangles.size, dtype=bool)
+        f = self.mesh.faces[triangles]
+        fv = values[f]  # (t, 3)
+        corner = np.max(np.abs(fv), axis=1)
+        x0, x1, x2 = (self.rest_points[f[:, i]] for i in range(3))
+        e1, e2 = x1 - x0, x2 - x0
+        d1, d2 = fv[:, 1] - fv[:, 0], fv[:, 2] - fv[:, 0]
+        # gradient of the linear interpolant: solve [e1 e2]^T g = (d1, d2) in the plane
+        g11 = np.einsum("ij,ij->i", e1, e1)
+        g12 = np.einsum("ij,ij->i", e1, e2)
+        g22 = np.einsum("ij,ij->i", e2, e2)
+        det = g11 * g22 - g12 * g12
+        det = np.where(det > 0, det, np.inf)
+        c1 = (g22 * d1 - g12 * d2) / det
+        c2 = (g11 * d2 - g12 * d1) / det
+        grad = np.linalg.norm(c1[:, None] * e1 + c2[:, None] * e2, axis=1)
+        length = ZERO_LINE_LENGTH * self.mesh.bounding_box_diagonal
+        local = np.maximum(corner, grad * length)
+        return local >= ZERO_LINE_FRACTION * a
 
     def _show_lines(
         self, lines: pv.PolyData, seg: np.ndarray, disp: np.ndarray, width: float, attr: str
@@ -257,9 +360,168 @@ class MeshScene:
         # copies: the animation writes into the line points in place
         return seg.reshape(-1, 3).copy(), disp.reshape(-1, 3).copy()
 
+    def show_plain(self) -> None:
+        """The plain light-grey surface, no field and no isolines (a fresh mesh)."""
+        self.surface.point_data["field"] = np.zeros(self.mesh.n_vertices)
+        self._mapper.ScalarVisibilityOff()
+        self.field_name = ""
+        self.kind = "plain"
+        for actor in (self.iso_actor, self.zero_actor):
+            if actor is not None:
+                actor.SetVisibility(False)
+        self._iso_rest = self._zero_rest = None
+        self._update_colorbar_actor()
+
     @property
     def n_isoline_points(self) -> int:
         return 0 if self._iso_rest is None else len(self._iso_rest)
+
+    # ------------------------------------------------------ legend, colour bar
+    def set_legend(self, text: str | None) -> None:
+        """Show ``text`` (lines separated by newlines) at the top left of the view, and in
+        exports that ask for the legend; None or "" removes it.  No render."""
+        self.legend_text = text or None
+        if self.legend_actor is None and self.legend_text:
+            actor = vtkTextActor()
+            prop = actor.GetTextProperty()
+            prop.SetFontSize(FONT_PX)
+            prop.SetColor(0.0, 0.0, 0.0)
+            prop.SetJustificationToLeft()
+            prop.SetVerticalJustificationToTop()
+            prop.SetLineSpacing(1.2)
+            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            actor.GetPositionCoordinate().SetValue(0.01, 0.985)
+            self.plotter.renderer.AddViewProp(actor)
+            self.legend_actor = actor
+        if self.legend_actor is not None:
+            if self.legend_text:
+                self.legend_actor.SetInput(self.legend_text)
+            self.legend_actor.SetVisibility(bool(self.legend_text))
+
+    def set_colorbar(
+        self, title: str | None, clim: tuple[float, float] | None = None, labels=None
+    ) -> None:
+        """Show a colour bar titled ``title`` for the current field (None hides it), on
+        screen and in exports that ask for it.  ``clim`` overrides the field's range.  For
+        a threshold map the bar is a two-swatch legend (blue, white) labelled by
+        ``labels`` (default: ``title`` and "the rest").  No render."""
+        self.colorbar_title = title
+        self.colorbar_labels = list(labels) if labels is not None else None
+        if clim is not None:
+            self.clim = (float(clim[0]), float(clim[1]))
+            self._mapper.scalar_range = self.clim
+        self._update_colorbar_actor()
+
+    def colorbar(self) -> ColorBar | None:
+        """The colour bar as drawn (None when hidden or nothing is coloured)."""
+        if self.colorbar_title is None or self.kind == "plain" and not self.field_name:
+            return None
+        colors = [np.asarray(c, dtype=float) for c in COLORMAPS.get(self.kind, [WHITE, RED])]
+        if self.kind == "threshold":
+            labels = self.colorbar_labels or [self.colorbar_title, "the rest"]
+            return ColorBar("", colors, (0.0, 1.0), "swatches", labels[:2])
+        return ColorBar(self.colorbar_title, colors, tuple(self.clim))
+
+    def overlay(self, legend: bool = True, colorbar: bool | None = None) -> Overlay:
+        """Legend and colour bar for an export: the legend if ``legend`` and set; the
+        colour bar if shown (``colorbar`` None), or forced on/off."""
+        bar = self.colorbar()
+        if colorbar is False:
+            bar = None
+        elif colorbar is True and bar is None and self.kind != "plain":
+            title = self.field_name or "value"
+            saved = self.colorbar_title
+            self.colorbar_title = title
+            bar = self.colorbar()
+            self.colorbar_title = saved
+        return Overlay(self.legend_text if legend else None, bar)
+
+    def _update_colorbar_actor(self) -> None:
+        renderer = self.plotter.renderer
+        if self.colorbar_actor is not None:
+            renderer.RemoveViewProp(self.colorbar_actor)
+            self.colorbar_actor = None
+        bar = self.colorbar()
+        if bar is None:
+            return
+        if bar.kind == "swatches":
+            actor = vtkLegendBoxActor()
+            actor.SetNumberOfEntries(len(bar.colors))
+            square = pv.Plane(i_resolution=1, j_resolution=1)
+            for i, (color, label) in enumerate(zip(bar.colors, bar.labels, strict=False)):
+                actor.SetEntry(i, square, label, [float(c) for c in color])
+            actor.GetEntryTextProperty().SetColor(0.0, 0.0, 0.0)
+            actor.GetEntryTextProperty().SetFontSize(FONT_PX)
+            actor.BorderOff()
+            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            actor.GetPositionCoordinate().SetValue(0.01, 0.02)
+            actor.GetPosition2Coordinate().SetValue(0.4, 0.1)
+        else:
+            actor = vtkScalarBarActor()
+            actor.SetLookupTable(self._mapper.lookup_table)
+            actor.SetTitle(bar.title)
+            actor.SetOrientationToHorizontal()
+            actor.SetNumberOfLabels(0)
+            actor.SetMaximumNumberOfColors(256)
+            lo, hi = bar.clim
+            ticks = [lo, hi] + ([0.0] if lo < 0 < hi else [])
+            actor.SetUseCustomLabels(True)
+            from vtkmodules.vtkCommonCore import vtkDoubleArray
+
+            values = vtkDoubleArray()
+            for v in ticks:
+                values.InsertNextValue(v)
+            actor.SetCustomLabels(values)
+            actor.SetLabelFormat("%-#6.3g")
+            for prop in (actor.GetTitleTextProperty(), actor.GetLabelTextProperty()):
+                prop.SetColor(0.0, 0.0, 0.0)
+                prop.ShadowOff()
+                prop.ItalicOff()
+                prop.BoldOff()
+            actor.UnconstrainedFontSizeOn()
+            actor.GetTitleTextProperty().SetFontSize(FONT_PX)
+            actor.GetLabelTextProperty().SetFontSize(FONT_PX)
+            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
+            actor.GetPositionCoordinate().SetValue(0.3, 0.02)
+            actor.SetWidth(0.4)
+            actor.SetHeight(0.12)
+        renderer.AddViewProp(actor)
+        self.colorbar_actor = actor
+
+    def overlay_actors(self) -> list:
+        """The scene's 2D actors (legend, colour bar) that exports replace by the overlay."""
+        return [a for a in (self.legend_actor, self.colorbar_actor) if a is not None]
+
+    # ----------------------------------------------------------------- camera
+    def canonical_camera(self) -> cameras.Camera:
+        """The canonical first view of this mesh (see ``modalviewer.viewer.camera``)."""
+        return cameras.canonical_view(self.mesh.vertices, self.mesh.faces, up=self.up_axis)
+
+    def set_camera(self, camera: cameras.Camera, fit: bool = True) -> None:
+        """Put the camera at ``camera`` (position, focal point, up); with ``fit`` the
+        distance is then adjusted so the whole mesh is in view.  No render."""
+        cam = self.plotter.camera
+        cam.SetFocalPoint(*camera.focal_point)
+        cam.SetPosition(*camera.position)
+        cam.SetViewUp(*camera.up)
+        cam.OrthogonalizeViewUp()
+        if fit:
+            self.plotter.renderer.ResetCamera(*self.surface.bounds)
+        self.plotter.renderer.ResetCameraClippingRange()
+
+    def apply_camera_preset(self, name: str) -> cameras.Camera:
+        """Camera preset ``name``: "canonical", "+x", "-x", "+y", "-y", "+z", "-z" (seen
+        from that side) or "isometric"; returns the camera set.  No render."""
+        if name == "canonical":
+            camera = self.canonical_camera()
+        else:
+            camera = cameras.preset_view(self.mesh.vertices, name, up=self.up_axis)
+        self.set_camera(camera)
+        return camera
+
+    def reset_camera(self) -> cameras.Camera:
+        """Back to the canonical first view."""
+        return self.apply_camera_preset("canonical")
 
     # -------------------------------------------------------------- animation
     def set_displacement_scale(self, s: float) -> None:
@@ -323,3 +585,8 @@ class MeshScene:
     def remove(self) -> None:
         for name in ("surface", "iso_actor", "zero_actor", "marker"):
             self.plotter.remove_actor(name, render=False)
+        for actor in self.overlay_actors():
+            self.plotter.renderer.RemoveViewProp(actor)
+        self.legend_actor = self.colorbar_actor = None
+        if getattr(self.plotter, "_modalviewer_scene", None) is self:
+            self.plotter._modalviewer_scene = None

@@ -1,0 +1,60 @@
+"""Writing files atomically (a temporary file beside the target, then a rename) with the
+permissions of the user's umask.
+
+``tempfile.mkstemp`` creates its file with mode 0600 whatever the umask, and a rename keeps
+that mode, so every file written this way would be private; :func:`atomic_write` gives the
+temporary file the mode a plain ``open(path, "w")`` would have (0666 minus the umask)
+before renaming it.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+
+def current_umask() -> int:
+    """The process's umask (read from /proc where available, which changes nothing)."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)  # no read-only query elsewhere: set and restore at once
+    os.umask(mask)
+    return mask
+
+
+def new_file_mode() -> int:
+    """The mode a newly created regular file gets: 0666 minus the umask."""
+    return 0o666 & ~current_umask()
+
+
+def temp_beside(path: Path, suffix: str | None = None) -> Path:
+    """An empty temporary file in ``path``'s folder, with the umask's permissions."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(
+        prefix=f".{path.name}.", suffix=path.suffix if suffix is None else suffix, dir=path.parent
+    )
+    try:
+        os.fchmod(fd, new_file_mode())
+    finally:
+        os.close(fd)
+    return Path(tmp)
+
+
+def atomic_write(path: Path, write, suffix: str | None = None) -> Path:
+    """Call ``write(tmp_path)`` on a temporary file beside ``path``, then rename it to
+    ``path``; on any failure the temporary file is removed and ``path`` is untouched."""
+    path = Path(path)
+    tmp = temp_beside(path, suffix)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path

@@ -1,0 +1,127 @@
+"""The legend and colour bar of an exported picture, drawn with Pillow onto the rendered
+image at the export's scale (VTK's tiled rendering of a scaled screenshot repeats or
+overlaps 2D text; drawing the overlay afterwards keeps text size, placement and a
+transparent background right at any scale).  No Qt, no VTK.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+FONT_PX = 14  # text height at scale 1, in pixels
+MARGIN_PX = 10
+
+
+@dataclass
+class ColorBar:
+    """A colour bar: ``kind`` "continuous" (a gradient through ``colors`` from clim[0] to
+    clim[1], labelled at both ends and at 0 when the range straddles it) or "swatches"
+    (one square per colour, labelled by ``labels``)."""
+
+    title: str
+    colors: list = field(default_factory=list)  # RGB in [0, 1]
+    clim: tuple[float, float] = (0.0, 1.0)
+    kind: str = "continuous"
+    labels: list = field(default_factory=list)
+
+
+@dataclass
+class Overlay:
+    legend: str | None = None
+    colorbar: ColorBar | None = None
+
+    def __bool__(self) -> bool:
+        return bool(self.legend) or self.colorbar is not None
+
+
+def _font(size: float):
+    from PIL import ImageFont
+
+    return ImageFont.load_default(size=max(6, round(size)))
+
+
+def _rgba(c) -> tuple[int, int, int, int]:
+    c = np.clip(np.asarray(c, dtype=float), 0.0, 1.0)
+    return (int(round(255 * c[0])), int(round(255 * c[1])), int(round(255 * c[2])), 255)
+
+
+def colorbar_label(value: float) -> str:
+    """A colour-bar tick label: 3 significant digits, exact zero as "0"."""
+    return "0" if value == 0 else f"{value:.3g}"
+
+
+def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.ndarray:
+    """``img`` (h, w, 3 or 4) uint8 with the legend at the top left and the colour bar at
+    the bottom drawn on it; a copy.  Sizes are ``scale`` times the on-screen ones."""
+    from PIL import Image, ImageDraw
+
+    if not overlay:
+        return img
+    mode = "RGBA" if img.shape[2] == 4 else "RGB"
+    canvas = Image.fromarray(np.ascontiguousarray(img), mode)
+    draw = ImageDraw.Draw(canvas)
+    s = float(scale)
+    margin = MARGIN_PX * s
+    font = _font(FONT_PX * s)
+    black = (0, 0, 0, 255)
+    line_gap = 0.35 * FONT_PX * s
+    if overlay.legend:
+        draw.multiline_text(
+            (margin, margin), overlay.legend, fill=black, font=font, spacing=line_gap
+        )
+    bar = overlay.colorbar
+    if bar is not None:
+        h, w = img.shape[:2]
+        if bar.kind == "swatches":
+            box = FONT_PX * s
+            y = h - margin - len(bar.colors) * (box + line_gap)
+            if bar.title:
+                draw.text((margin, y - box - line_gap), bar.title, fill=black, font=font)
+            for color, label in zip(bar.colors, bar.labels, strict=False):
+                draw.rectangle(
+                    [margin, y, margin + box, y + box],
+                    fill=_rgba(color),
+                    outline=black,
+                    width=max(1, round(s)),
+                )
+                draw.text((margin + 1.6 * box, y), label, fill=black, font=font)
+                y += box + line_gap
+        else:
+            width = min(0.5 * w, 320 * s)
+            height = 0.9 * FONT_PX * s
+            x0 = 0.5 * (w - width)
+            y_labels = h - margin - FONT_PX * s
+            y1 = y_labels - 0.4 * FONT_PX * s
+            y0 = y1 - height
+            n = max(2, int(round(width)))
+            t = np.linspace(0.0, 1.0, n)
+            anchors = np.linspace(0.0, 1.0, len(bar.colors))
+            rgb = np.column_stack(
+                [np.interp(t, anchors, [c[i] for c in bar.colors]) for i in range(3)]
+            )
+            for i in range(n):
+                xa = x0 + width * i / n
+                draw.rectangle(
+                    [xa, y0, x0 + width * (i + 1) / n, y1], fill=_rgba(rgb[i]), outline=None
+                )
+            draw.rectangle([x0, y0, x0 + width, y1], outline=black, width=max(1, round(s)))
+            lo, hi = bar.clim
+            ticks = [(lo, 0.0), (hi, 1.0)]
+            if lo < 0 < hi:
+                ticks.append((0.0, (0.0 - lo) / (hi - lo)))
+            for value, pos in ticks:
+                text = colorbar_label(value)
+                tw = draw.textlength(text, font=font)
+                x = np.clip(x0 + pos * width - 0.5 * tw, 0, w - tw)
+                draw.text((x, y_labels), text, fill=black, font=font)
+            if bar.title:
+                tw = draw.textlength(bar.title, font=font)
+                draw.text(
+                    (max(0.0, 0.5 * (w - tw)), y0 - 1.4 * FONT_PX * s),
+                    bar.title,
+                    fill=black,
+                    font=font,
+                )
+    return np.asarray(canvas)

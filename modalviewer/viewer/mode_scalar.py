@@ -1,0 +1,102 @@
+"""The scalar that colours a mode: the mode itself for scalar operators; for 3D vibration
+modes (Discrete Shells) its normal component or its magnitude.
+
+Choice, measured by the roughness of the coloured scalar f, its Rayleigh quotient
+f^T S f / f^T M f under the cotan Laplacian (Discrete Shells modes 6-15):
+
+- The normal component is taken against *smoothed* vertex normals: the area-weighted
+  normals diffused by one implicit heat step of radius ``NORMAL_SMOOTHING`` mean edge
+  lengths, then normalised.  At a sharp edge the plain vertex normals jump from one face
+  orientation to the other within one ring of triangles, and so does the component of a
+  smooth displacement along them: jagged isolines and small loops along the edges.  The
+  smoothed normals turn over a few triangles; the roughness drops 2.5 to 3 times (machined
+  part: 4.2-7.8 -> 1.6-2.7; spot: 79-134 -> 32-57).  It stays signed, so the colouring
+  keeps the zero line where the surface does not move along its normal.
+- On a mesh with sharp features the normal itself turns by up to 90 degrees across an
+  edge, so any normal component changes quickly there; the magnitude |Phi| does not
+  (machined part: 0.11-0.31, as smooth as the mode's x, y, z components, 0.26-0.73).
+  :func:`default_vector_coloring` therefore proposes the magnitude when the edges with a
+  dihedral angle above ``SHARP_DEGREES`` are at least ``SHARP_LENGTH`` times as long
+  as the square root of the surface area (a measure that does not change with the mesh
+  resolution: a box 5.0 at 3.6k, 14k and 57k vertices; machined part 9.9, double torus
+  10.0), and the normal component elsewhere (spot 1.3, homer 1.4, folded plate 0.7,
+  the hands 0.14).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..core.laplacian import lumped_masses, stiffness_matrix, vertex_normals
+from ..core.mesh import Mesh
+
+NORMAL_SMOOTHING = 2.0  # diffusion radius in mean edge lengths
+SHARP_DEGREES = 40.0
+SHARP_LENGTH = 3.0
+
+
+def mean_edge_length(mesh: Mesh) -> float:
+    v, f = mesh.vertices, mesh.faces
+    e = np.concatenate([v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 1]], v[f[:, 0]] - v[f[:, 2]]])
+    return float(np.mean(np.linalg.norm(e, axis=1)))
+
+
+def smoothed_normals(mesh: Mesh, radius: float | None = None) -> np.ndarray:
+    """(n, 3) unit vertex normals after one implicit heat step (M + r^2 S) N' = M N of the
+    area-weighted normals N; ``radius`` r defaults to ``NORMAL_SMOOTHING`` mean edge
+    lengths.  Vertices whose diffused normal vanishes keep their plain normal."""
+    normals = vertex_normals(mesh)
+    r = NORMAL_SMOOTHING * mean_edge_length(mesh) if radius is None else float(radius)
+    if r <= 0:
+        return normals
+    m = lumped_masses(mesh)
+    system = (sp.diags(m) + r * r * stiffness_matrix(mesh)).tocsc()
+    smooth = spla.splu(system).solve(m[:, None] * normals)
+    norm = np.linalg.norm(smooth, axis=1, keepdims=True)
+    ok = norm[:, 0] > 1e-12
+    out = normals.copy()
+    out[ok] = smooth[ok] / norm[ok]
+    return out
+
+
+def vector_mode_scalar(phi: np.ndarray, normals: np.ndarray, coloring: str = "normal"):
+    """The scalar colouring a 3D mode ``phi`` (n, 3): "normal" -> phi . normals (pass
+    :func:`smoothed_normals`), "magnitude" -> |phi|."""
+    phi = np.asarray(phi, dtype=np.float64)
+    if coloring == "normal":
+        return np.einsum("ij,ij->i", phi, normals)
+    if coloring == "magnitude":
+        return np.linalg.norm(phi, axis=1)
+    raise ValueError(f"unknown colouring {coloring!r}; use 'normal' or 'magnitude'")
+
+
+def mode_scalar(spec, j: int, normals: np.ndarray, coloring: str = "normal") -> np.ndarray:
+    """The scalar colouring mode ``j`` of spectrum ``spec``: the mode for scalar operators,
+    :func:`vector_mode_scalar` for 3D modes (``normals`` from :func:`smoothed_normals`)."""
+    phi = spec.mode(j)
+    return vector_mode_scalar(phi, normals, coloring) if spec.is_vector else np.asarray(phi)
+
+
+def sharp_edge_length(mesh: Mesh, degrees: float = SHARP_DEGREES) -> float:
+    """Total length of the interior edges whose dihedral angle (between the two face
+    normals) exceeds ``degrees``, divided by the square root of the surface area."""
+    v, f = mesh.vertices, mesh.faces
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    area = 0.5 * float(np.linalg.norm(n, axis=1).sum())
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    face = np.tile(np.arange(len(f)), 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    edges, face = edges[order], face[order]
+    pair = np.flatnonzero(np.all(edges[1:] == edges[:-1], axis=1)) + 1  # interior edges
+    cos = np.einsum("ij,ij->i", n[face[pair]], n[face[pair - 1]])
+    sharp = pair[cos < np.cos(np.radians(degrees))]
+    length = np.linalg.norm(v[edges[sharp, 0]] - v[edges[sharp, 1]], axis=1).sum()
+    return float(length) / max(np.sqrt(area), 1e-300)
+
+
+def default_vector_coloring(mesh: Mesh) -> str:
+    """ "magnitude" on meshes with sharp features, else "normal" (see the module text)."""
+    return "magnitude" if sharp_edge_length(mesh) >= SHARP_LENGTH else "normal"

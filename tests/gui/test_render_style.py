@@ -1,0 +1,221 @@
+"""Pixels of the rendering style, legend and colour bar on exported screenshots, the bold
+zero line's filter, and the permissions of exported files (scene level, off-screen)."""
+
+import os
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import modalviewer as mv
+from modalviewer.core.laplacian import vertex_normals
+from modalviewer.core.primitives import icosphere
+from modalviewer.io import load_mesh
+
+pytestmark = pytest.mark.gui
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+
+
+@pytest.fixture(scope="module")
+def spot_mode():
+    mesh = load_mesh(ASSETS / "spot.obj")
+    spec = mv.compute_spectrum(mesh, "laplacian", k=8)
+    return mesh, spec.mode(6), spec.mode(1)
+
+
+@pytest.fixture
+def view():
+    import pyvista as pv
+
+    plotter = pv.Plotter(off_screen=True, window_size=(480, 400))
+    plotter.set_background("white")
+    plotter.show(auto_close=False, interactive=False)
+    yield SimpleNamespace(plotter=plotter)
+    plotter.close()
+
+
+def _scene(view, mesh, style="paper"):
+    from modalviewer.gui.scene import MeshScene
+
+    scene = MeshScene(view.plotter, mesh, vertex_normals(mesh), style=style)
+    scene.reset_camera()
+    return scene
+
+
+def _export(view, path, **kwargs):
+    from modalviewer.gui.export import save_screenshot
+
+    out = save_screenshot(view, path, **kwargs)
+    return np.asarray(Image.open(out))
+
+
+def _measure(view, scene, field, tmp_path):
+    from modalviewer.gui.render_metrics import saturation, white_level, zero_band_masks
+
+    scene.show_field(field, "diverging", isolines=0)
+    img = _export(view, tmp_path / f"{scene.style}.png")[:, :, :3]
+    mesh_px, band = zero_band_masks(scene, field)
+    assert band.sum() > 300 and mesh_px.sum() > 20000, (band.sum(), mesh_px.sum())
+    return white_level(img, band), saturation(img, mesh_px)
+
+
+def test_paper_style_white_zero_and_saturated_colours(view, spot_mode, tmp_path):
+    mesh, _, field = spot_mode  # mode 1: blue at one end, orange at the other
+    scene = _scene(view, mesh, "paper")
+    white, sat = _measure(view, scene, field, tmp_path)
+    # the zero band facing the viewer (normal within 45 degrees of the view): every
+    # channel at least 225 on 95 % of its pixels (measured 246; shaded style 185)
+    assert white["p5"] >= 225, white
+    # blue 60 above red on 28 % of the mesh's pixels, orange on 30 % (shaded: 20, 22 %)
+    assert sat["blue"] > 0.24 and sat["orange"] > 0.26, sat
+    scene.set_style("shaded")
+    shaded_white, shaded_sat = _measure(view, scene, field, tmp_path)
+    assert shaded_white["p5"] < 200, shaded_white
+    assert shaded_sat["blue"] < sat["blue"], (shaded_sat, sat)
+
+
+def test_paper_style_darkens_toward_silhouettes(view, spot_mode, tmp_path):
+    """Shape stays readable: surfaces seen at a grazing angle render clearly darker."""
+    from modalviewer.gui.render_metrics import _flat_render, facing
+
+    mesh, field, _ = spot_mode
+    scene = _scene(view, mesh, "paper")
+    scene.show_field(np.zeros(mesh.n_vertices), "diverging", isolines=0)  # all white
+    img = _export(view, tmp_path / "white.png")[:, :, :3].astype(int)
+    grazing = ~facing(scene, 0.35)
+    flat = _flat_render(scene, grazing).astype(int)
+    mask_grazing = (flat[:, :, 1] > 250) & (flat[:, :, 0] < 5)
+    mask_front = (flat[:, :, 0] > 250) & (flat[:, :, 1] < 5)
+    assert mask_grazing.sum() > 1000
+    brightness = img.max(axis=2)
+    assert np.median(brightness[mask_front]) >= 250
+    assert np.median(brightness[mask_grazing]) < 200, np.median(brightness[mask_grazing])
+
+
+def test_unknown_style_is_refused(view, spot_mode):
+    scene = _scene(view, spot_mode[0])
+    with pytest.raises(ValueError, match="unknown style"):
+        scene.set_style("glossy")
+
+
+def _dark(img, box, base):
+    """Number of dark opaque pixels in box = (x0, y0, x1, y1) (fractions of the size)
+    that are not in ``base``, the same export without legend and colour bar."""
+    h, w = img.shape[:2]
+    x0, y0, x1, y1 = int(box[0] * w), int(box[1] * h), int(box[2] * w), int(box[3] * h)
+    part = img[y0:y1, x0:x1].astype(int)
+    dark = part[:, :, :3].max(axis=2) < 100
+    if part.shape[2] == 4:
+        dark &= part[:, :, 3] > 128
+    dark &= np.any(part != base[y0:y1, x0:x1], axis=2)
+    return int(dark.sum())
+
+
+@pytest.mark.parametrize("scale", [1, 3])
+def test_legend_in_exports_with_and_without_colour_bar(view, spot_mode, tmp_path, scale):
+    mesh, field, _ = spot_mode
+    scene = _scene(view, mesh)
+    scene.show_field(field, "diverging", isolines=0, name="Laplacian mode 6")
+    legend_box = (0.0, 0.0, 0.45, 0.12)
+    bottom = (0.2, 0.8, 0.8, 1.0)
+    plain = _export(view, tmp_path / "plain.png", scale=scale, transparent=True)
+    assert plain.shape == (400 * scale, 480 * scale, 4)
+    scene.set_legend("Laplacian, mode 6: lambda = 12.3\nblue +, white 0, orange -")
+    for colorbar in (False, True):
+        img = _export(view, tmp_path / "l.png", scale=scale, transparent=True, colorbar=colorbar)
+        # text at the top left, its size proportional to the scale
+        assert _dark(img, legend_box, plain) > 150 * scale**2, _dark(img, legend_box, plain)
+        # transparent background stays transparent beside the text
+        assert img[-1, -1, 3] == 0 and img[0, -1, 3] == 0
+        bar = _dark(img, bottom, plain)
+        if colorbar:
+            assert bar > 60 * scale**2, bar
+        else:
+            assert bar == 0, bar
+    scene.set_colorbar("Laplacian mode 6")  # shown on screen: exported by default
+    base = _export(view, tmp_path / "b.png", scale=scale, legend=False, colorbar=False)
+    on_screen = _export(view, tmp_path / "c.png", scale=scale)
+    assert _dark(on_screen, bottom, base) > 60 * scale**2
+    no_legend = _export(view, tmp_path / "n.png", scale=scale, legend=False)
+    assert _dark(no_legend, legend_box, base) == 0
+
+
+def test_threshold_map_legend_follows_the_colour_bar_option(view, spot_mode, tmp_path):
+    mesh, field, _ = spot_mode
+    scene = _scene(view, mesh)
+    marked = (field > np.quantile(field, 0.3)).astype(float)  # 1 = not similar
+    scene.show_field(marked, "threshold", name="vibration distance < 0.12")
+    scene.set_legend("blue: vibration distance < 0.12, 8.4 % of the surface")
+    scene.set_colorbar("vibration distance < 0.12", labels=["< 0.12", ">= 0.12"])
+    swatch_box = (0.0, 0.8, 0.4, 1.0)
+
+    def swatch_blue(img):
+        h, w = img.shape[:2]
+        part = img[int(0.8 * h) :, : int(0.12 * w)].astype(int)
+        return int(((part[:, :, 2] > part[:, :, 0] + 60) & (part[:, :, 3] > 128)).sum())
+
+    base = _export(view, tmp_path / "t.png", transparent=True, legend=False, colorbar=False)
+    with_bar = _export(view, tmp_path / "t1.png", transparent=True, colorbar=True)
+    without = _export(view, tmp_path / "t0.png", transparent=True, colorbar=False)
+    assert swatch_blue(with_bar) > 50 and _dark(with_bar, swatch_box, base) > 50
+    assert swatch_blue(without) == 0 and _dark(without, swatch_box, base) == 0
+    for img in (with_bar, without):
+        assert _dark(img, (0.0, 0.0, 0.6, 0.1), base) > 100  # the legend in both
+
+
+def test_zero_line_absent_where_the_mode_is_dead(view):
+    """A field that is x z^3 on the upper hemisphere (a nodal line along the meridian
+    x = 0) and round-off noise (1e-6 of its maximum) on the lower: the bold zero line
+    keeps the meridian where the field around it is meaningful and drops the noise."""
+    mesh = icosphere(4)
+    v = mesh.vertices
+    rng = np.random.default_rng(1)
+    top = v[:, 0] * np.maximum(v[:, 2], 0.0) ** 3
+    field = np.where(v[:, 2] > 0, top, 3e-7 * rng.standard_normal(len(v)))
+    scene = _scene(view, mesh)
+    scene.show_field(field, "diverging", isolines=6)
+    zero = np.asarray(scene._zero_rest).reshape(-1, 3)
+    assert len(zero) > 20  # the real nodal line
+    h = 0.07  # about one edge length of the level-4 sphere
+    assert np.all(zero[:, 2] > 0.3), zero[:, 2].min()
+    assert np.all(np.abs(zero[:, 0]) < h), np.abs(zero[:, 0]).max()
+    # the thin isolines are unchanged by the filter: none in the dead half either way
+    iso = np.asarray(scene._iso_rest).reshape(-1, 3)
+    assert len(iso) > 100 and np.all(iso[:, 2] > -h)
+    # without the filter the noise draws zero crossings all over the lower hemisphere
+    tri = np.arange(mesh.n_faces)
+    keep = scene.meaningful_zero(field, tri)
+    low = v[mesh.faces].mean(axis=1)[:, 2] < -h
+    assert keep[low].sum() == 0 and keep[~low].sum() > 100
+
+
+def test_zero_line_of_a_low_mode_on_a_fine_mesh_is_kept(view):
+    """Next to the line of a smooth low mode on a fine mesh the corner values are small;
+    the gradient term keeps every segment of it."""
+    mesh = icosphere(5)
+    field = mesh.vertices[:, 2] * 1e-3  # any amplitude: the rule is relative
+    scene = _scene(view, mesh)
+    tri = np.arange(mesh.n_faces)
+    fv = field[mesh.faces]
+    crossed = tri[(fv.min(axis=1) < 0) & (fv.max(axis=1) >= 0)]
+    assert scene.meaningful_zero(field, crossed).all()
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o027])
+def test_exported_files_get_the_umask_permissions(view, spot_mode, tmp_path, umask):
+    from modalviewer.gui.export import save_field_mesh
+
+    mesh, field, _ = spot_mode
+    _scene(view, mesh)
+    old = os.umask(umask)
+    try:
+        png = tmp_path / "shot.png"
+        _export(view, png)
+        vtp = save_field_mesh(tmp_path / "field.vtp", mesh, {"f": field})
+    finally:
+        os.umask(old)
+    for path in (png, vtp):
+        assert (path.stat().st_mode & 0o777) == 0o666 & ~umask, oct(path.stat().st_mode)
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no leftovers

@@ -1,0 +1,109 @@
+"""The canonical first view and the camera presets (modalviewer.viewer.camera, no Qt)."""
+
+import numpy as np
+import pytest
+
+from modalviewer.core.primitives import grid_plate
+from modalviewer.viewer.camera import (
+    canonical_camera,
+    canonical_view,
+    preset_camera,
+    preset_view,
+    principal_axes,
+)
+
+
+def _box_points(size, n=2000, seed=0):
+    """Points on the surface of an axis-aligned box of the given size, centred at 0."""
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(-0.5, 0.5, (n, 3))
+    axis = rng.integers(0, 3, n)
+    p[np.arange(n), axis] = np.sign(p[np.arange(n), axis]) * 0.5
+    return p * np.asarray(size)
+
+
+def _rotation(seed=3):
+    q, _ = np.linalg.qr(np.random.default_rng(seed).standard_normal((3, 3)))
+    return q * np.sign(np.linalg.det(q))
+
+
+def test_straight_view_looks_at_the_largest_silhouette():
+    # long in X, tall in Y, thin in Z: the largest silhouette is seen along Z
+    v = _box_points((4.0, 2.0, 0.5)) + [10.0, -3.0, 1.0]
+    cam = canonical_view(v, azimuth=0.0, elevation=0.0)
+    assert np.allclose(cam.direction, [0, 0, 1], atol=1e-12)
+    assert np.allclose(cam.up, [0, 1, 0], atol=1e-12)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    assert np.allclose(cam.focal_point, 0.5 * (lo + hi))
+    # far enough to see the bounding sphere in VTK's 30-degree view angle
+    dist = np.linalg.norm(np.subtract(cam.position, cam.focal_point))
+    assert dist * np.sin(np.radians(15)) == pytest.approx(0.5 * np.linalg.norm(hi - lo))
+
+
+def test_canonical_view_is_turned_a_little_and_keeps_up():
+    v = _box_points((4.0, 2.0, 0.5))
+    cam = canonical_view(v)  # azimuth 20, elevation 15
+    d = cam.direction
+    assert np.degrees(np.arccos(d @ [0, 0, 1])) == pytest.approx(np.hypot(20, 15), abs=2.5)
+    assert d[1] > 0.2  # seen from a little above
+    assert np.dot(cam.up, d) == pytest.approx(0.0, abs=1e-12)
+    assert cam.up[1] > 0.95
+
+
+def test_up_axis_from_the_caller_and_unsnapped_principal_axes():
+    v = _box_points((4.0, 0.5, 2.0))  # thin in Y
+    cam = canonical_view(v, up="z", azimuth=0.0, elevation=0.0)
+    assert np.allclose(np.abs(cam.direction), [0, 1, 0], atol=1e-12)
+    assert np.allclose(cam.up, [0, 0, 1], atol=1e-12)
+    # a box turned far from the coordinate axes: the view follows its thin axis
+    rot = _rotation()
+    turned = _box_points((4.0, 2.0, 0.5)) @ rot.T
+    _, axes = principal_axes(turned)
+    thin = rot[:, 2]
+    assert abs(axes[2] @ thin) > 0.999
+    if np.max(np.abs(thin)) < np.cos(np.radians(25)):  # not snapped to an axis
+        cam = canonical_view(turned, up=rot[:, 1], azimuth=0.0, elevation=0.0)
+        assert abs(cam.direction @ thin) > 0.999
+
+
+def test_a_plate_lying_across_the_up_axis_is_seen_from_above():
+    plate = grid_plate(10, 10)  # in the XY plane
+    v = plate.vertices[:, [0, 2, 1]]  # now in the XZ plane, +Y up
+    cam = canonical_view(v, plate.faces, azimuth=0.0, elevation=0.0)
+    assert np.allclose(cam.direction, [0, 1, 0], atol=1e-12)
+    # the plate in its own plane faces the viewer with up the default +Y axis
+    cam = canonical_view(plate.vertices, plate.faces, azimuth=0.0, elevation=0.0)
+    assert np.allclose(np.abs(cam.direction), [0, 0, 1], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "name, direction, up",
+    [
+        ("+x", (1, 0, 0), (0, 1, 0)),
+        ("-x", (-1, 0, 0), (0, 1, 0)),
+        ("+y", (0, 1, 0), (0, 0, -1)),
+        ("-y", (0, -1, 0), (0, 0, 1)),
+        ("+z", (0, 0, 1), (0, 1, 0)),
+        ("-z", (0, 0, -1), (0, 1, 0)),
+    ],
+)
+def test_axis_presets(name, direction, up):
+    v = _box_points((1.0, 2.0, 3.0))
+    cam = preset_view(v, name)
+    assert np.allclose(cam.direction, direction, atol=1e-12)
+    assert np.allclose(cam.up, up, atol=1e-12)
+
+
+def test_isometric_preset_and_dict_form():
+    plate = grid_plate(5, 5)
+    cam = preset_view(plate.vertices, "isometric")
+    assert np.allclose(cam.direction, np.ones(3) / np.sqrt(3))
+    assert np.dot(cam.up, cam.direction) == pytest.approx(0.0, abs=1e-12)
+    assert cam.up[1] > 0.8
+    d = preset_camera(plate, "canonical")
+    assert set(d) == {"position", "focal_point", "view_up"}
+    assert d == canonical_camera(plate)
+    with pytest.raises(ValueError, match="unknown camera preset"):
+        preset_view(plate.vertices, "top")
+    with pytest.raises(ValueError, match="unknown up axis"):
+        canonical_view(plate.vertices, up="w")
