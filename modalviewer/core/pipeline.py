@@ -62,6 +62,7 @@ def compute_spectrum(
     membrane: float = 1.0,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
+    accuracy: str = "exact",
 ) -> Spectrum:
     """The k lowest eigenpairs of ``operator`` on ``mesh``.
 
@@ -72,6 +73,10 @@ def compute_spectrum(
     bending, membrane : Discrete Shells weights (ignored by the scalar energies).
     progress : ``progress(stage, fraction)`` with fraction in [0, 1].
     cancel : polled; returning True raises :class:`Cancelled`.
+    accuracy : "exact" (default) or "preview": a Rayleigh-Ritz approximation in a reduced
+        space of smooth functions on the same mesh (:mod:`.preview`), seconds instead of
+        minutes on big meshes; ``spec.is_preview`` is then True and
+        ``spec.estimated_error`` holds its estimated relative eigenvalue error.
 
     Returns
     -------
@@ -82,6 +87,12 @@ def compute_spectrum(
     k = int(k)
     if k < 1:
         raise ValueError(f"k must be at least 1, got {k}")
+    if accuracy not in ("exact", "preview"):
+        raise ValueError(f"accuracy must be 'exact' or 'preview', got {accuracy!r}")
+    if accuracy == "preview":
+        from .preview import compute_preview
+
+        return compute_preview(mesh, operator, k, bending, membrane, progress, cancel)
 
     def report(stage: str, fraction: float) -> None:
         if cancel is not None and cancel():

@@ -57,6 +57,18 @@ class Spectrum:
     def is_vector(self) -> bool:
         return self.modes.ndim == 3
 
+    @property
+    def is_preview(self) -> bool:
+        """True for a preview (``compute_spectrum(..., accuracy="preview")``): eigenvalues
+        are upper bounds with about ``estimated_error`` relative error, not exact ones."""
+        return bool(self.parameters.get("preview"))
+
+    @property
+    def estimated_error(self) -> float:
+        """Estimated largest relative eigenvalue error of a preview's non-zero modes
+        (``parameters["preview"]`` holds the per-mode estimates); 0.0 for exact spectra."""
+        return float(self.parameters.get("preview", {}).get("estimated_error", 0.0))
+
     def zero_mode_mask(self) -> np.ndarray:
         """(k,) True for modes whose eigenvalue is below 1e-8 times the largest."""
         return zero_modes(self.eigenvalues)
