@@ -102,3 +102,12 @@ def test_errors_are_one_line(tmp_path):
         lines = [line for line in r.stderr.splitlines() if line.startswith("modalviewer: error")]
         assert len(lines) == 1 and fragment in lines[0], r.stderr
         assert "Traceback" not in r.stderr
+
+
+def test_help_lists_the_subcommands():
+    from modalviewer.cli import COMMANDS
+
+    out = _run("--help")
+    assert out.returncode == 0, out.stderr
+    for command in COMMANDS:
+        assert f"\n  {command} " in out.stdout, out.stdout

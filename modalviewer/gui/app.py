@@ -26,8 +26,24 @@ def _has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
+def _commands_epilog() -> str:
+    """The headless subcommands with their one-line help, for ``modalviewer --help``."""
+    from ..cli import build_parser as cli_parser
+
+    sub = next(a for a in cli_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    lines = ["headless commands ('modalviewer COMMAND --help' shows their options):"]
+    lines += [f"  {c.dest:<10} {c.help}" for c in sub._choices_actions]
+    return "\n".join(lines)
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="modalviewer", description="Modal shape analysis viewer.")
+    p = argparse.ArgumentParser(
+        prog="modalviewer",
+        usage="%(prog)s [-h] [options] [mesh]\n       %(prog)s COMMAND ...",
+        description="Modal shape analysis viewer.",
+        epilog=_commands_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     p.add_argument("mesh", nargs="?", help="mesh file to open (default: the bundled mesh)")
     p.add_argument(
         "--operator",
