@@ -229,7 +229,15 @@ def _solve_reduced(
     if N <= max(1000, 3 * k):
         import scipy.linalg as la
 
-        return la.eigh(Kr.toarray(), Mr.toarray(), subset_by_index=[0, k - 1])
+        # the Mr-orthonormal eigenbasis of Mr's range: functions that vanish on the mesh
+        # (linearly dependent columns, when samples are as dense as the vertices) drop out
+        A, B = Kr.toarray(), Mr.toarray()
+        d = 1.0 / np.sqrt(np.maximum(np.diag(B), 1e-300))
+        w, E = la.eigh(B * np.outer(d, d))
+        keep = w > 1e-12 * w.max()
+        T = (E[:, keep] / np.sqrt(w[keep])) * d[:, None]
+        lam, Z = la.eigh(T.T @ A @ T, subset_by_index=[0, min(k, int(keep.sum())) - 1])
+        return lam, T @ Z
     typical = float(np.median(np.abs(Kr.diagonal()) / Mr.diagonal()))
     shift = -1e-6 * (typical or 1.0)
     for _ in range(8):
@@ -402,6 +410,9 @@ def preview_spectrum(
     if samples is None:
         samples = max(DEFAULT_SAMPLES, 2 * k)
     report("preview: sampling", 0.05)
+    # at least 6 vertices per sample: denser samples make the enriched functions
+    # linearly dependent on the mesh without adding anything
+    samples = max(1, min(int(samples), mesh.n_vertices // 6))
     P, D, info = reduced_basis(mesh, operator, samples, radius_factor, enrich)
     seconds["basis"] = time.perf_counter() - t
     t = time.perf_counter()
