@@ -63,6 +63,12 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-k", type=int, default=100)
     c.add_argument("--bending", type=float, default=1.0)
     c.add_argument("--membrane", type=float, default=1.0)
+    c.add_argument(
+        "--preview",
+        action="store_true",
+        help="a preview in seconds (Rayleigh-Ritz in a reduced space of smooth functions): "
+        "eigenvalues are upper bounds, with their estimated error",
+    )
     c.add_argument("-o", "--output", required=True)
     r = sub.add_parser("render", help="render a mode to PNG")
     r.add_argument("mesh")
@@ -141,9 +147,22 @@ def _run(args) -> int:
     if args.command == "compute":
         mesh = mv.load_mesh(args.mesh)
         spec = mv.compute_spectrum(
-            mesh, args.operator, args.k, args.bending, args.membrane, progress=_progress_bar()
+            mesh,
+            args.operator,
+            args.k,
+            args.bending,
+            args.membrane,
+            progress=_progress_bar(),
+            accuracy="preview" if args.preview else "exact",
         )
         mv.save_spectrum(spec, args.output)
+        if spec.is_preview:
+            info = spec.parameters["preview"]
+            print(
+                f"preview in {spec.parameters['seconds_total']:.1f} s ({info['samples']} "
+                f"samples, {info['reduced_dimension']} reduced unknowns): eigenvalues are "
+                f"upper bounds, estimated relative error up to {spec.estimated_error:.1%}"
+            )
         worst = float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
         print(
             f"{Path(args.mesh).name}: {spec.k} {args.operator} modes, eigenvalues "

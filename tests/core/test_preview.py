@@ -150,3 +150,21 @@ def test_farthest_point_samples_are_spread():
     np.fill_diagonal(d, np.inf)
     # well spread: nearest-sample distances vary by less than a factor 3
     assert d.min(axis=1).max() < 3 * d.min(axis=1).min()
+
+
+def test_cli_compute_preview(tmp_path, capsys):
+    from modalviewer.cli import main
+
+    mesh = bumpy_plate(20)
+    path = tmp_path / "plate.obj"
+    lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in mesh.vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in mesh.faces]
+    path.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "s.npz"
+    args = ["compute", str(path), "--operator", "shells", "-k", "12", "-o", str(out)]
+    assert main([*args, "--preview"]) == 0
+    assert "preview in" in capsys.readouterr().out
+    spec = mv.load_spectrum(out)
+    assert spec.is_preview and spec.k == 12 and 0 < spec.estimated_error < 1
+    assert main(args) == 0
+    assert not mv.load_spectrum(out).is_preview
