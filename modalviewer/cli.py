@@ -263,7 +263,12 @@ def _distance_to(args, mesh_a) -> int:
         label = {"vibration": "vibration", "feature": "feature", "hks": "heat kernel"}[args.kind]
         display = "threshold" if args.threshold is not None else "continuous"
         panels = [
-            Panel(mesh_a, f"{Path(args.mesh).name}: vertex {args.vertex}", args.vertex),
+            Panel(
+                mesh_a,
+                f"{Path(args.mesh).name}: vertex {args.vertex}",
+                args.vertex,
+                face_marker=True,
+            ),
             Panel(
                 mesh_b,
                 f"{Path(args.to).name}: {label} distance, best match {best}",
@@ -271,6 +276,7 @@ def _distance_to(args, mesh_a) -> int:
                 distances=d,
                 display=display,
                 threshold=args.threshold if args.threshold is not None else 0.2,
+                face_marker=True,
             ),
         ]
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))

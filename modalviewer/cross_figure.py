@@ -35,6 +35,7 @@ class Panel:
     threshold: float = 0.2
     azimuth: float = 0.0  # degrees, added to the viewer's default view
     elevation: float = 0.0
+    face_marker: bool = False  # instead: look at the marker along its vertex normal
 
 
 def _caption(img: np.ndarray, text: str) -> np.ndarray:
@@ -43,8 +44,12 @@ def _caption(img: np.ndarray, text: str) -> np.ndarray:
     height = max(24, img.shape[0] // 20)
     band = Image.new("RGB", (img.shape[1], height), "white")
     draw = ImageDraw.Draw(band)
+    size = int(height * 0.6)
     try:
-        font = ImageFont.load_default(size=int(height * 0.6))
+        font = ImageFont.load_default(size=size)
+        while size > 8 and draw.textlength(text, font=font) > img.shape[1] - 16:
+            size -= 1
+            font = ImageFont.load_default(size=size)
     except TypeError:  # Pillow < 10.1: a fixed bitmap font
         font = ImageFont.load_default()
     draw.text((8, height // 6), text, fill="black", font=font)
@@ -68,7 +73,8 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
 
     plotter = _plotter(size)
     try:
-        scene = MeshScene(plotter, panel.mesh, vertex_normals(panel.mesh))
+        normals = vertex_normals(panel.mesh)
+        scene = MeshScene(plotter, panel.mesh, normals)
         if panel.distances is not None:
             d = np.asarray(panel.distances, dtype=np.float64)
             if d.shape != (panel.mesh.n_vertices,):
@@ -79,10 +85,15 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
             else:
                 scene.show_field(d, "sequential", isolines=0, name="distance")
         scene.show_marker(panel.marker)
-        # the viewer's first view: looking down -z, y up, turned a little
-        plotter.view_xy()
-        plotter.camera.Azimuth(25 + panel.azimuth)
-        plotter.camera.Elevation(15 + panel.elevation)
+        if panel.face_marker and panel.marker is not None:
+            n = normals[panel.marker]
+            centre = 0.5 * (panel.mesh.vertices.min(axis=0) + panel.mesh.vertices.max(axis=0))
+            up = (0.0, 0.0, 1.0) if abs(n[1]) > 0.9 else (0.0, 1.0, 0.0)
+            plotter.camera_position = [tuple(centre + 3.0 * n), tuple(centre), up]
+        else:  # the viewer's first view: looking down -z, y up, turned a little
+            plotter.view_xy()
+            plotter.camera.Azimuth(25 + panel.azimuth)
+            plotter.camera.Elevation(15 + panel.elevation)
         plotter.camera.OrthogonalizeViewUp()
         plotter.reset_camera()
         plotter.render()
