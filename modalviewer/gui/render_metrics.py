@@ -26,7 +26,7 @@ def _flat_render(scene, indicator: np.ndarray) -> np.ndarray:
         prop.GetInterpolation(),
     )
     hidden = []
-    for attr in ("iso_actor", "zero_actor", "marker_actor", "legend_actor"):
+    for attr in ("iso_actor", "zero_actor", "marker_actor", "overlay_actor"):
         a = getattr(scene, attr, None)
         if a is not None and a.GetVisibility():
             a.SetVisibility(False)

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-from vtkmodules.vtkRenderingAnnotation import vtkLegendBoxActor, vtkScalarBarActor
-from vtkmodules.vtkRenderingCore import vtkCellPicker, vtkTextActor
+from vtkmodules.util.numpy_support import numpy_to_vtk
+from vtkmodules.vtkCommonDataModel import vtkImageData
+from vtkmodules.vtkRenderingCore import vtkActor2D, vtkCellPicker, vtkImageMapper
 
 from ..core.mesh import Mesh
 from ..viewer import camera as cameras
-from .overlay import FONT_PX, ColorBar, Overlay
+from .overlay import ColorBar, Overlay, draw_overlay
 
 # The paper's colours: blue positive, white zero, orange negative.
 BLUE = np.array([0.16, 0.38, 0.78])
@@ -57,7 +58,8 @@ STYLES = {
 DEFAULT_STYLE = "paper"
 # The bold zero line is drawn only where the mode is meaningfully non-zero nearby: in a
 # triangle whose corner values or whose change over ZERO_LINE_LENGTH (a fraction of the
-# bounding-box diagonal, along the gradient) reach ZERO_LINE_FRACTION of max |field|.
+# bounding-box diagonal, along the gradient) reach ZERO_LINE_FRACTION of max |field|, and
+# along lines connected to those where they reach a quarter of it (no dashes).
 ZERO_LINE_FRACTION = 0.01
 ZERO_LINE_LENGTH = 0.01
 
@@ -106,7 +108,8 @@ def _line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
 
 def _segments(points, faces, values, levels, displacement=None, with_triangles=False):
     """(segments (s, 2, 3), their displacement (s, 2, 3) or None, level of each (s,)),
-    and with ``with_triangles`` the triangle of each segment (s,) as a fourth item."""
+    and with ``with_triangles`` two more items: the triangle of each segment (s,) and the
+    mesh edges its two ends lie on (s, 2, 2), each edge as (smaller, larger) vertex."""
     levels = np.sort(np.asarray(levels, dtype=np.float64))
     # levels crossed by each triangle: those in (min, max] of its corner values
     level = np.searchsorted(levels, values, side="right").astype(np.int32)
@@ -117,7 +120,8 @@ def _segments(points, faces, values, levels, displacement=None, with_triangles=F
     if tri.size == 0:
         empty = np.zeros((0, 2, 3))
         out = (empty, (empty if displacement is not None else None), np.zeros(0))
-        return (*out, np.zeros(0, dtype=np.int64)) if with_triangles else out
+        none = (np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2), dtype=np.int64))
+        return (*out, *none) if with_triangles else out
     counts = hi[tri] - lo[tri]
     tri_rep = np.repeat(tri, counts)
     first = np.repeat(lo[tri], counts)
@@ -139,7 +143,10 @@ def _segments(points, faces, values, levels, displacement=None, with_triangles=F
     disp = None
     if displacement is not None:
         disp = displacement[va] * (1 - t) + displacement[vb] * t
-    return (seg, disp, c, tri_rep) if with_triangles else (seg, disp, c)
+    if not with_triangles:
+        return seg, disp, c
+    edges = np.stack([np.minimum(va, vb), np.maximum(va, vb)], axis=-1)  # (s, 2, 2)
+    return seg, disp, c, tri_rep, edges
 
 
 class MeshScene:
@@ -202,8 +209,11 @@ class MeshScene:
         self.legend_text: str | None = None
         self.colorbar_title: str | None = None
         self.colorbar_labels: list[str] | None = None
-        self.legend_actor = None
-        self.colorbar_actor = None
+        # drawn by Pillow into one transparent image over the view (the same drawing as
+        # in exports), redrawn before a render when the text or the view's size changed
+        self.overlay_actor = None
+        self._overlay_key = None
+        self._overlay_observer = None
         # canonical first view of this mesh; the scene keeps a reference on the plotter so
         # an export of the plotter finds the scene's legend and colour bar
         self.up_axis: str | None = None
@@ -267,7 +277,7 @@ class MeshScene:
         self.clim = clim
         self.kind = kind
         self.field_name = name
-        self._update_colorbar_actor()
+        self._overlay_changed()
         self.set_isolines(values, isolines if kind != "threshold" else 0, kind == "diverging")
 
     def set_isolines(self, values: np.ndarray, count: int, emphasise_zero: bool) -> None:
@@ -280,7 +290,7 @@ class MeshScene:
         want_zero = count > 0 and emphasise_zero and lo < 0 < hi
         # one pass over the triangles for all levels, the zero line split off after
         everything = list(levels) + ([0.0] if want_zero else [])
-        seg, disp, level, tri = _segments(
+        seg, disp, level, tri, edges = _segments(
             self.rest_points,
             self.mesh.faces,
             values,
@@ -290,7 +300,7 @@ class MeshScene:
         )
         zero = level == 0.0 if want_zero else np.zeros(len(level), dtype=bool)
         if want_zero:
-            keep = self.meaningful_zero(values, tri[zero])
+            keep = self._meaningful_zero_lines(values, tri[zero], edges[zero])
             drop = np.flatnonzero(zero)[~keep]
             seg, disp, zero = (np.delete(x, drop, axis=0) for x in (seg, disp, zero))
         self._iso_rest, self._iso_disp = self._show_lines(
@@ -300,7 +310,35 @@ class MeshScene:
             self.zero_line, seg[zero], disp[zero], 3.5, "zero_actor"
         )
 
-    def meaningful_zero(self, values: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    def _meaningful_zero_lines(self, values, triangles, edges) -> np.ndarray:
+        """(s,) bool: which zero-line segments to draw, with hysteresis: a segment passing
+        :meth:`meaningful_zero` is drawn, and so is every segment connected to one through
+        segments that pass it at a quarter of the fraction, so a line does not break into
+        dashes where the field hovers around the limit.  Segments connect where they end
+        on the same mesh edge."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        strong = self.meaningful_zero(values, triangles)
+        weak = np.flatnonzero(self.meaningful_zero(values, triangles, 0.25))
+        if weak.size == 0:
+            return strong
+        key = edges[weak, :, 0].astype(np.int64) * self.mesh.n_vertices + edges[weak, :, 1]
+        _, node = np.unique(key.ravel(), return_inverse=True)  # mesh edge -> graph node
+        w = weak.size
+        rows = np.repeat(np.arange(w), 2)
+        n = w + int(node.max()) + 1
+        graph = coo_matrix((np.ones(rows.size), (rows, w + node)), shape=(n, n))
+        _, label = connected_components(graph, directed=False)
+        label = label[:w]
+        has_strong = np.bincount(label, weights=strong[weak]) > 0
+        keep = strong.copy()
+        keep[weak] |= has_strong[label]
+        return keep
+
+    def meaningful_zero(
+        self, values: np.ndarray, triangles: np.ndarray, factor: float = 1.0
+    ) -> np.ndarray:
         """(len(triangles),) bool: True where the field is meaningfully non-zero near the
         triangle, so a zero crossing there is a real nodal line.  A triangle qualifies if a
         corner value, or the change of the field along its gradient over
@@ -328,7 +366,7 @@ class MeshScene:
         grad = np.linalg.norm(c1[:, None] * e1 + c2[:, None] * e2, axis=1)
         length = ZERO_LINE_LENGTH * self.mesh.bounding_box_diagonal
         local = np.maximum(corner, grad * length)
-        return local >= ZERO_LINE_FRACTION * a
+        return local >= factor * ZERO_LINE_FRACTION * a
 
     def _show_lines(
         self, lines: pv.PolyData, seg: np.ndarray, disp: np.ndarray, width: float, attr: str
@@ -370,7 +408,7 @@ class MeshScene:
             if actor is not None:
                 actor.SetVisibility(False)
         self._iso_rest = self._zero_rest = None
-        self._update_colorbar_actor()
+        self._overlay_changed()
 
     @property
     def n_isoline_points(self) -> int:
@@ -381,22 +419,7 @@ class MeshScene:
         """Show ``text`` (lines separated by newlines) at the top left of the view, and in
         exports that ask for the legend; None or "" removes it.  No render."""
         self.legend_text = text or None
-        if self.legend_actor is None and self.legend_text:
-            actor = vtkTextActor()
-            prop = actor.GetTextProperty()
-            prop.SetFontSize(FONT_PX)
-            prop.SetColor(0.0, 0.0, 0.0)
-            prop.SetJustificationToLeft()
-            prop.SetVerticalJustificationToTop()
-            prop.SetLineSpacing(1.2)
-            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-            actor.GetPositionCoordinate().SetValue(0.01, 0.985)
-            self.plotter.renderer.AddViewProp(actor)
-            self.legend_actor = actor
-        if self.legend_actor is not None:
-            if self.legend_text:
-                self.legend_actor.SetInput(self.legend_text)
-            self.legend_actor.SetVisibility(bool(self.legend_text))
+        self._overlay_changed()
 
     def set_colorbar(
         self, title: str | None, clim: tuple[float, float] | None = None, labels=None
@@ -410,7 +433,7 @@ class MeshScene:
         if clim is not None:
             self.clim = (float(clim[0]), float(clim[1]))
             self._mapper.scalar_range = self.clim
-        self._update_colorbar_actor()
+        self._overlay_changed()
 
     def colorbar(self) -> ColorBar | None:
         """The colour bar as drawn (None when hidden or nothing is coloured)."""
@@ -436,61 +459,47 @@ class MeshScene:
             self.colorbar_title = saved
         return Overlay(self.legend_text if legend else None, bar)
 
-    def _update_colorbar_actor(self) -> None:
-        renderer = self.plotter.renderer
-        if self.colorbar_actor is not None:
-            renderer.RemoveViewProp(self.colorbar_actor)
-            self.colorbar_actor = None
-        bar = self.colorbar()
-        if bar is None:
-            return
-        if bar.kind == "swatches":
-            actor = vtkLegendBoxActor()
-            actor.SetNumberOfEntries(len(bar.colors))
-            square = pv.Plane(i_resolution=1, j_resolution=1)
-            for i, (color, label) in enumerate(zip(bar.colors, bar.labels, strict=False)):
-                actor.SetEntry(i, square, label, [float(c) for c in color])
-            actor.GetEntryTextProperty().SetColor(0.0, 0.0, 0.0)
-            actor.GetEntryTextProperty().SetFontSize(FONT_PX)
-            actor.BorderOff()
-            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-            actor.GetPositionCoordinate().SetValue(0.01, 0.02)
-            actor.GetPosition2Coordinate().SetValue(0.4, 0.1)
-        else:
-            actor = vtkScalarBarActor()
-            actor.SetLookupTable(self._mapper.lookup_table)
-            actor.SetTitle(bar.title)
-            actor.SetOrientationToHorizontal()
-            actor.SetNumberOfLabels(0)
-            actor.SetMaximumNumberOfColors(256)
-            lo, hi = bar.clim
-            ticks = [lo, hi] + ([0.0] if lo < 0 < hi else [])
-            actor.SetUseCustomLabels(True)
-            from vtkmodules.vtkCommonCore import vtkDoubleArray
+    def _overlay_changed(self) -> None:
+        """Legend or colour bar changed: make sure the overlay actor exists (it redraws
+        itself before the next render)."""
+        self._overlay_key = None
+        if self.overlay_actor is None and (self.legend_text or self.colorbar() is not None):
+            mapper = vtkImageMapper()
+            mapper.SetColorWindow(255.0)
+            mapper.SetColorLevel(127.5)
+            actor = vtkActor2D()
+            actor.SetMapper(mapper)
+            actor.PickableOff()
+            self.plotter.renderer.AddViewProp(actor)
+            self.overlay_actor = actor
+            self._overlay_observer = self.plotter.renderer.AddObserver(
+                "StartEvent", self._refresh_overlay
+            )
 
-            values = vtkDoubleArray()
-            for v in ticks:
-                values.InsertNextValue(v)
-            actor.SetCustomLabels(values)
-            actor.SetLabelFormat("%-#6.3g")
-            for prop in (actor.GetTitleTextProperty(), actor.GetLabelTextProperty()):
-                prop.SetColor(0.0, 0.0, 0.0)
-                prop.ShadowOff()
-                prop.ItalicOff()
-                prop.BoldOff()
-            actor.UnconstrainedFontSizeOn()
-            actor.GetTitleTextProperty().SetFontSize(FONT_PX)
-            actor.GetLabelTextProperty().SetFontSize(FONT_PX)
-            actor.GetPositionCoordinate().SetCoordinateSystemToNormalizedViewport()
-            actor.GetPositionCoordinate().SetValue(0.3, 0.02)
-            actor.SetWidth(0.4)
-            actor.SetHeight(0.12)
-        renderer.AddViewProp(actor)
-        self.colorbar_actor = actor
+    def _refresh_overlay(self, *_args) -> None:
+        """Redraw the overlay image if the legend, colour bar or view size changed."""
+        actor = self.overlay_actor
+        if actor is None or not actor.GetVisibility():
+            return
+        w, h = self.plotter.renderer.GetSize()
+        overlay = self.overlay()
+        key = (w, h, repr(overlay))
+        if key == self._overlay_key or w < 2 or h < 2:
+            return
+        self._overlay_key = key
+        rgba = np.zeros((h, w, 4), np.uint8)
+        if overlay:
+            rgba = draw_overlay(rgba, overlay, 1.0)
+        image = vtkImageData()
+        image.SetDimensions(w, h, 1)
+        scalars = numpy_to_vtk(rgba[::-1].reshape(-1, 4).copy(), deep=True)
+        scalars.SetNumberOfComponents(4)
+        image.GetPointData().SetScalars(scalars)
+        actor.GetMapper().SetInputData(image)
 
     def overlay_actors(self) -> list:
         """The scene's 2D actors (legend, colour bar) that exports replace by the overlay."""
-        return [a for a in (self.legend_actor, self.colorbar_actor) if a is not None]
+        return [self.overlay_actor] if self.overlay_actor is not None else []
 
     # ----------------------------------------------------------------- camera
     def canonical_camera(self) -> cameras.Camera:
@@ -587,6 +596,8 @@ class MeshScene:
             self.plotter.remove_actor(name, render=False)
         for actor in self.overlay_actors():
             self.plotter.renderer.RemoveViewProp(actor)
-        self.legend_actor = self.colorbar_actor = None
+        if self._overlay_observer is not None:
+            self.plotter.renderer.RemoveObserver(self._overlay_observer)
+        self.overlay_actor = self._overlay_observer = None
         if getattr(self.plotter, "_modalviewer_scene", None) is self:
             self.plotter._modalviewer_scene = None
