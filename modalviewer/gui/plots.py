@@ -18,11 +18,11 @@ def nice_ticks(lo: float, hi: float, count: int = 5) -> np.ndarray:
     """About ``count`` round tick positions (1, 2 or 5 times a power of ten) in [lo, hi]."""
     if not np.isfinite(lo) or not np.isfinite(hi) or hi <= lo:
         return np.array([lo])
-    raw = (hi - lo) / max(count - 1, 1)
+    raw = (hi - lo) / max(count, 1)
     power = 10.0 ** np.floor(np.log10(raw))
     step = next(m * power for m in (1, 2, 5, 10) if m * power >= raw)
     first = np.ceil(lo / step - 1e-9) * step
-    return np.arange(first, hi + 1e-9 * step, step)
+    return np.arange(first, hi + 1e-9 * step, step) + 0.0  # + 0.0: no "-0"
 
 
 class LinePlot(QtWidgets.QWidget):

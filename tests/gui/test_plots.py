@@ -1,0 +1,39 @@
+"""The spectrum plot: zero modes read 0, tick labels along the bottom."""
+
+import numpy as np
+import pytest
+
+from modalviewer.gui.plots import LinePlot, axis_label, nice_ticks
+
+pytestmark = pytest.mark.gui
+
+
+def test_axis_labels_of_zero_modes_and_round_ticks():
+    assert axis_label(3.99e-14, 52.0) == "0"
+    assert axis_label(-1.6e-07, 52.0) == "0"
+    assert axis_label(-1.6e-07, 1e-3) == "-1.6e-07"  # not round-off at that scale
+    assert axis_label(52.123, 52.123) == "52.1"
+    assert list(nice_ticks(0, 99, 5)) == [0, 20, 40, 60, 80]
+    assert list(nice_ticks(0.0, 1.0, 6)) == pytest.approx([0, 0.2, 0.4, 0.6, 0.8, 1.0])
+
+
+def test_spectrum_plot_shows_zero_and_tick_labels(qtbot):
+    plot = LinePlot("Spectrum", "mode index", "eigenvalue")
+    qtbot.addWidget(plot)
+    plot.resize(360, 180)
+    lam = np.array([3.99e-14, -1.6e-07, 2.0, 5.0, 9.0, 14.0, 20.0, 27.0, 35.0, 44.0])
+    plot.set_data(np.arange(10), lam, zero_mask=lam < 1e-6)
+    assert plot.y[:2].tolist() == [0.0, 0.0]
+    ticks = plot.x_ticks()
+    assert [v for v, _ in ticks] == [0, 2, 4, 6, 8]
+    xs = [x for _, x in ticks]
+    assert xs == sorted(xs) and xs[0] >= 40 and xs[-1] <= 360
+    image = plot.grab().toImage()
+    rect = plot._transform()[0]
+    # dark text pixels in the band just below the frame (the tick labels)
+    dark = 0
+    for y in range(rect.bottom() + 4, rect.bottom() + 17):
+        for x in range(rect.left(), rect.right()):
+            c = image.pixelColor(x, y)
+            dark += c.red() < 100 and c.green() < 100 and c.blue() < 100
+    assert dark > 30, dark
