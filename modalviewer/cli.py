@@ -289,6 +289,14 @@ def _distance_to(args, mesh_a) -> int:
         + "; nearest "
         + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
     )
+    if args.threshold is not None:
+        # between two meshes even the best match is at a distance above zero
+        share = float(np.mean(d <= args.threshold * d.max()))
+        print(
+            f"threshold {args.threshold:g} of the largest distance: {100 * share:.2f} % of "
+            f"{Path(args.to).name}'s vertices are closer (the best match is at "
+            f"{d[best] / d.max():.3g} of the largest)"
+        )
     return 0
 
 

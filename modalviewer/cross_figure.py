@@ -35,7 +35,7 @@ class Panel:
     threshold: float = 0.2
     azimuth: float = 0.0  # degrees, added to the viewer's default view
     elevation: float = 0.0
-    face_marker: bool = False  # instead: look at the marker along its vertex normal
+    face_marker: bool = False  # turned about y so the marker faces the camera
 
 
 def _caption(img: np.ndarray, text: str) -> np.ndarray:
@@ -85,15 +85,17 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
             else:
                 scene.show_field(d, "sequential", isolines=0, name="distance")
         scene.show_marker(panel.marker)
+        # the viewer's first view: looking down -z, y up, turned a little
+        azimuth, elevation = 25.0 + panel.azimuth, 15.0 + panel.elevation
         if panel.face_marker and panel.marker is not None:
-            n = normals[panel.marker]
-            centre = 0.5 * (panel.mesh.vertices.min(axis=0) + panel.mesh.vertices.max(axis=0))
-            up = (0.0, 0.0, 1.0) if abs(n[1]) > 0.9 else (0.0, 1.0, 0.0)
-            plotter.camera_position = [tuple(centre + 3.0 * n), tuple(centre), up]
-        else:  # the viewer's first view: looking down -z, y up, turned a little
-            plotter.view_xy()
-            plotter.camera.Azimuth(25 + panel.azimuth)
-            plotter.camera.Elevation(15 + panel.elevation)
+            # turn about the y axis until the marker's normal points at the camera (a
+            # normal along y, like a fingertip's, is seen from the default view)
+            nx, _, nz = normals[panel.marker]
+            if np.hypot(nx, nz) > 0.3:
+                azimuth = float(np.degrees(np.arctan2(nx, nz)))
+        plotter.view_xy()
+        plotter.camera.Azimuth(azimuth)
+        plotter.camera.Elevation(elevation)
         plotter.camera.OrthogonalizeViewUp()
         plotter.reset_camera()
         plotter.render()
