@@ -2,13 +2,15 @@
 axis presets.
 
 Canonical view: the up axis is the caller's (a file convention) or +Y, the convention of
-most OBJ/PLY/OFF models; the viewer looks along the principal axis of least spread of the
-surface (area-weighted covariance of the triangles), which is the direction from which the
-surface shows its largest silhouette, snapped to a coordinate axis when it lies within
-25 degrees of one; then the camera turns by a small azimuth and elevation so the view
-shows depth.  A flat object lying across the up axis (a plate in the XZ plane with +Y up)
-is seen from above.  The camera sits on the side of +Z (then +X, then +Y) of that axis,
-the side most models face.
+most OBJ/PLY/OFF models.  Among the horizontal viewing directions (perpendicular to up,
+every 5 degrees) the viewer looks along the one from which the surface shows the largest
+silhouette (estimated from the projected vertices on a grid of 3 mean edge lengths),
+preferring a coordinate axis when it shows at least 90 % of the best; if the view from
+above shows more than ``TOP_VIEW_RATIO`` times that (a plate lying across the up axis),
+it looks from above.  Then the camera turns by a small azimuth and elevation so the
+view shows depth.  The camera sits on the side of +Z (then +X, then +Y) of its axis, the
+side most models face.  Without faces the principal axis of least spread stands in for
+the direction of the largest silhouette.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ PRESETS = ("+x", "-x", "+y", "-y", "+z", "-z", "isometric")
 DEFAULT_UP = "+y"
 VIEW_ANGLE = 30.0  # degrees, VTK's default
 SNAP_DEGREES = 25.0
+TOP_VIEW_RATIO = 1.5
+AXIS_PREFERENCE = 0.9  # a coordinate axis showing this share of the best is taken
 # which side of the viewing axis the camera sits on: the +Z side first (models face +Z)
 _FRONT = np.array([0.1, 0.2, 1.0]) / np.linalg.norm([0.1, 0.2, 1.0])
 _TURN_TOWARD = np.array([0.5, 0.0, 1.0])
@@ -153,6 +157,58 @@ def look_from(vertices, direction, up) -> Camera:
     return Camera(tuple(position), tuple(centre), tuple(u))
 
 
+def silhouette_area(vertices, directions, cell: float) -> np.ndarray:
+    """(d,) area of the silhouette seen along each unit direction (d, 3), estimated by
+    the square cells of side ``cell`` that the projected vertices fall into (take about
+    3 mean edge lengths: with less, surfaces seen face-on leave empty cells)."""
+    v = np.asarray(vertices, dtype=np.float64)
+    if len(v) > 200000:  # a regular subset of a very fine mesh covers the same cells
+        v = v[:: int(np.ceil(len(v) / 200000))]
+    v = v - v.mean(axis=0)
+    out = np.zeros(len(directions))
+    for i, d in enumerate(np.asarray(directions, dtype=np.float64)):
+        d = _unit(d)
+        k = int(np.argmin(np.abs(d)))
+        a = np.zeros(3)
+        a[k] = 1.0
+        a = _unit(a - (a @ d) * d)
+        b = np.cross(d, a)
+        ij = np.floor(np.column_stack([v @ a, v @ b]) / cell).astype(np.int64)
+        ij -= ij.min(axis=0)
+        key = ij[:, 0] * (int(ij[:, 1].max()) + 1) + ij[:, 1]
+        out[i] = np.unique(key).size * cell * cell
+    return out
+
+
+def _largest_silhouette(vertices, faces, up_vec: np.ndarray) -> np.ndarray:
+    """The viewing axis (unit, sign not chosen) showing the largest projected area."""
+    if faces is None or len(faces) == 0:
+        _, axes = principal_axes(vertices)
+        return _snap(axes[2])
+    k = int(np.argmax(np.abs(up_vec)))
+    a = np.zeros(3)
+    a[(k + 1) % 3] = 1.0
+    a = _unit(a - (a @ up_vec) * up_vec)
+    b = np.cross(up_vec, a)
+    angles = np.radians(np.arange(0.0, 180.0, 5.0))
+    horizontal = np.outer(np.cos(angles), a) + np.outer(np.sin(angles), b)
+    axes = [np.array(d) for d in AXES.values() if abs(np.dot(d, up_vec)) < 1e-9]
+    candidates = np.vstack([horizontal, *axes, up_vec]) if axes else np.vstack([horizontal, up_vec])
+    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
+    edge = np.linalg.norm(v[f[:, 1]] - v[f[:, 0]], axis=1).mean()
+    area = silhouette_area(v, candidates, 3.0 * edge)
+    best_h = int(np.argmax(area[: len(horizontal)]))
+    best = horizontal[best_h]
+    best_area = area[best_h]
+    for i, axis in enumerate(axes):
+        if area[len(horizontal) + i] >= AXIS_PREFERENCE * best_area:
+            best, best_area = axis, area[len(horizontal) + i]
+            break
+    if area[-1] > TOP_VIEW_RATIO * best_area:
+        return up_vec.copy()
+    return best
+
+
 def canonical_view(
     vertices, faces=None, up=None, azimuth: float = 20.0, elevation: float = 15.0
 ) -> Camera:
@@ -160,14 +216,16 @@ def canonical_view(
     name ("+y", "z", ...) or a vector; ``azimuth``/``elevation`` in degrees turn the
     camera about the up axis and toward it from the straight front view."""
     up_vec = _up_vector(up)
-    _, axes = principal_axes(vertices, faces)
-    view = _snap(axes[2])
+    view = _largest_silhouette(vertices, faces, up_vec)
     if abs(view @ up_vec) > np.cos(np.radians(30.0)):
         # flat across the up axis: from above, the longest axis left to right
         view = up_vec.copy()
+        _, axes = principal_axes(vertices, faces)
         middle = _snap(axes[1])
-        screen_up = _unit(middle - (middle @ view) * view)
-        screen_up = -_face_front(screen_up)  # the front side at the bottom of the screen
+        screen_up = middle - (middle @ view) * view
+        if np.linalg.norm(screen_up) < 1e-6:
+            screen_up = _snap(axes[2]) - (_snap(axes[2]) @ view) * view
+        screen_up = -_face_front(_unit(screen_up))  # the front side at the bottom
     else:
         view = _face_front(view)
         screen_up = _unit(up_vec - (up_vec @ view) * view)

@@ -107,3 +107,16 @@ def test_isometric_preset_and_dict_form():
         preset_view(plate.vertices, "top")
     with pytest.raises(ValueError, match="unknown up axis"):
         canonical_view(plate.vertices, up="w")
+
+
+def test_silhouette_of_a_box_mesh_picks_its_broad_side():
+    import trimesh
+
+    box = trimesh.creation.box(extents=(0.5, 2.0, 4.0))  # thin in X, long in Z
+    v, f = trimesh.remesh.subdivide_to_size(box.vertices, box.faces, max_edge=0.1)
+    cam = canonical_view(v, f, azimuth=0.0, elevation=0.0)
+    assert np.allclose(cam.direction, [1, 0, 0], atol=1e-12)  # the 2 x 4 side
+    assert np.allclose(cam.up, [0, 1, 0], atol=1e-12)
+    # lying flat (thin in Y, the up axis): seen from above
+    flat = v[:, [1, 0, 2]]
+    assert np.allclose(canonical_view(flat, f, azimuth=0, elevation=0).direction, [0, 1, 0])
