@@ -42,6 +42,7 @@ __all__ = [
     "solve_lowest",
     "relative_residuals",
     "zero_modes",
+    "typical_eigenvalue",
     "ZERO_MODE_RTOL",
 ]
 
@@ -54,6 +55,17 @@ converges in fewer operator applications but costs memory (at 130k vertices, she
 300 modes: 1.7 GB for the basis) and orthogonalisation time; 0.6 measured best."""
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
+
+SHIFT_RTOL = 1e-6
+"""The shift is ``-SHIFT_RTOL * median(diag(K) / mass)`` when K's null space is not
+deflated: far enough below zero that rounding in the solves cannot blow up the null
+vectors' components (OP multiplies them by 1 / |shift|)."""
+DEFLATED_SHIFT_RTOL = 1e-10
+"""The shift's relative size when the exactly known null vectors are deflated (every
+solve is projected, so their amplification does no harm).  The shift must stay small
+against the first non-zero eigenvalue, which it compresses the spectrum towards: the
+median diagonal ratio grows like 1/h^4 for bending energies, and at 130k vertices
+(bumpy plate, shells) 1e-6 of it is 17 times the first non-zero eigenvalue."""
 
 ProgressFn = Callable[[str, float], None]
 CancelFn = Callable[[], bool]
@@ -97,6 +109,8 @@ class EigenResult:
     row-major result), "dense"."""
     operator_columns: int = 0
     """Columns the shift-invert operator was applied to, refinement included."""
+    null_dim: int = 0
+    """The first ``null_dim`` pairs are the given exact null vectors (eigenvalue 0)."""
 
 
 def _sparse_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice, np.ndarray]]:
@@ -116,13 +130,27 @@ def _sparse_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice,
                 yield slice(start, start + width), KY
 
 
-def zero_modes(lam: np.ndarray, lam_scale: float = 0.0) -> np.ndarray:
-    """Boolean mask (k,) of the zero modes: ``lam < ZERO_MODE_RTOL * lam_max`` (rounding
-    can make them slightly negative) with ``lam_max = max(largest |lam|, lam_scale)``;
-    ``lam_scale`` (a typical eigenvalue size) keeps a spectrum of only zero modes from
-    judging itself by its own rounding noise."""
+def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
+    """Boolean mask (k,) of the zero modes, the one rule for masks, signatures and
+    residual checks.
+
+    The first ``null_dim`` modes are the deflated exact null vectors
+    (:mod:`.nullspace`): zero modes whatever k is.  Any other mode is a zero mode if
+    ``lam < ZERO_MODE_RTOL * lam_max`` (rounding can make it slightly negative) with
+    ``lam_max = max(largest |lam|, lam_scale)``; ``lam_scale`` (a typical eigenvalue
+    size, :func:`typical_eigenvalue`) keeps a spectrum of only zero modes from judging
+    itself by its own rounding noise.
+    """
     lam = np.asarray(lam, dtype=np.float64)
-    return lam < ZERO_MODE_RTOL * _lam_max(lam, lam_scale)
+    mask = lam < ZERO_MODE_RTOL * _lam_max(lam, lam_scale)
+    mask[: max(0, int(null_dim))] = True
+    return mask
+
+
+def typical_eigenvalue(K, mass_diag: np.ndarray) -> float:
+    """median(diag(K) / mass): the eigenvalue size zero modes are judged against when a
+    spectrum holds nothing larger (``lam_scale`` of :func:`zero_modes`)."""
+    return float(np.median(np.abs(K.diagonal()) / np.asarray(mass_diag)))
 
 
 def _lam_max(lam: np.ndarray, lam_scale: float) -> float:
@@ -131,14 +159,20 @@ def _lam_max(lam: np.ndarray, lam_scale: float) -> float:
 
 
 def relative_residuals(
-    K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray, lam_scale: float = 0.0
+    K,
+    mass_diag: np.ndarray,
+    lam: np.ndarray,
+    X: np.ndarray,
+    lam_scale: float = 0.0,
+    null_dim: int = 0,
 ) -> np.ndarray:
     """|K x - lam M x| / |lam M x| per column; for zero modes |K x| / (lam_max |M x|).
 
-    Zero modes are those of :func:`zero_modes` (``lam_scale`` is passed on).
+    Zero modes are those of :func:`zero_modes` (``lam_scale`` and ``null_dim`` are
+    passed on).
     """
     scale = np.abs(lam).copy()
-    scale[zero_modes(lam, lam_scale)] = _lam_max(lam, lam_scale)
+    scale[zero_modes(lam, lam_scale, null_dim)] = _lam_max(lam, lam_scale)
     out = np.empty(X.shape[1])
     for cols, KX in _sparse_products(K, X):  # (N, 32) temporaries, not three (N, k) ones
         MX = mass_diag[:, None] * X[:, cols]
@@ -180,6 +214,7 @@ def solve_lowest(
     dense_limit: int = DENSE_LIMIT,
     tol: float = 1e-10,
     block: int | None = None,
+    null_space: sp.spmatrix | np.ndarray | None = None,
 ) -> EigenResult:
     """The k lowest eigenpairs of ``K x = lam diag(mass_diag) x``.
 
@@ -190,10 +225,17 @@ def solve_lowest(
     k : number of eigenpairs, 1 <= k <= N.
     progress : called as ``progress(stage, fraction)``.
     cancel : polled during the solve; returning True raises :class:`Cancelled`.
+    null_space : (N, d) exact null vectors of K, Mass-orthonormal
+        (:func:`.nullspace.null_space`).  They are returned first, as eigenvalue 0,
+        counted in k; the iteration works in their Mass-orthogonal complement (the start
+        block and every solve are projected), so it cannot return them again or miss
+        any.  With d >= k the first k are returned without any factorisation.
 
     Returns
     -------
-    EigenResult with ascending eigenvalues and Mass-orthonormal vectors.
+    EigenResult with eigenvalues ascending (the d deflated zeros first, then the
+    iteration's, which start at zero up to rounding if K has further null vectors) and
+    Mass-orthonormal vectors.
     """
     K = sp.csr_matrix(K)
     N = K.shape[0]
@@ -212,42 +254,119 @@ def solve_lowest(
             progress(stage, float(min(max(fraction, 0.0), 1.0)))
 
     inv_sqrt_m = 1.0 / np.sqrt(mass_diag)
-    median_ratio = float(np.median(np.abs(K.diagonal()) / mass_diag))
+    median_ratio = typical_eigenvalue(K, mass_diag)
+    Z = _null_vectors(null_space, N, mass_diag)
+    d = Z.shape[1]
 
     timer = StageTimer()
-    lam = None
     columns = 0
-    if N > dense_limit:
-        lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
-        try:
-            lam, X, shift, backend, columns = _shift_invert(
-                K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer
-            )
-            method = f"shift-invert block Krylov-Schur ({backend})"
-        except _TooSmall:
-            lam = None
-    if lam is None:
-        report("solving (dense)", 0.1)
-        with timer("dense"):
-            lam, X = la.eigh(K.toarray(), np.diag(mass_diag), subset_by_index=[0, k - 1])
-        method, shift = "dense", 0.0
+    method, shift = "null space (no iteration)", 0.0
+    lam, X = np.zeros(0), np.zeros((N, 0))
+    if d < k:
+        # the standard-form null vectors M^1/2 Z are orthonormal: project them out
+        Y0 = sp.csr_matrix(sp.diags(np.sqrt(mass_diag)) @ Z)
+        Y0t = sp.csr_matrix(Y0.T)
+
+        def project(V: np.ndarray) -> np.ndarray:
+            if d:
+                V -= Y0 @ (Y0t @ V)
+            return V
+
+        lam = None
+        if N - d > dense_limit:
+            lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
+            try:
+                lam, X, shift, backend, columns = _shift_invert(
+                    K, mass_diag, inv_sqrt_m, k - d, lam_typical, report, tol, block, timer,
+                    project, N - d, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL,
+                )  # fmt: skip
+                method = f"shift-invert block Krylov-Schur ({backend})"
+            except _TooSmall:
+                lam = None
+        if lam is None:
+            report("solving (dense)", 0.1)
+            with timer("dense"):
+                lam, X = _dense_complement(K, mass_diag, Y0, k - d)
+            method, shift = "dense", 0.0
+        if d:
+            method += f", {d} null vectors deflated"
+    all_lam = np.concatenate([np.zeros(min(d, k)), lam])
     report("checking residuals", 0.97)
     with timer("residuals"):
         X = _fix_signs(X)
-        res = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
+        res_rest = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
+        Zk = _fix_column_signs(Z[:, : min(d, k)])
+        res_null = _null_residuals(K, mass_diag, Zk, _lam_max(all_lam, median_ratio))
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
     with timer("copy"):  # own row-major array ((n, 3, k) shells modes are then a view)
-        X = np.ascontiguousarray(X)
-    return EigenResult(lam, X, res, shift, method, timer.seconds, columns)
+        out = np.empty((N, k))
+        out[:, Zk.shape[1] :] = X
+        out[:, : Zk.shape[1]] = 0.0
+        coo = Zk.tocoo()
+        out[coo.row, coo.col] = coo.data
+    res = np.concatenate([res_null, res_rest])
+    return EigenResult(all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1])
 
 
-def _factor_below_spectrum(K, mass_diag, lam_typical, report, timer) -> tuple[SPDSolver, float]:
-    """Factor ``K - shift * M`` with a shift just below zero (K may be singular)."""
+def _null_vectors(null_space, N: int, mass_diag: np.ndarray) -> sp.csc_matrix:
+    """The given null vectors as (N, d) CSC; checks shape and Mass-orthonormality."""
+    if null_space is None:
+        return sp.csc_matrix((N, 0))
+    Z = sp.csc_matrix(null_space, dtype=np.float64)
+    if Z.shape[0] != N:
+        raise ValueError(f"null_space must have {N} rows (the unknowns), got {Z.shape[0]}")
+    gram = (Z.T @ sp.diags(mass_diag) @ Z).toarray()
+    if Z.shape[1] and np.abs(gram - np.eye(Z.shape[1])).max() > 1e-8:
+        raise ValueError("null_space must be Mass-orthonormal (Z^T M Z = I)")
+    return Z
+
+
+def _fix_column_signs(Z: sp.csc_matrix) -> sp.csc_matrix:
+    """Sparse columns with their entry of largest magnitude positive (as _fix_signs)."""
+    Z = sp.csc_matrix(Z, copy=True)
+    for j in range(Z.shape[1]):
+        data = Z.data[Z.indptr[j] : Z.indptr[j + 1]]
+        if data.size and data[np.abs(data).argmax()] < 0:
+            data *= -1.0
+    return Z
+
+
+def _null_residuals(K, mass_diag, Z: sp.csc_matrix, lam_max: float) -> np.ndarray:
+    """|K z| / (lam_max |M z|) per column of the sparse null vectors."""
+    if Z.shape[1] == 0:
+        return np.zeros(0)
+    KZ = sp.csc_matrix(K @ Z)
+    MZ = sp.csc_matrix(sp.diags(mass_diag) @ Z)
+
+    def norms(A):
+        return np.sqrt(np.asarray(A.multiply(A).sum(axis=0)).ravel())
+
+    return norms(KZ) / (lam_max * norms(MZ))
+
+
+def _dense_complement(K, mass_diag, Y0: sp.csr_matrix, k: int):
+    """Lowest k pairs of the standard form restricted to the orthogonal complement of
+    the orthonormal columns Y0 (dense; small problems)."""
+    if Y0.shape[1] == 0:
+        return la.eigh(K.toarray(), np.diag(mass_diag), subset_by_index=[0, k - 1])
+    inv_sqrt_m = 1.0 / np.sqrt(mass_diag)
+    C = inv_sqrt_m[:, None] * K.toarray() * inv_sqrt_m[None, :]
+    Q = la.qr(Y0.toarray(), mode="full")[0][:, Y0.shape[1] :]
+    CQ = C @ Q
+    lam, W = la.eigh(0.5 * (Q.T @ CQ + CQ.T @ Q), subset_by_index=[0, k - 1])
+    return lam, inv_sqrt_m[:, None] * (Q @ W)
+
+
+def _factor_below_spectrum(
+    K, mass_diag, lam_typical, report, timer, relative: float = SHIFT_RTOL
+) -> tuple[SPDSolver, float]:
+    """Factor ``K - shift * M`` with ``shift = -relative * lam_typical`` just below zero
+    (K may be singular), moving further down while the factorisation fails."""
     # Far below the first non-zero mode, yet factorisable.  Scaled by the typical diagonal
     # ratio, not the largest: one sliver triangle can make the largest 1e12 times bigger.
-    shift = -1e-6 * lam_typical
-    for _ in range(4):
+    shift = -relative * lam_typical
+    for _ in range(1 + round(np.log(1.0 / relative) / np.log(100.0))):  # up to -lam_typical
         report("factorising", 0.02)
         try:
             with timer("factorisation"):
@@ -255,8 +374,9 @@ def _factor_below_spectrum(K, mass_diag, lam_typical, report, timer) -> tuple[SP
         except np.linalg.LinAlgError:
             shift *= 100.0  # move further below the spectrum and try again
     raise EigenError(
-        "the operator could not be factorised even with a shift below zero; "
-        "it is probably not positive semi-definite (check the mesh for degenerate faces)"
+        "the operator could not be factorised even with a shift below zero: it is "
+        "numerically indefinite; if the mesh has nearly degenerate (sliver) triangles, "
+        "modalviewer.fix_slivers(mesh) removes them (in the viewer: Mesh > Fix slivers)"
     )
 
 
@@ -303,7 +423,11 @@ _SWEEP_ROWS = 1024
 
 
 def _orthonormal_block(
-    W: np.ndarray, Q: np.ndarray, rng: np.random.Generator, local: int = 0
+    W: np.ndarray,
+    Q: np.ndarray,
+    rng: np.random.Generator,
+    local: int = 0,
+    project: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Orthonormalise W (N, b) against the orthonormal columns of Q and among itself.
 
@@ -354,6 +478,8 @@ def _orthonormal_block(
     if np.any(lost):
         # invariant subspace found: continue with fresh directions, coupling zero
         fresh = rng.standard_normal((W.shape[0], int(lost.sum())))
+        if project is not None:
+            fresh = project(fresh)
         for _ in range(2):
             fresh -= Q @ (Q.T @ fresh)
             keep = V[:, ~lost]
@@ -385,6 +511,7 @@ def block_krylov_schur(
     max_restarts: int = 60,
     seed: int = 12345,
     timer: StageTimer | None = None,
+    project: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """The k largest eigenpairs of a symmetric positive definite operator.
 
@@ -401,6 +528,9 @@ def block_krylov_schur(
     k : wanted eigenpairs; ``k <= keep``, ``keep + block <= max_basis <= N - block``.
     tol : a pair counts as converged when ``|OP y - theta y| <= tol * theta``.
     timer : accumulates the seconds of "solves", "orthogonalisation", "ritz", "restarts".
+    project : removes a known invariant subspace (deflated null vectors) from an (N, b)
+        array in place; applied to the start block and to fresh random directions
+        (apply_op must project its results itself).
 
     Returns
     -------
@@ -412,7 +542,10 @@ def block_krylov_schur(
     b = block
     Q = np.empty((N, max_basis + b))
     T = np.zeros((max_basis, max_basis))
-    Q[:, :b] = np.linalg.qr(rng.standard_normal((N, b)))[0]
+    start = rng.standard_normal((N, b))
+    if project is not None:
+        start = project(start)
+    Q[:, :b] = np.linalg.qr(start)[0]
     j = 0  # closed columns: OP already applied
     sequence_start = 0  # j of the first block after the last (re)start
     R = np.zeros((b, 0))  # OP Q[:, :j] = Q[:, :j] T[:j, :j] + Q[:, j:j+b] R
@@ -429,7 +562,7 @@ def block_krylov_schur(
         # block, except right after a (re)start, where it couples to all kept vectors.
         local = j - b if j > sequence_start else 0
         with timer("orthogonalisation"):
-            V, h, Rn = _orthonormal_block(W, Q[:, : j + b], rng, local)
+            V, h, Rn = _orthonormal_block(W, Q[:, : j + b], rng, local, project)
             Q[:, j + b : j + 2 * b] = V
         T[: j + b, j : j + b] = h
         T[j : j + b, : j + b] = h.T
@@ -462,7 +595,7 @@ def block_krylov_schur(
             worst = float(np.max(estimates[:k] / np.abs(theta[:k])))
             raise EigenError(
                 f"the eigensolver did not converge after {restarts} restarts "
-                f"(worst relative residual {worst:.1e}); try fewer modes"
+                f"(worst relative residual {worst:.1e})"
             )
         # thick restart: keep the best Ritz vectors, continue from the open block
         restarts += 1
@@ -477,25 +610,37 @@ def block_krylov_schur(
         sequence_start = p
 
 
-def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer):
-    """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2``:
-    (eigenvalues, vectors (a view into the Krylov basis), shift, backend name, operator
-    columns)."""
-    N = K.shape[0]
-    sqrt_m = np.sqrt(mass_diag)
-    # A few more pairs than requested: the last requested pairs then converge as fast
-    # as the others (the gap to the unwanted part of the spectrum is larger).
-    k_work = max(k, min(N // 2, k + max(8, k // 10)))
+def _krylov_sizes(k: int, n_free: int, block: int | None) -> tuple[int, int, int, int]:
+    """(working pairs, block size, basis size, pairs kept at a restart) for k pairs."""
+    k_work = max(k, min(n_free // 2, k + max(8, k // 10)))
     if block is None:
         block = int(np.clip(k_work // 16, 4, 16))
     max_basis = k_work + max(2 * block, int(BASIS_EXTRA * k_work))
     max_basis = ((max_basis + block - 1) // block) * block
-    if max_basis + block > N:
+    return k_work, block, max_basis, k_work + (max_basis - k_work) // 3
+
+
+def _shift_invert(
+    K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer, project, n_free,
+    shift_rtol,
+):  # fmt: skip
+    """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2`` in the
+    complement of the deflated null vectors (``project`` removes them, ``n_free`` is the
+    complement's dimension): (eigenvalues, vectors (a view into the Krylov basis),
+    shift, backend name, operator columns)."""
+    N = K.shape[0]
+    sqrt_m = np.sqrt(mass_diag)
+    # A few more pairs than requested: the last requested pairs then converge as fast
+    # as the others (the gap to the unwanted part of the spectrum is larger).
+    k_work, block, max_basis, keep = _krylov_sizes(k, n_free, block)
+    if max_basis + block > n_free:
         raise _TooSmall()  # the basis would not fit: the dense solver is the right tool
-    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report, timer)
+    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report, timer, shift_rtol)
 
     def apply_op(V: np.ndarray) -> np.ndarray:
-        return sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * V)
+        # the null vectors are an invariant subspace of OP, with its largest eigenvalue
+        # 1 / |shift|: rounding brings them back in every solve, so each result is projected
+        return project(sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * V))
 
     # At a restart the basis keeps the working pairs and the best third of the unwanted
     # Ritz vectors next to them, which carry the part of the spectrum the last wanted
@@ -505,12 +650,13 @@ def _shift_invert(K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, 
         apply_op,
         N,
         k,
-        keep=k_work + (max_basis - k_work) // 3,
+        keep=keep,
         block=block,
         max_basis=max_basis,
         tol=tol,
         report=report,
         timer=timer,
+        project=project,
     )
     # One block step of inverse iteration on the converged subspace, then Rayleigh-Ritz
     # with the operator itself.  Rounding in the Gram-Schmidt steps leaves noise of

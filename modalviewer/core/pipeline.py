@@ -7,9 +7,17 @@ import time
 import numpy as np
 
 from .dirichlet import modified_dirichlet_matrix
-from .eigen import CancelFn, EigenError, ProgressFn, solve_lowest, zero_modes
+from .eigen import (
+    CancelFn,
+    EigenError,
+    ProgressFn,
+    solve_lowest,
+    typical_eigenvalue,
+    zero_modes,
+)
 from .laplacian import lumped_masses, stiffness_matrix
 from .mesh import Mesh
+from .nullspace import null_space
 from .shells import normal_shells_hessian, shells_hessian
 from .spectrum import OPERATORS, Spectrum
 
@@ -81,6 +89,10 @@ def compute_spectrum(
     Returns
     -------
     Spectrum with ascending eigenvalues and Mass-orthonormal modes, (n, k) or (n, 3, k).
+    The exactly known null vectors of the operator (:mod:`.nullspace`: a constant per
+    component for the Laplacian, six rigid motions per component for the shells, ...)
+    come first, as eigenvalue 0, counted in k; ``spec.null_space_dimension`` says how
+    many, ``spec.parameters["null_space"]`` says it in words.
     """
     if operator not in OPERATORS:
         raise ValueError(f"unknown operator {operator!r}; choose one of {', '.join(OPERATORS)}")
@@ -107,21 +119,20 @@ def compute_spectrum(
     K, mass = operator_matrices(mesh, operator, bending, membrane)
     assembled = time.perf_counter()
     k = min(k, K.shape[0])
-    result = solve_lowest(K, mass, k, progress=progress, cancel=cancel)
-    lam_typical = float(np.median(np.abs(K.diagonal()) / mass))
-    nonzero = ~zero_modes(result.eigenvalues, lam_typical)
+    nulls = null_space(mesh, operator, K, mass)
+    try:
+        result = solve_lowest(
+            K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors
+        )
+    except EigenError as exc:
+        raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
+    lam_typical = typical_eigenvalue(K, mass)
+    nonzero = ~zero_modes(result.eigenvalues, lam_typical, result.null_dim)
     worst = float(result.residuals[nonzero].max()) if nonzero.any() else 0.0
     if worst > RESIDUAL_LIMIT:
-        slivers = sliver_report(mesh)
-        hint = (
-            f"; the mesh has {slivers}, which make the operator numerically indefinite: "
-            "remesh it (or clean those triangles) and try again"
-            if slivers
-            else " (try fewer modes)"
-        )
         raise EigenError(
             f"the eigensolver's residual {worst:.1e} is above {RESIDUAL_LIMIT:.0e}; "
-            f"the result is not trustworthy{hint}"
+            f"the result is not trustworthy{_failure_hint(mesh)}"
         )
     n = mesh.n_vertices
     modes = result.vectors
@@ -146,5 +157,21 @@ def compute_spectrum(
             "seconds_total": time.perf_counter() - started,
             "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
             "operator_columns": result.operator_columns,
+            "null_space_dimension": result.null_dim,
+            "zero_mode_scale": lam_typical,
+            "n_components": nulls.n_components,
+            "null_space": nulls.summary(),
         },
     )
+
+
+def _failure_hint(mesh: Mesh) -> str:
+    """What the mesh may have to do with a failed solve, or "" (no advice that may be
+    wrong for the case: the exactly known null vectors are already deflated)."""
+    slivers = sliver_report(mesh)
+    if slivers:
+        return (
+            f"; the mesh has {slivers}, which make the operator ill-conditioned: remesh "
+            "it (or clean those triangles) and try again"
+        )
+    return ""

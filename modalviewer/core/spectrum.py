@@ -69,9 +69,22 @@ class Spectrum:
         (``parameters["preview"]`` holds the per-mode estimates); 0.0 for exact spectra."""
         return float(self.parameters.get("preview", {}).get("estimated_error", 0.0))
 
+    @property
+    def null_space_dimension(self) -> int:
+        """How many of the first modes are deflated exact null vectors (constants per
+        component, rigid motions per component, ...; :mod:`.nullspace`)."""
+        return int(self.parameters.get("null_space_dimension", 0))
+
     def zero_mode_mask(self) -> np.ndarray:
-        """(k,) True for modes whose eigenvalue is below 1e-8 times the largest."""
-        return zero_modes(self.eigenvalues)
+        """(k,) True for the zero modes: the deflated null vectors, and modes whose
+        eigenvalue is below 1e-8 times the largest (or the operator's typical
+        eigenvalue size, if larger); the rule of :func:`.eigen.zero_modes`, the same the
+        residual check used."""
+        return zero_modes(
+            self.eigenvalues,
+            float(self.parameters.get("zero_mode_scale", 0.0)),
+            self.null_space_dimension,
+        )
 
     def mode(self, j: int) -> np.ndarray:
         """Mode j: (n,) for scalar operators, (n, 3) for ``"shells"``."""

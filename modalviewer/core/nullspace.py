@@ -1,0 +1,213 @@
+"""The exactly known null spaces of the four operators, per connected component.
+
+Each operator's energy is a sum over the mesh's connected components, so its null space
+is the direct sum of the components' null spaces.  What is known exactly:
+
+=====================  ==============================================================
+operator               null vectors per component
+=====================  ==============================================================
+``laplacian``          the constant (the cotan rows sum to zero): 1 per component
+``shells``             the six rigid motions (3 translations, 3 infinitesimal rotations
+                       about the component's centre of mass): every term of the energy
+                       (lengths, areas, dihedral angles) is invariant under them
+``modified_dirichlet`` ``f`` with ``f_i N_i`` constant (``f^T A f`` is the Dirichlet
+                       energy of the vector field ``f N``): only on a *flat* component,
+                       where it is the constant; none on a curved one
+``shells_normal``      ``f`` with ``f_i N_i`` a rigid motion (``H_N = P^T H P``): only on
+                       a flat component, where these are the affine functions of the
+                       plane (3 per component); none on a curved one
+=====================  ==============================================================
+
+Other null vectors can exist (a Discrete Shells component whose pieces meet at a single
+vertex can rotate them about it); they are not deflated and the eigensolver finds them
+like any other mode.
+
+Every candidate is checked numerically on the assembled matrix before it is used: it
+must satisfy ``|K z| <= NULL_RTOL * | |K| |z| |`` (the rounding bound of the product,
+so exact null vectors pass at about 1e-15 and a nearly flat component's constant fails
+for E_D^N).  The accepted vectors are Mass-orthonormal: ``Z^T Mass Z = I``.
+
+>>> ns = null_space(mesh, "shells", K, mass)          # doctest: +SKIP
+>>> ns.dimension, ns.n_components, ns.summary()       # doctest: +SKIP
+(264, 44, '44 connected components: ...')
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .laplacian import vertex_normals
+from .mesh import Mesh
+
+__all__ = ["NullSpace", "null_space", "NULL_RTOL"]
+
+NULL_RTOL = 1e-10
+"""A candidate null vector z is accepted if ``|K z| <= NULL_RTOL * | |K| |z| |``: exact
+null vectors reach 1e-16 to 1e-14 (rounding in the assembly and the product)."""
+
+_KIND = {
+    "laplacian": "constants",
+    "modified_dirichlet": "constants of flat components",
+    "shells": "rigid motions",
+    "shells_normal": "normal rigid motions of flat components",
+}
+
+
+@dataclass(frozen=True)
+class NullSpace:
+    """Mass-orthonormal exact null vectors of one operator on one mesh.
+
+    Attributes
+    ----------
+    vectors : (N, d) sparse CSC matrix, N unknowns (3n for ``"shells"``, dof 3i+c),
+        ``vectors.T @ diag(mass) @ vectors = I`` and ``K @ vectors = 0`` to rounding.
+        Each column lives on one component; columns are ordered by component.
+    operator : the operator's name.
+    n_components : connected components of the mesh.
+    per_component : (n_components,) null vectors found on each component.
+    """
+
+    vectors: sp.csc_matrix
+    operator: str
+    n_components: int
+    per_component: np.ndarray
+
+    @property
+    def dimension(self) -> int:
+        return int(self.vectors.shape[1])
+
+    def summary(self) -> str:
+        """One sentence on the zero modes a spectrum of this operator starts with."""
+        d, c = self.dimension, self.n_components
+        comps = f"{c} connected component{'s' if c != 1 else ''}"
+        if d == 0:
+            return f"{comps}; no exactly known zero modes ({_KIND[self.operator]}: none)."
+        with_null = self.per_component[self.per_component > 0]
+        counts = np.unique(with_null)
+        if len(with_null) == c and len(counts) == 1:
+            where = f"{counts[0]} per component"
+        else:
+            where = f"on {len(with_null)} of the {c} components"
+        first = (
+            "the first mode is an exact zero mode"
+            if d == 1
+            else (f"the first {d} modes are exact zero modes")
+        )
+        return (
+            f"{comps}: {first} ({_KIND[self.operator]}, {where}), "
+            "computed directly, not by iteration."
+        )
+
+
+def _component_vertices(mesh: Mesh) -> list[np.ndarray]:
+    labels = mesh.component_labels
+    order = np.argsort(labels, kind="stable")
+    bounds = np.searchsorted(labels[order], np.arange(labels.max() + 2))
+    return [order[bounds[c] : bounds[c + 1]] for c in range(len(bounds) - 1)]
+
+
+def _rigid_fields(x: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """(p, 3, 6) velocities of 3 translations and 3 rotations about the centre of mass."""
+    c = (m[:, None] * x).sum(axis=0) / m.sum()
+    r = x - c
+    fields = np.zeros((len(x), 3, 6))
+    fields[:, [0, 1, 2], [0, 1, 2]] = 1.0
+    for a in range(3):
+        axis = np.zeros(3)
+        axis[a] = 1.0
+        fields[:, :, 3 + a] = np.cross(axis, r)
+    return fields
+
+
+def _mass_orthonormal(B: np.ndarray, w: np.ndarray, rtol: float = 1e-10) -> np.ndarray:
+    """Columns spanning B's range, orthonormal in the weights w (eigenvectors of the
+    Gram matrix, so principal directions come out; rank-deficient parts dropped)."""
+    if B.shape[1] == 0:
+        return B
+    G = B.T @ (w[:, None] * B)
+    ev, V = np.linalg.eigh(0.5 * (G + G.T))
+    keep = ev > rtol * max(float(ev.max()), np.finfo(float).tiny)
+    return B @ (V[:, keep] / np.sqrt(ev[keep]))
+
+
+def _candidates(mesh: Mesh, operator: str, mass: np.ndarray, normals):
+    """Per component: (rows of the unknowns, Mass-orthonormal dense candidate columns)."""
+    x = mesh.vertices
+    for verts in _component_vertices(mesh):
+        m = mass[verts] if operator != "shells" else mass[3 * verts]
+        if operator == "laplacian":
+            yield verts, _mass_orthonormal(np.ones((len(verts), 1)), m)
+        elif operator == "shells":
+            fields = _rigid_fields(x[verts], m)  # (p, 3, 6), rows 3i+c
+            rows = (3 * verts[:, None] + np.arange(3)).ravel()
+            yield rows, _mass_orthonormal(fields.reshape(-1, 6), np.repeat(m, 3))
+        else:
+            fields = _rigid_fields(x[verts], m)
+            if operator == "modified_dirichlet":
+                fields = fields[:, :, :3]  # f N constant: translations only
+            N = normals[verts]
+            along = np.einsum("pc,pcj->pj", N, fields)  # normal component f = N . r
+            tangential = fields - N[:, :, None] * along[:, None, :]
+            # rigid motions that are normal everywhere: the null space of the tangential
+            # parts (relative to the whole motion; rotations and translations differ in size)
+            T = (np.sqrt(m)[:, None, None] * tangential).reshape(-1, fields.shape[2])
+            whole = (np.sqrt(m)[:, None, None] * fields).reshape(-1, fields.shape[2])
+            _, s, Vt = np.linalg.svd(T, full_matrices=False)
+            size = np.linalg.norm(whole @ Vt.T, axis=0)
+            ok = s <= 1e-8 * size
+            yield verts, _mass_orthonormal(along @ Vt[ok].T, m)
+
+
+def null_space(
+    mesh: Mesh,
+    operator: str,
+    K: sp.spmatrix,
+    mass: np.ndarray,
+    normals: np.ndarray | None = None,
+) -> NullSpace:
+    """The exactly known null vectors of ``operator`` on ``mesh`` (see the module text).
+
+    Parameters
+    ----------
+    K, mass : the operator's matrix and diagonal mass (``pipeline.operator_matrices``);
+        every candidate is checked against K.
+    normals : the vertex normals the operator was built with (E_D^N, normal shells);
+        default: the area-weighted ones the operators use.
+    """
+    if operator not in _KIND:
+        raise ValueError(f"unknown operator {operator!r}")
+    mass = np.asarray(mass, dtype=np.float64)
+    if operator in ("modified_dirichlet", "shells_normal") and normals is None:
+        normals = vertex_normals(mesh)
+    rows, cols, vals = [], [], []
+    component = []
+    for c, (comp_rows, Z) in enumerate(_candidates(mesh, operator, mass, normals)):
+        r, j = np.nonzero(Z)
+        rows.append(comp_rows[r])
+        cols.append(j + len(component))
+        vals.append(Z[r, j])
+        component.extend([c] * Z.shape[1])
+    n_components = c + 1
+    d = len(component)
+    Z = sp.csc_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(K.shape[0], d),
+    )
+    if d:
+        # one sparse product for every candidate; a subset of orthonormal columns that
+        # live on disjoint components stays orthonormal
+        K = sp.csr_matrix(K)
+        KZ = (K @ Z).tocsc()
+        bound = (abs(K) @ abs(Z)).tocsc()
+        exact = _column_norms(KZ) <= NULL_RTOL * _column_norms(bound)
+        Z = Z[:, np.flatnonzero(exact)]
+        component = np.asarray(component)[exact]
+    per_component = np.bincount(np.asarray(component, dtype=np.int64), minlength=n_components)
+    return NullSpace(sp.csc_matrix(Z), operator, n_components, per_component)
+
+
+def _column_norms(A: sp.csc_matrix) -> np.ndarray:
+    return np.sqrt(np.asarray(A.multiply(A).sum(axis=0)).ravel())
