@@ -32,6 +32,7 @@ relative error (see :func:`estimated_errors`).
 from __future__ import annotations
 
 import time
+from functools import partial
 
 import numpy as np
 import scipy.sparse as sp
@@ -192,10 +193,25 @@ def reduced_basis(
     return P, None, info
 
 
+def _in_two_threads(fn, items):
+    """``[fn(item) for item in items]`` on two threads (scipy's sparse products release
+    the GIL and run on one core each)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(2) as pool:
+        return list(pool.map(fn, items))
+
+
+def _halves(n: int) -> list[slice]:
+    return [slice(0, n // 2), slice(n // 2, n)]
+
+
 def _project(K, P: sp.csr_matrix, D: np.ndarray | None) -> sp.csr_matrix:
     """``[P D]^T K [P D]`` as a sparse symmetric matrix (D: dense columns or None)."""
-    KP = (K @ P).tocsc()
-    A = (P.T @ KP).tocsr()
+    K = sp.csr_matrix(K)
+    halves = _halves(K.shape[0])
+    KP = _in_two_threads(lambda rows: (K[rows] @ P).tocsr(), halves)
+    A = sum(_in_two_threads(lambda i: (P[halves[i]].T @ KP[i]).tocsr(), [0, 1]))
     if D is not None:
         KD = K @ D
         cross = np.asarray(P.T @ KD)
@@ -240,9 +256,17 @@ def _solve_reduced(
         return lam, T @ Z
     typical = float(np.median(np.abs(Kr.diagonal()) / Mr.diagonal()))
     shift = -1e-6 * (typical or 1.0)
+    dense = N <= 4000 and Kr.nnz > 0.05 * N * N  # the factor would be nearly dense
+    if dense:  # BLAS-3 products and a dense Cholesky factor
+        import scipy.linalg as la
+
+        Kr, Mr = Kr.toarray(), Mr.toarray()
     for _ in range(8):
         try:
-            solver = SPDSolver((Kr - shift * Mr).tocsr())
+            if dense:
+                solve = partial(la.cho_solve, la.cho_factor(Kr - shift * Mr))
+            else:
+                solve = SPDSolver((Kr - shift * Mr).tocsr()).solve
             break
         except np.linalg.LinAlgError:
             shift *= 10.0
@@ -278,7 +302,7 @@ def _solve_reduced(
             if res.max() <= tol or s + b > N or X.shape[1] == 0:
                 return lam, V @ Z
             check_at = s + 2 * b
-        X = solver.solve(MX)
+        X = solve(MX)
 
 
 def _jacobi_blocks(K: sp.csr_matrix, block: int):
@@ -323,27 +347,40 @@ def _threaded_product(K, X: np.ndarray) -> np.ndarray:
 def _smoothing_step(K, mass, lam, U, KU, precondition, k):
     """Rayleigh-Ritz on [U, B^-1 R] with the block-Jacobi preconditioned residuals R.
 
-    The enlarged space contains U, so every Ritz value is at most the one it replaces and
-    still an upper bound of the exact eigenvalue.  Returns (lam, X, KX).
+    U holds the Mass-orthonormal Galerkin modes with ``U^T K U = diag(lam)``, so only the
+    blocks involving the new directions W are computed (three (N, k) x (N, k) products
+    and two to orthogonalise W against U).  The enlarged space contains U, so every Ritz
+    value is at most the one it replaces and still an upper bound of the exact
+    eigenvalue.  Returns (lam, X, KX).
     """
-    R = KU - mass[:, None] * U * lam[None, :]
-    W = precondition(R)
-    # directions of (numerically) converged pairs, e.g. the zero modes, add nothing
+    W = precondition(KU - mass[:, None] * U * lam[None, :])
+    # M-orthogonal to U; directions of (numerically) converged pairs add nothing
     W -= U @ (U.T @ (mass[:, None] * W))
     KW = _threaded_product(K, W)
-    S = np.hstack([U, W])
-    KS = np.hstack([KU, KW])
-    H = S.T @ KS
-    G = S.T @ (mass[:, None] * S)
+    G_ww = W.T @ (mass[:, None] * W)
+    H_uw = KU.T @ W
+    H_ww = W.T @ KW
+    c = U.shape[1]
+    H = np.zeros((2 * c, 2 * c))
+    G = np.zeros((2 * c, 2 * c))
+    H[:c, :c] = np.diag(lam)
+    H[:c, c:] = H_uw
+    H[c:, :c] = H_uw.T
+    H[c:, c:] = 0.5 * (H_ww + H_ww.T)
+    G[:c, :c] = np.eye(c)
+    G[c:, c:] = 0.5 * (G_ww + G_ww.T)
     d = 1.0 / np.sqrt(np.maximum(np.diag(G), 1e-300))
-    H = 0.5 * (H + H.T) * np.outer(d, d)
-    G = 0.5 * (G + G.T) * np.outer(d, d)
+    d[c:][np.diag(G)[c:] <= 1e-14 * max(1.0, float(np.max(np.diag(G))))] = 0.0
+    H *= np.outer(d, d)
+    G *= np.outer(d, d)
     w, E = np.linalg.eigh(G)
     keep = w > 1e-10 * w.max()
     T = E[:, keep] / np.sqrt(w[keep])
     new_lam, Z = np.linalg.eigh(T.T @ H @ T)
     C = (T @ Z[:, :k]) * d[:, None]
-    return new_lam[:k], S @ C, KS @ C
+    X = U @ C[:c] + W @ C[c:]
+    KX = KU @ C[:c] + KW @ C[c:]
+    return new_lam[:k], X, KX
 
 
 def _residuals(K_U, mass, lam, U, lam_scale):
