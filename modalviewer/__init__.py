@@ -22,6 +22,7 @@ _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
 from .io import load_mesh  # noqa: E402
+from .repair import SliverReport, fix_slivers  # noqa: E402
 
 __version__ = "0.1.0"
-__all__ = [*_core_all, "load_mesh"]
+__all__ = [*_core_all, "load_mesh", "fix_slivers", "SliverReport"]
