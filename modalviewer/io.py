@@ -143,6 +143,11 @@ def read_arrays(path) -> tuple[np.ndarray, np.ndarray]:
         vertices, faces = _read_trimesh(path)
         if ext == ".ply" and len(faces) == 0 and b"tristrips" in path.read_bytes()[:4096]:
             return _read_ply_tristrips(path)
+        if len(vertices) == 0:
+            raise MeshError(
+                f"{path.name}: no vertices found in this {ext[1:].upper()} file; "
+                "the file may be damaged, truncated or of another type"
+            )
         return vertices, faces
     except MeshError:
         raise
@@ -157,9 +162,11 @@ def read_arrays(path) -> tuple[np.ndarray, np.ndarray]:
 def load_mesh(path, repair: bool = True) -> Mesh:
     """Read a triangle mesh from ``path``.
 
-    With ``repair=True`` (default) duplicate vertices are merged, degenerate and
-    duplicate faces and unreferenced vertices removed, and the orientation made
-    consistent; ``mesh.report`` says what was done.  With ``repair=False`` the arrays
+    With ``repair=True`` (default) duplicate vertices are merged, zero-area faces
+    collapsed (a closed surface stays closed), faces repeating a vertex, duplicate faces
+    and unreferenced vertices removed, and the orientation made consistent;
+    ``mesh.report`` says what was done.  Nearly degenerate triangles (slivers) are left
+    as they are: :func:`modalviewer.fix_slivers` removes them.  With ``repair=False`` the arrays
     are validated as they are.
 
     Raises

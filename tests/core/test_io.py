@@ -143,3 +143,11 @@ def test_import_loads_no_qt_and_no_vtk():
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("text", ["garbage\nmore garbage\n", "# only a comment\n"])
+def test_an_obj_without_vertices_names_the_file_and_the_format(tmp_path, text):
+    path = tmp_path / "broken.obj"
+    path.write_text(text)
+    with pytest.raises(mv.MeshError, match=r"^broken\.obj: no vertices found in this OBJ file"):
+        mv.load_mesh(path)
