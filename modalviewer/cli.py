@@ -203,7 +203,7 @@ def _run(args) -> int:
         return _distance_to(args, mesh)
     if args.rescale:
         raise ValueError("--rescale applies to two meshes (with --to)")
-    spec = mv.compute_spectrum(mesh, KINDS[args.kind], args.k, progress=_progress_bar())
+    spec = _cached_spectrum(mesh, KINDS[args.kind], args.k)
     d = mv.multiscale_distance(spec, args.vertex)
     if args.csv:
         _write_csv(args.csv, d)
@@ -235,6 +235,20 @@ def _write_csv(path, d: np.ndarray) -> None:
     )
 
 
+def _cached_spectrum(mesh, operator: str, k: int):
+    """The spectrum from the viewer's disk cache (``$MODALVIEWER_CACHE``), or computed
+    with a progress bar and cached, so a second pick on the same meshes is quick."""
+    import modalviewer as mv
+    from modalviewer.core.cache import SpectrumCache
+
+    cache = SpectrumCache()
+    spec = cache.get(mesh, operator, k)
+    if spec is None:
+        spec = mv.compute_spectrum(mesh, operator, k, progress=_progress_bar())
+        cache.put(mesh, spec, k)
+    return spec
+
+
 def _distance_to(args, mesh_a) -> int:
     """``distance A --vertex V --to B``: from vertex V of A to every vertex of B."""
     import warnings
@@ -245,8 +259,8 @@ def _distance_to(args, mesh_a) -> int:
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
     operator = KINDS[args.kind]
-    spec_a = mv.compute_spectrum(mesh_a, operator, args.k, progress=_progress_bar())
-    spec_b = mv.compute_spectrum(mesh_b, operator, args.k, progress=_progress_bar())
+    spec_a = _cached_spectrum(mesh_a, operator, args.k)
+    spec_b = _cached_spectrum(mesh_b, operator, args.k)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", mv.ScaleWarning)
         tables = mv.CrossTables(spec_a, spec_b)

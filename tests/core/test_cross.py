@@ -168,7 +168,8 @@ def _write_obj(path: Path, mesh: mv.Mesh) -> Path:
     return path
 
 
-def test_cli_distance_to_a_second_mesh(tmp_path, spot):
+def test_cli_distance_to_a_second_mesh(tmp_path, spot, monkeypatch):
+    monkeypatch.setenv("MODALVIEWER_CACHE", str(tmp_path / "cache"))
     a = _write_obj(tmp_path / "a.obj", spot)
     b = _write_obj(tmp_path / "b.obj", _moved(spot, scale=1.2))
     csv, png = tmp_path / "d.csv", tmp_path / "d.png"
@@ -193,6 +194,7 @@ def test_cli_distance_to_a_second_mesh(tmp_path, spot):
     assert image.shape[1] == 400 and image.shape[0] > 200  # two panels and their captions
     right = image[:, 200:].reshape(-1, 3).astype(int)
     assert np.sum((right[:, 0] > 150) & (right[:, 1] < 100)) > 500  # red: far vertices
+    assert len(list((tmp_path / "cache").glob("*.npz"))) == 2  # both spectra kept
     # both rescaled to unit area: the copy's own vertex, a mutual best match, no warning
     r = subprocess.run(list(map(str, [*run, "--rescale"])), capture_output=True, text=True)
     assert r.returncode == 0 and "warning" not in r.stderr, r.stderr
