@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .eigen import zero_modes
+from .files import atomic_write
 
 __all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
 
@@ -100,18 +99,14 @@ class Spectrum:
 
 
 def _atomic_write(path: Path, write) -> None:
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".part", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
+    """``write(fh)`` into a temporary file beside ``path``, then rename it (permissions of
+    the user's umask, see :mod:`.files`)."""
+
+    def to_file(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:
             write(fh)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+
+    atomic_write(Path(path), to_file, suffix=".part")
 
 
 def save_spectrum(spec: Spectrum, path) -> None:

@@ -34,3 +34,18 @@ def test_failed_write_leaves_nothing(tmp_path):
         atomic_write(target, fail)
     assert target.read_text() == "old"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["b.txt"]
+
+
+def test_saved_spectrum_gets_the_umask_permissions(tmp_path):
+    import modalviewer as mv
+    from modalviewer.core.primitives import icosphere
+
+    spec = mv.compute_spectrum(icosphere(1), "laplacian", k=4)
+    old = os.umask(0o022)
+    try:
+        mv.save_spectrum(spec, tmp_path / "s.npz")
+    finally:
+        os.umask(old)
+    assert (tmp_path / "s.npz").stat().st_mode & 0o777 == 0o644
+    again = mv.load_spectrum(tmp_path / "s.npz")
+    assert again.eigenvalues.tolist() == spec.eigenvalues.tolist()
