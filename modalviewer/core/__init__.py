@@ -1,5 +1,11 @@
 """Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
 
+from .components import (
+    ComponentSpectrum,
+    compute_spectrum_per_component,
+    largest_component,
+    split_components,
+)
 from .cross import (
     CrossTables,
     Matches,
@@ -31,6 +37,10 @@ __all__ = [
     "mutual_best_matches",
     "rescale_to_area",
     "Cancelled",
+    "ComponentSpectrum",
+    "compute_spectrum_per_component",
+    "largest_component",
+    "split_components",
     "EigenError",
     "Mesh",
     "MeshError",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 
 import numpy as np
 
@@ -21,7 +22,19 @@ from .nullspace import null_space
 from .shells import normal_shells_hessian, shells_hessian
 from .spectrum import OPERATORS, Spectrum
 
-__all__ = ["compute_spectrum", "operator_matrices", "sliver_report", "RESIDUAL_LIMIT"]
+__all__ = [
+    "compute_spectrum",
+    "operator_matrices",
+    "sliver_report",
+    "RESIDUAL_LIMIT",
+    "ZeroModesWarning",
+]
+
+
+class ZeroModesWarning(UserWarning):
+    """Every requested mode is an exact zero mode (constants or rigid motions of the
+    mesh's components): nothing of the shape's vibrations is in the spectrum."""
+
 
 RESIDUAL_LIMIT = 1e-4
 """A spectrum whose non-zero modes have a larger relative residual is rejected.
@@ -126,6 +139,15 @@ def compute_spectrum(
         )
     except EigenError as exc:
         raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
+    if result.null_dim >= k and nulls.n_components > 1:
+        warnings.warn(
+            f"all {k} modes are exact zero modes: {nulls.summary()} Ask for more than "
+            f"{nulls.dimension} modes, keep the largest component "
+            "(modalviewer.largest_component) or compute per component "
+            "(modalviewer.compute_spectrum_per_component).",
+            ZeroModesWarning,
+            stacklevel=2,
+        )
     lam_typical = typical_eigenvalue(K, mass)
     nonzero = ~zero_modes(result.eigenvalues, lam_typical, result.null_dim)
     worst = float(result.residuals[nonzero].max()) if nonzero.any() else 0.0

@@ -8,7 +8,7 @@ import scipy.linalg as la
 import modalviewer as mv
 from modalviewer.core.eigen import EigenError, block_krylov_schur, solve_lowest
 from modalviewer.core.nullspace import null_space
-from modalviewer.core.pipeline import operator_matrices
+from modalviewer.core.pipeline import ZeroModesWarning, operator_matrices
 from modalviewer.core.primitives import grid_plate, icosphere, torus
 
 
@@ -100,7 +100,8 @@ def test_rigid_motions_span_translations_and_rotations(three_spheres):
 
 def test_null_space_larger_than_k_is_answered_without_iteration(three_spheres):
     # 18 rigid motions, 10 modes asked: exact zeros, no factorisation, flagged as zero modes
-    spec = mv.compute_spectrum(three_spheres, "shells", k=10)
+    with pytest.warns(ZeroModesWarning, match="all 10 modes are exact zero modes.*18 modes"):
+        spec = mv.compute_spectrum(three_spheres, "shells", k=10)
     assert spec.eigenvalues.tolist() == [0.0] * 10
     assert spec.parameters["method"] == "null space (no iteration)"
     assert spec.parameters["seconds_by_stage"].get("factorisation", 0.0) == 0.0
@@ -114,6 +115,7 @@ def test_null_space_larger_than_k_is_answered_without_iteration(three_spheres):
     assert "18 modes" in spec.parameters["null_space"]
 
 
+@pytest.mark.filterwarnings("ignore::modalviewer.core.pipeline.ZeroModesWarning")
 @pytest.mark.parametrize("k", [17, 18, 19, 30])
 def test_null_space_around_k_is_never_half_found(three_spheres, k):
     # 3 spheres: 18 rigid motions (5844 unknowns, the sparse solver) for k below,
@@ -165,7 +167,8 @@ def test_zero_mode_mask_does_not_depend_on_k():
 
 
 def test_saved_spectrum_keeps_the_zero_modes(three_spheres, tmp_path):
-    spec = mv.compute_spectrum(three_spheres, "shells", k=12)
+    with pytest.warns(ZeroModesWarning):
+        spec = mv.compute_spectrum(three_spheres, "shells", k=12)
     mv.save_spectrum(spec, tmp_path / "s.npz")
     back = mv.load_spectrum(tmp_path / "s.npz")
     assert back.null_space_dimension == 12
