@@ -28,7 +28,7 @@ format: $(STAMP)
 	$(PY) -m ruff format modalviewer tests benchmarks
 
 bench: $(STAMP)
-	$(PY) -m benchmarks.run --sizes 10k 50k 130k --baseline-max-unknowns 200000
+	$(PY) -m benchmarks.run --sizes 10k 50k 130k --baseline-max-unknowns 200000 --few 12 50
 
 clean:
 	rm -rf $(VENV)

@@ -1,6 +1,7 @@
 """Timings of modalviewer against a plain-scipy baseline on the same matrices.
 
     python -m benchmarks.run [--sizes 10k 50k 130k] [--k 300] [--operators laplacian shells]
+                             [--few 12 50] [--output latest]
 
 Meshes (reproducible): spot subdivided once (~11.7k vertices) and twice (~47k), and the
 bumpy plate on a 360 x 360 grid (~130k).  For each mesh and operator: Hessian/matrix
@@ -9,8 +10,11 @@ assembly, the eigenproblem for k modes (modalviewer's solver and the baseline
 vertices, the ratio, the largest relative eigenvalue difference (non-zero modes) and peak
 memory (RSS high-water mark of the process that ran it: every measurement runs in a fresh
 process), and where the solver's time went (factorisation, solves, orthogonalisation,
-restarts, projected eigenproblems, refinement; ``EigenResult.stage_seconds``).  Results go
-to benchmarks/results/latest.json and two Markdown tables are printed.
+restarts, projected eigenproblems, refinement; ``EigenResult.stage_seconds``).  The
+solver gets the operator's exactly known null space, as ``compute_spectrum`` does.
+``--few`` adds rows for few modes (the Discrete Shells on the largest mesh, no baseline)
+and a third table of their times against the k-mode row of the same run.  Results go to
+benchmarks/results/<output>.json and the Markdown tables are printed.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ sys.path.insert(0, str(ROOT))
 import modalviewer as mv  # noqa: E402
 from modalviewer.core.demo_shapes import bumpy_plate  # noqa: E402
 from modalviewer.core.eigen import solve_lowest  # noqa: E402
+from modalviewer.core.nullspace import null_space  # noqa: E402
 from modalviewer.core.pipeline import operator_matrices  # noqa: E402
 
 
@@ -72,12 +77,18 @@ def _ours(size: str, operator: str, k: int) -> dict:
     K, mass = operator_matrices(mesh, operator)
     t_assembly = time.perf_counter() - t0
     t0 = time.perf_counter()
-    result = solve_lowest(K, mass, k)
+    nulls = null_space(mesh, operator, K, mass)
+    result = solve_lowest(K, mass, k, null_space=nulls.vectors)
     t_eigen = time.perf_counter() - t0
     shells = operator == "shells"
     modes = result.vectors.reshape(mesh.n_vertices, 3, k) if shells else result.vectors
     spec = mv.Spectrum(
-        result.eigenvalues, modes, operator, mass[::3] if shells else mass, result.residuals
+        result.eigenvalues,
+        modes,
+        operator,
+        mass[::3] if shells else mass,
+        result.residuals,
+        parameters={"null_space_dimension": result.null_dim},
     )
     t0 = time.perf_counter()
     mv.signature(spec)
@@ -94,7 +105,8 @@ def _ours(size: str, operator: str, k: int) -> dict:
         "operator_columns": result.operator_columns,
         "signature_s": t_signature,
         "method": result.method,
-        "max_residual": float(result.residuals[~spec.zero_mode_mask()].max()),
+        "null_space_dimension": result.null_dim,
+        "max_residual": float(result.residuals[~spec.zero_mode_mask()].max(initial=0.0)),
         "peak_mb": peak_mb(),
         "eigenvalues": result.eigenvalues.tolist(),
         "shift": result.shift,
@@ -120,7 +132,7 @@ def _in_child(fn, *args):
         return pool.apply(fn, args)
 
 
-def run(sizes, operators, k, with_baseline=True, baseline_max_unknowns=None):
+def run(sizes, operators, k, with_baseline=True, baseline_max_unknowns=None, few=()):
     rows = []
     for size in sizes:
         for operator in operators:
@@ -146,7 +158,32 @@ def run(sizes, operators, k, with_baseline=True, baseline_max_unknowns=None):
                 )
             rows.append(row)
             print(json.dumps(row), flush=True)
+    for k_few in few:  # few modes of the shells on the largest mesh
+        row = _in_child(_ours, sizes[-1], "shells", k_few)
+        row.pop("eigenvalues")
+        row.pop("shift")
+        rows.append(row)
+        print(json.dumps(row), flush=True)
     return rows
+
+
+def few_table(rows) -> str:
+    """Few-mode rows against the row of the same mesh and operator with the most modes."""
+    lines = [
+        "| mesh | operator | k | columns | eigen s | of the k-mode time | k-mode row |",
+        "|" + " --- |" * 7,
+    ]
+    for r in rows:
+        same = [q for q in rows if (q["mesh"], q["operator"]) == (r["mesh"], r["operator"])]
+        most = max(same, key=lambda q: q["k"])
+        if most is r:
+            continue
+        lines.append(
+            f"| {r['mesh']} | {r['operator']} | {r['k']} | {r.get('operator_columns', '-')} "
+            f"| {r['eigen_s']:.1f} | {r['eigen_s'] / most['eigen_s']:.2f} "
+            f"| k = {most['k']}, {most['eigen_s']:.1f} s |"
+        )
+    return "\n".join(lines)
 
 
 def table(rows) -> str:
@@ -185,14 +222,19 @@ STAGES = (
 
 def stage_table(rows) -> str:
     """Where the solver's time went, per row: seconds per stage and operator columns."""
-    head = "| mesh | operator | unknowns | columns | " + " | ".join(STAGES) + " | other | eigen s |"
-    lines = [head, "|" + " --- |" * (len(STAGES) + 6)]
+    head = (
+        "| mesh | operator | k | unknowns | columns | "
+        + " | ".join(STAGES)
+        + " | other | eigen s |"
+    )
+    lines = [head, "|" + " --- |" * (len(STAGES) + 7)]
     for r in rows:
         stages = r.get("stage_s", {})
         cells = [f"{stages.get(name, 0.0):.1f}" for name in STAGES]
         other = r["eigen_s"] - sum(stages.get(name, 0.0) for name in STAGES)
         lines.append(
-            f"| {r['mesh']} | {r['operator']} | {r['unknowns']} | {r.get('operator_columns', '-')} "
+            f"| {r['mesh']} | {r['operator']} | {r['k']} | {r['unknowns']} "
+            f"| {r.get('operator_columns', '-')} "
             f"| " + " | ".join(cells) + f" | {other:.1f} | {r['eigen_s']:.1f} |"
         )
     return "\n".join(lines)
@@ -210,12 +252,30 @@ def main(argv=None) -> int:
         default=None,
         help="skip the plain-scipy baseline above this many unknowns (it is slow)",
     )
+    p.add_argument(
+        "--few",
+        nargs="*",
+        type=int,
+        default=[],
+        help="also these (small) numbers of shells modes on the largest mesh",
+    )
+    p.add_argument("--output", default="latest", help="results file name (no extension)")
     args = p.parse_args(argv)
-    rows = run(args.sizes, args.operators, args.k, not args.no_baseline, args.baseline_max_unknowns)
-    save_result("latest", rows)
+    rows = run(
+        args.sizes,
+        args.operators,
+        args.k,
+        not args.no_baseline,
+        args.baseline_max_unknowns,
+        args.few,
+    )
+    save_result(args.output, rows)
     print(table(rows))
     print()
     print(stage_table(rows))
+    if args.few:
+        print()
+        print(few_table(rows))
     return 0
 
 
