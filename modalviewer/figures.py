@@ -30,30 +30,29 @@ def build_figures(out_dir, progress=print) -> list[Path]:
 
     # Fig. 1: folded plate, Laplacian / E_D^N / shells normal, same mode index
     win.open_mesh(ASSETS / "demo_folded_plate.obj")
-    win.iso_spin.setValue(10)
+    state = win.state
+    state.set_isolines(10)
     compare = win.open_comparison(["laplacian", "modified_dirichlet", "shells_normal"])
-    win.current_operator = "laplacian"
-    win.show_mode(5)
+    compare.show_mode(5)
     save("fig1_folded_plate_modes", compare)
     compare.close()
     # Fig. 3: double torus, Laplacian vs E_D^N
     win.open_mesh(ASSETS / "demo_double_torus.obj")
     compare = win.open_comparison(["laplacian", "modified_dirichlet"])
-    win.current_operator = "modified_dirichlet"
-    win.show_mode(3)
+    compare.show_mode(3)
     save("fig3_double_torus_modes", compare)
     compare.close()
     # Fig. 4: a vibration mode at its peak, soft and stiff membrane
     for membrane in (0.01, 100.0):
-        win.membrane_spin.setValue(membrane)
+        state.set_compute_settings(membrane=membrane)
         win.compute("shells", k=16, wait=True)
-        win.color_combo.setCurrentIndex(win.color_combo.findData("magnitude"))
+        state.set_shell_coloring("magnitude")
         win.show_mode(8)
-        win.amp_slider.setValue(30)
+        state.set_animation(amplitude=30)
         win.animation_frame(np.pi / 2)
         save(f"fig4_vibration_membrane_{membrane:g}")
-    win.membrane_spin.setValue(1.0)
-    win.color_combo.setCurrentIndex(win.color_combo.findData("normal"))
+    state.set_compute_settings(membrane=1.0)
+    state.set_shell_coloring("normal")
     # Figs. 5 and 7: vibration distance on spot, continuous and two thresholds
     win.open_mesh(ASSETS / "spot.obj")
     win.compute("shells", k=100, wait=True)
@@ -77,16 +76,16 @@ def build_figures(out_dir, progress=print) -> list[Path]:
     tips_straight = json.loads((ASSETS / "demo_landmarks.json").read_text())["demo_hand"]
     for coarse in (False, True):
         win.open_mesh(ASSETS / "demo_hand.obj")
-        win.coarse_check.setChecked(coarse)
+        state.set_compute_settings(coarse=coarse)
         win.compute("shells", k=100, wait=True)
         win.pick_vertex(tips_straight["finger1"])
         win.show_distance("vibration", display="continuous")
         save(f"fig9_hand_vibration_distance_{'coarse_to_fine' if coarse else 'full'}")
-    win.coarse_check.setChecked(False)
+    state.set_compute_settings(coarse=False)
     # Fig. 8: feature signature on the machined part at three scales, and curvature
     win.open_mesh(ASSETS / "demo_machined_part.obj")
     win.compute("modified_dirichlet", k=100, wait=True)
-    win.kind_combo.setCurrentIndex(win.kind_combo.findData("feature"))
+    state.set_display(distance_kind="feature")
     for sample in (10, 50, 90):
         win.show_signature(sample)
         save(f"fig8_feature_signature_scale{sample}")

@@ -1,8 +1,8 @@
 """Side-by-side views with one shared camera: operators (Fig. 1) or distance kinds (Figs. 6, 7).
 
 Each view draws its own :class:`MeshScene` of the main window's mesh; all renderers use
-the same VTK camera, so rotating one rotates all.  The main window drives the mode index
-and the picked vertex.
+the same VTK camera, so rotating one rotates all.  The views follow the main window's
+state (pick, threshold, isolines) and never change it.
 """
 
 from __future__ import annotations
@@ -12,44 +12,41 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from qtpy import QtWidgets
+from qtpy import QtGui, QtWidgets
 
+from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from .scene import MeshScene
 from .viewport import make_viewport
 
-LABELS = {
-    "laplacian": "Laplacian",
-    "modified_dirichlet": "E_D^N",
-    "shells": "Shells 3D",
-    "shells_normal": "Shells normal",
-    "vibration": "Vibration distance",
-    "feature": "Feature distance",
-    "hks": "Heat kernel distance",
-}
-
 
 class CompareWindow(QtWidgets.QWidget):
-    """Two or three linked views; ``items`` are operators or distance kinds."""
+    """Two or three linked views; ``items`` are operators or distance kinds.
+
+    It reads the main window's state (spectra, pick, threshold, isolines) and never
+    changes it.  Operator views keep their own mode index, starting at the first
+    non-zero mode; Left / Right step it, Esc and Ctrl+W close the window.
+    """
 
     def __init__(self, main, items: list[str], force_offscreen: bool | None = None):
         super().__init__()
         if not 2 <= len(items) <= 3:
             raise ValueError("compare two or three operators or distance kinds")
         self.main = main
+        self.state = main.state
         self.items = list(items)
-        self.distances = all(item in ("vibration", "feature", "hks") for item in items)
-        self.setWindowTitle("modalviewer - compare " + " / ".join(LABELS[i] for i in items))
+        self.distances = all(item in DISTANCE_KINDS for item in items)
+        self.setWindowTitle("modalviewer - compare " + " / ".join(_label(i) for i in items))
         layout = QtWidgets.QHBoxLayout(self)
         self.viewports, self.scenes, self.titles = [], [], []
         camera = None
         for item in self.items:
             column = QtWidgets.QVBoxLayout()
-            title = QtWidgets.QLabel(LABELS[item])
+            title = QtWidgets.QLabel(_label(item))
             column.addWidget(title)
             viewport = make_viewport(self, force_offscreen)
             column.addWidget(viewport.widget, 1)
             layout.addLayout(column, 1)
-            scene = MeshScene(viewport.plotter, main.mesh, main.normals)
+            scene = MeshScene(viewport.plotter, self.state.mesh, self.state.normals)
             if camera is None:
                 camera = viewport.plotter.renderer.GetActiveCamera()
                 camera.DeepCopy(main.plotter.renderer.GetActiveCamera())
@@ -60,7 +57,25 @@ class CompareWindow(QtWidgets.QWidget):
             self.viewports.append(viewport)
             self.scenes.append(scene)
             self.titles.append(title)
+        first = self.items[0]
+        self.mode_index = 0 if self.distances else self.state.first_nonzero_mode(first)
+        for key, slot in (
+            ("Escape", self.close),
+            ("Ctrl+W", self.close),
+            ("Right", lambda: self.show_mode(self.mode_index + 1)),
+            ("Left", lambda: self.show_mode(self.mode_index - 1)),
+        ):
+            shortcut = QtGui.QShortcut(QtGui.QKeySequence(key), self)
+            shortcut.activated.connect(slot)
+        for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
+            event.connect(self._on_state)
         self.resize(420 * len(items), 480)
+
+    def _on_state(self) -> None:
+        if self.distances:
+            self.show_distance()
+        else:
+            self.show_mode(self.mode_index)
 
     def render_all(self) -> None:
         for viewport in self.viewports:
@@ -68,45 +83,49 @@ class CompareWindow(QtWidgets.QWidget):
 
     def show_mode(self, index: int) -> None:
         """Mode ``index`` of each operator (those without a spectrum stay grey)."""
+        self.mode_index = max(0, int(index))
         for item, scene, title in zip(self.items, self.scenes, self.titles, strict=True):
-            spec = self.main.spectra.get(item)
+            spec = self.state.spectrum(item)
             if spec is None:
-                title.setText(f"{LABELS[item]}: no spectrum")
+                title.setText(f"{_label(item)}: no spectrum")
                 continue
-            j = int(np.clip(index, 0, spec.k - 1))
-            scalar, disp = self.main.mode_fields(spec, j)
+            j = int(np.clip(self.mode_index, 0, spec.k - 1))
+            scalar, disp = self.state.mode_fields(spec, j)
             scene.show_field(
                 scalar,
                 "diverging",
-                isolines=self.main.iso_spin.value(),
+                isolines=self.state.style.isolines,
                 displacement=disp,
-                name=f"{item} mode {j}",
+                name=f"{_label(item)} mode {j}",
             )
-            title.setText(f"{LABELS[item]}: mode {j}, lambda = {spec.eigenvalues[j]:.5g}")
+            lam = "0 (zero mode)" if spec.zero_mode_mask()[j] else f"{spec.eigenvalues[j]:.5g}"
+            title.setText(f"{_label(item)}: mode {j}, lambda = {lam}")
         self.render_all()
 
     def show_distance(self) -> None:
         """Each kind's distance from the main window's picked vertex."""
-        vertex = self.main.picked
+        vertex = self.state.picked
+        display = self.state.display
         for item, scene, title in zip(self.items, self.scenes, self.titles, strict=True):
             scene.show_marker(vertex)
-            d = self.main.distance_map(item) if vertex is not None else None
+            d = self.state.distance_map(item) if vertex is not None else None
             if d is None:
-                title.setText(f"{LABELS[item]}: pick a vertex / compute the spectrum")
+                title.setText(f"{_label(item)}: pick a vertex / compute the spectrum")
                 continue
-            if self.main.distance_display == "threshold":
-                thr = self.main.threshold_fraction * float(d.max())
-                scene.show_field((d > thr).astype(float), "threshold", name=LABELS[item])
+            if display.distance_display == "threshold":
+                thr = display.threshold * float(d.max())
+                scene.show_field((d > thr).astype(float), "threshold", name=_label(item))
+                share = 100.0 * float(np.mean(d <= thr))
+                title.setText(
+                    f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({share:.1f} %)"
+                )
             else:
-                scene.show_field(d, "sequential", name=LABELS[item])
-            title.setText(f"{LABELS[item]} from vertex {vertex}")
+                scene.show_field(d, "sequential", name=_label(item))
+                title.setText(f"{_label(item)} from vertex {vertex}")
         self.render_all()
 
     def refresh(self) -> None:
-        if self.distances:
-            self.show_distance()
-        else:
-            self.show_mode(self.main.mode_index)
+        self._on_state()
 
     def grab_images(self) -> list[np.ndarray]:
         return [viewport.render_now() for viewport in self.viewports]
@@ -135,8 +154,16 @@ class CompareWindow(QtWidgets.QWidget):
         return path
 
     def closeEvent(self, event):  # noqa: N802
+        for event_ in (self.state.events.pick, self.state.events.display, self.state.events.style):
+            event_.disconnect(self._on_state)
         for viewport in self.viewports:
             viewport.close_plotter()
         if self.main.compare is self:
             self.main.compare = None
         super().closeEvent(event)
+
+
+def _label(item: str) -> str:
+    if item in DISTANCE_KINDS:
+        return DISTANCE_KINDS[item]
+    return OPERATOR_INFO[item].short_label

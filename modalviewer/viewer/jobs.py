@@ -190,6 +190,7 @@ class JobQueue:
         self.cancel_all(reason="the window was closed")
         if running is not None:
             running.join(timeout)
+            self._end(running, CANCELLED, "the window was closed")
 
     # ------------------------------------------------------------ internal
     def _start_next(self) -> None:

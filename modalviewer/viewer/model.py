@@ -123,7 +123,11 @@ class ViewerModel:
         if show:
 
             def show_when_done(j: Job, before=display_at_request) -> None:
-                if j.status == DONE and self.state.display in (before, _blank(before)):
+                if (
+                    j.status == DONE
+                    and self.state.has_spectrum(key)
+                    and self.state.display in (before, _blank(before))
+                ):
                     self._show_first_mode(key.operator)
 
             job.then(show_when_done)
@@ -145,7 +149,7 @@ class ViewerModel:
             if spec is None:
                 spec = _compute(mesh, key, cache, progress, cancel)
             table = None
-            if needs_table:
+            if needs_table and (~spec.zero_mode_mask()).any():
                 # built here, off the GUI thread: 0.4 s at 130k vertices
                 progress("preparing distances", 0.99)
                 if cancel():

@@ -155,7 +155,7 @@ class ViewerEvents(SignalGroup):
 class _Style:
     isolines: int = 12
     shell_coloring: str = "normal"
-    colorbar: bool = False
+    colorbar: bool = True  # legend and colour bar, on screen and in exports
 
 
 @dataclass
@@ -231,6 +231,8 @@ class ViewerState:
             raise ValueError("the spectrum does not belong to the loaded mesh")
         self.spectra[key] = spec
         self._latest[key.operator] = key
+        if self.display.kind == "mode" and self.display.operator == key.operator:
+            self.display = replace(self.display, mode=min(self.display.mode, spec.k - 1))
         stale = [k for k in self._derived.tables if k[0] == key.operator]
         for k in stale:
             del self._derived.tables[k]
@@ -387,6 +389,12 @@ class ViewerState:
         return None
 
     # ---------------------------------------------------- derived values
+    def has_signatures(self, operator: str) -> bool:
+        """Whether ``operator``'s spectrum exists and has non-zero modes (signatures
+        leave zero modes out)."""
+        spec = self.spectrum(operator)
+        return spec is not None and not spec.zero_mode_mask().all()
+
     def table(self, operator: str) -> SignatureTable:
         """The signature table of ``operator``'s spectrum over the current scale range."""
         spec = self.spectrum(operator)
@@ -408,7 +416,8 @@ class ViewerState:
         """Distance of ``kind`` from the picked vertex, or None if a spectrum is missing."""
         kind = kind or self.display.distance_kind
         operator = operator_for_distance(kind)
-        if self.picked is None or self.spectrum(operator) is None:
+        spec = self.spectrum(operator)
+        if self.picked is None or spec is None or spec.zero_mode_mask().all():
             return None
         key = (kind, self.picked, self.t_range, id(self.spectrum(operator)))
         d = self._derived.distance.get(key)
@@ -493,7 +502,7 @@ class ViewerState:
         if d.kind == "signature":
             operator = operator_for_distance(d.distance_kind)
             spec = self.spectrum(operator)
-            if spec is None:
+            if not self.has_signatures(operator):
                 return plain
             t = self.signature_time()
             _, values = signature(spec, [t])
@@ -546,7 +555,7 @@ class ViewerState:
             name = DISTANCE_KINDS[d.distance_kind]
             dist = self.distance_map()
             if dist is None:
-                return f"{name}: pick a vertex"
+                return f"{name}: {self._missing_distance_reason(d.distance_kind)}"
             if d.distance_display == "threshold":
                 thr = self.threshold_value(dist)
                 share = 100.0 * float(np.mean(dist <= thr))
@@ -561,13 +570,21 @@ class ViewerState:
             )
         if d.kind == "signature":
             operator = operator_for_distance(d.distance_kind)
-            if self.spectrum(operator) is None:
+            if not self.has_signatures(operator):
                 return ""
             word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
             return f"{word[d.distance_kind]} signature at t = {self.signature_time():.3g}"
         if d.kind == "curvature":
             return "Curvature sqrt(k1^2 + k2^2), white 0 to red (98th percentile)"
         return ""
+
+    def _missing_distance_reason(self, kind: str) -> str:
+        if self.picked is None:
+            return "pick a vertex"
+        spec = self.spectrum(operator_for_distance(kind))
+        if spec is None:
+            return f"needs the {operator_info(operator_for_distance(kind)).label} spectrum"
+        return "the spectrum has no non-zero modes; compute more modes"
 
     def scale_limits(self) -> tuple[float, float]:
         """(t1, t2) the distances and signatures use: the chosen range or the default."""

@@ -37,6 +37,7 @@ def _both_sides(window):
 
 def test_mode_colours_and_isolines(window, spot_path):
     assert window.open_mesh(spot_path)
+    window.state.set_colorbar(False)  # the legend's black text would count as lines
     spec = window.compute("laplacian", k=20, wait=True)
     assert spec.k == 20 and window.current_operator == "laplacian"
     window.show_mode(6)
@@ -48,10 +49,10 @@ def test_mode_colours_and_isolines(window, spot_path):
     # symmetric range: white at zero
     lo, hi = window.scene.clim
     assert lo == pytest.approx(-hi)
-    window.iso_spin.setValue(0)
+    window.modes_panel.iso_spin.setValue(0)
     no_lines = _both_sides(window)
     assert no_lines["black"] < counts["black"] / 3
-    assert "lambda_6" in window.eigen_label.text()
+    assert "lambda_6" in window.modes_panel.eigen_label.text()
 
 
 def test_a_freshly_opened_mesh_is_plain_grey(window, spot_path):
@@ -84,17 +85,17 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     window.show_mode(8)
     rest = np.array(window.scene.surface.points)
     before = window.viewport.render_now()
-    window.play_button.click()
+    window.animation_panel.play_button.click()
     qtbot.wait(300)
-    assert window.anim_timer.isActive() and len(window.frame_times) > 3
+    assert window.scene_view.timer.isActive() and len(window.frame_times) > 3
     moved = np.array(window.scene.surface.points)
     assert np.abs(moved - rest).max() > 1e-3 * window.mesh.bounding_box_diagonal
     assert max(window.frame_times) < 0.05
     window.animation_frame(np.pi / 2)  # peak displacement
     after = window.viewport.render_now()
     assert np.mean(np.any(before != after, axis=2)) > 0.002
-    window.play_button.click()
-    assert not window.anim_timer.isActive()
+    window.animation_panel.play_button.click()
+    assert not window.scene_view.timer.isActive()
     np.testing.assert_allclose(window.scene.surface.points, rest)
 
 
@@ -128,8 +129,9 @@ def test_threshold_display_and_slider(window, spot_path):
     d = window.show_distance("feature", display="threshold", threshold=0.1)
     assert d is not None
     low = _classify(window.viewport.render_now())["blue"]
-    window.threshold_slider.setValue(700)  # what dragging the slider does
-    assert window.threshold_fraction == pytest.approx(0.7)
+    window.distances_panel.by_share_check.setChecked(False)  # linear in the largest
+    window.distances_panel.threshold_slider.setValue(700)  # what dragging the slider does
+    assert window.state.display.threshold == pytest.approx(0.7)
     high = _classify(window.viewport.render_now())["blue"]
     assert high > low + 1000
     field = window.scene.surface.point_data["field"]
@@ -161,12 +163,12 @@ def _big_mesh_file(tmp_path):
 def test_cancel_a_running_computation(window, tmp_path, qtbot):
     window.open_mesh(_big_mesh_file(tmp_path))
     window.compute("shells", k=200, wait=False)
-    job = window._job
+    job = window.running_job
     assert job is not None and window.cancel_button.isVisible()
     qtbot.wait(1500)
     window.cancel_button.click()
-    qtbot.waitUntil(lambda: not job.is_running(), timeout=30000)
-    qtbot.waitUntil(lambda: window._job is None, timeout=5000)
+    qtbot.waitUntil(lambda: job.done, timeout=30000)
+    assert job.status == "cancelled" and not window.busy
     assert "shells" not in window.spectra
     assert not window.cancel_button.isVisible()
 
@@ -176,10 +178,10 @@ def test_loading_a_mesh_during_a_computation_drops_the_old_result(
 ):
     window.open_mesh(_big_mesh_file(tmp_path))
     window.compute("laplacian", k=50, wait=False)
-    old_job = window._job
+    old_job = window.running_job
     assert window.open_mesh(spot_path)
     assert window.mesh.n_vertices == 2930
-    qtbot.waitUntil(lambda: not old_job.is_running(), timeout=60000)
+    qtbot.waitUntil(lambda: old_job.done, timeout=60000)
     qtbot.wait(100)
     assert window.spectra == {}
     spec = window.compute("laplacian", k=10, wait=True)
@@ -202,14 +204,14 @@ def test_bad_file_gives_a_message_and_keeps_the_mesh(window, spot_path, tmp_path
 def test_settings_are_remembered(qtbot, spot_path):
     from modalviewer.gui import MainWindow
 
-    first = MainWindow()
+    first = MainWindow(remember_settings=True)
     qtbot.addWidget(first)
-    first.iso_spin.setValue(21)
+    first.modes_panel.iso_spin.setValue(21)
     first.open_mesh(spot_path)
     first.close()
-    second = MainWindow()
+    second = MainWindow(remember_settings=True)
     qtbot.addWidget(second)
-    assert second.iso_spin.value() == 21
+    assert second.modes_panel.iso_spin.value() == 21 and second.state.style.isolines == 21
     assert str(spot_path.resolve()) in second._recent_files()
     second.close()
 
@@ -219,7 +221,7 @@ def test_cached_spectrum_reopens_instantly(window, spot_path):
     first = window.compute("shells_normal", k=15, wait=True)
     window.open_mesh(spot_path)
     again = window.compute("shells_normal", k=15, wait=True)
-    assert window._job is None  # served from the disk cache, no worker job
+    assert not window.busy  # served from the disk cache
     np.testing.assert_array_equal(first.eigenvalues, again.eigenvalues)
 
 
@@ -230,8 +232,7 @@ def test_linked_comparison_of_three_operators(window, spot_path, tmp_path, qtbot
     compare = window.open_comparison(["laplacian", "modified_dirichlet", "shells_normal"])
     cameras = {id(vp.plotter.renderer.GetActiveCamera()) for vp in compare.viewports}
     assert len(cameras) == 1  # one shared camera
-    window.current_operator = "laplacian"
-    window.show_mode(7)
+    compare.show_mode(7)
     for op, scene in zip(compare.items, compare.scenes, strict=True):
         np.testing.assert_allclose(
             scene.surface.point_data["field"], window.spectra[op].mode(7), rtol=0, atol=0
@@ -286,7 +287,7 @@ def test_export_field_as_vtp(window, spot_path, tmp_path):
 def test_corrupted_cache_entry_is_recomputed(window, spot_path):
     window.open_mesh(spot_path)
     first = window.compute("laplacian", k=9, wait=True)
-    path = window.cache.path(window.compute_mesh, "laplacian", 9, 1.0, 1.0)
+    path = window.cache.path(window.state.compute_mesh(), "laplacian", 9, 1.0, 1.0)
     assert path.is_file()
     path.write_bytes(b"not a spectrum at all")
     window.open_mesh(spot_path)
@@ -314,7 +315,7 @@ def test_coarse_to_fine_option(window):
 
     assets = Path(__file__).resolve().parents[2] / "assets"
     window.open_mesh(assets / "demo_hand.obj")
-    window.coarse_check.setChecked(True)
+    window.state.set_compute_settings(coarse=True)
     spec = window.compute("shells", k=60, wait=True)
     assert spec.n_vertices == window.mesh.n_vertices
     assert spec.parameters["coarse_vertices"] < 0.25 * window.mesh.n_vertices
@@ -328,12 +329,13 @@ def test_coarse_to_fine_option(window):
 
 def test_too_large_computation_is_refused_up_front(window, spot_path, monkeypatch):
     from modalviewer.gui import main_window
+    from modalviewer.viewer import model
 
     window.open_mesh(spot_path)
-    monkeypatch.setattr(main_window, "_physical_memory", lambda: 64 * 2**20)  # 64 MiB
+    monkeypatch.setattr(model, "physical_memory", lambda: 64 * 2**20)  # 64 MiB
     with pytest.raises(main_window.ComputeError, match="GiB of memory"):
         window.compute("shells", k=300, wait=True)
-    assert "Coarse-to-fine" in window.last_error and window._job is None
+    assert "Coarse-to-fine" in window.last_error and not window.busy
 
 
 def test_closing_during_a_computation_stops_it(qtbot, tmp_path):
@@ -344,11 +346,11 @@ def test_closing_during_a_computation_stops_it(qtbot, tmp_path):
     win.show()
     win.open_mesh(_big_mesh_file(tmp_path))
     win.compute("shells", k=200, wait=False)
-    job = win._job
+    job = win.running_job
     qtbot.wait(800)
     win.close()  # cancels and waits for the worker
-    assert not job.is_running()
-    assert win._job is None
+    assert job.join(0)  # the worker has stopped
+    assert not win.busy
 
 
 def test_isolines_match_vtk_contour_filter():
@@ -394,13 +396,13 @@ def test_shells_on_an_inconsistently_oriented_mesh_fail_with_a_message(window):
     window.set_mesh(Mesh(v, np.vstack([plate.faces, fin])))
     with pytest.raises(main_window.ComputeError, match="not consistently oriented"):
         window.compute("shells", k=6, wait=True)
-    assert "cannot run" in window.last_error and window._job is None
+    assert "cannot run" in window.last_error and not window.busy
     spec = window.compute("laplacian", k=6, wait=True)  # the Laplacian still works
     assert spec.k == 6 and window.display == "mode"
 
 
 def test_spectrum_plot_leaves_room_for_its_axis_labels(window):
-    plot = window.spectrum_plot
+    plot = window.modes_panel.spectrum_plot
     plot.resize(300, 140)
     plot.set_data(np.arange(5), [-4.75e-8, 1.0, 2.0, 3.0, 5470.0])
     rect = plot._transform()[0]

@@ -1,0 +1,66 @@
+"""Dialogs: screenshot export options, yes/no questions."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from qtpy import QtWidgets
+
+
+def ask(parent, title: str, question: str) -> bool:
+    """A yes/no question (default No).  With MODALVIEWER_NO_DIALOGS set (tests, scripts)
+    the answer is MODALVIEWER_ASSUME_YES, so nothing starts without being asked for."""
+    if os.environ.get("MODALVIEWER_NO_DIALOGS"):
+        return bool(os.environ.get("MODALVIEWER_ASSUME_YES"))
+    buttons = QtWidgets.QMessageBox.StandardButton
+    answer = QtWidgets.QMessageBox.question(
+        parent, title, question, buttons.Yes | buttons.No, buttons.No
+    )
+    return answer == buttons.Yes
+
+
+class ScreenshotDialog(QtWidgets.QDialog):
+    """File, size multiplier, transparent background, colour bar and legend."""
+
+    def __init__(self, parent, start_dir: str, colorbar: bool = False):
+        super().__init__(parent)
+        self.setWindowTitle("Export screenshot")
+        form = QtWidgets.QFormLayout(self)
+        self.path_edit = QtWidgets.QLineEdit(str(Path(start_dir) / "figure.png"))
+        browse = QtWidgets.QPushButton("...")
+        browse.clicked.connect(self._browse)
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(self.path_edit)
+        row.addWidget(browse)
+        form.addRow("File", row)
+        self.scale = QtWidgets.QSpinBox()
+        self.scale.setRange(1, 8)
+        self.transparent = QtWidgets.QCheckBox("Transparent background")
+        self.colorbar = QtWidgets.QCheckBox("Colour bar and legend")
+        self.colorbar.setChecked(colorbar)
+        form.addRow("Size multiplier", self.scale)
+        form.addRow(self.transparent)
+        form.addRow(self.colorbar)
+        buttons = QtWidgets.QDialogButtonBox(
+            QtWidgets.QDialogButtonBox.StandardButton.Save
+            | QtWidgets.QDialogButtonBox.StandardButton.Cancel
+        )
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def _browse(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Screenshot", self.path_edit.text(), "PNG (*.png)"
+        )
+        if path:
+            self.path_edit.setText(path)
+
+    def values(self):
+        return (
+            self.path_edit.text(),
+            self.scale.value(),
+            self.transparent.isChecked(),
+            self.colorbar.isChecked(),
+        )

@@ -1,0 +1,44 @@
+"""Animation panel: play / pause, amplitude and speed of the mode's vibration."""
+
+from __future__ import annotations
+
+from qtpy import QtCore, QtWidgets
+
+from ...viewer.state import ViewerState
+from .common import quiet
+
+
+class AnimationPanel(QtWidgets.QWidget):
+    """Sets ``state.animation``; only a mode on screen can play."""
+
+    def __init__(self, state: ViewerState, parent=None):
+        super().__init__(parent)
+        self.state = state
+        form = QtWidgets.QFormLayout(self)
+        self.play_button = QtWidgets.QPushButton("Play")
+        self.play_button.setCheckable(True)
+        self.play_button.setToolTip("Animate the mode (Space)")
+        self.amp_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.amp_slider.setRange(0, 100)
+        self.amp_slider.setToolTip("Amplitude: percent of a quarter of the bounding box")
+        self.speed_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.speed_slider.setRange(1, 100)
+        form.addRow(self.play_button)
+        form.addRow("Amplitude", self.amp_slider)
+        form.addRow("Speed", self.speed_slider)
+        self.play_button.toggled.connect(lambda on: state.set_animation(playing=on))
+        self.amp_slider.valueChanged.connect(lambda v: state.set_animation(amplitude=v))
+        self.speed_slider.valueChanged.connect(lambda v: state.set_animation(speed=v))
+        state.events.animation.connect(self.update_from_state)
+        state.events.display.connect(self.update_from_state)
+        state.events.mesh.connect(self.update_from_state)
+        self.update_from_state()
+
+    def update_from_state(self) -> None:
+        anim = self.state.animation
+        with quiet(self.play_button, self.amp_slider, self.speed_slider):
+            self.play_button.setChecked(anim.playing)
+            self.amp_slider.setValue(anim.amplitude)
+            self.speed_slider.setValue(anim.speed)
+        self.play_button.setText("Pause" if anim.playing else "Play")
+        self.play_button.setEnabled(self.state.display.kind == "mode")

@@ -1,0 +1,90 @@
+"""Compute panel: operator, number of modes, weights, options; the mesh's load report."""
+
+from __future__ import annotations
+
+from qtpy import QtCore, QtWidgets
+
+from ...core.operators import OPERATOR_INFO
+from ...viewer.state import ViewerState
+from .common import combo, quiet, select_data
+
+
+class ComputePanel(QtWidgets.QWidget):
+    """Sets ``state.compute_settings``; the button asks the window to compute."""
+
+    computeRequested = QtCore.Signal()
+
+    def __init__(self, state: ViewerState, parent=None):
+        super().__init__(parent)
+        self.state = state
+        form = QtWidgets.QFormLayout(self)
+        self.operator_combo = combo()
+        for info in OPERATOR_INFO.values():
+            self.operator_combo.addItem(info.label, info.name)
+        self.k_spin = QtWidgets.QSpinBox()
+        self.k_spin.setRange(1, 2000)
+        self.k_spin.setToolTip("Number of modes (lowest eigenpairs) to compute")
+        self.bending_spin = QtWidgets.QDoubleSpinBox()
+        self.membrane_spin = QtWidgets.QDoubleSpinBox()
+        for spin in (self.bending_spin, self.membrane_spin):
+            spin.setDecimals(4)
+            spin.setRange(0.0, 1e6)
+        self.rescale_check = QtWidgets.QCheckBox("Rescale to unit area (default: off)")
+        self.rescale_check.setToolTip(
+            "Compute on a copy scaled to total area 1. The shells spectrum depends on the "
+            "absolute size; rescaling makes meshes of different sizes comparable."
+        )
+        self.coarse_check = QtWidgets.QCheckBox("Coarse-to-fine (default: off)")
+        self.coarse_check.setToolTip(
+            "Compute on a copy decimated to about a fifth of the vertices and carry the modes "
+            "to this mesh by nearest vertex (paper Section 7): much faster on big meshes."
+        )
+        self.compute_button = QtWidgets.QPushButton("Compute spectrum")
+        self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")
+        form.addRow("Operator", self.operator_combo)
+        form.addRow("Modes k", self.k_spin)
+        form.addRow("Bending weight", self.bending_spin)
+        form.addRow("Membrane weight", self.membrane_spin)
+        form.addRow(self.rescale_check)
+        form.addRow(self.coarse_check)
+        form.addRow(self.compute_button)
+        self.mesh_info = QtWidgets.QLabel("No mesh")
+        self.mesh_info.setWordWrap(True)
+        form.addRow(self.mesh_info)
+
+        self.operator_combo.currentIndexChanged.connect(
+            lambda _: state.set_compute_settings(operator=self.operator_combo.currentData())
+        )
+        self.k_spin.valueChanged.connect(lambda v: state.set_compute_settings(k=v))
+        self.bending_spin.valueChanged.connect(lambda v: state.set_compute_settings(bending=v))
+        self.membrane_spin.valueChanged.connect(lambda v: state.set_compute_settings(membrane=v))
+        self.rescale_check.toggled.connect(lambda on: state.set_compute_settings(rescale=on))
+        self.coarse_check.toggled.connect(lambda on: state.set_compute_settings(coarse=on))
+        self.compute_button.clicked.connect(self.computeRequested)
+        state.events.compute_settings.connect(self.update_from_state)
+        state.events.mesh.connect(self.update_from_state)
+        self.update_from_state()
+
+    def update_from_state(self) -> None:
+        s = self.state.compute_settings
+        widgets = (
+            self.operator_combo,
+            self.k_spin,
+            self.bending_spin,
+            self.membrane_spin,
+            self.rescale_check,
+            self.coarse_check,
+        )
+        with quiet(*widgets):
+            select_data(self.operator_combo, s.operator)
+            self.k_spin.setValue(s.k)
+            self.bending_spin.setValue(s.bending)
+            self.membrane_spin.setValue(s.membrane)
+            self.rescale_check.setChecked(s.rescale)
+            self.coarse_check.setChecked(s.coarse)
+        weights = OPERATOR_INFO[s.operator].has_weights
+        self.bending_spin.setEnabled(weights)
+        self.membrane_spin.setEnabled(weights)
+        mesh = self.state.mesh
+        self.compute_button.setEnabled(mesh is not None)
+        self.mesh_info.setText(str(mesh.report) if mesh is not None else "No mesh")

@@ -1,0 +1,185 @@
+"""Distances panel: kind, continuous or threshold, the threshold, scale range, signature."""
+
+from __future__ import annotations
+
+import numpy as np
+from qtpy import QtCore, QtGui, QtWidgets
+
+from ...core.operators import DISTANCE_KINDS, operator_for_distance
+from ...core.signatures import signature
+from ...viewer.state import ViewerState
+from ..plots import LinePlot
+from .common import combo, quiet, select_data
+
+SLIDER_STEPS = 1000
+
+
+class DistancesPanel(QtWidgets.QWidget):
+    """Shows and sets the distance part of ``state.display`` and the scale range.
+
+    The threshold slider moves, by default, through the share of the surface marked
+    similar (a quantile of the distances), so its whole travel is useful whatever the
+    distribution; "by value" makes it linear in the fraction of the largest distance.
+    Its label shows both numbers.  Actions needing a spectrum go to the window through
+    ``showDistanceRequested`` (it may start a computation).
+    """
+
+    showDistanceRequested = QtCore.Signal()
+    showSignatureRequested = QtCore.Signal()
+
+    def __init__(self, state: ViewerState, parent=None):
+        super().__init__(parent)
+        self.state = state
+        form = QtWidgets.QFormLayout(self)
+        self.kind_combo = combo()
+        for key, label in DISTANCE_KINDS.items():
+            self.kind_combo.addItem(label, key)
+        self.display_combo = combo()
+        self.display_combo.addItem("Continuous (white to red)", "continuous")
+        self.display_combo.addItem("Threshold (blue = similar)", "threshold")
+        self.threshold_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.threshold_slider.setRange(1, SLIDER_STEPS)
+        self.threshold_slider.setToolTip("Threshold of the blue (similar) region")
+        self.by_share_check = QtWidgets.QCheckBox("Slider by share of surface")
+        self.by_share_check.setChecked(True)
+        self.by_share_check.setToolTip(
+            "On: the slider moves through the share of the surface marked similar. "
+            "Off: linear in the fraction of the largest distance."
+        )
+        self.threshold_label = QtWidgets.QLabel("-")
+        self.t1_edit = QtWidgets.QLineEdit()
+        self.t2_edit = QtWidgets.QLineEdit()
+        for edit in (self.t1_edit, self.t2_edit):
+            edit.setPlaceholderText("default")
+            edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
+        self.pick_label = QtWidgets.QLabel("Click the surface to pick a vertex.")
+        self.pick_label.setWordWrap(True)
+        self.distance_button = QtWidgets.QPushButton("Show distance")
+        self.distance_button.setToolTip("Distance from the picked vertex (D)")
+        form.addRow("Kind", self.kind_combo)
+        form.addRow("Display", self.display_combo)
+        form.addRow("Threshold", self.threshold_slider)
+        form.addRow("", self.threshold_label)
+        form.addRow(self.by_share_check)
+        form.addRow("t1", self.t1_edit)
+        form.addRow("t2", self.t2_edit)
+        form.addRow(self.pick_label)
+        form.addRow(self.distance_button)
+        self.scale_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.scale_slider.setRange(0, 99)
+        self.scale_slider.setToolTip("Show the signature at this scale")
+        form.addRow("Signature at scale", self.scale_slider)
+        self.signature_plot = LinePlot("Signature of the picked vertex", "t (log)", "S_t")
+        form.addRow(self.signature_plot)
+
+        self.kind_combo.currentIndexChanged.connect(self._on_kind)
+        self.display_combo.currentIndexChanged.connect(self._on_display)
+        self.threshold_slider.valueChanged.connect(self._on_slider)
+        self.by_share_check.toggled.connect(lambda _: self.update_from_state())
+        self.t1_edit.editingFinished.connect(self._on_range)
+        self.t2_edit.editingFinished.connect(self._on_range)
+        self.distance_button.clicked.connect(self.showDistanceRequested)
+        self.scale_slider.valueChanged.connect(self._on_scale)
+        for event in (
+            state.events.display,
+            state.events.pick,
+            state.events.spectra,
+            state.events.mesh,
+            state.events.scale_range,
+        ):
+            event.connect(self.update_from_state)
+        self.update_from_state()
+
+    # ------------------------------------------------------------- input
+    def _on_kind(self, _index: int) -> None:
+        self.state.set_display(distance_kind=self.kind_combo.currentData())
+        if self.state.display.kind == "distance":
+            self.showDistanceRequested.emit()
+        elif self.state.display.kind == "signature":
+            self.showSignatureRequested.emit()
+
+    def _on_display(self, _index: int) -> None:
+        self.state.set_display(distance_display=self.display_combo.currentData())
+
+    def _on_slider(self, value: int) -> None:
+        position = value / SLIDER_STEPS
+        if self.by_share_check.isChecked():
+            fraction = self.state.threshold_for_share(position)
+        else:
+            fraction = position
+        self.state.set_display(threshold=fraction)
+
+    def _on_range(self) -> None:
+        try:
+            t1, t2 = float(self.t1_edit.text()), float(self.t2_edit.text())
+        except ValueError:
+            if not self.t1_edit.text() and not self.t2_edit.text():
+                self.state.set_scale_range(None)
+            return
+        if 0 < t1 < t2:
+            self.state.set_scale_range((t1, t2))
+
+    def _on_scale(self, value: int) -> None:
+        self.state.set_display(signature_sample=value)
+        self.showSignatureRequested.emit()
+
+    # ------------------------------------------------------------ output
+    def update_from_state(self, *_args) -> None:
+        state = self.state
+        d = state.display
+        with quiet(self.kind_combo, self.display_combo, self.threshold_slider, self.scale_slider):
+            select_data(self.kind_combo, d.distance_kind)
+            select_data(self.display_combo, d.distance_display)
+            self.scale_slider.setValue(d.signature_sample)
+            dist = state.distance_map()
+            if dist is not None and self.by_share_check.isChecked():
+                thr = d.threshold * float(dist.max())
+                position = float(np.mean(dist <= thr))
+            else:
+                position = d.threshold
+            self.threshold_slider.setValue(max(1, int(round(position * SLIDER_STEPS))))
+        self.threshold_slider.setEnabled(d.distance_display == "threshold")
+        if dist is not None:
+            thr = d.threshold * float(dist.max())
+            share = 100.0 * float(np.mean(dist <= thr))
+            self.threshold_label.setText(f"< {thr:.4g}  ({share:.1f} % of the surface)")
+        else:
+            self.threshold_label.setText(f"{d.threshold:.3g} of the largest distance")
+        if state.picked is None:
+            self.pick_label.setText("Click the surface to pick a vertex.")
+        else:
+            x, y, z = state.mesh.vertices[state.picked]
+            self.pick_label.setText(f"Picked vertex {state.picked} at ({x:.4g}, {y:.4g}, {z:.4g})")
+        self._update_range_placeholders()
+        self._update_signature_plot()
+
+    def _update_range_placeholders(self) -> None:
+        operator = operator_for_distance(self.state.display.distance_kind)
+        if not self.state.has_signatures(operator):
+            self.t1_edit.setPlaceholderText("default")
+            self.t2_edit.setPlaceholderText("default")
+            return
+        table = self.state.table(operator)
+        self.t1_edit.setPlaceholderText(f"default {table.times[0]:.4g}")
+        self.t2_edit.setPlaceholderText(f"default {table.times[-1]:.4g}")
+        if self.state.t_range is None:
+            with quiet(self.t1_edit, self.t2_edit):
+                self.t1_edit.clear()
+                self.t2_edit.clear()
+
+    def _update_signature_plot(self) -> None:
+        state = self.state
+        operator = operator_for_distance(state.display.distance_kind)
+        spec = state.spectrum(operator)
+        if not state.has_signatures(operator) or state.picked is None:
+            self.signature_plot.set_data([], [])
+            return
+        table = state.table(operator)
+        times, values = signature(spec, table.times, vertices=[state.picked])
+        self.signature_plot.set_data(
+            times,
+            values[0],
+            logx=True,
+            markers=False,
+            title=f"Signature of vertex {state.picked} ({operator})",
+        )

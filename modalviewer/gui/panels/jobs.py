@@ -1,0 +1,49 @@
+"""Jobs panel: the running and queued computations, each with its own Cancel."""
+
+from __future__ import annotations
+
+from qtpy import QtCore, QtWidgets
+
+from ...viewer.jobs import RUNNING, Job, JobQueue
+
+
+class JobsPanel(QtWidgets.QWidget):
+    """One row per queued or running job: description, progress, Cancel."""
+
+    def __init__(self, jobs: JobQueue, parent=None):
+        super().__init__(parent)
+        self.jobs = jobs
+        self.layout_ = QtWidgets.QVBoxLayout(self)
+        self.layout_.setContentsMargins(0, 0, 0, 0)
+        self.empty = QtWidgets.QLabel("No computation running.")
+        self.layout_.addWidget(self.empty)
+        self.rows: dict[int, tuple[QtWidgets.QWidget, QtWidgets.QLabel]] = {}
+        jobs.events.changed.connect(self._on_changed)
+
+    def _on_changed(self, job: Job) -> None:
+        row = self.rows.get(job.id)
+        if job.done:
+            if row is not None:
+                row[0].deleteLater()
+                del self.rows[job.id]
+        else:
+            if row is None:
+                row = self._make_row(job)
+                self.rows[job.id] = row
+            state = f"{job.stage} {100 * job.fraction:.0f} %" if job.status == RUNNING else "queued"
+            row[1].setText(f"{job.description}\n{state}")
+        self.empty.setVisible(not self.rows)
+
+    def _make_row(self, job: Job):
+        widget = QtWidgets.QWidget()
+        lay = QtWidgets.QHBoxLayout(widget)
+        lay.setContentsMargins(0, 0, 0, 0)
+        label = QtWidgets.QLabel()
+        label.setWordWrap(True)
+        button = QtWidgets.QPushButton("Cancel")
+        button.setToolTip("Cancel this computation")
+        button.clicked.connect(lambda: self.jobs.cancel(job))
+        lay.addWidget(label, 1)
+        lay.addWidget(button, 0, QtCore.Qt.AlignmentFlag.AlignTop)
+        self.layout_.addWidget(widget)
+        return widget, label

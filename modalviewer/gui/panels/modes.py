@@ -1,0 +1,134 @@
+"""Modes panel: which spectrum, which mode, its eigenvalue, the spectrum plot, isolines."""
+
+from __future__ import annotations
+
+import numpy as np
+from qtpy import QtCore, QtWidgets
+
+from ...core.operators import OPERATOR_INFO
+from ...viewer.state import ViewerState
+from ..plots import LinePlot
+from .common import combo, quiet, select_data
+
+
+class ModesPanel(QtWidgets.QWidget):
+    """Shows and sets ``state.display`` for modes and ``state.style``.
+
+    When the surface shows something else (a distance, a signature), the panel says so
+    instead of naming a mode that is not on screen.
+    """
+
+    def __init__(self, state: ViewerState, parent=None):
+        super().__init__(parent)
+        self.state = state
+        lay = QtWidgets.QVBoxLayout(self)
+        self.spectrum_combo = combo()
+        self.spectrum_combo.setToolTip("The computed spectrum whose modes are shown")
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(QtWidgets.QLabel("Spectrum"))
+        row.addWidget(self.spectrum_combo, 1)
+        lay.addLayout(row)
+        row = QtWidgets.QHBoxLayout()
+        self.mode_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.mode_slider.setToolTip("Mode index (arrow keys step while the slider has focus)")
+        self.mode_spin = QtWidgets.QSpinBox()
+        row.addWidget(QtWidgets.QLabel("Mode"))
+        row.addWidget(self.mode_slider, 1)
+        row.addWidget(self.mode_spin)
+        lay.addLayout(row)
+        self.eigen_label = QtWidgets.QLabel("No spectrum yet.")
+        self.eigen_label.setWordWrap(True)
+        lay.addWidget(self.eigen_label)
+        self.spectrum_plot = LinePlot("Spectrum", "mode index", "eigenvalue")
+        lay.addWidget(self.spectrum_plot)
+        form = QtWidgets.QFormLayout()
+        self.color_combo = combo()
+        self.color_combo.addItem("Normal component", "normal")
+        self.color_combo.addItem("Magnitude", "magnitude")
+        self.color_combo.setToolTip("Scalar shown for 3D vibration modes")
+        self.iso_spin = QtWidgets.QSpinBox()
+        self.iso_spin.setRange(0, 60)
+        self.iso_spin.setToolTip("Number of isolines (0: none)")
+        form.addRow("Colour 3D modes by", self.color_combo)
+        form.addRow("Isolines", self.iso_spin)
+        lay.addLayout(form)
+
+        self.spectrum_combo.activated.connect(self._on_spectrum_chosen)
+        self.mode_slider.valueChanged.connect(self._on_mode_input)
+        self.mode_spin.valueChanged.connect(self._on_mode_input)
+        self.spectrum_plot.sampleClicked.connect(self._on_mode_input)
+        self.color_combo.currentIndexChanged.connect(
+            lambda _: state.set_shell_coloring(self.color_combo.currentData())
+        )
+        self.iso_spin.valueChanged.connect(state.set_isolines)
+        for event in (state.events.display, state.events.spectra, state.events.mesh):
+            event.connect(self.update_from_state)
+        state.events.style.connect(self._update_style)
+        self.update_from_state()
+        self._update_style()
+
+    def _operator(self) -> str | None:
+        d = self.state.display
+        if d.kind == "mode":
+            return d.operator
+        return self.spectrum_combo.currentData()
+
+    def _on_spectrum_chosen(self, _index: int) -> None:
+        op = self.spectrum_combo.currentData()
+        if op is not None:
+            self.state.show_mode(self.state.first_nonzero_mode(op), op)
+
+    def _on_mode_input(self, index: int) -> None:
+        op = self._operator()
+        if op is not None and self.state.spectrum(op) is not None:
+            self.state.show_mode(int(index), op)
+
+    def update_from_state(self, *_args) -> None:
+        state = self.state
+        computed = state.operators_computed()
+        op = self._operator()
+        if op not in computed:
+            op = computed[0] if computed else None
+        with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
+            self.spectrum_combo.clear()
+            for name in computed:
+                self.spectrum_combo.addItem(OPERATOR_INFO[name].label, name)
+            if op is not None:
+                select_data(self.spectrum_combo, op)
+            spec = state.spectrum(op)
+            k = spec.k if spec is not None else 1
+            self.mode_slider.setRange(0, k - 1)
+            self.mode_spin.setRange(0, k - 1)
+            showing_mode = state.display.kind == "mode" and spec is not None
+            if showing_mode:
+                self.mode_slider.setValue(state.display.mode)
+                self.mode_spin.setValue(state.display.mode)
+        for w in (self.spectrum_combo, self.mode_slider, self.mode_spin):
+            w.setEnabled(spec is not None)
+        if spec is None:
+            self.eigen_label.setText("No spectrum yet: compute one (Ctrl+R).")
+            self.spectrum_plot.set_data([], [])
+            return
+        zero = spec.zero_mode_mask()
+        if showing_mode:
+            j = min(state.display.mode, spec.k - 1)
+            lam = float(spec.eigenvalues[j])
+            if zero[j]:
+                text = f"lambda_{j} = 0 (zero mode)"
+            else:
+                text = f"lambda_{j} = {lam:.6g}   sqrt(lambda) = {np.sqrt(max(lam, 0.0)):.6g}"
+        else:
+            shown = state.legend().split("\n")[0] or "nothing"
+            text = f"Not shown: the surface shows {shown}. Choose a mode to show it."
+        self.eigen_label.setText(text)
+        self.spectrum_plot.set_data(
+            np.arange(spec.k),
+            np.where(zero, 0.0, spec.eigenvalues),
+            state.display.mode if showing_mode else None,
+            title=f"Spectrum: {OPERATOR_INFO[op].label}",
+        )
+
+    def _update_style(self) -> None:
+        with quiet(self.color_combo, self.iso_spin):
+            select_data(self.color_combo, self.state.style.shell_coloring)
+            self.iso_spin.setValue(self.state.style.isolines)

@@ -1,0 +1,194 @@
+"""Sessions: the viewer state to and from a versioned JSON file (no Qt).
+
+A session stores the mesh file (path and geometry hash), the spectra by their keys (not
+their arrays: they come back from the spectrum cache, or are recomputed), and what is
+displayed: the display, pick, threshold, scale range, isolines, colouring, colour bar
+and camera.  Restoring it draws the same picture.  A mesh whose file changed on disk is
+opened all the same, with a note; what no longer fits (a picked vertex beyond the new
+mesh) is dropped with a note.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+from .jobs import Job
+from .state import ComputeSettings, Display, SpectrumKey, ViewerState
+
+FORMAT = "modalviewer-session"
+VERSION = 1
+
+
+class SessionError(ValueError):
+    """A session file is unreadable, foreign, or from a newer version."""
+
+
+@dataclass
+class Restored:
+    """What :func:`restore_session` started and what it could not restore as saved."""
+
+    jobs: list[Job] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def session_dict(state: ViewerState, base: Path | None = None) -> dict:
+    """The state as plain data.  ``base``: the folder mesh paths are stored relative to
+    (as well as absolute), so a session moved with its mesh still finds it."""
+    if state.mesh is None:
+        raise ValueError("no mesh is loaded: nothing to save")
+    path = Path(state.mesh_path).resolve() if state.mesh_path else None
+    relative = None
+    if path is not None and base is not None:
+        try:
+            relative = os.path.relpath(path, base)
+        except ValueError:
+            relative = None
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "mesh": {
+            "path": str(path) if path else None,
+            "relative_path": relative,
+            "hash": state.mesh.hash,
+            "vertices": state.mesh.n_vertices,
+        },
+        "spectra": [asdict(key) for key in state.spectra],
+        "compute_settings": asdict(state.compute_settings),
+        "display": asdict(state.display),
+        "picked": state.picked,
+        "t_range": list(state.t_range) if state.t_range else None,
+        "style": {
+            "isolines": state.style.isolines,
+            "shell_coloring": state.style.shell_coloring,
+            "colorbar": state.style.colorbar,
+        },
+        "animation": {"amplitude": state.animation.amplitude, "speed": state.animation.speed},
+        "camera": state.camera,
+    }
+
+
+def save_session(state: ViewerState, path) -> Path:
+    """Write the session to ``path`` atomically; returns the path."""
+    path = Path(path)
+    data = session_dict(state, base=path.resolve().parent)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            json.dump(data, fh, indent=2)
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def read_session(path) -> dict:
+    """The session file's data, checked for format and version."""
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise SessionError(f"{path} does not exist") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise SessionError(f"{path.name} is not a readable session file ({exc})") from None
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise SessionError(f"{path.name} is not a modalviewer session file")
+    if int(data.get("version", 0)) > VERSION:
+        raise SessionError(
+            f"{path.name} was written by a newer modalviewer (session version "
+            f"{data['version']}; this one reads up to {VERSION})"
+        )
+    return data
+
+
+def _known(cls, values: dict) -> dict:
+    names = {f.name for f in fields(cls)}
+    return {k: v for k, v in (values or {}).items() if k in names}
+
+
+def restore_session(model, path) -> Restored:
+    """Open the session's mesh and restore its state in ``model`` (a ViewerModel).
+
+    Spectra are requested from the model (the cache answers at once; others are
+    recomputed in the background): the returned jobs end when they are in.  The display
+    is set once every spectrum it needs has arrived.
+    """
+    path = Path(path)
+    data = read_session(path)
+    out = Restored()
+    mesh_info = data.get("mesh") or {}
+    candidates = []
+    if mesh_info.get("relative_path"):
+        candidates.append((path.resolve().parent / mesh_info["relative_path"]).resolve())
+    if mesh_info.get("path"):
+        candidates.append(Path(mesh_info["path"]))
+    mesh_path = next((p for p in candidates if p.is_file()), None)
+    if mesh_path is None:
+        raise SessionError(
+            f"the session's mesh {mesh_info.get('path') or '(none)'} cannot be found"
+        )
+    mesh = model.open_mesh(mesh_path)
+    state = model.state
+    if mesh.hash != mesh_info.get("hash"):
+        out.notes.append(
+            f"{mesh_path.name} changed on disk since the session was saved: spectra are "
+            "recomputed and the pick may point elsewhere"
+        )
+    style = data.get("style") or {}
+    state.set_isolines(int(style.get("isolines", state.style.isolines)))
+    state.set_shell_coloring(str(style.get("shell_coloring", state.style.shell_coloring)))
+    state.set_colorbar(bool(style.get("colorbar", True)))
+    anim = data.get("animation") or {}
+    state.set_animation(**_known(type(state.animation), anim))
+    settings = ComputeSettings(**_known(ComputeSettings, data.get("compute_settings")))
+    state.set_compute_settings(**asdict(settings))
+    if data.get("t_range"):
+        state.set_scale_range(tuple(data["t_range"]))
+    picked = data.get("picked")
+    if picked is not None:
+        if 0 <= int(picked) < mesh.n_vertices:
+            state.set_pick(int(picked))
+        else:
+            out.notes.append(f"the picked vertex {picked} is not on this mesh; pick again")
+    display = Display(**_known(Display, data.get("display")))
+    for raw in data.get("spectra") or []:
+        key = SpectrumKey(**_known(SpectrumKey, raw))
+        saved = state.compute_settings
+        state.set_compute_settings(
+            bending=key.bending, membrane=key.membrane, rescale=key.rescale, coarse=key.coarse
+        )
+        try:
+            out.jobs.append(model.request_spectrum(key.operator, key.k))
+        except ValueError as exc:
+            out.notes.append(f"{key.describe()}: {exc}")
+        state.set_compute_settings(**asdict(saved))
+    camera = data.get("camera")
+
+    def apply_display(_job=None) -> None:
+        if not all(job.done for job in out.jobs):
+            return
+        try:
+            state.set_display(**asdict(display))
+        except ValueError as exc:
+            out.notes.append(f"the saved display cannot be shown: {exc}")
+        if camera:
+            state.set_camera(camera)
+
+    if out.jobs:
+        for job in out.jobs:
+            job.then(apply_display)
+    else:
+        apply_display()
+    return out

@@ -1,0 +1,85 @@
+"""Session files: save and restore the state (no Qt)."""
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modalviewer.core.cache import SpectrumCache
+from modalviewer.viewer import ViewerModel
+from modalviewer.viewer.session import SessionError, restore_session, save_session
+
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+
+
+def _model(tmp_path):
+    return ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+
+
+def _wait_all(model, restored):
+    for job in restored.jobs:
+        model.jobs.wait(job)
+
+
+def test_a_restored_session_shows_the_same_picture(tmp_path):
+    mesh_path = tmp_path / "spot.obj"
+    shutil.copy(ASSETS / "spot.obj", mesh_path)
+    first = _model(tmp_path)
+    first.open_mesh(mesh_path)
+    s = first.state
+    first.jobs.wait(first.request_spectrum("laplacian", k=25))
+    s.set_isolines(7)
+    s.set_scale_range((0.01, 2.0))
+    s.set_pick(321)
+    s.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
+    s.set_display(threshold=s.threshold_for_share(0.15))
+    s.camera = {"position": [1, 2, 3], "focal_point": [0, 0, 0], "view_up": [0, 1, 0]}
+    path = save_session(s, tmp_path / "a.json")
+    data = json.loads(path.read_text())
+    assert data["version"] == 1 and data["mesh"]["hash"] == first.state.mesh.hash
+
+    second = _model(tmp_path)  # same cache: the spectrum comes back from disk
+    restored = restore_session(second, path)
+    _wait_all(second, restored)
+    t = second.state
+    assert restored.notes == []
+    assert t.display == s.display and t.picked == 321 and t.t_range == (0.01, 2.0)
+    assert t.style.isolines == 7 and t.camera == s.camera
+    np.testing.assert_array_equal(t.field().values, s.field().values)
+    assert t.legend() == s.legend()
+
+
+def test_a_session_whose_mesh_changed_says_so_and_opens_what_it_can(tmp_path):
+    mesh_path = tmp_path / "spot.obj"
+    shutil.copy(ASSETS / "spot.obj", mesh_path)
+    model = _model(tmp_path)
+    model.open_mesh(mesh_path)
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    model.state.set_pick(2900)
+    path = save_session(model.state, tmp_path / "b.json")
+    # the file is replaced by a smaller mesh
+    shutil.copy(ASSETS / "demo_plate.obj", mesh_path)
+    other = _model(tmp_path)
+    restored = restore_session(other, path)
+    _wait_all(other, restored)
+    assert any("changed on disk" in note for note in restored.notes)
+    assert any("picked vertex 2900" in note for note in restored.notes)
+    assert other.state.mesh is not None and other.state.picked is None
+    assert other.state.display.kind == "mode"  # the spectrum was recomputed
+
+
+def test_bad_session_files_raise_clear_errors(tmp_path):
+    model = _model(tmp_path)
+    junk = tmp_path / "junk.json"
+    junk.write_text("{not json")
+    with pytest.raises(SessionError, match="not a readable session"):
+        restore_session(model, junk)
+    junk.write_text(json.dumps({"format": "modalviewer-session", "version": 99}))
+    with pytest.raises(SessionError, match="newer modalviewer"):
+        restore_session(model, junk)
+    junk.write_text(json.dumps({"format": "something else"}))
+    with pytest.raises(SessionError, match="not a modalviewer session"):
+        restore_session(model, junk)
+    assert model.state.mesh is None  # nothing was half-loaded

@@ -1,0 +1,171 @@
+"""The viewer's state model and jobs, without Qt or VTK."""
+
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modalviewer.core.cache import SpectrumCache
+from modalviewer.core.primitives import icosphere
+from modalviewer.viewer import ViewerModel
+from modalviewer.viewer.jobs import CANCELLED, DONE, FAILED, JobQueue
+
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+
+
+@pytest.fixture
+def model(tmp_path):
+    m = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    m.open_mesh(ASSETS / "spot.obj")
+    return m
+
+
+def test_importing_the_viewer_model_loads_no_qt_and_no_vtk():
+    code = (
+        "import sys, modalviewer, modalviewer.viewer, modalviewer.viewer.session;"
+        "bad = [m for m in sys.modules if m.split('.')[0] in "
+        "('PySide6', 'qtpy', 'vtk', 'vtkmodules', 'pyvista', 'pyvistaqt')];"
+        "print(','.join(bad))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+def test_each_wait_returns_its_own_spectrum(model):
+    """Problem 1: a shells request made while a Laplacian request waited used to be
+    returned to the Laplacian's caller (one shared wait, and the new job cancelled the
+    old one)."""
+    lap = model.request_spectrum("laplacian", k=37)
+    shells = model.request_spectrum("shells", k=12)  # as a click on the surface does
+    model.jobs.wait(lap)
+    assert lap.status == DONE and lap.result[0].operator == "laplacian"
+    assert lap.result[0].k == 37
+    assert shells.status in ("queued", "running", DONE)  # not cancelled by anyone
+    model.jobs.wait(shells)
+    assert shells.status == DONE and shells.result[0].operator == "shells"
+    assert model.state.spectrum("laplacian") is lap.result[0]
+    assert model.state.spectrum("shells") is shells.result[0]
+
+
+def test_identical_requests_join_one_job_and_others_queue(model):
+    a = model.request_spectrum("modified_dirichlet", k=20)
+    b = model.request_spectrum("modified_dirichlet", k=20)
+    c = model.request_spectrum("modified_dirichlet", k=21)
+    assert a is b and c is not a
+    assert [j.status for j in model.jobs.jobs] == ["running", "queued"]
+    model.jobs.cancel(c)
+    assert c.status == CANCELLED and a.status == "running"
+    model.jobs.wait(a)
+    assert a.status == DONE
+
+
+def test_a_failing_job_reports_its_own_error_and_the_queue_goes_on():
+    queue = JobQueue()
+
+    def boom(progress, cancel):
+        raise RuntimeError("the matrix is singular")
+
+    bad = queue.submit(boom, "bad", "bad")
+    good = queue.submit(lambda p, c: 42, "good", "good")
+    queue.wait(good, timeout=10)
+    assert bad.status == FAILED and "singular" in bad.error
+    assert good.status == DONE and good.result == 42
+
+
+def test_cancel_a_running_job_ends_it_as_cancelled():
+    queue = JobQueue()
+    started = threading.Event()
+
+    def slow(progress, cancel):
+        started.set()
+        while not cancel():
+            time.sleep(0.01)
+        return "never shown"
+
+    job = queue.submit(slow, "slow", "slow")
+    started.wait(5)
+    queue.cancel(job)
+    queue.wait(job, timeout=10)
+    assert job.status == CANCELLED and job.result is None
+
+
+def test_a_new_mesh_cancels_the_old_mesh_jobs_and_drops_their_result(model):
+    job = model.request_spectrum("shells", k=30)
+    model.set_mesh(icosphere(2))
+    model.jobs.wait(job)
+    assert job.status in (CANCELLED, DONE)
+    assert model.state.spectrum("shells") is None
+
+
+def test_a_finished_job_does_not_replace_a_display_changed_meanwhile(model):
+    """Problem 2's cause: a result arriving later took over the picture."""
+    model.jobs.wait(model.request_spectrum("laplacian", k=20, show=True))
+    state = model.state
+    assert state.display.kind == "mode" and state.display.operator == "laplacian"
+    job = model.request_spectrum("modified_dirichlet", k=20, show=True)
+    state.set_pick(100)
+    state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
+    model.jobs.wait(job)
+    assert state.display.kind == "distance"  # the result did not take over
+    assert state.spectrum("modified_dirichlet") is not None
+
+
+def test_legend_and_summary_follow_the_threshold(model):
+    """Problem 5: the status kept the first threshold's numbers while the slider moved."""
+    state = model.state
+    model.jobs.wait(model.request_spectrum("laplacian", k=30))
+    state.set_pick(500)
+    state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
+    for share in (0.05, 0.2, 0.6):
+        state.set_display(threshold=state.threshold_for_share(share))
+        d = state.distance_map()
+        marked = float(np.mean(d <= state.threshold_value()))
+        assert marked == pytest.approx(share, abs=0.01)
+        assert f"{100 * marked:.1f} % of the surface" in state.summary()
+        assert f"{100 * marked:.1f} % of the surface" in state.legend()
+        field = state.field()
+        assert field.colormap == "threshold"
+        assert float(np.mean(field.values == 0.0)) == pytest.approx(marked, abs=1e-12)
+
+
+def test_field_is_derived_from_the_state(model):
+    state = model.state
+    assert state.field().colormap == "plain"
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    assert state.display.mode == 1  # the first non-zero mode: mode 0 is constant
+    field = state.field()
+    spec = state.spectrum("laplacian")
+    np.testing.assert_allclose(field.values, spec.mode(1), rtol=0, atol=0)
+    assert field.colormap == "diverging" and field.isolines == state.style.isolines
+    assert "Laplacian (cotan), mode 1" in state.legend()
+    state.set_display(kind="curvature")
+    assert state.field().clim[0] == 0.0
+
+
+def test_display_validation_and_clipping(model):
+    state = model.state
+    with pytest.raises(ValueError, match="no spectrum"):
+        state.set_display(kind="mode", operator="shells")
+    with pytest.raises(ValueError, match="distance kind"):
+        state.set_display(distance_kind="nonsense")
+    with pytest.raises(ValueError, match="does not exist"):
+        state.set_pick(10**9)
+    model.jobs.wait(model.request_spectrum("laplacian", k=12))
+    state.show_mode(99, "laplacian")
+    assert state.display.mode == 11
+
+
+def test_events_fire_once_per_change(model):
+    state = model.state
+    seen = []
+    state.events.display.connect(lambda: seen.append("display"))
+    state.events.style.connect(lambda: seen.append("style"))
+    state.set_isolines(5)
+    state.set_isolines(5)  # no change, no event
+    state.set_display(distance_display="threshold")
+    state.set_display(distance_display="threshold")
+    assert seen == ["style", "display"]
