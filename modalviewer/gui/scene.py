@@ -203,6 +203,7 @@ class MeshScene:
         self.field_name = ""
         self.clim = (0.0, 1.0)
         self.kind = "plain"
+        self.threshold: float | None = None  # of a map made by show_threshold
         self.style = ""
         self.set_style(style)
         # legend and colour bar: what the caller asked for, and their on-screen actors
@@ -397,6 +398,41 @@ class MeshScene:
         actor.SetVisibility(True)
         # copies: the animation writes into the line points in place
         return seg.reshape(-1, 3).copy(), disp.reshape(-1, 3).copy()
+
+    def show_threshold(self, distances: np.ndarray, threshold: float, name: str = "") -> None:
+        """Threshold map drawn from the distances themselves: blue where d <= threshold,
+        white elsewhere.  The colour is looked up after interpolation along the surface,
+        so the boundary follows the line where the interpolated distance crosses the
+        threshold instead of a staircase along triangle edges (which colouring the 0/1
+        indicator gives); :meth:`set_threshold` then only changes the lookup table."""
+        values = np.asarray(distances, dtype=np.float64)
+        self.surface.point_data["field"] = values
+        hi = float(np.max(values)) or 1.0
+        self.clim = (0.0, hi)
+        self._mapper.scalar_range = self.clim
+        self._mapper.SetInterpolateScalarsBeforeMapping(True)
+        self._mapper.ScalarVisibilityOn()
+        self.kind = "threshold"
+        self.field_name = name
+        self.set_isolines(values, 0, False)
+        self.set_threshold(threshold)
+
+    def set_threshold(self, threshold: float) -> None:
+        """Move the threshold of a map made by :meth:`show_threshold`; no render."""
+        n = 2048
+        lo, hi = self.clim
+        cut = int(np.clip(np.floor((threshold - lo) / ((hi - lo) or 1.0) * n), 0, n - 1))
+        table = np.empty((n, 4))
+        table[:, :3] = WHITE
+        table[: cut + 1, :3] = SIMILAR_BLUE
+        table[:, 3] = 1.0
+        lut = pv.LookupTable()
+        lut.SetNumberOfTableValues(n)
+        lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
+        self._mapper.lookup_table = lut
+        self._mapper.scalar_range = self.clim
+        self.threshold = float(threshold)
+        self._overlay_changed()
 
     def show_plain(self) -> None:
         """The plain light-grey surface, no field and no isolines (a fresh mesh)."""

@@ -219,3 +219,28 @@ def test_exported_files_get_the_umask_permissions(view, spot_mode, tmp_path, uma
     for path in (png, vtp):
         assert (path.stat().st_mode & 0o777) == 0o666 & ~umask, oct(path.stat().st_mode)
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no leftovers
+
+
+def test_threshold_map_from_distances_moves_with_the_lookup_table_only(view, spot_mode):
+    mesh, _, _ = spot_mode
+    v = mesh.vertices
+    d = np.linalg.norm(v - v[np.argmax(v[:, 0])], axis=1)  # a vertex on the seen side
+    scene = _scene(view, mesh)
+
+    def blue_pixels():
+        view.plotter.render()
+        img = np.asarray(view.plotter.screenshot(None, return_img=True)).astype(int)
+        return int((img[:, :, 2] > img[:, :, 0] + 60).sum())
+
+    scene.show_threshold(d, 0.2 * d.max(), name="distance < t")
+    field = scene.surface.point_data["field"]
+    assert np.array_equal(field, d)
+    counts = [blue_pixels()]
+    for t in (0.4, 0.6):
+        scene.set_threshold(t * d.max())
+        counts.append(blue_pixels())
+        assert np.array_equal(scene.surface.point_data["field"], d)
+    assert 500 < counts[0] < counts[1] < counts[2], counts
+    assert scene.colorbar() is None  # until the caller asks for the swatches
+    scene.set_colorbar("distance < t")
+    assert scene.colorbar().kind == "swatches"
