@@ -1,72 +1,72 @@
-"""Measure the rendering style on the viewer's own exports: white level of the zero band
-facing the viewer and colour saturation, for a Laplacian mode of a mesh.
+"""Measure the rendering styles on exported screenshots: the white level of the zero band
+facing the viewer and the colour saturation, for Laplacian modes of a mesh, both styles in
+the same (canonical) view.
 
-    python scripts/measure_render_style.py [MESH] [--mode 6] [--style paper|shaded] [-o DIR]
+    python scripts/measure_render_style.py [MESH ...] [--modes 1 6] [-o DIR]
+
+Zero band: |phi| < 5 % of max |phi| on vertices whose normal is within 45 degrees of the
+direction to the camera; white level: percentiles of min(R, G, B) over its pixels;
+saturation: shares of the mesh's pixels with blue 60 above red / red 80 above blue.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
-os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-os.environ.setdefault("MODALVIEWER_NO_DIALOGS", "1")
-# a settings file of its own: the measurement changes the isoline count
-os.environ.setdefault("MODALVIEWER_SETTINGS", "/tmp/modalviewer-measure-settings.ini")
 if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import numpy as np  # noqa: E402
-from qtpy import QtWidgets  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("mesh", nargs="?", default=str(ROOT / "assets" / "spot.obj"))
-    ap.add_argument("--mode", type=int, default=6)
-    ap.add_argument("--operator", default="laplacian")
-    ap.add_argument("--style", default=None)
-    ap.add_argument("-o", "--out", default="/tmp")
+    ap.add_argument("meshes", nargs="*", default=[str(ROOT / "assets" / "spot.obj")])
+    ap.add_argument("--modes", type=int, nargs="+", default=[1, 6])
+    ap.add_argument("--size", default="800x700")
+    ap.add_argument("-o", "--out", default=None, help="folder for the exported PNGs")
     args = ap.parse_args()
+    import pyvista as pv
     from PIL import Image
 
-    from modalviewer.gui import MainWindow
+    import modalviewer as mv
+    from modalviewer.core.laplacian import vertex_normals
+    from modalviewer.gui.export import save_screenshot
     from modalviewer.gui.render_metrics import saturation, white_level, zero_band_masks
+    from modalviewer.gui.scene import STYLES, MeshScene
 
-    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
-    win = MainWindow()
-    win.resize(1280, 800)
-    win.show()
-    app.processEvents()
-    win.open_mesh(args.mesh)
-    win.compute(args.operator, k=max(20, args.mode + 1), wait=True)
-    if args.style and hasattr(win.scene, "set_style"):
-        win.scene.set_style(args.style)
-    win.show_mode(args.mode)
-    field = np.array(win.scene.surface.point_data["field"])
-    name = f"{Path(args.mesh).stem}_{args.operator}_{args.mode}_{args.style or 'default'}"
-    out = Path(args.out)
-    lines = win.export_screenshot(out / f"{name}_lines.png")
-    win.iso_spin.setValue(0)
-    path = win.export_screenshot(out / f"{name}.png")
-    img = np.asarray(Image.open(path))[:, :, :3]
-    mesh, band = zero_band_masks(win.scene, field)
-    result = {
-        "mesh": Path(args.mesh).name,
-        "mode": args.mode,
-        "style": args.style or "default",
-        "white_level_zero_band": white_level(img, band),
-        "white_level_mesh_p95": white_level(img, mesh)["p95"],
-        "saturation": saturation(img, mesh),
-        "images": [str(lines), str(path)],
-    }
-    print(json.dumps(result, indent=1))
-    win.close()
+    out = Path(args.out) if args.out else Path(os.environ.get("TMPDIR", "/tmp"))
+    w, h = (int(x) for x in args.size.split("x"))
+    for path in args.meshes:
+        mesh = mv.load_mesh(path)
+        spec = mv.compute_spectrum(mesh, "laplacian", k=max(args.modes) + 1)
+        plotter = pv.Plotter(off_screen=True, window_size=(w, h))
+        plotter.set_background("white")
+        plotter.show(auto_close=False, interactive=False)
+        view = SimpleNamespace(plotter=plotter)
+        scene = MeshScene(plotter, mesh, vertex_normals(mesh))
+        scene.reset_camera()
+        for j in args.modes:
+            field = spec.mode(j)
+            for style in STYLES:
+                scene.set_style(style)
+                scene.show_field(field, "diverging", isolines=0)
+                png = save_screenshot(view, out / f"{Path(path).stem}_mode{j}_{style}.png")
+                img = np.asarray(Image.open(png))[:, :, :3]
+                mesh_px, band = zero_band_masks(scene, field)
+                wl, sat = white_level(img, band), saturation(img, mesh_px)
+                print(
+                    f"{Path(path).name:24s} mode {j:2d} {style:6s} zero band {wl['n']:6d} px: "
+                    f"min(R,G,B) p5 {wl['p5']:.0f} p50 {wl['p50']:.0f} p95 {wl['p95']:.0f}; "
+                    f"blue {100 * sat['blue']:.1f} %, orange {100 * sat['orange']:.1f} %"
+                )
+        plotter.close()
     return 0
 
 
