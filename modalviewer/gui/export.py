@@ -64,7 +64,7 @@ def save_screenshot(
             plotter.render()
     img = np.ascontiguousarray(img)
     if overlay:
-        img = draw_overlay(img, overlay, scale)
+        img = draw_overlay(img, overlay, scale * getattr(scene, "overlay_scale", 1.0))
     atomic_write(path, lambda tmp: Image.fromarray(img).save(tmp, format="PNG"))
     return path
 

@@ -213,6 +213,9 @@ class MeshScene:
         # drawn by Pillow into one transparent image over the view (the same drawing as
         # in exports), redrawn before a render when the text or the view's size changed
         self.overlay_actor = None
+        # text size factor: the device pixel ratio of the screen (2 on a HiDPI display,
+        # where the render window counts device pixels); exports multiply their scale by it
+        self.overlay_scale = 1.0
         self._overlay_key = None
         self._overlay_observer = None
         # canonical first view of this mesh; the scene keeps a reference on the plotter so
@@ -519,13 +522,13 @@ class MeshScene:
             return
         w, h = self.plotter.renderer.GetSize()
         overlay = self.overlay()
-        key = (w, h, repr(overlay))
+        key = (w, h, self.overlay_scale, repr(overlay))
         if key == self._overlay_key or w < 2 or h < 2:
             return
         self._overlay_key = key
         rgba = np.zeros((h, w, 4), np.uint8)
         if overlay:
-            rgba = draw_overlay(rgba, overlay, 1.0)
+            rgba = draw_overlay(rgba, overlay, self.overlay_scale)
         image = vtkImageData()
         image.SetDimensions(w, h, 1)
         scalars = numpy_to_vtk(rgba[::-1].reshape(-1, 4).copy(), deep=True)
