@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from qtpy import QtGui, QtWidgets
+from qtpy import QtCore, QtWidgets
 
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from .scene import MeshScene
@@ -59,17 +59,22 @@ class CompareWindow(QtWidgets.QWidget):
             self.titles.append(title)
         first = self.items[0]
         self.mode_index = 0 if self.distances else self.state.first_nonzero_mode(first)
-        for key, slot in (
-            ("Escape", self.close),
-            ("Ctrl+W", self.close),
-            ("Right", lambda: self.show_mode(self.mode_index + 1)),
-            ("Left", lambda: self.show_mode(self.mode_index - 1)),
-        ):
-            shortcut = QtGui.QShortcut(QtGui.QKeySequence(key), self)
-            shortcut.activated.connect(slot)
         for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event.connect(self._on_state)
         self.resize(420 * len(items), 480)
+
+    def keyPressEvent(self, event):  # noqa: N802
+        """Esc and Ctrl+W close; Left / Right step the mode of operator views."""
+        key, mods = event.key(), event.modifiers()
+        ctrl = bool(mods & QtCore.Qt.KeyboardModifier.ControlModifier)
+        if key == QtCore.Qt.Key.Key_Escape or (key == QtCore.Qt.Key.Key_W and ctrl):
+            self.close()
+        elif key == QtCore.Qt.Key.Key_Right and not self.distances:
+            self.show_mode(self.mode_index + 1)
+        elif key == QtCore.Qt.Key.Key_Left and not self.distances:
+            self.show_mode(self.mode_index - 1)
+        else:
+            super().keyPressEvent(event)
 
     def _on_state(self) -> None:
         if self.distances:

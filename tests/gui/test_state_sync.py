@@ -1,0 +1,162 @@
+"""The window around the state model: jobs keep to themselves, panels agree with the
+picture, keys go to the focused widget, sessions restore the picture.  Each numbered
+test is one of the problems the state model was built to fix."""
+
+import configparser
+
+import numpy as np
+import pytest
+from qtpy import QtCore, QtWidgets
+
+pytestmark = pytest.mark.gui
+
+
+def test_1_a_waiting_compute_returns_its_own_spectrum(window, spot_path, qtbot):
+    """A shells request arriving while a Laplacian request waits (as a click on the
+    surface does) used to cancel it and hand its spectrum to the Laplacian's caller."""
+    window.open_mesh(spot_path)
+    QtCore.QTimer.singleShot(100, lambda: window.compute("shells", k=20, wait=False))
+    spec = window.compute("laplacian", k=237, wait=True)
+    assert spec.operator == "laplacian" and spec.k == 237
+    qtbot.waitUntil(lambda: not window.busy, timeout=120000)
+    assert window.spectra["shells"].k == 20  # the other request was not lost either
+
+
+def test_2_the_modes_panel_does_not_name_a_mode_that_is_not_shown(window, spot_path, qtbot):
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=40, wait=True)
+    window.show_mode(31)
+    assert window.modes_panel.eigen_label.text().startswith("lambda_31 = ")
+    window.pick_vertex(700)
+    window.show_distance("vibration", display="threshold", threshold=0.3)
+    qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
+    label = window.modes_panel.eigen_label.text()
+    assert "lambda_31" not in label and label.startswith("Not shown")
+    assert "vibration distance" in label
+    assert window.status_line.text().startswith("blue: vibration distance <")
+    assert window.distances_panel.display_combo.currentData() == "threshold"
+
+
+def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
+    window, spot_path, qtbot, monkeypatch
+):
+    window.open_mesh(spot_path)
+    window.compute("modified_dirichlet", k=20, wait=True)
+    window.state.set_display(distance_kind="feature")  # a pick then needs no new spectrum
+    window.pick_vertex(50)
+    window.show_distance("feature", display="threshold", threshold=0.2)
+    before = window.state.display
+    # the menu's Ctrl+1 with the question answered No: nothing starts
+    assert window.open_comparison(["laplacian", "modified_dirichlet"], wait=False) is None
+    assert not window.busy and "laplacian" not in window.spectra
+    # answered Yes: computed in the background, then opened; the main view is unchanged
+    monkeypatch.setenv("MODALVIEWER_ASSUME_YES", "1")
+    window.open_comparison(["laplacian", "modified_dirichlet"], wait=False)
+    qtbot.waitUntil(lambda: window.compare is not None, timeout=120000)
+    assert window.state.display == before
+    compare = window.compare
+    assert compare.mode_index == 1  # the first non-zero mode, not the constant mode 0
+    assert "mode 1," in compare.titles[0].text()
+    field = np.array(compare.scenes[0].surface.point_data["field"])
+    assert np.ptp(field) > 0  # not one solid colour
+    compare.show()
+    qtbot.waitExposed(compare)
+    qtbot.keyClick(compare, QtCore.Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: window.compare is None, timeout=5000)
+    window.open_comparison(["laplacian", "modified_dirichlet"])
+    compare = window.compare
+    compare.show()
+    qtbot.waitExposed(compare)
+    qtbot.keyClick(compare, QtCore.Qt.Key.Key_W, QtCore.Qt.KeyboardModifier.ControlModifier)
+    qtbot.waitUntil(lambda: window.compare is None, timeout=5000)
+
+
+def test_4_arrow_keys_move_a_focused_slider_not_the_mode(window, spot_path, qtbot):
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=30, wait=True)
+    window.show_mode(3)
+    window.state.set_display(distance_display="threshold")
+    slider = window.distances_panel.threshold_slider
+    slider.setFocus()
+    qtbot.waitUntil(slider.hasFocus, timeout=2000)
+    start = slider.value()
+    for _ in range(5):
+        qtbot.keyClick(slider, QtCore.Qt.Key.Key_Right)
+    assert slider.value() == start + 5 * slider.singleStep()
+    assert window.state.display.mode == 3
+    # in the 3D view the arrows do step modes
+    view = window.viewport.widget
+    view.setFocus()
+    qtbot.waitUntil(view.hasFocus, timeout=2000)
+    qtbot.keyClick(view, QtCore.Qt.Key.Key_Right)
+    assert window.state.display.kind == "mode" and window.state.display.mode == 4
+
+
+def test_5_status_and_legend_follow_the_threshold_slider(window, spot_path):
+    window.open_mesh(spot_path)
+    window.compute("modified_dirichlet", k=30, wait=True)
+    window.pick_vertex(1000)
+    d = window.show_distance("feature", display="threshold", threshold=0.5)
+    slider = window.distances_panel.threshold_slider
+    for position in (50, 200, 600):  # share of the surface, in thousandths
+        slider.setValue(position)  # what dragging does
+        thr = window.state.display.threshold * d.max()
+        share = 100.0 * np.mean(d <= thr)
+        assert share == pytest.approx(position / 10, abs=1.0)
+        text = f"{share:.1f} % of the surface"
+        assert text in window.status_line.text()
+        assert text in window.scene.legend_text
+        assert f"{thr:.4g}" in window.distances_panel.threshold_label.text()
+        field = np.asarray(window.scene.surface.point_data["field"])
+        np.testing.assert_array_equal(field, (d > thr).astype(float))
+
+
+def test_6_a_headless_window_writes_no_desktop_settings(qtbot, tmp_path, monkeypatch):
+    from modalviewer.gui import MainWindow
+
+    ini = tmp_path / "headless.ini"
+    monkeypatch.setenv("MODALVIEWER_SETTINGS", str(ini))
+    assert QtWidgets.QApplication.platformName() == "offscreen"
+    win = MainWindow()
+    qtbot.addWidget(win)
+    win.resize(900, 500)
+    win.show()
+    win.close()
+    parser = configparser.ConfigParser()
+    parser.read(ini)
+    assert not parser.has_section("window")
+    assert not ini.exists() or "geometry" not in ini.read_text()
+
+
+def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
+    from modalviewer.gui import MainWindow
+
+    first = MainWindow()
+    qtbot.addWidget(first)
+    first.resize(1000, 700)
+    first.show()
+    qtbot.waitExposed(first)
+    first.open_mesh(spot_path)
+    first.compute("modified_dirichlet", k=30, wait=True)
+    first.state.set_isolines(5)
+    first.pick_vertex(1234)
+    first.show_distance("feature", display="threshold", threshold=0.25)
+    first.plotter.camera.Azimuth(70)
+    first.plotter.camera.Elevation(20)
+    image = first.viewport.render_now()
+    session = first.save_session(tmp_path / "s.json")
+    first.close()
+
+    second = MainWindow()
+    qtbot.addWidget(second)
+    second.resize(1000, 700)
+    second.show()
+    qtbot.waitExposed(second)
+    assert second.open_session(session, wait=True) == []
+    again = second.viewport.render_now()
+    assert again.shape == image.shape
+    differ = np.mean(np.any(np.abs(again.astype(int) - image.astype(int)) > 8, axis=2))
+    assert differ < 0.002, differ
+    assert second.status_line.text() == second.state.summary()
+    assert "feature distance" in second.status_line.text()
+    second.close()
