@@ -142,7 +142,7 @@ class Mesh:
         if degenerate.any():
             raise MeshError(
                 f"{_plural(int(degenerate.sum()), 'face')} have zero area (first: face "
-                f"{int(np.flatnonzero(degenerate)[0])}); load with repair=True to drop them"
+                f"{int(np.flatnonzero(degenerate)[0])}); repair_mesh (or load_mesh) collapses them"
             )
         self.report = report if report is not None else MeshReport()
 
