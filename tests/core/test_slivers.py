@@ -203,3 +203,11 @@ def test_fix_slivers_falls_back_to_local_remeshing(slivered_sphere, monkeypatch)
     assert r.triangles_changed < bad.n_faces / 2
     assert r.max_vertex_shift < 1e-6 and r.max_deviation < 0.01
     assert fixed.total_area == pytest.approx(bad.total_area, rel=0.01)
+
+
+def test_fix_slivers_without_pymeshlab_says_what_to_install(slivered_sphere, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "pymeshlab", None)  # import pymeshlab -> ImportError
+    with pytest.raises(mv.MeshError, match="pip install pymeshlab"):
+        mv.fix_slivers(slivered_sphere[1])
