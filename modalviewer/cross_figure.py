@@ -81,7 +81,7 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
                 raise ValueError("a panel's distances must have one value per vertex")
             if panel.display == "threshold":
                 thr = panel.threshold * float(d.max())
-                scene.show_field((d > thr).astype(np.float64), "threshold", name="threshold")
+                scene.show_threshold(d, thr, name="threshold")
             else:
                 scene.show_field(d, "sequential", isolines=0, name="distance")
         scene.show_marker(panel.marker)
