@@ -426,9 +426,10 @@ def preview_spectrum(
     """Preview eigenpairs of ``K x = lambda diag(mass) x`` for ``operator`` on ``mesh``.
 
     Galerkin projection onto :func:`reduced_basis` (``samples`` centres, default
-    ``max(DEFAULT_SAMPLES, 2 k)``), then (``smoothing``) one Rayleigh-Ritz step on the
-    prolonged modes together with their block-Jacobi preconditioned residuals, which adds
-    the mesh-scale components a smooth space lacks.
+    ``max(DEFAULT_SAMPLES, 2 k)``, for the shells ``max(140, 1.4 k)``), then
+    (``smoothing``) one Rayleigh-Ritz step on the prolonged modes together with their
+    block-Jacobi preconditioned residuals, which adds the mesh-scale components a smooth
+    space lacks.
 
     Returns (eigenvalues (k,), modes (N, k) Mass-orthonormal, residuals (k,), info) where
     info holds the reduced space's size, timings and ``estimated_errors``.
@@ -445,7 +446,11 @@ def preview_spectrum(
     seconds = {}
     t = time.perf_counter()
     if samples is None:
-        samples = max(DEFAULT_SAMPLES, 2 * k)
+        # the shells' 9 functions per sample make the reduced problem the costly part;
+        # fewer samples hardly change their error, which the smoothing step dominates
+        # (10k bumpy plate, 100 modes: 140 / 200 samples, largest error 8.8 / 7.9 %)
+        samples = int(1.4 * k) if operator == "shells" else 2 * k
+        samples = max(DEFAULT_SAMPLES if operator != "shells" else 140, samples)
     report("preview: sampling", 0.05)
     # at least 6 vertices per sample: denser samples make the enriched functions
     # linearly dependent on the mesh without adding anything
