@@ -360,6 +360,30 @@ def _collapsible(p: int, q: int, v, f, topo, min_area: float) -> bool:
     return True
 
 
+def _flippable(t: int, a: int, b: int, x: int, v, f, topo, min_area: float):
+    """(face across edge ab, its third vertex d) if the zero-area face t = (a, b, x) and
+    that face can trade their edge ab for xd: the surface stays a manifold (no edge xd
+    yet, consistent orientation) and both new faces (a, d, x), (d, b, x) have area and
+    face the way the old neighbour did; else None."""
+    fi, fp, ni, nptr, on_boundary, adj = topo
+    around_a = fi[fp[a] : fp[a + 1]]
+    across = [int(g) for g in around_a if g != t and b in f[g]]
+    if len(across) != 1:
+        return None
+    g = across[0]
+    k = int(np.flatnonzero(f[g] == b)[0])
+    if f[g][(k + 1) % 3] != a:  # the neighbour must run b -> a
+        return None
+    d = int(f[g][(k + 2) % 3])
+    if d == x or x in ni[nptr[d] : nptr[d + 1]]:
+        return None
+    old = _cross_rows(v[[a]] - v[[b]], v[[d]] - v[[b]])[0]
+    new = _cross_rows(v[[d, b]] - v[[a, d]], v[[x, x]] - v[[a, d]])
+    if np.any(0.5 * np.linalg.norm(new, axis=1) <= min_area) or np.any(new @ old <= 0):
+        return None
+    return g, d
+
+
 def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max_rounds=100):
     """Collapse an edge, the shortest where possible, of every face of area at most
     ``min_area``.
@@ -374,16 +398,20 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
     around the moved vertex upside down; if it would not, the face's other edges and
     directions are tried, shortest first (a marching-cubes surface of 206k vertices had
     two faces of area 1e-14 of the squared diagonal whose first choice folded a face).
+    An apex well inside the longest edge (between 10 % and 90 % of it) is handled by
+    flipping that edge instead, where the result is a manifold with two faces of area:
+    no vertex moves (a T-junction of a remesh).
     A zero-area face whose longest edge is on the boundary is removed instead: the
     boundary then runs through its apex, along the same line, so no hole opens.
     Collapses are done in rounds of non-adjacent edges until no zero-area face is left
     or none can be collapsed.
 
-    Returns (faces, number of collapsed edges, faces removed along the boundary, largest
-    move, faces still of zero area).
+    Returns (faces, number of flipped edges, number of collapsed edges, faces removed
+    along the boundary, largest move, faces still of zero area).
     """
     n = len(v)
-    collapsed, dropped, largest = 0, 0, 0.0
+    f = f.copy()
+    collapsed, flipped, dropped, largest = 0, 0, 0, 0.0
     for _ in range(max_rounds):
         zero = np.flatnonzero(0.5 * _double_areas(v, f) <= min_area)
         if zero.size == 0:
@@ -429,15 +457,31 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
         locked[f[drop].ravel()] = True
         remap = np.arange(n)
         merged = 0
+        flipped_before = flipped
 
         topo = (fi, fp, ni, nptr, on_boundary, adj)
 
         for i in order:
-            if along_boundary[i]:
-                continue
-            # the apex into the nearer end first; then the other ways of collapsing an
-            # edge of this face, shortest edge first
             corners = zf[i]
+            if along_boundary[i] or locked[corners].any():
+                continue  # a neighbour changed in this round: the next round sees it
+            # an apex well inside the longest edge: flip that edge (nothing moves)
+            a_, b_, x_ = (int(corners[(lo[i] + c) % 3]) for c in range(3))
+            ab = v[b_] - v[a_]
+            t = float(np.dot(v[x_] - v[a_], ab) / max(np.dot(ab, ab), np.finfo(float).tiny))
+            if 0.1 <= t <= 0.9:
+                flip = _flippable(zero[i], a_, b_, x_, v, f, topo, min_area)
+                if flip is not None and not locked[flip[1]]:
+                    other, d = flip
+                    f[zero[i]] = (a_, d, x_)
+                    f[other] = (d, b_, x_)
+                    for w in (a_, b_, x_, d):
+                        locked[w] = True
+                        locked[ni[nptr[w] : nptr[w + 1]]] = True
+                    flipped += 1
+                    continue
+            # else collapse: the apex into the nearer end first; then the other ways of
+            # collapsing an edge of this face, shortest edge first
             edges = np.argsort(lengths[i], kind="stable")
             tries = [(int(moved[i]), int(kept[i]))]
             for e in edges:
@@ -453,14 +497,14 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
                 largest = max(largest, float(np.linalg.norm(v[p] - v[q])))
                 merged += 1
                 break
-        if merged == 0 and not drop.any():
+        if merged == 0 and flipped == flipped_before and not drop.any():
             break
         collapsed += merged
         dropped += int(drop.sum())
         f = remap[f[~drop]]
         f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
     left = int((0.5 * _double_areas(v, f) <= min_area).sum()) if len(f) else 0
-    return f, collapsed, dropped, largest, left
+    return f, flipped, collapsed, dropped, largest, left
 
 
 def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
@@ -527,7 +571,8 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     Steps: check finiteness and index range (errors, not repairs), merge vertices
     closer than ``merge_tolerance`` times the bounding-box diagonal, drop faces that
     repeat a vertex, collapse the shortest edge of faces of (near) zero area (so a closed
-    surface stays closed; see :func:`_collapse_zero_area_faces`), drop duplicate faces,
+    surface stays closed; see :func:`_collapse_zero_area_faces`, which flips the longest
+    edge instead where a vertex lies inside it), drop duplicate faces,
     drop unreferenced vertices, make the orientation consistent per component where
     possible.
 
@@ -571,7 +616,15 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     min_area = 1e-14 * diag**2
     n_collapsed = 0
     if len(f) and np.any(0.5 * _double_areas(v, f) <= min_area):
-        f, n_collapsed, dropped, largest, left = _collapse_zero_area_faces(v, f, min_area)
+        f, n_flipped, n_collapsed, dropped, largest, left = _collapse_zero_area_faces(
+            v, f, min_area
+        )
+        if n_flipped:
+            report.add(
+                f"Flipped the longest edge of {_plural(n_flipped, 'degenerate (zero-area) face')}"
+                " (a vertex lying inside that edge: the two faces on it became two faces "
+                "with area; no vertex moved, no holes opened)."
+            )
         if n_collapsed:
             report.add(
                 f"Collapsed {_plural(n_collapsed, 'degenerate (zero-area) face')} (merged the "
@@ -587,7 +640,8 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
             f = f[0.5 * _double_areas(v, f) > min_area]
             report.add(
                 f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
-                "collapsed without tearing or folding the surface (this can leave holes)."
+                "flipped or collapsed without tearing or folding the surface (this can "
+                "leave holes)."
             )
     if len(f) == 0:
         raise MeshError("no faces are left after removing degenerate ones: not a surface")

@@ -10,9 +10,9 @@ from modalviewer.core.mesh import triangle_quality
 from modalviewer.core.primitives import grid_plate, icosphere
 
 
-def add_slivers(mesh, needles, caps, eps, seed=0):
+def add_slivers(mesh, needles, caps, eps, seed=0, at=0.5):
     """(vertices, faces) of ``mesh`` with ``caps`` faces split at a point ``eps`` (relative)
-    off the midpoint of an edge (a cap: a triangle with a vertex almost on its longest
+    off the point ``at`` of an edge (a cap: a triangle with a vertex almost on its longest
     edge, zero area for eps = 0) and ``needles`` edges split at ``eps`` of their length
     from one end (two needle triangles each).  Closed meshes stay closed."""
     rng = np.random.default_rng(seed)
@@ -23,7 +23,7 @@ def add_slivers(mesh, needles, caps, eps, seed=0):
         t = next(picks)
         a, b, c = f[t]
         x = len(v)
-        v.append(0.5 * (v[a] + v[b]) * (1 - eps) + eps * v[c])
+        v.append(((1 - at) * v[a] + at * v[b]) * (1 - eps) + eps * v[c])
         f[t] = [a, b, x]  # the cap
         f = np.vstack([f, [[b, c, x], [c, a, x]]])
     made = 0
@@ -66,27 +66,49 @@ def test_triangle_quality_values():
 
 
 # ------------------------------------------------------------- the loader
-def test_loader_collapses_zero_area_caps_and_a_closed_mesh_stays_closed(tmp_path):
-    sphere = icosphere(2)
-    v, f = add_slivers(sphere, needles=0, caps=10, eps=0.0)
-    assert (0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]),
-                                 axis=1) < 1e-15).sum() == 10  # fmt: skip
-    path = tmp_path / "caps.obj"
+def _write_obj(path, v, f):
     path.write_text(
         "".join(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in v)
         + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
     )
-    mesh = mv.load_mesh(path)
+    return path
+
+
+def _zero_area_count(v, f):
+    double = np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+    return int((0.5 * double < 1e-15).sum())
+
+
+def test_loader_flips_zero_area_caps_and_a_closed_mesh_stays_closed(tmp_path):
+    # a vertex in the middle of an edge (a T-junction): the edge is flipped, nothing moves
+    sphere = icosphere(2)
+    v, f = add_slivers(sphere, needles=0, caps=10, eps=0.0)
+    assert _zero_area_count(v, f) == 10
+    mesh = mv.load_mesh(_write_obj(tmp_path / "caps.obj", v, f))
     text = str(mesh.report)
     assert mesh.is_closed and mesh.n_boundary_edges == 0  # 30 boundary edges when deleted
     assert euler(mesh) == 2 and mesh.n_components == 1 and mesh.is_consistently_oriented
+    assert "Flipped the longest edge of 10 degenerate (zero-area) faces" in text
+    assert "no vertex moved" in text
+    np.testing.assert_array_equal(mesh.vertices, v)  # every vertex kept, none moved
+    assert mesh.n_faces == len(f)
+    assert mesh.total_area == pytest.approx(sphere.total_area, rel=1e-14)
+    assert mesh.face_quality.min() > 0.3
+
+
+def test_loader_collapses_zero_area_caps_near_a_corner(tmp_path):
+    # a vertex on an edge next to its end: the short edge is collapsed
+    sphere = icosphere(2)
+    v, f = add_slivers(sphere, needles=0, caps=10, eps=0.0, at=0.02)
+    mesh = mv.load_mesh(_write_obj(tmp_path / "caps.obj", v, f))
+    text = str(mesh.report)
+    assert mesh.is_closed and euler(mesh) == 2 and mesh.is_consistently_oriented
     assert "Collapsed 10 degenerate (zero-area) faces" in text and "no holes" in text
     # each cap's apex was only used by the split face: the sphere comes back exactly
     assert mesh.n_vertices == sphere.n_vertices and mesh.n_faces == sphere.n_faces
     np.testing.assert_array_equal(mesh.vertices, sphere.vertices)
     same = {tuple(np.roll(t, -np.argmin(t))) for t in sphere.faces}
     assert {tuple(np.roll(t, -np.argmin(t))) for t in mesh.faces} == same
-    assert mesh.total_area == pytest.approx(sphere.total_area, rel=1e-14)
 
 
 def test_loader_keeps_the_boundary_of_an_open_mesh():
@@ -94,7 +116,7 @@ def test_loader_keeps_the_boundary_of_an_open_mesh():
     v, f = add_slivers(plate, needles=0, caps=12, eps=0.0, seed=3)
     mesh = mv.repair_mesh(v, f, source="plate")
     text = str(mesh.report)
-    assert "Collapsed" in text and "lying along the boundary" in text
+    assert "Flipped" in text and "lying along the boundary" in text
     # the outline is still the unit square: no interior holes, no lost area
     assert boundary_length(mesh) == pytest.approx(4.0, rel=1e-12)
     assert mesh.total_area == pytest.approx(1.0, rel=1e-12)
