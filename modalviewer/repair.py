@@ -143,7 +143,7 @@ def _hausdorff(ms, sampled_id: int, target_id: int, n_samples: int) -> float:
     return float(res["max"])
 
 
-def fix_slivers(mesh: Mesh, min_quality: float = 0.05) -> Mesh:
+def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     """A copy of ``mesh`` without needle and cap triangles, made by edge flips and
     collapses; ``result.report`` is a :class:`SliverReport`.
 
@@ -161,6 +161,8 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05) -> Mesh:
     Parameters
     ----------
     mesh : the mesh to repair (not changed).
+    progress : optional ``progress(stage, fraction)``, called before each repair tried
+        and before the measurements (each MeshLab filter runs to its end).
     min_quality : the quality every triangle should have afterwards.  A thin triangle
         whose longest edge L is r times the height onto it has quality between
         sqrt(3) / r and 4 / (sqrt(3) r); MeshLab's criterion is applied with
@@ -222,7 +224,9 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05) -> Mesh:
         "consistent orientation",
     )
     result, refused = None, []
-    for method in _METHODS:
+    for number, method in enumerate(_METHODS):
+        if progress is not None:
+            progress(f"fixing slivers: {_METHODS[method].split(' (')[0]}", 0.8 * number / 3)
         try:
             v, f, tags, ms = _run_meshlab(v0, f0, q0, method, min_quality)
         except pymeshlab.PyMeshLabException as exc:
@@ -273,6 +277,8 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05) -> Mesh:
     code_in = (key_in[:, 0] * base + key_in[:, 1]) * base + key_in[:, 2]
     unchanged = np.isin(code_in, code_out)
 
+    if progress is not None:
+        progress("measuring the change", 0.9)
     out_id = ms.current_mesh_id()
     ms.add_mesh(pymeshlab.Mesh(v0, f0.astype(np.int32)))
     in_id = ms.current_mesh_id()
@@ -291,6 +297,8 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05) -> Mesh:
         report.max_vertex_shift = float(moved[whole].max(initial=0.0)) / diag
     report.max_deviation = max(to_new, to_old) / diag
     report.seconds = time.perf_counter() - started
+    if progress is not None:
+        progress("done", 1.0)
     report.messages.insert(
         0,
         f"Changed {report.triangles_changed} of {report.triangles_before} triangles by "

@@ -146,7 +146,10 @@ def slivered_sphere():
 def test_fix_slivers_removes_needles_and_caps_and_keeps_the_surface(slivered_sphere):
     sphere, bad = slivered_sphere
     assert bad.is_closed and (bad.face_quality < 1e-3).sum() == 60
-    fixed = mv.fix_slivers(bad)
+    stages = []
+    fixed = mv.fix_slivers(bad, progress=lambda stage, x: stages.append((stage, x)))
+    assert stages[0][1] == 0.0 and stages[-1] == ("done", 1.0)
+    assert all(a[1] <= b[1] for a, b in zip(stages, stages[1:], strict=False))
     r = fixed.report
     assert isinstance(r, mv.SliverReport)
     # topology: still one closed sphere
