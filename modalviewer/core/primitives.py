@@ -6,7 +6,7 @@ import numpy as np
 
 from .mesh import Mesh
 
-__all__ = ["grid_plate", "icosphere", "torus"]
+__all__ = ["add_slivers", "grid_plate", "icosphere", "torus"]
 
 
 def grid_plate(nx: int = 10, ny: int = 10, width: float = 1.0, height: float = 1.0) -> Mesh:
@@ -81,3 +81,44 @@ def torus(n_major: int = 32, n_minor: int = 16, major: float = 1.0, minor: float
          np.column_stack([a.ravel(), c.ravel(), d.ravel()])]
     )  # fmt: skip
     return Mesh(v, f)
+
+
+def add_slivers(
+    mesh: Mesh, needles: int, caps: int, eps: float, seed: int = 0, at: float = 0.5
+) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of ``mesh`` with nearly degenerate triangles, as remeshers and
+    iso-surfaces make them (for tests and benchmarks of the repairs).
+
+    ``caps`` faces (a, b, c) are split at x = (1 - at) a + at b moved ``eps`` (relative)
+    towards c: the cap (a, b, x) has a vertex almost on its longest edge (zero area for
+    eps = 0).  ``needles`` edges are split at ``eps`` of their length from one end (two
+    needle triangles each).  Random faces (``seed``); a closed mesh stays closed.  The
+    arrays are raw: ``Mesh`` refuses faces of zero area, ``repair_mesh`` repairs them.
+    """
+    rng = np.random.default_rng(seed)
+    v = [np.asarray(p) for p in mesh.vertices]
+    f = np.array(mesh.faces)
+    picks = iter(rng.permutation(len(f)))
+    for _ in range(caps):
+        t = next(picks)
+        a, b, c = f[t]
+        x = len(v)
+        v.append(((1 - at) * v[a] + at * v[b]) * (1 - eps) + eps * v[c])
+        f[t] = [a, b, x]  # the cap
+        f = np.vstack([f, [[b, c, x], [c, a, x]]])
+    made = 0
+    while made < needles:
+        t = next(picks)
+        a, b, c = f[t]
+        other = np.flatnonzero(((f == b) & (np.roll(f, -1, axis=1) == a)).any(axis=1))
+        if len(other) != 1 or len(set(f[t]) & set(f[other[0]])) != 2:
+            continue  # on the boundary, or not a simple neighbour
+        o = other[0]
+        d = next(int(x) for x in f[o] if x not in (a, b))  # the face across runs (b, a, d)
+        x = len(v)
+        v.append(v[a] * (1 - eps) + eps * v[b])
+        f[t] = [a, x, c]
+        f[o] = [b, x, d]
+        f = np.vstack([f, [[x, b, c], [x, a, d]]])
+        made += 1
+    return np.array(v), f

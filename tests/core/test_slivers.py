@@ -7,42 +7,7 @@ import pytest
 
 import modalviewer as mv
 from modalviewer.core.mesh import triangle_quality
-from modalviewer.core.primitives import grid_plate, icosphere
-
-
-def add_slivers(mesh, needles, caps, eps, seed=0, at=0.5):
-    """(vertices, faces) of ``mesh`` with ``caps`` faces split at a point ``eps`` (relative)
-    off the point ``at`` of an edge (a cap: a triangle with a vertex almost on its longest
-    edge, zero area for eps = 0) and ``needles`` edges split at ``eps`` of their length
-    from one end (two needle triangles each).  Closed meshes stay closed."""
-    rng = np.random.default_rng(seed)
-    v = [np.asarray(p) for p in mesh.vertices]
-    f = np.array(mesh.faces)
-    picks = iter(rng.permutation(len(f)))
-    for _ in range(caps):
-        t = next(picks)
-        a, b, c = f[t]
-        x = len(v)
-        v.append(((1 - at) * v[a] + at * v[b]) * (1 - eps) + eps * v[c])
-        f[t] = [a, b, x]  # the cap
-        f = np.vstack([f, [[b, c, x], [c, a, x]]])
-    made = 0
-    while made < needles:
-        t = next(picks)
-        a, b, c = f[t]
-        # the face across edge (a, b) runs (b, a, d)
-        other = np.flatnonzero(((f == b) & (np.roll(f, -1, axis=1) == a)).any(axis=1))
-        if len(other) != 1 or len(set(f[t]) & set(f[other[0]])) != 2:
-            continue
-        o = other[0]
-        d = next(int(x) for x in f[o] if x not in (a, b))
-        x = len(v)
-        v.append(v[a] * (1 - eps) + eps * v[b])
-        f[t] = [a, x, c]
-        f[o] = [b, x, d]
-        f = np.vstack([f, [[x, b, c], [x, a, d]]])
-        made += 1
-    return np.array(v), f
+from modalviewer.core.primitives import add_slivers, grid_plate, icosphere
 
 
 def boundary_length(mesh):
