@@ -14,9 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .core.operators import DISTANCE_KINDS, OPERATOR_NAMES, operator_for_distance
+
 COMMANDS = ("compute", "render", "distance", "figures")
-OPERATORS = ("laplacian", "modified_dirichlet", "shells", "shells_normal")
-KINDS = {"vibration": "shells", "feature": "modified_dirichlet", "hks": "laplacian"}
+OPERATORS = OPERATOR_NAMES
+KINDS = {kind: operator_for_distance(kind) for kind in DISTANCE_KINDS}
 
 
 class _Parser(argparse.ArgumentParser):

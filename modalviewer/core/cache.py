@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .mesh import Mesh
+from .operators import operator_info
 from .spectrum import Spectrum, load_spectrum, save_spectrum
 
 __all__ = ["CacheEntry", "SpectrumCache", "default_cache_dir", "default_cache_limit"]
@@ -95,7 +96,7 @@ class SpectrumCache:
     # ---------------------------------------------------------------- keys
     def key(self, mesh: Mesh, operator: str, k: int, bending: float, membrane: float) -> str:
         params = {"op": operator, "k": int(k)}
-        if operator in ("shells", "shells_normal"):
+        if operator_info(operator).has_weights:
             params.update(bending=float(bending), membrane=float(membrane))
         blob = mesh.hash + json.dumps(params, sort_keys=True)
         return hashlib.sha256(blob.encode()).hexdigest()[:32]

@@ -19,6 +19,7 @@ from .eigen import (
 from .laplacian import lumped_masses, stiffness_matrix
 from .mesh import Mesh
 from .nullspace import null_space
+from .operators import operator_info
 from .shells import normal_shells_hessian, shells_hessian
 from .spectrum import OPERATORS, Spectrum
 
@@ -107,8 +108,7 @@ def compute_spectrum(
     come first, as eigenvalue 0, counted in k; ``spec.null_space_dimension`` says how
     many, ``spec.parameters["null_space"]`` says it in words.
     """
-    if operator not in OPERATORS:
-        raise ValueError(f"unknown operator {operator!r}; choose one of {', '.join(OPERATORS)}")
+    operator_info(operator)  # a ValueError naming the known operators
     k = int(k)
     if k < 1:
         raise ValueError(f"k must be at least 1, got {k}")
@@ -158,7 +158,8 @@ def compute_spectrum(
         )
     n = mesh.n_vertices
     modes = result.vectors
-    if operator == "shells":
+    per_vertex = operator_info(operator).unknowns_per_vertex
+    if per_vertex == 3:
         modes = modes.reshape(n, 3, k)
     if progress is not None:
         progress("done", 1.0)
@@ -166,7 +167,7 @@ def compute_spectrum(
         eigenvalues=result.eigenvalues,
         modes=modes,
         operator=operator,
-        mass=mass[:n] if operator != "shells" else mass[::3],
+        mass=mass[::per_vertex],
         residuals=result.residuals,
         mesh_hash=mesh.hash,
         parameters={

@@ -10,10 +10,11 @@ import numpy as np
 
 from .eigen import zero_modes
 from .files import atomic_write
+from .operators import OPERATOR_NAMES, operator_info
 
 __all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
 
-OPERATORS = ("laplacian", "modified_dirichlet", "shells", "shells_normal")
+OPERATORS = OPERATOR_NAMES
 FORMAT_VERSION = 1
 
 
@@ -157,7 +158,8 @@ def load_spectrum(path, mesh_hash: str | None = None) -> Spectrum:
         raise SpectrumFileError(f"{path} is not a modalviewer spectrum file")
     k = spec.eigenvalues.shape[0]
     n = spec.mass.shape[0]
-    expected = (n, 3, k) if spec.operator == "shells" else (n, k)
+    per_vertex = operator_info(spec.operator).unknowns_per_vertex
+    expected = (n, 3, k) if per_vertex == 3 else (n, k)
     if spec.modes.shape != expected or spec.residuals.shape != (k,):
         raise SpectrumFileError(f"{path} has inconsistent array shapes")
     if not (np.all(np.isfinite(spec.eigenvalues)) and np.all(np.isfinite(spec.modes))):

@@ -17,6 +17,8 @@ import traceback
 import weakref
 from pathlib import Path
 
+from ..core.operators import OPERATOR_NAMES
+
 log = logging.getLogger("modalviewer")
 
 
@@ -48,7 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--operator",
         default=None,
-        choices=["laplacian", "modified_dirichlet", "shells", "shells_normal"],
+        choices=list(OPERATOR_NAMES),
         help="spectrum to compute at start (headless default: modified_dirichlet)",
     )
     p.add_argument("--mode", type=int, default=None, help="mode to show")
