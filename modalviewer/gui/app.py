@@ -56,6 +56,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--mode", type=int, default=None, help="mode to show")
     p.add_argument("-k", type=int, default=None, help="number of modes")
     p.add_argument("--screenshot", default=None, help="render to this PNG and exit")
+    p.add_argument(
+        "--session",
+        default=None,
+        help="restore a session file (File > Save Session) instead of opening a mesh",
+    )
     return p
 
 
@@ -90,6 +95,24 @@ def main(argv: list[str] | None = None) -> int:
         window.resize(1500, 900)
     window.show()
     app.processEvents()
+    if args.session:
+        notes = window.open_session(args.session, wait=headless)
+        if window.state.mesh is None:
+            print(f"error: {window.last_error}", file=sys.stderr)
+            if headless:
+                return 1
+        if not headless:
+            return app.exec()
+        for note in notes:
+            print(f"note: {note}")
+        out = Path(args.screenshot) if args.screenshot else SCREENSHOTS / "headless_run.png"
+        app.processEvents()
+        window.export_screenshot(out)
+        print(f"session {args.session}: screenshot {out}")
+        window.close()
+        window = None
+        gc.collect()
+        return 0
     path = Path(args.mesh) if args.mesh else DEFAULT_MESH
     opened = window.open_mesh(path)
     if not headless:

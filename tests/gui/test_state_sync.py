@@ -160,3 +160,35 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     assert second.status_line.text() == second.state.summary()
     assert "feature distance" in second.status_line.text()
     second.close()
+
+
+def test_the_app_restores_a_session_from_the_command_line(tmp_path, spot_path):
+    import os
+    import subprocess
+    import sys
+
+    from PIL import Image
+
+    from modalviewer.core.cache import SpectrumCache
+    from modalviewer.viewer import ViewerModel
+    from modalviewer.viewer.session import save_session
+
+    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    model.open_mesh(spot_path)
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    model.state.show_mode(5)
+    session = save_session(model.state, tmp_path / "s.json")
+    out = tmp_path / "shot.png"
+    env = dict(os.environ, MODALVIEWER_CACHE=str(tmp_path / "cache"), QT_QPA_PLATFORM="offscreen")
+    run = subprocess.run(
+        [sys.executable, "-m", "modalviewer", "--session", str(session), "--screenshot", str(out)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    img = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    assert ((b > r + 60) & (b > g + 20)).sum() > 1000  # mode 5 in blue and orange
+    assert ((r > b + 80) & (g > b + 20)).sum() > 1000
