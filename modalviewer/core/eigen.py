@@ -65,7 +65,7 @@ DEFLATED_SHIFT_RTOL = 1e-10
 solve is projected, so their amplification does no harm).  The shift must stay small
 against the first non-zero eigenvalue, which it compresses the spectrum towards: the
 median diagonal ratio grows like 1/h^4 for bending energies, and at 130k vertices
-(bumpy plate, shells) 1e-6 of it is 17 times the first non-zero eigenvalue."""
+(bumpy plate, shells) 1e-6 of it is 77 times the first non-zero eigenvalue, 1e-10 0.8 %."""
 
 ProgressFn = Callable[[str, float], None]
 CancelFn = Callable[[], bool]
