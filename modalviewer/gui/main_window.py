@@ -25,7 +25,13 @@ from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distanc
 from ..core.spectrum import Spectrum, save_spectrum
 from ..io import SUPPORTED_EXTENSIONS
 from ..viewer.jobs import DONE, Job
-from ..viewer.model import ComputeRefused, ViewerModel, cost_estimate, worst_residual
+from ..viewer.model import (
+    REPAIRS,
+    ComputeRefused,
+    ViewerModel,
+    cost_estimate,
+    worst_residual,
+)
 from .compare import CompareWindow
 from .dialogs import ScreenshotDialog, ask
 from .export import save_field_mesh, save_screenshot
@@ -176,7 +182,15 @@ class MainWindow(QtWidgets.QMainWindow):
         self._action(m, "Export per-vertex &field (PLY/VTP)...", self._field_dialog, "Ctrl+Shift+E")
         self._action(m, "Export s&pectrum (.npz)...", self._spectrum_dialog, "Ctrl+Shift+S")
         m.addSeparator()
+        self.clear_cache_action = self._action(
+            m, "Clear spectrum &cache...", self._clear_cache_dialog
+        )
+        m.aboutToShow.connect(self._update_cache_label)
+        m.addSeparator()
         self._action(m, "&Quit", self.close, "Ctrl+Q")
+        m = bar.addMenu("&Mesh")
+        for name, label in REPAIRS.items():
+            self._action(m, label + "...", lambda _=False, n=name: self.repair_mesh(n, wait=False))
         m = bar.addMenu("&Compute")
         self._action(m, "&Compute spectrum", lambda: self.compute(wait=False), "Ctrl+R")
         self._action(m, "C&ancel running computation", self.cancel_computation, "Esc")
@@ -774,6 +788,51 @@ class MainWindow(QtWidgets.QMainWindow):
                 save_spectrum(spec, path)
             except OSError as exc:
                 self.show_error(f"Could not save the spectrum: {exc}")
+
+    # ============================================================ repairs
+    def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
+        """Apply repair ``name`` ("fix_slivers", "largest_component") to the loaded mesh in
+        the background; the repaired mesh replaces it and its report is shown."""
+        try:
+            job = self.model.repair(name)
+        except ValueError as exc:
+            self.show_error(str(exc))
+            return None
+        job.then(self._on_repaired)
+        if not wait:
+            return None
+        self.wait_for(job)
+        if job.status != DONE:
+            raise ComputeError(job.error or job.status)
+        return job.result
+
+    def _on_repaired(self, job: Job) -> None:
+        if job.status == DONE:
+            self.statusBar().showMessage(str(job.result.report), 20000)
+        elif job.status == "failed":
+            self.show_error(f"{job.description} failed: {job.error}", "Repair failed")
+
+    # =============================================================== cache
+    def _update_cache_label(self) -> None:
+        size = self.cache.size_bytes()
+        self.clear_cache_action.setText(f"Clear spectrum &cache ({size / 2**20:.0f} MB)...")
+
+    def clear_cache(self) -> int:
+        """Delete every cached spectrum; returns the bytes freed."""
+        size = self.cache.clear()
+        self.statusBar().showMessage(f"Cache cleared: {size / 2**20:.0f} MB freed.", 8000)
+        return size
+
+    def _clear_cache_dialog(self) -> None:
+        size = self.cache.size_bytes()
+        limit = getattr(self.cache, "max_bytes", 0)
+        question = (
+            f"The spectrum cache in {self.cache.directory} holds {size / 2**20:.0f} MB "
+            f"(limit {limit / 2**20:.0f} MB; the least recently used spectra go first). "
+            "Delete all cached spectra? Spectra on screen stay."
+        )
+        if ask(self, "Clear cache", question):
+            self.clear_cache()
 
     # ============================================================ sessions
     def save_session(self, path) -> Path:

@@ -63,12 +63,34 @@ class ViewerModel:
         self.jobs.events.finished.connect(self._on_job_finished)
 
     # -------------------------------------------------------------- mesh
-    def set_mesh(self, mesh: Mesh, path=None) -> None:
+    def set_mesh(self, mesh: Mesh, path=None, repairs: list[str] | None = None) -> None:
         """Show ``mesh``: the previous mesh's jobs are cancelled and its spectra dropped."""
         old = self.state.mesh
         if old is not None:
             self.jobs.cancel_all(owner=old.hash, reason="superseded: another mesh was opened")
-        self.state.set_mesh(mesh, path)
+        self.state.set_mesh(mesh, path, repairs)
+
+    def repair(self, name: str) -> Job:
+        """A job applying repair ``name`` (see ``REPAIRS``) to the loaded mesh; when it
+        ends the repaired mesh replaces it (its report says what changed)."""
+        state = self.state
+        if state.mesh is None:
+            raise ComputeRefused("Open a mesh first.")
+        if name not in REPAIRS:
+            raise ValueError(f"unknown repair {name!r}; choose one of {', '.join(REPAIRS)}")
+        mesh, path, done = state.mesh, state.mesh_path, list(state.mesh_repairs)
+        job = self.jobs.submit(
+            lambda progress, cancel: apply_repair(name, mesh, progress),
+            ("repair", mesh.hash, name),
+            REPAIRS[name],
+            mesh.hash,
+        )
+
+        def replace_mesh(j: Job) -> None:
+            if j.status == DONE and self.state.mesh is mesh:
+                self.set_mesh(j.result, path, [*done, name])
+
+        return job.then(replace_mesh)
 
     def open_mesh(self, path) -> Mesh:
         """Load and show a mesh file; raises MeshError or OSError with a user message."""
@@ -176,6 +198,26 @@ class ViewerModel:
         if self.state.spectrum(operator) is not None:
             return None
         return self.request_spectrum(operator)
+
+
+REPAIRS = {
+    "fix_slivers": "Fix slivers (edge flips and collapses)",
+    "largest_component": "Keep the largest component",
+}
+"""Repairs the viewer offers on a loaded mesh, with their names in words."""
+
+
+def apply_repair(name: str, mesh: Mesh, progress=None) -> Mesh:
+    """Repair ``name`` applied to ``mesh`` (a new Mesh whose report says what changed)."""
+    if name == "fix_slivers":
+        from ..repair import fix_slivers
+
+        return fix_slivers(mesh, progress=progress)
+    if name == "largest_component":
+        from ..core.components import largest_component
+
+        return largest_component(mesh)
+    raise ValueError(f"unknown repair {name!r}")
 
 
 def _blank(display):

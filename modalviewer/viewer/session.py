@@ -55,6 +55,7 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
             "relative_path": relative,
             "hash": state.mesh.hash,
             "vertices": state.mesh.n_vertices,
+            "repairs": list(state.mesh_repairs),
         },
         "spectra": [asdict(key) for key in state.spectra],
         "compute_settings": asdict(state.compute_settings),
@@ -141,6 +142,14 @@ def restore_session(model, path) -> Restored:
         )
     mesh = model.open_mesh(mesh_path)
     state = model.state
+    repairs = [str(r) for r in mesh_info.get("repairs") or []]
+    if repairs:
+        # re-applied here, in order (a sliver repair of a big scan takes seconds)
+        from .model import apply_repair
+
+        for name in repairs:
+            mesh = apply_repair(name, mesh)
+        model.set_mesh(mesh, mesh_path, repairs)
     if mesh.hash != mesh_info.get("hash"):
         out.notes.append(
             f"{mesh_path.name} changed on disk since the session was saved: spectra are "

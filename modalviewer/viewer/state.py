@@ -182,6 +182,7 @@ class ViewerState:
         self.events = ViewerEvents()
         self.mesh: Mesh | None = None
         self.mesh_path: Path | None = None
+        self.mesh_repairs: list[str] = []  # repairs applied after loading, in order
         self.compute_settings = ComputeSettings()
         self.spectra: dict[SpectrumKey, Spectrum] = {}
         self._latest: dict[str, SpectrumKey] = {}
@@ -194,9 +195,13 @@ class ViewerState:
         self._derived = _Derived()
 
     # ------------------------------------------------------------- mesh
-    def set_mesh(self, mesh: Mesh | None, path: Path | str | None = None) -> None:
-        """Load ``mesh``: spectra, pick and display of the previous mesh are dropped."""
+    def set_mesh(
+        self, mesh: Mesh | None, path: Path | str | None = None, repairs: list[str] | None = None
+    ) -> None:
+        """Load ``mesh`` (read from ``path``, then given ``repairs``): spectra, pick and
+        display of the previous mesh are dropped."""
         self.mesh = mesh
+        self.mesh_repairs = list(repairs or [])
         self.mesh_path = Path(path) if path is not None else None
         self.spectra.clear()
         self._latest.clear()

@@ -192,3 +192,12 @@ def test_the_app_restores_a_session_from_the_command_line(tmp_path, spot_path):
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
     assert ((b > r + 60) & (b > g + 20)).sum() > 1000  # mode 5 in blue and orange
     assert ((r > b + 80) & (g > b + 20)).sum() > 1000
+
+
+def test_clear_cache_from_the_window(window, spot_path):
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=10, wait=True)
+    assert window.cache.size_bytes() > 0
+    freed = window.clear_cache()
+    assert freed > 0 and window.cache.size_bytes() == 0
+    assert window.spectra["laplacian"].k == 10  # the spectrum on screen stays

@@ -1,0 +1,65 @@
+"""Mesh repairs offered by the viewer, through the model (no Qt)."""
+
+import numpy as np
+
+from modalviewer.core.cache import SpectrumCache
+from modalviewer.core.mesh import Mesh
+from modalviewer.core.primitives import add_slivers, icosphere
+from modalviewer.viewer import ViewerModel
+from modalviewer.viewer.jobs import DONE
+from modalviewer.viewer.session import restore_session, save_session
+
+
+def _two_spheres(tmp_path):
+    import trimesh
+
+    big, small = icosphere(2), icosphere(1)
+    v = np.vstack([big.vertices, 0.3 * small.vertices + [3.0, 0.0, 0.0]])
+    f = np.vstack([big.faces, small.faces + big.n_vertices])
+    path = tmp_path / "two.ply"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    return path
+
+
+def test_keep_the_largest_component_replaces_the_mesh_and_survives_a_session(tmp_path):
+    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    model.open_mesh(_two_spheres(tmp_path))
+    assert model.state.mesh.n_components == 2
+    job = model.repair("largest_component")
+    model.jobs.wait(job)
+    assert job.status == DONE
+    mesh = model.state.mesh
+    assert mesh.n_components == 1 and mesh.n_vertices == icosphere(2).n_vertices
+    assert model.state.mesh_repairs == ["largest_component"]
+    assert "removed" in str(mesh.report)
+    model.jobs.wait(model.request_spectrum("laplacian", k=8, show=True))
+    session = save_session(model.state, tmp_path / "s.json")
+    other = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    restored = restore_session(other, session)
+    for j in restored.jobs:
+        other.jobs.wait(j)
+    assert restored.notes == []
+    assert other.state.mesh.hash == mesh.hash and other.state.display.kind == "mode"
+
+
+def test_fix_slivers_from_the_viewer_improves_the_worst_triangle(tmp_path):
+    import trimesh
+
+    v, f = add_slivers(icosphere(3), needles=10, caps=10, eps=1e-4, seed=1)
+    path = tmp_path / "slivers.ply"
+    trimesh.Trimesh(v, f, process=False).export(path)
+    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    model.open_mesh(path)
+    before = model.state.mesh
+
+    def worst_quality(mesh: Mesh) -> float:
+        e = mesh.vertices[mesh.faces[:, [1, 2, 0]]] - mesh.vertices[mesh.faces]
+        return float(np.min(4 * np.sqrt(3) * mesh.face_areas / (e**2).sum(axis=(1, 2))))
+
+    job = model.repair("fix_slivers")
+    model.jobs.wait(job, timeout=120)
+    assert job.status == DONE, job.error
+    after = model.state.mesh
+    assert after is not before and model.state.mesh_repairs == ["fix_slivers"]
+    assert worst_quality(before) < 0.01 < worst_quality(after)
+    assert after.is_closed and after.n_components == 1
