@@ -87,4 +87,12 @@ class ComputePanel(QtWidgets.QWidget):
         self.membrane_spin.setEnabled(weights)
         mesh = self.state.mesh
         self.compute_button.setEnabled(mesh is not None)
-        self.mesh_info.setText(str(mesh.report) if mesh is not None else "No mesh")
+        text = str(mesh.report) if mesh is not None else "No mesh"
+        if mesh is not None and mesh.n_components > 1:
+            c = mesh.n_components
+            text += (
+                f"\n{c} connected components: every spectrum starts with zero modes per "
+                f"component ({c} for the Laplacian, {6 * c} rigid motions for the shells). "
+                "Mesh > Keep the largest component, or compute more modes."
+            )
+        self.mesh_info.setText(text)
