@@ -1,0 +1,486 @@
+"""Two meshes side by side: a pick on one, the distance between shapes on the other (no Qt).
+
+:class:`PairState` holds mesh A and mesh B, the distance kind (vibration, feature or
+heat kernel), how the distance is shown (continuous, or a threshold given as a share of
+the other mesh's surface area), whether both meshes are rescaled to unit area before
+their spectra are computed, and the picked vertex (on A or on B).  It asks a
+:class:`~.jobs.JobQueue` (the main window's, so one computation runs at a time and its
+progress shows there) for the spectra both meshes need, reads them from the disk cache
+when they are there, and reuses a spectrum of A the main window's state already holds.
+The window draws :meth:`PairState.view` of each side and observes ``events``:
+
+- ``meshes()``: mesh A or B was replaced (its spectra and the pick were dropped).
+- ``spectra()``: a spectrum of either side arrived.
+- ``display()``: what either side shows changed (kind, display, share, pick, scale).
+- ``message(str)``: something the user should read (a failed computation, a warning).
+
+Distances are :class:`~modalviewer.core.cross.CrossTables` queries: eq. (31) with both
+signatures at the common scales, each normalised by its own Z(t).  Rescaling matters:
+Laplacian and E_D^N signatures carry a factor 1/area, and the Discrete Shells spectrum
+is not scale covariant at all (a larger copy vibrates differently, not just slower), so
+two meshes of different size are only comparable after both are brought to one area.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from psygnal import Signal, SignalGroup
+
+from ..core.cache import SpectrumCache
+from ..core.cross import CrossTables, ScaleWarning
+from ..core.laplacian import lumped_masses
+from ..core.mesh import Mesh
+from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
+from ..core.spectrum import Spectrum
+from .jobs import DONE, Job, JobQueue
+from .state import DISTANCE_DISPLAYS, SpectrumKey, ViewerState, default_k
+
+SIDES = ("a", "b")
+
+
+def other(side: str) -> str:
+    _check_side(side)
+    return "b" if side == "a" else "a"
+
+
+def _check_side(side: str) -> None:
+    if side not in SIDES:
+        raise ValueError(f"side must be 'a' or 'b', got {side!r}")
+
+
+@dataclass
+class PairView:
+    """What one side of the pair draws.
+
+    values : (n,) distances on this side from the pick on the other side, or None (the
+        plain surface: nothing picked yet, the spectra are not in, or this side is the
+        picked one).
+    colormap : "sequential" (white 0 to red), "threshold" (blue below ``threshold``) or
+        "plain".
+    marker : the picked vertex (picked side) or the best match (other side).
+    back_marker : on the picked side, the best match back from the best match when it is
+        not the picked vertex (the match is not mutual); else None.
+    legend : the lines drawn at the top left of the view and in exports.
+    colorbar_title, colorbar_labels : the colour bar (labels for a threshold's swatches).
+    """
+
+    values: np.ndarray | None
+    colormap: str
+    threshold: float | None
+    marker: int | None
+    back_marker: int | None
+    legend: str
+    colorbar_title: str | None = None
+    colorbar_labels: list[str] | None = None
+
+
+class PairEvents(SignalGroup):
+    meshes = Signal()
+    spectra = Signal()
+    display = Signal()
+    message = Signal(str)
+
+
+class _Side:
+    def __init__(self, mesh: Mesh, path) -> None:
+        self.mesh = mesh
+        self.path = Path(path) if path is not None else None
+        self.masses = lumped_masses(mesh)
+        self.unit_mesh: Mesh | None = None
+
+    @property
+    def name(self) -> str:
+        return self.path.name if self.path is not None else "mesh"
+
+    def compute_mesh(self, rescale: bool) -> Mesh:
+        if not rescale:
+            return self.mesh
+        if self.unit_mesh is None:
+            # the same arithmetic as ViewerState.compute_mesh (rescale_to_area's rounds
+            # differently in the last bit), so the main window's unit-area spectra and
+            # this pair's share their disk cache entries
+            m = self.mesh
+            self.unit_mesh = Mesh(m.vertices * (1.0 / np.sqrt(m.total_area)), m.faces, m.report)
+        return self.unit_mesh
+
+
+class PairState:
+    """Mesh A and mesh B, their spectra, the pick and the display; see the module docstring.
+
+    ``jobs`` and ``cache``: the queue and disk cache the spectra go through.
+    ``state_a``: a viewer state whose spectra of mesh A may be reused (the main window's).
+    ``k``: modes per spectrum (the same on both meshes), by default 100 or fewer for tiny
+    meshes.  ``weights``: the Discrete Shells (bending, membrane) weights.
+    """
+
+    def __init__(
+        self,
+        jobs: JobQueue,
+        cache: SpectrumCache,
+        mesh_a: Mesh,
+        mesh_b: Mesh,
+        path_a=None,
+        path_b=None,
+        state_a: ViewerState | None = None,
+        k: int | None = None,
+        weights: tuple[float, float] = (1.0, 1.0),
+        kind: str = "hks",
+        rescale: bool = True,
+    ) -> None:
+        self.events = PairEvents()
+        self.jobs = jobs
+        self.cache = cache
+        self.state_a = state_a
+        self.sides = {"a": _Side(mesh_a, path_a), "b": _Side(mesh_b, path_b)}
+        if kind not in DISTANCE_KINDS:
+            raise ValueError(f"distance kind must be one of {tuple(DISTANCE_KINDS)}")
+        self.kind = kind
+        self.k = int(k) if k is not None else self._default_k()
+        if self.k < 1:
+            raise ValueError("the number of modes must be at least 1")
+        self.weights = (float(weights[0]), float(weights[1]))
+        self.rescale = bool(rescale)
+        self.distance_display = "continuous"
+        self.share = 0.05  # of the other mesh's surface area, for the threshold display
+        self.picked: tuple[str, int] | None = None
+        self.note = ""  # a warning about the current pair (scale), shown in legends
+        self._spectra: dict[tuple[str, str, SpectrumKey], Spectrum] = {}
+        self._pending: dict[tuple[str, str, SpectrumKey], Job] = {}
+        self._failed: dict[tuple[str, str, SpectrumKey], str] = {}
+        self._tables: tuple | None = None  # (ids of both spectra, CrossTables or error)
+        self._distance: tuple | None = None  # (tables id, pick, distances)
+
+    # ----------------------------------------------------------- meshes
+    def mesh(self, side: str) -> Mesh:
+        _check_side(side)
+        return self.sides[side].mesh
+
+    def name(self, side: str) -> str:
+        _check_side(side)
+        return self.sides[side].name
+
+    def set_mesh(self, side: str, mesh: Mesh, path=None) -> None:
+        """Replace mesh ``side``: its pending jobs are cancelled and the pick dropped."""
+        _check_side(side)
+        self.jobs.cancel_all(owner=self.owner(side), reason="superseded: another mesh")
+        self.sides[side] = _Side(mesh, path)
+        self.picked = None
+        self._tables = self._distance = None
+        self.events.meshes.emit()
+        self.events.display.emit()
+
+    def _default_k(self) -> int:
+        return min(default_k(self.sides[s].mesh.n_vertices) for s in SIDES)
+
+    def owner(self, side: str) -> tuple:
+        """The owner of this pair's jobs for ``side`` (cancelling them leaves others')."""
+        return ("pair", id(self), side, self.sides[side].mesh.hash)
+
+    # ---------------------------------------------------------- settings
+    @property
+    def operator(self) -> str:
+        return operator_for_distance(self.kind)
+
+    def key(self) -> SpectrumKey:
+        """The spectrum both meshes need for the current kind, k, weights and scaling."""
+        weights = operator_info(self.operator).has_weights
+        bending, membrane = self.weights if weights else (1.0, 1.0)
+        return SpectrumKey(self.operator, self.k, bending, membrane, rescale=self.rescale)
+
+    def set_kind(self, kind: str) -> None:
+        if kind not in DISTANCE_KINDS:
+            raise ValueError(f"distance kind must be one of {', '.join(DISTANCE_KINDS)}")
+        if kind != self.kind:
+            self.kind = kind
+            self.events.display.emit()
+
+    def set_k(self, k: int) -> None:
+        k = int(k)
+        if k < 1:
+            raise ValueError("the number of modes must be at least 1")
+        if k != self.k:
+            self.k = k
+            self.events.display.emit()
+
+    def set_rescale(self, on: bool) -> None:
+        if bool(on) != self.rescale:
+            self.rescale = bool(on)
+            self.events.display.emit()
+
+    def set_display(self, display: str, share: float | None = None) -> None:
+        """``display``: "continuous" or "threshold"; ``share``: the part (0..1) of the
+        other mesh's surface area the threshold marks blue."""
+        if display not in DISTANCE_DISPLAYS:
+            raise ValueError(f"display must be one of {DISTANCE_DISPLAYS}")
+        changed = display != self.distance_display
+        self.distance_display = display
+        if share is not None:
+            share = float(share)
+            if not np.isfinite(share):
+                raise ValueError("the share must be a number between 0 and 1")
+            share = float(np.clip(share, 0.0, 1.0))
+            changed |= share != self.share
+            self.share = share
+        if changed:
+            self.events.display.emit()
+
+    def pick(self, side: str, vertex: int | None) -> None:
+        """Pick ``vertex`` of mesh ``side`` (None clears the pick)."""
+        _check_side(side)
+        if vertex is not None:
+            n = self.sides[side].mesh.n_vertices
+            if isinstance(vertex, bool) or not isinstance(vertex, int | np.integer):
+                raise ValueError(f"a vertex is an integer index, got {vertex!r}")
+            vertex = int(vertex)
+            if not 0 <= vertex < n:
+                raise ValueError(f"Vertex {vertex} does not exist on {side.upper()} (0..{n - 1}).")
+        new = None if vertex is None else (side, vertex)
+        if new != self.picked:
+            self.picked = new
+            self.events.display.emit()
+
+    # ----------------------------------------------------------- spectra
+    def spectrum(self, side: str, key: SpectrumKey | None = None) -> Spectrum | None:
+        """The spectrum of mesh ``side`` for ``key`` (default: the current one), if in."""
+        _check_side(side)
+        key = key or self.key()
+        mesh = self.sides[side].mesh
+        spec = self._spectra.get((side, mesh.hash, key))
+        if spec is None and side == "a" and self.state_a is not None:
+            if self.state_a.mesh is not None and self.state_a.mesh.hash == mesh.hash:
+                spec = self.state_a.spectra.get(key)
+        return spec
+
+    def ready(self) -> bool:
+        return all(self.spectrum(s) is not None for s in SIDES)
+
+    def pending(self) -> list[Job]:
+        """This pair's jobs that have not ended (queued or running)."""
+        return [job for job in self._pending.values() if not job.done]
+
+    def failure(self) -> str | None:
+        """Why a spectrum the current display needs could not be computed, if it failed."""
+        key = self.key()
+        for side in SIDES:
+            error = self._failed.get((side, self.sides[side].mesh.hash, key))
+            if error:
+                return f"{side.upper()}: {error}"
+        return None
+
+    def request(self) -> list[Job]:
+        """Jobs for the spectra the current kind needs that are not in yet (computed or
+        read from the disk cache in the background); the list of those still pending."""
+        key = self.key()
+        jobs = []
+        for side in SIDES:
+            s = self.sides[side]
+            slot = (side, s.mesh.hash, key)
+            if self.spectrum(side) is not None:
+                continue
+            job = self._pending.get(slot)
+            if job is None or job.done:
+                self._failed.pop(slot, None)
+                job = self.jobs.submit(
+                    self._work(side, key),
+                    (s.mesh.hash, key),
+                    f"{key.describe()} of {side.upper()} ({s.name})",
+                    self.owner(side),
+                )
+                self._pending[slot] = job
+                job.then(lambda j, slot=slot: self._on_job(slot, j))
+            jobs.append(job)
+        return [job for job in jobs if not job.done]
+
+    def cancel(self) -> None:
+        """Cancel this pair's jobs (queued and running)."""
+        for side in SIDES:
+            self.jobs.cancel_all(owner=self.owner(side), reason="cancelled")
+
+    def _work(self, side: str, key: SpectrumKey):
+        from .model import _compute
+
+        mesh = self.sides[side].compute_mesh(key.rescale)
+        cache = self.cache
+        args = (mesh, key.operator, key.k, key.bending, key.membrane)
+
+        def work(progress, cancel):
+            spec = cache.get(*args)
+            if spec is None:
+                spec = _compute(mesh, key, cache, progress, cancel)
+            return spec, None
+
+        return work
+
+    def _on_job(self, slot, job: Job) -> None:
+        self._pending.pop(slot, None)
+        side, mesh_hash, key = slot
+        if mesh_hash != self.sides[side].mesh.hash:
+            return
+        if job.status == DONE:
+            self._spectra[slot] = job.result[0]
+            self.events.spectra.emit()
+            if key == self.key():
+                self.events.display.emit()
+        elif job.error and not job.error.startswith("superseded"):
+            self._failed[slot] = job.error
+            if key == self.key():
+                self.events.message.emit(
+                    f"The {key.describe()} of {side.upper()} ({self.name(side)}) could not "
+                    f"be computed: {job.error}"
+                )
+                self.events.display.emit()
+
+    # --------------------------------------------------------- distances
+    def tables(self) -> CrossTables | None:
+        """Both signature tables at the common scales, or None if a spectrum is missing
+        or the pair cannot be compared (``note`` says why)."""
+        sa, sb = self.spectrum("a"), self.spectrum("b")
+        if sa is None or sb is None:
+            return None
+        ids = (id(sa), id(sb))
+        if self._tables is None or self._tables[0] != ids:
+            self.note = ""
+            try:
+                with warnings.catch_warnings(record=True) as caught:
+                    warnings.simplefilter("always", ScaleWarning)
+                    tables = CrossTables(sa, sb)
+                if any(issubclass(w.category, ScaleWarning) for w in caught):
+                    area_a, area_b = (float(s.mass.sum()) for s in (sa, sb))
+                    self.note = (
+                        f"areas differ ({area_a:.3g} and {area_b:.3g}): tick Rescale to "
+                        "compare shapes"
+                    )
+            except ValueError as exc:
+                tables = str(exc)
+                self.note = str(exc)
+            self._tables = (ids, tables)
+        tables = self._tables[1]
+        return tables if isinstance(tables, CrossTables) else None
+
+    def distance_on(self, side: str) -> np.ndarray | None:
+        """(n,) distance from the picked vertex (on the other side) to every vertex of
+        ``side``; None if nothing is picked there, or the spectra are not in."""
+        _check_side(side)
+        if self.picked is None or self.picked[0] == side:
+            return None
+        tables = self.tables()
+        if tables is None:
+            return None
+        key = (id(tables), self.picked)
+        if self._distance is None or self._distance[0] != key:
+            from_side, v = self.picked
+            d = tables.a_to_b(v) if from_side == "a" else tables.b_to_a(v)
+            self._distance = (key, d)
+        return self._distance[1]
+
+    def best_match(self) -> tuple[str, int, float] | None:
+        """(side, vertex, distance): the vertex of the other mesh closest to the pick."""
+        if self.picked is None:
+            return None
+        side = other(self.picked[0])
+        d = self.distance_on(side)
+        if d is None:
+            return None
+        w = int(np.argmin(d))
+        return side, w, float(d[w])
+
+    def back_match(self) -> int | None:
+        """The vertex of the picked mesh closest to the best match (the pick itself when
+        the match is mutual)."""
+        match = self.best_match()
+        tables = self.tables()
+        if match is None or tables is None:
+            return None
+        side, w, _ = match
+        d = tables.a_to_b(w) if side == "a" else tables.b_to_a(w)
+        return int(np.argmin(d))
+
+    def mutual_best_matches(self, vertices_a, vertices_b=None):
+        """:meth:`CrossTables.mutual_best_matches` of picked vertices of A (None if the
+        spectra are not in)."""
+        tables = self.tables()
+        return None if tables is None else tables.mutual_best_matches(vertices_a, vertices_b)
+
+    def threshold(self, side: str, d: np.ndarray | None = None) -> tuple[float, float] | None:
+        """(distance, share of the area) of the threshold display on ``side``: the
+        smallest distance whose sub-level set ``d <= t`` covers ``share`` of the mesh's
+        area, and the part of the area that set really covers (>= share)."""
+        d = self.distance_on(side) if d is None else d
+        if d is None:
+            return None
+        masses = self.sides[side].masses
+        order = np.argsort(d, kind="stable")
+        covered = np.cumsum(masses[order]) / masses.sum()
+        i = int(np.clip(np.searchsorted(covered, self.share - 1e-12), 0, len(d) - 1))
+        value = float(d[order[i]])
+        return value, float(masses[d <= value].sum() / masses.sum())
+
+    # -------------------------------------------------------------- words
+    def _missing(self) -> str:
+        failure = self.failure()
+        if failure:
+            return f"failed: {failure}"
+        waiting = [s.upper() for s in SIDES if self.spectrum(s) is None]
+        if waiting:
+            label = operator_info(self.operator).label
+            return f"computing the {label} spectrum of {' and '.join(waiting)}"
+        return self.note or "the two meshes cannot be compared"
+
+    def view(self, side: str) -> PairView:
+        """What ``side`` shows: see :class:`PairView`."""
+        _check_side(side)
+        head = f"{side.upper()}: {self.name(side)}, {self.mesh(side).n_vertices} vertices"
+        name = DISTANCE_KINDS[self.kind]
+        plain = PairView(None, "plain", None, None, None, head)
+        if self.picked is None:
+            return PairView(None, "plain", None, None, None, f"{head}\nclick A or B to pick")
+        from_side, v = self.picked
+        if self.tables() is None:
+            marker = v if from_side == side else None
+            plain.marker = marker
+            plain.legend = f"{head}\n{name}: {self._missing()}"
+            return plain
+        _, w, dist = self.best_match()
+        note = f"\n{self.note}" if self.note else ""
+        if from_side == side:
+            back = self.back_match()
+            mutual = "mutual" if back == v else f"not mutual: its best match is vertex {back}"
+            return PairView(
+                None,
+                "plain",
+                None,
+                v,
+                None if back == v else back,
+                f"{head}\npicked vertex {v}; best match on {other(side).upper()}: vertex "
+                f"{w} ({mutual}){note}",
+            )
+        d = self.distance_on(side)
+        source = f"from vertex {v} of {from_side.upper()}"
+        if self.distance_display == "threshold":
+            thr, share = self.threshold(side, d)
+            similar = f"{name.lower()} < {thr:.3g} ({100 * share:.1f} %)"
+            return PairView(
+                d,
+                "threshold",
+                thr,
+                w,
+                None,
+                f"{head}\nblue: {name.lower()} < {thr:.3g}, {100 * share:.1f} % of "
+                f"{side.upper()}\n{source}; best match vertex {w}{note}",
+                f"{name} < {thr:.3g}",
+                [similar, "the rest"],
+            )
+        return PairView(
+            d,
+            "sequential",
+            None,
+            w,
+            None,
+            f"{head}\n{name} {source}: white 0 to red {float(d.max()):.3g}\n"
+            f"best match: vertex {w} (d = {dist:.3g}){note}",
+            name,
+        )

@@ -1,0 +1,173 @@
+"""The shape pair's state (viewer/pair.py): a pick on one mesh, distances on the other,
+spectra through the job queue; no Qt, no VTK."""
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import modalviewer as mv
+from modalviewer.core.cache import SpectrumCache
+from modalviewer.core.laplacian import lumped_masses
+from modalviewer.viewer import ViewerModel
+from modalviewer.viewer.jobs import JobQueue, ManualDispatcher
+from modalviewer.viewer.pair import PairState
+
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+K = 20
+
+
+def _moved(mesh, scale=1.0, seed=3):
+    q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    if np.linalg.det(q) < 0:
+        q[:, 0] *= -1
+    return mv.Mesh(scale * mesh.vertices @ q.T + [0.5, -1.0, 2.0], mesh.faces)
+
+
+@pytest.fixture(scope="module")
+def spot():
+    return mv.load_mesh(ASSETS / "spot.obj")
+
+
+def _pair(tmp_path, a, b, **kw):
+    jobs = JobQueue(ManualDispatcher())
+    pair = PairState(jobs, SpectrumCache(tmp_path / "cache"), a, b, "spot.obj", "moved.obj", **kw)
+    return pair
+
+
+def _wait(pair):
+    for job in pair.request():
+        pair.jobs.wait(job, timeout=120)
+    assert pair.ready(), pair.failure()
+
+
+def test_rigid_motion_pick_on_a_matches_the_same_vertex_on_b(tmp_path, spot):
+    pair = _pair(tmp_path, spot, _moved(spot), k=K)
+    displays = []
+    pair.events.display.connect(lambda: displays.append(1))
+    assert pair.view("b").values is None and "click A or B" in pair.view("b").legend
+    _wait(pair)
+    assert displays  # the window redraws when the spectra arrive
+    for v in (0, 700, 2900):
+        pair.pick("a", v)
+        d = pair.distance_on("b")
+        assert d.shape == (spot.n_vertices,) and pair.distance_on("a") is None
+        # the distance to the moved copy of the picked vertex is zero (round-off)
+        assert d[v] <= 1e-8 * d.max()
+        assert pair.best_match()[:2] == ("b", v) and pair.back_match() == v
+        view = pair.view("b")
+        assert view.colormap == "sequential" and view.marker == v
+        assert f"best match: vertex {v} " in view.legend
+        assert "(mutual)" in pair.view("a").legend and pair.view("a").back_marker is None
+    # the same numbers as the library's function
+    np.testing.assert_allclose(
+        pair.distance_on("b"),
+        mv.cross_distance(pair.spectrum("a"), 2900, pair.spectrum("b")),
+        rtol=0,
+        atol=1e-12 * pair.distance_on("b").max(),
+    )
+
+
+def test_a_pick_on_b_works_the_other_way(tmp_path, spot):
+    pair = _pair(tmp_path, spot, _moved(spot), k=K)
+    _wait(pair)
+    pair.pick("b", 1234)
+    d = pair.distance_on("a")
+    expected = mv.cross_distance(pair.spectrum("b"), 1234, pair.spectrum("a"))
+    np.testing.assert_allclose(d, expected, rtol=0, atol=1e-12 * expected.max())
+    assert pair.best_match()[:2] == ("a", 1234)
+    assert pair.view("a").marker == 1234 and pair.view("b").marker == 1234
+
+
+def test_threshold_marks_the_asked_share_of_b_by_area(tmp_path, spot):
+    pair = _pair(tmp_path, spot, _moved(spot), k=K)
+    _wait(pair)
+    pair.pick("a", 700)
+    pair.set_display("threshold", share=0.084)
+    view = pair.view("b")
+    d = pair.distance_on("b")
+    masses = lumped_masses(pair.mesh("b"))
+    share_at = masses[d <= view.threshold].sum() / masses.sum()
+    below = masses[d < view.threshold].sum() / masses.sum()
+    # the smallest level whose sub-level set covers 8.4 % of the area
+    assert below < 0.084 <= share_at < 0.084 + 0.01
+    m = re.search(r"blue: heat kernel distance < ([0-9.e-]+), ([0-9.]+) % of B", view.legend)
+    assert m, view.legend
+    assert float(m.group(1)) == pytest.approx(view.threshold, rel=1e-2)
+    assert float(m.group(2)) == pytest.approx(100 * share_at, abs=0.05)
+    assert view.colormap == "threshold" and view.colorbar_labels[1] == "the rest"
+    pair.set_display("threshold", share=0.0)  # only the best match itself
+    assert pair.view("b").threshold == pytest.approx(d.min())
+    with pytest.raises(ValueError, match="display must be"):
+        pair.set_display("blue")
+
+
+def test_rescale_makes_a_larger_copy_comparable(tmp_path, spot):
+    big = _moved(spot, scale=1.7)
+    pair = _pair(tmp_path, spot, big, k=K, rescale=False)
+    _wait(pair)
+    pair.pick("a", 700)
+    d = pair.distance_on("b")
+    assert "areas differ" in pair.note and "areas differ" in pair.view("b").legend
+    assert d[700] > 0.3 * d.max()  # unscaled: the copy is far everywhere
+    pair.set_rescale(True)
+    assert pair.distance_on("b") is None  # unit-area spectra are not in yet
+    _wait(pair)
+    d = pair.distance_on("b")
+    assert pair.note == "" and d[700] <= 1e-6 * d.max() and pair.best_match()[1] == 700
+    assert pair.spectrum("a").mass.sum() == pytest.approx(1.0, rel=1e-9)
+
+
+def test_spectra_of_a_come_from_the_main_state_and_the_disk_cache(tmp_path, spot, monkeypatch):
+    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    model.set_mesh(spot, ASSETS / "spot.obj")
+    model.state.set_compute_settings(rescale=True)
+    model.jobs.wait(model.request_spectrum("laplacian", K), timeout=120)
+    pair = PairState(
+        model.jobs, model.cache, spot, _moved(spot), state_a=model.state, k=K, rescale=True
+    )
+    jobs = pair.request()
+    assert [j.owner[2] for j in jobs] == ["b"]  # A's spectrum is the main window's
+    assert pair.spectrum("a") is model.state.spectrum("laplacian")
+    for job in jobs:
+        model.jobs.wait(job, timeout=120)
+
+    # a second pair on the same meshes reads both from the disk cache, computing nothing
+    def no_compute(*args):
+        raise AssertionError("computed instead of read from the cache")
+
+    monkeypatch.setattr("modalviewer.viewer.model._compute", no_compute)
+    again = PairState(model.jobs, model.cache, spot, _moved(spot), k=K)
+    jobs = again.request()
+    for job in jobs:
+        model.jobs.wait(job, timeout=120)
+    assert len(jobs) == 2 and again.ready(), again.failure()
+    np.testing.assert_array_equal(again.spectrum("b").eigenvalues, pair.spectrum("b").eigenvalues)
+
+
+def test_bad_input_gets_clear_errors(tmp_path, spot):
+    pair = _pair(tmp_path, spot, _moved(spot), k=K)
+    with pytest.raises(ValueError, match=r"Vertex 5000 does not exist on B \(0..2929\)"):
+        pair.pick("b", 5000)
+    with pytest.raises(ValueError, match="integer"):
+        pair.pick("a", 1.5)
+    with pytest.raises(ValueError, match="side must be"):
+        pair.pick("c", 1)
+    with pytest.raises(ValueError, match="distance kind"):
+        pair.set_kind("curvature")
+    with pytest.raises(ValueError, match="at least 1"):
+        pair.set_k(0)
+
+
+def test_replacing_a_mesh_cancels_its_jobs_and_drops_the_pick(tmp_path, spot):
+    pair = _pair(tmp_path, spot, _moved(spot), k=K, kind="vibration")
+    jobs = pair.request()
+    assert len(jobs) == 2
+    pair.pick("a", 3)
+    pair.set_mesh("b", _moved(spot, seed=9), "other.obj")
+    for job in jobs:
+        pair.jobs.wait(job, timeout=120)
+    assert jobs[1].status == "cancelled" and pair.picked is None
+    assert pair.name("b") == "other.obj" and pair.spectrum("b") is None
+    assert "computing the Discrete Shells" in pair.view("b").legend or pair.picked is None
