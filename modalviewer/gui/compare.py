@@ -119,7 +119,7 @@ class CompareWindow(QtWidgets.QWidget):
                 continue
             if display.distance_display == "threshold":
                 thr = display.threshold * float(d.max())
-                scene.show_field((d > thr).astype(float), "threshold", name=_label(item))
+                scene.show_threshold(d, thr, name=_label(item))
                 share = 100.0 * float(np.mean(d <= thr))
                 title.setText(
                     f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({share:.1f} %)"

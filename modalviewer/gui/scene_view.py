@@ -50,7 +50,9 @@ class SceneView(QtCore.QObject):
         self._drawn = None
         mesh = self.state.mesh
         if mesh is not None:
-            self.scene = MeshScene(self.plotter, mesh, self.state.normals)
+            self.scene = MeshScene(
+                self.plotter, mesh, self.state.normals, style=self.state.style.render
+            )
             self.reset_camera()
         self._update_colorbar()
         self.viewport.request_render()
@@ -62,7 +64,7 @@ class SceneView(QtCore.QObject):
         spec = state.spectrum(state.display_operator())
         return (
             replace(d, threshold=0.0),
-            (state.style.isolines, state.style.shell_coloring),
+            (state.style.isolines, state.style.shell_coloring, state.style.render),
             state.picked if d.kind == "distance" else None,
             id(spec),
             state.t_range,
@@ -75,6 +77,8 @@ class SceneView(QtCore.QObject):
         started = time.perf_counter()
         signature = self._signature()
         d = self.state.display
+        if self.scene.style != self.state.style.render:
+            self.scene.set_style(self.state.style.render)
         if (
             self._drawn == signature
             and d.kind == "distance"
@@ -83,9 +87,9 @@ class SceneView(QtCore.QObject):
             and self.field.colormap == "threshold"
             and self.state.distance_map() is not None
         ):
-            dist = self.state.distance_map()
-            thr = self.state.threshold_value(dist)
-            self.scene.surface.point_data["field"] = (dist > thr).astype(np.float64)
+            thr = self.state.threshold_value()
+            self.scene.set_threshold(thr)
+            self.field.threshold = thr
             self.field.legend = self.state.legend()
         else:
             self._draw_field()
@@ -101,6 +105,9 @@ class SceneView(QtCore.QObject):
         scene.set_displacement_scale(0.0)
         if field is None or field.colormap == "plain":
             scene.show_plain()
+            return
+        if field.colormap == "threshold":
+            scene.show_threshold(field.values, field.threshold, name=field.title)
             return
         scene.show_field(
             field.values,

@@ -66,6 +66,7 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
             "isolines": state.style.isolines,
             "shell_coloring": state.style.shell_coloring,
             "colorbar": state.style.colorbar,
+            "render": state.style.render,
         },
         "animation": {"amplitude": state.animation.amplitude, "speed": state.animation.speed},
         "camera": state.camera,
@@ -159,6 +160,7 @@ def restore_session(model, path) -> Restored:
     state.set_isolines(int(style.get("isolines", state.style.isolines)))
     state.set_shell_coloring(str(style.get("shell_coloring", state.style.shell_coloring)))
     state.set_colorbar(bool(style.get("colorbar", True)))
+    state.set_render_style(str(style.get("render", "paper")))
     anim = data.get("animation") or {}
     state.set_animation(**_known(type(state.animation), anim))
     settings = ComputeSettings(**_known(ComputeSettings, data.get("compute_settings")))

@@ -40,10 +40,12 @@ from ..core.operators import (
 )
 from ..core.signatures import SignatureTable, signature
 from ..core.spectrum import Spectrum
+from .mode_scalar import default_vector_coloring, smoothed_normals, vector_mode_scalar
 
 DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature")
 DISTANCE_DISPLAYS = ("continuous", "threshold")
-SHELL_COLORINGS = ("normal", "magnitude")
+SHELL_COLORINGS = ("auto", "normal", "magnitude")
+RENDER_STYLES = ("paper", "shaded")
 
 
 def default_k(n_vertices: int) -> int:
@@ -127,6 +129,7 @@ class Field:
 
     colormap : "diverging" (blue / white / orange), "sequential" (white to red),
     "threshold" (blue = similar) or "plain" (no field: the grey surface).
+    threshold : for "threshold": values (the distances) up to it are blue.
     """
 
     values: np.ndarray
@@ -137,6 +140,7 @@ class Field:
     title: str = ""
     legend: str = ""
     share_similar: float | None = None
+    threshold: float | None = None
 
 
 class ViewerEvents(SignalGroup):
@@ -154,7 +158,8 @@ class ViewerEvents(SignalGroup):
 @dataclass
 class _Style:
     isolines: int = 12
-    shell_coloring: str = "normal"
+    shell_coloring: str = "auto"  # auto: magnitude on meshes with sharp features
+    render: str = "paper"  # paper: white zero, saturated colours; shaded: light kit
     colorbar: bool = True  # legend and colour bar, on screen and in exports
 
 
@@ -170,6 +175,8 @@ class _Derived:
     """Values computed from the state and kept until it changes (not part of it)."""
 
     normals: np.ndarray | None = None
+    smooth_normals: np.ndarray | None = None
+    auto_coloring: str | None = None
     tables: dict = field(default_factory=dict)
     distance: dict = field(default_factory=dict)
     curvature: np.ndarray | None = None
@@ -289,6 +296,23 @@ class ViewerState:
         if coloring != self.style.shell_coloring:
             self.style.shell_coloring = coloring
             self.events.style.emit()
+
+    def set_render_style(self, style: str) -> None:
+        if style not in RENDER_STYLES:
+            raise ValueError(f"render style must be one of {RENDER_STYLES}")
+        if style != self.style.render:
+            self.style.render = style
+            self.events.style.emit()
+
+    def vector_coloring(self) -> str:
+        """The colouring of 3D modes in effect: the chosen one, or for "auto" the
+        magnitude on meshes with sharp features and the normal component elsewhere
+        (see :mod:`modalviewer.viewer.mode_scalar`)."""
+        if self.style.shell_coloring != "auto":
+            return self.style.shell_coloring
+        if self._derived.auto_coloring is None:
+            self._derived.auto_coloring = default_vector_coloring(self.mesh)
+        return self._derived.auto_coloring
 
     def set_colorbar(self, on: bool) -> None:
         if bool(on) != self.style.colorbar:
@@ -449,16 +473,15 @@ class ViewerState:
     def mode_fields(self, spec: Spectrum, j: int) -> tuple[np.ndarray, np.ndarray]:
         """(scalar to colour (n,), displacement (n, 3) scaled to a peak of 1) of mode j."""
         phi = spec.mode(j)
-        normals = self.normals
         if spec.is_vector:
-            if self.style.shell_coloring == "normal":
-                scalar = np.einsum("ij,ij->i", phi, normals)
-            else:
-                scalar = np.linalg.norm(phi, axis=1)
+            coloring = self.vector_coloring()
+            if coloring == "normal" and self._derived.smooth_normals is None:
+                self._derived.smooth_normals = smoothed_normals(self.mesh)
+            scalar = vector_mode_scalar(phi, self._derived.smooth_normals, coloring)
             disp = phi
         else:
             scalar = phi
-            disp = phi[:, None] * normals
+            disp = phi[:, None] * self.normals
         peak = float(np.max(np.linalg.norm(disp, axis=1))) or 1.0
         return scalar, disp / peak
 
@@ -480,7 +503,7 @@ class ViewerState:
                 return plain
             j = int(np.clip(d.mode, 0, spec.k - 1))
             scalar, disp = self.mode_fields(spec, j)
-            magnitude = spec.is_vector and self.style.shell_coloring == "magnitude"
+            magnitude = spec.is_vector and self.vector_coloring() == "magnitude"
             return Field(
                 scalar,
                 "sequential" if magnitude else "diverging",
@@ -497,8 +520,9 @@ class ViewerState:
             if d.distance_display == "threshold":
                 thr = self.threshold_value(dist)
                 return Field(
-                    (dist > thr).astype(np.float64),
+                    dist,
                     "threshold",
+                    threshold=thr,
                     title=f"{name} < {thr:.3g}",
                     legend=self.legend(),
                     share_similar=float(np.mean(dist <= thr)),
@@ -551,10 +575,10 @@ class ViewerState:
             zero = spec.zero_mode_mask()[j]
             value = "0 (zero mode)" if zero else f"{lam:.4g}"
             colours = "blue +, white 0, orange -"
-            if spec.is_vector and self.style.shell_coloring == "magnitude":
+            if spec.is_vector and self.vector_coloring() == "magnitude":
                 colours = "white 0 to red: displacement magnitude"
             elif spec.is_vector:
-                colours += " (normal component)"
+                colours += " (normal component, smoothed normals)"
             return f"{operator_info(d.operator).label}, mode {j}: lambda = {value}\n{colours}"
         if d.kind == "distance":
             name = DISTANCE_KINDS[d.distance_kind]

@@ -86,8 +86,9 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     rest = np.array(window.scene.surface.points)
     before = window.viewport.render_now()
     window.animation_panel.play_button.click()
-    qtbot.wait(300)
-    assert window.scene_view.timer.isActive() and len(window.frame_times) > 3
+    # frames arrive every 16 ms on an idle machine; allow for a loaded one
+    qtbot.waitUntil(lambda: len(window.frame_times) > 3, timeout=5000)
+    assert window.scene_view.timer.isActive()
     moved = np.array(window.scene.surface.points)
     assert np.abs(moved - rest).max() > 1e-3 * window.mesh.bounding_box_diagonal
     assert max(window.frame_times) < 0.05
@@ -135,7 +136,7 @@ def test_threshold_display_and_slider(window, spot_path):
     high = _classify(window.viewport.render_now())["blue"]
     assert high > low + 1000
     field = window.scene.surface.point_data["field"]
-    np.testing.assert_array_equal(field, (d > 0.7 * d.max()).astype(float))
+    np.testing.assert_array_equal(field, d)  # blue up to the threshold, by the colour table
 
 
 def test_export_png_size_and_transparency(window, spot_path, tmp_path):

@@ -43,6 +43,12 @@ class ModesPanel(QtWidgets.QWidget):
         lay.addWidget(self.spectrum_plot)
         form = QtWidgets.QFormLayout()
         self.color_combo = combo()
+        self.color_combo.addItem("Automatic", "auto")
+        self.color_combo.setItemData(
+            0,
+            "Magnitude on meshes with sharp features, else the normal component",
+            QtCore.Qt.ItemDataRole.ToolTipRole,
+        )
         self.color_combo.addItem("Normal component", "normal")
         self.color_combo.addItem("Magnitude", "magnitude")
         self.color_combo.setToolTip("Scalar shown for 3D vibration modes")
