@@ -35,6 +35,7 @@ from ..viewer.model import (
 from .compare import CompareWindow
 from .dialogs import ScreenshotDialog, ask
 from .export import save_field_mesh, save_screenshot
+from .pair_window import PairWindow, open_pair_window, open_second_mesh_dialog
 from .panels import (
     AnimationPanel,
     ComputePanel,
@@ -174,6 +175,13 @@ class MainWindow(QtWidgets.QMainWindow):
         m = bar.addMenu("&File")
         self._action(m, "&Open mesh...", self._open_dialog, "Ctrl+O")
         self.recent_menu = m.addMenu("Open &recent")
+        self._action(
+            m,
+            "Open &second mesh (shape pair)...",
+            lambda: open_second_mesh_dialog(self),
+            "Ctrl+Shift+B",
+            "Open mesh B beside this mesh: a click on one shows the similar points on the other",
+        )
         m.addSeparator()
         self._action(m, "Open s&ession...", self._open_session_dialog, "Ctrl+Shift+O")
         self._action(m, "Save se&ssion...", self._save_session_dialog, "Ctrl+S")
@@ -662,6 +670,13 @@ class MainWindow(QtWidgets.QMainWindow):
     def show_curvature(self) -> None:
         if self.state.mesh is not None:
             self.state.set_display(kind="curvature")
+
+    # ========================================================= shape pair
+    def open_second_mesh(self, path, wait: bool = True, k: int | None = None) -> PairWindow:
+        """Open ``path`` as mesh B beside this window's mesh A in a shape pair window: a
+        click on one mesh shows the distance between shapes on the other.  With ``wait``
+        the call returns once both spectra are in (``k`` modes each, default 100)."""
+        return open_pair_window(self, path, wait=wait, k=k)
 
     # ========================================================= comparison
     def open_comparison(self, items: list[str], wait: bool = True) -> CompareWindow | None:

@@ -1,0 +1,669 @@
+"""The shape pair window: mesh A (the main window's) beside mesh B, a pick on one shows the
+distance between shapes on the other.
+
+It draws :class:`~modalviewer.viewer.pair.PairState` and keeps nothing else but VTK
+objects.  Its spectra go through the main window's job queue and disk cache (one
+computation at a time, progress in this window and in the main window's status bar);
+A's spectra are reused from the main window's state when it has them.  The main
+window's own display and pick are never changed.  Scripting::
+
+    pair = win.open_second_mesh("assets/demo_hand_bent.obj")   # waits for the spectra
+    pair.set_kind("vibration"); pair.wait()
+    pair.pick_a(12541); pair.best_match()                       # ("b", vertex, distance)
+    pair.set_display("threshold", share=0.05)
+    pair.export_screenshot("pair.png", scale=2)
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from pathlib import Path
+
+import numpy as np
+import pyvista as pv
+from qtpy import QtCore, QtWidgets
+
+from ..core.files import atomic_write
+from ..core.laplacian import vertex_normals
+from ..core.mesh import Mesh, MeshError
+from ..core.operators import DISTANCE_KINDS, operator_info
+from ..viewer.jobs import DONE
+from ..viewer.model import cost_estimate
+from ..viewer.pair import SIDES, PairState, PairView
+from .scene import MeshScene
+from .viewport import make_viewport
+
+log = logging.getLogger("modalviewer")
+
+BACK_MARKER_COLOR = (1.0, 0.75, 0.0)  # the best match back, when it is not the pick
+RESCALE_TIP = (
+    "Scale both meshes to unit area before their spectra are computed (the distances are "
+    "shown on the meshes as loaded).\nHeat kernel and feature signatures carry a factor "
+    "1/area, so two copies of one shape of different size differ everywhere; the Discrete "
+    "Shells spectrum is not scale covariant at all (bending, stretching and area terms "
+    "scale by different powers of the size), so a larger copy vibrates differently, not "
+    "just slower. Untick only for meshes known to share one scale."
+)
+
+
+class PairError(RuntimeError):
+    """A scripted pair action failed; the message is for users."""
+
+
+class PairWindow(QtWidgets.QWidget):
+    """Two views, A (left) and B (right); see the module docstring."""
+
+    def __init__(self, main, mesh_b: Mesh, path_b=None, k: int | None = None, force_offscreen=None):
+        super().__init__(main, QtCore.Qt.WindowType.Window)
+        self.setAttribute(QtCore.Qt.WidgetAttribute.WA_DeleteOnClose, False)
+        self.setAcceptDrops(True)
+        self.main = main
+        state_a = main.state
+        if state_a.mesh is None:
+            raise PairError("Open a mesh first (it becomes mesh A).")
+        kind = state_a.display.distance_kind
+        weights = (state_a.compute_settings.bending, state_a.compute_settings.membrane)
+        self.pair = PairState(
+            main.model.jobs,
+            main.model.cache,
+            state_a.mesh,
+            mesh_b,
+            state_a.mesh_path,
+            path_b,
+            state_a=state_a,
+            k=k,
+            weights=weights,
+            kind=kind,
+        )
+        self._closed = False
+        self._syncing = False
+        self._link = None
+        self._build(force_offscreen)
+        self.pair.events.display.connect(self.redraw)
+        self.pair.events.meshes.connect(self._on_meshes)
+        self.pair.events.message.connect(self._on_message)
+        main.model.jobs.events.changed.connect(self._on_jobs)
+        state_a.events.mesh.connect(self._on_main_mesh)
+        main.installEventFilter(self)
+        self._on_meshes()
+        self.resize(1200, 640)
+
+    # ================================================================ UI
+    def _build(self, force_offscreen) -> None:
+        layout = QtWidgets.QVBoxLayout(self)
+        bar = QtWidgets.QHBoxLayout()
+        self.kind_combo = QtWidgets.QComboBox()
+        for kind, label in DISTANCE_KINDS.items():
+            self.kind_combo.addItem(label, kind)
+        self.kind_combo.setToolTip(
+            "The signature compared: vibration (Discrete Shells), feature (E_D^N) or "
+            "heat kernel (Laplacian)"
+        )
+        self.kind_combo.currentIndexChanged.connect(
+            lambda: self.set_kind(self.kind_combo.currentData())
+        )
+        self.display_combo = QtWidgets.QComboBox()
+        self.display_combo.addItem("Continuous", "continuous")
+        self.display_combo.addItem("Threshold", "threshold")
+        self.display_combo.currentIndexChanged.connect(
+            lambda: self.set_display(self.display_combo.currentData())
+        )
+        self.share_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.share_slider.setRange(1, 500)  # tenths of a percent of the other mesh's area
+        self.share_slider.setToolTip(
+            "Threshold: the share of the other mesh's surface area shown blue (the most "
+            "similar points)"
+        )
+        self.share_slider.valueChanged.connect(
+            lambda v: self.set_display("threshold", share=v / 1000.0)
+        )
+        self.share_label = QtWidgets.QLabel()
+        self.share_label.setMinimumWidth(150)
+        self.k_spin = QtWidgets.QSpinBox()
+        self.k_spin.setRange(2, 1000)
+        self.k_spin.setPrefix("k = ")
+        self.k_spin.setToolTip("Modes computed on each mesh (the same number on both)")
+        self.k_spin.editingFinished.connect(lambda: self.set_k(self.k_spin.value()))
+        self.rescale_check = QtWidgets.QCheckBox("Rescale both to the same area before computing")
+        self.rescale_check.setToolTip(RESCALE_TIP)
+        self.rescale_check.toggled.connect(self.set_rescale)
+        self.link_check = QtWidgets.QCheckBox("Linked cameras")
+        self.link_check.setToolTip(
+            "Turning or zooming one view turns the other the same way (each about its own "
+            "mesh's centre)"
+        )
+        self.link_check.setChecked(True)
+        self.link_check.toggled.connect(self.set_linked)
+        export = QtWidgets.QPushButton("Export...")
+        export.setToolTip("Save both views side by side, with their legends, as one PNG")
+        export.clicked.connect(self._export_dialog)
+        for widget in (
+            QtWidgets.QLabel("Distance"),
+            self.kind_combo,
+            self.display_combo,
+            self.share_slider,
+            self.share_label,
+            self.k_spin,
+        ):
+            bar.addWidget(widget)
+        bar.addStretch(1)
+        bar.addWidget(export)
+        layout.addLayout(bar)
+        bar2 = QtWidgets.QHBoxLayout()
+        bar2.addWidget(self.rescale_check)
+        bar2.addWidget(self.link_check)
+        bar2.addStretch(1)
+        layout.addLayout(bar2)
+        views = QtWidgets.QHBoxLayout()
+        self.viewports, self.titles = {}, {}
+        for side in SIDES:
+            column = QtWidgets.QVBoxLayout()
+            title = QtWidgets.QLabel()
+            column.addWidget(title)
+            viewport = make_viewport(self, force_offscreen)
+            viewport.clicked.connect(lambda x, y, s=side: self._on_click(s, x, y))
+            if hasattr(viewport, "cameraChanged"):
+                viewport.cameraChanged.connect(lambda s=side: self._on_camera(s))
+            column.addWidget(viewport.widget, 1)
+            views.addLayout(column, 1)
+            self.viewports[side], self.titles[side] = viewport, title
+        layout.addLayout(views, 1)
+        status = QtWidgets.QHBoxLayout()
+        self.status = QtWidgets.QLabel()
+        self.status.setWordWrap(True)
+        self.progress = QtWidgets.QProgressBar()
+        self.progress.setRange(0, 1000)
+        self.progress.setMaximumWidth(320)
+        self.progress.hide()
+        self.cancel_button = QtWidgets.QPushButton("Cancel")
+        self.cancel_button.setToolTip("Cancel this window's computations")
+        self.cancel_button.clicked.connect(self.pair.cancel)
+        self.cancel_button.hide()
+        status.addWidget(self.status, 1)
+        status.addWidget(self.progress)
+        status.addWidget(self.cancel_button)
+        layout.addLayout(status)
+        self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
+        self.back_markers: dict[str, object] = {"a": None, "b": None}
+        self._sync_controls()
+
+    def _sync_controls(self) -> None:
+        p = self.pair
+        for widget, value in (
+            (self.kind_combo, p.kind),
+            (self.display_combo, p.distance_display),
+        ):
+            widget.blockSignals(True)
+            widget.setCurrentIndex(widget.findData(value))
+            widget.blockSignals(False)
+        for widget, value, setter in (
+            (self.share_slider, int(round(1000 * p.share)), "setValue"),
+            (self.k_spin, p.k, "setValue"),
+            (self.rescale_check, p.rescale, "setChecked"),
+        ):
+            widget.blockSignals(True)
+            getattr(widget, setter)(value)
+            widget.blockSignals(False)
+        self.share_slider.setEnabled(p.distance_display == "threshold")
+
+    # ============================================================ meshes
+    def _on_meshes(self) -> None:
+        for side in SIDES:
+            mesh = self.pair.mesh(side)
+            scene = self.scenes[side]
+            if scene is not None and scene.mesh is mesh:
+                continue
+            if scene is not None:
+                scene.remove()
+            self._remove_back_marker(side)
+            plotter = self.viewports[side].plotter
+            scene = MeshScene(plotter, mesh, vertex_normals(mesh))
+            scene.overlay_scale = getattr(self.main.scene, "overlay_scale", 1.0)
+            scene.reset_camera()
+            self.scenes[side] = scene
+            self.titles[side].setText(
+                f"{side.upper()}: {self.pair.name(side)} ({mesh.n_vertices} vertices)"
+            )
+        self.setWindowTitle(
+            f"modalviewer - shape pair: {self.pair.name('a')} / {self.pair.name('b')}"
+        )
+        self.set_linked(self.linked)
+        self.redraw()
+
+    def _on_main_mesh(self) -> None:
+        """The main window opened another mesh: it becomes A (or the window closes)."""
+        mesh = self.main.state.mesh
+        if mesh is None:
+            self.close()
+            return
+        self.pair.set_mesh("a", mesh, self.main.state.mesh_path)
+        self.request()
+
+    def open_b(self, path) -> bool:
+        """Replace mesh B by the mesh file ``path``; False (after a message) if it failed."""
+        mesh = _load(self.main, path)
+        if mesh is None:
+            return False
+        self.pair.set_mesh("b", mesh, Path(path))
+        self.request()
+        return True
+
+    def dragEnterEvent(self, event):  # noqa: N802
+        if event.mimeData().hasUrls():
+            event.acceptProposedAction()
+
+    def dropEvent(self, event):  # noqa: N802
+        urls = event.mimeData().urls()
+        if urls:
+            self.open_b(urls[0].toLocalFile())
+
+    # =========================================================== drawing
+    def redraw(self) -> None:
+        """Draw both sides from the pair state."""
+        if self._closed:
+            return
+        for side in SIDES:
+            scene = self.scenes[side]
+            if scene is None:
+                continue
+            self._draw(side, scene, self.pair.view(side))
+            self.viewports[side].request_render()
+        self._sync_controls()
+        self._update_status()
+
+    def _draw(self, side: str, scene: MeshScene, view: PairView) -> None:
+        if view.values is None:
+            scene.show_plain()
+        elif view.colormap == "threshold":
+            scene.show_threshold(view.values, view.threshold, name=view.colorbar_title)
+        else:
+            scene.show_field(view.values, "sequential", isolines=0, name=view.colorbar_title)
+        scene.set_legend(view.legend)
+        if view.values is None:
+            scene.set_colorbar(None)
+        else:
+            scene.set_colorbar(view.colorbar_title, labels=view.colorbar_labels)
+        scene.show_marker(view.marker)
+        self._remove_back_marker(side)
+        if view.back_marker is not None:
+            radius = 0.009 * scene.mesh.bounding_box_diagonal
+            sphere = pv.Sphere(radius=radius, center=scene.surface.points[view.back_marker])
+            self.back_markers[side] = scene.plotter.add_mesh(
+                sphere,
+                color=BACK_MARKER_COLOR,
+                name="back_marker",
+                render=False,
+                reset_camera=False,
+                show_scalar_bar=False,
+                scalars=None,
+            )
+
+    def _remove_back_marker(self, side: str) -> None:
+        actor = self.back_markers[side]
+        if actor is not None:
+            self.viewports[side].plotter.remove_actor(actor, render=False)
+            self.back_markers[side] = None
+
+    def _update_status(self) -> None:
+        p = self.pair
+        if p.distance_display == "threshold":
+            self.share_label.setText(f"{100 * p.share:.1f} % of the other mesh")
+        else:
+            self.share_label.setText("")
+        match = p.best_match()
+        if match is not None:
+            side, w, dist = match
+            text = f"Best match on {side.upper()}: vertex {w} (distance {dist:.3g})"
+            back = p.back_match()
+            text += "; mutual" if back == p.picked[1] else f"; not mutual (back: vertex {back})"
+        elif p.picked is None:
+            text = "Click a point on A or on B."
+        else:
+            text = p.view(SIDES[0]).legend.splitlines()[-1]
+        self.status.setText(text)
+
+    def _on_message(self, text: str) -> None:
+        self.status.setText(text)
+        if hasattr(self.main, "show_error"):
+            self.main.show_error(text, "Shape pair")
+
+    def _on_jobs(self, _job=None) -> None:
+        if self._closed:
+            return
+        pending = self.pair.pending()
+        running = next((j for j in pending if j.status == "running"), None)
+        self.progress.setVisible(bool(pending))
+        self.cancel_button.setVisible(bool(pending))
+        if running is not None:
+            self.progress.setValue(int(1000 * running.fraction))
+            more = f" (+{len(pending) - 1} queued)" if len(pending) > 1 else ""
+            self.progress.setFormat(f"{running.description}: {running.stage} %p%{more}")
+        elif pending:
+            self.progress.setValue(0)
+            self.progress.setFormat(f"waiting: {pending[0].description}")
+
+    # ========================================================== cameras
+    def set_linked(self, on: bool) -> None:
+        """Linked cameras: the two views keep the relative viewpoint they have when the
+        link is made (each mesh's canonical view after opening or R), so turning,
+        zooming or panning one view does the same to the other about its own mesh.
+        Free cameras: turn B by hand to line it up with A, then link them."""
+        self.link_check.blockSignals(True)
+        self.link_check.setChecked(bool(on))
+        self.link_check.blockSignals(False)
+        self._link = self._make_link() if on else None
+
+    @property
+    def linked(self) -> bool:
+        return self.link_check.isChecked()
+
+    def _make_link(self):
+        """(Q, s, focal A, focal B): the similarity x_B = focal_B + s Q (x_A - focal_A)
+        that maps A's camera onto B's as they are now."""
+        if self.scenes["a"] is None or self.scenes["b"] is None:
+            return None
+        fa, da, focal_a = _camera_frame(self.viewports["a"].plotter.camera)
+        fb, db, focal_b = _camera_frame(self.viewports["b"].plotter.camera)
+        return fb @ fa.T, db / da, focal_a, focal_b
+
+    def _on_camera(self, side: str) -> None:
+        if self.linked and not self._syncing:
+            dst = "b" if side == "a" else "a"
+            self._copy_camera(side, dst)
+            self.viewports[dst].request_render()
+
+    def _copy_camera(self, src: str, dst: str) -> None:
+        """Move ``dst``'s camera to the image of ``src``'s under the link."""
+        if getattr(self, "_link", None) is None:
+            return
+        q, s, focal_a, focal_b = self._link
+        if src == "a":
+
+            def to_dst(x):
+                return focal_b + s * q @ (np.asarray(x) - focal_a)
+
+            rot, factor = q, s
+        else:
+
+            def to_dst(x):
+                return focal_a + q.T @ (np.asarray(x) - focal_b) / s
+
+            rot, factor = q.T, 1.0 / s
+        a = self.viewports[src].plotter.camera
+        b = self.viewports[dst].plotter.camera
+        self._syncing = True
+        try:
+            b.SetFocalPoint(*to_dst(a.GetFocalPoint()))
+            b.SetPosition(*to_dst(a.GetPosition()))
+            b.SetViewUp(*(rot @ np.asarray(a.GetViewUp())))
+            b.SetViewAngle(a.GetViewAngle())
+            b.SetParallelProjection(a.GetParallelProjection())
+            b.SetParallelScale(a.GetParallelScale() * factor)
+            b.OrthogonalizeViewUp()
+            self.viewports[dst].plotter.renderer.ResetCameraClippingRange()
+        finally:
+            self._syncing = False
+
+    def reset_cameras(self) -> None:
+        """Each mesh's canonical first view (R); linked cameras are linked anew."""
+        for side in SIDES:
+            if self.scenes[side] is not None:
+                self.scenes[side].reset_camera()
+        self.set_linked(self.linked)
+        self.render_all()
+
+    def render_all(self) -> None:
+        for viewport in self.viewports.values():
+            viewport.request_render()
+
+    # ====================================================== interaction
+    def _on_click(self, side: str, x: float, y: float) -> None:
+        scene = self.scenes[side]
+        vertex = scene.vertex_at_display(x, y) if scene is not None else None
+        if vertex is not None:
+            self.pick(side, vertex)
+
+    def pick(self, side: str, vertex: int) -> None:
+        """Pick ``vertex`` of ``side`` (as a click does); a missing spectrum is computed."""
+        try:
+            self.pair.pick(side, vertex)
+        except ValueError as exc:
+            self._on_message(str(exc))
+            return
+        self.request()
+
+    def pick_a(self, vertex: int) -> None:
+        self.pick("a", vertex)
+
+    def pick_b(self, vertex: int) -> None:
+        self.pick("b", vertex)
+
+    def set_kind(self, kind: str) -> None:
+        """ "vibration" | "feature" | "hks"; its spectra are computed in the background."""
+        self.pair.set_kind(kind)
+        self.request()
+
+    def set_k(self, k: int) -> None:
+        self.pair.set_k(k)
+        self.request()
+
+    def set_rescale(self, on: bool) -> None:
+        self.pair.set_rescale(on)
+        self.request()
+
+    def set_display(self, display: str, share: float | None = None) -> None:
+        """ "continuous" or "threshold"; ``share``: the part (0..1) of the other mesh's
+        surface area the threshold marks blue."""
+        self.pair.set_display(display, share)
+
+    def request(self) -> list:
+        """Start the computations the current kind needs (asking first for long ones
+        unless scripted); returns the pending jobs."""
+        key = self.pair.key()
+        missing = [s for s in SIDES if self.pair.spectrum(s) is None]
+        seconds = sum(cost_estimate(key, self.pair.mesh(s).n_vertices)[0] for s in missing)
+        if missing and seconds > 300:
+            self.status.setText(
+                f"Computing the {operator_info(key.operator).label} spectra of both meshes "
+                f"takes about {seconds / 60:.0f} min (Cancel stops it)."
+            )
+        jobs = self.pair.request()
+        self._on_jobs()
+        return jobs
+
+    def wait(self, timeout: float | None = None) -> None:
+        """Run the event loop until this window's spectra for the current kind are in;
+        raises PairError if one could not be computed."""
+        for job in self.request():
+            self.main.wait_for(job)
+            if job.status != DONE:
+                raise PairError(self.pair.failure() or job.error or job.status)
+        QtWidgets.QApplication.processEvents()
+        if not self.pair.ready():
+            raise PairError(self.pair.failure() or "the spectra are not in")
+
+    # ========================================================== results
+    def distance_on_b(self) -> np.ndarray | None:
+        """(n_b,) distance from the pick on A to every vertex of B (None: no pick on A,
+        or the spectra are not in)."""
+        return self.pair.distance_on("b")
+
+    def distance_on_a(self) -> np.ndarray | None:
+        return self.pair.distance_on("a")
+
+    def best_match(self) -> tuple[str, int, float] | None:
+        """(side, vertex, distance) of the best match of the pick on the other mesh."""
+        return self.pair.best_match()
+
+    def mutual_best_matches(self, vertices_a, vertices_b=None):
+        """Best matches of several vertices of A on B and whether each is mutual."""
+        return self.pair.mutual_best_matches(vertices_a, vertices_b)
+
+    # =========================================================== export
+    def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
+        """Each view rendered at ``scale`` with its legend and colour bar drawn on."""
+        from .overlay import draw_overlay
+
+        images = []
+        for side in SIDES:
+            viewport, scene = self.viewports[side], self.scenes[side]
+            if hasattr(viewport, "render_now"):
+                viewport.render_now()  # an off-screen view sizes its plotter here
+            plotter = viewport.plotter
+            overlay = scene.overlay(legend=True)
+            hidden = [a for a in scene.overlay_actors() if a.GetVisibility()]
+            for actor in hidden:
+                actor.SetVisibility(False)
+            try:
+                plotter.render()
+                img = plotter.screenshot(
+                    None, transparent_background=transparent, return_img=True, scale=scale
+                )
+            finally:
+                for actor in hidden:
+                    actor.SetVisibility(True)
+            img = np.ascontiguousarray(img)
+            if overlay:
+                img = draw_overlay(img, overlay, scale * scene.overlay_scale)
+            images.append(img)
+        return images
+
+    def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
+        """Both views side by side, with their legends, in one PNG written atomically."""
+        from PIL import Image
+
+        path = Path(path)
+        if path.suffix.lower() != ".png":
+            path = path.with_suffix(".png")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if not os.access(path.parent, os.W_OK):
+            raise OSError(f"the folder {path.parent} is not writable; choose another one")
+        images = self.grab_images(int(max(1, scale)), transparent)
+        channels = 4 if transparent else 3
+        gap = 4 * int(max(1, scale))
+        height = max(img.shape[0] for img in images)
+        width = sum(img.shape[1] for img in images) + gap
+        canvas = np.zeros((height, width, channels), np.uint8)
+        if not transparent:
+            canvas[:] = 255
+        x = 0
+        for img in images:
+            if img.shape[2] < channels:
+                img = np.dstack([img, np.full(img.shape[:2], 255, np.uint8)])
+            canvas[: img.shape[0], x : x + img.shape[1]] = img[:, :, :channels]
+            x += img.shape[1] + gap
+        self.render_all()
+        return atomic_write(path, lambda tmp: Image.fromarray(canvas).save(tmp, format="PNG"))
+
+    def _export_dialog(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Export the pair", "pair.png", "PNG (*.png)"
+        )
+        if path:
+            try:
+                out = self.export_screenshot(path)
+            except (OSError, ValueError) as exc:
+                self._on_message(f"Could not save the screenshot: {exc}")
+                return
+            self.status.setText(f"Saved {out}")
+
+    # ============================================================ close
+    def keyPressEvent(self, event):  # noqa: N802
+        key, mods = event.key(), event.modifiers()
+        ctrl = bool(mods & QtCore.Qt.KeyboardModifier.ControlModifier)
+        if key == QtCore.Qt.Key.Key_Escape or (key == QtCore.Qt.Key.Key_W and ctrl):
+            self.close()
+        elif key == QtCore.Qt.Key.Key_R and not mods:
+            self.reset_cameras()
+        else:
+            super().keyPressEvent(event)
+
+    def eventFilter(self, obj, event):  # noqa: N802
+        if obj is self.main and event.type() == QtCore.QEvent.Type.Close:
+            self.close()
+        return False
+
+    def closeEvent(self, event):  # noqa: N802
+        if not self._closed:
+            self._closed = True
+            self.pair.cancel()
+            self.main.model.jobs.events.changed.disconnect(self._on_jobs)
+            self.main.state.events.mesh.disconnect(self._on_main_mesh)
+            self.main.removeEventFilter(self)
+            for viewport in self.viewports.values():
+                viewport.close_plotter()
+            if getattr(self.main, "pair_window", None) is self:
+                self.main.pair_window = None
+        super().closeEvent(event)
+
+
+def _camera_frame(camera) -> tuple[np.ndarray, float, np.ndarray]:
+    """((3, 3) columns right, up, back of ``camera``; distance to the focal point; the
+    focal point)."""
+    focal = np.asarray(camera.GetFocalPoint(), dtype=float)
+    d = focal - np.asarray(camera.GetPosition(), dtype=float)
+    distance = float(np.linalg.norm(d)) or 1.0
+    back = -d / distance
+    up = np.asarray(camera.GetViewUp(), dtype=float)
+    up = up - back * float(up @ back)
+    up /= np.linalg.norm(up) or 1.0
+    return np.column_stack([np.cross(up, back), up, back]), distance, focal
+
+
+def _load(main, path) -> Mesh | None:
+    from ..io import load_mesh
+
+    path = Path(path)
+    try:
+        return load_mesh(path)
+    except MeshError as exc:
+        main.show_error(str(exc), "Cannot open mesh")
+    except OSError as exc:
+        main.show_error(f"{path.name}: cannot be read ({exc.strerror or exc})", "Cannot open mesh")
+    return None
+
+
+def open_pair_window(main, path, wait: bool = True, k: int | None = None) -> PairWindow | None:
+    """Open ``path`` as mesh B beside the main window's mesh A (a previous pair window is
+    closed).  With ``wait`` the call returns once both spectra are in (PairError if one
+    fails); None (after a message) if there is no mesh A or ``path`` cannot be read."""
+    if main.state.mesh is None:
+        main.show_error("Open a mesh first: it becomes mesh A of the pair.")
+        if wait:
+            raise PairError("Open a mesh first: it becomes mesh A of the pair.")
+        return None
+    mesh = _load(main, path)
+    if mesh is None:
+        if wait:
+            raise PairError(main.last_error or f"cannot open {path}")
+        return None
+    previous = getattr(main, "pair_window", None)
+    if previous is not None:
+        previous.close()
+    window = PairWindow(main, mesh, Path(path), k=k)
+    main.pair_window = window
+    window.show()
+    window.request()
+    if wait:
+        window.wait()
+    return window
+
+
+def open_second_mesh_dialog(main) -> None:
+    """File > Open second mesh...: choose mesh B."""
+    from ..io import SUPPORTED_EXTENSIONS
+
+    if main.state.mesh is None:
+        main.show_error("Open a mesh first: it becomes mesh A of the pair.")
+        return
+    start = str(main.settings.value("files/last_dir", str(Path.cwd())))
+    patterns = " ".join(f"*{e}" for e in SUPPORTED_EXTENSIONS)
+    path, _ = QtWidgets.QFileDialog.getOpenFileName(
+        main, "Open second mesh (B)", start, f"Meshes ({patterns});;All files (*)"
+    )
+    if path:
+        open_pair_window(main, path, wait=False)
+
+
+__all__ = ["PairError", "PairWindow", "open_pair_window", "open_second_mesh_dialog"]

@@ -1,0 +1,140 @@
+"""The shape pair window: spot as A, spot rigidly moved as B; picks by click and by script,
+threshold and marker pixels in the export, linked and free cameras."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from PIL import Image
+from qtpy import QtCore
+
+import modalviewer as mv
+from modalviewer.core.laplacian import vertex_normals
+from modalviewer.viewer.camera import Camera
+
+pytestmark = pytest.mark.gui
+
+
+@pytest.fixture
+def moved_spot(spot_path, tmp_path) -> Path:
+    mesh = mv.load_mesh(spot_path)
+    q, _ = np.linalg.qr(np.random.default_rng(5).normal(size=(3, 3)))
+    if np.linalg.det(q) < 0:
+        q[:, 0] *= -1
+    path = tmp_path / "moved_spot.obj"
+    trimesh.Trimesh(mesh.vertices @ q.T + [2.0, -1.0, 0.5], mesh.faces, process=False).export(path)
+    return path
+
+
+def _click(qtbot, widget, pos):
+    qtbot.mouseClick(widget, QtCore.Qt.MouseButton.LeftButton, pos=pos)
+
+
+def _drag(qtbot, widget, dx):
+    start = QtCore.QPoint(widget.width() // 2, widget.height() // 2)
+    qtbot.mousePress(widget, QtCore.Qt.MouseButton.LeftButton, pos=start)
+    for step in range(1, 6):
+        qtbot.mouseMove(widget, start + QtCore.QPoint(dx * step // 5, 0))
+    qtbot.mouseRelease(widget, QtCore.Qt.MouseButton.LeftButton, pos=start + QtCore.QPoint(dx, 0))
+
+
+def _blue(img):  # the threshold's SIMILAR_BLUE (51, 115, 217), shaded
+    r, g, b = (img[..., i].astype(int) for i in range(3))
+    return (b > 120) & (b - r > 80) & (b - g > 40)
+
+
+def _magenta(img):  # the marker (230, 26, 153), shaded
+    r, g, b = (img[..., i].astype(int) for i in range(3))
+    return (r > 110) & (r - g > 80) & (b - g > 40) & (r > b)
+
+
+def test_pick_on_a_shows_the_distance_and_best_match_on_b(
+    window, spot_path, moved_spot, tmp_path, qtbot
+):
+    window.open_mesh(spot_path)
+    window.state.set_display(distance_kind="hks")  # the pair starts with the main's kind
+    pair = window.open_second_mesh(moved_spot, k=20)
+    assert window.pair_window is pair and pair.pair.kind == "hks" and pair.pair.ready()
+    assert pair.pair.rescale and "scale covariant" in pair.rescale_check.toolTip()
+    # a click in the middle of A picks a vertex of A that faces the viewer
+    a_view = pair.viewports["a"].widget
+    _click(qtbot, a_view, QtCore.QPoint(a_view.width() // 2, a_view.height() // 2))
+    assert pair.pair.picked is not None and pair.pair.picked[0] == "a"
+    v = pair.pair.picked[1]
+    d = pair.distance_on_b()
+    assert d[v] <= 1e-8 * d.max()  # the moved copy of the pick: distance zero
+    side, w, dist = pair.best_match()
+    assert (side, w) == ("b", v) and dist <= 1e-8 * d.max()
+    assert pair.pair.back_match() == v  # mutual
+    field = np.array(pair.scenes["b"].surface.point_data["field"])
+    np.testing.assert_allclose(field, d, rtol=0, atol=1e-12 * d.max())
+    assert "best match: vertex" in pair.scenes["b"].legend_text
+    assert window.state.picked is None and window.state.display.kind == "none"  # untouched
+
+    # look at the match on B from outside along its normal; the linked A turns with it
+    mesh_b = pair.pair.mesh("b")
+    normal = vertex_normals(mesh_b)[w]
+    point = mesh_b.vertices[w]
+    up = np.cross(normal, [1.0, 0.0, 0.0])
+    if np.linalg.norm(up) < 0.1:
+        up = np.cross(normal, [0.0, 1.0, 0.0])
+    a_before = np.array(pair.viewports["a"].plotter.camera.GetPosition())
+    pair.scenes["b"].set_camera(
+        Camera(tuple(point + 2.5 * normal), tuple(point), tuple(up / np.linalg.norm(up))),
+        fit=False,
+    )
+    pair._on_camera("b")
+    assert np.linalg.norm(pair.viewports["a"].plotter.camera.GetPosition() - a_before) > 0.1
+
+    pair.set_display("threshold", share=0.05)
+    legend = pair.scenes["b"].legend_text
+    assert "blue: heat kernel distance < " in legend and "% of B" in legend
+    out = pair.export_screenshot(tmp_path / "pair.png")
+    assert [p.name for p in tmp_path.glob(".pair.png*")] == []  # no temporary file left
+    img = np.asarray(Image.open(out).convert("RGB"))
+    half = img.shape[1] // 2
+    left, right = img[:, :half], img[:, half:]
+    # B: a blue region around the match (5 % of its area) and the marker at the match;
+    # A: no distance map (plain grey)
+    assert _blue(right).sum() > 1500, _blue(right).sum()
+    assert _blue(left).sum() < 50
+    assert _magenta(right).sum() > 30
+    # the marker on B sits where the match projects
+    x, y, _ = pair.scenes["b"].display_position(w)
+    h = right.shape[0]
+    ys, xs = np.nonzero(_magenta(right))
+    assert np.min(np.hypot(xs - x, ys - (h - 1 - y))) < 6
+    big = pair.export_screenshot(tmp_path / "pair2.png", scale=2, transparent=True)
+    big_img = Image.open(big)
+    assert big_img.mode == "RGBA" and big_img.size[0] >= 2 * img.shape[1] - 8
+
+    # a click on B works the other way
+    pair.pick_b(123)
+    d_a = pair.distance_on_a()
+    assert pair.distance_on_b() is None and d_a[123] <= 1e-8 * d_a.max()
+    assert pair.best_match()[:2] == ("a", 123)
+
+    # free cameras: turning A leaves B where it is; linked again, B follows
+    pair.set_linked(False)
+    b_before = np.array(pair.viewports["b"].plotter.camera.GetPosition())
+    _drag(qtbot, a_view, 80)
+    assert np.allclose(pair.viewports["b"].plotter.camera.GetPosition(), b_before)
+    pair.set_linked(True)
+    _drag(qtbot, a_view, 80)
+    assert not np.allclose(pair.viewports["b"].plotter.camera.GetPosition(), b_before)
+    assert pair.pair.picked == ("b", 123)  # drags are not clicks
+
+    pair.close()
+    assert window.pair_window is None
+
+
+def test_open_second_mesh_reports_a_bad_file(window, spot_path, tmp_path):
+    from modalviewer.gui.pair_window import PairError
+
+    window.open_mesh(spot_path)
+    bad = tmp_path / "bad.obj"
+    bad.write_text("this is not a mesh\n")
+    with pytest.raises(PairError):
+        window.open_second_mesh(bad)
+    assert window.last_error and getattr(window, "pair_window", None) is None
