@@ -32,6 +32,7 @@ from ..viewer.model import (
     cost_estimate,
     worst_residual,
 )
+from ..viewer.state import RENDER_STYLES, SHELL_COLORINGS
 from .compare import CompareWindow
 from .dialogs import ScreenshotDialog, ask
 from .export import save_field_mesh, save_screenshot
@@ -217,6 +218,16 @@ class MainWindow(QtWidgets.QMainWindow):
         self.state.events.style.connect(
             lambda: self.colorbar_action.setChecked(self.state.style.colorbar)
         )
+        self.shaded_action = self._action(
+            m,
+            "S&haded look (light kit, greyer)",
+            lambda on: self.state.set_render_style("shaded" if on else "paper"),
+            "Shift+S",
+        )
+        self.shaded_action.setCheckable(True)
+        self.state.events.style.connect(
+            lambda: self.shaded_action.setChecked(self.state.style.render == "shaded")
+        )
         self._action(m, "&Reset camera", self.scene_view.reset_camera, "R")
         views = m.addMenu("Camera &presets")
         for name, label, key in (
@@ -310,7 +321,10 @@ class MainWindow(QtWidgets.QMainWindow):
             self.restoreState(state)
         st = self.state
         st.set_isolines(int(s.value("view/isolines", 12)))
-        st.set_shell_coloring(str(s.value("view/shell_color", "normal")))
+        coloring = str(s.value("view/shell_color", "auto"))
+        st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "auto")
+        style = str(s.value("view/style", "paper"))
+        st.set_render_style(style if style in RENDER_STYLES else "paper")
         st.set_animation(
             amplitude=int(s.value("view/amplitude", 8)), speed=int(s.value("view/speed", 30))
         )
@@ -334,6 +348,7 @@ class MainWindow(QtWidgets.QMainWindow):
         s.setValue("view/amplitude", st.animation.amplitude)
         s.setValue("view/speed", st.animation.speed)
         s.setValue("view/shell_color", st.style.shell_coloring)
+        s.setValue("view/style", st.style.render)
         c = st.compute_settings
         s.setValue("compute/operator", c.operator)
         s.setValue("compute/bending", c.bending)
