@@ -448,15 +448,15 @@ class PairState:
         note = f"\n{self.note}" if self.note else ""
         if from_side == side:
             back = self.back_match()
-            mutual = "mutual" if back == v else f"not mutual: its best match is vertex {back}"
+            mutual = "mutual" if back == v else f"not mutual: back to vertex {back} (yellow)"
             return PairView(
                 None,
                 "plain",
                 None,
                 v,
                 None if back == v else back,
-                f"{head}\npicked vertex {v}; best match on {other(side).upper()}: vertex "
-                f"{w} ({mutual}){note}",
+                f"{head}\npicked vertex {v}\nbest match on {other(side).upper()}: vertex {w}"
+                f"\n{mutual}{note}",
             )
         d = self.distance_on(side)
         source = f"from vertex {v} of {from_side.upper()}"

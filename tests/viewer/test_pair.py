@@ -59,7 +59,7 @@ def test_rigid_motion_pick_on_a_matches_the_same_vertex_on_b(tmp_path, spot):
         view = pair.view("b")
         assert view.colormap == "sequential" and view.marker == v
         assert f"best match: vertex {v} " in view.legend
-        assert "(mutual)" in pair.view("a").legend and pair.view("a").back_marker is None
+        assert "\nmutual" in pair.view("a").legend and pair.view("a").back_marker is None
     # the same numbers as the library's function
     np.testing.assert_allclose(
         pair.distance_on("b"),
