@@ -23,11 +23,16 @@ from ..core.pipeline import compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from .jobs import DONE, Job, JobQueue
+from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
 PROCESS_THRESHOLD = 20000
 """Problems with at least this many unknowns are computed in a separate process
 (sparse factorisations hold the GIL; a process also cancels at once)."""
+
+PREVIEW_MIN_UNKNOWNS = 30000
+"""With the Preview option, problems with at least this many unknowns show a preview
+spectrum (seconds) while the exact one is computed (minutes)."""
 
 COARSE_FRACTION = 0.2
 """Share of the vertices the Coarse-to-fine copy keeps."""
@@ -71,8 +76,9 @@ class ViewerModel:
         self.state.set_mesh(mesh, path, repairs)
 
     def repair(self, name: str) -> Job:
-        """A job applying repair ``name`` (see ``REPAIRS``) to the loaded mesh; when it
-        ends the repaired mesh replaces it (its report says what changed)."""
+        """A job applying repair ``name`` (see ``REPAIRS``) to the loaded mesh, in a child
+        process (see :mod:`.process`); when it ends the repaired mesh replaces it (its
+        report says what changed)."""
         state = self.state
         if state.mesh is None:
             raise ComputeRefused("Open a mesh first.")
@@ -80,7 +86,7 @@ class ViewerModel:
             raise ValueError(f"unknown repair {name!r}; choose one of {', '.join(REPAIRS)}")
         mesh, path, done = state.mesh, state.mesh_path, list(state.mesh_repairs)
         job = self.jobs.submit(
-            lambda progress, cancel: apply_repair(name, mesh, progress),
+            lambda progress, cancel: repair_in_process(name, mesh, progress, cancel),
             ("repair", mesh.hash, name),
             REPAIRS[name],
             mesh.hash,
@@ -139,27 +145,54 @@ class ViewerModel:
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
+        if self._wants_preview(key):
+            preview = self.jobs.submit(
+                self._work(key, preview=True),
+                (state.mesh.hash, key, "preview"),
+                f"preview of {key.describe()}",
+                state.mesh.hash,
+            )
+            preview.spectrum_key = key
+            if show:
+                preview.then(self._shower(key, display_at_request))
         work = self._work(key)
         job = self.jobs.submit(work, (state.mesh.hash, key), key.describe(), state.mesh.hash)
         job.spectrum_key = key
         if show:
-
-            def show_when_done(j: Job, before=display_at_request) -> None:
-                if (
-                    j.status == DONE
-                    and self.state.has_spectrum(key)
-                    and self.state.display in (before, _blank(before))
-                ):
-                    self._show_first_mode(key.operator)
-
-            job.then(show_when_done)
+            job.then(self._shower(key, display_at_request))
         return job
+
+    def _wants_preview(self, key: SpectrumKey) -> bool:
+        """Preview first: asked for, a big problem, no preview yet, not in the cache."""
+        state = self.state
+        n = operator_info(key.operator).unknowns(state.mesh.n_vertices)
+        if not state.compute_settings.preview or key.coarse or n < PREVIEW_MIN_UNKNOWNS:
+            return False
+        if key in state.spectra:
+            return False
+        mesh = state.compute_mesh(key)
+        return not self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
+
+    def _shower(self, key: SpectrumKey, before):
+        """A job callback showing ``key``'s first non-zero mode if the display has not
+        changed since the request (``before``)."""
+
+        def show_when_done(j: Job) -> None:
+            if (
+                j.status == DONE
+                and key in self.state.spectra
+                and self.state.display in (before, _blank(before))
+            ):
+                self._show_first_mode(key.operator)
+
+        return show_when_done
 
     def _show_first_mode(self, operator: str) -> None:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
 
-    def _work(self, key: SpectrumKey):
-        """The function a job runs for ``key``: cache, compute, signature table."""
+    def _work(self, key: SpectrumKey, preview: bool = False):
+        """The function a job runs for ``key``: cache, compute, signature table (a
+        ``preview``: the reduced-space approximation, never cached)."""
         mesh = self.state.compute_mesh(key)
         cache = self.cache
         t_range = self.state.t_range
@@ -167,7 +200,10 @@ class ViewerModel:
         needs_table = operator_info(key.operator).distance_kind is not None
 
         def work(progress, cancel):
-            spec = None if key.coarse else cache.get(*cache_args)
+            if preview:
+                spec = compute_spectrum(mesh, *cache_args[1:], progress, cancel, accuracy="preview")
+            else:
+                spec = None if key.coarse else cache.get(*cache_args)
             if spec is None:
                 spec = _compute(mesh, key, cache, progress, cancel)
             table = None

@@ -1,13 +1,21 @@
-"""A spectrum computation in a child process, with progress relayed and cancel at once.
+"""Work in a child process, with progress relayed and cancel at once.
 
-Sparse factorisations hold the GIL, so a big computation in a thread would stall the
-viewer's event loop; a child process keeps it free and is killed to cancel.
+- Spectra: sparse factorisations hold the GIL, so a big computation in a thread would
+  stall the viewer's event loop; a child process keeps it free and is killed to cancel.
+- Mesh repairs: MeshLab (pymeshlab) run in a thread of a process that later runs MKL's
+  solver corrupts the heap (the process aborts at exit with "malloc_consolidate():
+  unaligned fastbin chunk"); in a child process it cannot, and a long repair can be
+  cancelled.
+
+The child reports progress as JSON lines ``{"stage": ..., "fraction": ...}`` on stdout
+and a failure as ``{"error": message}`` with exit code 1.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import pickle
 import queue
 import subprocess
 import sys
@@ -18,21 +26,14 @@ from pathlib import Path
 import numpy as np
 
 from ..core.eigen import Cancelled
+from ..core.mesh import Mesh
 from ..core.spectrum import load_spectrum
 
 
-def compute_in_process(mesh, operator, k, bending, membrane, out_path, progress, cancel):
-    """Run ``modalviewer.core.job_main`` in a child Python; relay progress; kill on cancel.
-
-    Returns the Spectrum read back from ``out_path``; the child's error message is
-    raised as RuntimeError.
-    """
-    params = {"operator": operator, "k": int(k), "bending": bending, "membrane": membrane}
-    fd, job_path = tempfile.mkstemp(prefix="modalviewer-job-", suffix=".npz")
-    os.close(fd)
-    np.savez(job_path, vertices=mesh.vertices, faces=mesh.faces, params=json.dumps(params))
+def _run_child(argv: list[str], progress, cancel, what: str) -> None:
+    """Run ``python -m ...argv``; relay its progress; kill it on cancel; raise its error."""
     child = subprocess.Popen(
-        [sys.executable, "-m", "modalviewer.core.job_main", job_path, str(out_path)],
+        [sys.executable, "-m", *argv],
         stdout=subprocess.PIPE,
         stderr=subprocess.DEVNULL,
         stdin=subprocess.DEVNULL,
@@ -70,12 +71,48 @@ def compute_in_process(mesh, operator, k, bending, membrane, out_path, progress,
         if child.poll() is None:
             child.kill()
         child.wait()
-        Path(job_path).unlink(missing_ok=True)
     if error is not None:
         raise RuntimeError(error)
     if child.returncode != 0:
         raise RuntimeError(
-            f"the computation process stopped unexpectedly (exit code {child.returncode}); "
+            f"the {what} process stopped unexpectedly (exit code {child.returncode}); "
             "it may have run out of memory"
         )
+
+
+def _temp_path(suffix: str) -> str:
+    fd, path = tempfile.mkstemp(prefix="modalviewer-job-", suffix=suffix)
+    os.close(fd)
+    return path
+
+
+def compute_in_process(mesh, operator, k, bending, membrane, out_path, progress, cancel):
+    """Run ``modalviewer.core.job_main`` in a child Python; returns the Spectrum read back
+    from ``out_path``; the child's error message is raised as RuntimeError."""
+    params = {"operator": operator, "k": int(k), "bending": bending, "membrane": membrane}
+    job_path = _temp_path(".npz")
+    try:
+        np.savez(job_path, vertices=mesh.vertices, faces=mesh.faces, params=json.dumps(params))
+        _run_child(
+            ["modalviewer.core.job_main", job_path, str(out_path)], progress, cancel, "computation"
+        )
+    finally:
+        Path(job_path).unlink(missing_ok=True)
     return load_spectrum(out_path, mesh_hash=mesh.hash)
+
+
+def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
+    """Repair ``name`` (see :data:`modalviewer.viewer.model.REPAIRS`) of ``mesh`` in a
+    child Python; returns the repaired Mesh with its report."""
+    job_path, out_path = _temp_path(".pickle"), _temp_path(".pickle")
+    try:
+        with open(job_path, "wb") as fh:
+            pickle.dump((name, np.asarray(mesh.vertices), np.asarray(mesh.faces), mesh.report), fh)
+        _run_child(
+            ["modalviewer.viewer.repair_main", job_path, out_path], progress, cancel, "repair"
+        )
+        with open(out_path, "rb") as fh:
+            return pickle.load(fh)  # written by our own child process just now
+    finally:
+        Path(job_path).unlink(missing_ok=True)
+        Path(out_path).unlink(missing_ok=True)

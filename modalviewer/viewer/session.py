@@ -145,11 +145,12 @@ def restore_session(model, path) -> Restored:
     state = model.state
     repairs = [str(r) for r in mesh_info.get("repairs") or []]
     if repairs:
-        # re-applied here, in order (a sliver repair of a big scan takes seconds)
-        from .model import apply_repair
+        # re-applied here, in order, each in a child process (see .process); a sliver
+        # repair of a big scan takes seconds
+        from .process import repair_in_process
 
         for name in repairs:
-            mesh = apply_repair(name, mesh)
+            mesh = repair_in_process(name, mesh, lambda *_: None, lambda: False)
         model.set_mesh(mesh, mesh_path, repairs)
     if mesh.hash != mesh_info.get("hash"):
         out.notes.append(

@@ -63,6 +63,7 @@ class ComputeSettings:
     membrane: float = 1.0
     rescale: bool = False
     coarse: bool = False
+    preview: bool = True  # big meshes: a preview spectrum first, the exact one after
 
     def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
         op = operator or self.operator
@@ -241,6 +242,8 @@ class ViewerState:
         """Store a computed spectrum (and its signature table, if already built)."""
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
             raise ValueError("the spectrum does not belong to the loaded mesh")
+        if spec.is_preview and self.has_spectrum(key):
+            return  # the exact spectrum is in already
         self.spectra[key] = spec
         self._latest[key.operator] = key
         if self.display.kind == "mode" and self.display.operator == key.operator:
@@ -268,7 +271,9 @@ class ViewerState:
         return [op for op in OPERATOR_INFO if op in self._latest]
 
     def has_spectrum(self, key: SpectrumKey) -> bool:
-        return key in self.spectra
+        """Whether the exact spectrum of ``key`` is in (a preview does not count)."""
+        spec = self.spectra.get(key)
+        return spec is not None and not spec.is_preview
 
     # --------------------------------------------------------- settings
     def set_compute_settings(self, **changes) -> None:
@@ -574,6 +579,8 @@ class ViewerState:
             lam = float(spec.eigenvalues[j])
             zero = spec.zero_mode_mask()[j]
             value = "0 (zero mode)" if zero else f"{lam:.4g}"
+            if spec.is_preview:
+                value += f" (preview, about {100 * spec.estimated_error:.1g} % high)"
             colours = "blue +, white 0, orange -"
             if spec.is_vector and self.vector_coloring() == "magnitude":
                 colours = "white 0 to red: displacement magnitude"

@@ -63,3 +63,33 @@ def test_fix_slivers_from_the_viewer_improves_the_worst_triangle(tmp_path):
     assert after is not before and model.state.mesh_repairs == ["fix_slivers"]
     assert worst_quality(before) < 0.01 < worst_quality(after)
     assert after.is_closed and after.n_components == 1
+
+
+def test_a_process_that_repaired_and_then_computed_exits_cleanly(tmp_path):
+    """MeshLab run in a worker thread, then MKL's solver, corrupted the heap: the process
+    aborted at exit (status 134, "malloc_consolidate(): unaligned fastbin chunk").  The
+    viewer runs repairs in a child process."""
+    import subprocess
+    import sys
+
+    script = f"""
+import trimesh
+from pathlib import Path
+from modalviewer.core.cache import SpectrumCache
+from modalviewer.core.primitives import add_slivers, icosphere
+from modalviewer.viewer import ViewerModel
+tmp = Path({str(tmp_path)!r})
+v, f = add_slivers(icosphere(3), needles=10, caps=10, eps=1e-4, seed=1)
+trimesh.Trimesh(v, f, process=False).export(tmp / "s.ply")
+model = ViewerModel(cache=SpectrumCache(tmp / "cache"))
+model.open_mesh(tmp / "s.ply")
+job = model.repair("fix_slivers")
+model.jobs.wait(job, timeout=120)
+spec = model.jobs.wait(model.request_spectrum("laplacian", k=20)).result[0]
+print(job.status, spec.k)
+"""
+    run = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=300
+    )
+    assert run.returncode == 0, run.stderr[-1000:]
+    assert run.stdout.split() == ["done", "20"]

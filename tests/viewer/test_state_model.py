@@ -170,3 +170,36 @@ def test_events_fire_once_per_change(model):
     state.set_display(distance_display="threshold")
     state.set_display(distance_display="threshold")
     assert seen == ["style", "display"]
+
+
+def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeypatch):
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    state = model.state
+    exact_job = model.request_spectrum("laplacian", k=20, show=True)
+    preview_job, running = model.jobs.jobs[0], model.jobs.jobs[1]
+    assert running is exact_job and preview_job.description.startswith("preview of")
+    model.jobs.wait(preview_job)
+    spec = state.spectrum("laplacian")
+    assert spec.is_preview and state.display.kind == "mode"
+    assert "preview" in state.legend() and "preview" in state.summary()
+    # the user moves on while the exact spectrum is computed
+    state.show_mode(4)
+    state.set_pick(300)
+    state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
+    preview_map = state.distance_map().copy()
+    model.jobs.wait(exact_job)
+    exact = state.spectrum("laplacian")
+    assert not exact.is_preview and exact is exact_job.result[0]
+    assert state.display.kind == "distance" and state.picked == 300  # kept on screen
+    assert "preview" not in state.legend()
+    exact_map = state.distance_map()
+    assert not np.array_equal(exact_map, preview_map)  # redrawn from the exact spectrum
+    assert np.corrcoef(exact_map, preview_map)[0, 1] > 0.9
+    # Galerkin eigenvalues are upper bounds of the exact ones
+    nonzero = ~exact.zero_mode_mask()
+    assert np.all(spec.eigenvalues[nonzero] >= exact.eigenvalues[nonzero] * (1 - 1e-9))
+    # asking again answers at once with the exact spectrum
+    again = model.request_spectrum("laplacian", k=20)
+    assert again.done and again.result[0] is exact

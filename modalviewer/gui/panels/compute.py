@@ -39,6 +39,12 @@ class ComputePanel(QtWidgets.QWidget):
             "Compute on a copy decimated to about a fifth of the vertices and carry the modes "
             "to this mesh by nearest vertex (paper Section 7): much faster on big meshes."
         )
+        self.preview_check = QtWidgets.QCheckBox("Preview first on big meshes")
+        self.preview_check.setToolTip(
+            "Above 30 000 unknowns, show a preview spectrum (a Galerkin approximation on "
+            "the same mesh, seconds) while the exact one is computed (minutes); the mode, "
+            "pick and map on screen stay when the exact spectrum replaces it."
+        )
         self.compute_button = QtWidgets.QPushButton("Compute spectrum")
         self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")
         form.addRow("Operator", self.operator_combo)
@@ -47,6 +53,7 @@ class ComputePanel(QtWidgets.QWidget):
         form.addRow("Membrane weight", self.membrane_spin)
         form.addRow(self.rescale_check)
         form.addRow(self.coarse_check)
+        form.addRow(self.preview_check)
         form.addRow(self.compute_button)
         self.mesh_info = QtWidgets.QLabel("No mesh")
         self.mesh_info.setWordWrap(True)
@@ -60,6 +67,7 @@ class ComputePanel(QtWidgets.QWidget):
         self.membrane_spin.valueChanged.connect(lambda v: state.set_compute_settings(membrane=v))
         self.rescale_check.toggled.connect(lambda on: state.set_compute_settings(rescale=on))
         self.coarse_check.toggled.connect(lambda on: state.set_compute_settings(coarse=on))
+        self.preview_check.toggled.connect(lambda on: state.set_compute_settings(preview=on))
         self.compute_button.clicked.connect(self.computeRequested)
         state.events.compute_settings.connect(self.update_from_state)
         state.events.mesh.connect(self.update_from_state)
@@ -74,6 +82,7 @@ class ComputePanel(QtWidgets.QWidget):
             self.membrane_spin,
             self.rescale_check,
             self.coarse_check,
+            self.preview_check,
         )
         with quiet(*widgets):
             select_data(self.operator_combo, s.operator)
@@ -82,6 +91,7 @@ class ComputePanel(QtWidgets.QWidget):
             self.membrane_spin.setValue(s.membrane)
             self.rescale_check.setChecked(s.rescale)
             self.coarse_check.setChecked(s.coarse)
+            self.preview_check.setChecked(s.preview)
         weights = OPERATOR_INFO[s.operator].has_weights
         self.bending_spin.setEnabled(weights)
         self.membrane_spin.setEnabled(weights)

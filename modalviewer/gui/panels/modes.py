@@ -126,12 +126,17 @@ class ModesPanel(QtWidgets.QWidget):
         else:
             shown = state.legend().split("\n")[0] or "nothing"
             text = f"Not shown: the surface shows {shown}. Choose a mode to show it."
+        if spec.is_preview:
+            text += (
+                f"\nPreview (eigenvalues about {100 * spec.estimated_error:.1g} % high); "
+                "the exact spectrum replaces it when ready."
+            )
         self.eigen_label.setText(text)
         self.spectrum_plot.set_data(
             np.arange(spec.k),
             np.where(zero, 0.0, spec.eigenvalues),
             state.display.mode if showing_mode else None,
-            title=f"Spectrum: {OPERATOR_INFO[op].label}",
+            title=f"Spectrum{' (preview)' if spec.is_preview else ''}: {OPERATOR_INFO[op].label}",
         )
 
     def _update_style(self) -> None:

@@ -1,0 +1,44 @@
+"""A mesh repair in a child process: ``python -m modalviewer.viewer.repair_main IN OUT``.
+
+IN is a pickle of (repair name, vertices, faces, report) written by
+:func:`modalviewer.viewer.process.repair_in_process`; OUT receives the repaired Mesh
+(pickled).  Progress and errors go to stdout as JSON lines.
+"""
+
+from __future__ import annotations
+
+import json
+import pickle
+import sys
+
+
+def _emit(payload: dict) -> None:
+    sys.stdout.write(json.dumps(payload) + "\n")
+    sys.stdout.flush()
+
+
+def main(argv: list[str] | None = None) -> int:
+    job_path, out_path = sys.argv[1:] if argv is None else argv
+    from ..core.mesh import Mesh
+    from .model import apply_repair
+
+    try:
+        with open(job_path, "rb") as fh:
+            name, vertices, faces, report = pickle.load(fh)
+        mesh = Mesh(vertices, faces, report=report)
+        repaired = apply_repair(
+            name, mesh, progress=lambda stage, f: _emit({"stage": stage, "fraction": f})
+        )
+        with open(out_path, "wb") as fh:
+            pickle.dump(repaired, fh)
+    except MemoryError:
+        _emit({"error": "not enough memory for this repair"})
+        return 1
+    except Exception as exc:  # reported to the viewer as a message
+        _emit({"error": str(exc) or type(exc).__name__})
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
