@@ -186,6 +186,7 @@ class PairWindow(QtWidgets.QWidget):
         layout.addLayout(status)
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
         self.back_markers: dict[str, object] = {"a": None, "b": None}
+        self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
         self._sync_controls()
 
     def _sync_controls(self) -> None:
@@ -260,20 +261,32 @@ class PairWindow(QtWidgets.QWidget):
 
     # =========================================================== drawing
     def redraw(self) -> None:
-        """Draw both sides from the pair state."""
+        """Draw both sides from the pair state; a side whose picture did not change is
+        left alone, and a threshold move on the same distances only changes the colour
+        table and the legend."""
         if self._closed:
             return
         for side in SIDES:
             scene = self.scenes[side]
             if scene is None:
                 continue
-            self._draw(side, scene, self.pair.view(side))
-            self.viewports[side].request_render()
+            if self._draw(side, scene, self.pair.view(side)):
+                self.viewports[side].request_render()
         self._sync_controls()
         self._update_status()
 
-    def _draw(self, side: str, scene: MeshScene, view: PairView) -> None:
-        if view.values is None:
+    def _draw(self, side: str, scene: MeshScene, view: PairView) -> bool:
+        """Bring ``scene`` to ``view``; False if it already showed it."""
+        values_id = None if view.values is None else id(view.values)
+        drawn = self._drawn.get(side)
+        field = (values_id, view.colormap)
+        whole = (field, view.threshold, view.legend, view.marker, view.back_marker)
+        if drawn is not None and drawn[0] == whole and drawn[1] is scene:
+            return False
+        if drawn is not None and drawn[1] is scene and drawn[0][0] == field:
+            if view.colormap == "threshold" and drawn[0][1] != view.threshold:
+                scene.set_threshold(view.threshold)
+        elif view.values is None:
             scene.show_plain()
         elif view.colormap == "threshold":
             scene.show_threshold(view.values, view.threshold, name=view.colorbar_title)
@@ -284,20 +297,25 @@ class PairWindow(QtWidgets.QWidget):
             scene.set_colorbar(None)
         else:
             scene.set_colorbar(view.colorbar_title, labels=view.colorbar_labels)
-        scene.show_marker(view.marker)
-        self._remove_back_marker(side)
-        if view.back_marker is not None:
-            radius = 0.009 * scene.mesh.bounding_box_diagonal
-            sphere = pv.Sphere(radius=radius, center=scene.surface.points[view.back_marker])
-            self.back_markers[side] = scene.plotter.add_mesh(
-                sphere,
-                color=BACK_MARKER_COLOR,
-                name="back_marker",
-                render=False,
-                reset_camera=False,
-                show_scalar_bar=False,
-                scalars=None,
-            )
+        if drawn is None or drawn[1] is not scene or drawn[0][3] != view.marker:
+            scene.show_marker(view.marker)
+        if drawn is None or drawn[1] is not scene or drawn[0][4] != view.back_marker:
+            self._remove_back_marker(side)
+            if view.back_marker is not None:
+                radius = 0.009 * scene.mesh.bounding_box_diagonal
+                sphere = pv.Sphere(radius=radius, center=scene.surface.points[view.back_marker])
+                self.back_markers[side] = scene.plotter.add_mesh(
+                    sphere,
+                    color=BACK_MARKER_COLOR,
+                    name="back_marker",
+                    render=False,
+                    reset_camera=False,
+                    show_scalar_bar=False,
+                    scalars=None,
+                )
+        # keep the values alive with the record, so their id cannot be reused
+        self._drawn[side] = (whole, scene, view.values)
+        return True
 
     def _remove_back_marker(self, side: str) -> None:
         actor = self.back_markers[side]

@@ -153,6 +153,7 @@ class PairState:
         self._failed: dict[tuple[str, str, SpectrumKey], str] = {}
         self._tables: tuple | None = None  # (ids of both spectra, CrossTables or error)
         self._distance: tuple | None = None  # (tables id, pick, distances)
+        self._back: tuple | None = None  # (tables id, side, best match, back match)
 
     # ----------------------------------------------------------- meshes
     def mesh(self, side: str) -> Mesh:
@@ -396,8 +397,11 @@ class PairState:
         if match is None or tables is None:
             return None
         side, w, _ = match
-        d = tables.a_to_b(w) if side == "a" else tables.b_to_a(w)
-        return int(np.argmin(d))
+        key = (id(tables), side, w)
+        if self._back is None or self._back[0] != key:
+            d = tables.a_to_b(w) if side == "a" else tables.b_to_a(w)
+            self._back = (key, int(np.argmin(d)))
+        return self._back[1]
 
     def mutual_best_matches(self, vertices_a, vertices_b=None):
         """:meth:`CrossTables.mutual_best_matches` of picked vertices of A (None if the

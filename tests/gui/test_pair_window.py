@@ -105,6 +105,13 @@ def test_pick_on_a_shows_the_distance_and_best_match_on_b(
     h = right.shape[0]
     ys, xs = np.nonzero(_magenta(right))
     assert np.min(np.hypot(xs - x, ys - (h - 1 - y))) < 6
+    # moving the threshold recolours B only (A's picture is unchanged)
+    renders_a = pair.viewports["a"].render_count
+    pair.share_slider.setValue(200)  # 20 %
+    assert pair.pair.share == pytest.approx(0.2)
+    assert pair.scenes["b"].threshold == pytest.approx(pair.pair.view("b").threshold)
+    assert "20.0 % of B" in pair.scenes["b"].legend_text
+    assert pair.viewports["a"].render_count == renders_a
     big = pair.export_screenshot(tmp_path / "pair2.png", scale=2, transparent=True)
     big_img = Image.open(big)
     assert big_img.mode == "RGBA" and big_img.size[0] >= 2 * img.shape[1] - 8
