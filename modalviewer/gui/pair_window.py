@@ -221,7 +221,6 @@ class PairWindow(QtWidgets.QWidget):
             plotter = self.viewports[side].plotter
             scene = MeshScene(plotter, mesh, vertex_normals(mesh))
             scene.overlay_scale = getattr(self.main.scene, "overlay_scale", 1.0)
-            scene.reset_camera()
             self.scenes[side] = scene
             self.titles[side].setText(
                 f"{side.upper()}: {self.pair.name(side)} ({mesh.n_vertices} vertices)"
@@ -229,7 +228,7 @@ class PairWindow(QtWidgets.QWidget):
         self.setWindowTitle(
             f"modalviewer - shape pair: {self.pair.name('a')} / {self.pair.name('b')}"
         )
-        self.set_linked(self.linked)
+        self._start_views()
         self.redraw()
 
     def _on_main_mesh(self) -> None:
@@ -364,9 +363,9 @@ class PairWindow(QtWidgets.QWidget):
     # ========================================================== cameras
     def set_linked(self, on: bool) -> None:
         """Linked cameras: the two views keep the relative viewpoint they have when the
-        link is made (each mesh's canonical view after opening or R), so turning,
-        zooming or panning one view does the same to the other about its own mesh.
-        Free cameras: turn B by hand to line it up with A, then link them."""
+        link is made (after opening or R: the same direction, each about its own mesh's
+        centre), so turning, zooming or panning one view does the same to the other.
+        Free cameras: turn B by hand to line it up with A (a rotated copy), then link."""
         self.link_check.blockSignals(True)
         self.link_check.setChecked(bool(on))
         self.link_check.blockSignals(False)
@@ -423,12 +422,21 @@ class PairWindow(QtWidgets.QWidget):
         finally:
             self._syncing = False
 
-    def reset_cameras(self) -> None:
-        """Each mesh's canonical first view (R); linked cameras are linked anew."""
-        for side in SIDES:
-            if self.scenes[side] is not None:
-                self.scenes[side].reset_camera()
+    def _start_views(self) -> None:
+        """A's canonical view; B seen from the same direction, about its own centre and
+        at its own size (meshes in one frame, like a shape and its deformed copy, then
+        show the same side); linked cameras are linked anew."""
+        ma, mb = self.pair.mesh("a"), self.pair.mesh("b")
+        self.scenes["a"].reset_camera()
+        factor = mb.bounding_box_diagonal / (ma.bounding_box_diagonal or 1.0)
+        self._link = (np.eye(3), factor, _bbox_centre(ma), _bbox_centre(mb))
+        self._copy_camera("a", "b")
         self.set_linked(self.linked)
+
+    def reset_cameras(self) -> None:
+        """Back to the first views (R): see :meth:`_start_views`."""
+        if self.scenes["a"] is not None and self.scenes["b"] is not None:
+            self._start_views()
         self.render_all()
 
     def render_all(self) -> None:
@@ -614,6 +622,11 @@ class PairWindow(QtWidgets.QWidget):
             if getattr(self.main, "pair_window", None) is self:
                 self.main.pair_window = None
         super().closeEvent(event)
+
+
+def _bbox_centre(mesh: Mesh) -> np.ndarray:
+    v = mesh.vertices
+    return 0.5 * (v.min(axis=0) + v.max(axis=0))
 
 
 def _camera_frame(camera) -> tuple[np.ndarray, float, np.ndarray]:
