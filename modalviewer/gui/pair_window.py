@@ -341,6 +341,8 @@ class PairWindow(QtWidgets.QWidget):
         self.status.setText(text)
 
     def _on_message(self, text: str) -> None:
+        if self._closed:
+            return
         self.status.setText(text)
         if hasattr(self.main, "show_error"):
             self.main.show_error(text, "Shape pair")

@@ -36,7 +36,7 @@ from ..core.laplacian import lumped_masses
 from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
 from ..core.spectrum import Spectrum
-from .jobs import DONE, Job, JobQueue
+from .jobs import CANCELLED, DONE, Job, JobQueue
 from .state import DISTANCE_DISPLAYS, SpectrumKey, ViewerState, default_k
 
 SIDES = ("a", "b")
@@ -326,8 +326,13 @@ class PairState:
             self.events.spectra.emit()
             if key == self.key():
                 self.events.display.emit()
-        elif job.error and not job.error.startswith("superseded"):
-            self._failed[slot] = job.error
+        elif job.status == CANCELLED:
+            # not a failure: the legend says so, and the next request computes again
+            self._failed[slot] = "cancelled; pick again to compute"
+            if key == self.key():
+                self.events.display.emit()
+        else:
+            self._failed[slot] = f"failed: {job.error or 'unknown error'}"
             if key == self.key():
                 self.events.message.emit(
                     f"The {key.describe()} of {side.upper()} ({self.name(side)}) could not "
@@ -427,7 +432,7 @@ class PairState:
     def _missing(self) -> str:
         failure = self.failure()
         if failure:
-            return f"failed: {failure}"
+            return failure
         waiting = [s.upper() for s in SIDES if self.spectrum(s) is None]
         if waiting:
             label = operator_info(self.operator).label

@@ -172,3 +172,24 @@ def test_replacing_a_mesh_cancels_its_jobs_and_drops_the_pick(tmp_path, spot):
     assert pair.name("b") == "other.obj" and pair.spectrum("b") is None
     pair.pick("a", 3)
     assert "computing the Modified Dirichlet energy E_D^N spectrum of B" in pair.view("b").legend
+
+
+def test_a_cancel_is_not_reported_as_a_failure_and_a_failure_is(tmp_path, spot, monkeypatch):
+    pair = _pair(tmp_path, spot, _moved(spot), k=K)
+    messages = []
+    pair.events.message.connect(messages.append)
+    jobs = pair.request()
+    pair.cancel()
+    for job in jobs:
+        pair.jobs.wait(job, timeout=120)
+    pair.pick("a", 5)
+    assert messages == [] and "cancelled; pick again to compute" in pair.view("b").legend
+
+    def broken(*args):
+        raise ValueError("the factorisation broke")
+
+    monkeypatch.setattr("modalviewer.viewer.model._compute", broken)
+    for job in pair.request():  # asked again: computed again (and failing now)
+        pair.jobs.wait(job, timeout=120)
+    assert len(messages) == 2 and "could not be computed: the factorisation broke" in messages[0]
+    assert "failed: the factorisation broke" in pair.view("b").legend
