@@ -538,11 +538,10 @@ class MainWindow(QtWidgets.QMainWindow):
         return job
 
     def cancel_computation(self) -> None:
-        """Cancel the running computation (queued ones keep their turn)."""
-        running = self.model.jobs.running
-        if running is not None:
-            self.model.jobs.cancel(running)
-            self.statusBar().showMessage("Cancelling...", 3000)
+        """Cancel the running computation, and the exact spectrum waiting behind its
+        preview; other queued requests keep their turn."""
+        self.model.cancel_running()
+        self.statusBar().showMessage("Cancelling...", 3000)
 
     def cancel_all(self) -> None:
         self.model.jobs.cancel_all()

@@ -162,6 +162,17 @@ class ViewerModel:
             job.then(self._shower(key, display_at_request))
         return job
 
+    def cancel_running(self) -> None:
+        """Cancel the running job and the jobs of the same spectrum request (a preview
+        and the exact computation behind it)."""
+        running = self.jobs.running
+        if running is None:
+            return
+        key = getattr(running, "spectrum_key", None)
+        for job in list(self.jobs.jobs):
+            if job is running or (key is not None and getattr(job, "spectrum_key", None) == key):
+                self.jobs.cancel(job)
+
     def _wants_preview(self, key: SpectrumKey) -> bool:
         """Preview first: asked for, a big problem, no preview yet, not in the cache."""
         state = self.state

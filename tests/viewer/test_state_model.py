@@ -203,3 +203,19 @@ def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeyp
     # asking again answers at once with the exact spectrum
     again = model.request_spectrum("laplacian", k=20)
     assert again.done and again.result[0] is exact
+
+
+def test_cancel_stops_a_preview_and_the_exact_spectrum_behind_it(model, monkeypatch):
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    exact = model.request_spectrum("shells", k=20)
+    other = model.request_spectrum("laplacian", k=10)
+    preview = model.jobs.running
+    assert preview is not exact and preview.spectrum_key == exact.spectrum_key
+    model.cancel_running()
+    model.jobs.wait(exact)
+    model.jobs.wait(other)
+    assert preview.status == "cancelled" and exact.status == "cancelled"
+    assert other.status == "done"  # another request keeps its turn
+    assert model.state.spectrum("shells") is None
