@@ -213,7 +213,10 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     try:
         import pymeshlab
     except ImportError:
-        raise MeshError("fix_slivers needs the pymeshlab package (pip install pymeshlab)") from None
+        raise MeshError(
+            "fix_slivers needs the optional pymeshlab package (GPL-3.0): "
+            "pip install 'modalviewer[repair]' (or pip install pymeshlab)"
+        ) from None
 
     before = _topology(mesh)
     names = (
