@@ -6,7 +6,7 @@ import pytest
 import scipy.linalg as la
 
 import modalviewer as mv
-from modalviewer.core.eigen import EigenError, block_krylov_schur, solve_lowest
+from modalviewer.core.eigen import EigenError, block_krylov_schur, solve_lowest, zero_modes
 from modalviewer.core.nullspace import null_space
 from modalviewer.core.pipeline import ZeroModesWarning, operator_matrices
 from modalviewer.core.primitives import grid_plate, icosphere, torus
@@ -164,6 +164,17 @@ def test_zero_mode_mask_does_not_depend_on_k():
         mask = spec.zero_mode_mask()
         assert mask[:6].all() and not mask[6:].any(), k
         assert spec.null_space_dimension == 6
+
+
+def test_low_vibrations_of_fine_meshes_are_not_zero_modes():
+    # numbers of the shells on cheburashka subdivided twice (107k vertices): the typical
+    # eigenvalue size is 1.58e11, the first vibrations 631 to 1566; 1e-8 of the typical
+    # size (the rule before) called them zero modes and exempted them from the check
+    lam = np.array([0.0] * 6 + [631.02, 1177.83, 1409.83, 1566.29, 2549.8, 3402.11])
+    mask = zero_modes(lam, lam_scale=1.58e11, null_dim=6)
+    assert mask.tolist() == [True] * 6 + [False] * 6
+    # undeflated rounding noise is still a zero mode
+    assert zero_modes(np.array([3e-2, 631.0]), lam_scale=1.58e11).tolist() == [True, False]
 
 
 def test_saved_spectrum_keeps_the_zero_modes(three_spheres, tmp_path):
