@@ -41,9 +41,10 @@ class ComputePanel(QtWidgets.QWidget):
         )
         self.preview_check = QtWidgets.QCheckBox("Preview first on big meshes")
         self.preview_check.setToolTip(
-            "Above 30 000 unknowns, show a preview spectrum (a Galerkin approximation on "
-            "the same mesh, seconds) while the exact one is computed (minutes); the mode, "
-            "pick and map on screen stay when the exact spectrum replaces it."
+            "Scalar operators above 30 000 vertices: show a preview spectrum (a Galerkin "
+            "approximation on the same mesh, seconds) while the exact one is computed; the "
+            "mode, pick and map on screen stay when the exact spectrum replaces it. Not "
+            "for the 3D shells, whose preview is neither fast nor close enough."
         )
         self.compute_button = QtWidgets.QPushButton("Compute spectrum")
         self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")
