@@ -187,10 +187,69 @@ def reduced_basis(
     """
     centers = farthest_point_samples(mesh.vertices, samples, seed=seed)
     P, r = partition_of_unity_basis(mesh, centers, radius_factor, enrich)
-    info = {"samples": int(len(centers)), "support_radius": r, "enriched": bool(enrich)}
+    info = {
+        "samples": int(len(centers)),
+        "support_radius": r,
+        "enriched": bool(enrich),
+        "components_per_function": 3 if operator == "shells" else 1,
+    }
     if operator == "shells":
         return sp.kron(P, sp.eye(3), format="csr"), rotation_fields(mesh), info
     return P, None, info
+
+
+MAX_NULL_COLUMNS = 96
+"""Exact null vectors (:mod:`.nullspace`) are added to the reduced space up to this
+many (a mesh of many components, e.g. a broken scan, has six rigid motions each)."""
+
+
+def _null_space_complement(mesh, operator, K, mass, P, D, Mr) -> np.ndarray | None:
+    """Dense columns that complete span [P D] to contain the operator's exact null
+    vectors (constants and rigid motions per connected component), or None.
+
+    The Mass-orthogonal projection of each null vector onto the reduced space is removed;
+    what remains (for example the rotations of a second component, or its constant
+    where basis functions straddle two components) is Mass-orthonormalised, and parts
+    below 1e-8 of the vector are dropped (already contained).
+    """
+    from .nullspace import null_space
+
+    Z = null_space(mesh, operator, K, mass).vectors
+    if Z.shape[1] == 0 or Z.shape[1] > MAX_NULL_COLUMNS:
+        return None
+    Z = Z.toarray()
+    MZ = mass[:, None] * Z
+    rhs = np.asarray(P.T @ MZ)
+    if D is not None:
+        rhs = np.vstack([rhs, D.T @ MZ])
+    import scipy.linalg as la
+
+    A = Mr.toarray() if Mr.shape[0] <= 4000 else None
+    if A is not None:
+        w, V = la.eigh(A)
+        keep = w > 1e-12 * w.max()
+        c = V[:, keep] @ ((V[:, keep].T @ rhs) / w[keep, None])
+    else:
+        c = SPDSolver(Mr).solve(rhs)
+    R = Z - np.asarray(P @ c[: P.shape[1]])
+    if D is not None:
+        R -= D @ c[P.shape[1] :]
+    G = R.T @ (mass[:, None] * R)
+    w, V = np.linalg.eigh(0.5 * (G + G.T))
+    keep = w > 1e-16 * max(1.0, float(np.max(np.diag(Z.T @ MZ))))
+    if not keep.any():
+        return None
+    return R @ (V[:, keep] / np.sqrt(w[keep]))
+
+
+def _extend(A: sp.csr_matrix, K, P, D, E: np.ndarray) -> sp.csr_matrix:
+    """``[X E]^T K [X E]`` from ``A = X^T K X`` with ``X = [P D]`` (E dense)."""
+    KE = np.asarray(K @ E)
+    cross = np.asarray(P.T @ KE)
+    if D is not None:
+        cross = np.vstack([cross, D.T @ KE])
+    B = sp.bmat([[A, sp.csr_matrix(cross)], [sp.csr_matrix(cross.T), sp.csr_matrix(E.T @ KE)]])
+    return (0.5 * (B + B.T)).tocsr()
 
 
 def _in_two_threads(fn, items):
@@ -476,6 +535,11 @@ def preview_spectrum(
     report("preview: projecting", 0.2)
     Kr = _project(K, P, D)
     Mr = _project_mass(mass, P, D)
+    E = _null_space_complement(mesh, operator, K, mass, P, D, Mr)
+    if E is not None:  # exact null vectors the space lacks (components, rotations)
+        Kr, Mr = _extend(Kr, K, P, D, E), _extend(Mr, sp.diags(mass), P, D, E)
+        D = E if D is None else np.hstack([D, E])
+    info["null_space_columns_added"] = 0 if E is None else int(E.shape[1])
     seconds["projection"] = time.perf_counter() - t
     t = time.perf_counter()
     dim = Kr.shape[0]
@@ -518,10 +582,11 @@ def _nested_eigenvalues(Kr, Mr, P, D, info, k: int) -> np.ndarray:
     """Ritz values of the partition-of-unity functions alone (with the dense columns), a
     subspace of the enriched space: each is at least the enriched space's one; inf where
     the subspace is too small."""
-    q = P.shape[1] // max(info["samples"] * (3 if D is not None else 1), 1)
+    dims = info["components_per_function"]
+    q = P.shape[1] // max(info["samples"] * dims, 1)
     if not info["enriched"] or q <= 1:
         return np.full(k, np.inf)
-    step = q * (3 if D is not None else 1)
+    step = q * dims
     cols = np.arange(P.shape[1]).reshape(-1, step)[:, : step // q].ravel()
     if D is not None:
         cols = np.concatenate([cols, np.arange(P.shape[1], Kr.shape[0])])

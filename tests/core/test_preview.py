@@ -168,3 +168,21 @@ def test_cli_compute_preview(tmp_path, capsys):
     assert spec.is_preview and spec.k == 12 and 0 < spec.estimated_error < 1
     assert main(args) == 0
     assert not mv.load_spectrum(out).is_preview
+
+
+@pytest.mark.parametrize("operator,zeros", [("laplacian", 2), ("shells", 12)])
+def test_every_component_keeps_its_exact_zero_modes(operator, zeros):
+    # two tori 0.4 apart: basis functions straddle both, and the global rotations alone
+    # miss the second component's (without the null vectors: 1 and 6 zero modes; the
+    # second constant came out as 0.15, the other rigid motions as 0.37 to 5.9)
+    a, b = torus(24, 10), torus(20, 8)
+    mesh = mv.Mesh(
+        np.vstack([a.vertices, b.vertices + [2.7, 0.3, 0.2]]),
+        np.vstack([a.faces, b.faces + a.n_vertices]),
+    )
+    spec = mv.compute_spectrum(mesh, operator, k=zeros + 4, accuracy="preview")
+    assert int(spec.zero_mode_mask().sum()) == zeros
+    lam = spec.eigenvalues
+    assert np.all(np.abs(lam[:zeros]) < 1e-9 * lam[zeros])
+    exact = _exact(mesh, operator, zeros + 4)
+    assert np.all(lam >= exact - 1e-9 * exact.max())
