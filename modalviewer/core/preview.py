@@ -224,13 +224,15 @@ def _null_space_complement(mesh, operator, K, mass, P, D, Mr) -> np.ndarray | No
         rhs = np.vstack([rhs, D.T @ MZ])
     import scipy.linalg as la
 
-    A = Mr.toarray() if Mr.shape[0] <= 4000 else None
-    if A is not None:
-        w, V = la.eigh(A)
+    try:
+        if Mr.shape[0] <= 4000:
+            c = la.cho_solve(la.cho_factor(Mr.toarray()), rhs)
+        else:
+            c = SPDSolver(Mr).solve(rhs)
+    except np.linalg.LinAlgError:  # numerically dependent functions: least squares
+        w, V = la.eigh(Mr.toarray())
         keep = w > 1e-12 * w.max()
         c = V[:, keep] @ ((V[:, keep].T @ rhs) / w[keep, None])
-    else:
-        c = SPDSolver(Mr).solve(rhs)
     R = Z - np.asarray(P @ c[: P.shape[1]])
     if D is not None:
         R -= D @ c[P.shape[1] :]
