@@ -609,8 +609,16 @@ def compute_preview(
 ) -> Spectrum:
     """``compute_spectrum(..., accuracy="preview")``: a :class:`Spectrum` whose
     ``parameters["preview"]`` holds the reduced space, timings and estimated errors
-    (``spec.is_preview``, ``spec.estimated_error``)."""
-    from .pipeline import operator_matrices
+    (``spec.is_preview``, ``spec.estimated_error``).
+
+    A mesh too small for a reduced space of 3 k functions (at most one sample per 6
+    vertices) gets the exact spectrum instead, which is quick there (``is_preview``
+    False)."""
+    from .pipeline import compute_spectrum, operator_matrices
+
+    per_sample = 9 if operator == "shells" else 3
+    if (mesh.n_vertices // 6) * per_sample < 3 * int(k):
+        return compute_spectrum(mesh, operator, k, bending, membrane, progress, cancel)
 
     started = time.perf_counter()
     if cancel is not None and cancel():

@@ -186,3 +186,13 @@ def test_every_component_keeps_its_exact_zero_modes(operator, zeros):
     assert np.all(np.abs(lam[:zeros]) < 1e-9 * lam[zeros])
     exact = _exact(mesh, operator, zeros + 4)
     assert np.all(lam >= exact - 1e-9 * exact.max())
+
+
+def test_a_mesh_too_small_for_a_preview_gets_the_exact_spectrum():
+    from modalviewer.core.primitives import icosphere
+
+    mesh = icosphere(1)  # 42 vertices: 7 samples, 21 scalar functions
+    spec = mv.compute_spectrum(mesh, "laplacian", k=30, accuracy="preview")
+    assert not spec.is_preview and spec.k == 30
+    np.testing.assert_allclose(spec.eigenvalues[1:], _exact(mesh, "laplacian", 30)[1:], rtol=1e-8)
+    assert mv.compute_spectrum(mesh, "shells", k=20, accuracy="preview").is_preview
