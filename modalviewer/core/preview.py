@@ -306,9 +306,13 @@ def _solve_reduced(
     if N <= max(1000, 3 * k):
         import scipy.linalg as la
 
+        A, B = Kr.toarray(), Mr.toarray()
+        try:
+            return la.eigh(A, B, subset_by_index=[0, k - 1], driver="gvx")
+        except np.linalg.LinAlgError:
+            pass
         # the Mr-orthonormal eigenbasis of Mr's range: functions that vanish on the mesh
         # (linearly dependent columns, when samples are as dense as the vertices) drop out
-        A, B = Kr.toarray(), Mr.toarray()
         d = 1.0 / np.sqrt(np.maximum(np.diag(B), 1e-300))
         w, E = la.eigh(B * np.outer(d, d))
         keep = w > 1e-12 * w.max()
