@@ -12,6 +12,7 @@ from .eigen import (
     CancelFn,
     EigenError,
     ProgressFn,
+    rounding_floors,
     solve_lowest,
     typical_eigenvalue,
     zero_modes,
@@ -32,13 +33,22 @@ __all__ = [
 ]
 
 
+FLOOR_FACTOR = 10.0
+"""Residuals above RESIDUAL_LIMIT are accepted up to this times their rounding floor
+(LAPACK's dense eigenvectors land at 1.4 to 2.7 times it on a small ellipsoid, the
+Krylov solver's at 0.2 to 0.6 times it on the 107k cheburashka)."""
+
+
 class ZeroModesWarning(UserWarning):
     """Every requested mode is an exact zero mode (constants or rigid motions of the
     mesh's components): nothing of the shape's vibrations is in the spectrum."""
 
 
 RESIDUAL_LIMIT = 1e-4
-"""A spectrum whose non-zero modes have a larger relative residual is rejected.
+"""A spectrum whose non-zero modes have a larger relative residual is rejected, unless
+the residual is within ``FLOOR_FACTOR`` of the mode's rounding floor
+(:func:`.eigen.rounding_floors`: what rounding the mode to double precision alone can
+cause; no solver does better).
 
 On well-shaped meshes the residuals are around 1e-10 (the tests require 1e-8); sliver
 triangles make the operator ill-conditioned (largest/smallest eigenvalue ~1e13 on an
@@ -150,12 +160,18 @@ def compute_spectrum(
         )
     lam_typical = typical_eigenvalue(K, mass)
     nonzero = ~zero_modes(result.eigenvalues, lam_typical, result.null_dim)
-    worst = float(result.residuals[nonzero].max()) if nonzero.any() else 0.0
-    if worst > RESIDUAL_LIMIT:
-        raise EigenError(
-            f"the eigensolver's residual {worst:.1e} is above {RESIDUAL_LIMIT:.0e}; "
-            f"the result is not trustworthy{_failure_hint(mesh)}"
-        )
+    above = np.flatnonzero(nonzero & (result.residuals > RESIDUAL_LIMIT))
+    at_floor = 0
+    if above.size:
+        floors = rounding_floors(K, mass, result.eigenvalues[above], result.vectors[:, above])
+        bad = above[result.residuals[above] > FLOOR_FACTOR * floors]
+        if bad.size:
+            worst = float(result.residuals[bad].max())
+            raise EigenError(
+                f"the eigensolver's residual {worst:.1e} is above {RESIDUAL_LIMIT:.0e} and "
+                f"above the rounding floor; the result is not trustworthy{_failure_hint(mesh)}"
+            )
+        at_floor = int(above.size)
     n = mesh.n_vertices
     modes = result.vectors
     per_vertex = operator_info(operator).unknowns_per_vertex
@@ -181,6 +197,7 @@ def compute_spectrum(
             "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
             "operator_columns": result.operator_columns,
             "null_space_dimension": result.null_dim,
+            "modes_at_rounding_floor": at_floor,
             "zero_mode_scale": lam_typical,
             "n_components": nulls.n_components,
             "null_space": nulls.summary(),

@@ -6,7 +6,14 @@ import pytest
 import scipy.linalg as la
 
 import modalviewer as mv
-from modalviewer.core.eigen import EigenError, block_krylov_schur, solve_lowest, zero_modes
+from modalviewer.core.eigen import (
+    EigenError,
+    block_krylov_schur,
+    relative_residuals,
+    rounding_floors,
+    solve_lowest,
+    zero_modes,
+)
 from modalviewer.core.nullspace import null_space
 from modalviewer.core.pipeline import ZeroModesWarning, operator_matrices
 from modalviewer.core.primitives import grid_plate, icosphere, torus
@@ -215,3 +222,37 @@ def test_bad_null_space_is_refused(three_spheres):
         solve_lowest(K, mass, 5, null_space=np.ones((K.shape[0], 1)))
     with pytest.raises(ValueError, match="rows"):
         solve_lowest(K, mass, 5, null_space=np.ones((3, 1)))
+
+
+def test_rounding_floor_bounds_what_rounding_does(three_spheres):
+    K, mass = operator_matrices(three_spheres, "shells")
+    lam, X = la.eigh(K.toarray(), np.diag(mass), subset_by_index=[18, 23])
+    rng = np.random.default_rng(0)
+    rounded = X * (1.0 + np.finfo(float).eps * rng.uniform(-1, 1, X.shape))
+    floors = rounding_floors(K, mass, lam, rounded)
+    res = relative_residuals(K, mass, lam, rounded)
+    # LAPACK's vectors and their rounding land at 1 to 3 times the floor (measured 1.4-2.7)
+    assert np.all(res <= 4.0 * floors) and np.all(floors < 1e-10)
+    noisy = X + 1e-6 * rng.standard_normal(X.shape) * np.abs(X).max()
+    assert np.all(relative_residuals(K, mass, lam, noisy) > 1e3 * floors)
+
+
+def test_residual_check_accepts_the_rounding_floor_and_rejects_garbage(monkeypatch):
+    import modalviewer.core.pipeline as pipeline
+
+    s = icosphere(2)  # 486 unknowns: the dense solver, residuals at the rounding floor
+    ellipsoid = mv.Mesh(s.vertices * [1.0, 0.8, 1.3], s.faces)
+    monkeypatch.setattr(pipeline, "RESIDUAL_LIMIT", 1e-300)  # every mode is "above" it
+    spec = mv.compute_spectrum(ellipsoid, "shells", k=30)
+    assert spec.parameters["modes_at_rounding_floor"] == 24
+    real = pipeline.solve_lowest
+
+    def spoiled(*args, **kwargs):
+        result = real(*args, **kwargs)
+        result.vectors[:, -1] += 1e-6 * result.vectors[:, -2]
+        result.residuals[-1] = 1e-3
+        return result
+
+    monkeypatch.setattr(pipeline, "solve_lowest", spoiled)
+    with pytest.raises(EigenError, match="above the rounding floor"):
+        mv.compute_spectrum(ellipsoid, "shells", k=30)
