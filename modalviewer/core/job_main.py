@@ -38,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
             float(params["bending"]),
             float(params["membrane"]),
             progress=lambda stage, fraction: _emit({"stage": stage, "fraction": fraction}),
+            accuracy=params.get("accuracy", "exact"),
         )
         save_spectrum(spec, out_path)
     except MemoryError:

@@ -53,6 +53,7 @@ class SceneView(QtCore.QObject):
             self.scene = MeshScene(
                 self.plotter, mesh, self.state.normals, style=self.state.style.render
             )
+            self._show_outline(mesh)
             self.reset_camera()
         self._update_colorbar()
         self.viewport.request_render()
@@ -119,6 +120,29 @@ class SceneView(QtCore.QObject):
         )
         if self.state.animation.playing:
             self._phase = 0.0
+
+    def _show_outline(self, mesh) -> None:
+        """The mesh's boundary as thin grey lines: in the paper style a surface facing
+        the viewer is as white as the background, so an open mesh (a plate) seen from
+        the front had no visible edge.  Hidden while a mode vibrates (it would stay put)."""
+        import pyvista as pv
+
+        self.plotter.remove_actor("outline", render=False)
+        self.outline_actor = None
+        boundary = mesh.edges[mesh.edge_face_counts == 1]
+        if len(boundary) == 0:
+            return
+        cells = np.column_stack([np.full(len(boundary), 2), boundary]).ravel()
+        lines = pv.PolyData(np.asarray(mesh.vertices, dtype=np.float64), lines=cells)
+        self.outline_actor = self.plotter.add_mesh(
+            lines,
+            color=(0.45, 0.45, 0.45),
+            line_width=1.5,
+            name="outline",
+            render=False,
+            reset_camera=False,
+            show_scalar_bar=False,
+        )
 
     def _on_pick(self) -> None:
         if self.scene is not None:
@@ -187,6 +211,9 @@ class SceneView(QtCore.QObject):
 
     # --------------------------------------------------------- animation
     def _on_animation(self) -> None:
+        outline = getattr(self, "outline_actor", None)
+        if outline is not None:
+            outline.SetVisibility(not self.state.animation.playing)
         if self.state.animation.playing and self.scene is not None:
             self._last_tick = time.perf_counter()
             self.timer.start()

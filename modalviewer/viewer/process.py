@@ -86,10 +86,18 @@ def _temp_path(suffix: str) -> str:
     return path
 
 
-def compute_in_process(mesh, operator, k, bending, membrane, out_path, progress, cancel):
+def compute_in_process(
+    mesh, operator, k, bending, membrane, out_path, progress, cancel, accuracy="exact"
+):
     """Run ``modalviewer.core.job_main`` in a child Python; returns the Spectrum read back
     from ``out_path``; the child's error message is raised as RuntimeError."""
-    params = {"operator": operator, "k": int(k), "bending": bending, "membrane": membrane}
+    params = {
+        "operator": operator,
+        "k": int(k),
+        "bending": bending,
+        "membrane": membrane,
+        "accuracy": accuracy,
+    }
     job_path = _temp_path(".npz")
     try:
         np.savez(job_path, vertices=mesh.vertices, faces=mesh.faces, params=json.dumps(params))

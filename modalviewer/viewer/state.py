@@ -592,16 +592,16 @@ class ViewerState:
             dist = self.distance_map()
             if dist is None:
                 return f"{name}: {self._missing_distance_reason(d.distance_kind)}"
+            source = f"from vertex {self.picked}"
+            if self.spectrum(operator_for_distance(d.distance_kind)).is_preview:
+                source += " (preview spectrum; the exact one follows)"
             if d.distance_display == "threshold":
                 thr = self.threshold_value(dist)
                 share = 100.0 * float(np.mean(dist <= thr))
-                return (
-                    f"blue: {name.lower()} < {thr:.3g}, {share:.1f} % of the surface\n"
-                    f"from vertex {self.picked}"
-                )
+                return f"blue: {name.lower()} < {thr:.3g}, {share:.1f} % of the surface\n{source}"
             t1, t2 = self.scale_limits()
             return (
-                f"{name} from vertex {self.picked}: white 0 to red {float(dist.max()):.3g}\n"
+                f"{name} {source}: white 0 to red {float(dist.max()):.3g}\n"
                 f"scales t = {t1:.3g} .. {t2:.3g}"
             )
         if d.kind == "signature":
