@@ -430,9 +430,17 @@ class MainWindow(QtWidgets.QMainWindow):
             event.acceptProposedAction()
 
     def dropEvent(self, event):  # noqa: N802
+        """A file dropped on the left half opens as the mesh; on the right half, with a
+        mesh open, as the second mesh of a shape pair."""
         urls = event.mimeData().urls()
-        if urls:
-            self.open_mesh(urls[0].toLocalFile())
+        if not urls:
+            return
+        path = urls[0].toLocalFile()
+        x = event.position().x() if hasattr(event, "position") else event.pos().x()
+        if self.state.mesh is not None and x > self.width() / 2:
+            self.open_second_mesh(path, wait=False)
+        else:
+            self.open_mesh(path)
 
     def open_mesh(self, path) -> bool:
         """Load a mesh file and show it; returns False (after a message) if it failed."""
@@ -974,4 +982,5 @@ Everywhere
   R: canonical view    Alt+1..Alt+6: from +X, -X, +Y, -Y, +Z, -Z    Alt+7: isometric
   Ctrl+R: compute    Esc: cancel the running computation
   Ctrl+1 / Ctrl+2: compare operators / distances    Ctrl+E: export screenshot
-  Ctrl+S / Ctrl+Shift+O: save / open session    Ctrl+O: open mesh"""
+  Ctrl+S / Ctrl+Shift+O: save / open session    Ctrl+O: open mesh
+  Ctrl+Shift+B: open a second mesh beside this one (or drop a file on the right half)"""
