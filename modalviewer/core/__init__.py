@@ -21,7 +21,7 @@ from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
 from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
 from .mesh import Mesh, MeshError, MeshReport, repair_mesh
-from .pipeline import compute_spectrum
+from .pipeline import ZeroModesWarning, compute_spectrum
 from .shells import normal_shells_hessian, shells_hessian
 from .signatures import SignatureTable, default_times, multiscale_distance, signature
 from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, save_spectrum
@@ -50,6 +50,7 @@ __all__ = [
     "Spectrum",
     "SpectrumFileError",
     "compute_spectrum",
+    "ZeroModesWarning",
     "default_times",
     "load_spectrum",
     "mass_matrix",
