@@ -74,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     from qtpy import QtWidgets
 
-    from .main_window import DEFAULT_MESH, SCREENSHOTS, MainWindow
+    from .main_window import MainWindow
+    from .paths import DEFAULT_MESH, SCREENSHOTS
 
     app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
     app.setApplicationName("modalviewer")

@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-from qtpy import QtCore, QtWidgets
+from qtpy import QtCore, QtGui, QtWidgets
 
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from .scene import MeshScene
@@ -61,7 +61,23 @@ class CompareWindow(QtWidgets.QWidget):
         self.mode_index = 0 if self.distances else self.state.first_nonzero_mode(first)
         for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event.connect(self._on_state)
+        # On a desktop the focused 3D view (pyvistaqt's QtInteractor) takes key presses
+        # before this window's keyPressEvent sees them; window shortcuts come first.
+        context = QtCore.Qt.ShortcutContext.WidgetWithChildrenShortcut
+        for key, slot in (
+            ("Escape", self.close),
+            ("Ctrl+W", self.close),
+            ("Right", lambda: self._step(+1)),
+            ("Left", lambda: self._step(-1)),
+        ):
+            shortcut = QtGui.QShortcut(QtGui.QKeySequence(key), self)
+            shortcut.setContext(context)
+            shortcut.activated.connect(slot)
         self.resize(420 * len(items), 480)
+
+    def _step(self, step: int) -> None:
+        if not self.distances:
+            self.show_mode(self.mode_index + step)
 
     def keyPressEvent(self, event):  # noqa: N802
         """Esc and Ctrl+W close; Left / Right step the mode of operator views."""

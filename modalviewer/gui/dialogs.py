@@ -28,6 +28,7 @@ class ScreenshotDialog(QtWidgets.QDialog):
         self.setWindowTitle("Export screenshot")
         form = QtWidgets.QFormLayout(self)
         self.path_edit = QtWidgets.QLineEdit(str(Path(start_dir) / "figure.png"))
+        self.path_edit.setMinimumWidth(420)
         browse = QtWidgets.QPushButton("...")
         browse.clicked.connect(self._browse)
         row = QtWidgets.QHBoxLayout()

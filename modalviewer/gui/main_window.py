@@ -17,26 +17,24 @@ import os
 from pathlib import Path
 
 import numpy as np
-from qtpy import QtCore, QtGui, QtWidgets
+from qtpy import QtCore, QtWidgets
 
 from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
-from ..core.spectrum import Spectrum, save_spectrum
-from ..io import SUPPORTED_EXTENSIONS
+from ..core.spectrum import Spectrum
 from ..viewer.jobs import DONE, Job
 from ..viewer.model import (
-    REPAIRS,
     ComputeRefused,
     ViewerModel,
     cost_estimate,
     worst_residual,
 )
-from ..viewer.state import RENDER_STYLES, SHELL_COLORINGS
+from . import menus, window_settings
 from .compare import CompareWindow
-from .dialogs import ScreenshotDialog, ask
+from .dialogs import ask
 from .export import save_field_mesh, save_screenshot
-from .pair_window import PairWindow, open_pair_window, open_second_mesh_dialog
+from .pair_window import PairWindow, open_pair_window
 from .panels import (
     AnimationPanel,
     ComputePanel,
@@ -50,22 +48,6 @@ from .scene_view import SceneView
 from .viewport import make_viewport
 
 log = logging.getLogger("modalviewer")
-
-ASSETS = Path(__file__).resolve().parents[2] / "assets"
-DEFAULT_MESH = ASSETS / "spot.obj"
-SCREENSHOTS = Path(__file__).resolve().parents[2] / "screenshots"
-
-
-def settings() -> QtCore.QSettings:
-    path = os.environ.get("MODALVIEWER_SETTINGS")
-    if path:
-        return QtCore.QSettings(path, QtCore.QSettings.Format.IniFormat)
-    return QtCore.QSettings("modalviewer", "modalviewer")
-
-
-def headless() -> bool:
-    """True on Qt's off-screen or minimal platform (no desktop to remember)."""
-    return QtGui.QGuiApplication.platformName() in ("offscreen", "minimal")
 
 
 class ComputeError(RuntimeError):
@@ -87,9 +69,11 @@ class MainWindow(QtWidgets.QMainWindow):
         super().__init__()
         self.setWindowTitle("modalviewer")
         self.setAcceptDrops(True)
-        self.settings = settings()
+        self.settings = window_settings.settings()
         self.remember_settings = (
-            (not headless()) if remember_settings is None else bool(remember_settings)
+            (not window_settings.headless())
+            if remember_settings is None
+            else bool(remember_settings)
         )
         self.dispatcher = QtDispatcher(self)
         self.model = ViewerModel(cache=cache, dispatch=self.dispatcher)
@@ -118,14 +102,14 @@ class MainWindow(QtWidgets.QMainWindow):
             lambda: self.show_signature(self.state.display.signature_sample)
         )
         self._build_docks()
-        self._build_menus()
+        menus.build_menus(self)
         self._build_status_bar()
 
         self.state.events.mesh.connect(self._on_mesh)
         self.state.events.spectra.connect(self.spectrumReady.emit)
         self.model.jobs.events.changed.connect(self._on_job_changed)
         self.model.jobs.events.finished.connect(self._on_job_finished)
-        self._restore_settings()
+        window_settings.restore(self)
 
     # ================================================================== UI
     def _build_docks(self) -> None:
@@ -161,112 +145,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
-    def _action(self, menu, text, slot, shortcut=None, tip=None) -> QtGui.QAction:
-        action = QtGui.QAction(text, self)
-        if shortcut:
-            action.setShortcut(QtGui.QKeySequence(shortcut))
-        if tip:
-            action.setStatusTip(tip)
-        action.triggered.connect(slot)
-        menu.addAction(action)
-        return action
-
-    def _build_menus(self) -> None:
-        bar = self.menuBar()
-        m = bar.addMenu("&File")
-        self._action(m, "&Open mesh...", self._open_dialog, "Ctrl+O")
-        self.recent_menu = m.addMenu("Open &recent")
-        self._action(
-            m,
-            "Open &second mesh (shape pair)...",
-            lambda: open_second_mesh_dialog(self),
-            "Ctrl+Shift+B",
-            "Open mesh B beside this mesh: a click on one shows the similar points on the other",
-        )
-        m.addSeparator()
-        self._action(m, "Open s&ession...", self._open_session_dialog, "Ctrl+Shift+O")
-        self._action(m, "Save se&ssion...", self._save_session_dialog, "Ctrl+S")
-        m.addSeparator()
-        self._action(m, "Export &screenshot...", self._screenshot_dialog, "Ctrl+E")
-        self._action(m, "Export per-vertex &field (PLY/VTP)...", self._field_dialog, "Ctrl+Shift+E")
-        self._action(m, "Export s&pectrum (.npz)...", self._spectrum_dialog, "Ctrl+Shift+S")
-        m.addSeparator()
-        self.clear_cache_action = self._action(
-            m, "Clear spectrum &cache...", self._clear_cache_dialog
-        )
-        m.aboutToShow.connect(self._update_cache_label)
-        m.addSeparator()
-        self._action(m, "&Quit", self.close, "Ctrl+Q")
-        m = bar.addMenu("&Mesh")
-        for name, label in REPAIRS.items():
-            self._action(m, label + "...", lambda _=False, n=name: self.repair_mesh(n, wait=False))
-        m = bar.addMenu("&Compute")
-        self._action(m, "&Compute spectrum", lambda: self.compute(wait=False), "Ctrl+R")
-        self._action(m, "C&ancel running computation", self.cancel_computation, "Esc")
-        self._action(m, "Cancel &all computations", self.cancel_all, "Ctrl+Shift+Esc")
-        m = bar.addMenu("&View")
-        self._action(m, "&Next mode", lambda: self.step_mode(+1), "Ctrl+Right")
-        self._action(m, "&Previous mode", lambda: self.step_mode(-1), "Ctrl+Left")
-        self._action(m, "Play / pause animation", self.toggle_animation, "P")
-        self._action(m, "Show &mode", self._show_current_mode, "M")
-        self._action(m, "Show &distance", lambda: self.show_distance(), "D")
-        self._action(m, "Show &curvature sqrt(k1^2 + k2^2)", self.show_curvature, "C")
-        self.colorbar_action = self._action(
-            m, "Colour &bar and legend", lambda on: self.state.set_colorbar(on), "B"
-        )
-        self.colorbar_action.setCheckable(True)
-        self.state.events.style.connect(
-            lambda: self.colorbar_action.setChecked(self.state.style.colorbar)
-        )
-        self.shaded_action = self._action(
-            m,
-            "S&haded look (light kit, greyer)",
-            lambda on: self.state.set_render_style("shaded" if on else "paper"),
-            "Shift+S",
-        )
-        self.shaded_action.setCheckable(True)
-        self.state.events.style.connect(
-            lambda: self.shaded_action.setChecked(self.state.style.render == "shaded")
-        )
-        self._action(m, "&Reset camera", self.scene_view.reset_camera, "R")
-        views = m.addMenu("Camera &presets")
-        for name, label, key in (
-            ("+x", "From +X", "Alt+1"),
-            ("-x", "From -X", "Alt+2"),
-            ("+y", "From +Y", "Alt+3"),
-            ("-y", "From -Y", "Alt+4"),
-            ("+z", "From +Z", "Alt+5"),
-            ("-z", "From -Z", "Alt+6"),
-            ("isometric", "Isometric", "Alt+7"),
-        ):
-            self._action(
-                views, label, lambda _=False, n=name: self.scene_view.camera_preset(n), key
-            )
-        m.addSeparator()
-        self._action(
-            m,
-            "Compare &operators (Laplacian, E_D^N, shells normal)...",
-            lambda: self.open_comparison(
-                ["laplacian", "modified_dirichlet", "shells_normal"], wait=False
-            ),
-            "Ctrl+1",
-        )
-        self._action(
-            m,
-            "Compare d&istances (vibration, heat kernel)...",
-            lambda: self.open_comparison(["vibration", "hks"], wait=False),
-            "Ctrl+2",
-        )
-        m = bar.addMenu("&Help")
-        self._action(m, "&Controls", self._controls)
-        self._action(m, "&About", self._about)
-
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
         self.status_line = StatusLine(self.state)
-        bar.addPermanentWidget(self.status_line, 1)
+        self.status_line.setMaximumWidth(620)
+        bar.addPermanentWidget(self.status_line)
         self.progress = QtWidgets.QProgressBar()
-        self.progress.setMaximumWidth(240)
+        self.progress.setFixedWidth(260)
         self.progress.setRange(0, 1000)
         self.progress.hide()
         self.cancel_button = QtWidgets.QPushButton("Cancel")
@@ -275,20 +160,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cancel_button.hide()
         bar.addPermanentWidget(self.progress)
         bar.addPermanentWidget(self.cancel_button)
-
-    def _about(self) -> None:
-        from .. import __version__
-
-        QtWidgets.QMessageBox.about(
-            self,
-            "About modalviewer",
-            f"modalviewer {__version__}: modal shape analysis beyond the Laplacian.\n\n"
-            "Laplacian, modified Dirichlet energy E_D^N and Discrete Shells vibration "
-            "modes; heat kernel, feature and vibration signatures and distances.",
-        )
-
-    def _controls(self) -> None:
-        QtWidgets.QMessageBox.information(self, "Controls", CONTROLS)
 
     # ============================================================ messages
     def show_error(self, message: str, title: str = "modalviewer") -> None:
@@ -309,74 +180,6 @@ class MainWindow(QtWidgets.QMainWindow):
         box.open()
 
     # =========================================================== settings
-    def _restore_settings(self) -> None:
-        s = self.settings
-        geometry = s.value("window/geometry") if self.remember_settings else None
-        if geometry is not None:
-            self.restoreGeometry(geometry)
-        else:
-            self.resize(1280, 820)
-        state = s.value("window/state") if self.remember_settings else None
-        if state is not None:
-            self.restoreState(state)
-        st = self.state
-        st.set_isolines(int(s.value("view/isolines", 12)))
-        coloring = str(s.value("view/shell_color", "auto"))
-        st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "auto")
-        style = str(s.value("view/style", "paper"))
-        st.set_render_style(style if style in RENDER_STYLES else "paper")
-        st.set_animation(
-            amplitude=int(s.value("view/amplitude", 8)), speed=int(s.value("view/speed", 30))
-        )
-        operator = str(s.value("compute/operator", "modified_dirichlet"))
-        st.set_compute_settings(
-            operator=operator if operator in OPERATOR_INFO else "modified_dirichlet",
-            bending=float(s.value("compute/bending", 1.0)),
-            membrane=float(s.value("compute/membrane", 1.0)),
-            rescale=str(s.value("compute/rescale", "false")).lower() == "true",
-        )
-        self._rebuild_recent()
-
-    def save_settings(self) -> None:
-        """Remember window layout, view and compute preferences (desktop runs only)."""
-        if not self.remember_settings:
-            return
-        s, st = self.settings, self.state
-        s.setValue("window/geometry", self.saveGeometry())
-        s.setValue("window/state", self.saveState())
-        s.setValue("view/isolines", st.style.isolines)
-        s.setValue("view/amplitude", st.animation.amplitude)
-        s.setValue("view/speed", st.animation.speed)
-        s.setValue("view/shell_color", st.style.shell_coloring)
-        s.setValue("view/style", st.style.render)
-        c = st.compute_settings
-        s.setValue("compute/operator", c.operator)
-        s.setValue("compute/bending", c.bending)
-        s.setValue("compute/membrane", c.membrane)
-        s.setValue("compute/rescale", "true" if c.rescale else "false")
-        s.sync()
-
-    def _recent_files(self) -> list[str]:
-        value = self.settings.value("files/recent", [])
-        if isinstance(value, str):
-            value = [value]
-        return [str(v) for v in (value or [])]
-
-    def _rebuild_recent(self) -> None:
-        self.recent_menu.clear()
-        for path in self._recent_files():
-            action = self.recent_menu.addAction(path)
-            action.triggered.connect(lambda _=False, p=path: self.open_mesh(p))
-        self.recent_menu.setEnabled(bool(self._recent_files()))
-
-    def _remember_file(self, path: Path) -> None:
-        if not self.remember_settings:
-            return
-        recent = [str(path)] + [p for p in self._recent_files() if p != str(path)]
-        self.settings.setValue("files/recent", recent[:10])
-        self.settings.setValue("files/last_dir", str(path.parent))
-        self._rebuild_recent()
-
     def closeEvent(self, event):  # noqa: N802
         self.state.set_animation(playing=False)
         if self.compare is not None:
@@ -384,7 +187,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.model.jobs.shutdown(5.0)
         for loop in self._waits:
             loop.quit()
-        self.save_settings()
+        window_settings.save(self)
         self.viewport.close_plotter()
         super().closeEvent(event)
 
@@ -416,15 +219,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.state.set_animation(playing=not self.state.animation.playing)
 
     # ============================================================= loading
-    def _open_dialog(self) -> None:
-        start = str(self.settings.value("files/last_dir", str(ASSETS)))
-        patterns = " ".join(f"*{e}" for e in SUPPORTED_EXTENSIONS)
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(
-            self, "Open mesh", start, f"Meshes ({patterns});;All files (*)"
-        )
-        if path:
-            self.open_mesh(path)
-
     def dragEnterEvent(self, event):  # noqa: N802
         if event.mimeData().hasUrls():
             event.acceptProposedAction()
@@ -461,7 +255,7 @@ class MainWindow(QtWidgets.QMainWindow):
         finally:
             QtWidgets.QApplication.restoreOverrideCursor()
         self.set_mesh(mesh, path)
-        self._remember_file(path.resolve())
+        window_settings.remember_file(self, path.resolve())
         return True
 
     def set_mesh(self, mesh: Mesh, path: Path | None = None) -> None:
@@ -562,7 +356,9 @@ class MainWindow(QtWidgets.QMainWindow):
             self.progress.setValue(int(1000 * running.fraction))
             queued = len(self.model.jobs.jobs) - 1
             more = f" (+{queued} queued)" if queued else ""
-            self.progress.setFormat(f"{running.stage} %p%{more}")
+            stage = running.stage if len(running.stage) <= 20 else running.stage[:19] + "…"
+            self.progress.setFormat(f"{stage} %p%{more}")
+            self.progress.setToolTip(f"{running.description}: {running.stage}")
             if job is running and job.stage == "starting":
                 self.statusBar().showMessage(f"Computing {job.description}...")
 
@@ -590,10 +386,12 @@ class MainWindow(QtWidgets.QMainWindow):
         self.state.show_mode(index, op)
 
     def _show_current_mode(self) -> None:
-        op = self.current_operator
+        """Back to the mode last shown (M), or the first non-zero mode."""
+        d = self.state.display
+        op = d.operator if self.state.spectrum(d.operator) is not None else self.current_operator
         if op is not None:
-            d = self.state.display
-            self.show_mode(d.mode if d.kind == "mode" else self.state.first_nonzero_mode(op), op)
+            mode = d.mode if op == d.operator else self.state.first_nonzero_mode(op)
+            self.show_mode(mode, op)
 
     def set_animating(self, on: bool) -> None:
         self.state.set_animation(playing=on)
@@ -657,6 +455,9 @@ class MainWindow(QtWidgets.QMainWindow):
                     if j.status == DONE and self.state.display == before:
                         self.state.set_display(kind="distance")
 
+                preview = getattr(job, "preview_job", None)
+                if preview is not None:  # the map from the preview first
+                    preview.then(show_when_ready)
                 job.then(show_when_ready)
                 self.statusBar().showMessage(
                     f"Computing the spectrum for the {DISTANCE_KINDS[kind].lower()}..."
@@ -720,7 +521,8 @@ class MainWindow(QtWidgets.QMainWindow):
             total = sum(cost_estimate(settings_.key(op), n)[0] for op in missing)
             names = ", ".join(OPERATOR_INFO[op].label for op in missing)
             question = (
-                f"The comparison needs {names} ({k} modes each, about {max(total, 1):.0f} s). "
+                f"The comparison needs {names} ({k} modes each; at least "
+                f"{max(total, 1):.0f} s on an idle machine). "
                 "Compute now? The main view is not changed."
             )
             if not ask(self, "Compare", question):
@@ -768,21 +570,6 @@ class MainWindow(QtWidgets.QMainWindow):
             self.viewport, Path(path), scale=scale, transparent=transparent, scene=self.scene
         )
 
-    def _screenshot_dialog(self) -> None:
-        start = str(self.settings.value("files/screenshot_dir", str(SCREENSHOTS)))
-        dialog = ScreenshotDialog(self, start, self.state.style.colorbar)
-        if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
-            return
-        path, scale, transparent, colorbar = dialog.values()
-        try:
-            out = self.export_screenshot(path, scale, transparent, colorbar)
-        except (OSError, ValueError) as exc:
-            self.show_error(f"Could not save the screenshot: {exc}")
-            return
-        if self.remember_settings:
-            self.settings.setValue("files/screenshot_dir", str(Path(path).parent))
-        self.statusBar().showMessage(f"Saved {out}", 8000)
-
     def current_field(self) -> tuple[str, np.ndarray] | None:
         """(name, per-vertex values) of what the surface shows, or None without a mesh."""
         scene = self.scene
@@ -796,35 +583,6 @@ class MainWindow(QtWidgets.QMainWindow):
             raise ValueError("nothing to export: open a mesh first")
         name, values = field
         return save_field_mesh(Path(path), self.state.mesh, {name.replace(" ", "_"): values})
-
-    def _field_dialog(self) -> None:
-        if self.scene is None:
-            return
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self,
-            "Export per-vertex field",
-            str(SCREENSHOTS / "field.vtp"),
-            "VTK PolyData (*.vtp);;PLY (*.ply)",
-        )
-        if path:
-            try:
-                self.export_field(path)
-            except (OSError, ValueError) as exc:
-                self.show_error(f"Could not export the field: {exc}")
-
-    def _spectrum_dialog(self) -> None:
-        spec = self.state.spectrum(self.current_operator)
-        if spec is None:
-            self.show_error("Compute a spectrum first.")
-            return
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Export spectrum", f"{spec.operator}.npz", "NumPy (*.npz)"
-        )
-        if path:
-            try:
-                save_spectrum(spec, path)
-            except OSError as exc:
-                self.show_error(f"Could not save the spectrum: {exc}")
 
     # ============================================================ repairs
     def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
@@ -850,26 +608,11 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"{job.description} failed: {job.error}", "Repair failed")
 
     # =============================================================== cache
-    def _update_cache_label(self) -> None:
-        size = self.cache.size_bytes()
-        self.clear_cache_action.setText(f"Clear spectrum &cache ({size / 2**20:.0f} MB)...")
-
     def clear_cache(self) -> int:
         """Delete every cached spectrum; returns the bytes freed."""
         size = self.cache.clear()
         self.statusBar().showMessage(f"Cache cleared: {size / 2**20:.0f} MB freed.", 8000)
         return size
-
-    def _clear_cache_dialog(self) -> None:
-        size = self.cache.size_bytes()
-        limit = getattr(self.cache, "max_bytes", 0)
-        question = (
-            f"The spectrum cache in {self.cache.directory} holds {size / 2**20:.0f} MB "
-            f"(limit {limit / 2**20:.0f} MB; the least recently used spectra go first). "
-            "Delete all cached spectra? Spectra on screen stay."
-        )
-        if ask(self, "Clear cache", question):
-            self.clear_cache()
 
     # ============================================================ sessions
     def save_session(self, path) -> Path:
@@ -892,35 +635,13 @@ class MainWindow(QtWidgets.QMainWindow):
             self.show_error(f"Cannot open the session: {exc}", "Cannot open session")
             return [str(exc)]
         if self.state.mesh_path is not None and self.remember_settings:
-            self._remember_file(Path(self.state.mesh_path).resolve())
+            window_settings.remember_file(self, Path(self.state.mesh_path).resolve())
         if wait:
             for job in restored.jobs:
                 self.wait_for(job)
         if restored.notes:
             self.statusBar().showMessage("; ".join(restored.notes), 15000)
         return restored.notes
-
-    def _save_session_dialog(self) -> None:
-        if self.state.mesh is None:
-            self.show_error("Open a mesh first.")
-            return
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Save session", "session.modalviewer.json", "Session (*.json)"
-        )
-        if path:
-            try:
-                out = self.save_session(path)
-            except (OSError, ValueError) as exc:
-                self.show_error(f"Could not save the session: {exc}")
-                return
-            self.statusBar().showMessage(f"Saved {out}", 8000)
-
-    def _open_session_dialog(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getOpenFileName(
-            self, "Open session", "", "Session (*.json);;All files (*)"
-        )
-        if path:
-            self.open_session(path, wait=False)
 
     # ==================================================== read-only views
     @property
@@ -967,20 +688,3 @@ class MainWindow(QtWidgets.QMainWindow):
     @property
     def busy(self) -> bool:
         return self.model.jobs.busy
-
-
-CONTROLS = """Mouse
-  Left drag: rotate    Right drag or wheel: zoom    Middle drag: pan
-  Left click (no drag): pick a vertex and show its distance map
-
-Keys in the 3D view (click it first)
-  Left / Right: previous / next mode    Space: play / pause the vibration
-
-Everywhere
-  Ctrl+Left / Ctrl+Right: previous / next mode    P: play / pause
-  M: show mode    D: show distance    C: curvature    B: colour bar and legend
-  R: canonical view    Alt+1..Alt+6: from +X, -X, +Y, -Y, +Z, -Z    Alt+7: isometric
-  Ctrl+R: compute    Esc: cancel the running computation
-  Ctrl+1 / Ctrl+2: compare operators / distances    Ctrl+E: export screenshot
-  Ctrl+S / Ctrl+Shift+O: save / open session    Ctrl+O: open mesh
-  Ctrl+Shift+B: open a second mesh beside this one (or drop a file on the right half)"""

@@ -155,9 +155,12 @@ class ViewerModel:
             preview.spectrum_key = key
             if show:
                 preview.then(self._shower(key, display_at_request))
+        else:
+            preview = None
         work = self._work(key)
         job = self.jobs.submit(work, (state.mesh.hash, key), key.describe(), state.mesh.hash)
         job.spectrum_key = key
+        job.preview_job = preview
         if show:
             job.then(self._shower(key, display_at_request))
         return job

@@ -580,7 +580,7 @@ class ViewerState:
             zero = spec.zero_mode_mask()[j]
             value = "0 (zero mode)" if zero else f"{lam:.4g}"
             if spec.is_preview:
-                value += f" (preview, about {100 * spec.estimated_error:.1g} % high)"
+                value += f" (preview; estimated error up to {100 * spec.estimated_error:.1g} %)"
             colours = "blue +, white 0, orange -"
             if spec.is_vector and self.vector_coloring() == "magnitude":
                 colours = "white 0 to red: displacement magnitude"

@@ -69,6 +69,16 @@ def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
     qtbot.waitExposed(compare)
     qtbot.keyClick(compare, QtCore.Qt.Key.Key_W, QtCore.Qt.KeyboardModifier.ControlModifier)
     qtbot.waitUntil(lambda: window.compare is None, timeout=5000)
+    # a key pressed in one of its 3D views reaches the window too
+    window.open_comparison(["laplacian", "modified_dirichlet"])
+    compare = window.compare
+    compare.show()
+    qtbot.waitExposed(compare)
+    view = compare.viewports[0].widget
+    qtbot.keyClick(view, QtCore.Qt.Key.Key_Right)
+    assert compare.mode_index == 2
+    qtbot.keyClick(view, QtCore.Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: window.compare is None, timeout=5000)
 
 
 def test_4_arrow_keys_move_a_focused_slider_not_the_mode(window, spot_path, qtbot):
@@ -138,6 +148,7 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     qtbot.waitExposed(first)
     first.open_mesh(spot_path)
     first.compute("modified_dirichlet", k=30, wait=True)
+    first.show_mode(7)
     first.state.set_isolines(5)
     first.pick_vertex(1234)
     first.show_distance("feature", display="threshold", threshold=0.25)
@@ -159,6 +170,10 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     assert differ < 0.002, differ
     assert second.status_line.text() == second.state.summary()
     assert "feature distance" in second.status_line.text()
+    # M shows the mode last shown before the distance, as before the restart
+    assert second.modes_panel.mode_spin.value() == 7
+    second._show_current_mode()
+    assert second.state.display.kind == "mode" and second.state.display.mode == 7
     second.close()
 
 
@@ -201,3 +216,23 @@ def test_clear_cache_from_the_window(window, spot_path):
     freed = window.clear_cache()
     assert freed > 0 and window.cache.size_bytes() == 0
     assert window.spectra["laplacian"].k == 10  # the spectrum on screen stays
+
+
+def test_a_pick_shows_the_distance_from_the_preview_first(window, spot_path, monkeypatch):
+    """Found under Xvfb: the map waited for the exact spectrum although the preview had
+    arrived a minute earlier."""
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    window.open_mesh(spot_path)
+    window.state.set_display(distance_kind="hks")
+    window.pick_vertex(800)  # needs the Laplacian: a preview job, then the exact one
+    preview = window.running_job
+    assert preview.description.startswith("preview of")
+    window.wait_for(preview)
+    assert window.state.display.kind == "distance"
+    assert window.state.spectrum("laplacian").is_preview
+    assert "preview spectrum" in window.status_line.text()
+    window.wait_for(window.running_job)
+    assert not window.state.spectrum("laplacian").is_preview
+    assert window.state.display.kind == "distance" and window.state.picked == 800

@@ -204,7 +204,7 @@ def test_bad_file_gives_a_message_and_keeps_the_mesh(window, spot_path, tmp_path
 
 
 def test_settings_are_remembered(qtbot, spot_path):
-    from modalviewer.gui import MainWindow
+    from modalviewer.gui import MainWindow, window_settings
 
     first = MainWindow(remember_settings=True)
     qtbot.addWidget(first)
@@ -214,7 +214,7 @@ def test_settings_are_remembered(qtbot, spot_path):
     second = MainWindow(remember_settings=True)
     qtbot.addWidget(second)
     assert second.modes_panel.iso_spin.value() == 21 and second.state.style.isolines == 21
-    assert str(spot_path.resolve()) in second._recent_files()
+    assert str(spot_path.resolve()) in window_settings.recent_files(second)
     second.close()
 
 

@@ -47,6 +47,9 @@ class DistancesPanel(QtWidgets.QWidget):
             "Off: linear in the fraction of the largest distance."
         )
         self.threshold_label = QtWidgets.QLabel("-")
+        self.threshold_label.setWordWrap(True)
+        self.threshold_slider.setSingleStep(5)  # 0.5 % of the surface per arrow key
+        self.threshold_slider.setPageStep(50)
         self.t1_edit = QtWidgets.QLineEdit()
         self.t2_edit = QtWidgets.QLineEdit()
         for edit in (self.t1_edit, self.t2_edit):
@@ -99,7 +102,16 @@ class DistancesPanel(QtWidgets.QWidget):
             self.showSignatureRequested.emit()
 
     def _on_display(self, _index: int) -> None:
-        self.state.set_display(distance_display=self.display_combo.currentData())
+        """Switching to a threshold map that would mark more than half of the surface
+        starts at a tenth of it instead (the paper's maps mark a few per cent)."""
+        display = self.display_combo.currentData()
+        changes = {"distance_display": display}
+        dist = self.state.distance_map()
+        if display == "threshold" and dist is not None:
+            thr = self.state.threshold_value(dist)
+            if float(np.mean(dist <= thr)) > 0.5:
+                changes["threshold"] = self.state.threshold_for_share(0.1, dist)
+        self.state.set_display(**changes)
 
     def _on_slider(self, value: int) -> None:
         position = value / SLIDER_STEPS
@@ -142,7 +154,7 @@ class DistancesPanel(QtWidgets.QWidget):
         if dist is not None:
             thr = d.threshold * float(dist.max())
             share = 100.0 * float(np.mean(dist <= thr))
-            self.threshold_label.setText(f"< {thr:.4g}  ({share:.1f} % of the surface)")
+            self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
         else:
             self.threshold_label.setText(f"{d.threshold:.3g} of the largest distance")
         if state.picked is None:

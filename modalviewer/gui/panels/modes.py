@@ -106,7 +106,8 @@ class ModesPanel(QtWidgets.QWidget):
             self.mode_slider.setRange(0, k - 1)
             self.mode_spin.setRange(0, k - 1)
             showing_mode = state.display.kind == "mode" and spec is not None
-            if showing_mode:
+            if spec is not None and state.display.operator == op:
+                # the mode shown, or last shown (M shows it again)
                 self.mode_slider.setValue(state.display.mode)
                 self.mode_spin.setValue(state.display.mode)
         for w in (self.spectrum_combo, self.mode_slider, self.mode_spin):
@@ -128,7 +129,7 @@ class ModesPanel(QtWidgets.QWidget):
             text = f"Not shown: the surface shows {shown}. Choose a mode to show it."
         if spec.is_preview:
             text += (
-                f"\nPreview (eigenvalues about {100 * spec.estimated_error:.1g} % high); "
+                f"\nPreview (eigenvalues high by up to about {100 * spec.estimated_error:.1g} %); "
                 "the exact spectrum replaces it when ready."
             )
         self.eigen_label.setText(text)

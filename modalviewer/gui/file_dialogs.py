@@ -1,0 +1,133 @@
+"""File dialogs of the main window: each asks for a path or a confirmation, then calls
+the window's scripting method (``open_mesh``, ``export_screenshot``, ``save_session``,
+...), which does the work and reports errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from qtpy import QtWidgets
+
+from ..core.spectrum import save_spectrum
+from ..io import SUPPORTED_EXTENSIONS
+from .dialogs import ScreenshotDialog, ask
+from .paths import ASSETS, SCREENSHOTS
+
+
+def _mesh_folder(win) -> Path:
+    """Where files about the open mesh go by default: its folder if writable, else the
+    screenshots folder of a source checkout, else the home folder."""
+    import os
+
+    path = win.state.mesh_path
+    if path is not None and os.access(Path(path).resolve().parent, os.W_OK):
+        return Path(path).resolve().parent
+    if os.access(SCREENSHOTS, os.W_OK):
+        return SCREENSHOTS
+    return Path.home()
+
+
+def _mesh_stem(win) -> str:
+    path = win.state.mesh_path
+    return Path(path).stem if path is not None else "mesh"
+
+
+def open_mesh_dialog(win) -> None:
+    start = str(win.settings.value("files/last_dir", str(ASSETS)))
+    patterns = " ".join(f"*{e}" for e in SUPPORTED_EXTENSIONS)
+    path, _ = QtWidgets.QFileDialog.getOpenFileName(
+        win, "Open mesh", start, f"Meshes ({patterns});;All files (*)"
+    )
+    if path:
+        win.open_mesh(path)
+
+
+def screenshot_dialog(win) -> None:
+    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    dialog = ScreenshotDialog(win, start, win.state.style.colorbar)
+    if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
+        return
+    path, scale, transparent, colorbar = dialog.values()
+    try:
+        out = win.export_screenshot(path, scale, transparent, colorbar)
+    except (OSError, ValueError) as exc:
+        win.show_error(f"Could not save the screenshot: {exc}")
+        return
+    if win.remember_settings:
+        win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
+    win.statusBar().showMessage(f"Saved {out}", 8000)
+
+
+def field_dialog(win) -> None:
+    if win.scene is None:
+        return
+    path, _ = QtWidgets.QFileDialog.getSaveFileName(
+        win,
+        "Export per-vertex field",
+        str(_mesh_folder(win) / "field.vtp"),
+        "VTK PolyData (*.vtp);;PLY (*.ply)",
+    )
+    if path:
+        try:
+            win.export_field(path)
+        except (OSError, ValueError) as exc:
+            win.show_error(f"Could not export the field: {exc}")
+
+
+def spectrum_dialog(win) -> None:
+    spec = win.state.spectrum(win.current_operator)
+    if spec is None:
+        win.show_error("Compute a spectrum first.")
+        return
+    path, _ = QtWidgets.QFileDialog.getSaveFileName(
+        win, "Export spectrum", f"{spec.operator}.npz", "NumPy (*.npz)"
+    )
+    if path:
+        try:
+            save_spectrum(spec, path)
+        except OSError as exc:
+            win.show_error(f"Could not save the spectrum: {exc}")
+
+
+def update_cache_label(win) -> None:
+    size = win.cache.size_bytes()
+    win.clear_cache_action.setText(f"Clear spectrum &cache ({size / 2**20:.0f} MB)...")
+
+
+def clear_cache_dialog(win) -> None:
+    size = win.cache.size_bytes()
+    limit = getattr(win.cache, "max_bytes", 0)
+    question = (
+        f"The spectrum cache in {win.cache.directory} holds {size / 2**20:.0f} MB "
+        f"(limit {limit / 2**20:.0f} MB; the least recently used spectra go first). "
+        "Delete all cached spectra? Spectra on screen stay."
+    )
+    if ask(win, "Clear cache", question):
+        win.clear_cache()
+
+
+def save_session_dialog(win) -> None:
+    if win.state.mesh is None:
+        win.show_error("Open a mesh first.")
+        return
+    path, _ = QtWidgets.QFileDialog.getSaveFileName(
+        win,
+        "Save session",
+        str(_mesh_folder(win) / f"{_mesh_stem(win)}.session.json"),
+        "Session (*.json)",
+    )
+    if path:
+        try:
+            out = win.save_session(path)
+        except (OSError, ValueError) as exc:
+            win.show_error(f"Could not save the session: {exc}")
+            return
+        win.statusBar().showMessage(f"Saved {out}", 8000)
+
+
+def open_session_dialog(win) -> None:
+    path, _ = QtWidgets.QFileDialog.getOpenFileName(
+        win, "Open session", "", "Session (*.json);;All files (*)"
+    )
+    if path:
+        win.open_session(path, wait=False)

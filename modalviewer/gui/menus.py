@@ -1,0 +1,178 @@
+"""The main window's menus and the Help texts (actions call the window's public methods
+and the file dialogs; no state of their own)."""
+
+from __future__ import annotations
+
+import html
+
+from qtpy import QtCore, QtGui, QtWidgets
+
+from ..viewer.model import REPAIRS
+from . import file_dialogs
+from .pair_window import open_second_mesh_dialog
+
+
+def _action(win, menu, text, slot, shortcut=None, tip=None) -> QtGui.QAction:
+    action = QtGui.QAction(text, win)
+    if shortcut:
+        action.setShortcut(QtGui.QKeySequence(shortcut))
+    if tip:
+        action.setStatusTip(tip)
+    action.triggered.connect(slot)
+    menu.addAction(action)
+    return action
+
+
+def build_menus(win) -> None:
+    bar = win.menuBar()
+    m = bar.addMenu("&File")
+    _action(win, m, "&Open mesh...", lambda: file_dialogs.open_mesh_dialog(win), "Ctrl+O")
+    win.recent_menu = m.addMenu("Open &recent")
+    _action(
+        win,
+        m,
+        "Open &second mesh (shape pair)...",
+        lambda: open_second_mesh_dialog(win),
+        "Ctrl+Shift+B",
+        "Open mesh B beside this mesh: a click on one shows the similar points on the other",
+    )
+    m.addSeparator()
+    _action(
+        win, m, "Open s&ession...", lambda: file_dialogs.open_session_dialog(win), "Ctrl+Shift+O"
+    )
+    _action(win, m, "Save se&ssion...", lambda: file_dialogs.save_session_dialog(win), "Ctrl+S")
+    m.addSeparator()
+    _action(win, m, "Export &screenshot...", lambda: file_dialogs.screenshot_dialog(win), "Ctrl+E")
+    _action(
+        win,
+        m,
+        "Export per-vertex &field (PLY/VTP)...",
+        lambda: file_dialogs.field_dialog(win),
+        "Ctrl+Shift+E",
+    )
+    _action(
+        win,
+        m,
+        "Export s&pectrum (.npz)...",
+        lambda: file_dialogs.spectrum_dialog(win),
+        "Ctrl+Shift+S",
+    )
+    m.addSeparator()
+    win.clear_cache_action = _action(
+        win, m, "Clear spectrum &cache...", lambda: file_dialogs.clear_cache_dialog(win)
+    )
+    m.aboutToShow.connect(lambda: file_dialogs.update_cache_label(win))
+    m.addSeparator()
+    _action(win, m, "&Quit", win.close, "Ctrl+Q")
+    m = bar.addMenu("&Mesh")
+    for name, label in REPAIRS.items():
+        _action(win, m, label + "...", lambda _=False, n=name: win.repair_mesh(n, wait=False))
+    m = bar.addMenu("&Compute")
+    _action(win, m, "&Compute spectrum", lambda: win.compute(wait=False), "Ctrl+R")
+    _action(win, m, "C&ancel running computation", win.cancel_computation, "Esc")
+    _action(win, m, "Cancel &all computations", win.cancel_all, "Ctrl+Shift+Esc")
+    m = bar.addMenu("&View")
+    _action(win, m, "&Next mode", lambda: win.step_mode(+1), "Ctrl+Right")
+    _action(win, m, "&Previous mode", lambda: win.step_mode(-1), "Ctrl+Left")
+    _action(win, m, "Play / pause animation", win.toggle_animation, "P")
+    _action(win, m, "Show &mode", win._show_current_mode, "M")
+    _action(win, m, "Show &distance", lambda: win.show_distance(), "D")
+    _action(win, m, "Show &curvature sqrt(k1^2 + k2^2)", win.show_curvature, "C")
+    win.colorbar_action = _action(
+        win, m, "Colour &bar and legend", lambda on: win.state.set_colorbar(on), "B"
+    )
+    win.colorbar_action.setCheckable(True)
+    win.state.events.style.connect(lambda: win.colorbar_action.setChecked(win.state.style.colorbar))
+    win.shaded_action = _action(
+        win,
+        m,
+        "S&haded look (light kit, greyer)",
+        lambda on: win.state.set_render_style("shaded" if on else "paper"),
+        "Shift+S",
+    )
+    win.shaded_action.setCheckable(True)
+    win.state.events.style.connect(
+        lambda: win.shaded_action.setChecked(win.state.style.render == "shaded")
+    )
+    _action(win, m, "&Reset camera", win.scene_view.reset_camera, "R")
+    views = m.addMenu("Camera &presets")
+    for name, label, key in (
+        ("+x", "From +X", "Alt+1"),
+        ("-x", "From -X", "Alt+2"),
+        ("+y", "From +Y", "Alt+3"),
+        ("-y", "From -Y", "Alt+4"),
+        ("+z", "From +Z", "Alt+5"),
+        ("-z", "From -Z", "Alt+6"),
+        ("isometric", "Isometric", "Alt+7"),
+    ):
+        _action(win, views, label, lambda _=False, n=name: win.scene_view.camera_preset(n), key)
+    m.addSeparator()
+    _action(
+        win,
+        m,
+        "Compare &operators (Laplacian, E_D^N, shells normal)...",
+        lambda: win.open_comparison(
+            ["laplacian", "modified_dirichlet", "shells_normal"], wait=False
+        ),
+        "Ctrl+1",
+    )
+    _action(
+        win,
+        m,
+        "Compare d&istances (vibration, heat kernel)...",
+        lambda: win.open_comparison(["vibration", "hks"], wait=False),
+        "Ctrl+2",
+    )
+    m = bar.addMenu("&Help")
+    _action(win, m, "&Controls", lambda: controls(win))
+    _action(win, m, "&About", lambda: about(win))
+
+
+def about(win) -> None:
+    from .. import __version__
+
+    QtWidgets.QMessageBox.about(
+        win,
+        "About modalviewer",
+        f"modalviewer {__version__}: modal shape analysis beyond the Laplacian.\n\n"
+        "Laplacian, modified Dirichlet energy E_D^N and Discrete Shells vibration "
+        "modes; heat kernel, feature and vibration signatures and distances.",
+    )
+
+
+def controls(win) -> None:
+    box = QtWidgets.QMessageBox(win)
+    box.setWindowTitle("Controls")
+    box.setTextFormat(QtCore.Qt.TextFormat.RichText)
+    box.setText("<pre>" + html.escape(CONTROLS) + "</pre>")  # one item per line, no wrapping
+    box.exec()
+
+
+CONTROLS = """Mouse
+  Left drag             rotate
+  Right drag, wheel     zoom
+  Middle drag           pan
+  Left click            pick a vertex and show its distance map
+
+Keys in the 3D view (click it first)
+  Left / Right          previous / next mode
+  Space                 play / pause the vibration
+
+Everywhere
+  Ctrl+Left / Right     previous / next mode
+  P                     play / pause
+  M / D / C             show the mode / the distance / the curvature
+  B                     colour bar and legend on or off
+  Shift+S               shaded look on or off
+  R                     canonical view
+  Alt+1 .. Alt+6        view from +X, -X, +Y, -Y, +Z, -Z
+  Alt+7                 isometric view
+  Ctrl+R                compute the spectrum
+  Esc                   cancel the running computation
+  Ctrl+1 / Ctrl+2       compare operators / distances
+                        (in that window: Left / Right, Esc or Ctrl+W closes)
+  Ctrl+Shift+B          open a second mesh beside this one
+                        (or drop a file on the right half of the window)
+  Ctrl+O / Ctrl+E       open a mesh / export a screenshot
+  Ctrl+S / Ctrl+Shift+O save / open a session
+  Ctrl+Q                quit"""

@@ -1,0 +1,98 @@
+"""What the main window remembers between desktop runs (QSettings): layout, view and
+compute preferences, recent files.  Off-screen runs (tests, ``make run`` without a
+display) neither read the layout nor write anything."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from qtpy import QtCore, QtGui
+
+from ..core.operators import OPERATOR_INFO
+from ..viewer.state import RENDER_STYLES, SHELL_COLORINGS
+
+
+def settings() -> QtCore.QSettings:
+    path = os.environ.get("MODALVIEWER_SETTINGS")
+    if path:
+        return QtCore.QSettings(path, QtCore.QSettings.Format.IniFormat)
+    return QtCore.QSettings("modalviewer", "modalviewer")
+
+
+def headless() -> bool:
+    """True on Qt's off-screen or minimal platform (no desktop to remember)."""
+    return QtGui.QGuiApplication.platformName() in ("offscreen", "minimal")
+
+
+def restore(win) -> None:
+    s = win.settings
+    geometry = s.value("window/geometry") if win.remember_settings else None
+    if geometry is not None:
+        win.restoreGeometry(geometry)
+    else:
+        win.resize(1280, 820)
+    state = s.value("window/state") if win.remember_settings else None
+    if state is not None:
+        win.restoreState(state)
+    st = win.state
+    st.set_isolines(int(s.value("view/isolines", 12)))
+    coloring = str(s.value("view/shell_color", "auto"))
+    st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "auto")
+    style = str(s.value("view/style", "paper"))
+    st.set_render_style(style if style in RENDER_STYLES else "paper")
+    st.set_animation(
+        amplitude=int(s.value("view/amplitude", 8)), speed=int(s.value("view/speed", 30))
+    )
+    operator = str(s.value("compute/operator", "modified_dirichlet"))
+    st.set_compute_settings(
+        operator=operator if operator in OPERATOR_INFO else "modified_dirichlet",
+        bending=float(s.value("compute/bending", 1.0)),
+        membrane=float(s.value("compute/membrane", 1.0)),
+        rescale=str(s.value("compute/rescale", "false")).lower() == "true",
+    )
+    rebuild_recent(win)
+
+
+def save(win) -> None:
+    """Remember window layout, view and compute preferences (desktop runs only)."""
+    if not win.remember_settings:
+        return
+    s, st = win.settings, win.state
+    s.setValue("window/geometry", win.saveGeometry())
+    s.setValue("window/state", win.saveState())
+    s.setValue("view/isolines", st.style.isolines)
+    s.setValue("view/amplitude", st.animation.amplitude)
+    s.setValue("view/speed", st.animation.speed)
+    s.setValue("view/shell_color", st.style.shell_coloring)
+    s.setValue("view/style", st.style.render)
+    c = st.compute_settings
+    s.setValue("compute/operator", c.operator)
+    s.setValue("compute/bending", c.bending)
+    s.setValue("compute/membrane", c.membrane)
+    s.setValue("compute/rescale", "true" if c.rescale else "false")
+    s.sync()
+
+
+def recent_files(win) -> list[str]:
+    value = win.settings.value("files/recent", [])
+    if isinstance(value, str):
+        value = [value]
+    return [str(v) for v in (value or [])]
+
+
+def rebuild_recent(win) -> None:
+    win.recent_menu.clear()
+    for path in recent_files(win):
+        action = win.recent_menu.addAction(path)
+        action.triggered.connect(lambda _=False, p=path: win.open_mesh(p))
+    win.recent_menu.setEnabled(bool(recent_files(win)))
+
+
+def remember_file(win, path: Path) -> None:
+    if not win.remember_settings:
+        return
+    recent = [str(path)] + [p for p in recent_files(win) if p != str(path)]
+    win.settings.setValue("files/recent", recent[:10])
+    win.settings.setValue("files/last_dir", str(path.parent))
+    rebuild_recent(win)
