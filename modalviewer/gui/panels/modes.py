@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from qtpy import QtCore, QtWidgets
 
-from ...core.operators import OPERATOR_INFO
+from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
 from .common import combo, quiet, select_data
@@ -125,8 +125,7 @@ class ModesPanel(QtWidgets.QWidget):
             else:
                 text = f"lambda_{j} = {lam:.6g}   sqrt(lambda) = {np.sqrt(max(lam, 0.0)):.6g}"
         else:
-            shown = state.legend().split("\n")[0] or "nothing"
-            text = f"Not shown: the surface shows {shown}. Choose a mode to show it."
+            text = f"Not shown: the surface shows {_what_is_shown(state)}. M shows the mode."
         if spec.is_preview:
             text += (
                 f"\nPreview (eigenvalues high by up to about {100 * spec.estimated_error:.1g} %); "
@@ -144,3 +143,16 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.color_combo, self.iso_spin):
             select_data(self.color_combo, self.state.style.shell_coloring)
             self.iso_spin.setValue(self.state.style.isolines)
+
+
+def _what_is_shown(state: ViewerState) -> str:
+    """The display in a few words, for a panel that is not the one on screen."""
+    d = state.display
+    if d.kind == "distance":
+        how = "threshold map" if d.distance_display == "threshold" else "map"
+        return f"the {DISTANCE_KINDS[d.distance_kind].lower()} {how} from vertex {state.picked}"
+    if d.kind == "signature":
+        return f"the {DISTANCE_KINDS[d.distance_kind].split()[0].lower()} signature"
+    if d.kind == "curvature":
+        return "the curvature"
+    return "no field"
