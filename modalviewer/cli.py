@@ -171,6 +171,8 @@ def _run(args) -> int:
             f"{spec.eigenvalues[0]:.6g} .. {spec.eigenvalues[-1]:.6g}, largest relative "
             f"residual {worst:.1e}; saved {args.output}"
         )
+        if spec.parameters.get("null_space"):
+            print(f"null space: {spec.parameters['null_space']}")
         stages = spec.parameters.get("seconds_by_stage", {})
         if stages:
             busiest = sorted(stages.items(), key=lambda item: -item[1])[:4]

@@ -74,6 +74,11 @@ class CacheEntry:
     last_used: float
 
 
+SOLVER_VERSION = 2
+"""Part of every cache key: raised when the solver's results change, so spectra of an
+older solver are not served (2: exactly known null spaces deflated and counted)."""
+
+
 class SpectrumCache:
     """Spectra stored as ``.npz`` files in ``directory``, at most ``max_bytes`` in all.
 
@@ -95,7 +100,7 @@ class SpectrumCache:
 
     # ---------------------------------------------------------------- keys
     def key(self, mesh: Mesh, operator: str, k: int, bending: float, membrane: float) -> str:
-        params = {"op": operator, "k": int(k)}
+        params = {"op": operator, "k": int(k), "solver": SOLVER_VERSION}
         if operator_info(operator).has_weights:
             params.update(bending=float(bending), membrane=float(membrane))
         blob = mesh.hash + json.dumps(params, sort_keys=True)

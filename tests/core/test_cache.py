@@ -127,3 +127,20 @@ def test_spectrum_of_another_mesh_is_dropped(tmp_path, mesh):
     _put(cache, mesh, 10).rename(path)  # a file under the other mesh's key
     assert cache.get(other, "laplacian", 10) is None
     assert not path.exists()
+
+
+def test_spectra_of_an_older_solver_are_not_served(tmp_path, monkeypatch):
+    """Spectra cached before the null-space deflation counted their zero modes by
+    eigenvalue alone; the solver version in the key keeps them from being served."""
+    import modalviewer as mv
+    from modalviewer.core import cache as cache_module
+    from modalviewer.core.primitives import icosphere
+
+    mesh = icosphere(1)
+    spec = mv.compute_spectrum(mesh, "laplacian", k=5)
+    store = cache_module.SpectrumCache(tmp_path)
+    monkeypatch.setattr(cache_module, "SOLVER_VERSION", cache_module.SOLVER_VERSION - 1)
+    store.put(mesh, spec, 5)
+    assert store.get(mesh, "laplacian", 5) is not None
+    monkeypatch.undo()
+    assert store.get(mesh, "laplacian", 5) is None
