@@ -28,7 +28,7 @@ def main() -> int:
     win.open_mesh(ROOT / "assets" / "spot.obj")
     win.compute("laplacian", k=30, wait=True)
     win.show_mode(9)
-    win.export_screenshot(OUT / "viewer_laplacian_mode.png")
+    win.export_screenshot(OUT / "viewer_laplacian_mode.png", colorbar=True)
     win.compute("modified_dirichlet", k=30, wait=True)
     win.show_mode(9)
     win.export_screenshot(OUT / "viewer_dirichlet_mode.png")
@@ -37,7 +37,7 @@ def main() -> int:
     win.show_distance("vibration", display="continuous")
     win.export_screenshot(OUT / "viewer_vibration_distance.png", colorbar=True)
     win.show_distance("vibration", display="threshold", threshold=0.15)
-    win.export_screenshot(OUT / "viewer_vibration_threshold.png", colorbar=False)
+    win.export_screenshot(OUT / "viewer_vibration_threshold.png", colorbar=True)
     win.close()
     return 0
 
