@@ -7,13 +7,12 @@ state (pick, threshold, isolines) and never change it.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 from qtpy import QtCore, QtGui, QtWidgets
 
+from ..core.files import atomic_write
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from .scene import MeshScene
 from .viewport import make_viewport
@@ -164,15 +163,7 @@ class CompareWindow(QtWidgets.QWidget):
             x += img.shape[1]
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
-        os.close(fd)
-        try:
-            Image.fromarray(canvas).save(tmp, format="PNG")
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+        return atomic_write(path, lambda tmp: Image.fromarray(canvas).save(tmp, format="PNG"))
 
     def closeEvent(self, event):  # noqa: N802
         for event_ in (self.state.events.pick, self.state.events.display, self.state.events.style):

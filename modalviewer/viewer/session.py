@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
+from ..core.files import atomic_write
 from .jobs import Job
 from .state import ComputeSettings, Display, SpectrumKey, ViewerState
 
@@ -78,22 +78,8 @@ def save_session(state: ViewerState, path) -> Path:
     path = Path(path)
     data = session_dict(state, base=path.resolve().parent)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            json.dump(data, fh, indent=2)
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
+    text = json.dumps(data, indent=2)
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), ".part")
 
 
 def read_session(path) -> dict:

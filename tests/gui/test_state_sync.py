@@ -38,7 +38,7 @@ def test_2_the_modes_panel_does_not_name_a_mode_that_is_not_shown(window, spot_p
 
 
 def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
-    window, spot_path, qtbot, monkeypatch
+    window, spot_path, qtbot, monkeypatch, tmp_path
 ):
     window.open_mesh(spot_path)
     window.compute("modified_dirichlet", k=20, wait=True)
@@ -77,6 +77,14 @@ def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
     view = compare.viewports[0].widget
     qtbot.keyClick(view, QtCore.Qt.Key.Key_Right)
     assert compare.mode_index == 2
+    import os
+
+    old = os.umask(0o022)
+    try:
+        out = compare.export_screenshot(tmp_path / "pair.png")
+    finally:
+        os.umask(old)
+    assert (out.stat().st_mode & 0o777) == 0o644  # mkstemp alone gave 0600
     qtbot.keyClick(view, QtCore.Qt.Key.Key_Escape)
     qtbot.waitUntil(lambda: window.compare is None, timeout=5000)
 

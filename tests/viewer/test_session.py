@@ -83,3 +83,17 @@ def test_bad_session_files_raise_clear_errors(tmp_path):
     with pytest.raises(SessionError, match="not a modalviewer session"):
         restore_session(model, junk)
     assert model.state.mesh is None  # nothing was half-loaded
+
+
+def test_session_files_get_the_umask_permissions(tmp_path):
+    import os
+
+    model = _model(tmp_path)
+    model.open_mesh(ASSETS / "spot.obj")
+    old = os.umask(0o022)
+    try:
+        path = save_session(model.state, tmp_path / "perm.json")
+    finally:
+        os.umask(old)
+    assert (path.stat().st_mode & 0o777) == 0o644
+    assert not list(tmp_path.glob(".perm.json.*"))  # no temporary file left
