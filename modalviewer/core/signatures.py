@@ -57,6 +57,8 @@ class SignatureTable:
     """
 
     def __init__(self, spec: Spectrum, t_range=None, samples: int = 100, include_zero=False):
+        self.t_range = None if t_range is None else (float(t_range[0]), float(t_range[1]))
+        """The scale range asked for (None: the default range, see :attr:`times`)."""
         mask = _used(spec, include_zero)
         lam = spec.eigenvalues[mask]
         if t_range is None:

@@ -75,7 +75,6 @@ class SceneView(QtCore.QObject):
         """Draw what the state displays (a threshold move only recolours)."""
         if self.scene is None:
             return
-        started = time.perf_counter()
         signature = self._signature()
         d = self.state.display
         if self.scene.style != self.state.style.render:
@@ -97,7 +96,6 @@ class SceneView(QtCore.QObject):
             self._drawn = signature
         self._update_colorbar()
         self.viewport.request_render()
-        self.last_redraw_seconds = time.perf_counter() - started
 
     def _draw_field(self) -> None:
         field = self.state.field()

@@ -18,7 +18,7 @@ from ..core.cache import SpectrumCache
 from ..core.coarse import estimate_cost
 from ..core.eigen import Cancelled
 from ..core.mesh import Mesh
-from ..core.operators import operator_for_distance, operator_info
+from ..core.operators import operator_info
 from ..core.pipeline import compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
@@ -234,7 +234,6 @@ class ViewerModel:
                 if cancel():
                     raise Cancelled()
                 table = SignatureTable(spec, t_range=t_range)
-                table.requested_range = t_range
             return spec, table
 
         return work
@@ -247,14 +246,6 @@ class ViewerModel:
         spec, table = job.result
         if not self.state.has_spectrum(key) or self.state.spectra[key] is not spec:
             self.state.add_spectrum(key, spec, table)
-
-    # ---------------------------------------------------------- distances
-    def request_distance_spectrum(self, kind: str) -> Job | None:
-        """A job for the spectrum distance ``kind`` needs, or None if it is there."""
-        operator = operator_for_distance(kind)
-        if self.state.spectrum(operator) is not None:
-            return None
-        return self.request_spectrum(operator)
 
 
 REPAIRS = {

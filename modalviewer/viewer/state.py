@@ -23,7 +23,7 @@ changed the state (the GUI thread in the viewer):
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -253,7 +253,7 @@ class ViewerState:
             del self._derived.tables[k]
         self._derived.distance.clear()
         if table is not None:
-            self._derived.tables[(key.operator, id(spec), table_range(table))] = table
+            self._derived.tables[(key.operator, id(spec), table.t_range)] = table
         self.events.spectra.emit(key.operator)
         if self.display.kind in ("mode", "distance", "signature"):
             if self.display_operator() == key.operator:
@@ -440,11 +440,6 @@ class ViewerState:
             table = SignatureTable(spec, t_range=self.t_range)
             self._derived.tables[key] = table
         return table
-
-    def keep_table(self, operator: str, spec: Spectrum, table: SignatureTable) -> None:
-        """Keep a table built elsewhere (in a worker) if it is still the current one."""
-        if self.spectrum(operator) is spec:
-            self._derived.tables.setdefault((operator, id(spec), table_range(table)), table)
 
     def distance_map(self, kind: str | None = None) -> np.ndarray | None:
         """Distance of ``kind`` from the picked vertex, or None if a spectrum is missing."""
@@ -637,21 +632,3 @@ class ViewerState:
             if not self.spectra:
                 text += "; compute a spectrum (Ctrl+R) or click the surface"
         return text
-
-    def snapshot(self) -> dict:
-        """The display-related state as plain data (for sessions and tests)."""
-        return {
-            "display": asdict(self.display),
-            "picked": self.picked,
-            "t_range": list(self.t_range) if self.t_range else None,
-            "isolines": self.style.isolines,
-            "shell_coloring": self.style.shell_coloring,
-            "colorbar": self.style.colorbar,
-            "animation": asdict(self.animation),
-            "compute_settings": asdict(self.compute_settings),
-        }
-
-
-def table_range(table: SignatureTable) -> tuple[float, float] | None:
-    """The t_range a table was built for (None when built over the default range)."""
-    return getattr(table, "requested_range", None)
