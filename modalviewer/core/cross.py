@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .mesh import Mesh
-from .signatures import SignatureTable, default_times
+from .signatures import SignatureTable, default_times, normalised_signatures
 from .spectrum import Spectrum
 
 __all__ = [
@@ -239,19 +239,9 @@ def cross_distance(
     v = int(_vertices(vertex, spec_a.n_vertices, "vertex")[0])
     _check_pair(spec_a, spec_b)
     times = common_times(spec_a, spec_b, t_range, samples)
-    t = (times[0], times[-1])
-    row = _normalised_rows(spec_a, t, len(times), include_zero, [v])[0]
-    return SignatureTable(spec_b, t, len(times), include_zero).distance_to(row)
-
-
-def _normalised_rows(spec, t_range, samples, include_zero, vertices) -> np.ndarray:
-    """Rows of ``SignatureTable(spec, ...).table`` for ``vertices`` only (same formula)."""
-    mask = np.ones(spec.k, dtype=bool) if include_zero else ~spec.zero_mode_mask()
-    times = np.exp(np.linspace(np.log(t_range[0]), np.log(t_range[1]), samples))
-    dlogt = (np.log(times[-1]) - np.log(times[0])) / (len(times) - 1)
-    weights = np.exp(-np.outer(spec.eigenvalues[mask], times))
-    z = weights.sum(axis=0)
-    return (spec.squared_modes(vertices)[:, mask] @ (weights / z)) * np.sqrt(dlogt)
+    table_b = SignatureTable(spec_b, (times[0], times[-1]), len(times), include_zero)
+    row = normalised_signatures(spec_a, table_b.times, include_zero, [v])[0]
+    return table_b.distance_to(row)
 
 
 def best_match(

@@ -48,6 +48,17 @@ def signature(spec: Spectrum, times=None, include_zero: bool = False, vertices=N
     return times, values
 
 
+def normalised_signatures(spec: Spectrum, times, include_zero: bool = False, vertices=None):
+    """(n, T), or (len(vertices), T): ``S_t(v) / Z(t) * sqrt(dlogt)`` at the log-spaced
+    ``times``, the rows whose Euclidean distances are eq. (31)'s Riemann sum."""
+    mask = _used(spec, include_zero)
+    times = np.asarray(times, dtype=np.float64)
+    dlogt = (np.log(times[-1]) - np.log(times[0])) / (len(times) - 1)
+    weights = np.exp(-np.outer(spec.eigenvalues[mask], times))  # (k, T)
+    z = weights.sum(axis=0)  # (T,)
+    return (spec.squared_modes(vertices)[:, mask] @ (weights / z)) * np.sqrt(dlogt)
+
+
 class SignatureTable:
     """Normalised signatures of all vertices, ready for fast distance queries.
 
@@ -59,8 +70,6 @@ class SignatureTable:
     def __init__(self, spec: Spectrum, t_range=None, samples: int = 100, include_zero=False):
         self.t_range = None if t_range is None else (float(t_range[0]), float(t_range[1]))
         """The scale range asked for (None: the default range, see :attr:`times`)."""
-        mask = _used(spec, include_zero)
-        lam = spec.eigenvalues[mask]
         if t_range is None:
             times = default_times(spec, samples, include_zero)
         else:
@@ -68,11 +77,8 @@ class SignatureTable:
             if not (0 < t1 < t2) or samples < 2:
                 raise ValueError("the scale range needs 0 < t1 < t2 and at least 2 samples")
             times = np.exp(np.linspace(np.log(t1), np.log(t2), samples))
-        dlogt = (np.log(times[-1]) - np.log(times[0])) / (len(times) - 1)
-        weights = np.exp(-np.outer(lam, times))  # (k, T)
-        z = weights.sum(axis=0)  # (T,)
         self.times = times
-        self.table = (spec.squared_modes()[:, mask] @ (weights / z)) * np.sqrt(dlogt)
+        self.table = normalised_signatures(spec, times, include_zero)
 
     @property
     def table(self) -> np.ndarray:
