@@ -302,8 +302,7 @@ class MainWindow(QtWidgets.QMainWindow):
         except ComputeRefused as exc:
             self.show_error(str(exc), "Computation too large")
             return None
-        key = job.key[1] if isinstance(job.key, tuple) else job.key
-        seconds, _ = cost_estimate(key, self.state.mesh.n_vertices)
+        seconds, _ = cost_estimate(job.spectrum_key, self.state.mesh.n_vertices)
         if not job.done and seconds > 300:
             self.statusBar().showMessage(
                 f"This will take about {seconds / 60:.0f} min (Esc cancels; Coarse-to-fine is "

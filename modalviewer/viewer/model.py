@@ -202,7 +202,7 @@ class ViewerModel:
             if (
                 j.status == DONE
                 and key in self.state.spectra
-                and self.state.display in (before, _blank(before))
+                and self.state.display in (before, before.blank())
             ):
                 self._show_first_mode(key.operator)
 
@@ -266,13 +266,6 @@ def apply_repair(name: str, mesh: Mesh, progress=None) -> Mesh:
 
         return largest_component(mesh)
     raise ValueError(f"unknown repair {name!r}")
-
-
-def _blank(display):
-    """The display as it looks on a fresh mesh (a request made then may still show)."""
-    from dataclasses import replace
-
-    return replace(display, kind="none", operator=None, mode=0)
 
 
 def _compute(mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cancel) -> Spectrum:

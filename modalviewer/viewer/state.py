@@ -123,6 +123,10 @@ class Display:
     threshold: float = 0.2
     signature_sample: int = 50
 
+    def blank(self) -> Display:
+        """This display as a newly loaded mesh shows it: nothing, other choices kept."""
+        return replace(self, kind="none", operator=None, mode=0)
+
 
 @dataclass
 class Field:
@@ -219,7 +223,7 @@ class ViewerState:
             self.compute_settings = replace(self.compute_settings, k=default_k(mesh.n_vertices))
         self.picked = None
         self.animation.playing = False
-        self.display = replace(self.display, kind="none", operator=None, mode=0)
+        self.display = self.display.blank()
         self.camera = None
         self.events.mesh.emit()
 
