@@ -7,8 +7,8 @@ Every term has the form ``1/2 * sum_i w_i (f_i(x) - f_i(xbar))^2`` with weights 
 - area E_A over faces: f = A_T, w = 1 / A_T;
 
 E = bending * E_F + membrane * (E_L + E_A).  Lemma 1 gives the Hessian at rest as
-``H = sum_i w_i grad f_i grad f_i^T``; it is assembled here fully vectorised, in
-vertex-major order (dof ``3 * i + c``).
+``H = sum_i w_i grad f_i grad f_i^T = G^T G``, G holding the rows ``sqrt(w_i) grad f_i``;
+it is assembled here as that sparse product, in vertex-major order (dof ``3 * i + c``).
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ __all__ = [
     "shells_hessian",
     "normal_shells_hessian",
     "normal_projection",
+    "weighted_gradient_matrix",
 ]
 
 
@@ -180,36 +181,61 @@ def shells_gradient(mesh: Mesh, x, bending: float = 1.0, membrane: float = 1.0) 
     return grad.ravel()
 
 
-def _assemble_outer_products(n: int, parts) -> sp.csr_matrix:
-    """Sum of w g g^T over elements, as a (3n, 3n) CSR built from 3x3 vertex blocks.
+def weighted_gradient_matrix(
+    mesh: Mesh,
+    bending: float = 1.0,
+    membrane: float = 1.0,
+    normals: np.ndarray | None = None,
+) -> sp.csr_matrix:
+    """G with one row ``sqrt(w_i) grad f_i^T`` per term, so that the Hessian at rest is
+    ``G^T G`` (Lemma 1).
 
-    ``parts`` yields (stencil (e, L), gradients (e, L, 3), weights (e,)).
-    Duplicate vertex pairs are summed with one sort of int64 keys and bincounts.
+    Rows: interior edges (flexural), edges (length), faces (area), in that order, for the
+    terms with a non-zero weight.  Columns: the 3n vertex-major dofs, or with ``normals``
+    (n, 3) the n normal variations (each gradient block dotted with the vertex normal,
+    which gives ``H_N = G_N^T G_N`` without forming the 3n Hessian).
     """
-    keys_list, blocks_list = [], []
-    for stencil, g, w in parts:
-        L = stencil.shape[1]
-        a = np.repeat(stencil, L, axis=1).ravel()  # row vertex of each block
-        b = np.tile(stencil, (1, L)).ravel()  # column vertex
-        keys_list.append(a.astype(np.int64) * n + b)
-        # block (p, q) of element e: w_e g[e, p] g[e, q]^T, shape (e, L, L, 3, 3)
-        wg = g * np.sqrt(w)[:, None, None]
-        blocks_list.append(np.einsum("epi,eqj->epqij", wg, wg).reshape(-1, 9))
-    keys = np.concatenate(keys_list)
-    blocks = np.concatenate(blocks_list)
-    del keys_list, blocks_list
-    unique, inverse = np.unique(keys, return_inverse=True)
-    summed = np.empty((len(unique), 9))
-    for c in range(9):
-        summed[:, c] = np.bincount(inverse, weights=blocks[:, c], minlength=len(unique))
-    rows = unique // n
-    cols = unique - rows * n
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
-    bsr = sp.bsr_matrix(
-        (summed.reshape(-1, 3, 3), cols.astype(np.int32), indptr.astype(np.int32)),
-        shape=(3 * n, 3 * n),
-    )
-    return bsr.tocsr()
+    _check_weights(bending, membrane)
+    x = mesh.vertices
+    n = mesh.n_vertices
+    blocks = []
+    for stencil, _, df, w in _terms(mesh, bending, membrane):
+        e, L = stencil.shape
+        g = df(x, stencil) * np.sqrt(w)[:, None, None]  # (e, L, 3)
+        if normals is None:
+            cols = (3 * stencil[:, :, None] + np.arange(3)).reshape(e, 3 * L)
+            vals = g.reshape(e, 3 * L)
+        else:
+            cols = stencil
+            vals = np.einsum("elc,elc->el", g, normals[stencil])
+        width = cols.shape[1]
+        indptr = np.arange(0, e * width + 1, width, dtype=np.int64)
+        blocks.append(
+            sp.csr_matrix(
+                (vals.ravel(), cols.ravel(), indptr),
+                shape=(e, n if normals is not None else 3 * n),
+            )
+        )
+    return sp.vstack(blocks, format="csr")
+
+
+def _gram(G: sp.csr_matrix) -> sp.csr_matrix:
+    """``G^T G`` as a symmetric CSR with sorted indices, its two row halves computed on
+    two threads (scipy's sparse product releases the GIL and runs on one core)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    GT = G.T.tocsr()
+    N = GT.shape[0]
+    halves = [slice(0, N // 2), slice(N // 2, N)]
+
+    def rows(part: slice) -> sp.csr_matrix:
+        A = (GT[part] @ G).tocsr()
+        A.sort_indices()
+        return A
+
+    with ThreadPoolExecutor(2) as pool:
+        top, bottom = pool.map(rows, halves)
+    return sp.vstack([top, bottom], format="csr")
 
 
 def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
@@ -217,12 +243,11 @@ def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> s
 
     Vertex-major dof order ``3 * i + c``.  Pair it with ``kron(M, I3)`` as mass.
     Units: bending part ~ 1 / length^2, membrane part ~ 1 / length^1 (hence the
-    spectrum depends on the mesh's absolute size).
+    spectrum depends on the mesh's absolute size).  Assembled as ``G^T G`` of
+    :func:`weighted_gradient_matrix` (one sparse product instead of summing 3x3 blocks
+    of every element's outer products).
     """
-    _check_weights(bending, membrane)
-    x = mesh.vertices
-    parts = ((stencil, df(x, stencil), w) for stencil, _, df, w in _terms(mesh, bending, membrane))
-    return _assemble_outer_products(mesh.n_vertices, parts)
+    return _gram(weighted_gradient_matrix(mesh, bending, membrane))
 
 
 def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_matrix:
@@ -235,7 +260,7 @@ def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_m
 
 
 def normal_shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
-    """H_N = P^T H P, (n, n): the shells Hessian restricted to normal variations."""
-    P = normal_projection(mesh)
-    H = shells_hessian(mesh, bending, membrane)
-    return (P.T @ H @ P).tocsr()
+    """H_N = P^T H P, (n, n): the shells Hessian restricted to normal variations, with P
+    of :func:`normal_projection` (assembled as ``(G P)^T (G P)``)."""
+    G_N = weighted_gradient_matrix(mesh, bending, membrane, normals=vertex_normals(mesh))
+    return _gram(G_N)
