@@ -32,6 +32,7 @@ relative error (see :func:`estimated_errors`).
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -50,6 +51,7 @@ __all__ = [
     "partition_of_unity_basis",
     "rotation_fields",
     "reduced_basis",
+    "SPACE_SETTINGS",
     "preview_spectrum",
     "estimated_errors",
     "compute_preview",
@@ -179,23 +181,75 @@ def reduced_basis(
     radius_factor: float = RADIUS_FACTOR,
     enrich: int = 1,
     seed: int = 0,
+    candidates: int | None = None,
 ) -> tuple[sp.csr_matrix, np.ndarray | None, dict]:
     """Prolongation for ``operator``: (P sparse, dense extra columns or None, info).
 
     For ``"shells"`` P is ``kron(P_scalar, I3)`` (vertex-major rows 3v + c) and the dense
     columns are the three rotations; for the scalar operators the dense part is None.
+    ``candidates``: see :func:`farthest_point_samples`.
     """
-    centers = farthest_point_samples(mesh.vertices, samples, seed=seed)
+    centers = farthest_point_samples(mesh.vertices, samples, candidates=candidates, seed=seed)
     P, r = partition_of_unity_basis(mesh, centers, radius_factor, enrich)
     info = {
         "samples": int(len(centers)),
         "support_radius": r,
         "enriched": bool(enrich),
+        "polynomial_degree": int(min(max(enrich, 0), 2)),
         "components_per_function": 3 if operator == "shells" else 1,
     }
     if operator == "shells":
         return sp.kron(P, sp.eye(3), format="csr"), rotation_fields(mesh), info
     return P, None, info
+
+
+def scalar_functions_per_sample(degree: int) -> int:
+    """Scalar basis functions per sample: the partition-of-unity function times 1 (degree
+    0), times 1, u, v (degree 1) or times 1, u, v, u^2, uv, v^2 (degree 2)."""
+    return {0: 1, 1: 3}.get(int(degree), 6)
+
+
+def max_samples(n_vertices: int, degree: int) -> int:
+    """Most samples a mesh of ``n_vertices`` gets: at least 2 vertices per scalar function
+    (and 6 per sample); denser samples make the enriched functions linearly dependent on
+    the mesh without adding anything."""
+    return n_vertices // (2 * max(scalar_functions_per_sample(degree), 3))
+
+
+@dataclass(frozen=True)
+class SpaceSettings:
+    """How the reduced space of a preview is built for one operator."""
+
+    samples_min: int
+    samples_per_mode: float
+    degree: int
+    """Polynomials times each partition-of-unity function: 1 = linear, 2 = quadratic."""
+    radius_factor: float
+    exact_sampling: bool
+    """Farthest-point sampling over all vertices (an even covering, so the support
+    radius is not set by one badly covered corner) instead of over random candidates."""
+    smoothing: bool
+
+    def samples(self, k: int) -> int:
+        return max(self.samples_min, int(self.samples_per_mode * k))
+
+
+SPACE_SETTINGS = {
+    # Without smoothing the space itself must be fine (10k spot, Galerkin alone: 200 / 300
+    # samples, largest error 2.0 / 1.4 %); the support radius comes from the covering
+    # radius of random-candidate sampling, which the 130k plate's lowest 50 eigenvalues
+    # need (0.24 % largest error against 1.1 % with an even sampling and 2 spacings).
+    "laplacian": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
+    "modified_dirichlet": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
+    "shells_normal": SpaceSettings(DEFAULT_SAMPLES, 2.0, 1, RADIUS_FACTOR, False, True),
+    # Bending energies need quadratic precision: on the 130k plate (100 modes, one
+    # smoothing step) linear functions leave 2.7 % median / 21 % largest error on the
+    # lowest 50 eigenvalues, quadratic ones 1.0 % / 2.2 % with a smaller space (100
+    # samples, 1803 functions).  More samples do not help either: the Galerkin error of
+    # smooth spaces stays near 5 % median (membrane locking on the bumps), which the
+    # smoothing step removes.
+    "shells": SpaceSettings(100, 1.0, 2, 1.8, True, True),
+}
 
 
 MAX_NULL_COLUMNS = 96
@@ -482,20 +536,20 @@ def preview_spectrum(
     mass: np.ndarray,
     k: int,
     samples: int | None = None,
-    radius_factor: float = RADIUS_FACTOR,
-    enrich: int = 1,
+    radius_factor: float | None = None,
+    enrich: int | None = None,
     smoothing: bool | None = None,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
     """Preview eigenpairs of ``K x = lambda diag(mass) x`` for ``operator`` on ``mesh``.
 
-    Galerkin projection onto :func:`reduced_basis` (``samples`` centres; by default
-    ``max(300, 3 k)`` for the Laplacian and E_D^N, ``max(200, 2 k)`` for the normal
-    shells, ``max(140, 1.4 k)`` for the shells), then (``smoothing``, by default for the
-    two Discrete Shells operators) one Rayleigh-Ritz step on the prolonged modes together
-    with their block-Jacobi preconditioned residuals, which adds the mesh-scale components
-    a smooth space lacks.
+    Galerkin projection onto :func:`reduced_basis` (``samples`` centres, polynomial
+    degree ``enrich`` and ``radius_factor``; the defaults per operator are in
+    :data:`SPACE_SETTINGS`), then (``smoothing``, by default for the two Discrete Shells
+    operators) one Rayleigh-Ritz step on the prolonged modes together with their
+    block-Jacobi preconditioned residuals, which adds the mesh-scale components a smooth
+    space lacks.
 
     The estimated errors are the eigenvalues' decrease in the smoothing step, or without
     it their decrease from the nested space of the partition-of-unity functions alone to
@@ -516,26 +570,20 @@ def preview_spectrum(
     mass = np.asarray(mass, dtype=np.float64)
     seconds = {}
     t = time.perf_counter()
-    shells_energy = operator in ("shells", "shells_normal")
+    settings = SPACE_SETTINGS[operator]
     if smoothing is None:
-        smoothing = shells_energy
+        smoothing = settings.smoothing
     if samples is None:
-        # the shells' 9 functions per sample make the reduced problem the costly part;
-        # fewer samples hardly change their error, which the smoothing step dominates
-        # (10k bumpy plate, 100 modes: 140 / 200 samples, largest error 8.8 / 7.9 %).
-        # Without smoothing the space itself must be finer (10k spot Laplacian, Galerkin
-        # alone: 200 / 300 samples, largest error 2.0 / 1.4 %)
-        if operator == "shells":
-            samples = max(140, int(1.4 * k))
-        elif shells_energy:
-            samples = max(DEFAULT_SAMPLES, 2 * k)
-        else:
-            samples = max(300, 3 * k)
+        samples = settings.samples(k)
+    enrich = settings.degree if enrich is None else int(enrich)
+    if radius_factor is None:
+        radius_factor = settings.radius_factor
     report("preview: sampling", 0.05)
-    # at least 6 vertices per sample: denser samples make the enriched functions
-    # linearly dependent on the mesh without adding anything
-    samples = max(1, min(int(samples), mesh.n_vertices // 6))
-    P, D, info = reduced_basis(mesh, operator, samples, radius_factor, enrich)
+    samples = max(1, min(int(samples), max_samples(mesh.n_vertices, enrich)))
+    candidates = mesh.n_vertices if settings.exact_sampling else None
+    P, D, info = reduced_basis(
+        mesh, operator, samples, radius_factor, enrich, candidates=candidates
+    )
     seconds["basis"] = time.perf_counter() - t
     t = time.perf_counter()
     report("preview: projecting", 0.2)
@@ -615,13 +663,13 @@ def compute_preview(
     ``parameters["preview"]`` holds the reduced space, timings and estimated errors
     (``spec.is_preview``, ``spec.estimated_error``).
 
-    A mesh too small for a reduced space of 3 k functions (at most one sample per 6
-    vertices) gets the exact spectrum instead, which is quick there (``is_preview``
-    False)."""
+    A mesh too small for a reduced space of 3 k functions (:func:`max_samples`) gets
+    the exact spectrum instead, which is quick there (``is_preview`` False)."""
     from .pipeline import compute_spectrum, operator_matrices
 
-    per_sample = 9 if operator == "shells" else 3
-    if (mesh.n_vertices // 6) * per_sample < 3 * int(k):
+    degree = SPACE_SETTINGS[operator].degree
+    functions = max_samples(mesh.n_vertices, degree) * scalar_functions_per_sample(degree)
+    if functions * (3 if operator == "shells" else 1) < 3 * int(k):
         return compute_spectrum(mesh, operator, k, bending, membrane, progress, cancel)
 
     started = time.perf_counter()

@@ -101,6 +101,25 @@ def test_preview_converges_as_the_reduced_space_grows():
     assert errors[0] > 10 * errors[2]
 
 
+def test_quadratic_functions_serve_the_bending_energy_better_than_linear_ones():
+    """Shells on a bumpy plate (1681 vertices, 30 modes, 30 samples, one smoothing step):
+    quadratic polynomials times the partition of unity leave 17 % largest / 7.5 % median
+    error on the non-rigid eigenvalues, linear ones 52 % / 22 % (when written)."""
+    mesh = bumpy_plate(40)
+    k = 30
+    exact = mv.compute_spectrum(mesh, "shells", k).eigenvalues[6:]  # 5043 unknowns
+    K, mass = operator_matrices(mesh, "shells")
+    errors = {}
+    for degree in (1, 2):
+        lam, *_ = pv.preview_spectrum(mesh, "shells", K, mass, k, samples=30, enrich=degree)
+        errors[degree] = (lam[6:] - exact) / exact
+    assert np.all(errors[2] > -1e-9) and np.all(errors[1] > -1e-9)  # upper bounds
+    assert errors[2].max() < 0.4 * errors[1].max()
+    assert np.median(errors[2]) < 0.5 * np.median(errors[1])
+    spec = mv.compute_spectrum(mesh, "shells", k, accuracy="preview")
+    assert spec.parameters["preview"]["polynomial_degree"] == 2
+
+
 def test_prolonged_modes_are_mass_orthonormal(plate):
     for operator in ("laplacian", "shells"):
         spec = mv.compute_spectrum(plate, operator, k=24, accuracy="preview")
@@ -191,8 +210,11 @@ def test_every_component_keeps_its_exact_zero_modes(operator, zeros):
 def test_a_mesh_too_small_for_a_preview_gets_the_exact_spectrum():
     from modalviewer.core.primitives import icosphere
 
-    mesh = icosphere(1)  # 42 vertices: 7 samples, 21 scalar functions
+    # 42 vertices: 7 samples of 3 linear functions (Laplacian), 3 samples of 6 quadratic
+    # functions times 3 components (shells)
+    mesh = icosphere(1)
     spec = mv.compute_spectrum(mesh, "laplacian", k=30, accuracy="preview")
     assert not spec.is_preview and spec.k == 30
     np.testing.assert_allclose(spec.eigenvalues[1:], _exact(mesh, "laplacian", 30)[1:], rtol=1e-8)
-    assert mv.compute_spectrum(mesh, "shells", k=20, accuracy="preview").is_preview
+    assert mv.compute_spectrum(mesh, "shells", k=18, accuracy="preview").is_preview
+    assert not mv.compute_spectrum(mesh, "shells", k=19, accuracy="preview").is_preview
