@@ -11,7 +11,14 @@ Laplace-Beltrami Eigenproblems*, SGP 2018):
 - each ``phi_i`` is enriched by ``phi_i * <x - c_i, t>/r`` for the two unit tangents t of
   the surface at c_i (locally linear functions, Nasikun et al.'s linear enrichment in the
   tangent plane, where the normal coordinate would be nearly linearly dependent on flat
-  parts).
+  parts); for the two Discrete Shells operators also by ``phi_i u^2, phi_i uv, phi_i v^2``
+  (u, v those tangent coordinates): a bending energy measures second derivatives, which
+  a partition of unity times linear functions does not approximate.
+
+For the shells operators one Rayleigh-Ritz step on the prolonged modes and their
+block-Jacobi preconditioned residuals follows: it adds the mesh-scale parts of the modes
+(the tangential give of a bumpy surface bending without stretching) that no smooth space
+holds.
 
 The columns of the prolongation P hold these functions.  The reduced problem
 ``(P^T K P) y = lambda (P^T M P) y`` is a small sparse generalised eigenproblem; the
@@ -43,6 +50,7 @@ from .eigen import CancelFn, Cancelled, EigenError, ProgressFn, zero_modes
 from .factor import SPDSolver
 from .laplacian import vertex_normals
 from .mesh import Mesh
+from .products import threaded_product
 from .spectrum import Spectrum
 
 __all__ = [
@@ -241,13 +249,14 @@ SPACE_SETTINGS = {
     # need (0.24 % largest error against 1.1 % with an even sampling and 2 spacings).
     "laplacian": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
     "modified_dirichlet": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
-    "shells_normal": SpaceSettings(DEFAULT_SAMPLES, 2.0, 1, RADIUS_FACTOR, False, True),
-    # Bending energies need quadratic precision: on the 130k plate (100 modes, one
-    # smoothing step) linear functions leave 2.7 % median / 21 % largest error on the
-    # lowest 50 eigenvalues, quadratic ones 1.0 % / 2.2 % with a smaller space (100
-    # samples, 1803 functions).  More samples do not help either: the Galerkin error of
-    # smooth spaces stays near 5 % median (membrane locking on the bumps), which the
-    # smoothing step removes.
+    # Bending energies need quadratic precision.  130k plate, 100 modes, one smoothing
+    # step, lowest 50 non-zero eigenvalues: normal shells, 200 samples of linear
+    # functions 6.8 % median / 10.3 % largest error, 100 samples of quadratic ones
+    # 0.9 % / 1.8 %; shells, 140 linear samples 2.7 % / 21 %, 100 quadratic samples
+    # (1803 functions) 1.0 % / 2.2 %.  More samples do not help the shells: the Galerkin
+    # error of smooth spaces stays near 5 % median for 60 to 300 samples (membrane
+    # locking on the bumps), which the smoothing step removes.
+    "shells_normal": SpaceSettings(100, 1.0, 2, RADIUS_FACTOR, False, True),
     "shells": SpaceSettings(100, 1.0, 2, 1.8, True, True),
 }
 
@@ -308,25 +317,11 @@ def _extend(A: sp.csr_matrix, K, P, D, E: np.ndarray) -> sp.csr_matrix:
     return (0.5 * (B + B.T)).tocsr()
 
 
-def _in_two_threads(fn, items):
-    """``[fn(item) for item in items]`` on two threads (scipy's sparse products release
-    the GIL and run on one core each)."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(2) as pool:
-        return list(pool.map(fn, items))
-
-
-def _halves(n: int) -> list[slice]:
-    return [slice(0, n // 2), slice(n // 2, n)]
-
-
 def _project(K, P: sp.csr_matrix, D: np.ndarray | None) -> sp.csr_matrix:
     """``[P D]^T K [P D]`` as a sparse symmetric matrix (D: dense columns or None)."""
     K = sp.csr_matrix(K)
-    halves = _halves(K.shape[0])
-    KP = _in_two_threads(lambda rows: (K[rows] @ P).tocsr(), halves)
-    A = sum(_in_two_threads(lambda i: (P[halves[i]].T @ KP[i]).tocsr(), [0, 1]))
+    KP = threaded_product(K, P)
+    A = threaded_product(P.T.tocsr(), KP)
     if D is not None:
         KD = K @ D
         cross = np.asarray(P.T @ KD)
@@ -448,21 +443,6 @@ def _jacobi_blocks(K: sp.csr_matrix, block: int):
     return apply
 
 
-def _threaded_product(K, X: np.ndarray) -> np.ndarray:
-    """K @ X with the columns split over two threads (scipy's product runs on one)."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    c = X.shape[1]
-    if c < 8:
-        return np.asarray(K @ X)
-    half = c // 2
-    with ThreadPoolExecutor(2) as pool:
-        parts = list(
-            pool.map(lambda sl: np.asarray(K @ X[:, sl]), [slice(0, half), slice(half, c)])
-        )
-    return np.hstack(parts)
-
-
 def _smoothing_step(K, mass, lam, U, KU, precondition, k):
     """Rayleigh-Ritz on [U, B^-1 R] with the block-Jacobi preconditioned residuals R.
 
@@ -475,7 +455,7 @@ def _smoothing_step(K, mass, lam, U, KU, precondition, k):
     W = precondition(KU - mass[:, None] * U * lam[None, :])
     # M-orthogonal to U; directions of (numerically) converged pairs add nothing
     W -= U @ (U.T @ (mass[:, None] * W))
-    KW = _threaded_product(K, W)
+    KW = threaded_product(K, W)
     G_ww = W.T @ (mass[:, None] * W)
     H_uw = KU.T @ W
     H_ww = W.T @ KW
@@ -606,7 +586,7 @@ def preview_spectrum(
     U = np.asarray(P @ Y[: P.shape[1]])
     if D is not None:
         U += D @ Y[P.shape[1] :]
-    KU = _threaded_product(K, U)
+    KU = threaded_product(K, U)
     seconds["prolongation"] = time.perf_counter() - t
     lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
     galerkin = lam

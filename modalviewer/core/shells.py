@@ -18,6 +18,7 @@ import scipy.sparse as sp
 
 from .laplacian import vertex_normals
 from .mesh import Mesh, MeshError
+from .products import threaded_product
 
 __all__ = [
     "hinges",
@@ -220,22 +221,10 @@ def weighted_gradient_matrix(
 
 
 def _gram(G: sp.csr_matrix) -> sp.csr_matrix:
-    """``G^T G`` as a symmetric CSR with sorted indices, its two row halves computed on
-    two threads (scipy's sparse product releases the GIL and runs on one core)."""
-    from concurrent.futures import ThreadPoolExecutor
-
-    GT = G.T.tocsr()
-    N = GT.shape[0]
-    halves = [slice(0, N // 2), slice(N // 2, N)]
-
-    def rows(part: slice) -> sp.csr_matrix:
-        A = (GT[part] @ G).tocsr()
-        A.sort_indices()
-        return A
-
-    with ThreadPoolExecutor(2) as pool:
-        top, bottom = pool.map(rows, halves)
-    return sp.vstack([top, bottom], format="csr")
+    """``G^T G`` as a symmetric CSR with sorted indices."""
+    A = threaded_product(G.T.tocsr(), G)
+    A.sort_indices()
+    return A
 
 
 def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
