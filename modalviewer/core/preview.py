@@ -452,11 +452,15 @@ def _smoothing_step(K, mass, lam, U, KU, precondition, k):
     value is at most the one it replaces and still an upper bound of the exact
     eigenvalue.  Returns (lam, X, KX).
     """
-    W = precondition(KU - mass[:, None] * U * lam[None, :])
+    MU = U * mass[:, None]
+    W = MU * -lam[None, :]
+    W += KU
+    W = precondition(W)
     # M-orthogonal to U; directions of (numerically) converged pairs add nothing
-    W -= U @ (U.T @ (mass[:, None] * W))
+    W -= U @ (MU.T @ W)
+    del MU
     KW = threaded_product(K, W)
-    G_ww = W.T @ (mass[:, None] * W)
+    G_ww = W.T @ (W * mass[:, None])
     H_uw = KU.T @ W
     H_ww = W.T @ KW
     c = U.shape[1]
@@ -477,8 +481,11 @@ def _smoothing_step(K, mass, lam, U, KU, precondition, k):
     T = E[:, keep] / np.sqrt(w[keep])
     new_lam, Z = np.linalg.eigh(T.T @ H @ T)
     C = (T @ Z[:, :k]) * d[:, None]
-    X = U @ C[:c] + W @ C[c:]
-    KX = KU @ C[:c] + KW @ C[c:]
+    X = U @ C[:c]
+    X += W @ C[c:]
+    del W
+    KX = KU @ C[:c]
+    KX += KW @ C[c:]
     return new_lam[:k], X, KX
 
 
