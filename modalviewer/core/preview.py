@@ -50,7 +50,7 @@ from .eigen import CancelFn, Cancelled, EigenError, ProgressFn, zero_modes
 from .factor import SPDSolver
 from .laplacian import vertex_normals
 from .mesh import Mesh
-from .products import threaded_product
+from .products import row_halves, threaded_product
 from .spectrum import Spectrum
 
 __all__ = [
@@ -319,9 +319,16 @@ def _extend(A: sp.csr_matrix, K, P, D, E: np.ndarray) -> sp.csr_matrix:
 
 def _project(K, P: sp.csr_matrix, D: np.ndarray | None) -> sp.csr_matrix:
     """``[P D]^T K [P D]`` as a sparse symmetric matrix (D: dense columns or None)."""
+    from concurrent.futures import ThreadPoolExecutor
+
     K = sp.csr_matrix(K)
-    KP = threaded_product(K, P)
-    A = threaded_product(P.T.tocsr(), KP)
+    # K P by row halves, then the sum of the halves' P_h^T (K P)_h: splitting the second
+    # product over its inner dimension is twice as fast as over its rows (130k shells,
+    # 1803 functions: 3.0-4.3 s against 6.2-6.7 s)
+    halves = row_halves(K)
+    with ThreadPoolExecutor(2) as pool:
+        KP = list(pool.map(lambda part: (part[1] @ P).tocsr(), halves))
+        A = sum(pool.map(lambda i: (P[halves[i][0]].T @ KP[i]).tocsr(), [0, 1]))
     if D is not None:
         KD = K @ D
         cross = np.asarray(P.T @ KD)
@@ -330,9 +337,18 @@ def _project(K, P: sp.csr_matrix, D: np.ndarray | None) -> sp.csr_matrix:
     return A.tocsr()
 
 
-def _project_mass(mass: np.ndarray, P: sp.csr_matrix, D: np.ndarray | None) -> sp.csr_matrix:
-    MP = P.multiply(mass[:, None]).tocsr() if sp.issparse(P) else mass[:, None] * P
-    A = (P.T @ MP).tocsr()
+def _project_mass(
+    mass: np.ndarray, P: sp.csr_matrix, D: np.ndarray | None, components: int = 1
+) -> sp.csr_matrix:
+    """``[P D]^T diag(mass) [P D]``.  With ``components`` 3, P is ``kron(P_s, I3)`` and
+    the mass repeats each vertex's value three times, so the sparse part is
+    ``kron(P_s^T diag(m) P_s, I3)`` (a ninth of the work)."""
+    if components == 3:
+        Ps = P[0::3][:, 0::3].tocsr()
+        m = mass[0::3]
+        A = sp.kron((Ps.T @ Ps.multiply(m[:, None]).tocsr()), sp.eye(3), format="csr")
+    else:
+        A = (P.T @ P.multiply(mass[:, None]).tocsr()).tocsr()
     if D is not None:
         MD = mass[:, None] * D
         cross = np.asarray(P.T @ MD)
@@ -575,7 +591,7 @@ def preview_spectrum(
     t = time.perf_counter()
     report("preview: projecting", 0.2)
     Kr = _project(K, P, D)
-    Mr = _project_mass(mass, P, D)
+    Mr = _project_mass(mass, P, D, info["components_per_function"])
     E = _null_space_complement(mesh, operator, K, mass, P, D, Mr)
     if E is not None:  # exact null vectors the space lacks (components, rotations)
         Kr, Mr = _extend(Kr, K, P, D, E), _extend(Mr, sp.diags(mass), P, D, E)
