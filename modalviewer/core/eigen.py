@@ -87,7 +87,12 @@ class EigenError(RuntimeError):
 
 
 class _NotConverged(EigenError):
-    """The Krylov iteration ran out of restarts (the solver may retry differently)."""
+    """The Krylov iteration ran out of restarts (the solver may retry differently);
+    ``columns``: the operator columns it applied before giving up."""
+
+    def __init__(self, message: str, columns: int = 0) -> None:
+        super().__init__(message)
+        self.columns = columns
 
 
 class StageTimer:
@@ -308,15 +313,17 @@ def solve_lowest(
                     lam, X, shift, backend, columns = _shift_invert(
                         *args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL
                     )
-                except _NotConverged:
+                except _NotConverged as failed:
                     if not d:
                         raise
                     # The tiny shift leaves K - shift M so close to singular that the
                     # solves' rounding floor can sit above the tolerance (1225-vertex
                     # folded plate, Laplacian, k = 99: residuals stuck at 9e-9); the
                     # undeflated shift does not, at the cost of a compressed spectrum.
+                    # The columns counted include the failed attempt's.
                     report("retrying with a larger shift", 0.05)
                     lam, X, shift, backend, columns = _shift_invert(*args, SHIFT_RTOL)
+                    columns += failed.columns
                 method = f"shift-invert block Krylov-Schur ({backend})"
             except _TooSmall:
                 lam = None
@@ -632,7 +639,8 @@ def block_krylov_schur(
             worst = float(np.max(estimates[:k] / np.abs(theta[:k])))
             raise _NotConverged(
                 f"the eigensolver did not converge after {restarts} restarts "
-                f"(worst relative residual {worst:.1e})"
+                f"(worst relative residual {worst:.1e})",
+                columns=applied,
             )
         # thick restart: keep the best Ritz vectors, continue from the open block
         restarts += 1

@@ -145,3 +145,21 @@ def test_deflated_solve_that_stalls_at_the_tiny_shift_is_retried():
     gram = spec.modes.T @ (m[:, None] * spec.modes)
     np.testing.assert_allclose(gram, np.eye(99), atol=1e-10)
     assert spec.residuals.max() < 1e-9
+
+
+def test_operator_columns_count_the_failed_attempt_before_a_retry():
+    """The folded plate's deflated attempt gives up after 60 restarts and the retry
+    converges with 440 columns; the count reports both attempts (3134 when written)."""
+    from pathlib import Path
+
+    import modalviewer as mv
+    from modalviewer.core.eigen import solve_lowest
+    from modalviewer.core.nullspace import null_space
+    from modalviewer.core.pipeline import operator_matrices
+
+    mesh = mv.load_mesh(Path(__file__).resolve().parents[2] / "assets" / "demo_folded_plate.obj")
+    K, mass = operator_matrices(mesh, "laplacian")
+    result = solve_lowest(K, mass, 99, null_space=null_space(mesh, "laplacian", K, mass).vectors)
+    # each of the 60 restarts is followed by at least one new block (6 columns for 99
+    # modes) before the retry starts
+    assert result.operator_columns > 440 + 60 * 6
