@@ -36,6 +36,7 @@ sys.path.insert(0, str(ROOT))
 import modalviewer as mv  # noqa: E402
 from modalviewer.core.demo_shapes import bumpy_plate  # noqa: E402
 from modalviewer.core.eigen import solve_lowest  # noqa: E402
+from modalviewer.core.memory import keep_freed_memory  # noqa: E402
 from modalviewer.core.nullspace import null_space  # noqa: E402
 from modalviewer.core.pipeline import operator_matrices  # noqa: E402
 
@@ -72,6 +73,7 @@ def baseline(K, mass, k, shift):
 
 def _ours(size: str, operator: str, k: int) -> dict:
     """One row of the project's timings, in a fresh process (so peak memory is its own)."""
+    keep_freed_memory()  # as the viewer's and the command line's computation processes
     mesh = make_mesh(size)
     t0 = time.perf_counter()
     K, mass = operator_matrices(mesh, operator)
@@ -114,6 +116,7 @@ def _ours(size: str, operator: str, k: int) -> dict:
 
 
 def _baseline_row(size: str, operator: str, k: int, shift: float) -> dict:
+    keep_freed_memory()  # the same allocator settings as the project's row
     mesh = make_mesh(size)
     K, mass = operator_matrices(mesh, operator)
     t0 = time.perf_counter()
