@@ -52,6 +52,23 @@ def colorbar_label(value: float) -> str:
     return "0" if value == 0 else f"{value:.3g}"
 
 
+def wrap_text(text: str, measure, width: float) -> str:
+    """``text`` with each line broken at spaces so that ``measure(line) <= width``
+    (a single word wider than that stays on its own line)."""
+    out = []
+    for line in text.split("\n"):
+        current = ""
+        for word in line.split(" "):
+            candidate = f"{current} {word}" if current else word
+            if current and measure(candidate) > width:
+                out.append(current)
+                current = word
+            else:
+                current = candidate
+        out.append(current)
+    return "\n".join(out)
+
+
 def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.ndarray:
     """``img`` (h, w, 3 or 4) uint8 with the legend at the top left and the colour bar at
     the bottom drawn on it; a copy.  Sizes are ``scale`` times the on-screen ones."""
@@ -68,9 +85,9 @@ def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.nd
     black = (0, 0, 0, 255)
     line_gap = 0.35 * FONT_PX * s
     if overlay.legend:
-        draw.multiline_text(
-            (margin, margin), overlay.legend, fill=black, font=font, spacing=line_gap
-        )
+        width = img.shape[1] - 2 * margin
+        text = wrap_text(overlay.legend, lambda t: draw.textlength(t, font=font), width)
+        draw.multiline_text((margin, margin), text, fill=black, font=font, spacing=line_gap)
     bar = overlay.colorbar
     if bar is not None:
         h, w = img.shape[:2]

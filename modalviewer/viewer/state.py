@@ -48,6 +48,12 @@ SHELL_COLORINGS = ("auto", "normal", "magnitude")
 RENDER_STYLES = ("paper", "shaded")
 
 
+def percent_text(fraction: float) -> str:
+    """A relative error as a short percentage: "0.24 %", "2.2 %", "21 %", "135 %"."""
+    value = 100.0 * float(fraction)
+    return f"{value:.0f} %" if value >= 10 else f"{value:.2g} %"
+
+
 def default_k(n_vertices: int) -> int:
     """A mode count suited to the mesh: 100 for most meshes, fewer for tiny ones."""
     return int(max(2, min(100, n_vertices // 4)))
@@ -579,7 +585,7 @@ class ViewerState:
             zero = spec.zero_mode_mask()[j]
             value = "0 (zero mode)" if zero else f"{lam:.4g}"
             if spec.is_preview:
-                value += f" (preview; estimated error up to {100 * spec.estimated_error:.1g} %)"
+                value += f" (preview; estimated error up to {percent_text(spec.estimated_error)})"
             colours = "blue +, white 0, orange -"
             if spec.is_vector and self.vector_coloring() == "magnitude":
                 colours = "white 0 to red: displacement magnitude"

@@ -244,3 +244,32 @@ def test_threshold_map_from_distances_moves_with_the_lookup_table_only(view, spo
     assert scene.colorbar() is None  # until the caller asks for the swatches
     scene.set_colorbar("distance < t")
     assert scene.colorbar().kind == "swatches"
+
+
+def test_a_long_legend_wraps_inside_the_export(view, spot_mode, tmp_path):
+    """A preview's legend is longer than a narrow export is wide: it wraps at spaces
+    instead of running off the right edge."""
+    mesh, field, _ = spot_mode
+    scene = _scene(view, mesh)
+    scene.show_field(field, "diverging", isolines=0, name="mode 9")
+    plain = _export(view, tmp_path / "plain.png", legend=False, colorbar=False)
+    scene.set_legend(
+        "Discrete Shells, normal variations, mode 9: lambda = 2.373e+04 "
+        "(preview; estimated error up to 2.2 %)\nblue +, white 0, orange -"
+    )
+    img = _export(view, tmp_path / "long.png", colorbar=False)
+    h, w = img.shape[:2]
+    assert w == 480
+    right_edge = (1.0 - 12 / w, 0.0, 1.0, 0.2)  # the last 12 pixels of the top fifth
+    assert _dark(img, right_edge, plain) == 0
+    third_line = (0.0, 0.09, 0.6, 0.14)  # the wrapped first line needs a second row
+    assert _dark(img, third_line, plain) > 30
+
+
+def test_wrap_text_breaks_at_spaces_within_the_width():
+    from modalviewer.gui.overlay import wrap_text
+
+    text = "aaa bbb ccc ddd\nee"
+    wrapped = wrap_text(text, len, 7)
+    assert wrapped == "aaa bbb\nccc ddd\nee"
+    assert wrap_text("averyveryverylongword x", len, 5) == "averyveryverylongword\nx"

@@ -6,7 +6,7 @@ import numpy as np
 from qtpy import QtCore, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
-from ...viewer.state import ViewerState
+from ...viewer.state import ViewerState, percent_text
 from ..plots import LinePlot
 from .common import combo, quiet, select_data
 
@@ -128,7 +128,8 @@ class ModesPanel(QtWidgets.QWidget):
             text = f"Not shown: the surface shows {_what_is_shown(state)}. M shows the mode."
         if spec.is_preview:
             text += (
-                f"\nPreview (eigenvalues high by up to about {100 * spec.estimated_error:.1g} %); "
+                "\nPreview (eigenvalues high by up to about "
+                f"{percent_text(spec.estimated_error)}); "
                 "the exact spectrum replaces it when ready."
             )
         self.eigen_label.setText(text)
