@@ -44,10 +44,16 @@ from modalviewer.core.pipeline import operator_matrices  # noqa: E402
 def make_mesh(size: str) -> mv.Mesh:
     import trimesh
 
+    """The benchmark meshes: "10k" / "50k" spot midpoint-subdivided once / twice (the
+    original triangles stay flat), "50k-smooth" spot Loop-subdivided twice (a smooth
+    surface), "130k" the bumpy plate."""
     if size == "130k":
         return bumpy_plate(360)
     spot = mv.load_mesh(ROOT / "assets" / "spot.obj")
     v, f = spot.vertices, spot.faces
+    if size == "50k-smooth":
+        v, f = trimesh.remesh.subdivide_loop(v, f, iterations=2)
+        return mv.Mesh(v, f)
     for _ in range({"10k": 1, "50k": 2}[size]):
         v, f = trimesh.remesh.subdivide(v, f)
     mesh = mv.repair_mesh(v, f)
