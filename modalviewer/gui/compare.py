@@ -60,15 +60,21 @@ class CompareWindow(QtWidgets.QWidget):
         self.mode_index = 0 if self.distances else self.state.first_nonzero_mode(first)
         for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event.connect(self._on_state)
-        # On a desktop the focused 3D view (pyvistaqt's QtInteractor) takes key presses
-        # before this window's keyPressEvent sees them; window shortcuts come first.
+        # One key table serves two routes: on a desktop the focused 3D view (pyvistaqt's
+        # QtInteractor) takes key presses before keyPressEvent sees them, and window
+        # shortcuts come first; without an active window (off-screen) shortcuts do not
+        # fire and keyPressEvent handles the keys.
+        self._keys = {
+            QtGui.QKeySequence(key).toString(): slot
+            for key, slot in (
+                ("Escape", self.close),
+                ("Ctrl+W", self.close),
+                ("Right", lambda: self._step(+1)),
+                ("Left", lambda: self._step(-1)),
+            )
+        }
         context = QtCore.Qt.ShortcutContext.WidgetWithChildrenShortcut
-        for key, slot in (
-            ("Escape", self.close),
-            ("Ctrl+W", self.close),
-            ("Right", lambda: self._step(+1)),
-            ("Left", lambda: self._step(-1)),
-        ):
+        for key, slot in self._keys.items():
             shortcut = QtGui.QShortcut(QtGui.QKeySequence(key), self)
             shortcut.setContext(context)
             shortcut.activated.connect(slot)
@@ -80,16 +86,11 @@ class CompareWindow(QtWidgets.QWidget):
 
     def keyPressEvent(self, event):  # noqa: N802
         """Esc and Ctrl+W close; Left / Right step the mode of operator views."""
-        key, mods = event.key(), event.modifiers()
-        ctrl = bool(mods & QtCore.Qt.KeyboardModifier.ControlModifier)
-        if key == QtCore.Qt.Key.Key_Escape or (key == QtCore.Qt.Key.Key_W and ctrl):
-            self.close()
-        elif key == QtCore.Qt.Key.Key_Right and not self.distances:
-            self.show_mode(self.mode_index + 1)
-        elif key == QtCore.Qt.Key.Key_Left and not self.distances:
-            self.show_mode(self.mode_index - 1)
-        else:
+        slot = self._keys.get(QtGui.QKeySequence(event.keyCombination()).toString())
+        if slot is None:
             super().keyPressEvent(event)
+        else:
+            slot()
 
     def _on_state(self) -> None:
         if self.distances:
