@@ -54,19 +54,21 @@ def colorbar_label(value: float) -> str:
 
 def wrap_text(text: str, measure, width: float) -> str:
     """``text`` with each line broken at spaces so that ``measure(line) <= width``
-    (a single word wider than that stays on its own line)."""
+    (a single word wider than that stays on its own line).  No-break spaces hold words
+    together and come out as plain spaces (the default font has no glyph for them)."""
+    nbsp = "\u00a0"
     out = []
     for line in text.split("\n"):
         current = ""
         for word in line.split(" "):
             candidate = f"{current} {word}" if current else word
-            if current and measure(candidate) > width:
+            if current and measure(candidate.replace(nbsp, " ")) > width:
                 out.append(current)
                 current = word
             else:
                 current = candidate
         out.append(current)
-    return "\n".join(out)
+    return "\n".join(out).replace(nbsp, " ")
 
 
 def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.ndarray:

@@ -49,9 +49,10 @@ RENDER_STYLES = ("paper", "shaded")
 
 
 def percent_text(fraction: float) -> str:
-    """A relative error as a short percentage: "0.24 %", "2.2 %", "21 %", "135 %"."""
+    """A relative error as a short percentage: "0.24 %", "2.2 %", "21 %", "135 %" (with a
+    no-break space, so a wrapped legend keeps number and sign together)."""
     value = 100.0 * float(fraction)
-    return f"{value:.0f} %" if value >= 10 else f"{value:.2g} %"
+    return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
 
 
 def default_k(n_vertices: int) -> int:

@@ -273,3 +273,5 @@ def test_wrap_text_breaks_at_spaces_within_the_width():
     wrapped = wrap_text(text, len, 7)
     assert wrapped == "aaa bbb\nccc ddd\nee"
     assert wrap_text("averyveryverylongword x", len, 5) == "averyveryverylongword\nx"
+    # a no-break space keeps "22 %" on one line and is drawn as a plain space
+    assert wrap_text("up to 22\u00a0%", len, 8) == "up to\n22 %"

@@ -234,7 +234,7 @@ def test_no_preview_for_the_3d_shells(model, monkeypatch):
 def test_percent_text_is_short_and_never_in_exponent_notation():
     from modalviewer.viewer.state import percent_text
 
-    assert percent_text(0.0024) == "0.24 %"
-    assert percent_text(0.0217) == "2.2 %"
-    assert percent_text(0.26) == "26 %"
-    assert percent_text(1.354) == "135 %"
+    assert percent_text(0.0024) == "0.24\u00a0%"
+    assert percent_text(0.0217) == "2.2\u00a0%"
+    assert percent_text(0.26) == "26\u00a0%"
+    assert percent_text(1.354) == "135\u00a0%"

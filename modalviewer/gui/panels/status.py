@@ -13,6 +13,9 @@ class StatusLine(QtWidgets.QLabel):
     def __init__(self, state: ViewerState, parent=None):
         super().__init__(parent)
         self.state = state
+        # framed, so a temporary message to its left ("Computing ...") does not read as
+        # the start of the same line
+        self.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
         for event in (
             state.events.display,
             state.events.pick,
