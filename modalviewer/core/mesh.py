@@ -521,15 +521,14 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
     order = np.argsort(inv, kind="stable")
     starts = np.concatenate([[0], np.cumsum(counts)])
     # neighbours only across manifold edges (exactly two faces)
-    pairs = []
-    for e in np.flatnonzero(counts == 2):
-        a, b = order[starts[e]], order[starts[e] + 1]
-        pairs.append((a, b))
-    if not pairs:
+    manifold = np.flatnonzero(counts == 2)
+    if len(manifold) == 0:
         return f, 0, True
-    pa = np.array(pairs)
+    pa = np.stack([order[starts[manifold]], order[starts[manifold] + 1]], axis=1)
     fa, fb = face_of[pa[:, 0]], face_of[pa[:, 1]]
     same_dir = np.all(he[pa[:, 0]] == he[pa[:, 1]], axis=1)  # same direction: inconsistent
+    if not same_dir.any():  # already consistent (the common case): nothing to walk
+        return f, 0, True
     nbrs: list[list[tuple[int, bool]]] = [[] for _ in range(m)]
     for x, y, s in zip(fa.tolist(), fb.tolist(), same_dir.tolist(), strict=True):
         nbrs[x].append((y, s))
