@@ -342,10 +342,46 @@ def _with_dense_columns(A: sp.csr_matrix, K, P: sp.csr_matrix, D: np.ndarray | N
     return A.tocsr()
 
 
-def _project(K, P: sp.csr_matrix, D: np.ndarray | None) -> sp.csr_matrix:
-    """``[P D]^T K [P D]`` as a sparse symmetric matrix (D: dense columns or None)."""
+def _kron_projection(K: sp.csr_matrix, Ps: sp.csr_matrix) -> sp.csr_matrix:
+    """``kron(Ps, I3)^T K kron(Ps, I3)`` for a symmetric (3n, 3n) K in vertex-major
+    order: block (a, b) of every 3 x 3 entry is ``Ps^T K_ab Ps`` with ``K_ab = K[a::3,
+    b::3]``; the six with a <= b are computed (two threads), the others are their
+    transposes.  A third fewer multiply-adds than through the 3n rows (130k shells,
+    1803 functions: 1.5 s against 2.7-3.6 s)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    PsT = Ps.T.tocsr()
+    pairs = [(a, b) for a in range(3) for b in range(a, 3)]
+
+    def block(ab: tuple[int, int]) -> sp.coo_matrix:
+        a, b = ab
+        return (PsT @ (K[a::3][:, b::3].tocsr() @ Ps)).tocoo()
+
+    with ThreadPoolExecutor(2) as pool:
+        blocks = list(pool.map(block, pairs))
+    rows, cols, vals = [], [], []
+    for (a, b), A in zip(pairs, blocks, strict=True):
+        rows.append(3 * A.row + a)
+        cols.append(3 * A.col + b)
+        vals.append(A.data)
+        if a != b:
+            rows.append(3 * A.col + b)
+            cols.append(3 * A.row + a)
+            vals.append(A.data)
+    m = 3 * Ps.shape[1]
+    return sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(m, m)
+    )
+
+
+def _project(K, P: sp.csr_matrix, D: np.ndarray | None, components: int = 1) -> sp.csr_matrix:
+    """``[P D]^T K [P D]`` as a sparse symmetric matrix (D: dense columns or None).
+    With ``components`` 3, P is ``kron(P_s, I3)`` (see :func:`_kron_projection`)."""
     K = sp.csr_matrix(K)
-    A = _transpose_product(P, threaded_product(K, P))
+    if components == 3:
+        A = _kron_projection(K, P[0::3][:, 0::3].tocsr())
+    else:
+        A = _transpose_product(P, threaded_product(K, P))
     return _with_dense_columns(A, K, P, D)
 
 
@@ -605,7 +641,7 @@ def preview_spectrum(
     seconds["basis"] = time.perf_counter() - t
     t = time.perf_counter()
     report("preview: projecting", 0.2)
-    Kr = _project(K, P, D)
+    Kr = _project(K, P, D, info["components_per_function"])
     Mr = _project_mass(mass, P, D, info["components_per_function"])
     E = _null_space_complement(mesh, operator, K, mass, P, D, Mr)
     if E is not None:  # exact null vectors the space lacks (components, rotations)

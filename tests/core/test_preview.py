@@ -67,6 +67,15 @@ def test_rigid_motions_are_exact_zero_modes_of_the_reduced_shells_problem(ring):
     assert np.abs(B @ coef - rigid).max() < 1e-10 * np.abs(rigid).max()
     Kr = pv._project(K, P, D).toarray()
     Mr = pv._project_mass(mass, P, D).toarray()
+    # the projections through the kron structure (what the preview uses) are the same
+    dense = B.T @ (K @ B)
+    np.testing.assert_allclose(Kr, dense, atol=1e-12 * np.abs(dense).max())
+    np.testing.assert_allclose(
+        pv._project(K, P, D, components=3).toarray(), dense, atol=1e-12 * np.abs(dense).max()
+    )
+    np.testing.assert_allclose(
+        pv._project_mass(mass, P, D, components=3).toarray(), Mr, atol=1e-12 * np.abs(Mr).max()
+    )
     # ... and are null vectors of the reduced stiffness
     assert np.abs(Kr @ coef).max() < 1e-9 * np.abs(Kr).max() * np.abs(coef).max()
     lam, Y = la.eigh(Kr, Mr, subset_by_index=[0, 9])
