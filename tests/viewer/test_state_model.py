@@ -222,7 +222,7 @@ def test_cancel_stops_a_preview_and_the_exact_spectrum_behind_it(model, monkeypa
 
 
 def test_no_preview_for_the_3d_shells(model, monkeypatch):
-    """Their preview costs 0.27 to 0.48 of the exact time (benchmarks/preview.py)."""
+    """Their preview costs 0.23 to 0.41 of the exact time (benchmarks/preview.py)."""
     from modalviewer.viewer import model as model_module
 
     monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
