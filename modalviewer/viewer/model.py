@@ -179,10 +179,10 @@ class ViewerModel:
     def _wants_preview(self, key: SpectrumKey) -> bool:
         """Preview first: asked for, a scalar operator, a big problem, no preview yet,
         not in the cache.  Not for the 3D Discrete Shells: their preview costs 0.23 to
-        0.41 of the exact time and is far off on creased meshes (README, "Preview
-        spectra"), so it would delay the exact spectrum by a third or more for a picture
-        that can mislead; the Laplacian's costs a fifth at 130k with 0.2 % eigenvalue
-        error."""
+        0.41 of the exact time and is far off on curved or creased meshes (README,
+        "Preview spectra"), so it would delay the exact spectrum by a quarter or more
+        for a picture that can mislead; the Laplacian's costs a fifth at 130k with 0.2 %
+        eigenvalue error."""
         state = self.state
         info = operator_info(key.operator)
         n = info.unknowns(state.mesh.n_vertices)
