@@ -47,9 +47,6 @@ def _distances(spec, vertices) -> np.ndarray:
 def _method(size: str, operator: str, k: int, method: str) -> dict:
     """One method in this (fresh) process: time, eigenvalues, distances, peak memory."""
     import modalviewer as mv
-    from modalviewer.core.memory import keep_freed_memory
-
-    keep_freed_memory()  # as the viewer's and the command line's computation processes
 
     mesh = make_mesh(size)
     vertices = np.random.default_rng(0).integers(0, mesh.n_vertices, N_VERTICES)

@@ -79,7 +79,6 @@ def baseline(K, mass, k, shift):
 
 def _ours(size: str, operator: str, k: int) -> dict:
     """One row of the project's timings, in a fresh process (so peak memory is its own)."""
-    keep_freed_memory()  # as the viewer's and the command line's computation processes
     mesh = make_mesh(size)
     t0 = time.perf_counter()
     K, mass = operator_matrices(mesh, operator)
@@ -122,7 +121,6 @@ def _ours(size: str, operator: str, k: int) -> dict:
 
 
 def _baseline_row(size: str, operator: str, k: int, shift: float) -> dict:
-    keep_freed_memory()  # the same allocator settings as the project's row
     mesh = make_mesh(size)
     K, mass = operator_matrices(mesh, operator)
     t0 = time.perf_counter()
@@ -135,9 +133,11 @@ def _baseline_row(size: str, operator: str, k: int, shift: float) -> dict:
 
 
 def _in_child(fn, *args):
+    """``fn(*args)`` in a fresh process that keeps freed memory, as the viewer's and the
+    command line's computation processes do (``core.memory``)."""
     import multiprocessing as mp
 
-    with mp.get_context("spawn").Pool(1) as pool:
+    with mp.get_context("spawn").Pool(1, initializer=keep_freed_memory) as pool:
         return pool.apply(fn, args)
 
 
