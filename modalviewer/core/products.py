@@ -11,7 +11,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["row_halves", "threaded_product"]
+__all__ = ["row_halves", "threaded_product", "threaded_transpose_product"]
 
 
 def row_halves(K: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
@@ -47,3 +47,13 @@ def threaded_product(K, X):
     with ThreadPoolExecutor(2) as pool:
         list(pool.map(rows, row_halves(K)))
     return out
+
+
+def threaded_transpose_product(P: sp.csr_matrix, Q: sp.csr_matrix) -> sp.csr_matrix:
+    """``P^T Q`` for two sparse matrices with the same rows, as the sum of the products
+    of their row halves on two threads: splitting over the inner dimension is twice as
+    fast as over the result's rows (130k shells preview, 1803 functions: 3.0-4.3 s
+    against 6.2-6.7 s)."""
+    pairs = zip(row_halves(sp.csr_matrix(P)), row_halves(sp.csr_matrix(Q)), strict=True)
+    with ThreadPoolExecutor(2) as pool:
+        return sum(pool.map(lambda pq: (pq[0][1].T @ pq[1][1]).tocsr(), pairs))

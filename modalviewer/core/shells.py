@@ -233,8 +233,7 @@ def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> s
     Vertex-major dof order ``3 * i + c``.  Pair it with ``kron(M, I3)`` as mass.
     Units: bending part ~ 1 / length^2, membrane part ~ 1 / length^1 (hence the
     spectrum depends on the mesh's absolute size).  Assembled as ``G^T G`` of
-    :func:`weighted_gradient_matrix` (one sparse product instead of summing 3x3 blocks
-    of every element's outer products).
+    :func:`weighted_gradient_matrix` (one sparse product on two threads).
     """
     return _gram(weighted_gradient_matrix(mesh, bending, membrane))
 
