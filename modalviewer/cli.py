@@ -147,9 +147,9 @@ def _run(args) -> int:
         print(f"{len(made)} figures written to {args.output}")
         return 0
     if args.command == "compute":
-        from .core.memory import keep_freed_memory
+        from .core.memory import prepare_compute_process
 
-        keep_freed_memory()  # this process exists to compute (see core.memory)
+        prepare_compute_process()  # this process exists to compute (see core.memory)
         mesh = mv.load_mesh(args.mesh)
         spec = mv.compute_spectrum(
             mesh,

@@ -23,12 +23,12 @@ def _emit(payload: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     job_path, out_path = argv
-    from .memory import keep_freed_memory
+    from .memory import prepare_compute_process
     from .mesh import Mesh
     from .pipeline import compute_spectrum
     from .spectrum import save_spectrum
 
-    keep_freed_memory()  # this process exists to compute (see core.memory)
+    prepare_compute_process()  # this process exists to compute (see core.memory)
     try:
         with np.load(job_path, allow_pickle=False) as job:
             vertices, faces = job["vertices"], job["faces"]

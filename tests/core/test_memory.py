@@ -1,4 +1,4 @@
-"""Keeping freed memory in computation processes (core.memory)."""
+"""Memory settings of computation processes (core.memory)."""
 
 import subprocess
 import sys
@@ -7,12 +7,14 @@ import pytest
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
-def test_keep_freed_memory_takes_effect_in_a_fresh_process():
+def test_the_memory_settings_take_effect_in_a_fresh_process():
     code = (
-        "from modalviewer.core.memory import keep_freed_memory\n"
+        "from modalviewer.core.memory import prepare_compute_process\n"
         "import numpy as np\n"
-        "ok = keep_freed_memory()\n"
+        "ok = prepare_compute_process()\n"
         "a = np.ones((4000, 4000)); del a\n"  # 128 MB from the heap, kept
+        # the setter returns the previous setting: huge-page advice is off
+        "assert np._core.multiarray._set_madvise_hugepage(True) is False\n"
         "print(ok)\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
@@ -20,8 +22,8 @@ def test_keep_freed_memory_takes_effect_in_a_fresh_process():
     assert out.stdout.strip() == "True"
 
 
-def test_the_viewer_child_process_computes_with_freed_memory_kept(tmp_path):
-    """The viewer's child process (core.job_main) computes with the setting on and
+def test_the_viewer_child_process_computes_with_the_memory_settings(tmp_path):
+    """The viewer's child process (core.job_main) computes with the settings on and
     still writes its spectrum."""
     import numpy as np
 
