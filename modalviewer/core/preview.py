@@ -39,8 +39,8 @@ relative error (see :func:`estimated_errors`).
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from functools import partial
 
 import numpy as np
 import scipy.sparse as sp
@@ -58,6 +58,7 @@ __all__ = [
     "farthest_point_samples",
     "partition_of_unity_basis",
     "rotation_fields",
+    "ReducedBasis",
     "reduced_basis",
     "SPACE_SETTINGS",
     "preview_spectrum",
@@ -182,6 +183,63 @@ def rotation_fields(mesh: Mesh) -> np.ndarray:
     return R / np.linalg.norm(R, axis=0, keepdims=True)
 
 
+@dataclass
+class ReducedBasis:
+    """The prolongation ``P = [kron(scalar, I_c)  dense]`` of a reduced space.
+
+    ``scalar`` (n, q) holds the scalar functions on the vertices.  With ``components``
+    3 (Discrete Shells) every one of them times e_x, e_y, e_z is a column: unknowns are
+    vertex-major (row 3 v + a), column 3 j + a is scalar function j times e_a.  The
+    Kronecker product is never formed: products with P go through the scalar matrix
+    (a third of the entries and of the work).  ``dense`` (c n, d) holds global columns
+    (the shells' rotations, exact null vectors the space lacks) or is None.
+    """
+
+    scalar: sp.csr_matrix
+    components: int
+    dense: np.ndarray | None
+    info: dict
+
+    @property
+    def n_sparse(self) -> int:
+        return self.scalar.shape[1] * self.components
+
+    @property
+    def dimension(self) -> int:
+        return self.n_sparse + (0 if self.dense is None else self.dense.shape[1])
+
+    def sparse_matrix(self) -> sp.csr_matrix:
+        """``kron(scalar, I_c)`` as a matrix (for checks on small meshes)."""
+        if self.components == 1:
+            return self.scalar
+        return sp.kron(self.scalar, sp.eye(self.components), format="csr")
+
+    def prolong(self, Y: np.ndarray) -> np.ndarray:
+        """``P Y`` for reduced coefficients Y (dimension, k): (c n, k) values."""
+        c, k = self.components, Y.shape[1]
+        Ys = np.ascontiguousarray(Y[: self.n_sparse]).reshape(-1, c * k)
+        U = threaded_product(self.scalar, Ys).reshape(-1, k)
+        if self.dense is not None:
+            Yd = Y[self.n_sparse :]
+            for rows in _row_blocks(U.shape[0]):  # no (c n, k) temporary
+                U[rows] += self.dense[rows] @ Yd
+        return U
+
+    def restrict(self, X: np.ndarray) -> np.ndarray:
+        """``P^T X`` for values X (c n, k): (dimension, k)."""
+        c, k = self.components, X.shape[1]
+        out = np.asarray(self.scalar.T @ np.ascontiguousarray(X).reshape(-1, c * k))
+        out = out.reshape(-1, k)
+        if self.dense is not None:
+            out = np.vstack([out, self.dense.T @ X])
+        return out
+
+    def with_dense(self, E: np.ndarray) -> ReducedBasis:
+        """The basis with the dense columns E appended."""
+        D = E if self.dense is None else np.hstack([self.dense, E])
+        return ReducedBasis(self.scalar, self.components, D, self.info)
+
+
 def reduced_basis(
     mesh: Mesh,
     operator: str,
@@ -190,25 +248,26 @@ def reduced_basis(
     enrich: int = 1,
     seed: int = 0,
     candidates: int | None = None,
-) -> tuple[sp.csr_matrix, np.ndarray | None, dict]:
-    """Prolongation for ``operator``: (P sparse, dense extra columns or None, info).
+) -> ReducedBasis:
+    """The reduced space of ``operator`` (see :class:`ReducedBasis`).
 
-    For ``"shells"`` P is ``kron(P_scalar, I3)`` (vertex-major rows 3v + c) and the dense
-    columns are the three rotations; for the scalar operators the dense part is None.
+    For ``"shells"`` every scalar function times e_x, e_y, e_z, and the three rotations
+    as dense columns; for the scalar operators the scalar functions alone.
     ``candidates``: see :func:`farthest_point_samples`.
     """
     centers = farthest_point_samples(mesh.vertices, samples, candidates=candidates, seed=seed)
     P, r = partition_of_unity_basis(mesh, centers, radius_factor, enrich)
+    vector = operator == "shells"
     info = {
         "samples": int(len(centers)),
         "support_radius": r,
         "enriched": bool(enrich),
         "polynomial_degree": int(min(max(enrich, 0), 2)),
-        "components_per_function": 3 if operator == "shells" else 1,
+        "components_per_function": 3 if vector else 1,
     }
-    if operator == "shells":
-        return sp.kron(P, sp.eye(3), format="csr"), rotation_fields(mesh), info
-    return P, None, info
+    if vector:
+        return ReducedBasis(P, 3, rotation_fields(mesh), info)
+    return ReducedBasis(P, 1, None, info)
 
 
 def scalar_functions_per_sample(degree: int) -> int:
@@ -268,25 +327,28 @@ MAX_NULL_COLUMNS = 96
 many (a mesh of many components, e.g. a broken scan, has six rigid motions each)."""
 
 
-def _null_space_complement(mesh, operator, K, mass, P, D, Mr) -> np.ndarray | None:
-    """Dense columns that complete span [P D] to contain the operator's exact null
+def _null_space_complement(mesh, operator, K, mass, basis: ReducedBasis, Mr) -> np.ndarray | None:
+    """Dense columns that complete the reduced space to contain the operator's exact null
     vectors (constants and rigid motions per connected component), or None.
 
-    The Mass-orthogonal projection of each null vector onto the reduced space is removed;
-    what remains (for example the rotations of a second component, or its constant
-    where basis functions straddle two components) is Mass-orthonormalised, and parts
-    below 1e-8 of the vector are dropped (already contained).
+    On a connected mesh the Laplacian's constant and the shells' rigid motions are in the
+    space by construction (the partition of unity, the rotation columns), so nothing is
+    computed.  Otherwise the Mass-orthogonal projection of each null vector onto the
+    reduced space is removed; what remains (for example the rotations of a second
+    component, or its constant where basis functions straddle two components) is
+    Mass-orthonormalised, and parts below 1e-8 of the vector are dropped (already
+    contained).
     """
     from .nullspace import null_space
 
+    if mesh.n_components == 1 and operator in ("laplacian", "shells"):
+        return None
     Z = null_space(mesh, operator, K, mass).vectors
     if Z.shape[1] == 0 or Z.shape[1] > MAX_NULL_COLUMNS:
         return None
     Z = Z.toarray()
     MZ = mass[:, None] * Z
-    rhs = np.asarray(P.T @ MZ)
-    if D is not None:
-        rhs = np.vstack([rhs, D.T @ MZ])
+    rhs = basis.restrict(MZ)
     import scipy.linalg as la
 
     try:
@@ -298,9 +360,7 @@ def _null_space_complement(mesh, operator, K, mass, P, D, Mr) -> np.ndarray | No
         w, V = la.eigh(Mr.toarray())
         keep = w > 1e-12 * w.max()
         c = V[:, keep] @ ((V[:, keep].T @ rhs) / w[keep, None])
-    R = Z - np.asarray(P @ c[: P.shape[1]])
-    if D is not None:
-        R -= D @ c[P.shape[1] :]
+    R = Z - basis.prolong(c)
     G = R.T @ (mass[:, None] * R)
     w, V = np.linalg.eigh(0.5 * (G + G.T))
     keep = w > 1e-16 * max(1.0, float(np.max(np.diag(Z.T @ MZ))))
@@ -309,25 +369,12 @@ def _null_space_complement(mesh, operator, K, mass, P, D, Mr) -> np.ndarray | No
     return R @ (V[:, keep] / np.sqrt(w[keep]))
 
 
-def _extend(A: sp.csr_matrix, K, P, D, E: np.ndarray) -> sp.csr_matrix:
-    """``[X E]^T K [X E]`` from ``A = X^T K X`` with ``X = [P D]`` (E dense)."""
+def _extend(A: sp.csr_matrix, K, basis: ReducedBasis, E: np.ndarray) -> sp.csr_matrix:
+    """``[P E]^T K [P E]`` from ``A = P^T K P`` (E dense)."""
     KE = np.asarray(K @ E)
-    cross = np.asarray(P.T @ KE)
-    if D is not None:
-        cross = np.vstack([cross, D.T @ KE])
+    cross = basis.restrict(KE)
     B = sp.bmat([[A, sp.csr_matrix(cross)], [sp.csr_matrix(cross.T), sp.csr_matrix(E.T @ KE)]])
     return (0.5 * (B + B.T)).tocsr()
-
-
-def _with_dense_columns(A: sp.csr_matrix, K, P: sp.csr_matrix, D: np.ndarray | None):
-    """``[P D]^T K [P D]`` from ``A = P^T K P`` (K sparse or a diagonal matrix),
-    symmetrised."""
-    if D is not None:
-        KD = K @ D
-        cross = np.asarray(P.T @ KD)
-        A = sp.bmat([[A, sp.csr_matrix(cross)], [sp.csr_matrix(cross.T), sp.csr_matrix(D.T @ KD)]])
-    A = 0.5 * (A + A.T)
-    return A.tocsr()
 
 
 def _kron_projection(K: sp.csr_matrix, Ps: sp.csr_matrix) -> sp.csr_matrix:
@@ -336,8 +383,6 @@ def _kron_projection(K: sp.csr_matrix, Ps: sp.csr_matrix) -> sp.csr_matrix:
     b::3]``; the six with a <= b are computed (two threads), the others are their
     transposes.  A third fewer multiply-adds than through the 3n rows (130k shells,
     1803 functions: 1.5 s against 2.7-3.6 s)."""
-    from concurrent.futures import ThreadPoolExecutor
-
     PsT = Ps.T.tocsr()
     pairs = [(a, b) for a in range(3) for b in range(a, 3)]
 
@@ -362,30 +407,42 @@ def _kron_projection(K: sp.csr_matrix, Ps: sp.csr_matrix) -> sp.csr_matrix:
     )
 
 
-def _project(K, P: sp.csr_matrix, D: np.ndarray | None, components: int = 1) -> sp.csr_matrix:
-    """``[P D]^T K [P D]`` as a sparse symmetric matrix (D: dense columns or None).
-    With ``components`` 3, P is ``kron(P_s, I3)`` (see :func:`_kron_projection`)."""
+def _with_dense_columns(A: sp.csr_matrix, K, basis: ReducedBasis) -> sp.csr_matrix:
+    """``P^T K P`` (symmetrised) from its sparse part ``A`` (K sparse or diagonal)."""
+    D = basis.dense
+    if D is not None:
+        KD = K @ D
+        cross = basis.restrict(KD)[: basis.n_sparse]
+        A = sp.bmat([[A, sp.csr_matrix(cross)], [sp.csr_matrix(cross.T), sp.csr_matrix(D.T @ KD)]])
+    A = 0.5 * (A + A.T)
+    return A.tocsr()
+
+
+def _project(K, basis: ReducedBasis) -> sp.csr_matrix:
+    """``P^T K P`` as a sparse symmetric matrix; for three components through the
+    scalar functions (see :func:`_kron_projection`)."""
     K = sp.csr_matrix(K)
-    if components == 3:
-        A = _kron_projection(K, P[0::3][:, 0::3].tocsr())
+    if basis.components == 3:
+        A = _kron_projection(K, basis.scalar)
     else:
-        A = threaded_transpose_product(P, threaded_product(K, P))
-    return _with_dense_columns(A, K, P, D)
+        A = threaded_transpose_product(basis.scalar, threaded_product(K, basis.scalar))
+    return _with_dense_columns(A, K, basis)
 
 
-def _project_mass(
-    mass: np.ndarray, P: sp.csr_matrix, D: np.ndarray | None, components: int = 1
-) -> sp.csr_matrix:
-    """``[P D]^T diag(mass) [P D]``.  With ``components`` 3, P is ``kron(P_s, I3)`` and
-    the mass repeats each vertex's value three times, so the sparse part is
-    ``kron(P_s^T diag(m) P_s, I3)`` (a ninth of the work)."""
-    if components == 3:
-        Ps = P[0::3][:, 0::3].tocsr()
-        A = threaded_transpose_product(Ps, Ps.multiply(mass[0::3, None]))
-        A = sp.kron(A, sp.eye(3), format="csr")
-    else:
-        A = threaded_transpose_product(P, P.multiply(mass[:, None]))
-    return _with_dense_columns(A, sp.diags(mass), P, D)
+def _project_mass(mass: np.ndarray, basis: ReducedBasis) -> sp.csr_matrix:
+    """``P^T diag(mass) P``.  With three components the mass repeats each vertex's value
+    three times, so the sparse part is ``kron(Ps^T diag(m) Ps, I3)``."""
+    Ps, c = basis.scalar, basis.components
+    A = threaded_transpose_product(Ps, Ps.multiply(mass[::c, None]).tocsr())
+    if c > 1:
+        A = sp.kron(A, sp.eye(c), format="csr")
+    return _with_dense_columns(A, sp.diags(mass), basis)
+
+
+DENSE_REDUCED = 4000
+"""Reduced problems up to this size are solved densely: 130k shells, 100 modes, 1803 /
+2703 / 3603 unknowns: 0.38 / 1.24 / 2.73 s dense against 0.97 / 1.93 / 3.34 s by the
+block Lanczos iteration."""
 
 
 def _solve_reduced(
@@ -396,10 +453,11 @@ def _solve_reduced(
     Block Lanczos on ``(Kr - s Mr)^-1 Mr`` (shift s just below zero, one sparse
     factorisation solving blocks of right-hand sides) with full re-orthogonalisation in
     the Mr inner product, and Rayleigh-Ritz with Kr; the basis grows until the k lowest
-    pairs have relative residuals below ``tol``.  Small problems are solved densely.
+    pairs have relative residuals below ``tol``.  Problems up to ``DENSE_REDUCED``
+    unknowns are solved densely (LAPACK's expert driver for the k lowest pairs).
     """
     N = Kr.shape[0]
-    if N <= max(1000, 3 * k):
+    if N <= max(DENSE_REDUCED, 3 * k):
         import scipy.linalg as la
 
         A, B = Kr.toarray(), Mr.toarray()
@@ -417,17 +475,9 @@ def _solve_reduced(
         return lam, T @ Z
     typical = float(np.median(np.abs(Kr.diagonal()) / Mr.diagonal()))
     shift = -1e-6 * (typical or 1.0)
-    dense = N <= 4000 and Kr.nnz > 0.05 * N * N  # the factor would be nearly dense
-    if dense:  # BLAS-3 products and a dense Cholesky factor
-        import scipy.linalg as la
-
-        Kr, Mr = Kr.toarray(), Mr.toarray()
     for _ in range(8):
         try:
-            if dense:
-                solve = partial(la.cho_solve, la.cho_factor(Kr - shift * Mr))
-            else:
-                solve = SPDSolver((Kr - shift * Mr).tocsr()).solve
+            solve = SPDSolver((Kr - shift * Mr).tocsr()).solve
             break
         except np.linalg.LinAlgError:
             shift *= 10.0
@@ -466,14 +516,24 @@ def _solve_reduced(
         X = solve(MX)
 
 
+ROW_BLOCK = 3 * 2730
+"""Rows per block in the smoothing step's passes over (N, k) arrays: a multiple of 3
+(whole vertices of the shells' 3 x 3 blocks), an (8190, 100) block is 6.5 MB."""
+
+
+def _row_blocks(N: int):
+    return (slice(start, min(start + ROW_BLOCK, N)) for start in range(0, N, ROW_BLOCK))
+
+
 def _jacobi_blocks(K: sp.csr_matrix, block: int):
-    """Inverse of the diagonal ``block`` x ``block`` blocks of K, as a function of (N, c)."""
+    """Inverse of the diagonal ``block`` x ``block`` blocks of K, as a function of
+    (rows of R, rows) for a slice of whole blocks."""
     K = sp.csr_matrix(K)
     N = K.shape[0]
     if block == 1:
         d = K.diagonal()
         d = np.where(d > 0, d, d.max() if d.size else 1.0)
-        return lambda R: R / d[:, None]
+        return lambda R, rows: R / d[rows, None]
     rows = np.repeat(np.arange(N), np.diff(K.indptr))
     inside = rows // block == K.indices // block
     B = np.zeros((N // block, block, block))
@@ -483,43 +543,73 @@ def _jacobi_blocks(K: sp.csr_matrix, block: int):
     B += (1e-12 * np.maximum(trace, trace.max() * 1e-12))[:, None, None] * np.eye(block)
     Binv = np.linalg.inv(B)
 
-    def apply(R):
+    def apply(R, rows: slice):
         c = R.shape[1]
-        return np.einsum("vab,vbk->vak", Binv, R.reshape(-1, block, c)).reshape(N, c)
+        inv = Binv[rows.start // block : rows.stop // block]
+        return np.matmul(inv, R.reshape(-1, block, c)).reshape(-1, c)
 
     return apply
 
 
-def _smoothing_step(K, mass, lam, U, KU, precondition, k):
-    """Rayleigh-Ritz on [U, B^-1 R] with the block-Jacobi preconditioned residuals R.
+def _row_slice(K: sp.csr_matrix, rows: slice) -> sp.csr_matrix:
+    """Rows of a CSR matrix as a matrix sharing its arrays (no copy)."""
+    p = K.indptr
+    return sp.csr_matrix(
+        (
+            K.data[p[rows.start] : p[rows.stop]],
+            K.indices[p[rows.start] : p[rows.stop]],
+            p[rows.start : rows.stop + 1] - p[rows.start],
+        ),
+        shape=(rows.stop - rows.start, K.shape[1]),
+    )
+
+
+def _smoothing_step(K, mass, lam, U, KU, precondition):
+    """Rayleigh-Ritz on [U, W] with W the block-Jacobi preconditioned residuals.
 
     U holds the Mass-orthonormal Galerkin modes with ``U^T K U = diag(lam)``, so only the
-    blocks involving the new directions W are computed (three (N, k) x (N, k) products
-    and two to orthogonalise W against U).  The enlarged space contains U, so every Ritz
-    value is at most the one it replaces and still an upper bound of the exact
-    eigenvalue.  Returns (lam, X, KX).
+    blocks involving W are computed: ``U^T M W``, ``W^T M W``, ``(K U)^T W`` and
+    ``W^T K W``.  The enlarged space contains U, so every Ritz value is at most the one it
+    replaces and still an upper bound of the exact eigenvalue.
+
+    Memory: first touches of fresh memory cost more than the arithmetic here (an
+    (N, k) array of the 130k shells is 313 MB), so the passes over (N, k) arrays go in
+    blocks of rows and only W is allocated: K W is formed block by block, the new modes
+    X overwrite U and K X is written into KU's memory.  Returns (lam, X, KX) with as
+    many pairs as U has columns.
     """
-    MU = U * mass[:, None]
-    W = MU * -lam[None, :]
-    W += KU
-    W = precondition(W)
-    # M-orthogonal to U; directions of (numerically) converged pairs add nothing
-    W -= U @ (MU.T @ W)
-    del MU
-    KW = threaded_product(K, W)
-    G_ww = W.T @ (W * mass[:, None])
-    H_uw = KU.T @ W
-    H_ww = W.T @ KW
-    c = U.shape[1]
+    N, c = U.shape
+    K = sp.csr_matrix(K)
+    W = np.empty_like(U)
+    G_uw = np.zeros((c, c))
+    for rows in _row_blocks(N):
+        MU = mass[rows, None] * U[rows]
+        R = KU[rows] - MU * lam[None, :]
+        W[rows] = precondition(R, rows)
+        G_uw += MU.T @ W[rows]
+    G_ww = np.zeros((c, c))
+    H_uw = np.zeros((c, c))
+    H_ww = np.zeros((c, c))
+    for rows in _row_blocks(N):
+        Wb = W[rows]
+        G_ww += Wb.T @ (mass[rows, None] * Wb)
+        H_uw += KU[rows].T @ Wb
+        H_ww += Wb.T @ (_row_slice(K, rows) @ W)
+    # the same space spanned by U and W' = W - U G_uw, which is M-orthogonal to U:
+    # its blocks follow from the ones above (U^T M U = I, U^T K U = diag(lam))
+    H_uw_o = H_uw - lam[:, None] * G_uw
+    H_ww_o = H_ww - G_uw.T @ H_uw - H_uw.T @ G_uw + G_uw.T @ (lam[:, None] * G_uw)
+    G_ww_o = G_ww - G_uw.T @ G_uw
     H = np.zeros((2 * c, 2 * c))
     G = np.zeros((2 * c, 2 * c))
     H[:c, :c] = np.diag(lam)
-    H[:c, c:] = H_uw
-    H[c:, :c] = H_uw.T
-    H[c:, c:] = 0.5 * (H_ww + H_ww.T)
+    H[:c, c:] = H_uw_o
+    H[c:, :c] = H_uw_o.T
+    H[c:, c:] = 0.5 * (H_ww_o + H_ww_o.T)
     G[:c, :c] = np.eye(c)
-    G[c:, c:] = 0.5 * (G_ww + G_ww.T)
+    G[c:, c:] = 0.5 * (G_ww_o + G_ww_o.T)
     d = 1.0 / np.sqrt(np.maximum(np.diag(G), 1e-300))
+    # directions of (numerically) converged pairs add nothing
     d[c:][np.diag(G)[c:] <= 1e-14 * max(1.0, float(np.max(np.diag(G))))] = 0.0
     H *= np.outer(d, d)
     G *= np.outer(d, d)
@@ -527,13 +617,16 @@ def _smoothing_step(K, mass, lam, U, KU, precondition, k):
     keep = w > 1e-10 * w.max()
     T = E[:, keep] / np.sqrt(w[keep])
     new_lam, Z = np.linalg.eigh(T.T @ H @ T)
-    C = (T @ Z[:, :k]) * d[:, None]
-    X = U @ C[:c]
-    X += W @ C[c:]
+    C = (T @ Z[:, :c]) * d[:, None]
+    C_w = C[c:]
+    C_u = C[:c] - G_uw @ C_w  # back from W' to W
+    for rows in _row_blocks(N):
+        x = U[rows] @ C_u
+        x += W[rows] @ C_w
+        U[rows] = x
     del W
-    KX = KU @ C[:c]
-    KX += KW @ C[c:]
-    return new_lam[:k], X, KX
+    threaded_product(K, U, out=KU)
+    return new_lam[:c], U, KU
 
 
 def _residuals(K_U, mass, lam, U, lam_scale):
@@ -623,18 +716,17 @@ def preview_spectrum(
     report("preview: sampling", 0.05)
     samples = max(1, min(int(samples), max_samples(mesh.n_vertices, enrich)))
     candidates = mesh.n_vertices if settings.exact_sampling else None
-    P, D, info = reduced_basis(
-        mesh, operator, samples, radius_factor, enrich, candidates=candidates
-    )
+    basis = reduced_basis(mesh, operator, samples, radius_factor, enrich, candidates=candidates)
+    info = basis.info
     seconds["basis"] = time.perf_counter() - t
     t = time.perf_counter()
     report("preview: projecting", 0.2)
-    Kr = _project(K, P, D, info["components_per_function"])
-    Mr = _project_mass(mass, P, D, info["components_per_function"])
-    E = _null_space_complement(mesh, operator, K, mass, P, D, Mr)
+    Kr = _project(K, basis)
+    Mr = _project_mass(mass, basis)
+    E = _null_space_complement(mesh, operator, K, mass, basis, Mr)
     if E is not None:  # exact null vectors the space lacks (components, rotations)
-        Kr, Mr = _extend(Kr, K, P, D, E), _extend(Mr, sp.diags(mass), P, D, E)
-        D = E if D is None else np.hstack([D, E])
+        Kr, Mr = _extend(Kr, K, basis, E), _extend(Mr, sp.diags(mass), basis, E)
+        basis = basis.with_dense(E)
     info["null_space_columns_added"] = 0 if E is None else int(E.shape[1])
     seconds["projection"] = time.perf_counter() - t
     t = time.perf_counter()
@@ -645,9 +737,7 @@ def preview_spectrum(
     seconds["reduced_solve"] = time.perf_counter() - t
     t = time.perf_counter()
     report("preview: prolonging", 0.65)
-    U = np.asarray(P @ Y[: P.shape[1]])
-    if D is not None:
-        U += D @ Y[P.shape[1] :]
+    U = basis.prolong(Y)
     KU = threaded_product(K, U)
     seconds["prolongation"] = time.perf_counter() - t
     lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
@@ -656,13 +746,13 @@ def preview_spectrum(
         t = time.perf_counter()
         report("preview: smoothing", 0.8)
         block = 3 if operator == "shells" else 1
-        lam, U, KU = _smoothing_step(K, mass, lam, U, KU, _jacobi_blocks(K, block), k_eff)
+        lam, U, KU = _smoothing_step(K, mass, lam, U, KU, _jacobi_blocks(K, block))
         seconds["smoothing"] = time.perf_counter() - t
     res = _residuals(KU, mass, lam, U, lam_scale)
     if smoothing:
         est = estimated_errors(galerkin, lam, lam_scale)
     else:
-        est = estimated_errors(_nested_eigenvalues(Kr, Mr, P, D, info, k_eff), lam, lam_scale)
+        est = estimated_errors(_nested_eigenvalues(Kr, Mr, basis, k_eff), lam, lam_scale)
     info.update(
         reduced_dimension=int(dim),
         smoothing=bool(smoothing),
@@ -674,18 +764,17 @@ def preview_spectrum(
     return lam, U, res, info
 
 
-def _nested_eigenvalues(Kr, Mr, P, D, info, k: int) -> np.ndarray:
+def _nested_eigenvalues(Kr, Mr, basis: ReducedBasis, k: int) -> np.ndarray:
     """Ritz values of the partition-of-unity functions alone (with the dense columns), a
     subspace of the enriched space: each is at least the enriched space's one; inf where
     the subspace is too small."""
-    dims = info["components_per_function"]
-    q = P.shape[1] // max(info["samples"] * dims, 1)
+    info, dims = basis.info, basis.components
+    q = basis.n_sparse // max(info["samples"] * dims, 1)
     if not info["enriched"] or q <= 1:
         return np.full(k, np.inf)
     step = q * dims
-    cols = np.arange(P.shape[1]).reshape(-1, step)[:, : step // q].ravel()
-    if D is not None:
-        cols = np.concatenate([cols, np.arange(P.shape[1], Kr.shape[0])])
+    cols = np.arange(basis.n_sparse).reshape(-1, step)[:, : step // q].ravel()
+    cols = np.concatenate([cols, np.arange(basis.n_sparse, Kr.shape[0])])
     sub = min(k, len(cols))
     lam = _solve_reduced(Kr[cols][:, cols].tocsr(), Mr[cols][:, cols].tocsr(), sub)[0]
     return np.concatenate([lam, np.full(k - sub, np.inf)])

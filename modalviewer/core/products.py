@@ -10,6 +10,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse import _sparsetools
 
 __all__ = ["row_halves", "threaded_product", "threaded_transpose_product"]
 
@@ -26,10 +27,12 @@ def row_halves(K: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
     return [(slice(0, h), top), (slice(h, N), bottom)]
 
 
-def threaded_product(K, X):
+def threaded_product(K, X, out: np.ndarray | None = None):
     """K @ X for a CSR matrix K and a dense array or sparse matrix X, the two row halves
     of K on two threads (scipy's products release the GIL and run on one core;
-    splitting rows keeps X whole and contiguous).  Sparse X gives a CSR result."""
+    splitting rows keeps X whole and contiguous).  Sparse X gives a CSR result.  For
+    dense X the product can be written into ``out`` (C-contiguous, not overlapping X),
+    which saves fresh memory."""
     K = sp.csr_matrix(K)
     if sp.issparse(X):
         X = sp.csr_matrix(X)
@@ -37,12 +40,30 @@ def threaded_product(K, X):
             parts = list(pool.map(lambda part: (part[1] @ X).tocsr(), row_halves(K)))
         return sp.vstack(parts, format="csr")
     X = np.ascontiguousarray(X)
-    if X.ndim == 1 or X.shape[1] < 4 or K.shape[0] < 2:
+    if out is None and (X.ndim == 1 or X.shape[1] < 4 or K.shape[0] < 2):
         return np.asarray(K @ X)
-    out = np.empty((K.shape[0], X.shape[1]))
+    if out is None:
+        out = np.empty((K.shape[0],) + X.shape[1:])
+    elif out.shape != (K.shape[0],) + X.shape[1:] or not out.flags.c_contiguous:
+        raise ValueError("out must be a C-contiguous array of the product's shape")
+    X2 = X.reshape(X.shape[0], -1)
+    out2 = out.reshape(out.shape[0], -1)
+
+    same_type = K.dtype == X2.dtype == out2.dtype == np.float64
 
     def rows(part: tuple[slice, sp.csr_matrix]) -> None:
-        out[part[0]] = part[1] @ X
+        s, M = part
+        block = out2[s]
+        if not same_type:
+            block[...] = M @ X2
+            return
+        # scipy's kernel behind ``M @ X2`` (it adds M X2 to the block), which writes in
+        # place instead of into a fresh array
+        block.fill(0.0)
+        _sparsetools.csr_matvecs(
+            M.shape[0], M.shape[1], X2.shape[1], M.indptr, M.indices,
+            M.data, X2.ravel(), block.ravel(),
+        )  # fmt: skip
 
     with ThreadPoolExecutor(2) as pool:
         list(pool.map(rows, row_halves(K)))
