@@ -15,10 +15,10 @@ Laplace-Beltrami Eigenproblems*, SGP 2018):
   (u, v those tangent coordinates): a bending energy measures second derivatives, which
   a partition of unity times linear functions does not approximate.
 
-For the shells operators one Rayleigh-Ritz step on the prolonged modes and their
-block-Jacobi preconditioned residuals follows: it adds the mesh-scale parts of the modes
-(the tangential give of a bumpy surface bending without stretching) that no smooth space
-holds.
+For the shells operators a two-level step follows: Rayleigh-Ritz in the reduced space
+enlarged by the block-Jacobi preconditioned residuals of the Galerkin modes, which adds
+the mesh-scale parts of the modes (the tangential give of a bumpy surface bending without
+stretching) that no smooth space holds.
 
 The columns of the prolongation P hold these functions.  The reduced problem
 ``(P^T K P) y = lambda (P^T M P) y`` is a small sparse generalised eigenproblem; the
@@ -214,11 +214,13 @@ class ReducedBasis:
             return self.scalar
         return sp.kron(self.scalar, sp.eye(self.components), format="csr")
 
-    def prolong(self, Y: np.ndarray) -> np.ndarray:
-        """``P Y`` for reduced coefficients Y (dimension, k): (c n, k) values."""
+    def prolong(self, Y: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """``P Y`` for reduced coefficients Y (dimension, k): (c n, k) values, written
+        into ``out`` if given (C-contiguous)."""
         c, k = self.components, Y.shape[1]
         Ys = np.ascontiguousarray(Y[: self.n_sparse]).reshape(-1, c * k)
-        U = threaded_product(self.scalar, Ys).reshape(-1, k)
+        flat = None if out is None else out.reshape(-1, c * k)
+        U = threaded_product(self.scalar, Ys, out=flat).reshape(-1, k)
         if self.dense is not None:
             Yd = Y[self.n_sparse :]
             for rows in _row_blocks(U.shape[0]):  # no (c n, k) temporary
@@ -228,8 +230,8 @@ class ReducedBasis:
     def restrict(self, X: np.ndarray) -> np.ndarray:
         """``P^T X`` for values X (c n, k): (dimension, k)."""
         c, k = self.components, X.shape[1]
-        out = np.asarray(self.scalar.T @ np.ascontiguousarray(X).reshape(-1, c * k))
-        out = out.reshape(-1, k)
+        Xs = np.ascontiguousarray(X).reshape(-1, c * k)
+        out = threaded_transpose_product(self.scalar, Xs).reshape(-1, k)
         if self.dense is not None:
             out = np.vstack([out, self.dense.T @ X])
         return out
@@ -296,6 +298,7 @@ class SpaceSettings:
     """Farthest-point sampling over all vertices (an even covering, so the support
     radius is not set by one badly covered corner) instead of over random candidates."""
     smoothing: bool
+    """The two-level step after the Galerkin projection (see :func:`_two_level_step`)."""
 
     def samples(self, k: int) -> int:
         return max(self.samples_min, int(self.samples_per_mode * k))
@@ -308,17 +311,16 @@ SPACE_SETTINGS = {
     # need (0.24 % largest error against 1.1 % with an even sampling and 2 spacings).
     "laplacian": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
     "modified_dirichlet": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
-    # Bending energies need quadratic precision.  130k plate, 100 modes, one smoothing
-    # step, lowest 50 non-zero eigenvalues: normal shells, 200 samples of linear
-    # functions 6.8 % median / 10.3 % largest error, of quadratic ones 0.5 % / 0.85 %
-    # (100 / 300 samples: 0.9 % / 1.8 %, 0.4 % / 0.6 %, all 3.3-3.8 s); on the 47k spot
-    # Loop-subdivided twice 100 / 200 / 300 samples leave 13 % / 8.2 % / 6.4 % largest
-    # error.  Shells, 140 linear samples 2.7 % / 21 %, 100 quadratic samples (1803
-    # functions) 1.0 % / 2.2 %.  More samples hardly help the shells on the plate: the
-    # Galerkin error of smooth spaces stays near 5 % median for 60 to 300 samples
-    # (membrane locking on the bumps), which the smoothing step removes.
+    # Bending energies need quadratic precision, and the Galerkin error of smooth spaces
+    # stays near 5 % median on the 130k plate for 60 to 300 samples (membrane locking on
+    # the bumps), which the two-level step (see _two_level_step) removes.  130k plate,
+    # 100 modes, lowest 50 non-zero eigenvalues, largest / median error: normal shells,
+    # 200 samples 0.48 % / 0.18 % (3.6 s; 100 samples 1.5 %, radius 1.5: 2.5 %); shells,
+    # 100 samples, radius factor 1.5: 1.7 % / 0.8 % in 5.9-6.2 s, 1.8: 0.66 % / 0.27 % in
+    # 7.2-8.0 s (the projection's work grows with the overlap of the supports).  Linear
+    # functions leave shells errors of 69 % (150 samples).
     "shells_normal": SpaceSettings(200, 2.0, 2, RADIUS_FACTOR, False, True),
-    "shells": SpaceSettings(100, 1.0, 2, 1.8, True, True),
+    "shells": SpaceSettings(100, 1.0, 2, 1.5, True, True),
 }
 
 
@@ -445,6 +447,26 @@ DENSE_REDUCED = 4000
 block Lanczos iteration."""
 
 
+def _dense_lowest(A: np.ndarray, B: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest k pairs of the dense symmetric pencil ``A y = lam B y``, Y B-orthonormal.
+
+    LAPACK's expert driver; where B is singular (functions that vanish on the mesh, or
+    linearly dependent columns) the problem is solved on the B-orthonormal eigenbasis of
+    B's range instead."""
+    import scipy.linalg as la
+
+    try:
+        return la.eigh(A, B, subset_by_index=[0, k - 1], driver="gvx")
+    except np.linalg.LinAlgError:
+        pass
+    d = 1.0 / np.sqrt(np.maximum(np.diag(B), 1e-300))
+    w, E = la.eigh(B * np.outer(d, d))
+    keep = w > 1e-12 * w.max()
+    T = (E[:, keep] / np.sqrt(w[keep])) * d[:, None]
+    lam, Z = la.eigh(T.T @ A @ T, subset_by_index=[0, min(k, int(keep.sum())) - 1])
+    return lam, T @ Z
+
+
 def _solve_reduced(
     Kr: sp.csr_matrix, Mr: sp.csr_matrix, k: int, tol: float = 1e-6
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -458,21 +480,7 @@ def _solve_reduced(
     """
     N = Kr.shape[0]
     if N <= max(DENSE_REDUCED, 3 * k):
-        import scipy.linalg as la
-
-        A, B = Kr.toarray(), Mr.toarray()
-        try:
-            return la.eigh(A, B, subset_by_index=[0, k - 1], driver="gvx")
-        except np.linalg.LinAlgError:
-            pass
-        # the Mr-orthonormal eigenbasis of Mr's range: functions that vanish on the mesh
-        # (linearly dependent columns, when samples are as dense as the vertices) drop out
-        d = 1.0 / np.sqrt(np.maximum(np.diag(B), 1e-300))
-        w, E = la.eigh(B * np.outer(d, d))
-        keep = w > 1e-12 * w.max()
-        T = (E[:, keep] / np.sqrt(w[keep])) * d[:, None]
-        lam, Z = la.eigh(T.T @ A @ T, subset_by_index=[0, min(k, int(keep.sum())) - 1])
-        return lam, T @ Z
+        return _dense_lowest(Kr.toarray(), Mr.toarray(), k)
     typical = float(np.median(np.abs(Kr.diagonal()) / Mr.diagonal()))
     shift = -1e-6 * (typical or 1.0)
     for _ in range(8):
@@ -517,7 +525,7 @@ def _solve_reduced(
 
 
 ROW_BLOCK = 3 * 2730
-"""Rows per block in the smoothing step's passes over (N, k) arrays: a multiple of 3
+"""Rows per block in the passes over (N, k) arrays: a multiple of 3
 (whole vertices of the shells' 3 x 3 blocks), an (8190, 100) block is 6.5 MB."""
 
 
@@ -551,82 +559,54 @@ def _jacobi_blocks(K: sp.csr_matrix, block: int):
     return apply
 
 
-def _row_slice(K: sp.csr_matrix, rows: slice) -> sp.csr_matrix:
-    """Rows of a CSR matrix as a matrix sharing its arrays (no copy)."""
-    p = K.indptr
-    return sp.csr_matrix(
-        (
-            K.data[p[rows.start] : p[rows.stop]],
-            K.indices[p[rows.start] : p[rows.stop]],
-            p[rows.start : rows.stop + 1] - p[rows.start],
-        ),
-        shape=(rows.stop - rows.start, K.shape[1]),
-    )
+def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, precondition):
+    """Rayleigh-Ritz in ``span [P, W]``: the reduced space together with the
+    block-Jacobi preconditioned residuals W of the Galerkin modes U.
 
+    The smooth space holds the modes' large scales and W their mesh-scale parts (the
+    tangential give of a bumpy surface bending without stretching) that no smooth space
+    holds; taking both whole, rather than W beside the Galerkin modes alone, lets the
+    large scales readjust to the fine corrections (130k plate, shells, lowest 50
+    eigenvalues: 0.66 % largest error against 2.2 % with ``span [U, W]``).  The space
+    contains P, so every Ritz value is at most the Galerkin one and still an upper bound
+    of the exact eigenvalue.
 
-def _smoothing_step(K, mass, lam, U, KU, precondition):
-    """Rayleigh-Ritz on [U, W] with W the block-Jacobi preconditioned residuals.
-
-    U holds the Mass-orthonormal Galerkin modes with ``U^T K U = diag(lam)``, so only the
-    blocks involving W are computed: ``U^T M W``, ``W^T M W``, ``(K U)^T W`` and
-    ``W^T K W``.  The enlarged space contains U, so every Ritz value is at most the one it
-    replaces and still an upper bound of the exact eigenvalue.
-
-    Memory: first touches of fresh memory cost more than the arithmetic here (an
-    (N, k) array of the 130k shells is 313 MB), so the passes over (N, k) arrays go in
-    blocks of rows and only W is allocated: K W is formed block by block, the new modes
-    X overwrite U and K X is written into KU's memory.  Returns (lam, X, KX) with as
-    many pairs as U has columns.
+    Memory: first touches of fresh memory cost more than much of the arithmetic here (an
+    (N, k) array of the 130k shells is 313 MB), so only W is allocated: K W and M W go
+    into KU's and U's memory once the residuals are formed, then the new modes and their
+    products with K.  Returns (lam, X, KX) with as many pairs as U has columns.
     """
     N, c = U.shape
-    K = sp.csr_matrix(K)
     W = np.empty_like(U)
-    G_uw = np.zeros((c, c))
+    norms = np.zeros(c)
     for rows in _row_blocks(N):
-        MU = mass[rows, None] * U[rows]
-        R = KU[rows] - MU * lam[None, :]
+        R = KU[rows] - (mass[rows, None] * U[rows]) * lam[None, :]
         W[rows] = precondition(R, rows)
-        G_uw += MU.T @ W[rows]
-    G_ww = np.zeros((c, c))
-    H_uw = np.zeros((c, c))
-    H_ww = np.zeros((c, c))
+        norms += np.einsum("ij,ij->j", W[rows], mass[rows, None] * W[rows])
+    # unit Mass norm; residuals of (numerically) converged pairs add nothing
+    norms = np.sqrt(norms)
+    live = norms > 1e-12 * max(float(norms.max()), 1e-300)
+    W = W[:, live] if not live.all() else W
+    W /= np.where(live, norms, 1.0)[live][None, :]
+    KW = threaded_product(K, W, out=KU[:, : W.shape[1]] if live.all() else None)
+    MW = U if live.all() else np.empty_like(W)
     for rows in _row_blocks(N):
-        Wb = W[rows]
-        G_ww += Wb.T @ (mass[rows, None] * Wb)
-        H_uw += KU[rows].T @ Wb
-        H_ww += Wb.T @ (_row_slice(K, rows) @ W)
-    # the same space spanned by U and W' = W - U G_uw, which is M-orthogonal to U:
-    # its blocks follow from the ones above (U^T M U = I, U^T K U = diag(lam))
-    H_uw_o = H_uw - lam[:, None] * G_uw
-    H_ww_o = H_ww - G_uw.T @ H_uw - H_uw.T @ G_uw + G_uw.T @ (lam[:, None] * G_uw)
-    G_ww_o = G_ww - G_uw.T @ G_uw
-    H = np.zeros((2 * c, 2 * c))
-    G = np.zeros((2 * c, 2 * c))
-    H[:c, :c] = np.diag(lam)
-    H[:c, c:] = H_uw_o
-    H[c:, :c] = H_uw_o.T
-    H[c:, c:] = 0.5 * (H_ww_o + H_ww_o.T)
-    G[:c, :c] = np.eye(c)
-    G[c:, c:] = 0.5 * (G_ww_o + G_ww_o.T)
-    d = 1.0 / np.sqrt(np.maximum(np.diag(G), 1e-300))
-    # directions of (numerically) converged pairs add nothing
-    d[c:][np.diag(G)[c:] <= 1e-14 * max(1.0, float(np.max(np.diag(G))))] = 0.0
-    H *= np.outer(d, d)
-    G *= np.outer(d, d)
-    w, E = np.linalg.eigh(G)
-    keep = w > 1e-10 * w.max()
-    T = E[:, keep] / np.sqrt(w[keep])
-    new_lam, Z = np.linalg.eigh(T.T @ H @ T)
-    C = (T @ Z[:, :c]) * d[:, None]
-    C_w = C[c:]
-    C_u = C[:c] - G_uw @ C_w  # back from W' to W
+        np.multiply(mass[rows, None], W[rows], out=MW[rows])
+    H_pw = basis.restrict(KW)
+    G_pw = basis.restrict(MW)
+    H_ww = W.T @ KW
+    G_ww = W.T @ MW
+    del KW, MW
+    H = np.block([[Kr.toarray(), H_pw], [H_pw.T, 0.5 * (H_ww + H_ww.T)]])
+    G = np.block([[Mr.toarray(), G_pw], [G_pw.T, 0.5 * (G_ww + G_ww.T)]])
+    new_lam, C = _dense_lowest(H, G, c)
+    dim = Kr.shape[0]
+    X = basis.prolong(C[:dim], out=U)
     for rows in _row_blocks(N):
-        x = U[rows] @ C_u
-        x += W[rows] @ C_w
-        U[rows] = x
+        X[rows] += W[rows] @ C[dim:]
     del W
-    threaded_product(K, U, out=KU)
-    return new_lam[:c], U, KU
+    KX = threaded_product(K, X, out=KU)
+    return new_lam, X, KX
 
 
 def _residuals(K_U, mass, lam, U, lam_scale):
@@ -682,11 +662,11 @@ def preview_spectrum(
     Galerkin projection onto :func:`reduced_basis` (``samples`` centres, polynomial
     degree ``enrich`` and ``radius_factor``; the defaults per operator are in
     :data:`SPACE_SETTINGS`), then (``smoothing``, by default for the two Discrete Shells
-    operators) one Rayleigh-Ritz step on the prolonged modes together with their
-    block-Jacobi preconditioned residuals, which adds the mesh-scale components a smooth
-    space lacks.
+    operators) Rayleigh-Ritz in the reduced space together with the block-Jacobi
+    preconditioned residuals of the Galerkin modes (:func:`_two_level_step`), which adds
+    the mesh-scale components a smooth space lacks.
 
-    The estimated errors are the eigenvalues' decrease in the smoothing step, or without
+    The estimated errors are the eigenvalues' decrease in that step, or without
     it their decrease from the nested space of the partition-of-unity functions alone to
     the enriched space (a conservative estimate: 3 to 8 times the measured error on the
     10k spot's Laplacian).
@@ -746,7 +726,7 @@ def preview_spectrum(
         t = time.perf_counter()
         report("preview: smoothing", 0.8)
         block = 3 if operator == "shells" else 1
-        lam, U, KU = _smoothing_step(K, mass, lam, U, KU, _jacobi_blocks(K, block))
+        lam, U, KU = _two_level_step(K, mass, basis, Kr, Mr, lam, U, KU, _jacobi_blocks(K, block))
         seconds["smoothing"] = time.perf_counter() - t
     res = _residuals(KU, mass, lam, U, lam_scale)
     if smoothing:

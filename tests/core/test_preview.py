@@ -230,3 +230,40 @@ def test_a_mesh_too_small_for_a_preview_gets_the_exact_spectrum():
     np.testing.assert_allclose(spec.eigenvalues[1:], _exact(mesh, "laplacian", 30)[1:], rtol=1e-8)
     assert mv.compute_spectrum(mesh, "shells", k=18, accuracy="preview").is_preview
     assert not mv.compute_spectrum(mesh, "shells", k=19, accuracy="preview").is_preview
+
+
+def test_the_two_level_step_improves_on_the_galerkin_modes_and_their_corrections():
+    """Rayleigh-Ritz in span [P, W] (the reduced space and the preconditioned residuals W
+    of the Galerkin modes U) against span [U, W] (the same corrections beside the Galerkin
+    modes alone), computed densely here: span [U, W] lies in span [P, W], so its Ritz
+    values are upper bounds of the two-level ones, which are upper bounds of the exact
+    eigenvalues; on a bumpy plate the large scales readjusting to the corrections is most
+    of the gain (bumpy_plate(40), 30 samples: largest error 10.4 % against 17.7 %,
+    median 6.5 % against 9.7 % when written)."""
+    mesh = bumpy_plate(40)
+    k = 30
+    K, mass = operator_matrices(mesh, "shells")
+    exact = mv.compute_spectrum(mesh, "shells", k).eigenvalues
+    lam, U, _, info = pv.preview_spectrum(mesh, "shells", K, mass, k, samples=30)
+    # span [U, W] by hand
+    galerkin = np.array(info["galerkin_eigenvalues"])
+    basis = pv.reduced_basis(mesh, "shells", 30, pv.SPACE_SETTINGS["shells"].radius_factor, 2,
+                             candidates=mesh.n_vertices)  # fmt: skip
+    Kr, Mr = pv._project(K, basis).toarray(), pv._project_mass(mass, basis).toarray()
+    g, Y = la.eigh(Kr, Mr, subset_by_index=[0, k - 1])
+    np.testing.assert_allclose(g[6:], galerkin[6:], rtol=1e-8)
+    Ug = basis.prolong(Y)
+    R = K @ Ug - mass[:, None] * Ug * g
+    W = pv._jacobi_blocks(K, 3)(R, slice(0, R.shape[0]))
+    V = np.hstack([Ug, W])
+    H, G = V.T @ (K @ V), V.T @ (mass[:, None] * V)
+    w, E = la.eigh(G)
+    T = E[:, w > 1e-10 * w.max()] / np.sqrt(w[w > 1e-10 * w.max()])
+    beside = la.eigh(T.T @ H @ T, eigvals_only=True, subset_by_index=[0, k - 1])
+    scale = exact.max()
+    assert np.all(lam <= beside + 1e-9 * scale)
+    assert np.all(lam >= exact - 1e-9 * scale)
+    err_two_level = (lam[6:] - exact[6:]) / exact[6:]
+    err_beside = (beside[6:] - exact[6:]) / exact[6:]
+    assert err_two_level.max() < 0.7 * err_beside.max()
+    assert np.median(err_two_level) < 0.8 * np.median(err_beside)

@@ -21,6 +21,7 @@ def test_threaded_product_equals_the_plain_product(K):
     np.testing.assert_allclose(
         threaded_transpose_product(S, K).toarray(), (S.T @ K).toarray(), atol=1e-13
     )
+    np.testing.assert_allclose(threaded_transpose_product(S, X), S.T @ X, atol=1e-13)
 
 
 def test_threaded_product_writes_into_out(K):
