@@ -149,6 +149,21 @@ def _segments(points, faces, values, levels, displacement=None, with_triangles=F
     return seg, disp, c, tri_rep, edges
 
 
+def view_angle_on_smaller_side(renderer) -> None:
+    """Make the active camera's view angle apply to the smaller side of the view.
+
+    VTK applies it to the height, so a view narrower than tall crops a mesh fitted in a
+    wider one at the sides.  With the angle on the smaller side, a camera fitted to the
+    mesh's bounding sphere keeps the whole mesh in sight at any shape of the view, and
+    nothing jumps at a square view.  The viewports call this before every render, and
+    fitting calls it first so the fit is computed with the setting it is drawn with."""
+    w, h = renderer.GetSize()
+    camera = renderer.GetActiveCamera()
+    narrow = bool(w < h)
+    if bool(camera.GetUseHorizontalViewAngle()) != narrow:
+        camera.SetUseHorizontalViewAngle(narrow)
+
+
 class MeshScene:
     """Owns the actors of one mesh on a pyvista plotter."""
 
@@ -554,6 +569,7 @@ class MeshScene:
         cam.SetViewUp(*camera.up)
         cam.OrthogonalizeViewUp()
         if fit:
+            view_angle_on_smaller_side(self.plotter.renderer)
             self.plotter.renderer.ResetCamera(*self.surface.bounds)
         self.plotter.renderer.ResetCameraClippingRange()
 

@@ -15,6 +15,8 @@ import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtGui, QtWidgets
 
+from .scene import view_angle_on_smaller_side
+
 CLICK_SLOP = 4  # pixels a press may move and still count as a click
 
 
@@ -24,6 +26,12 @@ def qt_opengl_available() -> bool:
         return False
     ctx = QtGui.QOpenGLContext()
     return bool(ctx.create())
+
+
+def fit_smaller_side(renderer) -> None:
+    """Before every render, let the camera's view angle apply to the smaller side of the
+    view (:func:`.scene.view_angle_on_smaller_side`)."""
+    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))
 
 
 class _ClickMixin:
@@ -56,6 +64,7 @@ class OffscreenViewport(QtWidgets.QWidget):
         self.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.plotter = pv.Plotter(off_screen=True, window_size=(640, 480))
         self.plotter.set_background("white")
+        fit_smaller_side(self.plotter.renderer)
         # pyvista skips render() until the first show; show once (off-screen: no window)
         self.plotter.show(auto_close=False, interactive=False)
         self._image: QtGui.QImage | None = None
@@ -172,6 +181,7 @@ class InteractorViewport(QtCore.QObject):
         # render whenever it changes the scene.
         self.plotter = QtInteractor(parent, auto_update=False)
         self.plotter.set_background("white")
+        fit_smaller_side(self.plotter.renderer)
         self._press = None
         iren = self.plotter.iren
         iren.add_observer("LeftButtonPressEvent", self._on_press)

@@ -428,3 +428,32 @@ def test_an_idle_window_does_not_render(window, spot_path, qtbot):
     window.show_mode(4)  # a change does render
     window.viewport.render_now()
     assert window.scene.n_isoline_points > 0
+
+
+def test_a_narrow_view_keeps_the_whole_mesh_in_sight(window, spot_path, qtbot):
+    """The view angle applies to the smaller side of the view, so a mesh fitted in a wide
+    view stays whole when the view is made narrower than tall (it was cropped at the
+    sides until the camera was reset)."""
+    assert window.open_mesh(spot_path)
+    window.state.set_colorbar(False)
+
+    def surface_columns():
+        img = window.viewport.render_now().astype(int)
+        surface = (img < 235).any(axis=2)
+        h, w = surface.shape
+        band = surface[h // 6 : h - h // 6]  # leave out the legend at the top
+        cols = np.flatnonzero(band.any(axis=0))
+        return cols, w, h
+
+    window.viewport.widget.setFixedSize(600, 400)
+    qtbot.wait(50)
+    window.scene_view.reset_camera()  # fitted in a wide view
+    cols, w, h = surface_columns()
+    assert (w, h) == (600, 400)
+    assert cols.size > 0 and cols.min() > 2 and cols.max() < w - 3
+    window.viewport.widget.setFixedSize(220, 520)
+    qtbot.wait(50)
+    cols, w, h = surface_columns()
+    assert (w, h) == (220, 520)
+    assert cols.size > 0
+    assert cols.min() > 2 and cols.max() < w - 3, (cols.min(), cols.max(), w)
