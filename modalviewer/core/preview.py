@@ -587,7 +587,7 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
         norms += np.einsum("ij,ij->j", W[rows], mass[rows, None] * W[rows])
     # unit Mass norm; residuals of (numerically) converged pairs add nothing
     norms = np.sqrt(norms)
-    live = norms > 1e-12 * max(float(norms.max()), 1e-300)
+    live = norms > 1e-10 * max(float(norms.max()), 1e-300)
     W = W[:, live] if not live.all() else W
     W /= np.where(live, norms, 1.0)[live][None, :]
     KW = threaded_product(K, W, out=KU[:, : W.shape[1]] if live.all() else None)
