@@ -362,6 +362,8 @@ class MainWindow(QtWidgets.QMainWindow):
                 self.statusBar().showMessage(f"Computing {job.description}...")
 
     def _on_job_finished(self, job: Job) -> None:
+        if job.status == DONE and getattr(job, "spectrum_key", None) is None:
+            return  # a repair: _on_repaired shows its report
         if job.status == DONE:
             spec = job.result[0]
             self.statusBar().showMessage(

@@ -246,16 +246,24 @@ class JobQueue:
 
     def _finish(self, job: Job, status, result, error, details) -> None:
         job.result, job.details = result, details
-        self._end(job, status, error)
-        self._start_next()
+        try:
+            self._end(job, status, error)
+        finally:
+            self._start_next()
 
     def _end(self, job: Job, status: str, error: str | None) -> None:
+        """Mark ``job`` ended, tell the observers, then run its own callbacks.  An
+        observer that raises does not keep the callbacks from running (a wait on the
+        job would never end) nor, in ``_finish``, the next job from starting; its error
+        is raised afterwards."""
         if job.done:
             return
         job.status, job.error = status, error
         if job in self.jobs:
             self.jobs.remove(job)
-        self.events.changed.emit(job)
-        self.events.finished.emit(job)
-        for callback in job.callbacks:
-            callback(job)
+        try:
+            self.events.changed.emit(job)
+            self.events.finished.emit(job)
+        finally:
+            for callback in job.callbacks:
+                callback(job)

@@ -244,3 +244,40 @@ def test_a_pick_shows_the_distance_from_the_preview_first(window, spot_path, mon
     window.wait_for(window.running_job)
     assert not window.state.spectrum("laplacian").is_preview
     assert window.state.display.kind == "distance" and window.state.picked == 800
+
+
+def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
+    """Mesh > Keep the largest component through the window: the repaired mesh replaces
+    the loaded one and its report is shown, with no error (the job-finished handler took
+    every finished job for a spectrum job: 'Mesh' object is not subscriptable, and the
+    mesh kept its three components)."""
+    import modalviewer as mv
+    from modalviewer.core.primitives import icosphere, torus
+
+    big, small = torus(24, 10), icosphere(1)
+    big = mv.Mesh(3.0 * big.vertices, big.faces)  # the largest by area too
+    parts = [big, small, small]
+    offsets = [(0.0, 0.0, 0.0), (6.0, 0.0, 0.0), (-6.0, 0.0, 0.0)]
+    vertices, faces, base = [], [], 0
+    for part, offset in zip(parts, offsets, strict=True):
+        vertices.append(part.vertices + offset)
+        faces.append(part.faces + base)
+        base += part.n_vertices
+    path = tmp_path / "three.obj"
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in np.vstack(vertices)]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in np.vstack(faces)]
+    path.write_text("\n".join(lines) + "\n")
+    assert window.open_mesh(path)
+    assert window.mesh.n_components == 3
+    errors = []
+    window.show_error = lambda *args, **kwargs: errors.append(args)
+    window.repair_mesh("largest_component", wait=False)
+    job = window.model.jobs.jobs[-1] if window.model.jobs.jobs else None
+    qtbot.waitUntil(lambda: window.mesh.n_components == 1, timeout=30000)
+    assert window.mesh.n_vertices == big.n_vertices
+    assert isinstance(window.mesh, mv.Mesh)
+    assert errors == []
+    assert "component" in window.statusBar().currentMessage()
+    # a scripted wait on such a job ends
+    if job is not None:
+        assert window.wait_for(job).status == "done"

@@ -76,6 +76,27 @@ def test_a_failing_job_reports_its_own_error_and_the_queue_goes_on():
     assert good.status == DONE and good.result == 42
 
 
+def test_an_observer_that_raises_stops_neither_the_job_callbacks_nor_the_queue():
+    """An observer of ``finished`` that raises (the window's handler did, for repair
+    jobs) must not keep the job's own callbacks from running (a scripted wait on it
+    never ended) nor the next job from starting."""
+    queue = JobQueue()
+
+    def broken_observer(job):
+        raise TypeError("'Mesh' object is not subscriptable")
+
+    queue.events.finished.connect(broken_observer)
+    seen = []
+    first = queue.submit(lambda p, c: "repaired mesh", "first", "first").then(seen.append)
+    second = queue.submit(lambda p, c: 42, "second", "second")
+    with pytest.raises(Exception, match="not subscriptable"):
+        queue.wait(first, timeout=10)
+    assert seen == [first] and first.status == DONE
+    queue.events.finished.disconnect(broken_observer)
+    queue.wait(second, timeout=10)
+    assert second.status == DONE and second.result == 42
+
+
 def test_cancel_a_running_job_ends_it_as_cancelled():
     queue = JobQueue()
     started = threading.Event()
