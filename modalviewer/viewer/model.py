@@ -161,6 +161,15 @@ class ViewerModel:
         job = self.jobs.submit(work, (state.mesh.hash, key), key.describe(), state.mesh.hash)
         job.spectrum_key = key
         job.preview_job = preview
+        if preview is not None:
+            state.set_exact_pending(key, True)
+            owner = state.mesh.hash
+
+            def exact_ended(_j: Job) -> None:
+                if self.state.mesh is not None and self.state.mesh.hash == owner:
+                    self.state.set_exact_pending(key, False)
+
+            job.then(exact_ended)
         if show:
             job.then(self._shower(key, display_at_request))
         return job

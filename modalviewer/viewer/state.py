@@ -205,6 +205,7 @@ class ViewerState:
         self.compute_settings = ComputeSettings()
         self.spectra: dict[SpectrumKey, Spectrum] = {}
         self._latest: dict[str, SpectrumKey] = {}
+        self.exact_pending: set[SpectrumKey] = set()
         self.display = Display()
         self.picked: int | None = None
         self.t_range: tuple[float, float] | None = None
@@ -224,6 +225,7 @@ class ViewerState:
         self.mesh_path = Path(path) if path is not None else None
         self.spectra.clear()
         self._latest.clear()
+        self.exact_pending.clear()
         self._derived = _Derived()
         if mesh is not None:
             self._derived.normals = vertex_normals(mesh)
@@ -269,6 +271,23 @@ class ViewerState:
         if self.display.kind in ("mode", "distance", "signature"):
             if self.display_operator() == key.operator:
                 self.events.display.emit()
+
+    def set_exact_pending(self, key: SpectrumKey, pending: bool) -> None:
+        """Whether the exact spectrum of ``key`` is being computed (or queued) behind
+        its preview; the panels say so only while it is."""
+        if pending == (key in self.exact_pending):
+            return
+        if pending:
+            self.exact_pending.add(key)
+        else:
+            self.exact_pending.discard(key)
+        self.events.spectra.emit(key.operator)
+
+    def exact_follows(self, operator: str | None) -> bool:
+        """True if the spectrum shown for ``operator`` is a preview whose exact spectrum
+        is on its way."""
+        key = self._latest.get(operator) if operator else None
+        return key is not None and key in self.exact_pending
 
     def spectrum(self, operator: str | None) -> Spectrum | None:
         """The most recent spectrum of ``operator``, or None."""
@@ -586,7 +605,7 @@ class ViewerState:
             zero = spec.zero_mode_mask()[j]
             value = "0 (zero mode)" if zero else f"{lam:.4g}"
             if spec.is_preview:
-                value += f" (preview; estimated error up to {percent_text(spec.estimated_error)})"
+                value += f" (preview; estimated error {percent_text(spec.estimated_error)})"
             colours = "blue +, white 0, orange -"
             if spec.is_vector and self.vector_coloring() == "magnitude":
                 colours = "white 0 to red: displacement magnitude"

@@ -255,7 +255,7 @@ def test_a_long_legend_wraps_inside_the_export(view, spot_mode, tmp_path):
     plain = _export(view, tmp_path / "plain.png", legend=False, colorbar=False)
     scene.set_legend(
         "Discrete Shells, normal variations, mode 9: lambda = 2.373e+04 "
-        "(preview; estimated error up to 2.2 %)\nblue +, white 0, orange -"
+        "(preview; estimated error 2.2 %)\nblue +, white 0, orange -"
     )
     img = _export(view, tmp_path / "long.png", colorbar=False)
     h, w = img.shape[:2]

@@ -281,3 +281,33 @@ def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
     # a scripted wait on such a job ends
     if job is not None:
         assert window.wait_for(job).status == "done"
+
+
+def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
+    window, spot_path, monkeypatch
+):
+    """Found under Xvfb: after Cancel the preview stayed (as it should) but the Modes
+    panel still said the exact spectrum would replace it; after opening another mesh the
+    empty plot kept the title "Spectrum (preview): ...", the signature plot its pick."""
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    window.open_mesh(spot_path)
+    window.state.set_display(distance_kind="hks")
+    window.pick_vertex(800)
+    preview = window.running_job
+    window.wait_for(preview)
+    exact = window.running_job
+    panel = window.modes_panel
+    assert "replaces it when ready" in panel.eigen_label.text()
+    assert "not a bound" in panel.eigen_label.text()
+    window.cancel_computation()
+    window.wait_for(exact)
+    assert exact.status == "cancelled"
+    assert window.state.spectrum("laplacian").is_preview
+    assert "replaces it when ready" not in panel.eigen_label.text()
+    assert "Ctrl+R" in panel.eigen_label.text()
+    assert window.distances_panel.signature_plot.title.startswith("Signature of vertex 800")
+    window.open_mesh(spot_path)
+    assert panel.spectrum_plot.title == "Spectrum"
+    assert window.distances_panel.signature_plot.title == "Signature of the picked vertex"

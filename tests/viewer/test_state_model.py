@@ -242,6 +242,34 @@ def test_cancel_stops_a_preview_and_the_exact_spectrum_behind_it(model, monkeypa
     assert model.state.spectrum("modified_dirichlet") is None
 
 
+def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monkeypatch):
+    """While the exact job behind a preview runs the state says it follows; once it is
+    cancelled, not (the Modes panel kept promising it after a Cancel)."""
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    state = model.state
+    seen = []
+    state.events.spectra.connect(seen.append)
+    exact = model.request_spectrum("laplacian", k=20)
+    preview = exact.preview_job
+    assert state.exact_follows("laplacian") is False  # nothing shown yet
+    model.jobs.wait(preview)
+    assert state.spectrum("laplacian").is_preview
+    assert state.exact_follows("laplacian") is True
+    model.jobs.cancel(exact)
+    model.jobs.wait(exact)
+    assert exact.status == "cancelled"
+    assert state.spectrum("laplacian").is_preview  # the preview stays on screen
+    assert state.exact_follows("laplacian") is False
+    assert seen.count("laplacian") >= 3  # pending, preview, no longer pending
+    # a finished exact spectrum ends the pending state too
+    again = model.request_spectrum("laplacian", k=20)
+    model.jobs.wait(again)
+    assert not state.spectrum("laplacian").is_preview
+    assert state.exact_follows("laplacian") is False
+
+
 def test_no_preview_for_the_3d_shells(model, monkeypatch):
     """Their preview costs 0.23 to 0.41 of the exact time (benchmarks/preview.py)."""
     from modalviewer.viewer import model as model_module

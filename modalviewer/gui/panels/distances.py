@@ -184,7 +184,7 @@ class DistancesPanel(QtWidgets.QWidget):
         operator = operator_for_distance(state.display.distance_kind)
         spec = state.spectrum(operator)
         if not state.has_signatures(operator) or state.picked is None:
-            self.signature_plot.set_data([], [])
+            self.signature_plot.set_data([], [], title="Signature of the picked vertex")
             return
         table = state.table(operator)
         times, values = signature(spec, table.times, vertices=[state.picked])

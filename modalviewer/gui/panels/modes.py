@@ -114,7 +114,7 @@ class ModesPanel(QtWidgets.QWidget):
             w.setEnabled(spec is not None)
         if spec is None:
             self.eigen_label.setText("No spectrum yet: compute one (Ctrl+R).")
-            self.spectrum_plot.set_data([], [])
+            self.spectrum_plot.set_data([], [], title="Spectrum")
             return
         zero = spec.zero_mode_mask()
         if showing_mode:
@@ -127,10 +127,14 @@ class ModesPanel(QtWidgets.QWidget):
         else:
             text = f"Not shown: the surface shows {_what_is_shown(state)}. M shows the mode."
         if spec.is_preview:
-            text += (
-                "\nPreview (eigenvalues high by up to about "
-                f"{percent_text(spec.estimated_error)}); "
+            follows = (
                 "the exact spectrum replaces it when ready."
+                if state.exact_follows(op)
+                else "Compute (Ctrl+R) for the exact spectrum."
+            )
+            text += (
+                "\nPreview: eigenvalues above the exact ones, by an estimated "
+                f"{percent_text(spec.estimated_error)} (not a bound); {follows}"
             )
         self.eigen_label.setText(text)
         self.spectrum_plot.set_data(
