@@ -155,6 +155,23 @@ class Field:
     threshold: float | None = None
 
 
+def _take_signs(spec: Spectrum, preview: Spectrum) -> None:
+    """Flip modes of ``spec`` in place so each has a non-negative Mass inner product
+    with the same mode of ``preview``: a mode's sign is arbitrary, and an exact spectrum
+    replacing its preview should not swap the colours of the mode on screen."""
+    k = min(spec.k, preview.k)
+    if spec.modes.shape[:-1] != preview.modes.shape[:-1] or k == 0:
+        return
+    if not spec.modes.flags.writeable:
+        return
+    a = spec.modes[..., :k].reshape(spec.modes.shape[0], -1, k)
+    b = preview.modes[..., :k].reshape(preview.modes.shape[0], -1, k)
+    inner = np.einsum("v,vcj,vcj->j", spec.mass, a, b)
+    flip = np.flatnonzero(inner < 0)
+    if flip.size:
+        spec.modes[..., flip] *= -1.0
+
+
 class ViewerEvents(SignalGroup):
     mesh = Signal()
     spectra = Signal(str)
@@ -257,6 +274,9 @@ class ViewerState:
             raise ValueError("the spectrum does not belong to the loaded mesh")
         if spec.is_preview and self.has_spectrum(key):
             return  # the exact spectrum is in already
+        shown = self.spectra.get(key)
+        if shown is not None and shown.is_preview and not spec.is_preview:
+            _take_signs(spec, shown)
         self.spectra[key] = spec
         self._latest[key.operator] = key
         if self.display.kind == "mode" and self.display.operator == key.operator:

@@ -218,6 +218,10 @@ def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeyp
     exact_map = state.distance_map()
     assert not np.array_equal(exact_map, preview_map)  # redrawn from the exact spectrum
     assert np.corrcoef(exact_map, preview_map)[0, 1] > 0.9
+    # the exact modes take the preview's signs, so the colours on screen do not swap
+    inner = np.einsum("v,vj,vj->j", exact.mass, exact.modes, spec.modes)
+    assert np.all(inner >= 0), inner
+    assert np.sum(np.abs(inner) > 0.9) >= 15  # most modes close to their preview
     # Galerkin eigenvalues are upper bounds of the exact ones
     nonzero = ~exact.zero_mode_mask()
     assert np.all(spec.eigenvalues[nonzero] >= exact.eigenvalues[nonzero] * (1 - 1e-9))
