@@ -311,3 +311,22 @@ def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
     window.open_mesh(spot_path)
     assert panel.spectrum_plot.title == "Spectrum"
     assert window.distances_panel.signature_plot.title == "Signature of the picked vertex"
+
+
+def test_ctrl_arrows_step_modes_from_a_number_field(window, spot_path, qtbot):
+    """README: Ctrl+Left/Right step modes anywhere.  Found under Xvfb: with the focus in
+    a spin box (Modes k, Bending weight) the field took them to move its cursor."""
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=30, wait=True)
+    window.show_mode(3)
+    for field in (window.compute_panel.k_spin, window.modes_panel.iso_spin):
+        field.setFocus()
+        qtbot.waitUntil(field.hasFocus, timeout=2000)
+        before = field.value()
+        mode = window.state.display.mode
+        target = QtWidgets.QApplication.focusWidget()  # the spin box's line edit
+        qtbot.keyClick(target, QtCore.Qt.Key.Key_Right, QtCore.Qt.KeyboardModifier.ControlModifier)
+        assert window.state.display.mode == mode + 1
+        qtbot.keyClick(target, QtCore.Qt.Key.Key_Left, QtCore.Qt.KeyboardModifier.ControlModifier)
+        assert window.state.display.mode == mode
+        assert field.value() == before
