@@ -330,3 +330,25 @@ def test_ctrl_arrows_step_modes_from_a_number_field(window, spot_path, qtbot):
         qtbot.keyClick(target, QtCore.Qt.Key.Key_Left, QtCore.Qt.KeyboardModifier.ControlModifier)
         assert window.state.display.mode == mode
         assert field.value() == before
+
+
+def test_the_mesh_info_grows_with_its_text(window, spot_path, qtbot, tmp_path):
+    """Found under Xvfb: opening a mesh of three components after a plain one left the
+    Compute panel's mesh text (now six lines) at the old height, cut at top and bottom."""
+    from modalviewer.core.primitives import icosphere
+
+    a, b = icosphere(2), icosphere(1)
+    path = tmp_path / "two.obj"
+    vertices = np.vstack([a.vertices, b.vertices + [3.0, 0.0, 0.0]])
+    faces = np.vstack([a.faces, b.faces + a.n_vertices])
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in vertices]
+    lines += [f"f {i + 1} {j + 1} {k + 1}" for i, j, k in faces]
+    path.write_text("\n".join(lines) + "\n")
+    window.open_mesh(spot_path)
+    qtbot.wait(50)
+    window.open_mesh(path)
+    label = window.compute_panel.mesh_info
+    qtbot.waitUntil(lambda: "connected components" in label.text(), timeout=2000)
+    qtbot.wait(100)
+    needed = label.heightForWidth(label.width())
+    assert label.height() >= needed, (label.height(), needed, label.width())

@@ -18,6 +18,31 @@ def combo() -> QtWidgets.QComboBox:
     return box
 
 
+class WrappingLabel(QtWidgets.QLabel):
+    """A word-wrapped label whose minimum height follows its text at its width.
+
+    Layouts inside a scroll area (the docks) size a wrapped label once and do not
+    follow its height-for-width when the text grows: a mesh report that went from two
+    lines to six stayed two lines high, cut at top and bottom."""
+
+    def __init__(self, text: str = "", parent=None):
+        super().__init__(text, parent)
+        self.setWordWrap(True)
+
+    def setText(self, text: str) -> None:  # noqa: N802 (Qt override)
+        super().setText(text)
+        self._fit()
+
+    def resizeEvent(self, event) -> None:  # noqa: N802
+        super().resizeEvent(event)
+        self._fit()
+
+    def _fit(self) -> None:
+        needed = self.heightForWidth(max(self.width(), 1))
+        if needed > 0 and needed != self.minimumHeight():
+            self.setMinimumHeight(needed)
+
+
 def select_data(box: QtWidgets.QComboBox, data) -> None:
     index = box.findData(data)
     if index >= 0 and index != box.currentIndex():

@@ -6,7 +6,7 @@ from qtpy import QtCore, QtWidgets
 
 from ...core.operators import OPERATOR_INFO
 from ...viewer.state import ViewerState
-from .common import combo, quiet, select_data
+from .common import WrappingLabel, combo, quiet, select_data
 
 
 class ComputePanel(QtWidgets.QWidget):
@@ -56,8 +56,7 @@ class ComputePanel(QtWidgets.QWidget):
         form.addRow(self.coarse_check)
         form.addRow(self.preview_check)
         form.addRow(self.compute_button)
-        self.mesh_info = QtWidgets.QLabel("No mesh")
-        self.mesh_info.setWordWrap(True)
+        self.mesh_info = WrappingLabel("No mesh")
         form.addRow(self.mesh_info)
 
         self.operator_combo.currentIndexChanged.connect(

@@ -9,7 +9,7 @@ from ...core.operators import DISTANCE_KINDS, operator_for_distance
 from ...core.signatures import signature
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
-from .common import combo, quiet, select_data
+from .common import WrappingLabel, combo, quiet, select_data
 
 SLIDER_STEPS = 1000
 
@@ -46,8 +46,7 @@ class DistancesPanel(QtWidgets.QWidget):
             "On: the slider moves through the share of the surface marked similar. "
             "Off: linear in the fraction of the largest distance."
         )
-        self.threshold_label = QtWidgets.QLabel("-")
-        self.threshold_label.setWordWrap(True)
+        self.threshold_label = WrappingLabel("-")
         self.threshold_slider.setSingleStep(5)  # 0.5 % of the surface per arrow key
         self.threshold_slider.setPageStep(50)
         self.t1_edit = QtWidgets.QLineEdit()
@@ -55,8 +54,7 @@ class DistancesPanel(QtWidgets.QWidget):
         for edit in (self.t1_edit, self.t2_edit):
             edit.setPlaceholderText("default")
             edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
-        self.pick_label = QtWidgets.QLabel("Click the surface to pick a vertex.")
-        self.pick_label.setWordWrap(True)
+        self.pick_label = WrappingLabel("Click the surface to pick a vertex.")
         self.distance_button = QtWidgets.QPushButton("Show distance")
         self.distance_button.setToolTip("Distance from the picked vertex (D)")
         form.addRow("Kind", self.kind_combo)

@@ -5,6 +5,7 @@ from __future__ import annotations
 from qtpy import QtCore, QtWidgets
 
 from ...viewer.jobs import RUNNING, Job, JobQueue
+from .common import WrappingLabel
 
 
 class JobsPanel(QtWidgets.QWidget):
@@ -38,8 +39,7 @@ class JobsPanel(QtWidgets.QWidget):
         widget = QtWidgets.QWidget()
         lay = QtWidgets.QHBoxLayout(widget)
         lay.setContentsMargins(0, 0, 0, 0)
-        label = QtWidgets.QLabel()
-        label.setWordWrap(True)
+        label = WrappingLabel()
         button = QtWidgets.QPushButton("Cancel")
         button.setToolTip("Cancel this computation")
         button.clicked.connect(lambda: self.jobs.cancel(job))

@@ -8,7 +8,7 @@ from qtpy import QtCore, QtWidgets
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState, percent_text
 from ..plots import LinePlot
-from .common import combo, quiet, select_data
+from .common import WrappingLabel, combo, quiet, select_data
 
 
 class ModesPanel(QtWidgets.QWidget):
@@ -36,8 +36,7 @@ class ModesPanel(QtWidgets.QWidget):
         row.addWidget(self.mode_slider, 1)
         row.addWidget(self.mode_spin)
         lay.addLayout(row)
-        self.eigen_label = QtWidgets.QLabel("No spectrum yet.")
-        self.eigen_label.setWordWrap(True)
+        self.eigen_label = WrappingLabel("No spectrum yet.")
         lay.addWidget(self.eigen_label)
         self.spectrum_plot = LinePlot("Spectrum", "mode index", "eigenvalue")
         lay.addWidget(self.spectrum_plot)
