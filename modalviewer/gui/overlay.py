@@ -95,18 +95,30 @@ def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.nd
         h, w = img.shape[:2]
         if bar.kind == "swatches":
             box = FONT_PX * s
-            y = h - margin - len(bar.colors) * (box + line_gap)
+            measure = lambda t: draw.textlength(t, font=font)  # noqa: E731
+            labels = [
+                wrap_text(label, measure, w - 2 * margin - 1.6 * box)
+                for label in bar.labels[: len(bar.colors)]
+            ]
+            lines = sum(label.count("\n") + 1 for label in labels)
+            y = h - margin - lines * (box + line_gap)
             if bar.title:
-                draw.text((margin, y - box - line_gap), bar.title, fill=black, font=font)
-            for color, label in zip(bar.colors, bar.labels, strict=False):
+                title = wrap_text(bar.title, measure, w - 2 * margin)
+                y_title = y - (title.count("\n") + 1) * (box + line_gap)
+                draw.multiline_text(
+                    (margin, y_title), title, fill=black, font=font, spacing=line_gap
+                )
+            for color, label in zip(bar.colors, labels, strict=False):
                 draw.rectangle(
                     [margin, y, margin + box, y + box],
                     fill=_rgba(color),
                     outline=black,
                     width=max(1, round(s)),
                 )
-                draw.text((margin + 1.6 * box, y), label, fill=black, font=font)
-                y += box + line_gap
+                draw.multiline_text(
+                    (margin + 1.6 * box, y), label, fill=black, font=font, spacing=line_gap
+                )
+                y += (label.count("\n") + 1) * (box + line_gap)
         else:
             width = min(0.5 * w, 320 * s)
             height = 0.9 * FONT_PX * s

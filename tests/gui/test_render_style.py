@@ -275,3 +275,30 @@ def test_wrap_text_breaks_at_spaces_within_the_width():
     assert wrap_text("averyveryverylongword x", len, 5) == "averyveryverylongword\nx"
     # a no-break space keeps "22 %" on one line and is drawn as a plain space
     assert wrap_text("up to 22\u00a0%", len, 8) == "up to\n22 %"
+
+
+def test_a_narrow_picture_keeps_the_swatch_labels_inside():
+    """Found in a 168-pixel-wide export of a threshold map: the swatch label read
+    "vibration distance < 0", its value cut off at the right edge.  Labels now wrap."""
+    from modalviewer.gui.overlay import FONT_PX, ColorBar, Overlay, draw_overlay
+
+    w, h = 168, 400
+    bar = ColorBar(
+        "",
+        [(0.2, 0.4, 0.9), (1.0, 1.0, 1.0)],
+        (0.0, 1.0),
+        "swatches",
+        ["vibration distance < 0.23", "the rest"],
+    )
+    img = draw_overlay(np.full((h, w, 3), 255, np.uint8), Overlay(None, bar))
+    ink = (img < 128).all(axis=2)
+    cols = np.flatnonzero(ink.any(axis=0))
+    assert cols.size > 0 and cols.max() < w - 1, cols.max()  # nothing reaches the edge
+    rows = np.flatnonzero(ink.any(axis=1))
+    # three lines of text: the first label on two
+    assert rows.max() - rows.min() > 2.5 * FONT_PX
+    assert rows.max() < h - 1
+    # a wide picture keeps each label on one line
+    wide = draw_overlay(np.full((h, 600, 3), 255, np.uint8), Overlay(None, bar))
+    rows_wide = np.flatnonzero((wide < 128).all(axis=2).any(axis=1))
+    assert rows_wide.max() - rows_wide.min() < rows.max() - rows.min()
