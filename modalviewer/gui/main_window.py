@@ -50,6 +50,10 @@ from .viewport import make_viewport
 log = logging.getLogger("modalviewer")
 
 
+MIN_VIEW_SIZE = (320, 240)
+"""The smallest the 3D view gets, in pixels; the window's minimum width follows."""
+
+
 class ComputeError(RuntimeError):
     """A computation started from the scripting API failed; the message is for users."""
 
@@ -85,6 +89,9 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.viewport = make_viewport(self, force_offscreen)
         self.plotter = self.viewport.plotter
+        # a usable 3D view however narrow the window: the docks keep the widths their
+        # contents need, so without it a 700-pixel window left the view 45 pixels wide
+        self.viewport.widget.setMinimumSize(MIN_VIEW_SIZE[0], MIN_VIEW_SIZE[1])
         self.setCentralWidget(self.viewport.widget)
         self.viewport.widget.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.viewport.widget.installEventFilter(self)

@@ -457,3 +457,13 @@ def test_a_narrow_view_keeps_the_whole_mesh_in_sight(window, spot_path, qtbot):
     assert (w, h) == (220, 520)
     assert cols.size > 0
     assert cols.min() > 2 and cols.max() < w - 3, (cols.min(), cols.max(), w)
+
+
+def test_the_3d_view_keeps_a_usable_size_in_a_narrow_window(window, spot_path, qtbot):
+    """Found under Xvfb: at 700 x 600 the docks kept their width and left the 3D view
+    about 45 pixels wide, its legend one word per line over the mesh."""
+    assert window.open_mesh(spot_path)
+    window.resize(500, 500)
+    qtbot.wait(100)
+    view = window.viewport.widget
+    assert view.width() >= 320 and view.height() >= 240, (view.width(), view.height())
