@@ -6,7 +6,7 @@ import configparser
 
 import numpy as np
 import pytest
-from qtpy import QtCore, QtWidgets
+from qtpy import QtCore, QtGui, QtWidgets
 
 pytestmark = pytest.mark.gui
 
@@ -352,3 +352,21 @@ def test_the_mesh_info_grows_with_its_text(window, spot_path, qtbot, tmp_path):
     qtbot.wait(100)
     needed = label.heightForWidth(label.width())
     assert label.height() >= needed, (label.height(), needed, label.width())
+
+
+def test_a_narrow_status_line_elides_its_text(window, spot_path, qtbot):
+    """Found under Xvfb: the status line's text was cut off mid-word at the right
+    ("...(normal componen"); it now ends in an ellipsis, the whole text in its tooltip."""
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=20, wait=True)
+    window.show_mode(3)
+    line = window.status_line
+    assert line.toolTip() == line.text() == window.state.summary()
+    line.setFixedWidth(160)
+    qtbot.wait(50)
+    img = line.grab().toImage()
+    w, h = img.width(), img.height()
+    ink = [x for x in range(w) for y in range(h) if QtGui.QColor(img.pixel(x, y)).lightness() < 100]
+    assert ink, "no text drawn"
+    # the text stops short of the frame (an ellipsis), instead of running into it
+    assert max(ink) < w - 5, (max(ink), w)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qtpy import QtWidgets
+from qtpy import QtCore, QtGui, QtWidgets
 
 from ...viewer.state import ViewerState
 
@@ -27,4 +27,23 @@ class StatusLine(QtWidgets.QLabel):
         self.update_from_state()
 
     def update_from_state(self, *_args) -> None:
-        self.setText(self.state.summary())
+        text = self.state.summary()
+        self.setText(text)
+        self.setToolTip(text)
+
+    def minimumSizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt override)
+        # narrower than its text: the text is elided (paintEvent), whole in the tooltip
+        hint = super().minimumSizeHint()
+        return QtCore.QSize(min(hint.width(), 160), hint.height())
+
+    def paintEvent(self, event) -> None:  # noqa: N802
+        """The text elided with "..." where the label is narrower than it (the status bar
+        shares its width with messages), instead of cut off mid-word."""
+        painter = QtGui.QPainter(self)
+        self.drawFrame(painter)
+        rect = self.contentsRect().adjusted(self.margin() + 3, 0, -self.margin() - 3, 0)
+        text = self.fontMetrics().elidedText(
+            self.text(), QtCore.Qt.TextElideMode.ElideRight, max(rect.width(), 0)
+        )
+        painter.drawText(rect, int(self.alignment()), text)
+        painter.end()
