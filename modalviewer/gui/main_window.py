@@ -369,10 +369,13 @@ class MainWindow(QtWidgets.QMainWindow):
                 self.statusBar().showMessage(f"Computing {job.description}...")
 
     def _on_job_finished(self, job: Job) -> None:
-        if job.status == DONE and getattr(job, "spectrum_key", None) is None:
-            return  # a repair: _on_repaired shows its report
-        if job.status == DONE:
-            spec = job.result[0]
+        result = job.result
+        spectrum = isinstance(result, tuple) and result and isinstance(result[0], Spectrum)
+        if job.status == DONE and not spectrum:
+            # a repair (whose own callback then shows its report) or other work
+            self.statusBar().showMessage(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
+        elif job.status == DONE:
+            spec = result[0]
             self.statusBar().showMessage(
                 f"{job.description} in {job.seconds:.1f} s; largest relative residual "
                 f"{worst_residual(spec):.1e}.",

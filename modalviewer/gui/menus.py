@@ -112,6 +112,7 @@ def build_menus(win) -> None:
         win, m, "Colour &bar and legend", lambda on: win.state.set_colorbar(on), "B"
     )
     win.colorbar_action.setCheckable(True)
+    win.colorbar_action.setChecked(win.state.style.colorbar)
     win.state.events.style.connect(lambda: win.colorbar_action.setChecked(win.state.style.colorbar))
     win.shaded_action = _action(
         win,
@@ -121,9 +122,13 @@ def build_menus(win) -> None:
         "Shift+S",
     )
     win.shaded_action.setCheckable(True)
+    win.shaded_action.setChecked(win.state.style.render == "shaded")
     win.state.events.style.connect(
         lambda: win.shaded_action.setChecked(win.state.style.render == "shaded")
     )
+    panels = m.addMenu("&Panels")
+    for dock in win.findChildren(QtWidgets.QDockWidget):
+        panels.addAction(dock.toggleViewAction())  # a closed panel comes back from here
     _action(win, m, "&Reset camera", win.scene_view.reset_camera, "R")
     views = m.addMenu("Camera &presets")
     for name, label, key in (
@@ -188,7 +193,7 @@ Keys in the 3D view (click it first)
   Left / Right          previous / next mode
   Space                 play / pause the vibration
 
-Everywhere
+Everywhere (the single letters not while typing in a field)
   Ctrl+Left / Right     previous / next mode
   P                     play / pause
   M / D / C             show the mode / the distance / the curvature

@@ -370,3 +370,39 @@ def test_a_narrow_status_line_elides_its_text(window, spot_path, qtbot):
     assert ink, "no text drawn"
     # the text stops short of the frame (an ellipsis), instead of running into it
     assert max(ink) < w - 5, (max(ink), w)
+
+
+def test_the_status_bar_ends_every_job_and_the_colour_bar_tick_matches_at_start(window, spot_path):
+    """Found under Xvfb: after the shape pair's spectra (jobs without a spectrum key) the
+    status bar kept "Computing ... of B (...)" for minutes; at start-up the colour bar was
+    shown but its View menu entry unticked, so the first B did nothing."""
+    assert window.state.style.colorbar and window.colorbar_action.isChecked()
+    window.colorbar_action.trigger()  # what B does
+    assert not window.state.style.colorbar
+    window.colorbar_action.trigger()
+    assert window.state.style.colorbar
+    window.open_mesh(spot_path)
+    spec = window.compute("laplacian", k=10, wait=True)
+    bar = window.statusBar()
+    for result, description in (((spec, None), "spectrum of B"), (42, "other work")):
+        job = window.model.jobs.submit(
+            lambda p, c, r=result: r, ("test", description), description, None
+        )
+        window.wait_for(job)
+        message = bar.currentMessage()
+        assert not message.startswith("Computing"), message
+        assert description in message
+
+
+def test_a_closed_panel_comes_back_from_the_view_menu(window):
+    """Found under Xvfb: a closed dock could only be restored from a dock title's context
+    menu, which is gone when all docks are closed."""
+    view = next(a.menu() for a in window.menuBar().actions() if a.text() == "&View")
+    panels = next(a.menu() for a in view.actions() if a.text() == "&Panels")
+    names = [a.text() for a in panels.actions()]
+    assert names == ["Compute", "Modes", "Distances and signatures"]
+    dock = next(d for d in window.findChildren(QtWidgets.QDockWidget) if d.windowTitle() == "Modes")
+    dock.close()
+    assert dock.isHidden()
+    panels.actions()[1].trigger()
+    assert not dock.isHidden()
