@@ -10,12 +10,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from qtpy import QtCore, QtGui, QtWidgets
+from qtpy import QtWidgets
 
 from ..core.files import atomic_write
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from .scene import MeshScene
 from .viewport import make_viewport
+from .window_keys import dispatch_key, install_keys
 
 
 class CompareWindow(QtWidgets.QWidget):
@@ -60,24 +61,15 @@ class CompareWindow(QtWidgets.QWidget):
         self.mode_index = 0 if self.distances else self.state.first_nonzero_mode(first)
         for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event.connect(self._on_state)
-        # One key table serves two routes: on a desktop the focused 3D view (pyvistaqt's
-        # QtInteractor) takes key presses before keyPressEvent sees them, and window
-        # shortcuts come first; without an active window (off-screen) shortcuts do not
-        # fire and keyPressEvent handles the keys.
-        self._keys = {
-            QtGui.QKeySequence(key).toString(): slot
-            for key, slot in (
+        self._keys = install_keys(
+            self,
+            [
                 ("Escape", self.close),
                 ("Ctrl+W", self.close),
                 ("Right", lambda: self._step(+1)),
                 ("Left", lambda: self._step(-1)),
-            )
-        }
-        context = QtCore.Qt.ShortcutContext.WidgetWithChildrenShortcut
-        for key, slot in self._keys.items():
-            shortcut = QtGui.QShortcut(QtGui.QKeySequence(key), self)
-            shortcut.setContext(context)
-            shortcut.activated.connect(slot)
+            ],
+        )
         self.resize(420 * len(items), 480)
 
     def _step(self, step: int) -> None:
@@ -86,11 +78,8 @@ class CompareWindow(QtWidgets.QWidget):
 
     def keyPressEvent(self, event):  # noqa: N802
         """Esc and Ctrl+W close; Left / Right step the mode of operator views."""
-        slot = self._keys.get(QtGui.QKeySequence(event.keyCombination()).toString())
-        if slot is None:
+        if not dispatch_key(self._keys, event):
             super().keyPressEvent(event)
-        else:
-            slot()
 
     def _on_state(self) -> None:
         if self.distances:

@@ -33,6 +33,7 @@ from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairState, PairView
 from .scene import MeshScene
 from .viewport import make_viewport
+from .window_keys import dispatch_key, install_keys
 
 log = logging.getLogger("modalviewer")
 
@@ -174,6 +175,7 @@ class PairWindow(QtWidgets.QWidget):
         self.status.setWordWrap(True)
         self.progress = QtWidgets.QProgressBar()
         self.progress.setRange(0, 1000)
+        self.progress.setMinimumWidth(240)  # room for "Discrete Shells ... of B"
         self.progress.setMaximumWidth(320)
         self.progress.hide()
         self.cancel_button = QtWidgets.QPushButton("Cancel")
@@ -187,6 +189,9 @@ class PairWindow(QtWidgets.QWidget):
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
         self.back_markers: dict[str, object] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
+        self._keys = install_keys(
+            self, [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]
+        )
         self._sync_controls()
 
     def _sync_controls(self) -> None:
@@ -597,14 +602,17 @@ class PairWindow(QtWidgets.QWidget):
             self.status.setText(f"Saved {out}")
 
     # ============================================================ close
-    def keyPressEvent(self, event):  # noqa: N802
-        key, mods = event.key(), event.modifiers()
-        ctrl = bool(mods & QtCore.Qt.KeyboardModifier.ControlModifier)
-        if key == QtCore.Qt.Key.Key_Escape or (key == QtCore.Qt.Key.Key_W and ctrl):
-            self.close()
-        elif key == QtCore.Qt.Key.Key_R and not mods:
-            self.reset_cameras()
+    def _escape(self) -> None:
+        """Esc cancels this window's computations if any run (as in the main window),
+        else closes the window."""
+        if self.pair.pending():
+            self.pair.cancel()
         else:
+            self.close()
+
+    def keyPressEvent(self, event):  # noqa: N802
+        """Esc cancels or closes, Ctrl+W closes, R resets the cameras."""
+        if not dispatch_key(self._keys, event):
             super().keyPressEvent(event)
 
     def eventFilter(self, obj, event):  # noqa: N802

@@ -145,3 +145,23 @@ def test_open_second_mesh_reports_a_bad_file(window, spot_path, tmp_path):
     with pytest.raises(PairError):
         window.open_second_mesh(bad)
     assert window.last_error and getattr(window, "pair_window", None) is None
+
+
+def test_pair_window_keys_esc_cancels_first_then_closes(window, spot_path, moved_spot, qtbot):
+    """Found under Xvfb: Esc during the pair's computation cancelled it and also closed
+    the window (pick and cameras lost), and R / Ctrl+W did nothing once a 3D view had
+    the focus.  The keys are window shortcuts now (one table with keyPressEvent), and Esc
+    cancels while something runs, closing only when nothing does."""
+    window.open_mesh(spot_path)
+    pair = window.open_second_mesh(moved_spot, wait=False, k=20)
+    qtbot.waitUntil(lambda: bool(pair.pair.pending()), timeout=5000)
+    qtbot.keyClick(pair, QtCore.Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: not pair.pair.pending(), timeout=20000)
+    assert pair.isVisible()  # cancelled, still open
+    cam = pair.viewports["a"].plotter.camera
+    cam.Azimuth(40)
+    before = cam.GetPosition()
+    qtbot.keyClick(pair, QtCore.Qt.Key.Key_R)
+    assert cam.GetPosition() != before  # the cameras went back
+    qtbot.keyClick(pair, QtCore.Qt.Key.Key_Escape)
+    qtbot.waitUntil(lambda: not pair.isVisible(), timeout=2000)
