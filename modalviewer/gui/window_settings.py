@@ -41,6 +41,7 @@ def restore(win) -> None:
     st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "auto")
     style = str(s.value("view/style", "paper"))
     st.set_render_style(style if style in RENDER_STYLES else "paper")
+    st.set_colorbar(str(s.value("view/colorbar", "true")).lower() == "true")
     st.set_animation(
         amplitude=int(s.value("view/amplitude", 8)), speed=int(s.value("view/speed", 30))
     )
@@ -50,6 +51,8 @@ def restore(win) -> None:
         bending=float(s.value("compute/bending", 1.0)),
         membrane=float(s.value("compute/membrane", 1.0)),
         rescale=str(s.value("compute/rescale", "false")).lower() == "true",
+        coarse=str(s.value("compute/coarse", "false")).lower() == "true",
+        preview=str(s.value("compute/preview", "true")).lower() == "true",
     )
     rebuild_recent(win)
 
@@ -66,11 +69,14 @@ def save(win) -> None:
     s.setValue("view/speed", st.animation.speed)
     s.setValue("view/shell_color", st.style.shell_coloring)
     s.setValue("view/style", st.style.render)
+    s.setValue("view/colorbar", "true" if st.style.colorbar else "false")
     c = st.compute_settings
     s.setValue("compute/operator", c.operator)
     s.setValue("compute/bending", c.bending)
     s.setValue("compute/membrane", c.membrane)
     s.setValue("compute/rescale", "true" if c.rescale else "false")
+    s.setValue("compute/coarse", "true" if c.coarse else "false")
+    s.setValue("compute/preview", "true" if c.preview else "false")
     s.sync()
 
 

@@ -406,3 +406,23 @@ def test_a_closed_panel_comes_back_from_the_view_menu(window):
     assert dock.isHidden()
     panels.actions()[1].trigger()
     assert not dock.isHidden()
+
+
+def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
+    """Found under Xvfb: Coarse-to-fine, Preview first and the colour bar came back at
+    their defaults after a restart (settings.ini held operator, weights and rescale
+    only)."""
+    from modalviewer.gui import MainWindow, window_settings
+
+    window.state.set_compute_settings(coarse=True, preview=False, operator="laplacian")
+    window.state.set_colorbar(False)
+    window.remember_settings = True  # as on a desktop
+    window_settings.save(window)
+    again = MainWindow()
+    qtbot.addWidget(again)
+    c = again.state.compute_settings
+    assert c.coarse is True and c.preview is False and c.operator == "laplacian"
+    assert again.state.style.colorbar is False
+    assert not again.colorbar_action.isChecked()
+    assert again.compute_panel.coarse_check.isChecked()
+    assert not again.compute_panel.preview_check.isChecked()
