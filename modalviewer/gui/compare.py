@@ -120,7 +120,12 @@ class CompareWindow(QtWidgets.QWidget):
             scene.show_marker(vertex)
             d = self.state.distance_map(item) if vertex is not None else None
             if d is None:
-                title.setText(f"{_label(item)}: pick a vertex / compute the spectrum")
+                need = (
+                    "pick a vertex in the main window"
+                    if vertex is None
+                    else "its spectrum is not computed yet"
+                )
+                title.setText(f"{_label(item)}: {need}")
                 continue
             if display.distance_display == "threshold":
                 thr = display.threshold * float(d.max())
