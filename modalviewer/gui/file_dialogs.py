@@ -58,6 +58,28 @@ def screenshot_dialog(win) -> None:
     win.statusBar().showMessage(f"Saved {out}", 8000)
 
 
+def pair_screenshot_dialog(pair_window) -> None:
+    """Export a shape pair window: the main window's dialog (folder, size multiplier,
+    transparent background), starting where the main window's screenshots go."""
+    win = pair_window.main
+    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    dialog = ScreenshotDialog(pair_window, start)
+    dialog.setWindowTitle("Export the pair")
+    dialog.path_edit.setText(str(Path(start) / "pair.png"))
+    dialog.colorbar.hide()  # the pair's legends are part of its picture
+    if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
+        return
+    path, scale, transparent, _ = dialog.values()
+    try:
+        out = pair_window.export_screenshot(path, scale, transparent)
+    except (OSError, ValueError) as exc:
+        pair_window.status.setText(f"Could not save the screenshot: {exc}")
+        return
+    if win.remember_settings:
+        win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
+    pair_window.status.setText(f"Saved {out}")
+
+
 def field_dialog(win) -> None:
     if win.scene is None:
         return

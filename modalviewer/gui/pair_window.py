@@ -590,16 +590,9 @@ class PairWindow(QtWidgets.QWidget):
         return atomic_write(path, lambda tmp: Image.fromarray(canvas).save(tmp, format="PNG"))
 
     def _export_dialog(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Export the pair", "pair.png", "PNG (*.png)"
-        )
-        if path:
-            try:
-                out = self.export_screenshot(path)
-            except (OSError, ValueError) as exc:
-                self._on_message(f"Could not save the screenshot: {exc}")
-                return
-            self.status.setText(f"Saved {out}")
+        from .file_dialogs import pair_screenshot_dialog
+
+        pair_screenshot_dialog(self)
 
     # ============================================================ close
     def _escape(self) -> None:

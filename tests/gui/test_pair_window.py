@@ -165,3 +165,36 @@ def test_pair_window_keys_esc_cancels_first_then_closes(window, spot_path, moved
     assert cam.GetPosition() != before  # the cameras went back
     qtbot.keyClick(pair, QtCore.Qt.Key.Key_Escape)
     qtbot.waitUntil(lambda: not pair.isVisible(), timeout=2000)
+
+
+def test_pair_export_dialog_offers_size_and_transparency(
+    window, spot_path, moved_spot, tmp_path, monkeypatch
+):
+    """Found under Xvfb: the pair's Export opened a bare file dialog in the working folder,
+    without the size multiplier or transparent background of the main export."""
+    from modalviewer.gui import dialogs
+
+    window.open_mesh(spot_path)
+    pair = window.open_second_mesh(moved_spot, k=20)
+    seen = {}
+
+    def accept(dialog):
+        seen["start"] = dialog.path_edit.text()
+        seen["colorbar_shown"] = dialog.colorbar.isVisibleTo(dialog)
+        dialog.path_edit.setText(str(tmp_path / "pair2x.png"))
+        dialog.scale.setValue(2)
+        dialog.transparent.setChecked(True)
+        return dialogs.QtWidgets.QDialog.DialogCode.Accepted
+
+    monkeypatch.setattr(dialogs.ScreenshotDialog, "exec", accept)
+    pair._export_dialog()
+    assert seen["start"] == str(spot_path.resolve().parent / "pair.png")
+    assert not seen["colorbar_shown"]
+    out = tmp_path / "pair2x.png"
+    assert out.is_file() and "Saved" in pair.status.text()
+    one = pair.export_screenshot(tmp_path / "pair1x.png")
+    from PIL import Image
+
+    big, small = Image.open(out), Image.open(one)
+    assert big.mode == "RGBA" and small.mode == "RGB"
+    assert abs(big.width - 2 * small.width) <= 8 and big.height == 2 * small.height
