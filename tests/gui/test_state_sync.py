@@ -426,3 +426,13 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     assert not again.colorbar_action.isChecked()
     assert again.compute_panel.coarse_check.isChecked()
     assert not again.compute_panel.preview_check.isChecked()
+
+
+def test_a_combo_box_names_its_whole_item_in_its_tooltip(window):
+    """The Operator box is 14 characters wide and shows "Discrete Shells, normal v..."."""
+    box = window.compute_panel.operator_combo
+    index = box.findData("shells_normal")
+    box.setCurrentIndex(index)
+    assert box.toolTip() == box.itemText(index) == "Discrete Shells, normal variations"
+    colours = window.modes_panel.color_combo  # a box with a purpose keeps it below
+    assert colours.toolTip() == colours.currentText() + "\nScalar shown for 3D vibration modes"

@@ -9,13 +9,29 @@ from qtpy import QtWidgets
 
 def combo() -> QtWidgets.QComboBox:
     """A combo box as wide as 14 characters, not as its longest item (a dock has a
-    340-pixel limit; a wider combo would cut off its right edge)."""
+    340-pixel limit; a wider combo would cut off its right edge), its current item's
+    whole text in its tooltip."""
     box = QtWidgets.QComboBox()
     box.setSizeAdjustPolicy(
         QtWidgets.QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon
     )
     box.setMinimumContentsLength(14)
+    # the box shows the start of a long item ("Discrete Shells, normal v..."); the
+    # tooltip names it whole, above what the box is for (see describe)
+    box.currentTextChanged.connect(lambda _text: _refresh_tooltip(box))
     return box
+
+
+def describe(box: QtWidgets.QComboBox, text: str) -> None:
+    """What ``box`` is for, shown in its tooltip below its current item's whole text."""
+    box.setProperty("purpose", text)
+    _refresh_tooltip(box)
+
+
+def _refresh_tooltip(box: QtWidgets.QComboBox) -> None:
+    purpose = box.property("purpose") or ""
+    parts = [part for part in (box.currentText(), purpose) if part]
+    box.setToolTip("\n".join(parts))
 
 
 class WrappingLabel(QtWidgets.QLabel):

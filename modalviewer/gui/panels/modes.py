@@ -8,7 +8,7 @@ from qtpy import QtCore, QtWidgets
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState, percent_text
 from ..plots import LinePlot
-from .common import WrappingLabel, combo, quiet, select_data
+from .common import WrappingLabel, combo, describe, quiet, select_data
 
 
 class ModesPanel(QtWidgets.QWidget):
@@ -23,7 +23,7 @@ class ModesPanel(QtWidgets.QWidget):
         self.state = state
         lay = QtWidgets.QVBoxLayout(self)
         self.spectrum_combo = combo()
-        self.spectrum_combo.setToolTip("The computed spectrum whose modes are shown")
+        describe(self.spectrum_combo, "The computed spectrum whose modes are shown")
         row = QtWidgets.QHBoxLayout()
         row.addWidget(QtWidgets.QLabel("Spectrum"))
         row.addWidget(self.spectrum_combo, 1)
@@ -50,7 +50,7 @@ class ModesPanel(QtWidgets.QWidget):
         )
         self.color_combo.addItem("Normal component", "normal")
         self.color_combo.addItem("Magnitude", "magnitude")
-        self.color_combo.setToolTip("Scalar shown for 3D vibration modes")
+        describe(self.color_combo, "Scalar shown for 3D vibration modes")
         self.iso_spin = QtWidgets.QSpinBox()
         self.iso_spin.setRange(0, 60)
         self.iso_spin.setToolTip("Number of isolines (0: none)")
