@@ -589,7 +589,7 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
     norms = np.sqrt(norms)
     live = norms > 1e-10 * max(float(norms.max()), 1e-300)
     W = W[:, live] if not live.all() else W
-    W /= np.where(live, norms, 1.0)[live][None, :]
+    W /= norms[live][None, :]
     KW = threaded_product(K, W, out=KU[:, : W.shape[1]] if live.all() else None)
     MW = U if live.all() else np.empty_like(W)
     for rows in _row_blocks(N):
@@ -618,8 +618,7 @@ def _residuals(K_U, mass, lam, U, lam_scale):
     # in blocks of rows: (N, k) temporaries would cost more (fresh pages) than the sums
     res2 = np.zeros(len(lam))
     mu2 = np.zeros(len(lam))
-    for start in range(0, U.shape[0], 8192):
-        rows = slice(start, start + 8192)
+    for rows in _row_blocks(U.shape[0]):
         MU = mass[rows, None] * U[rows]
         R = K_U[rows] - MU * lam[None, :]
         res2 += np.einsum("ij,ij->j", R, R)
