@@ -23,29 +23,27 @@ def _action(win, menu, text, slot, shortcut=None, tip=None) -> QtGui.QAction:
     return action
 
 
-MODE_STEP_KEYS = (QtCore.Qt.Key.Key_Left, QtCore.Qt.Key.Key_Right)
-"""With Ctrl: previous / next mode, the View menu's shortcuts."""
+class _ShortcutsThroughNumberFields(QtCore.QObject):
+    """Lets the shortcuts of some actions (Ctrl+Left/Right: previous / next mode) reach
+    them from a number field (a spin box), which would otherwise take the keys to move
+    its cursor by words: the override request is left unaccepted, so the window's
+    shortcut runs."""
 
-
-class _ModeKeysThroughNumberFields(QtCore.QObject):
-    """Lets Ctrl+Left/Right reach the mode actions from a number field (a spin box),
-    which would otherwise take them to move its cursor by words: the override request is
-    left unaccepted, so the window's shortcut runs."""
+    def __init__(self, actions, parent):
+        super().__init__(parent)
+        self.keys = {action.shortcut().toString() for action in actions}
 
     def eventFilter(self, obj, event) -> bool:  # noqa: N802 (Qt override)
-        if (
+        return (
             event.type() == QtCore.QEvent.Type.ShortcutOverride
-            and event.key() in MODE_STEP_KEYS
-            and event.modifiers() == QtCore.Qt.KeyboardModifier.ControlModifier
-        ):
-            return True
-        return False
+            and QtGui.QKeySequence(event.keyCombination()).toString() in self.keys
+        )
 
 
-def let_mode_keys_through(win) -> None:
-    """Install :class:`_ModeKeysThroughNumberFields` on every spin box of ``win``."""
-    keys = getattr(win, "_mode_keys_filter", None) or _ModeKeysThroughNumberFields(win)
-    win._mode_keys_filter = keys
+def let_shortcuts_through(win, actions) -> None:
+    """Install :class:`_ShortcutsThroughNumberFields` for ``actions`` on every spin box
+    of ``win``."""
+    keys = _ShortcutsThroughNumberFields(actions, win)
     for box in win.findChildren(QtWidgets.QAbstractSpinBox):
         box.installEventFilter(keys)
         if box.lineEdit() is not None:
@@ -101,9 +99,11 @@ def build_menus(win) -> None:
     _action(win, m, "C&ancel running computation", win.cancel_computation, "Esc")
     _action(win, m, "Cancel &all computations", win.cancel_all, "Ctrl+Shift+Esc")
     m = bar.addMenu("&View")
-    _action(win, m, "&Next mode", lambda: win.step_mode(+1), "Ctrl+Right")
-    _action(win, m, "&Previous mode", lambda: win.step_mode(-1), "Ctrl+Left")
-    let_mode_keys_through(win)
+    steps = [
+        _action(win, m, "&Next mode", lambda: win.step_mode(+1), "Ctrl+Right"),
+        _action(win, m, "&Previous mode", lambda: win.step_mode(-1), "Ctrl+Left"),
+    ]
+    let_shortcuts_through(win, steps)
     _action(win, m, "Play / pause animation", win.toggle_animation, "P")
     _action(win, m, "Show &mode", win._show_current_mode, "M")
     _action(win, m, "Show &distance", lambda: win.show_distance(), "D")

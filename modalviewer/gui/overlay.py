@@ -86,16 +86,19 @@ def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.nd
     font = _font(FONT_PX * s)
     black = (0, 0, 0, 255)
     line_gap = 0.35 * FONT_PX * s
+
+    def measure(text: str) -> float:
+        return draw.textlength(text, font=font)
+
     if overlay.legend:
         width = img.shape[1] - 2 * margin
-        text = wrap_text(overlay.legend, lambda t: draw.textlength(t, font=font), width)
+        text = wrap_text(overlay.legend, measure, width)
         draw.multiline_text((margin, margin), text, fill=black, font=font, spacing=line_gap)
     bar = overlay.colorbar
     if bar is not None:
         h, w = img.shape[:2]
         if bar.kind == "swatches":
             box = FONT_PX * s
-            measure = lambda t: draw.textlength(t, font=font)  # noqa: E731
             labels = [
                 wrap_text(label, measure, w - 2 * margin - 1.6 * box)
                 for label in bar.labels[: len(bar.colors)]

@@ -25,6 +25,15 @@ def headless() -> bool:
     return QtGui.QGuiApplication.platformName() in ("offscreen", "minimal")
 
 
+def _flag(settings, key: str, default: bool) -> bool:
+    """A remembered on/off setting (stored as "true" / "false")."""
+    return str(settings.value(key, _flag_text(default))).lower() == "true"
+
+
+def _flag_text(on: bool) -> str:
+    return "true" if on else "false"
+
+
 def restore(win) -> None:
     s = win.settings
     geometry = s.value("window/geometry") if win.remember_settings else None
@@ -41,7 +50,7 @@ def restore(win) -> None:
     st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "auto")
     style = str(s.value("view/style", "paper"))
     st.set_render_style(style if style in RENDER_STYLES else "paper")
-    st.set_colorbar(str(s.value("view/colorbar", "true")).lower() == "true")
+    st.set_colorbar(_flag(s, "view/colorbar", True))
     st.set_animation(
         amplitude=int(s.value("view/amplitude", 8)), speed=int(s.value("view/speed", 30))
     )
@@ -50,9 +59,9 @@ def restore(win) -> None:
         operator=operator if operator in OPERATOR_INFO else "modified_dirichlet",
         bending=float(s.value("compute/bending", 1.0)),
         membrane=float(s.value("compute/membrane", 1.0)),
-        rescale=str(s.value("compute/rescale", "false")).lower() == "true",
-        coarse=str(s.value("compute/coarse", "false")).lower() == "true",
-        preview=str(s.value("compute/preview", "true")).lower() == "true",
+        rescale=_flag(s, "compute/rescale", False),
+        coarse=_flag(s, "compute/coarse", False),
+        preview=_flag(s, "compute/preview", True),
     )
     rebuild_recent(win)
 
@@ -69,14 +78,14 @@ def save(win) -> None:
     s.setValue("view/speed", st.animation.speed)
     s.setValue("view/shell_color", st.style.shell_coloring)
     s.setValue("view/style", st.style.render)
-    s.setValue("view/colorbar", "true" if st.style.colorbar else "false")
+    s.setValue("view/colorbar", _flag_text(st.style.colorbar))
     c = st.compute_settings
     s.setValue("compute/operator", c.operator)
     s.setValue("compute/bending", c.bending)
     s.setValue("compute/membrane", c.membrane)
-    s.setValue("compute/rescale", "true" if c.rescale else "false")
-    s.setValue("compute/coarse", "true" if c.coarse else "false")
-    s.setValue("compute/preview", "true" if c.preview else "false")
+    s.setValue("compute/rescale", _flag_text(c.rescale))
+    s.setValue("compute/coarse", _flag_text(c.coarse))
+    s.setValue("compute/preview", _flag_text(c.preview))
     s.sync()
 
 
