@@ -38,8 +38,8 @@ class WrappingLabel(QtWidgets.QLabel):
     """A word-wrapped label whose minimum height follows its text at its width.
 
     Layouts inside a scroll area (the docks) size a wrapped label once and do not
-    follow its height-for-width when the text grows: a mesh report that went from two
-    lines to six stayed two lines high, cut at top and bottom."""
+    follow its height-for-width when the text grows: a plain label whose text goes from
+    two lines to six stays two lines high, cut at top and bottom."""
 
     def __init__(self, text: str = "", parent=None):
         super().__init__(text, parent)
