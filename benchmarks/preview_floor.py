@@ -181,6 +181,7 @@ def _measure(size: str, k: int, repeats: int) -> dict:
     from modalviewer.core.factor import SPDSolver, _load_mkl
     from modalviewer.core.pipeline import operator_matrices
     from modalviewer.core.products import threaded_product
+    from modalviewer.core.reduced_space import reduced_basis
 
     mesh = make_mesh(size)
     row: dict = {"size": size, "vertices": mesh.n_vertices, "k": k}
@@ -213,7 +214,7 @@ def _measure(size: str, k: int, repeats: int) -> dict:
     solver = shifted = B = None  # free the factor
 
     settings = pv.SPACE_SETTINGS["shells"]
-    basis = pv.reduced_basis(
+    basis = reduced_basis(
         mesh, "shells", settings.samples(k), settings.radius_factor, settings.degree,
         candidates=mesh.n_vertices,
     )  # fmt: skip

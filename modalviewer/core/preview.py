@@ -1,35 +1,18 @@
 """Preview spectra: Rayleigh-Ritz in a reduced space of smooth, locally supported functions.
 
 The fine mesh's own operator K and lumped mass M are projected onto a few thousand
-functions on the fine mesh (Nasikun, Brandt, Hildebrandt: *Fast Approximation of
-Laplace-Beltrami Eigenproblems*, SGP 2018):
-
-- ``m`` well-spread vertices are chosen by farthest-point sampling;
-- around each sample c_i a compactly supported Wendland function
-  ``psi_i = (1 - d/r)^4 (4 d/r + 1)`` of the Euclidean distance d, radius r a few sample
-  spacings; ``phi_i = psi_i / sum_j psi_j`` is a partition of unity;
-- each ``phi_i`` is enriched by ``phi_i * <x - c_i, t>/r`` for the two unit tangents t of
-  the surface at c_i (locally linear functions, Nasikun et al.'s linear enrichment in the
-  tangent plane, where the normal coordinate would be nearly linearly dependent on flat
-  parts); for the two Discrete Shells operators also by ``phi_i u^2, phi_i uv, phi_i v^2``
-  (u, v those tangent coordinates): a bending energy measures second derivatives, which
-  a partition of unity times linear functions does not approximate.
+functions on the fine mesh (:mod:`.reduced_space`, after Nasikun, Brandt, Hildebrandt:
+*Fast Approximation of Laplace-Beltrami Eigenproblems*, SGP 2018).  The reduced problem
+``(P^T K P) y = lambda (P^T M P) y`` is a small generalised eigenproblem; the preview
+modes are ``P y``.  Galerkin eigenvalues are upper bounds of the fine mesh's
+(Courant-Fischer), and the prolonged modes are exactly Mass-orthonormal on the fine mesh.
+For the Discrete Shells the space holds the six rigid motions, which are therefore exact
+zero modes of the reduced problem.
 
 For the shells operators a two-level step follows: Rayleigh-Ritz in the reduced space
 enlarged by the block-Jacobi preconditioned residuals of the Galerkin modes, which adds
 the mesh-scale parts of the modes (the tangential give of a bumpy surface bending without
 stretching) that no smooth space holds.
-
-The columns of the prolongation P hold these functions.  The reduced problem
-``(P^T K P) y = lambda (P^T M P) y`` is a small sparse generalised eigenproblem; the
-preview modes are ``P y``.  Galerkin eigenvalues are upper bounds of the fine mesh's
-(Courant-Fischer), and the prolonged modes are exactly Mass-orthonormal on the fine mesh.
-
-For the Discrete Shells the reduced space is vector valued: every scalar function times
-e_x, e_y, e_z, plus the three linearised rotations ``e_a x (x - centroid)`` as global
-functions, so the six rigid motions are exact zero modes of the reduced problem
-(translations come from the partition of unity).  For the normal-restricted shells the
-scalar functions multiply the vertex normals, which is the scalar problem of ``H_N``.
 
 The accuracy of each preview mode is reported by its relative residual on the fine mesh,
 ``|K u - lambda M u|_{M^-1} / (lambda |u|_M)``, and an estimate of its eigenvalue's
@@ -44,245 +27,27 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial import cKDTree
 
 from .eigen import CancelFn, Cancelled, EigenError, ProgressFn, zero_modes
 from .factor import SPDSolver
-from .laplacian import vertex_normals
 from .mesh import Mesh
-from .products import threaded_product, threaded_transpose_product
+from .products import row_blocks, threaded_product, threaded_transpose_product
+from .reduced_space import (
+    RADIUS_FACTOR,
+    ReducedBasis,
+    max_samples,
+    reduced_basis,
+    scalar_functions_per_sample,
+)
 from .spectrum import Spectrum
 
 __all__ = [
-    "DEFAULT_SAMPLES",
-    "farthest_point_samples",
-    "partition_of_unity_basis",
-    "rotation_fields",
-    "ReducedBasis",
-    "reduced_basis",
+    "SpaceSettings",
     "SPACE_SETTINGS",
     "preview_spectrum",
     "estimated_errors",
     "compute_preview",
 ]
-
-DEFAULT_SAMPLES = 200
-"""Samples (centres of basis functions) of :func:`reduced_basis` when none are given;
-:func:`preview_spectrum` takes its own per operator from :data:`SPACE_SETTINGS`."""
-
-RADIUS_FACTOR = 2.0
-"""Support radius of the basis functions in units of the sampling's covering radius (the
-largest distance from a vertex to its nearest sample)."""
-
-
-def farthest_point_samples(
-    points: np.ndarray, m: int, candidates: int | None = None, seed: int = 0
-) -> np.ndarray:
-    """Indices of ``m`` well-spread points (Euclidean farthest-point sampling).
-
-    The sampling runs over ``candidates`` points drawn at random (default ``8 m``, all
-    points if fewer), which costs O(m * candidates) instead of O(m * n) and spreads the
-    samples as evenly as candidates that dense allow.  Deterministic for a given seed.
-    """
-    n = len(points)
-    m = int(min(max(m, 1), n))
-    c = n if candidates is None else int(candidates)
-    c = min(n, max(c if candidates is not None else 8 * m, m))
-    rng = np.random.default_rng(seed)
-    idx = np.sort(rng.choice(n, c, replace=False)) if c < n else np.arange(n)
-    pts = np.ascontiguousarray(points[idx])
-    # start from the point farthest from the centroid
-    current = int(np.argmax(((pts - pts.mean(axis=0)) ** 2).sum(axis=1)))
-    dist = np.full(c, np.inf)
-    chosen = np.empty(m, dtype=np.int64)
-    for j in range(m):
-        chosen[j] = current
-        diff = pts - pts[current]
-        np.minimum(dist, np.einsum("ij,ij->i", diff, diff), out=dist)
-        current = int(np.argmax(dist))
-    return idx[chosen]
-
-
-def _tangents(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit tangents per unit normal, orthogonal to it and to each other."""
-    helper = np.zeros_like(normals)
-    along_x = np.abs(normals[:, 0]) < 0.9
-    helper[along_x, 0] = 1.0
-    helper[~along_x, 1] = 1.0
-    t1 = np.cross(normals, helper)
-    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    return t1, np.cross(normals, t1)
-
-
-def partition_of_unity_basis(
-    mesh: Mesh,
-    centers: np.ndarray,
-    radius_factor: float = RADIUS_FACTOR,
-    enrich: int = 1,
-    normals: np.ndarray | None = None,
-) -> tuple[sp.csr_matrix, float]:
-    """Scalar reduced basis P, (n, q * len(centers)), and the support radius r.
-
-    Column ``q * i`` is the partition-of-unity function phi_i of centre ``centers[i]``;
-    with ``enrich`` (q = 3) columns ``q * i + 1`` and ``q * i + 2`` are
-    ``phi_i * <x - c_i, t>/r`` for the two unit tangents t at c_i.  Rows sum to 1 over the
-    columns ``q * i`` (so constants are reproduced exactly).
-    """
-    x = mesh.vertices
-    c = x[np.asarray(centers, dtype=np.int64)]
-    tree_c = cKDTree(c)
-    nearest, _ = tree_c.query(x)
-    h = float(np.max(nearest))
-    if h <= 0:
-        h = float(np.max(np.ptp(x, axis=0))) or 1.0
-    r = radius_factor * h
-    pairs = tree_c.sparse_distance_matrix(cKDTree(x), r, output_type="ndarray")
-    ci = pairs["i"].astype(np.int64)
-    vi = pairs["j"].astype(np.int64)
-    s = pairs["v"] / r
-    # the centre's own vertex is at distance 0, which sparse_distance_matrix may leave out
-    own = np.asarray(centers, dtype=np.int64)
-    have = np.zeros(len(own), dtype=bool)
-    have[ci[vi == own[ci]]] = True
-    missing = np.flatnonzero(~have)
-    ci = np.concatenate([ci, missing])
-    vi = np.concatenate([vi, own[missing]])
-    s = np.concatenate([s, np.zeros(len(missing))])
-    psi = (1.0 - s) ** 4 * (4.0 * s + 1.0)
-    total = np.bincount(vi, psi, minlength=mesh.n_vertices)
-    phi = psi / total[vi]
-    q = 3 if enrich else 1
-    n, m = mesh.n_vertices, len(own)
-    if not enrich:
-        return sp.csr_matrix((phi, (vi, ci)), shape=(n, m)), r
-    if normals is None:
-        normals = vertex_normals(mesh)
-    t1, t2 = _tangents(normals[own])
-    rel = (x[vi] - c[ci]) / r
-    u = np.einsum("ij,ij->i", rel, t1[ci])
-    v = np.einsum("ij,ij->i", rel, t2[ci])
-    polys = [np.ones_like(u), u, v]
-    if int(enrich) >= 2:
-        polys += [u * u, u * v, v * v]
-    q = len(polys)
-    values = np.concatenate([phi * p for p in polys])
-    rows = np.tile(vi, q)
-    cols = np.concatenate([q * ci + j for j in range(q)])
-    return sp.csr_matrix((values, (rows, cols)), shape=(n, q * m)), r
-
-
-def rotation_fields(mesh: Mesh) -> np.ndarray:
-    """(3n, 3) linearised rotations ``e_a x (x - centroid)``, vertex-major, unit-scaled."""
-    x = mesh.vertices - mesh.vertices.mean(axis=0)
-    R = np.empty((mesh.n_vertices, 3, 3))
-    for a in range(3):
-        e = np.zeros(3)
-        e[a] = 1.0
-        R[:, :, a] = np.cross(e, x)
-    R = R.reshape(-1, 3)
-    return R / np.linalg.norm(R, axis=0, keepdims=True)
-
-
-@dataclass
-class ReducedBasis:
-    """The prolongation ``P = [kron(scalar, I_c)  dense]`` of a reduced space.
-
-    ``scalar`` (n, q) holds the scalar functions on the vertices.  With ``components``
-    3 (Discrete Shells) every one of them times e_x, e_y, e_z is a column: unknowns are
-    vertex-major (row 3 v + a), column 3 j + a is scalar function j times e_a.  The
-    Kronecker product is never formed: products with P go through the scalar matrix
-    (a third of the entries and of the work).  ``dense`` (c n, d) holds global columns
-    (the shells' rotations, exact null vectors the space lacks) or is None.
-    """
-
-    scalar: sp.csr_matrix
-    components: int
-    dense: np.ndarray | None
-    info: dict
-
-    @property
-    def n_sparse(self) -> int:
-        return self.scalar.shape[1] * self.components
-
-    @property
-    def dimension(self) -> int:
-        return self.n_sparse + (0 if self.dense is None else self.dense.shape[1])
-
-    def sparse_matrix(self) -> sp.csr_matrix:
-        """``kron(scalar, I_c)`` as a matrix (for checks on small meshes)."""
-        if self.components == 1:
-            return self.scalar
-        return sp.kron(self.scalar, sp.eye(self.components), format="csr")
-
-    def prolong(self, Y: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """``P Y`` for reduced coefficients Y (dimension, k): (c n, k) values, written
-        into ``out`` if given (C-contiguous)."""
-        c, k = self.components, Y.shape[1]
-        Ys = np.ascontiguousarray(Y[: self.n_sparse]).reshape(-1, c * k)
-        flat = None if out is None else out.reshape(-1, c * k)
-        U = threaded_product(self.scalar, Ys, out=flat).reshape(-1, k)
-        if self.dense is not None:
-            Yd = Y[self.n_sparse :]
-            for rows in _row_blocks(U.shape[0]):  # no (c n, k) temporary
-                U[rows] += self.dense[rows] @ Yd
-        return U
-
-    def restrict(self, X: np.ndarray) -> np.ndarray:
-        """``P^T X`` for values X (c n, k): (dimension, k)."""
-        c, k = self.components, X.shape[1]
-        Xs = np.ascontiguousarray(X).reshape(-1, c * k)
-        out = threaded_transpose_product(self.scalar, Xs).reshape(-1, k)
-        if self.dense is not None:
-            out = np.vstack([out, self.dense.T @ X])
-        return out
-
-    def with_dense(self, E: np.ndarray) -> ReducedBasis:
-        """The basis with the dense columns E appended."""
-        D = E if self.dense is None else np.hstack([self.dense, E])
-        return ReducedBasis(self.scalar, self.components, D, self.info)
-
-
-def reduced_basis(
-    mesh: Mesh,
-    operator: str,
-    samples: int = DEFAULT_SAMPLES,
-    radius_factor: float = RADIUS_FACTOR,
-    enrich: int = 1,
-    seed: int = 0,
-    candidates: int | None = None,
-) -> ReducedBasis:
-    """The reduced space of ``operator`` (see :class:`ReducedBasis`).
-
-    For ``"shells"`` every scalar function times e_x, e_y, e_z, and the three rotations
-    as dense columns; for the scalar operators the scalar functions alone.
-    ``candidates``: see :func:`farthest_point_samples`.
-    """
-    centers = farthest_point_samples(mesh.vertices, samples, candidates=candidates, seed=seed)
-    P, r = partition_of_unity_basis(mesh, centers, radius_factor, enrich)
-    vector = operator == "shells"
-    info = {
-        "samples": int(len(centers)),
-        "support_radius": r,
-        "enriched": bool(enrich),
-        "polynomial_degree": int(min(max(enrich, 0), 2)),
-        "components_per_function": 3 if vector else 1,
-    }
-    if vector:
-        return ReducedBasis(P, 3, rotation_fields(mesh), info)
-    return ReducedBasis(P, 1, None, info)
-
-
-def scalar_functions_per_sample(degree: int) -> int:
-    """Scalar basis functions per sample: the partition-of-unity function times 1 (degree
-    0), times 1, u, v (degree 1) or times 1, u, v, u^2, uv, v^2 (degree 2)."""
-    return {0: 1, 1: 3}.get(int(degree), 6)
-
-
-def max_samples(n_vertices: int, degree: int) -> int:
-    """Most samples a mesh of ``n_vertices`` gets: at least 2 vertices per scalar function
-    (and 6 per sample); denser samples make the enriched functions linearly dependent on
-    the mesh without adding anything."""
-    return n_vertices // (2 * max(scalar_functions_per_sample(degree), 3))
 
 
 @dataclass(frozen=True)
@@ -526,15 +291,6 @@ def _solve_reduced(
         X = solve(MX)
 
 
-ROW_BLOCK = 3 * 2730
-"""Rows per block in the passes over (N, k) arrays: a multiple of 3
-(whole vertices of the shells' 3 x 3 blocks), an (8190, 100) block is 6.5 MB."""
-
-
-def _row_blocks(N: int):
-    return (slice(start, min(start + ROW_BLOCK, N)) for start in range(0, N, ROW_BLOCK))
-
-
 def _jacobi_blocks(K: sp.csr_matrix, block: int):
     """Inverse of the diagonal ``block`` x ``block`` blocks of K, as a function of
     (rows of R, rows) for a slice of whole blocks."""
@@ -581,7 +337,7 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
     N, c = U.shape
     W = np.empty_like(U)
     norms = np.zeros(c)
-    for rows in _row_blocks(N):
+    for rows in row_blocks(N):
         R = KU[rows] - (mass[rows, None] * U[rows]) * lam[None, :]
         W[rows] = precondition(R, rows)
         norms += np.einsum("ij,ij->j", W[rows], mass[rows, None] * W[rows])
@@ -592,7 +348,7 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
     W /= norms[live][None, :]
     KW = threaded_product(K, W, out=KU[:, : W.shape[1]] if live.all() else None)
     MW = U if live.all() else np.empty_like(W)
-    for rows in _row_blocks(N):
+    for rows in row_blocks(N):
         np.multiply(mass[rows, None], W[rows], out=MW[rows])
     H_pw = basis.restrict(KW)
     G_pw = basis.restrict(MW)
@@ -604,7 +360,7 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
     new_lam, C = _dense_lowest(H, G, c)
     dim = Kr.shape[0]
     X = basis.prolong(C[:dim], out=U)
-    for rows in _row_blocks(N):
+    for rows in row_blocks(N):
         X[rows] += W[rows] @ C[dim:]
     del W
     KX = threaded_product(K, X, out=KU)
@@ -618,7 +374,7 @@ def _residuals(K_U, mass, lam, U, lam_scale):
     # in blocks of rows: (N, k) temporaries would cost more (fresh pages) than the sums
     res2 = np.zeros(len(lam))
     mu2 = np.zeros(len(lam))
-    for rows in _row_blocks(U.shape[0]):
+    for rows in row_blocks(U.shape[0]):
         MU = mass[rows, None] * U[rows]
         R = K_U[rows] - MU * lam[None, :]
         res2 += np.einsum("ij,ij->j", R, R)

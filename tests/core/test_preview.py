@@ -6,6 +6,7 @@ import scipy.linalg as la
 
 import modalviewer as mv
 from modalviewer.core import preview as pv
+from modalviewer.core import reduced_space as rs
 from modalviewer.core.demo_shapes import bumpy_plate
 from modalviewer.core.pipeline import operator_matrices
 from modalviewer.core.primitives import torus
@@ -58,7 +59,7 @@ def test_preview_eigenvalues_are_upper_bounds(plate, operator):
 
 def test_rigid_motions_are_exact_zero_modes_of_the_reduced_shells_problem(ring):
     K, mass = operator_matrices(ring, "shells")
-    basis = pv.reduced_basis(ring, "shells", samples=60)
+    basis = rs.reduced_basis(ring, "shells", samples=60)
     D = basis.dense
     assert D.shape == (3 * ring.n_vertices, 3)
     B = np.hstack([basis.sparse_matrix().toarray(), D])
@@ -174,7 +175,7 @@ def test_bad_accuracy_is_refused(plate):
 
 def test_farthest_point_samples_are_spread():
     pts = np.random.default_rng(1).random((4000, 3))
-    idx = pv.farthest_point_samples(pts, 50)
+    idx = rs.farthest_point_samples(pts, 50)
     assert len(set(idx.tolist())) == 50
     chosen = pts[idx]
     d = np.linalg.norm(chosen[:, None] - chosen[None], axis=2)
@@ -247,7 +248,7 @@ def test_the_two_level_step_improves_on_the_galerkin_modes_and_their_corrections
     lam, U, _, info = pv.preview_spectrum(mesh, "shells", K, mass, k, samples=30)
     # span [U, W] by hand
     galerkin = np.array(info["galerkin_eigenvalues"])
-    basis = pv.reduced_basis(mesh, "shells", 30, pv.SPACE_SETTINGS["shells"].radius_factor, 2,
+    basis = rs.reduced_basis(mesh, "shells", 30, pv.SPACE_SETTINGS["shells"].radius_factor, 2,
                              candidates=mesh.n_vertices)  # fmt: skip
     Kr, Mr = pv._project(K, basis).toarray(), pv._project_mass(mass, basis).toarray()
     g, Y = la.eigh(Kr, Mr, subset_by_index=[0, k - 1])
@@ -277,7 +278,7 @@ def test_the_two_level_step_drops_the_residuals_of_converged_pairs(plate, monkey
     k = 12
     K, mass = operator_matrices(plate, "shells")
     exact = _exact(plate, "shells", k)
-    basis = pv.reduced_basis(plate, "shells", 40, 1.8, 2, candidates=plate.n_vertices)
+    basis = rs.reduced_basis(plate, "shells", 40, 1.8, 2, candidates=plate.n_vertices)
     Kr, Mr = pv._project(K, basis), pv._project_mass(mass, basis)
     lam, Y = la.eigh(Kr.toarray(), Mr.toarray(), subset_by_index=[0, k - 1])
     U = basis.prolong(Y)
