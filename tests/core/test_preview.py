@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 import scipy.linalg as la
+import scipy.sparse as sp
 
 import modalviewer as mv
 from modalviewer.core import preview as pv
@@ -149,6 +150,36 @@ def test_prolonged_modes_are_mass_orthonormal(plate):
             lam[nz] * np.linalg.norm(mass[:, None] * U[:, nz], axis=0)
         )
         np.testing.assert_allclose(spec.residuals[nz], rho, rtol=1e-8)
+
+
+@pytest.mark.parametrize("operator", ["laplacian", "shells", "shells_normal"])
+@pytest.mark.parametrize("mesh_name", ["plate", "ring"])
+def test_estimated_errors_follow_the_measured_errors(request, mesh_name, operator):
+    mesh = request.getfixturevalue(mesh_name)
+    k = 20
+    exact = _exact(mesh, operator, k)
+    spec = mv.compute_spectrum(mesh, operator, k=k, accuracy="preview")
+    nonzero = exact > 1e-8 * exact.max()
+    measured = (spec.eigenvalues[nonzero] - exact[nonzero]) / exact[nonzero]
+    estimated = np.array(spec.parameters["preview"]["estimated_errors"])
+    assert np.all(estimated[~nonzero] == 0.0)
+    estimated = estimated[nonzero]
+    # measured here: largest estimate 0.85 to 0.99 times the largest error, per mode
+    # 0.85 to 0.99 in the median
+    assert 0.6 < estimated.max() / measured.max() < 1.3
+    assert 0.6 < np.median(estimated / measured) < 1.3
+
+
+def test_cg_energies_grow_to_the_inverse_quadratic_form(plate):
+    K, mass = operator_matrices(plate, "laplacian")
+    A = (K + 1e-2 * np.median(K.diagonal() / mass) * sp.diags(mass)).tocsr()
+    R = np.random.default_rng(3).standard_normal((A.shape[0], 4))
+    exact = np.einsum("ij,ij->j", R, la.solve(A.toarray(), R))
+    precondition = pv._jacobi_blocks(A, 1)
+    energies = [pv._cg_energies(A, R, precondition, m) for m in (1, 2, 4, 8, 16, 32, 200)]
+    assert np.all(np.diff(energies, axis=0) >= -1e-12 * exact)
+    assert np.all(energies[0] < 0.9 * exact)
+    np.testing.assert_allclose(energies[-1], exact, rtol=1e-8)
 
 
 def test_preview_flag_survives_save_and_load(plate, tmp_path):
