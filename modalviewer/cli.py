@@ -166,7 +166,8 @@ def _run(args) -> int:
             print(
                 f"preview in {spec.parameters['seconds_total']:.1f} s ({info['samples']} "
                 f"samples, {info['reduced_dimension']} reduced unknowns): eigenvalues are "
-                f"upper bounds, estimated relative error up to {spec.estimated_error:.1%}"
+                f"upper bounds, largest relative error estimated at {spec.estimated_error:.1%} "
+                "(estimated from below, not a bound)"
             )
         worst = float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
         print(

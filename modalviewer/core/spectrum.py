@@ -60,7 +60,8 @@ class Spectrum:
     @property
     def is_preview(self) -> bool:
         """True for a preview (``compute_spectrum(..., accuracy="preview")``): eigenvalues
-        are upper bounds with about ``estimated_error`` relative error, not exact ones."""
+        are upper bounds of the exact ones, with an estimated relative error
+        ``estimated_error`` (estimated from below)."""
         return bool(self.parameters.get("preview"))
 
     @property

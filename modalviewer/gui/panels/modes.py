@@ -133,7 +133,8 @@ class ModesPanel(QtWidgets.QWidget):
             )
             text += (
                 "\nPreview: eigenvalues above the exact ones, by an estimated "
-                f"{percent_text(spec.estimated_error)} (not a bound); {follows}"
+                f"{percent_text(spec.estimated_error)} (estimated from below, not a bound); "
+                f"{follows}"
             )
         self.eigen_label.setText(text)
         self.spectrum_plot.set_data(
