@@ -386,7 +386,7 @@ def _residual_norms(K_U, mass, lam, U, lam_scale, precondition):
     return np.sqrt(res2) / (scale * np.sqrt(mu2)), eta
 
 
-ESTIMATE_MODES = 16
+ESTIMATE_MODES = 8
 """Modes (evenly spread over the non-zero ones) whose errors are estimated by conjugate
 gradients in :func:`estimated_errors`; the others follow by the ratio measured there."""
 
@@ -401,22 +401,26 @@ def _cg_energies(K, R: np.ndarray, precondition, steps: int) -> np.ndarray:
     range of K; a column whose iteration breaks down keeps its last value)."""
     N = R.shape[0]
     whole = slice(0, N)
-    E = np.zeros_like(R)
+    # every (N, s) array is allocated once: fresh pages cost more than the arithmetic
+    R = np.ascontiguousarray(R)
+    E = np.zeros(R.shape)
     res = R.copy()
-    Z = precondition(res, whole)
-    P = Z.copy()
-    rz = np.einsum("ij,ij->j", res, Z)
+    P = np.ascontiguousarray(precondition(res, whole))
+    KP = np.empty(R.shape)
+    scratch = np.empty(R.shape)
+    rz = np.einsum("ij,ij->j", res, P)
     for _ in range(steps):
-        KP = threaded_product(K, P)
+        threaded_product(K, P, out=KP)
         pkp = np.einsum("ij,ij->j", P, KP)
         live = (pkp > 0) & (rz > 0)
         alpha = np.where(live, rz / np.where(live, pkp, 1.0), 0.0)
-        E += P * alpha
-        res -= KP * alpha
+        E += np.multiply(P, alpha, out=scratch)
+        res -= np.multiply(KP, alpha, out=scratch)
         Z = precondition(res, whole)
         rz_new = np.einsum("ij,ij->j", res, Z)
         beta = np.where(live, rz_new / np.where(rz > 0, rz, 1.0), 0.0)
-        P = Z + P * beta
+        P *= beta
+        P += Z
         rz = np.where(live, rz_new, 0.0)
     return np.einsum("ij,ij->j", R, E)
 
