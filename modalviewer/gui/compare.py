@@ -13,7 +13,7 @@ import numpy as np
 from qtpy import QtWidgets
 
 from ..core.files import atomic_write
-from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
+from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from .scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
@@ -61,6 +61,8 @@ class CompareWindow(QtWidgets.QWidget):
         self.mode_index = 0 if self.distances else self.state.first_nonzero_mode(first)
         for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event.connect(self._on_state)
+        # a spectrum replaced (the exact one after its preview) redraws the views
+        self.state.events.spectra.connect(self._on_spectra)
         self._keys = install_keys(
             self,
             [
@@ -80,6 +82,9 @@ class CompareWindow(QtWidgets.QWidget):
         """Esc and Ctrl+W close; Left / Right step the mode of operator views."""
         if not dispatch_key(self._keys, event):
             super().keyPressEvent(event)
+
+    def _on_spectra(self, _operator: str | None = None) -> None:
+        self._on_state()
 
     def _on_state(self) -> None:
         if self.distances:
@@ -109,7 +114,8 @@ class CompareWindow(QtWidgets.QWidget):
                 name=f"{_label(item)} mode {j}",
             )
             lam = "0 (zero mode)" if spec.zero_mode_mask()[j] else f"{spec.eigenvalues[j]:.5g}"
-            title.setText(f"{_label(item)}: mode {j}, lambda = {lam}")
+            mark = " (preview)" if spec.is_preview else ""
+            title.setText(f"{_label(item)}: mode {j}, lambda = {lam}{mark}")
         self.render_all()
 
     def show_distance(self) -> None:
@@ -127,16 +133,18 @@ class CompareWindow(QtWidgets.QWidget):
                 )
                 title.setText(f"{_label(item)}: {need}")
                 continue
+            spec = self.state.spectrum(operator_for_distance(item))
+            mark = " (preview)" if spec is not None and spec.is_preview else ""
             if display.distance_display == "threshold":
                 thr = display.threshold * float(d.max())
                 scene.show_threshold(d, thr, name=_label(item))
                 share = 100.0 * float(np.mean(d <= thr))
                 title.setText(
-                    f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({share:.1f} %)"
+                    f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({share:.1f} %)" + mark
                 )
             else:
                 scene.show_field(d, "sequential", name=_label(item))
-                title.setText(f"{_label(item)} from vertex {vertex}")
+                title.setText(f"{_label(item)} from vertex {vertex}{mark}")
         self.render_all()
 
     def refresh(self) -> None:
@@ -163,6 +171,7 @@ class CompareWindow(QtWidgets.QWidget):
     def closeEvent(self, event):  # noqa: N802
         for event_ in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event_.disconnect(self._on_state)
+        self.state.events.spectra.disconnect(self._on_spectra)
         for viewport in self.viewports:
             viewport.close_plotter()
         if self.main.compare is self:

@@ -347,9 +347,15 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def cancel_computation(self) -> None:
         """Cancel the running computation, and the exact spectrum waiting behind its
-        preview; other queued requests keep their turn."""
+        preview; other queued requests keep their turn (the status bar says how many, and
+        that Ctrl+Shift+Esc cancels them too)."""
+        if self.model.jobs.running is None:
+            self.statusBar().showMessage("No computation running.", 3000)
+            return
         self.model.cancel_running()
-        self.statusBar().showMessage("Cancelling...", 3000)
+        left = sum(1 for job in self.model.jobs.jobs if not job.done and not job.cancel_requested)
+        more = f"; {left} more queued (Ctrl+Shift+Esc cancels all)" if left else ""
+        self.statusBar().showMessage(f"Cancelling...{more}", 5000)
 
     def cancel_all(self) -> None:
         self.model.jobs.cancel_all()
@@ -366,7 +372,13 @@ class MainWindow(QtWidgets.QMainWindow):
             self.progress.setFormat(f"{stage} %p%{more}")
             self.progress.setToolTip(f"{running.description}: {running.stage}")
             if job is running and job.stage == "starting":
-                self.statusBar().showMessage(f"Computing {job.description}...")
+                key = getattr(job, "spectrum_key", None)
+                note = ""
+                if key is not None and getattr(job, "preview_job", False) is None:
+                    note = self.model.no_preview_note(key)
+                self.statusBar().showMessage(
+                    f"Computing {job.description}" + (f" ({note})..." if note else "...")
+                )
 
     def _on_job_finished(self, job: Job) -> None:
         result = job.result

@@ -161,7 +161,10 @@ class ViewerModel:
         job = self.jobs.submit(work, (state.mesh.hash, key), key.describe(), state.mesh.hash)
         job.spectrum_key = key
         job.preview_job = preview
-        if preview is not None:
+        behind_preview = state.spectra.get(key)
+        if preview is not None or (behind_preview is not None and behind_preview.is_preview):
+            # the exact spectrum is on its way behind a preview (this one's, or one kept
+            # from an earlier request whose exact computation was cancelled)
             state.set_exact_pending(key, True)
             owner = state.mesh.hash
 
@@ -203,6 +206,24 @@ class ViewerModel:
             return False
         mesh = state.compute_mesh(key)
         return not self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
+
+    def no_preview_note(self, key: SpectrumKey) -> str:
+        """Why a big request with "Preview first" on gets no preview ("" where it gets one,
+        or where none was asked for or the mesh is small)."""
+        state = self.state
+        info = operator_info(key.operator)
+        if not state.compute_settings.preview:
+            return ""
+        if info.unknowns(state.mesh.n_vertices) < PREVIEW_MIN_UNKNOWNS:
+            return ""
+        if key.coarse:
+            return "no preview with Coarse-to-fine, itself an approximation"
+        if info.unknowns_per_vertex != 1:
+            return (
+                "no preview for the 3D shells: close on nearly flat meshes, but far off on "
+                "curved ones"
+            )
+        return ""
 
     def _shower(self, key: SpectrumKey, before):
         """A job callback showing ``key``'s first non-zero mode if the display has not

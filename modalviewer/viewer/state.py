@@ -269,7 +269,11 @@ class ViewerState:
 
     # ---------------------------------------------------------- spectra
     def add_spectrum(self, key: SpectrumKey, spec: Spectrum, table=None) -> None:
-        """Store a computed spectrum (and its signature table, if already built)."""
+        """Store a computed spectrum (and its signature table, if already built).
+
+        It becomes the spectrum shown for its operator; the operator's spectra of other
+        keys (another k, other weights) are dropped: nothing shows them any more, and at
+        130k vertices each holds 100 to 300 MB (exact ones come back from the cache)."""
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
             raise ValueError("the spectrum does not belong to the loaded mesh")
         if spec.is_preview and self.has_spectrum(key):
@@ -277,6 +281,8 @@ class ViewerState:
         shown = self.spectra.get(key)
         if shown is not None and shown.is_preview and not spec.is_preview:
             _take_signs(spec, shown)
+        for other in [k for k in self.spectra if k.operator == key.operator and k != key]:
+            del self.spectra[other]
         self.spectra[key] = spec
         self._latest[key.operator] = key
         if self.display.kind == "mode" and self.display.operator == key.operator:
@@ -472,6 +478,22 @@ class ViewerState:
             return operator_for_distance(d.distance_kind)
         return None
 
+    def shows_preview(self) -> bool:
+        """True if the display is made of a preview spectrum (every title and legend of
+        the picture then says "preview")."""
+        spec = self.spectrum(self.display_operator())
+        return spec is not None and spec.is_preview
+
+    def preview_note(self, operator: str | None) -> str:
+        """ " (preview spectrum; the exact one follows)", " (preview spectrum)" or "" for
+        the spectrum shown for ``operator``."""
+        spec = self.spectrum(operator)
+        if spec is None or not spec.is_preview:
+            return ""
+        if self.exact_follows(operator):
+            return " (preview spectrum; the exact one follows)"
+        return " (preview spectrum)"
+
     # ---------------------------------------------------- derived values
     def has_signatures(self, operator: str) -> bool:
         """Whether ``operator``'s spectrum exists and has non-zero modes (signatures
@@ -547,6 +569,7 @@ class ViewerState:
         d = self.display
         n = self.mesh.n_vertices
         plain = Field(np.zeros(n), "plain")
+        mark = " (preview)" if self.shows_preview() else ""
         if d.kind == "mode":
             spec = self.spectrum(d.operator)
             if spec is None:
@@ -559,7 +582,7 @@ class ViewerState:
                 "sequential" if magnitude else "diverging",
                 isolines=self.style.isolines,
                 displacement=disp,
-                title=f"{operator_info(d.operator).short_label} mode {j}",
+                title=f"{operator_info(d.operator).short_label} mode {j}{mark}",
                 legend=self.legend(),
             )
         if d.kind == "distance":
@@ -573,11 +596,11 @@ class ViewerState:
                     dist,
                     "threshold",
                     threshold=thr,
-                    title=f"{name} < {thr:.3g}",
+                    title=f"{name} < {thr:.3g}{mark}",
                     legend=self.legend(),
                     share_similar=float(np.mean(dist <= thr)),
                 )
-            return Field(dist, "sequential", title=name, legend=self.legend())
+            return Field(dist, "sequential", title=name + mark, legend=self.legend())
         if d.kind == "signature":
             operator = operator_for_distance(d.distance_kind)
             spec = self.spectrum(operator)
@@ -589,7 +612,7 @@ class ViewerState:
                 values[:, 0],
                 "sequential",
                 isolines=self.style.isolines,
-                title=f"signature t = {t:.3g}",
+                title=f"signature t = {t:.3g}{mark}",
                 legend=self.legend(),
             )
         if d.kind == "curvature":
@@ -638,8 +661,7 @@ class ViewerState:
             if dist is None:
                 return f"{name}: {self._missing_distance_reason(d.distance_kind)}"
             source = f"from vertex {self.picked}"
-            if self.spectrum(operator_for_distance(d.distance_kind)).is_preview:
-                source += " (preview spectrum; the exact one follows)"
+            source += self.preview_note(operator_for_distance(d.distance_kind))
             if d.distance_display == "threshold":
                 thr = self.threshold_value(dist)
                 share = 100.0 * float(np.mean(dist <= thr))

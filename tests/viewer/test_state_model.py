@@ -267,21 +267,72 @@ def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monk
     assert state.spectrum("laplacian").is_preview  # the preview stays on screen
     assert state.exact_follows("laplacian") is False
     assert seen.count("laplacian") >= 3  # pending, preview, no longer pending
-    # a finished exact spectrum ends the pending state too
+    # the map's legend says the same as the Modes panel (it promised the exact one)
+    state.set_pick(300)
+    state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
+    assert "(preview spectrum)" in state.legend()
+    assert "follows" not in state.legend()
+    # asked again (Ctrl+R), the exact spectrum follows the preview on screen again
     again = model.request_spectrum("laplacian", k=20)
+    assert again.preview_job is None and not again.done
+    assert state.exact_follows("laplacian") is True
+    assert "(preview spectrum; the exact one follows)" in state.legend()
+    # a finished exact spectrum ends the pending state too
     model.jobs.wait(again)
     assert not state.spectrum("laplacian").is_preview
     assert state.exact_follows("laplacian") is False
 
 
 def test_no_preview_for_the_3d_shells(model, monkeypatch):
-    """Their preview costs 0.23 to 0.41 of the exact time (benchmarks/preview.py)."""
+    """Their preview is far off on curved meshes (README "Preview spectra"); the status
+    line says why there is none, as for Coarse-to-fine."""
     from modalviewer.viewer import model as model_module
 
     monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
     job = model.request_spectrum("shells", k=12)
-    assert model.jobs.jobs == [job]
+    assert model.jobs.jobs == [job] and job.preview_job is None
+    assert "no preview for the 3D shells" in model.no_preview_note(job.spectrum_key)
     model.jobs.wait(job)
+    model.state.set_compute_settings(coarse=True)
+    coarse = model.request_spectrum("laplacian", k=12)
+    assert coarse.preview_job is None
+    assert "Coarse-to-fine" in model.no_preview_note(coarse.spectrum_key)
+    model.jobs.wait(coarse)
+    model.state.set_compute_settings(coarse=False)
+    lap = model.request_spectrum("laplacian", k=12)
+    assert model.no_preview_note(lap.spectrum_key) == ""
+    model.jobs.cancel_all()
+
+
+def test_a_preview_is_marked_in_every_title_of_the_picture(model, monkeypatch):
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    state = model.state
+    exact = model.request_spectrum("laplacian", k=20, show=True)
+    model.jobs.wait(exact.preview_job)
+    assert state.shows_preview()
+    assert state.field().title.endswith("(preview)")
+    state.set_pick(300)
+    for display in ("threshold", "continuous"):
+        state.set_display(kind="distance", distance_kind="hks", distance_display=display)
+        assert state.field().title.endswith("(preview)")
+    model.jobs.wait(exact)
+    assert not state.shows_preview() and "preview" not in state.field().title
+
+
+def test_a_new_spectrum_of_an_operator_replaces_its_other_keys(model):
+    """Every k used to stay in memory (3.0 GB after 18 requests at 130k) and in saved
+    sessions, with one of them shown."""
+    first = model.request_spectrum("laplacian", k=12)
+    model.jobs.wait(first)
+    shells = model.request_spectrum("shells", k=8)
+    model.jobs.wait(shells)
+    second = model.request_spectrum("laplacian", k=15)
+    model.jobs.wait(second)
+    keys = sorted((key.operator, key.k) for key in model.state.spectra)
+    assert keys == [("laplacian", 15), ("shells", 8)]
+    assert model.state.spectrum("laplacian").k == 15
 
 
 def test_percent_text_is_short_and_never_in_exponent_notation():

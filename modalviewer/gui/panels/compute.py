@@ -44,7 +44,8 @@ class ComputePanel(QtWidgets.QWidget):
             "Scalar operators above 30 000 vertices: show a preview spectrum (a Galerkin "
             "approximation on the same mesh, seconds) while the exact one is computed; the "
             "mode, pick and map on screen stay when the exact spectrum replaces it. Not "
-            "for the 3D shells, whose preview is neither fast nor close enough."
+            "for the 3D shells, whose preview is close on nearly flat meshes but far off on "
+            "curved ones, and not with Coarse-to-fine."
         )
         self.compute_button = QtWidgets.QPushButton("Compute spectrum")
         self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")

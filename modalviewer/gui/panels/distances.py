@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from qtpy import QtCore, QtGui, QtWidgets
 
-from ...core.operators import DISTANCE_KINDS, operator_for_distance
+from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ...core.signatures import signature
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
@@ -191,5 +191,8 @@ class DistancesPanel(QtWidgets.QWidget):
             values[0],
             logx=True,
             markers=False,
-            title=f"Signature of vertex {state.picked} ({operator})",
+            title=(
+                f"Signature of vertex {state.picked} ({OPERATOR_INFO[operator].short_label}"
+                f"{', preview' if spec.is_preview else ''})"
+            ),
         )

@@ -97,7 +97,9 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
             self.spectrum_combo.clear()
             for name in computed:
-                self.spectrum_combo.addItem(OPERATOR_INFO[name].label, name)
+                shown = state.spectrum(name)
+                mark = " (preview)" if shown is not None and shown.is_preview else ""
+                self.spectrum_combo.addItem(OPERATOR_INFO[name].label + mark, name)
             if op is not None:
                 select_data(self.spectrum_combo, op)
             spec = state.spectrum(op)
