@@ -30,6 +30,7 @@ from ..viewer.model import (
     cost_estimate,
     worst_residual,
 )
+from ..viewer.state import percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
 from .dialogs import ask
@@ -372,13 +373,24 @@ class MainWindow(QtWidgets.QMainWindow):
             self.progress.setFormat(f"{stage} %p%{more}")
             self.progress.setToolTip(f"{running.description}: {running.stage}")
             if job is running and job.stage == "starting":
-                key = getattr(job, "spectrum_key", None)
-                note = ""
-                if key is not None and getattr(job, "preview_job", False) is None:
-                    note = self.model.no_preview_note(key)
-                self.statusBar().showMessage(
-                    f"Computing {job.description}" + (f" ({note})..." if note else "...")
-                )
+                self.statusBar().showMessage(self._starting_message(job))
+
+    def _starting_message(self, job: Job) -> str:
+        """ "Computing ...", after the preview shown before it (with its estimated error)
+        or with the reason a big request gets no preview."""
+        key = getattr(job, "spectrum_key", None)
+        preview = getattr(job, "preview_job", False)
+        if key is not None and preview is None:
+            note = self.model.no_preview_note(key)
+            if note:
+                return f"Computing {job.description} ({note})..."
+        if preview and preview.status == DONE:
+            spec = preview.result[0]
+            return (
+                f"Preview shown (estimated eigenvalue error {percent_text(spec.estimated_error)}"
+                f"); computing the exact spectrum, {job.description}..."
+            )
+        return f"Computing {job.description}..."
 
     def _on_job_finished(self, job: Job) -> None:
         result = job.result
@@ -388,10 +400,13 @@ class MainWindow(QtWidgets.QMainWindow):
             self.statusBar().showMessage(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
         elif job.status == DONE:
             spec = result[0]
+            quality = (
+                f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
+                if spec.is_preview
+                else f"largest relative residual {worst_residual(spec):.1e}"
+            )
             self.statusBar().showMessage(
-                f"{job.description} in {job.seconds:.1f} s; largest relative residual "
-                f"{worst_residual(spec):.1e}.",
-                15000,
+                f"{job.description} in {job.seconds:.1f} s; {quality}.", 15000
             )
         elif job.status == "failed":
             log.error("computation failed: %s\n%s", job.error, job.details)

@@ -297,10 +297,13 @@ def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
     window.pick_vertex(800)
     preview = window.running_job
     window.wait_for(preview)
+    # a preview's quality is its estimated error, not its (mesh-scale) residuals
+    assert "estimated eigenvalue error" in window.statusBar().currentMessage()
     exact = window.running_job
     panel = window.modes_panel
     assert "replaces it when ready" in panel.eigen_label.text()
     assert "not a bound" in panel.eigen_label.text()
+    assert window.modes_panel.spectrum_combo.currentText().endswith("(preview)")
     window.cancel_computation()
     window.wait_for(exact)
     assert exact.status == "cancelled"
@@ -308,6 +311,9 @@ def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
     assert "replaces it when ready" not in panel.eigen_label.text()
     assert "Ctrl+R" in panel.eigen_label.text()
     assert window.distances_panel.signature_plot.title.startswith("Signature of vertex 800")
+    assert window.distances_panel.signature_plot.title.endswith("preview)")
+    window.cancel_computation()  # nothing runs any more
+    assert window.statusBar().currentMessage() == "No computation running."
     window.open_mesh(spot_path)
     assert panel.spectrum_plot.title == "Spectrum"
     assert window.distances_panel.signature_plot.title == "Signature of the picked vertex"
