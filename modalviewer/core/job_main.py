@@ -39,9 +39,10 @@ def main(argv: list[str] | None = None) -> int:
             int(params["k"]),
             float(params["bending"]),
             float(params["membrane"]),
-            progress=lambda stage, fraction: _emit({"stage": stage, "fraction": fraction}),
+            progress=_report,
             accuracy=params.get("accuracy", "exact"),
         )
+        _emit({"stage": "writing the result", "fraction": 0.97})
         save_spectrum(spec, out_path)
     except MemoryError:
         _emit({"error": "not enough memory for this computation; try fewer modes"})
@@ -51,6 +52,14 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     _emit({"done": out_path})
     return 0
+
+
+def _report(stage: str, fraction: float) -> None:
+    """Progress to the viewer; the computation's own "done" is not the end of the job
+    (the spectrum is still written, read back and prepared), so it stops below 1."""
+    if stage == "done":
+        return
+    _emit({"stage": stage, "fraction": min(float(fraction), 0.96)})
 
 
 if __name__ == "__main__":

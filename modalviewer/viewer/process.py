@@ -106,6 +106,7 @@ def compute_in_process(
         )
     finally:
         Path(job_path).unlink(missing_ok=True)
+    progress("reading the result", 0.98)
     return load_spectrum(out_path, mesh_hash=mesh.hash)
 
 

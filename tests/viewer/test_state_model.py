@@ -342,3 +342,21 @@ def test_percent_text_is_short_and_never_in_exponent_notation():
     assert percent_text(0.0217) == "2.2\u00a0%"
     assert percent_text(0.26) == "26\u00a0%"
     assert percent_text(1.354) == "135\u00a0%"
+
+
+def test_a_child_computation_reports_its_hand_over_below_one(tmp_path):
+    """The progress bar read "done 100 %" for 1-2 s at 130k while the spectrum was
+    still written, read back and prepared."""
+    from modalviewer.viewer.process import compute_in_process
+
+    mesh = icosphere(2)
+    stages = []
+    spec = compute_in_process(
+        mesh, "laplacian", 10, 1.0, 1.0, tmp_path / "out.npz",
+        lambda stage, fraction: stages.append((stage, fraction)), lambda: False,
+    )  # fmt: skip
+    assert spec.k == 10
+    names = [s for s, _ in stages]
+    assert "done" not in names
+    assert names[-2:] == ["writing the result", "reading the result"]
+    assert all(f < 1.0 for _, f in stages)
