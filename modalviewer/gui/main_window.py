@@ -87,6 +87,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.last_error: str | None = None
         self.compare: CompareWindow | None = None
         self._waits: list[QtCore.QEventLoop] = []
+        self._cancel_note = ""  # what Esc cancelled, said again when the next job starts
 
         self.viewport = make_viewport(self, force_offscreen)
         self.plotter = self.viewport.plotter
@@ -349,14 +350,23 @@ class MainWindow(QtWidgets.QMainWindow):
     def cancel_computation(self) -> None:
         """Cancel the running computation, and the exact spectrum waiting behind its
         preview; other queued requests keep their turn (the status bar says how many, and
-        that Ctrl+Shift+Esc cancels them too)."""
+        that Ctrl+Shift+Esc cancels them too, also when the next one starts)."""
         if self.model.jobs.running is None:
             self.statusBar().showMessage("No computation running.", 3000)
             return
         self.model.cancel_running()
-        left = sum(1 for job in self.model.jobs.jobs if not job.done and not job.cancel_requested)
-        more = f"; {left} more queued (Ctrl+Shift+Esc cancels all)" if left else ""
-        self.statusBar().showMessage(f"Cancelling...{more}", 5000)
+        left = {
+            getattr(job, "spectrum_key", None) or job.key
+            for job in self.model.jobs.jobs
+            if not job.done and not job.cancel_requested
+        }
+        plural = "s" if len(left) > 1 else ""
+        self._cancel_note = (
+            f"Cancelled; {len(left)} more request{plural} queued (Ctrl+Shift+Esc cancels all)"
+            if left
+            else ""
+        )
+        self.statusBar().showMessage(self._cancel_note or "Cancelling...", 5000)
 
     def cancel_all(self) -> None:
         self.model.jobs.cancel_all()
@@ -377,20 +387,20 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _starting_message(self, job: Job) -> str:
         """ "Computing ...", after the preview shown before it (with its estimated error)
-        or with the reason a big request gets no preview."""
+        or with the reason a big request gets no preview; after an Esc that left other
+        requests queued, first what it cancelled."""
         key = getattr(job, "spectrum_key", None)
         preview = getattr(job, "preview_job", False)
+        text = f"Computing {job.description}..."
         if key is not None and preview is None:
             note = self.model.no_preview_note(key)
             if note:
-                return f"Computing {job.description} ({note})..."
-        if preview and preview.status == DONE:
-            spec = preview.result[0]
-            return (
-                f"Preview shown (estimated eigenvalue error {percent_text(spec.estimated_error)}"
-                f"); computing the exact spectrum, {job.description}..."
-            )
-        return f"Computing {job.description}..."
+                text = f"Computing {job.description}; {note}."
+        elif preview and preview.status == DONE:
+            error = percent_text(preview.result[0].estimated_error)
+            text = f"Preview shown (estimated error {error}); computing the exact spectrum..."
+        note, self._cancel_note = self._cancel_note, ""
+        return f"{note}. {text}" if note else text
 
     def _on_job_finished(self, job: Job) -> None:
         result = job.result

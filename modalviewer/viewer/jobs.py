@@ -136,12 +136,18 @@ class JobQueue:
         self.jobs: list[Job] = []  # queued and running, in order
 
     # -------------------------------------------------------------- public
-    def submit(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None) -> Job:
-        """Queue ``fn``; an identical queued or running request is returned instead."""
+    def submit(
+        self, fn: Callable, key: Hashable, description: str, owner: Hashable = None, **attributes
+    ) -> Job:
+        """Queue ``fn``; an identical queued or running request is returned instead.
+        ``attributes`` are set on a new job before it can start (its observers see them
+        from its first event on)."""
         for job in self.jobs:
             if job.key == key and not job.cancel_requested:
                 return job
         job = Job(fn, key, description, owner)
+        for name, value in attributes.items():
+            setattr(job, name, value)
         self.jobs.append(job)
         self.events.changed.emit(job)
         self._start_next()

@@ -151,18 +151,24 @@ class ViewerModel:
                 (state.mesh.hash, key, "preview"),
                 f"preview of {key.describe()}",
                 state.mesh.hash,
+                spectrum_key=key,
             )
-            preview.spectrum_key = key
             if show:
                 preview.then(self._shower(key, display_at_request))
         else:
             preview = None
         work = self._work(key)
-        job = self.jobs.submit(work, (state.mesh.hash, key), key.describe(), state.mesh.hash)
-        job.spectrum_key = key
-        job.preview_job = preview
+        job = self.jobs.submit(
+            work,
+            (state.mesh.hash, key),
+            key.describe(),
+            state.mesh.hash,
+            spectrum_key=key,
+            preview_job=preview,
+        )
         behind_preview = state.spectra.get(key)
-        if preview is not None or (behind_preview is not None and behind_preview.is_preview):
+        shown_preview = behind_preview is not None and behind_preview.is_preview
+        if preview is not None or shown_preview:
             # the exact spectrum is on its way behind a preview (this one's, or one kept
             # from an earlier request whose exact computation was cancelled)
             state.set_exact_pending(key, True)
@@ -173,7 +179,9 @@ class ViewerModel:
                     self.state.set_exact_pending(key, False)
 
             job.then(exact_ended)
-        if show:
+        if show and not shown_preview:
+            # behind a preview already on screen the exact spectrum replaces it in place
+            # (mode, pick and map stay), as after a preview of this request
             job.then(self._shower(key, display_at_request))
         return job
 
@@ -217,12 +225,9 @@ class ViewerModel:
         if info.unknowns(state.mesh.n_vertices) < PREVIEW_MIN_UNKNOWNS:
             return ""
         if key.coarse:
-            return "no preview with Coarse-to-fine, itself an approximation"
+            return "no preview with Coarse-to-fine (itself an approximation)"
         if info.unknowns_per_vertex != 1:
-            return (
-                "no preview for the 3D shells: close on nearly flat meshes, but far off on "
-                "curved ones"
-            )
+            return "no preview for the 3D shells (far off on curved meshes)"
         return ""
 
     def _shower(self, key: SpectrumKey, before):

@@ -308,6 +308,8 @@ class ViewerState:
         else:
             self.exact_pending.discard(key)
         self.events.spectra.emit(key.operator)
+        if self.display_operator() == key.operator:
+            self.events.display.emit()  # the picture's legend says whether it follows
 
     def exact_follows(self, operator: str | None) -> bool:
         """True if the spectrum shown for ``operator`` is a preview whose exact spectrum

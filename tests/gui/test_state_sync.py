@@ -298,7 +298,7 @@ def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
     preview = window.running_job
     window.wait_for(preview)
     # a preview's quality is its estimated error, not its (mesh-scale) residuals
-    assert "estimated eigenvalue error" in window.statusBar().currentMessage()
+    assert "Preview shown (estimated error" in window.statusBar().currentMessage()
     exact = window.running_job
     panel = window.modes_panel
     assert "replaces it when ready" in panel.eigen_label.text()
@@ -442,3 +442,25 @@ def test_a_combo_box_names_its_whole_item_in_its_tooltip(window):
     assert box.toolTip() == box.itemText(index) == "Discrete Shells, normal variations"
     colours = window.modes_panel.color_combo  # a box with a purpose keeps it below
     assert colours.toolTip() == colours.currentText() + "\nScalar shown for 3D vibration modes"
+
+
+def test_esc_says_what_stays_queued_also_once_the_next_job_starts(window, spot_path):
+    """Found under Xvfb: "Cancelling...; 2 more queued" was replaced within 0.15 s by the
+    next job's "Computing ...", and counted a preview and its exact job as two."""
+    window.open_mesh(spot_path)
+    messages = []
+    window.statusBar().messageChanged.connect(messages.append)
+    first = window.model.request_spectrum("shells", k=30)
+    window.model.request_spectrum("laplacian", k=15)
+    last = window.model.request_spectrum("modified_dirichlet", k=15)
+    assert window.running_job is first
+    window.cancel_computation()
+    assert window.statusBar().currentMessage() == (
+        "Cancelled; 2 more requests queued (Ctrl+Shift+Esc cancels all)"
+    )
+    window.wait_for(first)
+    window.wait_for(last)
+    assert first.status == "cancelled" and last.status == "done"
+    # the next job's start keeps the note in front of its own message, once
+    noted = [m for m in messages if m.startswith("Cancelled; 2 more requests queued")]
+    assert [m.split(". ", 1)[1] for m in noted[1:]] == ["Computing Laplacian (cotan), 15 modes..."]

@@ -272,13 +272,19 @@ def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monk
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
     assert "(preview spectrum)" in state.legend()
     assert "follows" not in state.legend()
-    # asked again (Ctrl+R), the exact spectrum follows the preview on screen again
-    again = model.request_spectrum("laplacian", k=20)
+    # asked again (Ctrl+R), the exact spectrum follows the preview on screen again; the
+    # picture's legend is redrawn (a display event), and the map stays when it arrives
+    redraws = []
+    state.events.display.connect(lambda: redraws.append(1))
+    again = model.request_spectrum("laplacian", k=20, show=True)
     assert again.preview_job is None and not again.done
     assert state.exact_follows("laplacian") is True
     assert "(preview spectrum; the exact one follows)" in state.legend()
+    assert redraws
     # a finished exact spectrum ends the pending state too
     model.jobs.wait(again)
+    assert state.display.kind == "distance" and state.display.distance_display == "threshold"
+    assert "follows" not in state.legend() and "preview" not in state.legend()
     assert not state.spectrum("laplacian").is_preview
     assert state.exact_follows("laplacian") is False
 
@@ -294,8 +300,12 @@ def test_no_preview_for_the_3d_shells(model, monkeypatch):
     assert "no preview for the 3D shells" in model.no_preview_note(job.spectrum_key)
     model.jobs.wait(job)
     model.state.set_compute_settings(coarse=True)
+    seen = []  # what an observer of the first event sees (the status line's note)
+    model.jobs.events.changed.connect(
+        lambda j: seen.append(getattr(j, "preview_job", "unset")) if not seen else None
+    )
     coarse = model.request_spectrum("laplacian", k=12)
-    assert coarse.preview_job is None
+    assert coarse.preview_job is None and seen == [None]
     assert "Coarse-to-fine" in model.no_preview_note(coarse.spectrum_key)
     model.jobs.wait(coarse)
     model.state.set_compute_settings(coarse=False)
