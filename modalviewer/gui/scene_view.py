@@ -167,8 +167,7 @@ class SceneView(QtCore.QObject):
             from ..core.operators import DISTANCE_KINDS
 
             similar = f"{DISTANCE_KINDS[d.distance_kind].lower()} < {thr:.3g} ({share:.1f} %)"
-            if self.state.shows_preview():
-                similar += " (preview)"
+            similar += self.state.display_mark()
             scene.set_colorbar(field.title, labels=[similar, "the rest"])
         else:
             scene.set_colorbar(field.title, clim=field.clim)

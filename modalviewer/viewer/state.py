@@ -486,12 +486,29 @@ class ViewerState:
         spec = self.spectrum(self.display_operator())
         return spec is not None and spec.is_preview
 
+    def is_coarse(self, operator: str | None) -> bool:
+        """True if the spectrum shown for ``operator`` was computed coarse-to-fine (on a
+        decimated copy, carried to this mesh: approximate)."""
+        key = self._latest.get(operator) if operator else None
+        return key is not None and key.coarse and key in self.spectra
+
+    def display_mark(self) -> str:
+        """ " (preview)", " (coarse-to-fine)" or "": what the titles of the picture add
+        when its spectrum is an approximation."""
+        if self.shows_preview():
+            return " (preview)"
+        if self.is_coarse(self.display_operator()):
+            return " (coarse-to-fine)"
+        return ""
+
     def preview_note(self, operator: str | None) -> str:
         """ " (preview spectrum; the exact one follows)", " (preview spectrum)" or "" for
         the spectrum shown for ``operator``."""
         spec = self.spectrum(operator)
-        if spec is None or not spec.is_preview:
+        if spec is None:
             return ""
+        if not spec.is_preview:
+            return " (coarse-to-fine spectrum)" if self.is_coarse(operator) else ""
         if self.exact_follows(operator):
             return " (preview spectrum; the exact one follows)"
         return " (preview spectrum)"
@@ -571,7 +588,7 @@ class ViewerState:
         d = self.display
         n = self.mesh.n_vertices
         plain = Field(np.zeros(n), "plain")
-        mark = " (preview)" if self.shows_preview() else ""
+        mark = self.display_mark()
         if d.kind == "mode":
             spec = self.spectrum(d.operator)
             if spec is None:
@@ -651,6 +668,8 @@ class ViewerState:
             value = "0 (zero mode)" if zero else f"{lam:.4g}"
             if spec.is_preview:
                 value += f" (preview; estimated error {percent_text(spec.estimated_error)})"
+            elif self.is_coarse(d.operator):
+                value += " (coarse-to-fine: approximate)"
             colours = "blue +, white 0, orange -"
             if spec.is_vector and self.vector_coloring() == "magnitude":
                 colours = "white 0 to red: displacement magnitude"

@@ -370,3 +370,20 @@ def test_a_child_computation_reports_its_hand_over_below_one(tmp_path):
     assert "done" not in names
     assert names[-2:] == ["writing the result", "reading the result"]
     assert all(f < 1.0 for _, f in stages)
+
+
+def test_a_coarse_to_fine_spectrum_is_marked_as_approximate(model):
+    """Found under Xvfb: a coarse-to-fine result replaced the exact spectrum and was
+    listed and drawn as a plain Laplacian spectrum (lambda_1 9.388 against 9.377)."""
+    state = model.state
+    state.set_compute_settings(coarse=True)
+    job = model.request_spectrum("laplacian", k=12, show=True)
+    model.jobs.wait(job)
+    assert state.is_coarse("laplacian") and state.display_mark() == " (coarse-to-fine)"
+    assert state.field().title.endswith("(coarse-to-fine)")
+    assert "(coarse-to-fine: approximate)" in state.legend()
+    state.set_compute_settings(coarse=False)
+    exact = model.request_spectrum("laplacian", k=12, show=True)
+    model.jobs.wait(exact)
+    assert not state.is_coarse("laplacian") and state.display_mark() == ""
+    assert "coarse" not in state.legend()

@@ -99,6 +99,7 @@ class ModesPanel(QtWidgets.QWidget):
             for name in computed:
                 shown = state.spectrum(name)
                 mark = " (preview)" if shown is not None and shown.is_preview else ""
+                mark = mark or (" (coarse-to-fine)" if state.is_coarse(name) else "")
                 self.spectrum_combo.addItem(OPERATOR_INFO[name].label + mark, name)
             if op is not None:
                 select_data(self.spectrum_combo, op)
@@ -138,12 +139,21 @@ class ModesPanel(QtWidgets.QWidget):
                 f"{percent_text(spec.estimated_error)} (estimated from below, not a bound); "
                 f"{follows}"
             )
+        elif state.is_coarse(op):
+            text += (
+                "\nCoarse-to-fine: computed on a copy decimated to about a fifth and carried "
+                "to this mesh; eigenvalues and modes approximate (untick Coarse-to-fine and "
+                "Compute for the exact spectrum)."
+            )
         self.eigen_label.setText(text)
+        approximate = (
+            " (preview)" if spec.is_preview else " (coarse-to-fine)" if state.is_coarse(op) else ""
+        )
         self.spectrum_plot.set_data(
             np.arange(spec.k),
             np.where(zero, 0.0, spec.eigenvalues),
             state.display.mode if showing_mode else None,
-            title=f"Spectrum{' (preview)' if spec.is_preview else ''}: {OPERATOR_INFO[op].label}",
+            title=f"Spectrum{approximate}: {OPERATOR_INFO[op].label}",
         )
 
     def _update_style(self) -> None:
