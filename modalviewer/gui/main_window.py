@@ -169,6 +169,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cancel_button.hide()
         bar.addPermanentWidget(self.progress)
         bar.addPermanentWidget(self.cancel_button)
+        # the message shares the bar with the status line and may be cut: whole on hover
+        bar.messageChanged.connect(bar.setToolTip)
 
     # ============================================================ messages
     def show_error(self, message: str, title: str = "modalviewer") -> None:

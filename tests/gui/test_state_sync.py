@@ -458,6 +458,8 @@ def test_esc_says_what_stays_queued_also_once_the_next_job_starts(window, spot_p
     assert window.statusBar().currentMessage() == (
         "Cancelled; 2 more requests queued (Ctrl+Shift+Esc cancels all)"
     )
+    # a long message may be cut where the status line begins: whole in the tooltip
+    assert window.statusBar().toolTip() == window.statusBar().currentMessage()
     window.wait_for(first)
     window.wait_for(last)
     assert first.status == "cancelled" and last.status == "done"
