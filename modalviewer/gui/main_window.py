@@ -170,7 +170,7 @@ class MainWindow(QtWidgets.QMainWindow):
         bar.addPermanentWidget(self.progress)
         bar.addPermanentWidget(self.cancel_button)
         # the message shares the bar with the status line and may be cut: whole on hover
-        bar.messageChanged.connect(bar.setToolTip)
+        bar.messageChanged.connect(lambda text: bar.setToolTip(text))
 
     # ============================================================ messages
     def show_error(self, message: str, title: str = "modalviewer") -> None:
