@@ -398,23 +398,27 @@ def _cg_energies(K, R: np.ndarray, precondition, steps: int) -> np.ndarray:
     """``r^T e_m`` for every column r of R, with e_m the m-th iterate (m = ``steps``) of
     preconditioned conjugate gradients on ``K e = r`` from zero, one independent
     iteration per column.  It grows monotonically with m to ``r^T K^-1 r`` (for r in the
-    range of K; a column whose iteration breaks down keeps its last value)."""
+    range of K; a column whose iteration breaks down keeps its last value).
+
+    The iterates themselves are never formed: ``r^T p_k = r_k^T z_k`` (the search
+    directions are K-conjugate), so ``r^T e_m`` is the sum of ``alpha_k r_k^T z_k``
+    (the form Strakos and Tichy use for the energy norm of the error, stable in
+    floating point)."""
     N = R.shape[0]
     whole = slice(0, N)
     # every (N, s) array is allocated once: fresh pages cost more than the arithmetic
-    R = np.ascontiguousarray(R)
-    E = np.zeros(R.shape)
-    res = R.copy()
+    res = np.array(R, order="C")
     P = np.ascontiguousarray(precondition(res, whole))
     KP = np.empty(R.shape)
     scratch = np.empty(R.shape)
     rz = np.einsum("ij,ij->j", res, P)
+    energy = np.zeros(R.shape[1])
     for _ in range(steps):
         threaded_product(K, P, out=KP)
         pkp = np.einsum("ij,ij->j", P, KP)
         live = (pkp > 0) & (rz > 0)
         alpha = np.where(live, rz / np.where(live, pkp, 1.0), 0.0)
-        E += np.multiply(P, alpha, out=scratch)
+        energy += alpha * rz
         res -= np.multiply(KP, alpha, out=scratch)
         Z = precondition(res, whole)
         rz_new = np.einsum("ij,ij->j", res, Z)
@@ -422,7 +426,7 @@ def _cg_energies(K, R: np.ndarray, precondition, steps: int) -> np.ndarray:
         P *= beta
         P += Z
         rz = np.where(live, rz_new, 0.0)
-    return np.einsum("ij,ij->j", R, E)
+    return energy
 
 
 def estimated_errors(
