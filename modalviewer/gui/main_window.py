@@ -50,6 +50,10 @@ from .viewport import make_viewport
 
 log = logging.getLogger("modalviewer")
 
+LONG_WAIT_SECONDS = 30.0
+"""Requests expected to take longer (and showing nothing meanwhile) say so when they
+start."""
+
 
 MIN_VIEW_SIZE = (320, 240)
 """The smallest the 3D view gets, in pixels; the window's minimum width follows."""
@@ -313,14 +317,24 @@ class MainWindow(QtWidgets.QMainWindow):
         except ComputeRefused as exc:
             self.show_error(str(exc), "Computation too large")
             return None
-        seconds, _ = cost_estimate(job.spectrum_key, self.state.mesh.n_vertices)
-        if not job.done and seconds > 300:
-            self.statusBar().showMessage(
-                f"This will take about {seconds / 60:.0f} min (Esc cancels; Coarse-to-fine is "
-                "much faster).",
-                20000,
-            )
+        note = self._long_wait_note(job)
+        if note:
+            self.statusBar().showMessage(f"{job.description}: {note}.", 20000)
         return job
+
+    def _long_wait_note(self, job: Job) -> str:
+        """ "this will take about ..." for a request expected to take long with nothing on
+        screen meanwhile (a click on the surface starts one for the vibration distance);
+        "" otherwise (with a preview the wait is for its exact spectrum, behind a
+        picture)."""
+        if job.done or getattr(job, "preview_job", None) is not None:
+            return ""
+        seconds, _ = cost_estimate(job.spectrum_key, self.state.mesh.n_vertices)
+        if seconds <= LONG_WAIT_SECONDS:
+            return ""
+        about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+        faster = "" if job.spectrum_key.coarse else "; Coarse-to-fine is much faster"
+        return f"this will take about {about} (Esc cancels{faster})"
 
     def _run(self, job: Job | None, wait: bool, then=None):
         if job is None:
@@ -509,8 +523,10 @@ class MainWindow(QtWidgets.QMainWindow):
                 if preview is not None:  # the map from the preview first
                     preview.then(show_when_ready)
                 job.then(show_when_ready)
+                note = self._long_wait_note(job)
                 self.statusBar().showMessage(
-                    f"Computing the spectrum for the {DISTANCE_KINDS[kind].lower()}..."
+                    f"Computing the spectrum for the {DISTANCE_KINDS[kind].lower()}"
+                    + (f"; {note}." if note else "...")
                 )
             return None
         self.state.set_display(kind="distance")

@@ -466,3 +466,19 @@ def test_esc_says_what_stays_queued_also_once_the_next_job_starts(window, spot_p
     # the next job's start keeps the note in front of its own message, once
     noted = [m for m in messages if m.startswith("Cancelled; 2 more requests queued")]
     assert [m.split(". ", 1)[1] for m in noted[1:]] == ["Computing Laplacian (cotan), 15 modes..."]
+
+
+def test_a_click_that_starts_a_long_computation_says_how_long(window, spot_path, monkeypatch):
+    """Found under Xvfb: a click with the default vibration distance started a 3D
+    shells computation of 40 s or more at 130k vertices with only "Computing ..." on
+    screen (the long-wait note came from 5 min on and was overwritten)."""
+    from modalviewer.gui import main_window
+
+    monkeypatch.setattr(main_window, "LONG_WAIT_SECONDS", 0.0)
+    window.open_mesh(spot_path)
+    window.state.set_display(distance_kind="vibration")
+    window.pick_vertex(100)
+    message = window.statusBar().currentMessage()
+    assert message.startswith("Computing the spectrum for the vibration distance; ")
+    assert "this will take about" in message and "Esc cancels" in message
+    window.cancel_all()
