@@ -199,7 +199,7 @@ class ViewerModel:
     def _wants_preview(self, key: SpectrumKey) -> bool:
         """Preview first: asked for, a scalar operator, a big problem, no preview yet,
         not in the cache.  Not for the 3D Discrete Shells: their preview is accurate on
-        the nearly flat 130k plate (0.7 %, 0.20 of the exact time) but far off on curved
+        the nearly flat 130k plate (0.7 %, 0.18 of the exact time) but far off on curved
         or creased meshes (45 to 129 % on the spot, README "Preview spectra"), a picture
         that can mislead; the Laplacian's costs a fifth of the exact time at 130k with
         0.2 % eigenvalue error."""
