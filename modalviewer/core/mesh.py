@@ -233,6 +233,18 @@ class Mesh:
         return int(self.component_labels.max()) + 1
 
     @cached_property
+    def n_face_components(self) -> int:
+        """Number of parts whose faces are connected through shared edges: more than
+        :attr:`n_components` where parts meet only at vertices (a part meeting the rest
+        at a single vertex can rotate about it: three more zero modes of the shells)."""
+        F, E = self.n_faces, len(self.edges)
+        faces = np.repeat(np.arange(F), 3)
+        graph = sp.coo_matrix(
+            (np.ones(3 * F), (faces, F + self.face_edges.ravel())), shape=(F + E, F + E)
+        )
+        return int(connected_components(graph, directed=False)[0])
+
+    @cached_property
     def component_labels(self) -> np.ndarray:
         """(n,) connected-component label of each vertex."""
         e = self.edges

@@ -256,3 +256,30 @@ def test_residual_check_accepts_the_rounding_floor_and_rejects_garbage(monkeypat
     monkeypatch.setattr(pipeline, "solve_lowest", spoiled)
     with pytest.raises(EigenError, match="above the rounding floor"):
         mv.compute_spectrum(ellipsoid, "shells", k=30)
+
+
+def _spheres_sharing_a_vertex() -> mv.Mesh:
+    """Two icospheres touching at one vertex, which they share: one connected component
+    through edges, two parts through faces."""
+    a = icosphere(1)
+    p = a.vertices[0]
+    b = -a.vertices + 2.0 * p  # a point reflection through p: b's vertex 0 lands on p
+    keep = np.arange(1, len(b))
+    index = np.empty(len(b), dtype=np.int64)
+    index[0] = 0
+    index[keep] = len(a.vertices) + np.arange(len(keep))
+    vertices = np.vstack([a.vertices, b[keep]])
+    faces = np.vstack([a.faces, index[a.faces[:, ::-1]]])  # the reflection turns b inside out
+    return mv.Mesh(vertices, faces)
+
+
+def test_a_part_held_at_a_single_vertex_adds_three_zero_modes_to_the_shells():
+    """The panel counted only rigid motions per component (18 for a teapot whose
+    spectrum had 21 zero modes): a part meeting the rest at one vertex can rotate
+    about it."""
+    mesh = _spheres_sharing_a_vertex()
+    assert mesh.n_components == 1 and mesh.n_face_components == 2
+    assert icosphere(1).n_face_components == 1
+    K, mass = operator_matrices(mesh, "shells")
+    lam = la.eigh(K.toarray(), np.diag(mass), eigvals_only=True)
+    assert int(np.sum(lam < 1e-8 * lam.max())) == 6 + 3

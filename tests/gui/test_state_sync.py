@@ -482,3 +482,23 @@ def test_a_click_that_starts_a_long_computation_says_how_long(window, spot_path,
     assert message.startswith("Computing the spectrum for the vibration distance; ")
     assert "this will take about" in message and "Esc cancels" in message
     window.cancel_all()
+
+
+def test_the_compute_panel_names_parts_held_at_a_vertex(window, tmp_path, qtbot):
+    """A teapot whose handle meets the body at vertices had 21 zero shells modes where the
+    panel promised 18."""
+    from modalviewer.core.primitives import icosphere
+
+    a = icosphere(1)
+    b = -a.vertices + 2.0 * a.vertices[0]  # touches a at its vertex 0
+    index = np.concatenate([[0], len(a.vertices) + np.arange(len(b) - 1)])
+    vertices = np.vstack([a.vertices, b[1:]])
+    faces = np.vstack([a.faces, index[a.faces[:, ::-1]]])
+    path = tmp_path / "touching.obj"
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in vertices]
+    lines += [f"f {i + 1} {j + 1} {k + 1}" for i, j, k in faces]
+    path.write_text("\n".join(lines) + "\n")
+    window.open_mesh(path)
+    label = window.compute_panel.mesh_info
+    qtbot.waitUntil(lambda: "the rest only at vertices" in label.text(), timeout=2000)
+    assert "1 part meets" in label.text() and "three more zero modes" in label.text()

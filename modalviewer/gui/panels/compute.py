@@ -106,4 +106,12 @@ class ComputePanel(QtWidgets.QWidget):
                 f"component ({c} for the Laplacian, {6 * c} rigid motions for the shells). "
                 "Mesh > Keep the largest component, or compute more modes."
             )
+        if mesh is not None and mesh.n_face_components > mesh.n_components:
+            joined = mesh.n_face_components - mesh.n_components
+            text += (
+                f"\n{joined} {'parts meet' if joined > 1 else 'part meets'} the rest only at "
+                "vertices: "
+                "a part held at a single vertex can rotate about it (three more zero modes "
+                "for the shells)."
+            )
         self.mesh_info.setText(text)
