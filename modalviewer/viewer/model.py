@@ -128,7 +128,8 @@ class ViewerModel:
 
         Uses the current compute settings for what is not given.  If the spectrum is
         already in the state, the returned job has ended already.  ``show``: display
-        its first non-zero mode when it arrives, unless the display changed meanwhile.
+        its first non-zero mode when it arrives, unless the display changed meanwhile
+        (or, for a spectrum in the state, unless it is the one on screen).
         Raises ComputeRefused if the computation is too large for this machine.
         """
         state = self.state
@@ -139,7 +140,8 @@ class ViewerModel:
         if state.has_spectrum(key):
             job = Job.ended((state.spectra[key], None), key, key.describe(), state.mesh.hash)
             job.spectrum_key = key
-            if show:
+            if show and state.display_operator() != key.operator:
+                # asked again for the spectrum on screen: the mode or map stays
                 self._show_first_mode(key.operator)
             return job
         refusal = self.refusal(key)

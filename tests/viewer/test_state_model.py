@@ -387,3 +387,23 @@ def test_a_coarse_to_fine_spectrum_is_marked_as_approximate(model):
     model.jobs.wait(exact)
     assert not state.is_coarse("laplacian") and state.display_mark() == ""
     assert "coarse" not in state.legend()
+
+
+def test_asking_again_for_the_spectrum_on_screen_keeps_the_mode(model):
+    """Found under Xvfb: Ctrl+R on the Laplacian at mode 5 went back to mode 3 (its
+    first non-zero mode), Compute on E_D^N at mode 9 to mode 0."""
+    job = model.request_spectrum("laplacian", k=12, show=True)
+    model.jobs.wait(job)
+    model.state.show_mode(7)
+    again = model.request_spectrum("laplacian", k=12, show=True)
+    assert again.done and model.state.display.mode == 7
+    model.state.set_pick(100)
+    model.state.set_display(kind="distance", distance_kind="hks")
+    model.request_spectrum("laplacian", k=12, show=True)
+    assert model.state.display.kind == "distance"
+    # another operator's spectrum, asked for from the picture of this one, is shown
+    other = model.request_spectrum("modified_dirichlet", k=12, show=True)
+    model.jobs.wait(other)
+    model.state.show_mode(5, "laplacian")
+    model.request_spectrum("modified_dirichlet", k=12, show=True)
+    assert model.state.display.operator == "modified_dirichlet"
