@@ -168,6 +168,14 @@ class ViewerModel:
             spectrum_key=key,
             preview_job=preview,
         )
+        state.set_computing(key, True)
+        owner_hash = state.mesh.hash
+
+        def computing_ended(_j: Job) -> None:
+            if self.state.mesh is not None and self.state.mesh.hash == owner_hash:
+                self.state.set_computing(key, False)
+
+        job.then(computing_ended)
         behind_preview = state.spectra.get(key)
         shown_preview = behind_preview is not None and behind_preview.is_preview
         if preview is not None or shown_preview:

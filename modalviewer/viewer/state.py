@@ -223,6 +223,7 @@ class ViewerState:
         self.spectra: dict[SpectrumKey, Spectrum] = {}
         self._latest: dict[str, SpectrumKey] = {}
         self.exact_pending: set[SpectrumKey] = set()
+        self.computing: set[SpectrumKey] = set()  # spectra being computed or queued
         self.display = Display()
         self.picked: int | None = None
         self.t_range: tuple[float, float] | None = None
@@ -243,6 +244,7 @@ class ViewerState:
         self.spectra.clear()
         self._latest.clear()
         self.exact_pending.clear()
+        self.computing.clear()
         self._derived = _Derived()
         if mesh is not None:
             self._derived.normals = vertex_normals(mesh)
@@ -310,6 +312,17 @@ class ViewerState:
         self.events.spectra.emit(key.operator)
         if self.display_operator() == key.operator:
             self.events.display.emit()  # the picture's legend says whether it follows
+
+    def set_computing(self, key: SpectrumKey, computing: bool) -> None:
+        """Whether the spectrum of ``key`` is being computed or waits its turn (the status
+        line says so while no spectrum is on screen)."""
+        if computing == (key in self.computing):
+            return
+        if computing:
+            self.computing.add(key)
+        else:
+            self.computing.discard(key)
+        self.events.spectra.emit(key.operator)
 
     def exact_follows(self, operator: str | None) -> bool:
         """True if the spectrum shown for ``operator`` is a preview whose exact spectrum
@@ -722,6 +735,11 @@ class ViewerState:
         text = self.legend().replace("\n", "; ")
         if not text:
             text = f"{self.mesh.n_vertices} vertices, {self.mesh.n_faces} faces"
-            if not self.spectra:
+            if self.computing and not self.spectra:
+                names = sorted({operator_info(key.operator).label for key in self.computing})
+                text += f"; computing {', '.join(names)} (Esc cancels)"
+                if self.picked is not None:
+                    text += f"; the map of vertex {self.picked} follows"
+            elif not self.spectra:
                 text += "; compute a spectrum (Ctrl+R) or click the surface"
         return text

@@ -407,3 +407,22 @@ def test_asking_again_for_the_spectrum_on_screen_keeps_the_mode(model):
     model.state.show_mode(5, "laplacian")
     model.request_spectrum("modified_dirichlet", k=12, show=True)
     assert model.state.display.operator == "modified_dirichlet"
+
+
+def test_the_status_line_says_what_is_computing_before_any_spectrum(model):
+    """Found under Xvfb: while the first spectrum (the vibration distance's, started by a
+    click) was computed the status line still said "compute a spectrum (Ctrl+R) or click
+    the surface"."""
+    state = model.state
+    assert "compute a spectrum (Ctrl+R)" in state.summary()
+    state.set_pick(100)
+    job = model.request_spectrum("shells", k=12)
+    assert "computing Discrete Shells" in state.summary()
+    assert "the map of vertex 100 follows" in state.summary()
+    assert "Ctrl+R" not in state.summary()
+    model.jobs.wait(job)
+    assert not state.computing and "computing" not in state.summary()
+    cancelled = model.request_spectrum("laplacian", k=12)
+    model.jobs.cancel(cancelled)
+    model.jobs.wait(cancelled)
+    assert not state.computing
