@@ -122,6 +122,8 @@ class CompareWindow(QtWidgets.QWidget):
         """Each kind's distance from the main window's picked vertex."""
         vertex = self.state.picked
         display = self.state.display
+        # every kind marks the share of the surface the main window's map marks
+        share = self.state.threshold_share()
         for item, scene, title in zip(self.items, self.scenes, self.titles, strict=True):
             scene.show_marker(vertex)
             d = self.state.distance_map(item) if vertex is not None else None
@@ -136,11 +138,14 @@ class CompareWindow(QtWidgets.QWidget):
             spec = self.state.spectrum(operator_for_distance(item))
             mark = " (preview)" if spec is not None and spec.is_preview else ""
             if display.distance_display == "threshold":
-                thr = display.threshold * float(d.max())
+                if share is None:
+                    thr = display.threshold * float(d.max())
+                else:
+                    thr = float(np.quantile(d, share))
                 scene.show_threshold(d, thr, name=_label(item))
-                share = 100.0 * float(np.mean(d <= thr))
+                marked = 100.0 * float(np.mean(d <= thr))
                 title.setText(
-                    f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({share:.1f} %)" + mark
+                    f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({marked:.1f} %)" + mark
                 )
             else:
                 scene.show_field(d, "sequential", name=_label(item))

@@ -566,6 +566,14 @@ class ViewerState:
             return None
         return self.display.threshold * float(d.max())
 
+    def threshold_share(self) -> float | None:
+        """The share (0..1) of the vertices the threshold map on screen marks similar, or
+        None without one."""
+        d = self.distance_map()
+        if self.display.distance_display != "threshold" or d is None:
+            return None
+        return float(np.mean(d <= self.threshold_value(d)))
+
     def threshold_for_share(self, share: float, d: np.ndarray | None = None) -> float:
         """The threshold fraction that marks ``share`` (0..1) of the vertices similar."""
         d = self.distance_map() if d is None else d

@@ -502,3 +502,25 @@ def test_the_compute_panel_names_parts_held_at_a_vertex(window, tmp_path, qtbot)
     label = window.compute_panel.mesh_info
     qtbot.waitUntil(lambda: "the rest only at vertices" in label.text(), timeout=2000)
     assert "1 part meets" in label.text() and "three more zero modes" in label.text()
+
+
+def test_another_distance_kind_keeps_the_share_of_the_threshold_map(window, spot_path):
+    """Found under Xvfb: a vibration map marking 10 % of the cow marked 0 % as a feature
+    map and 98 % as a heat kernel map (the threshold was a fixed fraction of each
+    kind's largest distance); the Compare window's views were almost all blue."""
+    window.open_mesh(spot_path)
+    for operator in ("laplacian", "modified_dirichlet"):
+        window.compute(operator=operator, k=30)
+    window.pick_vertex(300)
+    window.show_distance(kind="hks", display="threshold")
+    panel = window.distances_panel
+    panel.threshold_slider.setValue(120)  # by share: 12 % of the surface
+    before = window.state.threshold_share()
+    assert before == pytest.approx(0.12, abs=0.01)
+    panel.kind_combo.setCurrentIndex(panel.kind_combo.findData("feature"))
+    assert window.state.display.distance_kind == "feature"
+    assert window.state.threshold_share() == pytest.approx(before, abs=0.005)
+    compare = window.open_comparison(["hks", "feature"])
+    shares = [title.text().split("(")[-1] for title in compare.titles]
+    assert all(text.startswith("12.") for text in shares), shares
+    compare.close()

@@ -93,7 +93,16 @@ class DistancesPanel(QtWidgets.QWidget):
 
     # ------------------------------------------------------------- input
     def _on_kind(self, _index: int) -> None:
-        self.state.set_display(distance_kind=self.kind_combo.currentData())
+        """Another distance kind; with the slider by share, the threshold map keeps the
+        share of the surface it marks (the kinds' largest distances differ by orders of
+        magnitude in their spread: a fixed fraction marked 10 % with one kind and 0 % or
+        98 % with another)."""
+        state = self.state
+        share = state.threshold_share() if self.by_share_check.isChecked() else None
+        state.set_display(distance_kind=self.kind_combo.currentData())
+        new_map = state.distance_map()
+        if share is not None and new_map is not None:
+            state.set_display(threshold=state.threshold_for_share(share, new_map))
         if self.state.display.kind == "distance":
             self.showDistanceRequested.emit()
         elif self.state.display.kind == "signature":
