@@ -168,27 +168,18 @@ class ViewerModel:
             spectrum_key=key,
             preview_job=preview,
         )
+        # while it runs, behind a preview (this request's, or one kept from an earlier
+        # request whose exact computation was cancelled) the exact spectrum follows
         state.set_computing(key, True)
-        owner_hash = state.mesh.hash
+        owner = state.mesh.hash
 
         def computing_ended(_j: Job) -> None:
-            if self.state.mesh is not None and self.state.mesh.hash == owner_hash:
+            if self.state.mesh is not None and self.state.mesh.hash == owner:
                 self.state.set_computing(key, False)
 
         job.then(computing_ended)
         behind_preview = state.spectra.get(key)
         shown_preview = behind_preview is not None and behind_preview.is_preview
-        if preview is not None or shown_preview:
-            # the exact spectrum is on its way behind a preview (this one's, or one kept
-            # from an earlier request whose exact computation was cancelled)
-            state.set_exact_pending(key, True)
-            owner = state.mesh.hash
-
-            def exact_ended(_j: Job) -> None:
-                if self.state.mesh is not None and self.state.mesh.hash == owner:
-                    self.state.set_exact_pending(key, False)
-
-            job.then(exact_ended)
         if show and not shown_preview:
             # behind a preview already on screen the exact spectrum replaces it in place
             # (mode, pick and map stay), as after a preview of this request

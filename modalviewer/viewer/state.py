@@ -222,7 +222,6 @@ class ViewerState:
         self.compute_settings = ComputeSettings()
         self.spectra: dict[SpectrumKey, Spectrum] = {}
         self._latest: dict[str, SpectrumKey] = {}
-        self.exact_pending: set[SpectrumKey] = set()
         self.computing: set[SpectrumKey] = set()  # spectra being computed or queued
         self.display = Display()
         self.picked: int | None = None
@@ -243,7 +242,6 @@ class ViewerState:
         self.mesh_path = Path(path) if path is not None else None
         self.spectra.clear()
         self._latest.clear()
-        self.exact_pending.clear()
         self.computing.clear()
         self._derived = _Derived()
         if mesh is not None:
@@ -300,22 +298,10 @@ class ViewerState:
             if self.display_operator() == key.operator:
                 self.events.display.emit()
 
-    def set_exact_pending(self, key: SpectrumKey, pending: bool) -> None:
-        """Whether the exact spectrum of ``key`` is being computed (or queued) behind
-        its preview; the panels say so only while it is."""
-        if pending == (key in self.exact_pending):
-            return
-        if pending:
-            self.exact_pending.add(key)
-        else:
-            self.exact_pending.discard(key)
-        self.events.spectra.emit(key.operator)
-        if self.display_operator() == key.operator:
-            self.events.display.emit()  # the picture's legend says whether it follows
-
     def set_computing(self, key: SpectrumKey, computing: bool) -> None:
-        """Whether the spectrum of ``key`` is being computed or waits its turn (the status
-        line says so while no spectrum is on screen)."""
+        """Whether the spectrum of ``key`` is being computed or waits its turn: the status
+        line says so while no spectrum is on screen, and behind a preview the panels and
+        the picture's legend say the exact spectrum follows (:meth:`exact_follows`)."""
         if computing == (key in self.computing):
             return
         if computing:
@@ -323,12 +309,17 @@ class ViewerState:
         else:
             self.computing.discard(key)
         self.events.spectra.emit(key.operator)
+        if self.display_operator() == key.operator:
+            self.events.display.emit()
 
     def exact_follows(self, operator: str | None) -> bool:
         """True if the spectrum shown for ``operator`` is a preview whose exact spectrum
         is on its way."""
         key = self._latest.get(operator) if operator else None
-        return key is not None and key in self.exact_pending
+        if key is None or key not in self.computing:
+            return False
+        spec = self.spectra.get(key)
+        return spec is not None and spec.is_preview
 
     def spectrum(self, operator: str | None) -> Spectrum | None:
         """The most recent spectrum of ``operator``, or None."""
