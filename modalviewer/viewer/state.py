@@ -496,14 +496,19 @@ class ViewerState:
         key = self._latest.get(operator) if operator else None
         return key is not None and key.coarse and key in self.spectra
 
-    def display_mark(self) -> str:
-        """ " (preview)", " (coarse-to-fine)" or "": what the titles of the picture add
-        when its spectrum is an approximation."""
-        if self.shows_preview():
+    def approximation_mark(self, operator: str | None) -> str:
+        """ " (preview)", " (coarse-to-fine)" or "": what titles and lists add to the
+        spectrum shown for ``operator`` when it is an approximation."""
+        spec = self.spectrum(operator)
+        if spec is not None and spec.is_preview:
             return " (preview)"
-        if self.is_coarse(self.display_operator()):
+        if self.is_coarse(operator):
             return " (coarse-to-fine)"
         return ""
+
+    def display_mark(self) -> str:
+        """:meth:`approximation_mark` of the spectrum the picture is made of."""
+        return self.approximation_mark(self.display_operator())
 
     def preview_note(self, operator: str | None) -> str:
         """ " (preview spectrum; the exact one follows)", " (preview spectrum)" or "" for

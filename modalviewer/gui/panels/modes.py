@@ -97,10 +97,8 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
             self.spectrum_combo.clear()
             for name in computed:
-                shown = state.spectrum(name)
-                mark = " (preview)" if shown is not None and shown.is_preview else ""
-                mark = mark or (" (coarse-to-fine)" if state.is_coarse(name) else "")
-                self.spectrum_combo.addItem(OPERATOR_INFO[name].label + mark, name)
+                label = OPERATOR_INFO[name].label + state.approximation_mark(name)
+                self.spectrum_combo.addItem(label, name)
             if op is not None:
                 select_data(self.spectrum_combo, op)
             spec = state.spectrum(op)
@@ -146,9 +144,7 @@ class ModesPanel(QtWidgets.QWidget):
                 "Compute for the exact spectrum)."
             )
         self.eigen_label.setText(text)
-        approximate = (
-            " (preview)" if spec.is_preview else " (coarse-to-fine)" if state.is_coarse(op) else ""
-        )
+        approximate = state.approximation_mark(op)
         self.spectrum_plot.set_data(
             np.arange(spec.k),
             np.where(zero, 0.0, spec.eigenvalues),
