@@ -95,7 +95,7 @@ class DistancesPanel(QtWidgets.QWidget):
     def _on_kind(self, _index: int) -> None:
         """Another distance kind; with the slider by share, the threshold map keeps the
         share of the surface it marks (the kinds' largest distances differ by orders of
-        magnitude in their spread: a fixed fraction marked 10 % with one kind and 0 % or
+        magnitude in their spread: a fixed fraction marks 10 % with one kind and 0 % or
         98 % with another)."""
         state = self.state
         share = state.threshold_share() if self.by_share_check.isChecked() else None
