@@ -237,12 +237,18 @@ class Mesh:
         """Number of parts whose faces are connected through shared edges: more than
         :attr:`n_components` where parts meet only at vertices (a part meeting the rest
         at a single vertex can rotate about it: three more zero modes of the shells)."""
+        return int(self.face_component_labels.max(initial=-1)) + 1
+
+    @cached_property
+    def face_component_labels(self) -> np.ndarray:
+        """(m,) label of each face's part, faces connected through shared edges (see
+        :attr:`n_face_components`)."""
         F, E = self.n_faces, len(self.edges)
         faces = np.repeat(np.arange(F), 3)
         graph = sp.coo_matrix(
             (np.ones(3 * F), (faces, F + self.face_edges.ravel())), shape=(F + E, F + E)
         )
-        return int(connected_components(graph, directed=False)[0])
+        return connected_components(graph, directed=False)[1][:F]
 
     @cached_property
     def component_labels(self) -> np.ndarray:

@@ -96,6 +96,105 @@ def _tangents(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t1, np.cross(normals, t1)
 
 
+PATH_FACTOR = 1.5
+"""A support keeps a vertex of its ball when a path along the surface from the centre to
+the vertex is at most this many times the Euclidean distance plus the covering radius
+(see :func:`_near_along_surface`)."""
+
+
+def _surface_graph(mesh: Mesh) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray, np.ndarray]:
+    """The mesh's edge graph with parts that meet only at vertices kept apart.
+
+    Returns (graph, tails, heads, vertex_of): a sparse (N, N) matrix of edge lengths
+    over graph nodes, the nodes of every half-edge, and each node's vertex.  A vertex is
+    one node, except where parts whose faces are not connected through edges
+    (:attr:`.Mesh.n_face_components`) meet at it: there it is one node per part, so no
+    path passes from one part to the other through that vertex.
+    """
+    n, f = mesh.n_vertices, mesh.faces
+    corner_vertex = f.ravel()
+    node = corner_vertex
+    if mesh.n_face_components > mesh.n_components:
+        part = np.repeat(mesh.face_component_labels, 3)
+        lowest = np.full(n, np.iinfo(np.int64).max)
+        highest = np.full(n, -1)
+        np.minimum.at(lowest, corner_vertex, part)
+        np.maximum.at(highest, corner_vertex, part)
+        split = (lowest != highest)[corner_vertex]
+        key = corner_vertex[split] * (int(part.max()) + 1) + part[split]
+        node = corner_vertex.copy()
+        node[split] = n + np.unique(key, return_inverse=True)[1]
+    n_nodes = int(node.max(initial=n - 1)) + 1
+    heads = node.reshape(-1, 3)[:, [1, 2, 0]].ravel()
+    vertex_of = np.full(n_nodes, -1, dtype=np.int64)  # -1: a vertex split into parts
+    vertex_of[node] = corner_vertex
+    x = mesh.vertices
+    lengths = np.linalg.norm(x[vertex_of[heads]] - x[vertex_of[node]], axis=1)
+    # every half-edge once; an undirected search walks each edge either way
+    graph = sp.csr_matrix((lengths, (node, heads)), shape=(n_nodes, n_nodes))
+    return graph, node, heads, vertex_of
+
+
+def _near_along_surface(
+    mesh: Mesh, centers: np.ndarray, ci: np.ndarray, vi: np.ndarray, cover: float
+) -> np.ndarray:
+    """(P,) mask of the (centre, vertex) pairs ``(ci, vi)`` whose vertex lies near the
+    centre along the surface, not only in space.
+
+    Every vertex belongs to the cell of the centre nearest to it along mesh edges (one
+    multi-source Dijkstra run over :func:`_surface_graph`); two cells are neighbours
+    where an edge joins them, and the distance between cells is the length of the
+    shortest path through neighbouring centres.  A pair is kept when that distance from
+    the centre's cell to the vertex's cell is at most :data:`PATH_FACTOR` times (the
+    Euclidean distance from centre to vertex + ``cover``, the covering radius).  On one
+    sheet of surface the path is about as long as the straight line; a ball around a
+    cow's tail also holds part of the leg the tail lies against, and the path to the
+    leg runs over the body, so the leg gets no part of the tail's function, which would
+    couple the two.
+
+    A vertex where parts meet, a vertex in no cell (a part without a centre) and a
+    vertex that would lose every function keep their pairs.
+    """
+    from scipy.sparse.csgraph import dijkstra
+
+    n, m = mesh.n_vertices, len(centers)
+    graph, tails, heads, vertex_of = _surface_graph(mesh)
+    # one cell per source node: a centre where parts meet has one cell in each part
+    sources = np.flatnonzero(np.isin(vertex_of, centers))
+    n_cells = len(sources)
+    nearest = dijkstra(
+        graph, directed=False, indices=sources, min_only=True, return_predecessors=True
+    )[2]
+    cell_of_node = np.full(len(vertex_of), -1, dtype=np.int64)
+    cell_of_node[sources] = np.arange(n_cells)
+    cell = np.where(nearest >= 0, cell_of_node[np.maximum(nearest, 0)], -1)
+    a, b = cell[tails], cell[heads]
+    across = (a != b) & (a >= 0) & (b >= 0)
+    pair = np.unique(np.minimum(a[across], b[across]) * n_cells + np.maximum(a[across], b[across]))
+    first, second = pair // n_cells, pair % n_cells
+    position = mesh.vertices[vertex_of[sources]]
+    steps = sp.csr_matrix(
+        (np.linalg.norm(position[first] - position[second], axis=1), (first, second)),
+        shape=(n_cells, n_cells),
+    )
+    slot = np.full(n, -1, dtype=np.int64)
+    slot[centers] = np.arange(m)
+    between = np.full((m, n_cells), np.inf)  # from each centre's nearest own cell
+    np.minimum.at(between, slot[vertex_of[sources]], dijkstra(steps, directed=False))
+    # nodes below n are the vertices; one split into parts is in no cell
+    vertex_cell = cell[:n][vi]
+    inside = vertex_cell >= 0
+    straight = np.linalg.norm(mesh.vertices[vi] - mesh.vertices[centers[ci]], axis=1)
+    keep = ~inside
+    keep[inside] = between[ci[inside], vertex_cell[inside]] <= PATH_FACTOR * (
+        straight[inside] + cover
+    )
+    covered = np.zeros(n, dtype=bool)
+    covered[vi[keep]] = True
+    keep |= ~covered[vi]
+    return keep
+
+
 def partition_of_unity_basis(
     mesh: Mesh,
     centers: np.ndarray,
@@ -130,6 +229,8 @@ def partition_of_unity_basis(
     ci = np.concatenate([ci, missing])
     vi = np.concatenate([vi, own[missing]])
     s = np.concatenate([s, np.zeros(len(missing))])
+    keep = _near_along_surface(mesh, own, ci, vi, h)
+    ci, vi, s = ci[keep], vi[keep], s[keep]
     psi = (1.0 - s) ** 4 * (4.0 * s + 1.0)
     total = np.bincount(vi, psi, minlength=mesh.n_vertices)
     phi = psi / total[vi]
