@@ -7,7 +7,9 @@ Eigenproblems*, SGP 2018:
 - ``m`` well-spread vertices are chosen by farthest-point sampling;
 - around each sample c_i a compactly supported Wendland function
   ``psi_i = (1 - d/r)^4 (4 d/r + 1)`` of the Euclidean distance d, radius r a few sample
-  spacings; ``phi_i = psi_i / sum_j psi_j`` is a partition of unity;
+  spacings, kept only on the vertices that are also near c_i along the surface (parts
+  that touch in space, such as a tail against a leg, share no function);
+  ``phi_i = psi_i / sum_j psi_j`` is a partition of unity;
 - each ``phi_i`` is enriched by ``phi_i * <x - c_i, t>/r`` for the two unit tangents t of
   the surface at c_i (locally linear functions, Nasikun et al.'s linear enrichment in the
   tangent plane, where the normal coordinate would be nearly linearly dependent on flat
@@ -136,10 +138,15 @@ def _surface_graph(mesh: Mesh) -> tuple[sp.csr_matrix, np.ndarray, np.ndarray, n
 
 
 def _near_along_surface(
-    mesh: Mesh, centers: np.ndarray, ci: np.ndarray, vi: np.ndarray, cover: float
+    mesh: Mesh,
+    centers: np.ndarray,
+    ci: np.ndarray,
+    vi: np.ndarray,
+    straight: np.ndarray,
+    cover: float,
 ) -> np.ndarray:
-    """(P,) mask of the (centre, vertex) pairs ``(ci, vi)`` whose vertex lies near the
-    centre along the surface, not only in space.
+    """(P,) mask of the (centre, vertex) pairs ``(ci, vi)``, ``straight`` apart in
+    space, whose vertex lies near the centre along the surface, not only in space.
 
     Every vertex belongs to the cell of the centre nearest to it along mesh edges (one
     multi-source Dijkstra run over :func:`_surface_graph`); two cells are neighbours
@@ -184,7 +191,6 @@ def _near_along_surface(
     # nodes below n are the vertices; one split into parts is in no cell
     vertex_cell = cell[:n][vi]
     inside = vertex_cell >= 0
-    straight = np.linalg.norm(mesh.vertices[vi] - mesh.vertices[centers[ci]], axis=1)
     keep = ~inside
     keep[inside] = between[ci[inside], vertex_cell[inside]] <= PATH_FACTOR * (
         straight[inside] + cover
@@ -229,7 +235,7 @@ def partition_of_unity_basis(
     ci = np.concatenate([ci, missing])
     vi = np.concatenate([vi, own[missing]])
     s = np.concatenate([s, np.zeros(len(missing))])
-    keep = _near_along_surface(mesh, own, ci, vi, h)
+    keep = _near_along_surface(mesh, own, ci, vi, s * r, h)
     ci, vi, s = ci[keep], vi[keep], s[keep]
     psi = (1.0 - s) ** 4 * (4.0 * s + 1.0)
     total = np.bincount(vi, psi, minlength=mesh.n_vertices)
