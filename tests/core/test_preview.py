@@ -215,7 +215,7 @@ def test_subspace_step_returns_the_products_with_k(plate):
     lam, U, _, _ = pv.preview_spectrum(plate, "shells", K, mass, 12, refine=False)
     KU = K @ U
     solver = pv._factor_below(K, mass, lam, float(np.median(K.diagonal() / mass)))
-    new, X, KX = pv._subspace_step(K, mass, solver, U, KU, keep=15)
+    new, X, KX = pv._subspace_step(K, mass, solver, lam, U, KU, keep=15)
     assert X.shape == (U.shape[0], 15) and new.shape == (15,)
     np.testing.assert_allclose(KX, K @ X, atol=1e-9 * np.abs(KX).max())
     np.testing.assert_allclose(X.T @ (mass[:, None] * X), np.eye(15), atol=1e-9)
