@@ -231,7 +231,7 @@ def test_a_pick_shows_the_distance_from_the_preview_first(window, spot_path, mon
     arrived a minute earlier."""
     from modalviewer.viewer import model as model_module
 
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
     window.open_mesh(spot_path)
     window.state.set_display(distance_kind="hks")
     window.pick_vertex(800)  # needs the Laplacian: a preview job, then the exact one
@@ -291,7 +291,7 @@ def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
     empty plot kept the title "Spectrum (preview): ...", the signature plot its pick."""
     from modalviewer.viewer import model as model_module
 
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", 0)
+    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
     window.open_mesh(spot_path)
     window.state.set_display(distance_kind="hks")
     window.pick_vertex(800)
