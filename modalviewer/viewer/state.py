@@ -44,6 +44,9 @@ from .mode_scalar import default_vector_coloring, smoothed_normals, vector_mode_
 
 DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature")
 DISTANCE_DISPLAYS = ("continuous", "threshold")
+DEFAULT_THRESHOLD_SHARE = 0.1
+"""Share of the surface a first threshold map marks similar (the paper's maps mark a few
+per cent to a tenth)."""
 SHELL_COLORINGS = ("auto", "normal", "magnitude")
 RENDER_STYLES = ("paper", "shaded")
 
@@ -119,6 +122,8 @@ class Display:
     distance_kind : "vibration" | "feature" | "hks" (also picks the signature's spectrum).
     distance_display : "continuous" | "threshold".
     threshold : threshold as a fraction of the largest distance (0..1].
+    threshold_by_share : the threshold map keeps the share of the surface it marks when
+        its distances change (another pick, a new spectrum), instead of the fraction.
     signature_sample : index of the scale a signature is shown at (0..99).
     """
 
@@ -128,6 +133,7 @@ class Display:
     distance_kind: str = "vibration"
     distance_display: str = "continuous"
     threshold: float = 0.2
+    threshold_by_share: bool = True
     signature_sample: int = 50
 
     def blank(self) -> Display:
@@ -278,6 +284,7 @@ class ViewerState:
             raise ValueError("the spectrum does not belong to the loaded mesh")
         if spec.is_preview and self.has_spectrum(key):
             return  # the exact spectrum is in already
+        share = self.threshold_share() if self.display_operator() == key.operator else None
         shown = self.spectra.get(key)
         if shown is not None and shown.is_preview and not spec.is_preview:
             _take_signs(spec, shown)
@@ -293,6 +300,8 @@ class ViewerState:
         self._derived.distance.clear()
         if table is not None:
             self._derived.tables[(key.operator, id(spec), table.t_range)] = table
+        if self.display_operator() == key.operator:
+            self._keep_threshold_share(share)
         self.events.spectra.emit(key.operator)
         if self.display.kind in ("mode", "distance", "signature"):
             if self.display_operator() == key.operator:
@@ -470,7 +479,9 @@ class ViewerState:
             if not 0 <= vertex < self.mesh.n_vertices:
                 raise ValueError(f"Vertex {vertex} does not exist (0..{self.mesh.n_vertices - 1}).")
         if vertex != self.picked:
+            share = self.threshold_share()
             self.picked = vertex
+            self._keep_threshold_share(share)
             self.events.pick.emit()
             if self.display.kind == "distance":
                 self.events.display.emit()
@@ -569,6 +580,23 @@ class ViewerState:
         if self.display.distance_display != "threshold" or d is None:
             return None
         return float(np.mean(d <= self.threshold_value(d)))
+
+    def _keep_threshold_share(self, share: float | None) -> None:
+        """After the distances of a threshold map changed (a pick, a spectrum): with
+        ``threshold_by_share``, set the threshold to mark ``share`` of the surface again,
+        the share the map marked before, or :data:`DEFAULT_THRESHOLD_SHARE` for a first
+        map or one that marked more than half (the kinds' distances are so skewed that a
+        fixed fraction of the largest marks 95 % from one vertex and 10 % from another).
+        Emits nothing: the caller's event redraws."""
+        d = self.display
+        if d.distance_display != "threshold" or not d.threshold_by_share:
+            return
+        dist = self.distance_map()
+        if dist is None:
+            return
+        if share is None or share > 0.5:
+            share = DEFAULT_THRESHOLD_SHARE
+        self.display = replace(d, threshold=self.threshold_for_share(share, dist))
 
     def threshold_for_share(self, share: float, d: np.ndarray | None = None) -> float:
         """The threshold fraction that marks ``share`` (0..1) of the vertices similar."""

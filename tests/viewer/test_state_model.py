@@ -135,6 +135,37 @@ def test_a_finished_job_does_not_replace_a_display_changed_meanwhile(model):
     assert state.spectrum("modified_dirichlet") is not None
 
 
+def test_a_new_pick_keeps_the_share_the_threshold_map_marks(model):
+    """A threshold map chosen before the first pick marked what a fixed fraction of the
+    largest distance happened to mark (95 % of a cow from its head); a new pick kept the
+    fraction, not the share.  Now the first map marks a tenth and a new pick, or a new
+    spectrum, the share set before."""
+    from modalviewer.viewer.state import DEFAULT_THRESHOLD_SHARE
+
+    state = model.state
+    model.jobs.wait(model.request_spectrum("laplacian", k=30))
+    state.set_display(
+        kind="distance", distance_kind="hks", distance_display="threshold", threshold=0.9
+    )
+
+    def marked() -> float:
+        d = state.distance_map()
+        return float(np.mean(d <= state.threshold_value(d)))
+
+    state.set_pick(100)
+    assert marked() == pytest.approx(DEFAULT_THRESHOLD_SHARE, abs=0.005)
+    state.set_display(threshold=state.threshold_for_share(0.25))
+    for vertex in (2000, 2900, 5):
+        state.set_pick(vertex)
+        assert marked() == pytest.approx(0.25, abs=0.005)
+    model.jobs.wait(model.request_spectrum("laplacian", k=40))  # another spectrum
+    assert marked() == pytest.approx(0.25, abs=0.005)
+    # by value: the fraction of the largest distance stays
+    state.set_display(threshold_by_share=False, threshold=0.5)
+    state.set_pick(100)
+    assert state.display.threshold == 0.5
+
+
 def test_legend_and_summary_follow_the_threshold(model):
     """Problem 5: the status kept the first threshold's numbers while the slider moved."""
     state = model.state

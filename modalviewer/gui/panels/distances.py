@@ -7,7 +7,7 @@ from qtpy import QtCore, QtGui, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ...core.signatures import signature
-from ...viewer.state import ViewerState
+from ...viewer.state import DEFAULT_THRESHOLD_SHARE, ViewerState
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, quiet, select_data
 
@@ -76,7 +76,9 @@ class DistancesPanel(QtWidgets.QWidget):
         self.kind_combo.currentIndexChanged.connect(self._on_kind)
         self.display_combo.currentIndexChanged.connect(self._on_display)
         self.threshold_slider.valueChanged.connect(self._on_slider)
-        self.by_share_check.toggled.connect(lambda _: self.update_from_state())
+        self.by_share_check.toggled.connect(
+            lambda on: self.state.set_display(threshold_by_share=bool(on))
+        )
         self.t1_edit.editingFinished.connect(self._on_range)
         self.t2_edit.editingFinished.connect(self._on_range)
         self.distance_button.clicked.connect(self.showDistanceRequested)
@@ -117,7 +119,7 @@ class DistancesPanel(QtWidgets.QWidget):
         if display == "threshold" and dist is not None:
             thr = self.state.threshold_value(dist)
             if float(np.mean(dist <= thr)) > 0.5:
-                changes["threshold"] = self.state.threshold_for_share(0.1, dist)
+                changes["threshold"] = self.state.threshold_for_share(DEFAULT_THRESHOLD_SHARE, dist)
         self.state.set_display(**changes)
 
     def _on_slider(self, value: int) -> None:
@@ -146,7 +148,14 @@ class DistancesPanel(QtWidgets.QWidget):
     def update_from_state(self, *_args) -> None:
         state = self.state
         d = state.display
-        with quiet(self.kind_combo, self.display_combo, self.threshold_slider, self.scale_slider):
+        with quiet(
+            self.kind_combo,
+            self.display_combo,
+            self.threshold_slider,
+            self.scale_slider,
+            self.by_share_check,
+        ):
+            self.by_share_check.setChecked(d.threshold_by_share)
             select_data(self.kind_combo, d.distance_kind)
             select_data(self.display_combo, d.distance_display)
             self.scale_slider.setValue(d.signature_sample)
@@ -162,6 +171,8 @@ class DistancesPanel(QtWidgets.QWidget):
             thr = d.threshold * float(dist.max())
             share = 100.0 * float(np.mean(dist <= thr))
             self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
+        elif d.threshold_by_share:
+            self.threshold_label.setText("Marks a share of the surface once a vertex is picked")
         else:
             self.threshold_label.setText(f"{d.threshold:.3g} of the largest distance")
         if state.picked is None:
