@@ -524,3 +524,19 @@ def test_another_distance_kind_keeps_the_share_of_the_threshold_map(window, spot
     shares = [title.text().split("(")[-1] for title in compare.titles]
     assert all(text.startswith("12.") for text in shares), shares
     compare.close()
+
+
+def test_choosing_the_spectrum_on_screen_again_keeps_its_mode(window, spot_path):
+    """Found under Xvfb: choosing the Laplacian again in the Modes panel's Spectrum list
+    (teapot, a distance map of mode 15's spectrum on screen) jumped to mode 3."""
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=30, wait=True)
+    window.show_mode(15)
+    combo = window.modes_panel.spectrum_combo
+    index = combo.findData("laplacian")
+    combo.activated.emit(index)
+    assert window.state.display.kind == "mode" and window.state.display.mode == 15
+    window.pick_vertex(800)
+    window.state.set_display(kind="distance", distance_kind="hks")
+    combo.activated.emit(combo.findData("laplacian"))
+    assert window.state.display.kind == "mode" and window.state.display.mode == 15

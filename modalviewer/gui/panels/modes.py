@@ -79,9 +79,17 @@ class ModesPanel(QtWidgets.QWidget):
         return self.spectrum_combo.currentData()
 
     def _on_spectrum_chosen(self, _index: int) -> None:
+        """Show the chosen spectrum's modes: the mode last shown of it, or its first
+        non-zero mode; choosing the spectrum on screen again changes nothing."""
         op = self.spectrum_combo.currentData()
-        if op is not None:
-            self.state.show_mode(self.state.first_nonzero_mode(op), op)
+        if op is None:
+            return
+        d = self.state.display
+        if d.operator == op:
+            if d.kind != "mode":
+                self.state.show_mode(d.mode, op)
+            return
+        self.state.show_mode(self.state.first_nonzero_mode(op), op)
 
     def _on_mode_input(self, index: int) -> None:
         op = self._operator()
@@ -97,8 +105,13 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
             self.spectrum_combo.clear()
             for name in computed:
-                label = OPERATOR_INFO[name].label + state.approximation_mark(name)
-                self.spectrum_combo.addItem(label, name)
+                info, mark = OPERATOR_INFO[name], state.approximation_mark(name)
+                # marked: the short name, so the mark is not cut off in a narrow panel
+                self.spectrum_combo.addItem((info.short_label if mark else info.label) + mark, name)
+                index = self.spectrum_combo.count() - 1
+                self.spectrum_combo.setItemData(
+                    index, info.label + mark, QtCore.Qt.ItemDataRole.ToolTipRole
+                )
             if op is not None:
                 select_data(self.spectrum_combo, op)
             spec = state.spectrum(op)
