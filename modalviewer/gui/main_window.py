@@ -161,7 +161,7 @@ class MainWindow(QtWidgets.QMainWindow):
     def _build_status_bar(self) -> None:
         bar = self.statusBar()
         self.status_line = StatusLine(self.state)
-        self.status_line.setMaximumWidth(620)
+        self.status_line.setMaximumWidth(self.STATUS_LINE_WIDTH)
         bar.addPermanentWidget(self.status_line)
         self.progress = QtWidgets.QProgressBar()
         self.progress.setFixedWidth(260)
@@ -173,8 +173,20 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cancel_button.hide()
         bar.addPermanentWidget(self.progress)
         bar.addPermanentWidget(self.cancel_button)
-        # the message shares the bar with the status line and may be cut: whole on hover
-        bar.messageChanged.connect(lambda text: bar.setToolTip(text))
+        # the message shares the bar with the status line: while one is shown the status
+        # line (elided, whole in its tooltip) gives it room; whole message on hover
+        bar.messageChanged.connect(self._on_status_message)
+
+    STATUS_LINE_WIDTH = 620
+    """Widest the status line gets; :data:`STATUS_LINE_WIDTH_BESIDE_MESSAGE` while a
+    temporary message is shown, which needs the room more (what is computing and why)."""
+    STATUS_LINE_WIDTH_BESIDE_MESSAGE = 300
+
+    def _on_status_message(self, text: str) -> None:
+        self.statusBar().setToolTip(text)
+        self.status_line.setMaximumWidth(
+            self.STATUS_LINE_WIDTH_BESIDE_MESSAGE if text else self.STATUS_LINE_WIDTH
+        )
 
     # ============================================================ messages
     def show_error(self, message: str, title: str = "modalviewer") -> None:

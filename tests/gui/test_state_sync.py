@@ -540,3 +540,21 @@ def test_choosing_the_spectrum_on_screen_again_keeps_its_mode(window, spot_path)
     window.state.set_display(kind="distance", distance_kind="hks")
     combo.activated.emit(combo.findData("laplacian"))
     assert window.state.display.kind == "mode" and window.state.display.mode == 15
+
+
+def test_the_status_line_gives_room_to_a_message(window, spot_path, qtbot):
+    """Found under Xvfb: "Computing Discrete Shells (3D vibrations), 100 modes; no pr..."
+    was cut off by the status line beside it."""
+    window.resize(1600, 1000)
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=20, wait=True)
+    window.show_mode(3)
+    bar, line = window.statusBar(), window.status_line
+    message = "Computing Discrete Shells (3D vibrations), 100 modes; " + "x" * 60
+    bar.showMessage(message)
+    qtbot.wait(50)
+    assert line.width() <= window.STATUS_LINE_WIDTH_BESIDE_MESSAGE
+    assert bar.toolTip() == message
+    bar.clearMessage()
+    qtbot.wait(50)
+    assert line.maximumWidth() == window.STATUS_LINE_WIDTH
