@@ -123,6 +123,17 @@ class MainWindow(QtWidgets.QMainWindow):
         self.model.jobs.events.changed.connect(self._on_job_changed)
         self.model.jobs.events.finished.connect(self._on_job_finished)
         window_settings.restore(self)
+        # preferences are written a second after they change, not only on a clean quit
+        self._settings_timer = QtCore.QTimer(self)
+        self._settings_timer.setSingleShot(True)
+        self._settings_timer.setInterval(1000)
+        self._settings_timer.timeout.connect(lambda: window_settings.save(self))
+        for event in (
+            self.state.events.compute_settings,
+            self.state.events.style,
+            self.state.events.animation,
+        ):
+            event.connect(lambda *_: self._settings_timer.start())
 
     # ================================================================== UI
     def _build_docks(self) -> None:

@@ -558,3 +558,19 @@ def test_the_status_line_gives_room_to_a_message(window, spot_path, qtbot):
     bar.clearMessage()
     qtbot.wait(50)
     assert line.maximumWidth() == window.STATUS_LINE_WIDTH
+
+
+def test_preferences_are_written_soon_after_they_change(window, qtbot):
+    """Found under Xvfb: after the process was killed, the next start had forgotten the
+    operator (settings.ini held [files] only): preferences were written on quit alone."""
+    from modalviewer.gui import MainWindow
+
+    window.remember_settings = True  # as on a desktop
+    window.state.set_compute_settings(operator="shells_normal", preview=False)
+    qtbot.waitUntil(
+        lambda: window.settings.value("compute/operator") == "shells_normal", timeout=3000
+    )
+    again = MainWindow()  # no closeEvent of the first window: as after a kill
+    qtbot.addWidget(again)
+    assert again.state.compute_settings.operator == "shells_normal"
+    assert again.state.compute_settings.preview is False
