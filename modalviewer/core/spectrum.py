@@ -70,6 +70,12 @@ class Spectrum:
         (``parameters["preview"]`` holds the per-mode estimates); 0.0 for exact spectra."""
         return float(self.parameters.get("preview", {}).get("estimated_error", 0.0))
 
+    def estimated_mode_error(self, j: int) -> float:
+        """Estimated relative eigenvalue error of a preview's mode ``j`` (0.0 for zero
+        modes and exact spectra)."""
+        errors = self.parameters.get("preview", {}).get("estimated_errors") or []
+        return float(errors[j]) if 0 <= j < len(errors) else 0.0
+
     @property
     def null_space_dimension(self) -> int:
         """How many of the first modes are deflated exact null vectors (constants per

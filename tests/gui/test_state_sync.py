@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from qtpy import QtCore, QtGui, QtWidgets
 
+from modalviewer.viewer.state import percent_text
+
 pytestmark = pytest.mark.gui
 
 
@@ -303,6 +305,13 @@ def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
     panel = window.modes_panel
     assert "replaces it when ready" in panel.eigen_label.text()
     assert "not a bound" in panel.eigen_label.text()
+    # the mode on screen has its own estimate (the largest is over all modes)
+    spec = window.state.spectrum("laplacian")
+    window.show_mode(5)
+    j_text = f"this mode {percent_text(spec.estimated_mode_error(5))}"
+    assert j_text in panel.eigen_label.text()
+    assert spec.estimated_mode_error(5) == spec.parameters["preview"]["estimated_errors"][5]
+    assert "numbers one lower" in panel.eigen_label.text()
     assert window.modes_panel.spectrum_combo.currentText().endswith("(preview)")
     window.cancel_computation()
     window.wait_for(exact)
