@@ -52,9 +52,12 @@ RENDER_STYLES = ("paper", "shaded")
 
 
 def percent_text(fraction: float) -> str:
-    """A relative error as a short percentage: "0.24 %", "2.2 %", "21 %", "135 %" (with a
-    no-break space, so a wrapped legend keeps number and sign together)."""
+    """A relative error as a short percentage: "< 0.01 %", "0.24 %", "2.2 %", "21 %",
+    "135 %" (with a no-break space, so a wrapped legend keeps number and sign together);
+    below 0.01 % the digits would only show how converged a mode is, not its error."""
     value = 100.0 * float(fraction)
+    if 0 < value < 0.01:
+        return "<\u00a00.01\u00a0%"
     return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
 
 

@@ -401,6 +401,9 @@ def test_percent_text_is_short_and_never_in_exponent_notation():
     assert percent_text(0.0217) == "2.2\u00a0%"
     assert percent_text(0.26) == "26\u00a0%"
     assert percent_text(1.354) == "135\u00a0%"
+    # a refined preview's converged modes (seen under Xvfb: "this mode 1.8e-10 %")
+    assert percent_text(1.8e-12) == "<\u00a00.01\u00a0%"
+    assert percent_text(0.0) == "0\u00a0%"
 
 
 def test_a_child_computation_reports_its_hand_over_below_one(tmp_path):
