@@ -669,7 +669,7 @@ def preview_spectrum(
             refinement["failed"] = "the operator could not be factorised below its spectrum"
         c, lam_b = lam.shape[0], lam
         # guard vectors: the last wanted pairs converge at the rate lam_c / lam_(c+guard)
-        block = min(c + max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)), K.shape[0] // 2)
+        block = max(c, min(c + max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)), K.shape[0] // 2))
         while solver is not None and refinement["steps"] < REFINE_STEPS:
             report("preview: refining", 0.94 + 0.02 * refinement["steps"])
             lam_b, U, KU = _subspace_step(K, mass, solver, lam_b, U, KU, keep=block)
