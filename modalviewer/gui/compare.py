@@ -141,9 +141,9 @@ class CompareWindow(QtWidgets.QWidget):
                 if share is None:
                     thr = display.threshold * float(d.max())
                 else:
-                    thr = float(np.quantile(d, share))
+                    thr = self.state.threshold_for_share(share, d) * float(d.max())
                 scene.show_threshold(d, thr, name=_label(item))
-                marked = 100.0 * float(np.mean(d <= thr))
+                marked = 100.0 * self.state.surface_share(d, thr)
                 title.setText(
                     f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({marked:.1f} %)" + mark
                 )

@@ -163,7 +163,7 @@ class SceneView(QtCore.QObject):
             d = self.state.display
             dist = self.state.distance_map()
             thr = self.state.threshold_value(dist)
-            share = 100.0 * float(np.mean(dist <= thr))
+            share = 100.0 * self.state.surface_share(dist, thr)
             from ..core.operators import DISTANCE_KINDS
 
             similar = f"{DISTANCE_KINDS[d.distance_kind].lower()} < {thr:.3g} ({share:.1f} %)"

@@ -135,35 +135,54 @@ def test_a_finished_job_does_not_replace_a_display_changed_meanwhile(model):
     assert state.spectrum("modified_dirichlet") is not None
 
 
-def test_a_new_pick_keeps_the_share_the_threshold_map_marks(model):
+def test_a_threshold_map_keeps_its_share_of_the_surface(model):
     """A threshold map chosen before the first pick marked what a fixed fraction of the
-    largest distance happened to mark (95 % of a cow from its head); a new pick kept the
-    fraction, not the share.  Now the first map marks a tenth and a new pick, or a new
-    spectrum, the share set before."""
+    largest distance happened to mark (95 % of a cow from its head, 67 % of a
+    Cheburashka when the pick started the computation); a new pick, kind or spectrum
+    kept the fraction, not the share.  Now the first map marks a tenth of the surface's
+    area and later maps the share set last."""
+    from modalviewer.core.laplacian import lumped_masses
     from modalviewer.viewer.state import DEFAULT_THRESHOLD_SHARE
 
     state = model.state
-    model.jobs.wait(model.request_spectrum("laplacian", k=30))
-    state.set_display(
-        kind="distance", distance_kind="hks", distance_display="threshold", threshold=0.9
-    )
+    areas = lumped_masses(state.mesh)
 
-    def marked() -> float:
+    def marked() -> float:  # share of the area, computed here
         d = state.distance_map()
-        return float(np.mean(d <= state.threshold_value(d)))
+        return float(areas[d <= state.threshold_value(d)].sum() / areas.sum())
 
+    # threshold display chosen first; the pick starts the computation
+    state.set_display(distance_kind="hks", distance_display="threshold")
     state.set_pick(100)
+    model.jobs.wait(model.request_spectrum("laplacian", k=30))
+    state.set_display(kind="distance")
     assert marked() == pytest.approx(DEFAULT_THRESHOLD_SHARE, abs=0.005)
+    assert state.threshold_share() == pytest.approx(marked(), abs=1e-12)
     state.set_display(threshold=state.threshold_for_share(0.25))
+    assert marked() == pytest.approx(0.25, abs=0.005)
     for vertex in (2000, 2900, 5):
         state.set_pick(vertex)
         assert marked() == pytest.approx(0.25, abs=0.005)
     model.jobs.wait(model.request_spectrum("laplacian", k=40))  # another spectrum
     assert marked() == pytest.approx(0.25, abs=0.005)
+    # another kind whose spectrum is computed after the switch
+    state.set_display(threshold=state.threshold_for_share(0.36))
+    state.set_display(distance_kind="feature")
+    assert state.distance_map() is None
+    model.jobs.wait(model.request_spectrum("modified_dirichlet", k=30))
+    assert marked() == pytest.approx(0.36, abs=0.005)
     # by value: the fraction of the largest distance stays
     state.set_display(threshold_by_share=False, threshold=0.5)
     state.set_pick(100)
     assert state.display.threshold == 0.5
+    # a fraction asked for before its map is on screen is kept for it
+    state.set_display(threshold_by_share=True, kind="none")
+    state.set_display(distance_kind="hks", threshold=0.3)
+    state.set_display(kind="distance")
+    assert state.display.threshold == 0.3
+    share = marked()
+    state.set_pick(200)  # and the share it marks is the one kept
+    assert marked() == pytest.approx(share, abs=0.005)
 
 
 def test_legend_and_summary_follow_the_threshold(model):
@@ -172,17 +191,20 @@ def test_legend_and_summary_follow_the_threshold(model):
     model.jobs.wait(model.request_spectrum("laplacian", k=30))
     state.set_pick(500)
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
+    from modalviewer.core.laplacian import lumped_masses
+
+    areas = lumped_masses(state.mesh)
     for share in (0.05, 0.2, 0.6):
         state.set_display(threshold=state.threshold_for_share(share))
         d = state.distance_map()
-        marked = float(np.mean(d <= state.threshold_value()))
+        marked = float(areas[d <= state.threshold_value()].sum() / areas.sum())
         assert marked == pytest.approx(share, abs=0.01)
         assert f"{100 * marked:.1f} % of the surface" in state.summary()
         assert f"{100 * marked:.1f} % of the surface" in state.legend()
         field = state.field()
         assert field.colormap == "threshold"
         np.testing.assert_array_equal(field.values, d)
-        assert float(np.mean(field.values <= field.threshold)) == pytest.approx(marked, abs=1e-12)
+        assert field.share_similar == pytest.approx(marked, abs=1e-12)
 
 
 def test_field_is_derived_from_the_state(model):
@@ -346,7 +368,7 @@ def test_no_preview_where_it_would_save_little_time(model, monkeypatch):
     job = model.request_spectrum("shells", k=12)
     assert model.jobs.jobs == [job] and job.preview_job is None
     note = model.no_preview_note(job.spectrum_key)
-    assert note.startswith("no preview below 333 334 vertices for Shells 3D"), note
+    assert note == "no preview below 333\u00a0334 vertices", note
     model.jobs.wait(job)
     model.state.set_compute_settings(coarse=True)
     seen = []  # what an observer of the first event sees (the status line's note)

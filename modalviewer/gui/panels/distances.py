@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import numpy as np
 from qtpy import QtCore, QtGui, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ...core.signatures import signature
-from ...viewer.state import DEFAULT_THRESHOLD_SHARE, ViewerState
+from ...viewer.state import ViewerState
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, quiet, select_data
 
@@ -95,32 +94,16 @@ class DistancesPanel(QtWidgets.QWidget):
 
     # ------------------------------------------------------------- input
     def _on_kind(self, _index: int) -> None:
-        """Another distance kind; with the slider by share, the threshold map keeps the
-        share of the surface it marks (the kinds' largest distances differ by orders of
-        magnitude in their spread: a fixed fraction marks 10 % with one kind and 0 % or
-        98 % with another)."""
-        state = self.state
-        share = state.threshold_share() if self.by_share_check.isChecked() else None
-        state.set_display(distance_kind=self.kind_combo.currentData())
-        new_map = state.distance_map()
-        if share is not None and new_map is not None:
-            state.set_display(threshold=state.threshold_for_share(share, new_map))
+        """Another distance kind (a threshold map keeps its share of the surface: see
+        :meth:`ViewerState.set_display`)."""
+        self.state.set_display(distance_kind=self.kind_combo.currentData())
         if self.state.display.kind == "distance":
             self.showDistanceRequested.emit()
         elif self.state.display.kind == "signature":
             self.showSignatureRequested.emit()
 
     def _on_display(self, _index: int) -> None:
-        """Switching to a threshold map that would mark more than half of the surface
-        starts at a tenth of it instead (the paper's maps mark a few per cent)."""
-        display = self.display_combo.currentData()
-        changes = {"distance_display": display}
-        dist = self.state.distance_map()
-        if display == "threshold" and dist is not None:
-            thr = self.state.threshold_value(dist)
-            if float(np.mean(dist <= thr)) > 0.5:
-                changes["threshold"] = self.state.threshold_for_share(DEFAULT_THRESHOLD_SHARE, dist)
-        self.state.set_display(**changes)
+        self.state.set_display(distance_display=self.display_combo.currentData())
 
     def _on_slider(self, value: int) -> None:
         position = value / SLIDER_STEPS
@@ -161,16 +144,17 @@ class DistancesPanel(QtWidgets.QWidget):
             self.scale_slider.setValue(d.signature_sample)
             dist = state.distance_map()
             if dist is not None and self.by_share_check.isChecked():
-                thr = d.threshold * float(dist.max())
-                position = float(np.mean(dist <= thr))
+                position = state.surface_share(dist, d.threshold * float(dist.max()))
             else:
                 position = d.threshold
             self.threshold_slider.setValue(max(1, int(round(position * SLIDER_STEPS))))
         self.threshold_slider.setEnabled(d.distance_display == "threshold")
         if dist is not None:
             thr = d.threshold * float(dist.max())
-            share = 100.0 * float(np.mean(dist <= thr))
+            share = 100.0 * state.surface_share(dist, thr)
             self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
+        elif state.picked is not None:
+            self.threshold_label.setText("The map follows when its spectrum is computed")
         elif d.threshold_by_share:
             self.threshold_label.setText("Marks a share of the surface once a vertex is picked")
         else:
