@@ -4,6 +4,7 @@ with the permissions of the user's umask."""
 from __future__ import annotations
 
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -80,5 +81,13 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
     faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
     poly = pv.PolyData(np.array(mesh.vertices), faces)
     for name, values in fields.items():
-        poly.point_data[name] = np.asarray(values)
+        poly.point_data[array_name(name)] = np.asarray(values)
     return atomic_write(path, lambda tmp: poly.save(tmp, binary=True))
+
+
+def array_name(title: str) -> str:
+    """A point-data array name made of a picture's title: letters, digits, "_", "-" and
+    "." only.  VTK writes the name into XML unescaped, and a "<" ("Vibration distance <
+    0.0104") made a .vtp file no reader opens."""
+    name = re.sub(r"[^A-Za-z0-9_.-]+", "_", title).strip("_")
+    return name or "field"

@@ -671,7 +671,7 @@ class MainWindow(QtWidgets.QMainWindow):
         if field is None:
             raise ValueError("nothing to export: open a mesh first")
         name, values = field
-        return save_field_mesh(Path(path), self.state.mesh, {name.replace(" ", "_"): values})
+        return save_field_mesh(Path(path), self.state.mesh, {name: values})
 
     # ============================================================ repairs
     def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:

@@ -284,6 +284,14 @@ def test_export_field_as_vtp(window, spot_path, tmp_path):
     back = pv.read(out)
     name = back.point_data.keys()[0]
     np.testing.assert_allclose(back.point_data[name], spec.mode(3))
+    # a threshold map's title holds "<", which VTK wrote unescaped into the XML
+    window.pick_vertex(700)
+    d = window.show_distance("hks", display="threshold", threshold=0.3)
+    out = window.export_field(tmp_path / "map.vtp")
+    back = pv.read(out)
+    name = back.point_data.keys()[0]
+    assert "<" not in name and name.startswith("Heat_kernel_distance")
+    np.testing.assert_allclose(back.point_data[name], d)
 
 
 def test_corrupted_cache_entry_is_recomputed(window, spot_path):
