@@ -237,10 +237,7 @@ class ViewerModel:
         needed = PREVIEW_MIN_UNKNOWNS.get(key.operator, 0)
         if n < needed:
             vertices = -(-needed // info.unknowns_per_vertex)
-            return (
-                f"no preview below {vertices:,} vertices for {info.short_label} "
-                "(a preview would save little time)".replace(",", " ")
-            )
+            return f"no preview below {vertices:,} vertices".replace(",", "\u00a0")
         return ""
 
     def _shower(self, key: SpectrumKey, before):

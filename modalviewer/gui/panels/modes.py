@@ -146,15 +146,15 @@ class ModesPanel(QtWidgets.QWidget):
                 else "Compute (Ctrl+R) for the exact spectrum."
             )
             this_mode = (
-                f", this mode {percent_text(spec.estimated_mode_error(state.display.mode))}"
+                f"; this mode {percent_text(spec.estimated_mode_error(state.display.mode))}"
                 if showing_mode and not zero[min(state.display.mode, spec.k - 1)]
                 else ""
             )
             text += (
-                "\nPreview: eigenvalues above the exact ones, by an estimated "
-                f"{percent_text(spec.estimated_error)} at most{this_mode} (estimated from "
-                "below, not a bound); where it misses a mode, the modes above it have "
-                f"numbers one lower than in the exact spectrum. {follows[0].upper()}{follows[1:]}"
+                "\nPreview: eigenvalues above the exact ones. Estimated error (from below, "
+                f"not a bound): largest {percent_text(spec.estimated_error)}{this_mode}. "
+                "Where it misses a mode, the modes above it have numbers one lower than in "
+                f"the exact spectrum. {follows[0].upper()}{follows[1:]}"
             )
         elif state.is_coarse(op):
             text += (
