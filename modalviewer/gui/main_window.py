@@ -419,7 +419,7 @@ class MainWindow(QtWidgets.QMainWindow):
             queued = len(self.model.jobs.jobs) - 1
             more = f" (+{queued} queued)" if queued else ""
             stage = running.stage if len(running.stage) <= 20 else running.stage[:19] + "…"
-            self.progress.setFormat(f"{stage} %p%{more}")
+            self.progress.setFormat(f"{stage} %p %{more}")  # as in the Computations list
             self.progress.setToolTip(f"{running.description}: {running.stage}")
             if job is running and job.stage == "starting":
                 self.statusBar().showMessage(self._starting_message(job))

@@ -362,7 +362,7 @@ class PairWindow(QtWidgets.QWidget):
         if running is not None:
             self.progress.setValue(int(1000 * running.fraction))
             more = f" (+{len(pending) - 1} queued)" if len(pending) > 1 else ""
-            self.progress.setFormat(f"{running.description}: {running.stage} %p%{more}")
+            self.progress.setFormat(f"{running.description}: {running.stage} %p %{more}")
         elif pending:
             self.progress.setValue(0)
             self.progress.setFormat(f"waiting: {pending[0].description}")

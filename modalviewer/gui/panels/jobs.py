@@ -31,7 +31,9 @@ class JobsPanel(QtWidgets.QWidget):
             if row is None:
                 row = self._make_row(job)
                 self.rows[job.id] = row
-            state = f"{job.stage} {100 * job.fraction:.0f} %" if job.status == RUNNING else "queued"
+            state = (
+                f"{job.stage} {int(100 * job.fraction)} %" if job.status == RUNNING else "queued"
+            )
             row[1].setText(f"{job.description}\n{state}")
         self.empty.setVisible(not self.rows)
 
