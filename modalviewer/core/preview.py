@@ -14,6 +14,10 @@ enlarged by the block-Jacobi preconditioned residuals of the Galerkin modes, whi
 the mesh-scale parts of the modes (the tangential give of a bumpy surface bending without
 stretching) that no smooth space holds.
 
+Where the estimated error stays above 2 % for the 3D shells (curved meshes with thin
+parts lock the smooth space), two steps of subspace iteration with a factorisation of the
+fine operator refine the preview (:func:`_subspace_step`).
+
 The accuracy of each preview mode is reported by its relative residual on the fine mesh,
 ``|K u - lambda M u|_{M^-1} / (lambda |u|_M)``, and an estimate of its eigenvalue's
 relative error (see :func:`estimated_errors`).
