@@ -613,15 +613,16 @@ class ViewerState:
 
         With ``threshold_by_share``, a threshold map on screen that the threshold was not
         set for (another vertex, kind, scale range or spectrum, or a first map) gets the
-        threshold that marks the
-        share last set (:data:`DEFAULT_THRESHOLD_SHARE` at first); the distances are so
+        threshold that marks the share last set (:data:`DEFAULT_THRESHOLD_SHARE` at
+        first); the distances are so
         skewed that one fraction of the largest marks 95 % from one vertex and 10 % from
         another.  A threshold set by the user (or any, by value; also one set before its
         map is on screen, as ``show_distance(threshold=...)`` does) sets that share.
         Emits nothing: the caller's event redraws."""
         d = self.display
-        dist = self.distance_map()
-        if d.kind != "distance" or d.distance_display != "threshold" or dist is None:
+        on_screen = d.kind == "distance" and d.distance_display == "threshold"
+        dist = self.distance_map() if on_screen else None  # no distances for other pictures
+        if dist is None:
             # (a request's "display unchanged" test must not see a change here); a
             # fraction set for a map still to come is kept for it
             self._fraction_set |= set_by_user
