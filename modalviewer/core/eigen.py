@@ -402,7 +402,7 @@ def _dense_complement(K, mass_diag, Y0: sp.csr_matrix, k: int):
     return lam, inv_sqrt_m[:, None] * (Q @ W)
 
 
-def _factor_below_spectrum(
+def factor_below_spectrum(
     K, mass_diag, lam_typical, report, timer, relative: float = SHIFT_RTOL
 ) -> tuple[SPDSolver, float]:
     """Factor ``K - shift * M`` with ``shift = -relative * lam_typical`` just below zero
@@ -680,7 +680,7 @@ def _shift_invert(
     k_work, block, max_basis, keep = _krylov_sizes(k, n_free, block)
     if max_basis + block > n_free:
         raise _TooSmall()  # the basis would not fit: the dense solver is the right tool
-    solver, shift = _factor_below_spectrum(K, mass_diag, lam_typical, report, timer, shift_rtol)
+    solver, shift = factor_below_spectrum(K, mass_diag, lam_typical, report, timer, shift_rtol)
 
     def apply_op(V: np.ndarray) -> np.ndarray:
         # the null vectors are an invariant subspace of OP, with its largest eigenvalue

@@ -32,7 +32,15 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .eigen import CancelFn, Cancelled, EigenError, ProgressFn, zero_modes
+from .eigen import (
+    CancelFn,
+    Cancelled,
+    EigenError,
+    ProgressFn,
+    StageTimer,
+    factor_below_spectrum,
+    zero_modes,
+)
 from .factor import SPDSolver
 from .mesh import Mesh
 from .products import row_blocks, threaded_product, threaded_transpose_product
@@ -558,16 +566,16 @@ would not."""
 
 def _factor_below(K, mass: np.ndarray, lam: np.ndarray, lam_scale: float):
     """SPDSolver of ``K - shift M`` with ``shift = -REFINE_SHIFT * (lowest non-zero
-    lam)``, moving further down while the factorisation fails; None if it never
-    succeeds."""
+    lam)``, moving further down while the factorisation fails
+    (:func:`.eigen.factor_below_spectrum`); None if it never succeeds."""
     positive = lam[~zero_modes(lam, lam_scale)]
-    shift = -REFINE_SHIFT * float(positive.min() if positive.size else lam_scale)
-    for _ in range(4):
-        try:
-            return SPDSolver(K - shift * sp.diags(mass))
-        except np.linalg.LinAlgError:
-            shift *= 100.0
-    return None
+    lowest = float(positive.min() if positive.size else lam_scale)
+    try:
+        return factor_below_spectrum(
+            K, mass, lowest, lambda *_: None, StageTimer(), relative=REFINE_SHIFT
+        )[0]
+    except EigenError:
+        return None
 
 
 def preview_spectrum(
