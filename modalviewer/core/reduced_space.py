@@ -269,7 +269,6 @@ def partition_of_unity_basis(
     psi = (1.0 - s) ** 4 * (4.0 * s + 1.0)
     total = np.bincount(vi, psi, minlength=mesh.n_vertices)
     phi = psi / total[vi]
-    q = 3 if enrich else 1
     n, m = mesh.n_vertices, len(own)
     if not enrich:
         return sp.csr_matrix((phi, (vi, ci)), shape=(n, m)), r

@@ -43,6 +43,14 @@ as the preview would (100 modes; README "Preview spectra"): normal shells 2.5 s 
 8.9 s against 15.2 s at 50k (the spot), 7.8 s against 44.4 s on the 130k plate;
 Laplacian 0.8 s against 2.8 s at 50k."""
 
+
+def preview_min_vertices(operator: str) -> int:
+    """The fewest vertices of a mesh whose ``operator`` problem gets a preview
+    (:data:`PREVIEW_MIN_UNKNOWNS` in vertices)."""
+    per_vertex = operator_info(operator).unknowns_per_vertex
+    return -(-PREVIEW_MIN_UNKNOWNS.get(operator, 0) // per_vertex)
+
+
 COARSE_FRACTION = 0.2
 """Share of the vertices the Coarse-to-fine copy keeps."""
 
@@ -234,9 +242,8 @@ class ViewerModel:
             return ""
         if key.coarse:
             return "no preview with Coarse-to-fine (itself an approximation)"
-        needed = PREVIEW_MIN_UNKNOWNS.get(key.operator, 0)
-        if n < needed:
-            vertices = -(-needed // info.unknowns_per_vertex)
+        if n < PREVIEW_MIN_UNKNOWNS.get(key.operator, 0):
+            vertices = preview_min_vertices(key.operator)
             return f"no preview below {vertices:,} vertices".replace(",", "\u00a0")
         return ""
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from qtpy import QtCore, QtWidgets
 
 from ...core.operators import OPERATOR_INFO
+from ...viewer.model import PREVIEW_MIN_UNKNOWNS, preview_min_vertices
 from ...viewer.state import ViewerState
 from .common import WrappingLabel, combo, quiet, select_data
 
@@ -40,9 +41,12 @@ class ComputePanel(QtWidgets.QWidget):
             "to this mesh by nearest vertex (paper Section 7): much faster on big meshes."
         )
         self.preview_check = QtWidgets.QCheckBox("Preview first on big meshes")
+        sizes = ", ".join(
+            f"{OPERATOR_INFO[op].short_label} from {preview_min_vertices(op):,}".replace(",", " ")
+            for op in PREVIEW_MIN_UNKNOWNS
+        )
         self.preview_check.setToolTip(
-            "Big meshes (Laplacian and E_D^N from 30 000 vertices, normal shells from "
-            "100 000, 3D shells from 100 000): show a preview spectrum (a Galerkin "
+            f"Big meshes (vertices: {sizes}): show a preview spectrum (a Galerkin "
             "approximation on the same mesh) while the exact one is computed; the mode, "
             "pick and map on screen stay when the exact spectrum replaces it. On smaller "
             "meshes a preview would save little and delay the exact spectrum. Not with "
