@@ -28,9 +28,11 @@ from ..viewer.model import (
     ComputeRefused,
     ViewerModel,
     cost_estimate,
+    repair_for_failure,
+    repair_unavailable,
     worst_residual,
 )
-from ..viewer.state import percent_text
+from ..viewer.state import SpectrumKey, percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
 from .dialogs import ask
@@ -89,6 +91,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.state = self.model.state
         self.cache = self.model.cache
         self.last_error: str | None = None
+        self.message_box: QtWidgets.QMessageBox | None = None  # the last one opened
+        self.sliver_failure: SpectrumKey | None = None  # failed on slivers, to retry
         self.compare: CompareWindow | None = None
         self._waits: list[QtCore.QEventLoop] = []
         self._cancel_note = ""  # what Esc cancelled, said again when the next job starts
@@ -207,15 +211,32 @@ class MainWindow(QtWidgets.QMainWindow):
         self.statusBar().showMessage(message, 10000)
         if os.environ.get("MODALVIEWER_NO_DIALOGS"):
             return
-        box = QtWidgets.QMessageBox(
-            QtWidgets.QMessageBox.Icon.Warning,
-            title,
-            message,
-            QtWidgets.QMessageBox.StandardButton.Ok,
-            self,
-        )
+        self._open_box(QtWidgets.QMessageBox.Icon.Warning, title, message)
+
+    def show_info(self, message: str, title: str = "modalviewer") -> None:
+        """A non-blocking information dialog (and the status bar)."""
+        log.info("%s", message)
+        self.statusBar().showMessage(message.replace("\n", " "), 20000)
+        if not os.environ.get("MODALVIEWER_NO_DIALOGS"):
+            self._open_box(QtWidgets.QMessageBox.Icon.Information, title, message)
+
+    def _open_box(self, icon, title: str, message: str, action=None) -> QtWidgets.QMessageBox:
+        """Open a non-blocking message box (``self.message_box``); ``action``: (label,
+        callback) of a button that is the default, beside Close."""
+        buttons = QtWidgets.QMessageBox.StandardButton
+        box = QtWidgets.QMessageBox(icon, title, message, buttons.NoButton, self)
+        if action is None:
+            box.setStandardButtons(buttons.Ok)
+        else:
+            label, callback = action
+            button = box.addButton(label, QtWidgets.QMessageBox.ButtonRole.AcceptRole)
+            button.clicked.connect(callback)
+            box.addButton(buttons.Close)
+            box.setDefaultButton(button)  # the action the user asked for
         box.setAttribute(QtCore.Qt.WidgetAttribute.WA_DeleteOnClose)
         box.open()
+        self.message_box = box
+        return box
 
     # =========================================================== settings
     def closeEvent(self, event):  # noqa: N802
@@ -459,7 +480,17 @@ class MainWindow(QtWidgets.QMainWindow):
             )
         elif job.status == "failed":
             log.error("computation failed: %s\n%s", job.error, job.details)
-            self.show_error(f"The computation failed: {job.error}", "Computation failed")
+            key = getattr(job, "spectrum_key", None)
+            mesh = self.state.mesh
+            if (
+                key is not None
+                and mesh is not None
+                and job.owner == mesh.hash
+                and repair_for_failure(job.error) == "fix_slivers"
+            ):
+                self._offer_sliver_fix(job, key)
+            else:
+                self.show_error(f"The computation failed: {job.error}", "Computation failed")
         elif job.status == "cancelled":
             self.statusBar().showMessage(f"{job.description}: {job.error or 'cancelled'}.", 5000)
 
@@ -689,6 +720,64 @@ class MainWindow(QtWidgets.QMainWindow):
         if job.status != DONE:
             raise ComputeError(job.error or job.status)
         return job.result
+
+    def _offer_sliver_fix(self, job: Job, key: SpectrumKey) -> None:
+        """The failure of ``key`` on sliver triangles, with a "Fix slivers and retry"
+        button (the default); without dialogs, :meth:`fix_slivers_and_retry` does it."""
+        self.sliver_failure = key
+        message = f"The computation failed: {job.error}"
+        self.last_error = message
+        log.warning("%s", message)
+        self.statusBar().showMessage(message, 10000)
+        if os.environ.get("MODALVIEWER_NO_DIALOGS"):
+            return
+        self._open_box(
+            QtWidgets.QMessageBox.Icon.Warning,
+            "Computation failed",
+            f"{message}.\n\nFix slivers and retry: repair the mesh (Mesh > Fix slivers), "
+            f"then compute {key.describe()} again.",
+            ("Fix slivers and retry", lambda: self.fix_slivers_and_retry(key)),
+        )
+
+    def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
+        """Fix the loaded mesh's slivers (as Mesh > Fix slivers), show the repair's report
+        and request again the spectrum ``key`` (default: the last one whose factorisation
+        failed on slivers).  Without pymeshlab a dialog says how to install it.  Returns
+        the repair job (None if none started); with ``wait`` also waits for the spectrum
+        and returns it."""
+        key = key or self.sliver_failure
+        if key is None:
+            self.statusBar().showMessage("No computation failed on sliver triangles.", 5000)
+            return None
+        missing = repair_unavailable("fix_slivers")
+        if missing:
+            self.show_error(missing, "Fix slivers")
+            return None
+        try:
+            job = self.model.repair("fix_slivers")
+        except ValueError as exc:
+            self.show_error(str(exc))
+            return None
+        retried: list[Job | None] = []
+
+        def retry(j: Job) -> None:
+            # a failed repair is shown as any failed job (_on_job_finished)
+            if j.status != DONE or self.state.mesh is not j.result:
+                return  # failed, cancelled, or another mesh was opened meanwhile
+            self.sliver_failure = None
+            self.show_info(
+                f"{j.result.report}\n\nComputing {key.describe()} again...", "Slivers fixed"
+            )
+            self.state.set_compute_settings(operator=key.operator, k=key.k)
+            retried.append(self._request(key.operator, key.k, show=True))
+
+        job.then(retry)
+        if not wait:
+            return job
+        self.wait_for(job)
+        if job.status != DONE or not retried:
+            raise ComputeError(job.error or job.status)
+        return self._run(retried[0], wait=True)
 
     def _on_repaired(self, job: Job) -> None:
         if job.status == DONE:
