@@ -1,0 +1,533 @@
+"""Strict readers of OBJ, PLY (ASCII and binary), OFF and STL files.
+
+Each reader returns every vertex of the file in the file's order (vertices that no face
+uses included, so that vertex ``i`` is the file's vertex ``i``) and the faces as
+triangles (polygons fanned).  Damage is detected rather than loaded as part of a mesh:
+
+- a record cut in the middle (a ``v`` line with fewer than three numbers, a face with
+  fewer than three corners, a PLY/OFF/STL element whose data end early),
+- element counts that the data do not fill (PLY, OFF, binary STL),
+- faces that name vertices the file does not have.
+
+With ``strict=True`` each of these raises :class:`~modalviewer.core.mesh.MeshError`
+naming the file, the place (line or element) and what is missing.  With ``strict=False``
+what could be read is returned, and ``notes`` says exactly what was dropped.  Vertices
+that no face uses are never an error: :func:`read_mesh_file` adds a note with their
+number, since a file cut between two face records leaves such vertices behind.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .core.mesh import MeshError
+
+__all__ = ["MeshFile", "read_mesh_file", "strips_to_triangles", "READERS"]
+
+
+@dataclass
+class MeshFile:
+    """What a reader found: all vertices (n, 3), triangles (m, 3) and notes on damage."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    notes: list[str] = field(default_factory=list)
+
+
+class _Damage:
+    """Collects problems: raises the first one when strict, else keeps it as a note."""
+
+    def __init__(self, name: str, strict: bool):
+        self.name, self.strict, self.notes = name, strict, []
+
+    def __call__(self, where: str, what: str) -> None:
+        message = f"{self.name}: {where}: {what}"
+        if self.strict:
+            raise MeshError(
+                message + "; the file is damaged or truncated "
+                "(load_mesh(path, strict=False) or 'Open anyway' loads what is there)"
+            )
+        self.notes.append(f"{where}: {what}")
+
+    def note(self, where: str, what: str) -> None:
+        """A doubt that is no error: kept in the notes, strict or not."""
+        self.notes.append(f"{where}: {what}")
+
+
+def _count(count: int, singular: str, plural: str) -> str:
+    return f"{count} {singular if count == 1 else plural}"
+
+
+def _check_last_line(text: str, damage: _Damage, record: str) -> None:
+    """A text file whose last record has no line break may have been cut inside it."""
+    stripped = text.rstrip(" \t")
+    if stripped and not stripped.endswith(("\n", "\r")):
+        last = stripped.splitlines()[-1].strip()
+        if last and not last.startswith("#") and (record == "" or last.split()[0] in record):
+            damage.note(
+                f"line {stripped.count(chr(10)) + 1}",
+                f"the file ends inside the record '{last[:40]}' without a line break: "
+                "it may be cut there, and that record may be wrong",
+            )
+
+
+def _fan(polygon: list[int]) -> list[tuple[int, int, int]]:
+    return [(polygon[0], polygon[i], polygon[i + 1]) for i in range(1, len(polygon) - 1)]
+
+
+def _check_indices(faces: list, n_vertices: int, damage: _Damage, place) -> list:
+    """Faces whose indices all exist; the others reported at ``place(i)``."""
+    kept = []
+    for i, face in enumerate(faces):
+        bad = [j for j in face if j < 0 or j >= n_vertices]
+        if bad:
+            damage(
+                place(i),
+                f"the face names vertex {bad[0]} but the file has only "
+                f"{_count(n_vertices, 'vertex', 'vertices')}"
+                " (numbered from 0)",
+            )
+            continue
+        kept.append(face)
+    return kept
+
+
+def _triangles(polygons: list) -> np.ndarray:
+    if polygons and all(len(p) == 3 for p in polygons):
+        return np.array(polygons, dtype=np.int64).reshape(-1, 3)
+    tris = [t for p in polygons for t in _fan(p)]
+    return np.array(tris, dtype=np.int64).reshape(-1, 3)
+
+
+# --------------------------------------------------------------------------- OBJ
+
+
+def _read_obj_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """Vertices and triangles of a well-formed OBJ of triangles (every ``v`` line with
+    three coordinates, every ``f`` line three positive indices); None for any other
+    file, which the line-by-line reader then reads and checks."""
+    lines = text.splitlines()
+    v_lines = [line[2:] for line in lines if line[:2] == "v "]
+    face_text = "\n".join(line[2:] for line in lines if line[:2] == "f ")
+    widths = {len(line.split()) for line in v_lines}  # x y z, maybe w or r g b after
+    if len(widths) != 1 or min(widths) < 3:
+        return None
+    width = widths.pop()
+    if "/" in face_text:
+        face_text = re.sub(r"/\S*", "", face_text)
+    f_lines = face_text.splitlines()
+    if any(len(line.split()) != 3 for line in f_lines):
+        return None
+    try:
+        table = np.array(" ".join(v_lines).split(), dtype=np.float64).reshape(-1, width)
+        vertices = np.ascontiguousarray(table[:, :3])
+        faces = np.array(face_text.split(), dtype=np.int64).reshape(-1, 3) - 1 if f_lines else None
+    except ValueError:
+        return None
+    if faces is None:
+        return vertices, np.zeros((0, 3), dtype=np.int64)
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        return None
+    return vertices, faces
+
+
+def _read_obj(path: Path, strict: bool) -> MeshFile:
+    damage = _Damage(path.name, strict)
+    text = path.read_bytes().decode("utf-8", "replace")
+    fast = _read_obj_fast(text)
+    if fast is not None:
+        _check_last_line(text, damage, ("v", "f"))
+        return MeshFile(fast[0], fast[1], damage.notes)
+    vertices: list = []
+    polygons: list = []
+    face_lines: list = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        if line[:2] == "v " or line[:2] == "v\t":
+            words = line.split()
+            try:
+                xyz = [float(w) for w in words[1:4]]
+            except ValueError:
+                xyz = []
+            if len(xyz) < 3:
+                damage(f"line {number}", f"the vertex record '{line.strip()[:40]}' is incomplete")
+                continue
+            vertices.append(xyz)
+        elif line[:2] == "f " or line[:2] == "f\t":
+            words = line.split()[1:]
+            try:
+                corners = [int(w.split("/")[0]) for w in words]
+            except ValueError:
+                corners = []
+            if len(corners) < 3:
+                damage(f"line {number}", f"the face record '{line.strip()[:40]}' is incomplete")
+                continue
+            n = len(vertices)
+            # OBJ numbers from 1; negative numbers count back from the last vertex read
+            polygons.append([c - 1 if c > 0 else n + c for c in corners])
+            face_lines.append(number)
+    polygons = _check_indices(polygons, len(vertices), damage, lambda i: f"line {face_lines[i]}")
+    _check_last_line(text, damage, ("v", "f"))
+    v = np.array(vertices, dtype=np.float64).reshape(-1, 3)
+    return MeshFile(v, _triangles(polygons), damage.notes)
+
+
+# --------------------------------------------------------------------------- OFF
+
+
+def _read_off(path: Path, strict: bool) -> MeshFile:
+    damage = _Damage(path.name, strict)
+    text = path.read_bytes().decode("utf-8", "replace")
+    lines = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        words = line.split("#", 1)[0].split()
+        if words:
+            lines.append((number, words))
+    if not lines or not lines[0][1][0].upper().endswith("OFF"):
+        raise MeshError(f"{path.name}: not an OFF file (the first line is not 'OFF')")
+    head = lines[0][1][1:]
+    rest = lines[1:]
+    if not head:
+        if not rest:
+            raise MeshError(f"{path.name}: the OFF file ends before its vertex and face counts")
+        head, rest = rest[0][1], rest[1:]
+    try:
+        n_vertices, n_faces = int(head[0]), int(head[1])
+    except (ValueError, IndexError):
+        raise MeshError(f"{path.name}: the OFF counts line is not 'vertices faces edges'") from None
+    vertices = []
+    for i in range(n_vertices):
+        if i >= len(rest):
+            damage(
+                f"vertex {i}",
+                f"the file ends after {i} of the {n_vertices} vertices its header announces",
+            )
+            break
+        number, words = rest[i]
+        try:
+            xyz = [float(w) for w in words[:3]]
+        except ValueError:
+            xyz = []
+        if len(xyz) < 3:
+            damage(f"line {number} (vertex {i})", "the vertex record is incomplete")
+            xyz = [np.nan] * 3
+        vertices.append(xyz)
+    polygons, places = [], []
+    face_rows = rest[n_vertices:] if len(rest) > n_vertices else []
+    for i in range(n_faces):
+        if i >= len(face_rows):
+            damage(
+                f"face {i}",
+                f"the file ends after {i} of the {n_faces} faces its header announces",
+            )
+            break
+        number, words = face_rows[i]
+        try:
+            count = int(words[0])
+            corners = [int(w) for w in words[1 : 1 + count]]
+        except ValueError:
+            count, corners = 0, []
+        if count < 3 or len(corners) < count:
+            damage(f"line {number} (face {i})", "the face record is incomplete")
+            continue
+        polygons.append(corners)
+        places.append(f"line {number} (face {i})")
+    polygons = _check_indices(polygons, len(vertices), damage, lambda i: places[i])
+    _check_last_line(text, damage, "")
+    v = np.array(vertices, dtype=np.float64).reshape(-1, 3)
+    keep = np.all(np.isfinite(v), axis=1) if not strict else None
+    if keep is not None and not keep.all():
+        # vertices whose record was incomplete: faces using them are dropped too
+        polygons = [p for p in polygons if keep[p].all()]
+    return MeshFile(v, _triangles(polygons), damage.notes)
+
+
+# --------------------------------------------------------------------------- PLY
+
+_PLY_TYPES = {
+    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
+    "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+}  # fmt: skip
+
+_FACE_LISTS = ("vertex_indices", "vertex_index")
+
+
+def strips_to_triangles(strip: np.ndarray) -> np.ndarray:
+    """(m, 3) triangles of a triangle strip (-1 restarts), alternate ones flipped."""
+    tris = []
+    for run in np.split(strip, np.flatnonzero(strip < 0)):
+        run = run[run >= 0]
+        for i in range(len(run) - 2):
+            a, b, c = run[i], run[i + 1], run[i + 2]
+            tris.append((a, b, c) if i % 2 == 0 else (b, a, c))
+    return np.array(tris, dtype=np.int64).reshape(-1, 3)
+
+
+def _ply_header(path: Path, data: bytes):
+    if not data.startswith(b"ply"):
+        raise MeshError(f"{path.name}: not a PLY file (it does not start with 'ply')")
+    end = data.find(b"end_header")
+    if end < 0:
+        raise MeshError(f"{path.name}: the PLY header is truncated or damaged (no 'end_header')")
+    newline = data.find(b"\n", end)
+    body = data[newline + 1 :] if newline >= 0 else b""
+    fmt, elements = None, []
+    for line in data[:end].decode("ascii", "replace").splitlines():
+        words = line.split()
+        if words[:1] == ["format"] and len(words) > 1:
+            fmt = words[1]
+        elif words[:1] == ["element"] and len(words) == 3:
+            try:
+                elements.append((words[1], int(words[2]), []))
+            except ValueError:
+                raise MeshError(f"{path.name}: the PLY header line '{line}' has no count") from None
+        elif words[:1] == ["property"] and elements:
+            types = words[1:-1]
+            bad = [t for t in types if t != "list" and t not in _PLY_TYPES]
+            if bad or not types:
+                raise MeshError(f"{path.name}: the PLY property '{line.strip()}' is not understood")
+            elements[-1][2].append((words[-1], types))
+    if fmt not in ("ascii", "binary_little_endian", "binary_big_endian"):
+        raise MeshError(f"{path.name}: the PLY format '{fmt}' is not understood")
+    return fmt, elements, body
+
+
+def _ply_binary(name, count, props, body, offset, order, damage):
+    """Rows of one binary element: a dict of columns; the offset after it; rows read."""
+    if all(types[0] != "list" for _, types in props):
+        dtype = np.dtype([(p, order + _PLY_TYPES[t[0]]) for p, t in props])
+        available = (len(body) - offset) // dtype.itemsize if dtype.itemsize else count
+        rows = min(count, max(available, 0))
+        if rows < count:
+            damage(
+                f"element '{name}' {rows}",
+                f"the file ends after {rows} of the {count} {name} elements its header announces",
+            )
+        arr = np.frombuffer(body, dtype=dtype, count=rows, offset=offset)
+        return {p: arr[p] for p, _ in props}, offset + dtype.itemsize * rows, rows
+    # elements with lists: a fast path for the usual 'list uchar int' of triangles only
+    if len(props) == 1:
+        _, (_, count_type, item_type) = props[0]
+        ct, it = np.dtype(order + _PLY_TYPES[count_type]), np.dtype(order + _PLY_TYPES[item_type])
+        row = np.dtype([("n", ct), ("i", it, 3)])
+        if len(body) - offset >= row.itemsize * count:
+            arr = np.frombuffer(body, dtype=row, count=count, offset=offset)
+            if np.all(arr["n"] == 3):
+                lists = arr["i"].astype(np.int64)
+                return {props[0][0]: lists}, offset + row.itemsize * count, count
+    columns: dict = {p: [] for p, _ in props}
+    for i in range(count):
+        row_values = {}
+        for prop, types in props:
+            if types[0] == "list":
+                ct = np.dtype(order + _PLY_TYPES[types[1]])
+                it = np.dtype(order + _PLY_TYPES[types[2]])
+                if offset + ct.itemsize > len(body):
+                    break
+                n = int(np.frombuffer(body, ct, 1, offset)[0])
+                if offset + ct.itemsize + it.itemsize * n > len(body):
+                    break
+                row_values[prop] = np.frombuffer(body, it, n, offset + ct.itemsize).astype(np.int64)
+                offset += ct.itemsize + it.itemsize * n
+            else:
+                t = np.dtype(order + _PLY_TYPES[types[0]])
+                if offset + t.itemsize > len(body):
+                    break
+                row_values[prop] = np.frombuffer(body, t, 1, offset)[0]
+                offset += t.itemsize
+        if len(row_values) < len(props):
+            damage(
+                f"element '{name}' {i}",
+                f"the file ends in {name} element {i} of the {count} its header announces",
+            )
+            return columns, offset, i
+        for prop in columns:
+            columns[prop].append(row_values[prop])
+    return columns, offset, count
+
+
+def _ply_ascii(name, count, props, lines, line_index, damage):
+    columns: dict = {p: [] for p, _ in props}
+    for i in range(count):
+        if line_index >= len(lines):
+            damage(
+                f"element '{name}' {i}",
+                f"the file ends after {i} of the {count} {name} elements its header announces",
+            )
+            return columns, line_index, i
+        number, words = lines[line_index]
+        line_index += 1
+        pos, row = 0, {}
+        try:
+            for prop, types in props:
+                if types[0] == "list":
+                    n = int(words[pos])
+                    items = words[pos + 1 : pos + 1 + n]
+                    if len(items) < n:
+                        raise IndexError
+                    row[prop] = np.array([int(float(w)) for w in items], dtype=np.int64)
+                    pos += n + 1
+                else:
+                    row[prop] = float(words[pos])
+                    pos += 1
+        except (IndexError, ValueError):
+            damage(
+                f"line {number} ({name} element {i})",
+                f"the {name} record is incomplete or not numbers",
+            )
+            continue
+        for prop in columns:
+            columns[prop].append(row[prop])
+    return columns, line_index, count
+
+
+def _read_ply(path: Path, strict: bool) -> MeshFile:
+    damage = _Damage(path.name, strict)
+    data = path.read_bytes()
+    fmt, elements, body = _ply_header(path, data)
+    header_lines = data[: len(data) - len(body)].count(b"\n")
+    order = "<" if fmt == "binary_little_endian" else ">"
+    if fmt == "ascii":
+        lines = []
+        for number, line in enumerate(body.decode("ascii", "replace").splitlines()):
+            words = line.split()
+            if words:
+                lines.append((number + header_lines + 1, words))
+        _check_last_line(body.decode("ascii", "replace"), damage, "")
+    cursor = 0
+    vertices, polygons = None, []
+    for name, count, props in elements:
+        if fmt == "ascii":
+            columns, cursor, rows = _ply_ascii(name, count, props, lines, cursor, damage)
+        else:
+            columns, cursor, rows = _ply_binary(name, count, props, body, cursor, order, damage)
+        if name == "vertex":
+            missing = [c for c in "xyz" if c not in columns]
+            if missing:
+                raise MeshError(f"{path.name}: the PLY vertices have no '{missing[0]}' property")
+            vertices = np.column_stack(
+                [np.asarray(columns[c], dtype=np.float64).reshape(-1) for c in "xyz"]
+            )
+        elif name in ("face", "tristrips"):
+            key = next((p for p, _ in props if p in _FACE_LISTS), None)
+            if key is None:
+                raise MeshError(f"{path.name}: the PLY {name} element has no vertex_indices list")
+            lists = columns[key]
+            if name == "tristrips":
+                polygons += [list(t) for s in lists for t in strips_to_triangles(np.asarray(s))]
+            elif isinstance(lists, np.ndarray):
+                polygons = lists  # the fast path's (m, 3) array
+            else:
+                polygons += [list(p) for p in lists]
+        if rows < count:
+            break  # the data ended: no later element can be read
+    if vertices is None:
+        raise MeshError(f"{path.name}: the PLY file has no vertex element")
+    n = len(vertices)
+    if isinstance(polygons, np.ndarray):
+        bad = np.flatnonzero(np.any((polygons < 0) | (polygons >= n), axis=1))
+        for i in bad[:1] if strict else bad:
+            damage(
+                f"face {i}",
+                f"the face names vertex {polygons[i][(polygons[i] < 0) | (polygons[i] >= n)][0]}"
+                f" but the file has only {n} vertices (numbered from 0)",
+            )
+        return MeshFile(vertices, np.delete(polygons, bad, axis=0), damage.notes)
+    short = [i for i, p in enumerate(polygons) if len(p) < 3]
+    for i in short:
+        damage(f"face {i}", "the face has fewer than three corners")
+    polygons = [p for p in polygons if len(p) >= 3]
+    polygons = _check_indices(polygons, n, damage, lambda i: f"face {i}")
+    return MeshFile(vertices, _triangles(polygons), damage.notes)
+
+
+# --------------------------------------------------------------------------- STL
+
+
+def _read_stl(path: Path, strict: bool) -> MeshFile:
+    damage = _Damage(path.name, strict)
+    data = path.read_bytes()
+    binary_count = int(np.frombuffer(data, "<u4", 1, 80)[0]) if len(data) >= 84 else -1
+    is_ascii = data.lstrip()[:5].lower() == b"solid" and len(data) != 84 + 50 * binary_count
+    if not is_ascii:
+        if binary_count < 0:
+            raise MeshError(f"{path.name}: too short for a binary STL file ({len(data)} bytes)")
+        rows = (len(data) - 84) // 50
+        if rows < binary_count:
+            damage(
+                f"triangle {rows}",
+                f"the file ends after {rows} of the {binary_count} triangles its header announces",
+            )
+        rows = min(rows, binary_count)
+        dtype = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+        arr = np.frombuffer(data, dtype=dtype, count=rows, offset=84)
+        vertices = arr["v"].reshape(-1, 3).astype(np.float64)
+        return MeshFile(vertices, np.arange(3 * rows).reshape(-1, 3), damage.notes)
+    corners, triangles, current, facet_line = [], [], [], 0
+    lines = data.decode("ascii", "replace").splitlines()
+    ended = False
+    for number, line in enumerate(lines, start=1):
+        words = line.split()
+        if not words:
+            continue
+        key = words[0].lower()
+        if key == "facet":
+            current, facet_line = [], number
+        elif key == "vertex":
+            try:
+                current.append([float(w) for w in words[1:4]])
+                if len(current[-1]) < 3:
+                    raise ValueError
+            except ValueError:
+                damage(f"line {number}", "the vertex record is incomplete")
+                current.append(None)
+        elif key == "endfacet":
+            if len(current) != 3 or any(c is None for c in current):
+                damage(f"line {facet_line}", "the facet does not have three whole vertices")
+            else:
+                base = len(corners)
+                corners += current
+                triangles.append([base, base + 1, base + 2])
+            current = []
+        elif key == "endsolid":
+            ended = True
+    if not ended:
+        damage(f"line {len(lines)}", "the file ends before 'endsolid'")
+    vertices = np.array(corners, dtype=np.float64).reshape(-1, 3)
+    return MeshFile(vertices, np.array(triangles, dtype=np.int64).reshape(-1, 3), damage.notes)
+
+
+READERS = {".obj": _read_obj, ".off": _read_off, ".ply": _read_ply, ".stl": _read_stl}
+
+
+def read_mesh_file(path, strict: bool = True) -> MeshFile:
+    """Vertices, triangles and damage notes of an OBJ, PLY, OFF or STL file.
+
+    Raises
+    ------
+    MeshError
+        With ``strict=True``, at the first damaged or missing record, naming the file,
+        the line or element and what is missing; for any ``strict``, where the file is
+        not of its format at all.
+    """
+    path = Path(path)
+    result = READERS[path.suffix.lower()](path, strict)
+    used = np.zeros(len(result.vertices), dtype=bool)
+    used[result.faces.ravel()] = True
+    unused = int((~used).sum())
+    if unused and len(result.faces):
+        result.notes.append(
+            f"{_count(unused, 'vertex', 'vertices')} of the file "
+            f"{'is' if unused == 1 else 'are'} used by no face"
+            + (
+                " (the file may be truncated: a file cut between two face records "
+                "leaves such vertices)"
+                if path.suffix.lower() == ".obj"
+                else ""
+            )
+        )
+    return result
