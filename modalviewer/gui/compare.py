@@ -122,8 +122,11 @@ class CompareWindow(QtWidgets.QWidget):
         """Each kind's distance from the main window's picked vertex."""
         vertex = self.state.picked
         display = self.state.display
-        # every kind marks the share of the surface the main window's map marks
+        # every kind marks the share of the surface the main window's map marks (without
+        # one, the share its threshold maps keep: DEFAULT_THRESHOLD_SHARE at first)
         share = self.state.threshold_share()
+        if share is None and display.threshold_by_share:
+            share = self.state.share_target
         for item, scene, title in zip(self.items, self.scenes, self.titles, strict=True):
             scene.show_marker(vertex)
             d = self.state.distance_map(item) if vertex is not None else None

@@ -8,14 +8,22 @@ from pathlib import Path
 from qtpy import QtWidgets
 
 
-def ask(parent, title: str, question: str) -> bool:
-    """A yes/no question (default No).  With MODALVIEWER_NO_DIALOGS set (tests, scripts)
-    the answer is MODALVIEWER_ASSUME_YES, so nothing starts without being asked for."""
+def file_message(path, message: str) -> str:
+    """``message`` about the file ``path``, naming the file (prefixed unless it does)."""
+    name = Path(path).name
+    return message if name in message else f"{name}: {message}"
+
+
+def ask(parent, title: str, question: str, default_yes: bool = False) -> bool:
+    """A yes/no question (default No; ``default_yes`` where Yes is the action the user
+    asked for).  With MODALVIEWER_NO_DIALOGS set (tests, scripts) the answer is
+    MODALVIEWER_ASSUME_YES, so nothing starts without being asked for."""
     if os.environ.get("MODALVIEWER_NO_DIALOGS"):
         return bool(os.environ.get("MODALVIEWER_ASSUME_YES"))
     buttons = QtWidgets.QMessageBox.StandardButton
+    default = buttons.Yes if default_yes else buttons.No
     answer = QtWidgets.QMessageBox.question(
-        parent, title, question, buttons.Yes | buttons.No, buttons.No
+        parent, title, question, buttons.Yes | buttons.No, default
     )
     return answer == buttons.Yes
 

@@ -35,7 +35,7 @@ from ..viewer.model import (
 from ..viewer.state import SpectrumKey, percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
-from .dialogs import ask
+from .dialogs import ask, file_message
 from .export import save_field_mesh, save_screenshot
 from .pair_window import PairWindow, open_pair_window
 from .panels import (
@@ -303,8 +303,8 @@ class MainWindow(QtWidgets.QMainWindow):
             from ..io import load_mesh
 
             mesh = load_mesh(path)
-        except MeshError as exc:
-            self.show_error(str(exc), "Cannot open mesh")
+        except MeshError as exc:  # e.g. a point cloud: the message names the file
+            self.show_error(file_message(path, str(exc)), "Cannot open mesh")
             return False
         except OSError as exc:
             self.show_error(
@@ -645,7 +645,7 @@ class MainWindow(QtWidgets.QMainWindow):
                 f"{max(total, 1):.0f} s on an idle machine). "
                 "Compute now? The main view is not changed."
             )
-            if not ask(self, "Compare", question):
+            if not ask(self, "Compare", question, default_yes=True):  # asked for by the menu
                 return None
         jobs = [self._request(op, None, show=False) for op in missing]
         if any(job is None for job in jobs):

@@ -31,6 +31,7 @@ from ..core.operators import DISTANCE_KINDS, operator_info
 from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairState, PairView
+from .dialogs import file_message
 from .scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
@@ -652,7 +653,7 @@ def _load(main, path) -> Mesh | None:
     try:
         return load_mesh(path)
     except MeshError as exc:
-        main.show_error(str(exc), "Cannot open mesh")
+        main.show_error(file_message(path, str(exc)), "Cannot open mesh")
     except OSError as exc:
         main.show_error(f"{path.name}: cannot be read ({exc.strerror or exc})", "Cannot open mesh")
     return None

@@ -37,7 +37,13 @@ from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
 from ..core.spectrum import Spectrum
 from .jobs import CANCELLED, DONE, Job, JobQueue
-from .state import DISTANCE_DISPLAYS, SpectrumKey, ViewerState, default_k
+from .state import (
+    DEFAULT_THRESHOLD_SHARE,
+    DISTANCE_DISPLAYS,
+    SpectrumKey,
+    ViewerState,
+    default_k,
+)
 
 SIDES = ("a", "b")
 
@@ -145,7 +151,7 @@ class PairState:
         self.weights = (float(weights[0]), float(weights[1]))
         self.rescale = bool(rescale)
         self.distance_display = "continuous"
-        self.share = 0.05  # of the other mesh's surface area, for the threshold display
+        self.share = DEFAULT_THRESHOLD_SHARE  # of the other mesh's area, threshold display
         self.picked: tuple[str, int] | None = None
         self.note = ""  # a warning about the current pair (scale), shown in legends
         self._spectra: dict[tuple[str, str, SpectrumKey], Spectrum] = {}

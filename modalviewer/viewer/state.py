@@ -593,6 +593,12 @@ class ViewerState:
         areas = self.vertex_areas()
         return float(areas[d <= value].sum() / areas.sum())
 
+    @property
+    def share_target(self) -> float:
+        """The share (0..1) of the surface threshold maps mark similar: the one last set,
+        :data:`DEFAULT_THRESHOLD_SHARE` at first."""
+        return self._share_target
+
     def threshold_share(self) -> float | None:
         """The share (0..1) of the surface the threshold map on screen marks similar, or
         None without one."""
