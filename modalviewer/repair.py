@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.mesh import Mesh, MeshError, MeshReport
+from .core.mesh import Mesh, MeshError, MeshReport, _plural
 
 __all__ = ["SliverReport", "fix_slivers"]
 
@@ -304,9 +304,9 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         progress("done", 1.0)
     report.messages.insert(
         0,
-        f"Changed {report.triangles_changed} of {report.triangles_before} triangles by "
-        f"{report.method} ({report.triangles_after} triangles now, "
-        f"{report.vertices_removed} vertices fewer): triangles below quality "
+        f"Changed {report.triangles_changed} of {_plural(report.triangles_before, 'triangle')}"
+        f" by {report.method} ({_plural(report.triangles_after, 'triangle')} now, "
+        f"{_plural(report.vertices_removed, 'vertex')} fewer): triangles below quality "
         f"{min_quality:g} {report.below_min_quality_before} -> "
         f"{report.below_min_quality_after}, below {SLIVER_QUALITY:g} "
         f"{report.slivers_before} -> {report.slivers_after}, worst quality "
