@@ -31,7 +31,7 @@ from psygnal import Signal, SignalGroup
 
 from ..core.curvature import total_curvature
 from ..core.laplacian import lumped_masses, vertex_normals
-from ..core.mesh import Mesh
+from ..core.mesh import Mesh, _plural
 from ..core.operators import (
     DISTANCE_KINDS,
     OPERATOR_INFO,
@@ -813,7 +813,8 @@ class ViewerState:
             return "Open a mesh to begin (File > Open, Ctrl+O)."
         text = self.legend().replace("\n", "; ")
         if not text:
-            text = f"{self.mesh.n_vertices} vertices, {self.mesh.n_faces} faces"
+            m = self.mesh
+            text = f"{_plural(m.n_vertices, 'vertex')}, {_plural(m.n_faces, 'face')}"
             if self.computing and not self.spectra:
                 names = sorted({operator_info(key.operator).label for key in self.computing})
                 text += f"; computing {', '.join(names)} (Esc cancels)"
