@@ -40,8 +40,11 @@ Krylov solver's at 0.2 to 0.6 times it on the 107k cheburashka)."""
 
 
 class ZeroModesWarning(UserWarning):
-    """Every requested mode is an exact zero mode (constants or rigid motions of the
-    mesh's components): nothing of the shape's vibrations is in the spectrum."""
+    """Every requested mode is a zero mode (exact ones: constants or rigid motions of the
+    mesh's components; or eigenvalues at rounding level, :func:`.eigen.zero_modes`):
+    nothing of the shape's vibrations is in the spectrum.  Raised by a mesh of many
+    separate (or only vertex-joined) pieces, a damaged file, or k not larger than the
+    null space's dimension."""
 
 
 RESIDUAL_LIMIT = 1e-4
@@ -149,17 +152,12 @@ def compute_spectrum(
         )
     except EigenError as exc:
         raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
-    if result.null_dim >= k and nulls.n_components > 1:
-        warnings.warn(
-            f"all {k} modes are exact zero modes: {nulls.summary()} Ask for more than "
-            f"{nulls.dimension} modes, keep the largest component "
-            "(modalviewer.largest_component) or compute per component "
-            "(modalviewer.compute_spectrum_per_component).",
-            ZeroModesWarning,
-            stacklevel=2,
-        )
     lam_typical = typical_eigenvalue(K, mass)
     nonzero = ~zero_modes(result.eigenvalues, lam_typical, result.null_dim)
+    if not nonzero.any():
+        warnings.warn(
+            _all_zero_message(k, result, nulls, lam_typical), ZeroModesWarning, stacklevel=2
+        )
     above = np.flatnonzero(nonzero & (result.residuals > RESIDUAL_LIMIT))
     at_floor = 0
     if above.size:
@@ -202,6 +200,38 @@ def compute_spectrum(
             "n_components": nulls.n_components,
             "null_space": nulls.summary(),
         },
+    )
+
+
+def _all_zero_message(k: int, result, nulls, lam_typical: float) -> str:
+    """Why a spectrum holds only zero modes (see :class:`ZeroModesWarning`)."""
+    if result.null_dim >= k:
+        what = (
+            "the only mode is an exact zero mode"
+            if k == 1
+            else f"all {k} modes are exact zero modes"
+        )
+        head = f"{what}: {nulls.summary()}"
+    else:
+        head = (
+            f"all {k} eigenvalues are null-space values: {result.null_dim} exact zero "
+            f"modes and {k - result.null_dim} more at rounding level (|lambda| at most "
+            f"{float(np.abs(result.eigenvalues).max()):.1e}, against a typical eigenvalue "
+            f"size of {lam_typical:.1e}): {nulls.summary()} Pieces that move freely "
+            "(touching at single vertices, or a damaged file) add zero modes that are not "
+            "known in advance."
+        )
+    if nulls.n_components > 1:
+        advice = (
+            f" Ask for more than {max(nulls.dimension, k)} modes, keep the largest "
+            "component (modalviewer.largest_component) or compute per component "
+            "(modalviewer.compute_spectrum_per_component)."
+        )
+    else:
+        advice = f" Ask for more than {k} modes to see the shape's vibrations."
+    return (
+        head + " The mesh is made of separate pieces or is damaged, or k is not larger than "
+        "the null space's dimension." + advice
     )
 
 

@@ -1,6 +1,8 @@
 """Exactly known null spaces: built per component, deflated in the eigensolver, returned as
 exact zero modes counted in k, and flagged by one zero-mode rule whatever k is."""
 
+import warnings
+
 import numpy as np
 import pytest
 import scipy.linalg as la
@@ -283,3 +285,40 @@ def test_a_part_held_at_a_single_vertex_adds_three_zero_modes_to_the_shells():
     K, mass = operator_matrices(mesh, "shells")
     lam = la.eigh(K.toarray(), np.diag(mass), eigvals_only=True)
     assert int(np.sum(lam < 1e-8 * lam.max())) == 6 + 3
+
+
+def spheres_touching_at_a_vertex():
+    """Two icospheres sharing one vertex: one component whose halves rotate freely about
+    it, so 3 zero modes beyond the 6 rigid motions (not known in advance, not deflated)."""
+    s = icosphere(2)
+    v, n = s.vertices, s.n_vertices
+    top, bottom = int(np.argmax(v[:, 2])), int(np.argmin(v[:, 2]))
+    keep = np.delete(np.arange(n), bottom)
+    remap = np.full(n, -1)
+    remap[keep] = n + np.arange(n - 1)
+    remap[bottom] = top
+    return mv.Mesh(
+        np.vstack([v, (v - v[bottom] + v[top])[keep]]), np.vstack([s.faces, remap[s.faces]])
+    )
+
+
+def test_a_spectrum_of_rounding_level_eigenvalues_is_flagged():
+    mesh = spheres_touching_at_a_vertex()
+    assert mesh.n_components == 1
+    with pytest.warns(ZeroModesWarning, match="all 8 eigenvalues are null-space values: 6 exact"):
+        spec = mv.compute_spectrum(mesh, "shells", k=8)
+    assert spec.null_space_dimension == 6
+    assert np.abs(spec.eigenvalues).max() < 1e-9  # 2.3e-13 measured; typical size 2.1e3
+    assert spec.zero_mode_mask().all()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ZeroModesWarning)
+        spec = mv.compute_spectrum(mesh, "shells", k=10)  # the first vibration, 1.98
+    assert spec.eigenvalues[-1] > 1.0 and spec.zero_mode_mask().sum() == 9
+
+
+def test_k_not_above_the_null_space_of_one_component_is_flagged():
+    with pytest.warns(ZeroModesWarning, match="all 6 modes are exact zero modes.*k is not larger"):
+        spec = mv.compute_spectrum(icosphere(2), "shells", k=6)
+    assert spec.eigenvalues.tolist() == [0.0] * 6
+    with pytest.warns(ZeroModesWarning, match="the only mode is an exact zero mode"):
+        mv.compute_spectrum(icosphere(2), "laplacian", k=1)
