@@ -30,7 +30,7 @@ from ..viewer.model import (
     cost_estimate,
     repair_for_failure,
     repair_unavailable,
-    worst_residual,
+    residual_text,
 )
 from ..viewer.state import SpectrumKey, percent_text
 from . import menus, window_settings
@@ -473,7 +473,7 @@ class MainWindow(QtWidgets.QMainWindow):
             quality = (
                 f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
                 if spec.is_preview
-                else f"largest relative residual {worst_residual(spec):.1e}"
+                else residual_text(spec)
             )
             self.statusBar().showMessage(
                 f"{job.description} in {job.seconds:.1f} s; {quality}.", 15000

@@ -19,7 +19,7 @@ from ..core.coarse import estimate_cost
 from ..core.eigen import Cancelled
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
-from ..core.pipeline import compute_spectrum
+from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from .jobs import DONE, Job, JobQueue
@@ -404,3 +404,17 @@ def _compute_preview(mesh: Mesh, key: SpectrumKey, progress, cancel) -> Spectrum
 
 def worst_residual(spec: Spectrum) -> float:
     return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
+
+
+def residual_text(spec: Spectrum) -> str:
+    """'largest relative residual 1.3e-05' and, where that is above what well-shaped
+    meshes reach, the mode's rounding floor: the residual that rounding the mode to
+    double precision alone causes on this mesh (no solver goes below it)."""
+    worst = worst_residual(spec)
+    text = f"largest relative residual {worst:.1e}"
+    floor = float(spec.parameters.get("worst_residual_rounding_floor", 0.0))
+    if floor > 0.0 and worst <= FLOOR_FACTOR * floor:
+        text += f" (the rounding floor of double precision for that mode here: {floor:.1e})"
+    elif floor > 0.0:
+        text += f" (rounding floor {floor:.1e})"
+    return text
