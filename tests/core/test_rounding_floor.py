@@ -17,8 +17,10 @@ ASSETS = Path(__file__).resolve().parents[2] / "assets"
 def _floor(K, mass, lam, x):
     """eps | |K| |x| | / (|lam| |M x|), written out here independently of the solver."""
     K_abs = abs(K.tocsr())
-    return np.finfo(float).eps * np.linalg.norm(K_abs @ np.abs(x)) / (
-        abs(lam) * np.linalg.norm(mass * x)
+    return (
+        np.finfo(float).eps
+        * np.linalg.norm(K_abs @ np.abs(x))
+        / (abs(lam) * np.linalg.norm(mass * x))
     )
 
 
