@@ -26,7 +26,12 @@ import numpy as np
 
 from .core.mesh import MeshError
 
-__all__ = ["MeshFile", "read_mesh_file", "strips_to_triangles", "READERS"]
+__all__ = ["DamagedFileError", "MeshFile", "read_mesh_file", "strips_to_triangles", "READERS"]
+
+
+class DamagedFileError(MeshError):
+    """A file of its format, damaged or truncated: ``load_mesh(path, strict=False)``
+    loads its complete records (the viewer offers this as "Open anyway")."""
 
 
 @dataclass
@@ -47,7 +52,7 @@ class _Damage:
     def __call__(self, where: str, what: str) -> None:
         message = f"{self.name}: {where}: {what}"
         if self.strict:
-            raise MeshError(
+            raise DamagedFileError(
                 message + "; the file is damaged or truncated "
                 "(load_mesh(path, strict=False) or 'Open anyway' loads what is there)"
             )

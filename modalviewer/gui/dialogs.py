@@ -28,6 +28,20 @@ def ask(parent, title: str, question: str, default_yes: bool = False) -> bool:
     return answer == buttons.Yes
 
 
+def ask_action(parent, title: str, text: str, action: str) -> bool:
+    """A question with the button ``action`` (the default: what the user asked for) and
+    Cancel; True if ``action`` was chosen.  With MODALVIEWER_NO_DIALOGS set the answer
+    is MODALVIEWER_ASSUME_YES, as for :func:`ask`."""
+    if os.environ.get("MODALVIEWER_NO_DIALOGS"):
+        return bool(os.environ.get("MODALVIEWER_ASSUME_YES"))
+    box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Icon.Warning, title, text, parent=parent)
+    chosen = box.addButton(action, QtWidgets.QMessageBox.ButtonRole.AcceptRole)
+    box.addButton(QtWidgets.QMessageBox.StandardButton.Cancel)
+    box.setDefaultButton(chosen)
+    box.exec()
+    return box.clickedButton() is chosen
+
+
 class ScreenshotDialog(QtWidgets.QDialog):
     """File, size multiplier, transparent background, colour bar and legend."""
 

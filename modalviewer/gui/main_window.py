@@ -23,6 +23,7 @@ from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ..core.spectrum import Spectrum
+from ..readers import DamagedFileError
 from ..viewer.jobs import DONE, Job
 from ..viewer.model import (
     ComputeRefused,
@@ -35,7 +36,7 @@ from ..viewer.model import (
 from ..viewer.state import SpectrumKey, percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
-from .dialogs import ask, file_message
+from .dialogs import ask, ask_action, file_message
 from .export import save_field_mesh, save_screenshot
 from .pair_window import PairWindow, open_pair_window
 from .panels import (
@@ -295,14 +296,32 @@ class MainWindow(QtWidgets.QMainWindow):
         else:
             self.open_mesh(path)
 
-    def open_mesh(self, path) -> bool:
-        """Load a mesh file and show it; returns False (after a message) if it failed."""
+    def open_mesh(self, path, strict: bool = True) -> bool:
+        """Load a mesh file and show it; returns False (after a message) if it failed.
+
+        A damaged or truncated file is named with the place of the damage, and the
+        dialog offers "Open anyway": what the file holds of whole records is loaded
+        (``strict=False``) and the report says what was dropped."""
         path = Path(path)
         QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.CursorShape.WaitCursor)
         try:
             from ..io import load_mesh
 
-            mesh = load_mesh(path)
+            mesh = load_mesh(path, strict=strict)
+        except DamagedFileError as exc:
+            QtWidgets.QApplication.restoreOverrideCursor()
+            message = file_message(path, str(exc)).split("; the file is damaged")[0]
+            self.last_error = message
+            self.statusBar().showMessage(message, 10000)
+            if ask_action(
+                self,
+                "Damaged file",
+                f"{message}.\n\nThe file is damaged or truncated. Open anyway loads the "
+                "records that are whole and reports what was dropped.",
+                "Open anyway",
+            ):
+                return self.open_mesh(path, strict=False)
+            return False
         except MeshError as exc:  # e.g. a point cloud: the message names the file
             self.show_error(file_message(path, str(exc)), "Cannot open mesh")
             return False

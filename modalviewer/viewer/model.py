@@ -115,11 +115,12 @@ class ViewerModel:
 
         return job.then(replace_mesh)
 
-    def open_mesh(self, path) -> Mesh:
-        """Load and show a mesh file; raises MeshError or OSError with a user message."""
+    def open_mesh(self, path, strict: bool = True) -> Mesh:
+        """Load and show a mesh file; raises MeshError or OSError with a user message
+        (``strict`` as in :func:`modalviewer.load_mesh`)."""
         from ..io import load_mesh
 
-        mesh = load_mesh(Path(path))
+        mesh = load_mesh(Path(path), strict=strict)
         self.set_mesh(mesh, Path(path))
         return mesh
 

@@ -1,0 +1,55 @@
+"""A damaged file in the viewer: named with the place of the damage, and "Open anyway"
+(the default button) loads its whole records with a report of what was dropped."""
+
+import numpy as np
+from qtpy import QtCore, QtWidgets
+
+from modalviewer.core.primitives import grid_plate
+
+
+def _truncated_ply(path):
+    plate = grid_plate(8, 8)
+    header = (
+        f"ply\nformat binary_little_endian 1.0\nelement vertex {plate.n_vertices}\n"
+        "property double x\nproperty double y\nproperty double z\n"
+        f"element face {plate.n_faces}\nproperty list uchar int vertex_indices\nend_header\n"
+    ).encode()
+    row = np.dtype([("n", "u1"), ("i", "<i4", 3)])
+    faces = np.zeros(plate.n_faces, row)
+    faces["n"], faces["i"] = 3, plate.faces
+    data = header + np.asarray(plate.vertices, "<f8").tobytes() + faces.tobytes()
+    cut = len(data) - 30 * row.itemsize - 5  # 31 faces lost, the last one mid-record
+    path.write_bytes(data[:cut])
+    return path, plate.n_faces
+
+
+def test_a_damaged_file_is_named_and_not_loaded_without_asking(window, tmp_path):
+    path, n_faces = _truncated_ply(tmp_path / "cut_scan.ply")
+    assert window.open_mesh(path) is False
+    assert window.state.mesh is None
+    assert window.last_error.startswith("cut_scan.ply: element 'face' ")
+    assert f"of the {n_faces}" in window.last_error
+
+
+def test_open_anyway_is_the_default_and_loads_the_whole_records(
+    window, qtbot, monkeypatch, tmp_path
+):
+    monkeypatch.delenv("MODALVIEWER_NO_DIALOGS")  # the real dialog
+    path, n_faces = _truncated_ply(tmp_path / "cut_scan.ply")
+    asked = {}
+
+    def answer():
+        box = QtWidgets.QApplication.activeModalWidget()
+        asked["title"] = box.windowTitle()
+        asked["default"] = box.defaultButton().text().replace("&", "")
+        asked["text"] = box.text()
+        qtbot.keyClick(box, QtCore.Qt.Key.Key_Return)  # Enter: the default button
+
+    QtCore.QTimer.singleShot(300, answer)
+    assert window.open_mesh(path) is True
+    assert asked["title"] == "Damaged file" and asked["default"] == "Open anyway"
+    assert "cut_scan.ply" in asked["text"]
+    mesh = window.state.mesh
+    assert mesh.n_faces == n_faces - 31
+    report = str(mesh.report)
+    assert f"the file ends in face element {n_faces - 31} of the {n_faces}" in report
