@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.operators import DISTANCE_KINDS, OPERATOR_NAMES, operator_for_distance
+from .viewer.state import DEFAULT_THRESHOLD_SHARE
 
 COMMANDS = ("compute", "render", "distance", "figures")
 OPERATORS = OPERATOR_NAMES
@@ -88,11 +89,24 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--vertex", type=int, required=True)
     d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
     d.add_argument("-k", type=int, default=100)
-    d.add_argument(
+    marked = d.add_mutually_exclusive_group()
+    marked.add_argument(
+        "--share",
+        type=float,
+        nargs="?",
+        const=DEFAULT_THRESHOLD_SHARE,
+        default=None,
+        metavar="F",
+        help="threshold map marking this share (0..1] of the surface's area similar, as the "
+        f"viewer's threshold display (--share alone: {DEFAULT_THRESHOLD_SHARE:g}, the "
+        "viewer's first threshold); with --to, of B's area",
+    )
+    marked.add_argument(
         "--threshold",
         type=float,
         default=None,
-        help="threshold map at this fraction of the largest distance (0..1)",
+        metavar="D",
+        help="threshold map at this absolute distance (marks where distance <= D)",
     )
     d.add_argument("--size", type=_size, default=(1024, 768))
     d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
@@ -143,7 +157,7 @@ def _run(args) -> int:
     if args.command == "figures":
         from .figures import build_figures
 
-        made = build_figures(args.output)
+        made = build_figures(args.output)  # prints a "wrote" line per figure
         print(f"{len(made)} figures written to {args.output}")
         return 0
     if args.command == "compute":
@@ -151,16 +165,18 @@ def _run(args) -> int:
 
         prepare_compute_process()  # this process exists to compute (see core.memory)
         mesh = mv.load_mesh(args.mesh)
-        spec = mv.compute_spectrum(
-            mesh,
-            args.operator,
-            args.k,
-            args.bending,
-            args.membrane,
-            progress=_progress_bar(),
-            accuracy="preview" if args.preview else "exact",
-        )
+        with _warnings_printed():
+            spec = mv.compute_spectrum(
+                mesh,
+                args.operator,
+                args.k,
+                args.bending,
+                args.membrane,
+                progress=_progress_bar(),
+                accuracy="preview" if args.preview else "exact",
+            )
         mv.save_spectrum(spec, args.output)
+        _wrote(args.output, f"spectrum, {spec.k} {args.operator} modes")
         if spec.is_preview:
             info = spec.parameters["preview"]
             print(
@@ -196,43 +212,92 @@ def _run(args) -> int:
             raise ValueError(f"--mode must be between 0 and {spec.k - 1}")
         win.show_mode(args.mode)
         win.export_screenshot(args.output, transparent=args.transparent)
-        print(
-            f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}; "
-            f"saved {args.output}"
-        )
+        print(f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}")
+        _wrote(args.output, f"PNG {args.size[0]}x{args.size[1]}, mode {args.mode}")
         win.close()
         return 0
     # distance
     if not 0 <= args.vertex < mesh.n_vertices:
         raise ValueError(f"--vertex must be between 0 and {mesh.n_vertices - 1}")
-    if args.threshold is not None and not 0 < args.threshold <= 1:
-        raise ValueError("--threshold is a fraction of the largest distance, in (0, 1]")
+    if args.share is not None and not 0 < args.share <= 1:
+        raise ValueError("--share is a share of the surface's area, in (0, 1]")
+    if args.threshold is not None and not 0 < args.threshold < np.inf:
+        raise ValueError("--threshold is a distance, above 0")
     if args.to is not None:
         return _distance_to(args, mesh)
     if args.rescale:
         raise ValueError("--rescale applies to two meshes (with --to)")
     spec = _cached_spectrum(mesh, KINDS[args.kind], args.k)
     d = mv.multiscale_distance(spec, args.vertex)
+    marked = _threshold(args, mesh, d)
     if args.csv:
-        _write_csv(args.csv, d)
+        _write_csv(args.csv, d, f"{args.kind} distance from vertex {args.vertex}")
     if args.output:
         app, win = _window(args.size)
         win.set_mesh(mesh, Path(args.mesh))
         win.state.add_spectrum(win.state.compute_settings.key(spec.operator, spec.k), spec)
         win.pick_vertex(args.vertex)
-        display = "threshold" if args.threshold is not None else "continuous"
-        win.show_distance(args.kind, display=display, threshold=args.threshold)
+        display = "continuous" if marked is None else "threshold"
+        fraction = None if marked is None else marked[0] / float(d.max())
+        win.show_distance(args.kind, display=display, threshold=fraction)
         win.export_screenshot(args.output)
         win.close()
+        _wrote(args.output, f"PNG {args.size[0]}x{args.size[1]}, {args.kind} distance map")
     order = np.argsort(d)[1:6]
     print(
         f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "
         + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
     )
+    if marked is not None:
+        print(
+            f"threshold {marked[0]:.6g} ({marked[0] / d.max():.3g} of the largest distance): "
+            f"{100 * marked[1]:.2f} % of the surface's area is at most that far"
+        )
     return 0
 
 
-def _write_csv(path, d: np.ndarray) -> None:
+def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
+    """(distance, share of ``mesh``'s area where ``d`` is at most it) of ``--share`` or
+    ``--threshold``, or None without either: the share turned into a distance as the
+    viewer's threshold display does (by area, ``ViewerState.threshold_for_share``)."""
+    if args.share is None and args.threshold is None:
+        return None
+    from .viewer.state import ViewerState
+
+    state = ViewerState()
+    state.set_mesh(mesh)
+    if args.threshold is not None:
+        value = float(args.threshold)
+    else:
+        value = state.threshold_for_share(args.share, d) * float(d.max())
+    return value, state.surface_share(d, value)
+
+
+def _wrote(path, what: str) -> None:
+    """The line every command prints per file it wrote."""
+    print(f"wrote {path} ({what})")
+
+
+class _warnings_printed:
+    """Warnings of the core raised inside the block (mv.ZeroModesWarning, ...) printed as
+    one ``modalviewer: warning:`` line each on stderr, no source line."""
+
+    def __enter__(self):
+        import warnings
+
+        self._catch = warnings.catch_warnings(record=True)
+        self.caught = self._catch.__enter__()
+        warnings.simplefilter("always")
+        return self
+
+    def __exit__(self, *exc):
+        self._catch.__exit__(*exc)
+        for warning in self.caught:
+            sys.stderr.write(f"modalviewer: warning: {warning.message}\n")
+        return False
+
+
+def _write_csv(path, d: np.ndarray, what: str) -> None:
     np.savetxt(
         path,
         np.column_stack([np.arange(len(d)), d]),
@@ -241,6 +306,7 @@ def _write_csv(path, d: np.ndarray) -> None:
         comments="",
         fmt=["%d", "%.10g"],
     )
+    _wrote(path, f"CSV, {len(d)} rows vertex,distance: {what}")
 
 
 def _cached_spectrum(mesh, operator: str, k: int):
@@ -252,7 +318,8 @@ def _cached_spectrum(mesh, operator: str, k: int):
     cache = SpectrumCache()
     spec = cache.get(mesh, operator, k)
     if spec is None:
-        spec = mv.compute_spectrum(mesh, operator, k, progress=_progress_bar())
+        with _warnings_printed():
+            spec = mv.compute_spectrum(mesh, operator, k, progress=_progress_bar())
         cache.put(mesh, spec, k)
     return spec
 
@@ -277,13 +344,16 @@ def _distance_to(args, mesh_a) -> int:
     d = tables.a_to_b(args.vertex)
     best = int(np.argmin(d))
     back = int(np.argmin(tables.b_to_a(best)))
+    marked = _threshold(args, mesh_b, d)
     if args.csv:
-        _write_csv(args.csv, d)
+        _write_csv(
+            args.csv, d, f"{args.kind} distance from vertex {args.vertex} of A to B's vertices"
+        )
     if args.output:
         from .cross_figure import Panel, render_panels
 
         label = {"vibration": "vibration", "feature": "feature", "hks": "heat kernel"}[args.kind]
-        display = "threshold" if args.threshold is not None else "continuous"
+        display = "continuous" if marked is None else "threshold"
         panels = [
             Panel(
                 mesh_a,
@@ -297,11 +367,12 @@ def _distance_to(args, mesh_a) -> int:
                 marker=best,
                 distances=d,
                 display=display,
-                threshold=args.threshold if args.threshold is not None else 0.2,
+                threshold=1.0 if marked is None else min(1.0, marked[0] / float(d.max())),
                 face_marker=True,
             ),
         ]
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))
+        _wrote(args.output, f"PNG, vertex {args.vertex} of A and its {args.kind} distance on B")
     order = np.argsort(d, kind="stable")[:5]
     print(
         f"{args.kind} distance from vertex {args.vertex} of {Path(args.mesh).name} to "
@@ -311,13 +382,12 @@ def _distance_to(args, mesh_a) -> int:
         + "; nearest "
         + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
     )
-    if args.threshold is not None:
+    if marked is not None:
         # between two meshes even the best match is at a distance above zero
-        share = float(np.mean(d <= args.threshold * d.max()))
         print(
-            f"threshold {args.threshold:g} of the largest distance: {100 * share:.2f} % of "
-            f"{Path(args.to).name}'s vertices are closer (the best match is at "
-            f"{d[best] / d.max():.3g} of the largest)"
+            f"threshold {marked[0]:.6g} ({marked[0] / d.max():.3g} of the largest distance): "
+            f"{100 * marked[1]:.2f} % of {Path(args.to).name}'s area is at most that far (the "
+            f"best match is at {d[best] / d.max():.3g} of the largest)"
         )
     return 0
 

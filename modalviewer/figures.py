@@ -26,7 +26,7 @@ def build_figures(out_dir, progress=print) -> list[Path]:
         path = out / f"{name}.png"
         (obj or win).export_screenshot(path)
         made.append(path)
-        progress(f"  {path}")
+        progress(f"wrote {path} (PNG, paper figure)")
 
     # Fig. 1: folded plate, Laplacian / E_D^N / shells normal, same mode index
     win.open_mesh(ASSETS / "demo_folded_plate.obj")

@@ -39,6 +39,7 @@ def test_compute_writes_a_spectrum(tmp_path):
     assert spec.operator == "modified_dirichlet" and spec.k == 12
     assert "Traceback" not in r.stderr
     assert "solver:" in r.stdout and f"({spec.parameters['operator_columns']} operator" in r.stdout
+    assert f"wrote {out} (spectrum, 12 modified_dirichlet modes)" in r.stdout.splitlines()
 
 
 def test_render_and_distance_images(tmp_path):
@@ -59,6 +60,7 @@ def test_render_and_distance_images(tmp_path):
     )
     assert r.returncode == 0, r.stderr
     assert Image.open(png).size == (320, 240)
+    assert f"wrote {png} (PNG 320x240, mode 3)" in r.stdout.splitlines()
     csv = tmp_path / "d.csv"
     r = _run(
         "distance",
@@ -71,7 +73,7 @@ def test_render_and_distance_images(tmp_path):
         20,
         "--csv",
         csv,
-        "--threshold",
+        "--share",
         0.2,
         "-o",
         tmp_path / "d.png",
@@ -80,6 +82,54 @@ def test_render_and_distance_images(tmp_path):
     rows = np.loadtxt(csv, delimiter=",", skiprows=1)
     assert rows.shape == (1225, 2) and rows[0, 1] == 0.0
     assert Image.open(tmp_path / "d.png").size == (1024, 768)
+    lines = r.stdout.splitlines()
+    assert f"wrote {csv} (CSV, 1225 rows vertex,distance: hks distance from vertex 0)" in lines
+    assert f"wrote {tmp_path / 'd.png'} (PNG 1024x768, hks distance map)" in lines
+
+
+def _threshold_line(stdout):
+    """(distance, per cent of the area) of the CLI's threshold line."""
+    line = next(x for x in stdout.splitlines() if x.startswith("threshold "))
+    words = line.split()
+    return float(words[1]), float(words[words.index("%") - 1])
+
+
+def test_distance_share_and_threshold_are_area_share_and_distance(tmp_path):
+    from modalviewer.core.laplacian import lumped_masses
+    from modalviewer.viewer.state import DEFAULT_THRESHOLD_SHARE
+
+    plate = ASSETS / "demo_plate.obj"
+    areas = lumped_masses(mv.load_mesh(plate))
+    csv = tmp_path / "d.csv"
+    base = ("distance", plate, "--vertex", 0, "--kind", "hks", "-k", 20, "--csv", csv)
+    measured = {}
+    for extra in (["--share"], ["--share", 0.05], ["--threshold", 0.3]):
+        r = _run(*base, *extra)
+        assert r.returncode == 0, r.stderr
+        d = np.loadtxt(csv, delimiter=",", skiprows=1)[:, 1]
+        value, percent = _threshold_line(r.stdout)
+        # the value is printed to 6 digits, the CSV to 10, and the plate's symmetry ties
+        # distances: the share is bracketed by the sub-level sets just below and above
+        tol = 1e-5 * d.max()
+        below = areas[d < value - tol].sum() / areas.sum()
+        covered = areas[d <= value + tol].sum() / areas.sum()
+        assert below <= percent / 100 <= covered + 5e-5, (extra, below, covered, percent)
+        measured[tuple(extra)] = value, percent / 100
+        if extra[0] == "--share":
+            share = DEFAULT_THRESHOLD_SHARE if len(extra) == 1 else extra[1]
+            # the smallest distance of the map whose sub-level set covers the share
+            assert below < share <= covered, (extra, below, covered)
+    # measured: 0.28028 marks 10.01 %, 0.157067 marks 5.09 %; --threshold 0.3 (a distance,
+    # 0.159 of the largest, not a fraction of it) marks 10.65 % of the area
+    assert DEFAULT_THRESHOLD_SHARE == 0.1
+    assert abs(measured[("--share",)][1] - 0.1001) < 1e-3
+    assert abs(measured[("--share", 0.05)][1] - 0.0509) < 1e-3
+    assert measured[("--threshold", 0.3)][0] == 0.3
+    assert abs(measured[("--threshold", 0.3)][1] - 0.1065) < 1e-3
+    r = _run(*base, "--share", 0.1, "--threshold", 0.3)
+    assert r.returncode == 2 and "not allowed with argument --share" in r.stderr
+    r = _run(*base, "--share", 1.5)
+    assert r.returncode == 1 and "--share is a share of the surface's area" in r.stderr
 
 
 def test_errors_are_one_line(tmp_path):
