@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.mesh import Mesh, MeshError, MeshReport, repair_mesh
-from .readers import read_mesh_file, strips_to_triangles
+from .readers import count_text, read_mesh_file, strips_to_triangles
 
 __all__ = ["load_mesh", "read_arrays", "read_file", "strips_to_triangles", "SUPPORTED_EXTENSIONS"]
 
@@ -102,7 +102,9 @@ def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
     vertices, faces, notes = read_file(path, strict=strict)
     if len(faces) == 0:
         raise MeshError(
-            f"{path.name}: the file contains {len(vertices)} vertices but no faces: a point "
+            f"{path.name}: the file contains "
+            f"{count_text(len(vertices), 'vertex', 'vertices')} but "
+            "no faces: a point "
             "cloud is not a surface (reconstruct a surface from it first), or the file is "
             "truncated before its faces"
         )

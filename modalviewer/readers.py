@@ -63,7 +63,7 @@ class _Damage:
         self.notes.append(f"{where}: {what}")
 
 
-def _count(count: int, singular: str, plural: str) -> str:
+def count_text(count: int, singular: str, plural: str) -> str:
     return f"{count} {singular if count == 1 else plural}"
 
 
@@ -93,7 +93,7 @@ def _check_indices(faces: list, n_vertices: int, damage: _Damage, place) -> list
             damage(
                 place(i),
                 f"the face names vertex {bad[0]} but the file has only "
-                f"{_count(n_vertices, 'vertex', 'vertices')}"
+                f"{count_text(n_vertices, 'vertex', 'vertices')}"
                 " (numbered from 0)",
             )
             continue
@@ -208,7 +208,8 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
         if i >= len(rest):
             damage(
                 f"vertex {i}",
-                f"the file ends after {i} of the {n_vertices} vertices its header announces",
+                f"the file ends after {i} of the "
+                f"{count_text(n_vertices, 'vertex', 'vertices')} its header announces",
             )
             break
         number, words = rest[i]
@@ -226,7 +227,8 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
         if i >= len(face_rows):
             damage(
                 f"face {i}",
-                f"the file ends after {i} of the {n_faces} faces its header announces",
+                f"the file ends after {i} of the "
+                f"{count_text(n_faces, 'face', 'faces')} its header announces",
             )
             break
         number, words = face_rows[i]
@@ -439,7 +441,7 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
             damage(
                 f"face {i}",
                 f"the face names vertex {polygons[i][(polygons[i] < 0) | (polygons[i] >= n)][0]}"
-                f" but the file has only {n} vertices (numbered from 0)",
+                f" but the file has only {count_text(n, 'vertex', 'vertices')} (numbered from 0)",
             )
         return MeshFile(vertices, np.delete(polygons, bad, axis=0), damage.notes)
     short = [i for i, p in enumerate(polygons) if len(p) < 3]
@@ -465,7 +467,8 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
         if rows < binary_count:
             damage(
                 f"triangle {rows}",
-                f"the file ends after {rows} of the {binary_count} triangles its header announces",
+                f"the file ends after {rows} of the "
+                f"{count_text(binary_count, 'triangle', 'triangles')} its header announces",
             )
         rows = min(rows, binary_count)
         dtype = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
@@ -526,7 +529,7 @@ def read_mesh_file(path, strict: bool = True) -> MeshFile:
     unused = int((~used).sum())
     if unused and len(result.faces):
         result.notes.append(
-            f"{_count(unused, 'vertex', 'vertices')} of the file "
+            f"{count_text(unused, 'vertex', 'vertices')} of the file "
             f"{'is' if unused == 1 else 'are'} used by no face"
             + (
                 " (the file may be truncated: a file cut between two face records "
