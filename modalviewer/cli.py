@@ -28,6 +28,9 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+_BAR = {"open": False}  # a progress bar line is not finished: an error starts a new one
+
+
 def _progress_bar():
     state = {"last": 0.0}
 
@@ -40,6 +43,7 @@ def _progress_bar():
         sys.stderr.write(
             f"\r[{'#' * filled}{'.' * (30 - filled)}] {100 * fraction:5.1f}% {stage:<20}"
         )
+        _BAR["open"] = fraction < 1.0
         if fraction >= 1.0:
             sys.stderr.write("\n")
         sys.stderr.flush()
@@ -73,6 +77,12 @@ def build_parser() -> argparse.ArgumentParser:
         "eigenvalues are upper bounds, with their estimated error",
     )
     c.add_argument("-o", "--output", required=True)
+    c.add_argument(
+        "--fix-slivers",
+        action="store_true",
+        help="first remove needle and cap triangles with modalviewer.fix_slivers (needs "
+        "the optional pymeshlab: pip install 'modalviewer[repair]')",
+    )
     r = sub.add_parser("render", help="render a mode to PNG")
     r.add_argument("mesh")
     r.add_argument("--operator", choices=OPERATORS, default="laplacian")
@@ -82,6 +92,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--size", type=_size, default=(1024, 768))
     r.add_argument("--transparent", action="store_true")
     r.add_argument("-o", "--output", required=True)
+    r.add_argument(
+        "--fix-slivers",
+        action="store_true",
+        help="first remove needle and cap triangles with modalviewer.fix_slivers (needs "
+        "the optional pymeshlab: pip install 'modalviewer[repair]')",
+    )
     d = sub.add_parser(
         "distance", help="distance from a vertex to all vertices (of a second mesh with --to)"
     )
@@ -121,6 +137,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--rescale",
         action="store_true",
         help="with --to: scale both meshes to unit area before computing",
+    )
+    d.add_argument(
+        "--fix-slivers",
+        action="store_true",
+        help="first remove needle and cap triangles with modalviewer.fix_slivers (needs "
+        "the optional pymeshlab: pip install 'modalviewer[repair]'); with --to, both meshes",
     )
     f = sub.add_parser("figures", help="rebuild the paper's figures on the demo meshes")
     f.add_argument("-o", "--output", default="screenshots")
@@ -164,7 +186,7 @@ def _run(args) -> int:
         from .core.memory import prepare_compute_process
 
         prepare_compute_process()  # this process exists to compute (see core.memory)
-        mesh = mv.load_mesh(args.mesh)
+        mesh = _load(args.mesh, args.fix_slivers)
         with _warnings_printed():
             spec = mv.compute_spectrum(
                 mesh,
@@ -202,7 +224,7 @@ def _run(args) -> int:
                 + f" ({spec.parameters['operator_columns']} operator columns)"
             )
         return 0
-    mesh = mv.load_mesh(args.mesh)
+    mesh = _load(args.mesh, args.fix_slivers)
     if args.command == "render":
         app, win = _window(args.size)
         win.set_mesh(mesh, Path(args.mesh))
@@ -213,7 +235,7 @@ def _run(args) -> int:
         win.show_mode(args.mode)
         win.export_screenshot(args.output, transparent=args.transparent)
         print(f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}")
-        _wrote(args.output, f"PNG {args.size[0]}x{args.size[1]}, mode {args.mode}")
+        _wrote(args.output, f"{_png(args.output)}, mode {args.mode}")
         win.close()
         return 0
     # distance
@@ -242,7 +264,7 @@ def _run(args) -> int:
         win.show_distance(args.kind, display=display, threshold=fraction)
         win.export_screenshot(args.output)
         win.close()
-        _wrote(args.output, f"PNG {args.size[0]}x{args.size[1]}, {args.kind} distance map")
+        _wrote(args.output, f"{_png(args.output)}, {args.kind} distance map")
     order = np.argsort(d)[1:6]
     print(
         f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "
@@ -271,6 +293,41 @@ def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
     else:
         value = state.threshold_for_share(args.share, d) * float(d.max())
     return value, state.surface_share(d, value)
+
+
+class _Unavailable(Exception):
+    """An option needing an optional package that is not installed (exit code 2)."""
+
+
+def _load(path, fix_slivers: bool = False):
+    """The mesh read from ``path``; with ``fix_slivers``, repaired by
+    :func:`modalviewer.fix_slivers`, whose report is printed."""
+    import modalviewer as mv
+
+    if fix_slivers:  # before reading: a missing package is found out at once
+        from .viewer.model import REPAIR_PACKAGES
+
+        module, command = REPAIR_PACKAGES["fix_slivers"]
+        try:
+            __import__(module)
+        except ImportError:
+            raise _Unavailable(
+                f"--fix-slivers needs the optional package {module} (GPL-3.0), which is not "
+                f"installed: {command} (or pip install {module})"
+            ) from None
+    mesh = mv.load_mesh(path)
+    if fix_slivers:
+        mesh = mv.fix_slivers(mesh, progress=_progress_bar())
+        print(f"{Path(path).name}: fix slivers: {' '.join(mesh.report.messages)}")
+    return mesh
+
+
+def _png(path) -> str:
+    """The image written, as "PNG WxH" (a window has a smallest size)."""
+    from PIL import Image
+
+    with Image.open(path) as image:
+        return f"PNG {image.width}x{image.height}"
 
 
 def _wrote(path, what: str) -> None:
@@ -330,7 +387,7 @@ def _distance_to(args, mesh_a) -> int:
 
     import modalviewer as mv
 
-    mesh_b = mv.load_mesh(args.to)
+    mesh_b = _load(args.to, args.fix_slivers)
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
     operator = KINDS[args.kind]
@@ -372,7 +429,10 @@ def _distance_to(args, mesh_a) -> int:
             ),
         ]
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))
-        _wrote(args.output, f"PNG, vertex {args.vertex} of A and its {args.kind} distance on B")
+        _wrote(
+            args.output,
+            f"{_png(args.output)}, vertex {args.vertex} of A, {args.kind} distance on B",
+        )
     order = np.argsort(d, kind="stable")[:5]
     print(
         f"{args.kind} distance from vertex {args.vertex} of {Path(args.mesh).name} to "
@@ -403,7 +463,16 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except Cancelled:
         return 130
+    except _Unavailable as exc:
+        sys.stderr.write(f"modalviewer: error: {exc}\n")
+        return 2
     except (ValueError, OSError, RuntimeError, MemoryError) as exc:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        from .viewer.model import repair_for_failure
+
+        if _BAR["open"]:
+            sys.stderr.write("\n")
+        if repair_for_failure(message) == "fix_slivers" and not getattr(args, "fix_slivers", False):
+            message += "; retry with --fix-slivers"
         sys.stderr.write(f"modalviewer: error: {message}\n")
         return 1

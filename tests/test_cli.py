@@ -1,10 +1,12 @@
 """The headless command line: results, one-line errors, exit codes."""
 
+import os
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PIL import Image
 
 import modalviewer as mv
@@ -12,14 +14,85 @@ import modalviewer as mv
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 
 
-def _run(*args, cwd=None):
+def _run(*args, cwd=None, env=None):
     return subprocess.run(
         [sys.executable, "-m", "modalviewer", *map(str, args)],
         capture_output=True,
         text=True,
         cwd=cwd,
+        env=env,
         timeout=600,
     )
+
+
+def _error_lines(stderr):
+    return [line for line in stderr.splitlines() if line.startswith("modalviewer: error")]
+
+
+@pytest.fixture(scope="module")
+def sliver_obj(tmp_path_factory):
+    """A sphere with 20 needles and 20 caps of quality 1e-8, whose shells Hessian cannot
+    be factorised (as in tests/gui/test_sliver_retry.py)."""
+    from modalviewer.core.primitives import add_slivers, icosphere
+
+    v, f = add_slivers(icosphere(3), needles=20, caps=20, eps=1e-8, seed=2)
+    path = tmp_path_factory.mktemp("slivers") / "slivered.obj"
+    lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in v] + [
+        f"f {a} {b} {c}" for a, b, c in f + 1
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_fix_slivers_option_repairs_and_is_advised_where_factorisation_fails(sliver_obj, tmp_path):
+    out = tmp_path / "s.npz"
+    r = _run("compute", sliver_obj, "--operator", "shells", "-k", 12, "-o", out)
+    assert r.returncode == 1 and not out.exists()
+    (line,) = _error_lines(r.stderr)
+    assert "could not be factorised" in line and line.endswith("; retry with --fix-slivers")
+    assert "Traceback" not in r.stderr
+    r = _run("compute", sliver_obj, "--operator", "shells", "-k", 12, "--fix-slivers", "-o", out)
+    assert r.returncode == 0, r.stderr
+    # measured: 195 of 1360 triangles changed, 60 below quality 0.05 -> 0, 0.02 s
+    assert "slivered.obj: fix slivers: Changed " in r.stdout
+    assert "triangles below quality 0.05 60 -> 0" in r.stdout
+    spec = mv.load_spectrum(out)
+    assert spec.k == 12 and spec.null_space_dimension == 6 and spec.eigenvalues[6] > 1.0
+    png = tmp_path / "m.png"
+    r = _run(
+        "render", sliver_obj, "--operator", "shells", "-k", 12, "--mode", 7, "--fix-slivers",
+        "--size", "320x240", "-o", png,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    assert "fix slivers: Changed " in r.stdout and Image.open(png).size == (320, 240)
+    csv = tmp_path / "d.csv"
+    base = ("distance", sliver_obj, "--vertex", 0, "--kind", "vibration", "-k", 12, "--csv", csv)
+    r = _run(*base, env={**os.environ, "MODALVIEWER_CACHE": str(tmp_path / "cache")})
+    assert r.returncode == 1 and _error_lines(r.stderr)[0].endswith("retry with --fix-slivers")
+    r = _run(*base, "--fix-slivers", env={**os.environ, "MODALVIEWER_CACHE": str(tmp_path / "c")})
+    assert r.returncode == 0, r.stderr
+    assert "fix slivers: Changed " in r.stdout
+    assert np.loadtxt(csv, delimiter=",", skiprows=1).shape == (662, 2)  # 20 vertices fewer
+
+
+def test_fix_slivers_without_pymeshlab_says_how_to_install_it(sliver_obj, tmp_path):
+    (tmp_path / "pymeshlab.py").write_text("raise ImportError('no pymeshlab here')\n")
+    env = {**os.environ, "PYTHONPATH": str(tmp_path)}
+    r = _run("compute", sliver_obj, "--fix-slivers", "-o", tmp_path / "s.npz", env=env)
+    assert r.returncode == 2
+    (line,) = _error_lines(r.stderr)
+    assert "--fix-slivers needs the optional package pymeshlab" in line
+    assert "pip install 'modalviewer[repair]'" in line
+    assert "Traceback" not in r.stderr
+
+
+def test_compute_prints_a_spectrum_of_zero_modes_as_a_warning(tmp_path):
+    r = _run("compute", ASSETS / "demo_plate.obj", "-k", 1, "-o", tmp_path / "s.npz")
+    assert r.returncode == 0, r.stderr
+    warned = [x for x in r.stderr.splitlines() if "modalviewer: warning: " in x]
+    assert len(warned) == 1 and "the only mode is an exact zero mode" in warned[0]
+    assert "k is not larger than the null space's dimension" in warned[0]
+    assert "warnings.warn" not in r.stderr and "ZeroModesWarning" not in r.stderr
 
 
 def test_compute_writes_a_spectrum(tmp_path):
