@@ -23,6 +23,7 @@ from .nullspace import null_space
 from .operators import operator_info
 from .shells import normal_shells_hessian, shells_hessian
 from .spectrum import OPERATORS, Spectrum
+from .validate import check_count
 
 __all__ = [
     "compute_spectrum",
@@ -110,7 +111,8 @@ def compute_spectrum(
     Parameters
     ----------
     operator : "laplacian" | "modified_dirichlet" | "shells" | "shells_normal".
-    k : number of modes; capped at the number of unknowns.
+    k : number of modes, an integer >= 1 (Python or numpy; not a float or a bool);
+        capped at the number of unknowns.
     bending, membrane : Discrete Shells weights (ignored by the scalar energies).
     progress : ``progress(stage, fraction)`` with fraction in [0, 1].
     cancel : polled; returning True raises :class:`Cancelled`.
@@ -128,9 +130,7 @@ def compute_spectrum(
     many, ``spec.parameters["null_space"]`` says it in words.
     """
     operator_info(operator)  # a ValueError naming the known operators
-    k = int(k)
-    if k < 1:
-        raise ValueError(f"k must be at least 1, got {k}")
+    k = check_count(k, "k")
     if accuracy not in ("exact", "preview"):
         raise ValueError(f"accuracy must be 'exact' or 'preview', got {accuracy!r}")
     if accuracy == "preview":
@@ -165,7 +165,9 @@ def compute_spectrum(
             _all_zero_message(k, result, nulls, lam_typical), ZeroModesWarning, stacklevel=2
         )
     # modes above the accuracy well-shaped meshes reach: how close to rounding are they?
-    loose = np.flatnonzero(nonzero & (result.residuals > WELL_SHAPED_RESIDUAL))
+    loose = np.flatnonzero(
+        nonzero & (result.residuals > min(WELL_SHAPED_RESIDUAL, RESIDUAL_LIMIT))
+    )
     floors_loose = (
         rounding_floors(K, mass, result.eigenvalues[loose], result.vectors[:, loose])
         if loose.size
