@@ -26,6 +26,7 @@ from .eigen import CancelFn, ProgressFn
 from .mesh import Mesh, MeshReport
 from .pipeline import compute_spectrum
 from .spectrum import Spectrum
+from .validate import check_count
 
 __all__ = [
     "ComponentSpectrum",
@@ -123,6 +124,8 @@ def compute_spectrum_per_component(
     largest area first (arguments as :func:`~modalviewer.core.pipeline.compute_spectrum`;
     k is capped at each component's unknowns).  Progress runs from 0 to 1 over all
     components, weighted by their vertex counts."""
+    k = check_count(k, "k")
+    min_vertices = check_count(min_vertices, "min_vertices", 0)
     parts = [(m, v) for m, v in split_components(mesh) if m.n_vertices >= min_vertices]
     if not parts:
         raise ValueError(f"no component has at least {min_vertices} vertices")

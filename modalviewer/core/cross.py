@@ -43,6 +43,7 @@ by more than 5 %.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,6 +51,10 @@ import numpy as np
 from .mesh import Mesh
 from .signatures import SignatureTable, default_times, normalised_signatures
 from .spectrum import Spectrum
+from .validate import check_count, check_t_range, check_vertex, check_vertices
+
+TRange = Sequence[float] | np.ndarray | None
+Vertices = int | Sequence[int] | np.ndarray
 
 __all__ = [
     "CrossTables",
@@ -104,16 +109,14 @@ def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
 
 
 def common_times(
-    spec_a: Spectrum, spec_b: Spectrum, t_range=None, samples: int = 100
+    spec_a: Spectrum, spec_b: Spectrum, t_range: TRange = None, samples: int = 100
 ) -> np.ndarray:
     """(samples,) log-spaced scales shared by both spectra.
 
     ``t_range`` (t1, t2) if given, else the intersection of the two default ranges
     (see the module docstring).  Raises ValueError if they do not overlap.
     """
-    samples = int(samples)
-    if samples < 2:
-        raise ValueError("at least 2 scale samples are needed")
+    samples = check_count(samples, "samples", 2)
     if t_range is None:
         ta, tb = default_times(spec_a, 2), default_times(spec_b, 2)
         t1, t2 = max(ta[0], tb[0]), min(ta[-1], tb[-1])
@@ -124,20 +127,8 @@ def common_times(
                 "size (rescale both to the same area) or pass t_range"
             )
     else:
-        t1, t2 = (float(t) for t in t_range)
-        if not (0 < t1 < t2):
-            raise ValueError("the scale range needs 0 < t1 < t2")
+        t1, t2 = check_t_range(t_range)
     return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
-
-
-def _vertices(vertices, n: int, name: str) -> np.ndarray:
-    idx = np.atleast_1d(np.asarray(vertices))
-    if idx.ndim != 1 or idx.size == 0 or not np.issubdtype(idx.dtype, np.integer):
-        raise ValueError(f"{name} must be one vertex index or a non-empty list of them")
-    bad = idx[(idx < 0) | (idx >= n)]
-    if bad.size:
-        raise IndexError(f"{name}: vertex {int(bad[0])} out of range 0..{n - 1}")
-    return idx.astype(np.int64)
 
 
 class CrossTables:
@@ -156,7 +147,7 @@ class CrossTables:
         self,
         spec_a: Spectrum,
         spec_b: Spectrum,
-        t_range=None,
+        t_range: TRange = None,
         samples: int = 100,
         include_zero: bool = False,
     ):
@@ -169,21 +160,23 @@ class CrossTables:
 
     def a_to_b(self, vertex: int) -> np.ndarray:
         """(n_b,) distance from vertex ``vertex`` of A to every vertex of B."""
-        v = int(_vertices(vertex, self.a.table.shape[0], "vertex")[0])
+        v = check_vertex(vertex, self.a.table.shape[0])
         return self.b.distance_to(self.a.table[v])
 
     def b_to_a(self, vertex: int) -> np.ndarray:
         """(n_a,) distance from vertex ``vertex`` of B to every vertex of A."""
-        w = int(_vertices(vertex, self.b.table.shape[0], "vertex")[0])
+        w = check_vertex(vertex, self.b.table.shape[0])
         return self.a.distance_to(self.b.table[w])
 
-    def mutual_best_matches(self, vertices_a, vertices_b=None) -> Matches:
+    def mutual_best_matches(
+        self, vertices_a: Vertices, vertices_b: Vertices | None = None
+    ) -> Matches:
         """See :func:`mutual_best_matches`."""
-        va = _vertices(vertices_a, self.a.table.shape[0], "vertices_a")
+        va = check_vertices(vertices_a, self.a.table.shape[0], "vertices_a")
         vb = (
             None
             if vertices_b is None
-            else _vertices(vertices_b, self.b.table.shape[0], "vertices_b")
+            else check_vertices(vertices_b, self.b.table.shape[0], "vertices_b")
         )
         matches_b = np.empty(len(va), np.int64)
         distances = np.empty(len(va))
@@ -223,7 +216,7 @@ def cross_distance(
     spec_a: Spectrum,
     vertex: int,
     spec_b: Spectrum,
-    t_range=None,
+    t_range: TRange = None,
     samples: int = 100,
     include_zero: bool = False,
 ) -> np.ndarray:
@@ -236,7 +229,7 @@ def cross_distance(
     left out unless ``include_zero``.  Computed on the meshes as given: see the module
     docstring on scale and :func:`rescale_to_area`.
     """
-    v = int(_vertices(vertex, spec_a.n_vertices, "vertex")[0])
+    v = check_vertex(vertex, spec_a.n_vertices)
     _check_pair(spec_a, spec_b)
     times = common_times(spec_a, spec_b, t_range, samples)
     table_b = SignatureTable(spec_b, (times[0], times[-1]), len(times), include_zero)
@@ -248,7 +241,7 @@ def best_match(
     spec_a: Spectrum,
     vertex: int,
     spec_b: Spectrum,
-    t_range=None,
+    t_range: TRange = None,
     samples: int = 100,
     include_zero: bool = False,
 ) -> tuple[int, float]:
@@ -260,10 +253,10 @@ def best_match(
 
 def mutual_best_matches(
     spec_a: Spectrum,
-    vertices_a,
+    vertices_a: Vertices,
     spec_b: Spectrum,
-    vertices_b=None,
-    t_range=None,
+    vertices_b: Vertices | None = None,
+    t_range: TRange = None,
     samples: int = 100,
     include_zero: bool = False,
 ) -> Matches:
@@ -279,9 +272,9 @@ def mutual_best_matches(
     return tables.mutual_best_matches(vertices_a, vertices_b)
 
 
-def distance_ranks(distances: np.ndarray, vertices) -> np.ndarray:
+def distance_ranks(distances: np.ndarray, vertices: Vertices) -> np.ndarray:
     """1-based rank of each of ``vertices`` in a distance map: 1 + the number of
     vertices strictly closer (rank 1 = best match, ties share the better rank)."""
     d = np.asarray(distances, dtype=np.float64)
-    idx = _vertices(vertices, d.shape[0], "vertices")
+    idx = check_vertices(vertices, d.shape[0])
     return 1 + np.sum(d[None, :] < d[idx, None], axis=1)

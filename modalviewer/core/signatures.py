@@ -7,9 +7,12 @@ the vibration signature (3-vector shells modes) share one formula,
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from .spectrum import Spectrum
+from .validate import check_count, check_t_range, check_times, check_vertex, check_vertices
 
 __all__ = ["default_times", "signature", "multiscale_distance", "SignatureTable"]
 
@@ -23,6 +26,7 @@ def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
 
 def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False) -> np.ndarray:
     """(T,) log-spaced scales from 4 ln 10 / lambda_max to 4 ln 10 / lambda_min (non-zero)."""
+    samples = check_count(samples, "samples", 2)
     lam = spec.eigenvalues[~spec.zero_mode_mask()]
     if lam.size == 0:
         raise ValueError("the spectrum has no non-zero modes; compute more modes")
@@ -31,8 +35,16 @@ def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False
     return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
 
 
-def signature(spec: Spectrum, times=None, include_zero: bool = False, vertices=None):
+def signature(
+    spec: Spectrum,
+    times: float | Sequence[float] | np.ndarray | None = None,
+    include_zero: bool = False,
+    vertices: int | Sequence[int] | np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Signature at every vertex (or at ``vertices``) and scale.
+
+    ``times`` must be positive and finite, ``vertices`` integer indices in
+    ``0..n-1`` (TypeError, ValueError or IndexError otherwise).
 
     Returns
     -------
@@ -41,7 +53,9 @@ def signature(spec: Spectrum, times=None, include_zero: bool = False, vertices=N
     """
     mask = _used(spec, include_zero)
     times = default_times(spec, include_zero=include_zero) if times is None else times
-    times = np.atleast_1d(np.asarray(times, dtype=np.float64))
+    times = check_times(times)
+    if vertices is not None:
+        vertices = check_vertices(vertices, spec.n_vertices, allow_empty=True)
     lam = spec.eigenvalues[mask]
     weights = np.exp(-np.outer(lam, times))  # (k, T)
     values = spec.squared_modes(vertices)[:, mask] @ weights
@@ -67,15 +81,20 @@ class SignatureTable:
     each query then costs O(n T).
     """
 
-    def __init__(self, spec: Spectrum, t_range=None, samples: int = 100, include_zero=False):
-        self.t_range = None if t_range is None else (float(t_range[0]), float(t_range[1]))
+    def __init__(
+        self,
+        spec: Spectrum,
+        t_range: Sequence[float] | np.ndarray | None = None,
+        samples: int = 100,
+        include_zero: bool = False,
+    ):
+        samples = check_count(samples, "samples", 2)
+        self.t_range = None if t_range is None else check_t_range(t_range)
         """The scale range asked for (None: the default range, see :attr:`times`)."""
-        if t_range is None:
+        if self.t_range is None:
             times = default_times(spec, samples, include_zero)
         else:
-            t1, t2 = (float(t) for t in t_range)
-            if not (0 < t1 < t2) or samples < 2:
-                raise ValueError("the scale range needs 0 < t1 < t2 and at least 2 samples")
+            t1, t2 = self.t_range
             times = np.exp(np.linspace(np.log(t1), np.log(t2), samples))
         self.times = times
         self.table = normalised_signatures(spec, times, include_zero)
@@ -98,7 +117,7 @@ class SignatureTable:
         (distance below 1e-3 of the signature norms) the entries are recomputed directly,
         so near-zero distances keep full relative accuracy and d(v, v) = 0 exactly.
         """
-        return self.distance_to(self.table[vertex])
+        return self.distance_to(self.table[check_vertex(vertex, self.table.shape[0])])
 
     def distance_to(self, row: np.ndarray) -> np.ndarray:
         """(n,) distance from a normalised signature ``row`` (T,) to every vertex.
@@ -118,14 +137,16 @@ class SignatureTable:
 
 
 def multiscale_distance(
-    spec: Spectrum, vertex: int, t_range=None, samples: int = 100, include_zero: bool = False
+    spec: Spectrum,
+    vertex: int,
+    t_range: Sequence[float] | np.ndarray | None = None,
+    samples: int = 100,
+    include_zero: bool = False,
 ) -> np.ndarray:
     """(n,) distance delta_[t1,t2](vertex, w) of eq. (31) to every vertex w.
 
     A Riemann sum over ``samples`` log-spaced scales in ``t_range`` (default:
     :func:`default_times`), each difference normalised by ``Z(t) = sum_j exp(-lambda_j t)``.
     """
-    n = spec.n_vertices
-    if not (0 <= int(vertex) < n):
-        raise IndexError(f"vertex {vertex} out of range 0..{n - 1}")
-    return SignatureTable(spec, t_range, samples, include_zero).distance_from(int(vertex))
+    vertex = check_vertex(vertex, spec.n_vertices)
+    return SignatureTable(spec, t_range, samples, include_zero).distance_from(vertex)
