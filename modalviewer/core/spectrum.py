@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import numpy as np
 
 from .eigen import zero_modes
 from .files import atomic_write
+from .mesh import Mesh
 from .operators import OPERATOR_NAMES, operator_info
 
 __all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
@@ -44,6 +46,17 @@ class Spectrum:
     residuals: np.ndarray
     mesh_hash: str = ""
     parameters: dict = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        """One line: operator, k, vertices, the modes' shape ((n, 3, k) for vector modes,
+        (n, k) for scalar ones), the eigenvalue range, preview or exact (not the arrays)."""
+        lam = self.eigenvalues
+        span = f"{lam.min():.3g} .. {lam.max():.3g}" if lam.size else "none"
+        return (
+            f"Spectrum(operator={self.operator!r}, k={self.k}, n_vertices={self.n_vertices}, "
+            f"modes={tuple(self.modes.shape)}, "
+            f"eigenvalues={span}, {'preview' if self.is_preview else 'exact'})"
+        )
 
     @property
     def k(self) -> int:
@@ -117,7 +130,7 @@ def _atomic_write(path: Path, write) -> None:
     atomic_write(Path(path), to_file, suffix=".part")
 
 
-def save_spectrum(spec: Spectrum, path) -> None:
+def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
     """Write ``spec`` to ``path`` (.npz) atomically, with mesh hash and parameters."""
     meta = {
         "format": "modalviewer-spectrum",
@@ -140,11 +153,29 @@ def save_spectrum(spec: Spectrum, path) -> None:
     _atomic_write(Path(path), write)
 
 
-def load_spectrum(path, mesh_hash: str | None = None) -> Spectrum:
+def load_spectrum(
+    path: str | os.PathLike,
+    mesh: Mesh | None = None,
+    mesh_hash: str | None = None,
+) -> Spectrum:
     """Read a spectrum written by :func:`save_spectrum`.
 
-    If ``mesh_hash`` is given, a spectrum of another mesh raises SpectrumFileError.
+    If ``mesh`` (a :class:`Mesh`) or ``mesh_hash`` (its ``mesh.hash``, a keyword) is
+    given, a spectrum of another mesh raises SpectrumFileError.  A string passed as
+    ``mesh`` raises TypeError: pass a hash as ``mesh_hash=``.
     """
+    if mesh is not None:
+        if isinstance(mesh, (str, bytes)):
+            raise TypeError(
+                "mesh must be a Mesh; to check against a hash string pass mesh_hash=..."
+            )
+        if not isinstance(mesh, Mesh):
+            raise TypeError(f"mesh must be a Mesh, got {type(mesh).__name__}")
+        if mesh_hash is not None:
+            raise TypeError("pass mesh or mesh_hash, not both")
+        mesh_hash = mesh.hash
+    elif mesh_hash is not None and not isinstance(mesh_hash, str):
+        raise TypeError(f"mesh_hash must be a string (mesh.hash), got {type(mesh_hash).__name__}")
     try:
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
