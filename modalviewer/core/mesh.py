@@ -4,6 +4,17 @@ A :class:`Mesh` holds ``vertices`` (n, 3) float64 and ``faces`` (m, 3) int64 and
 immutable after construction.  Construction validates; it never repairs.  Repairs
 (merging duplicates, collapsing zero-area faces, re-orienting) happen only in
 :func:`repair_mesh`, which returns a new mesh and a report in plain words.
+
+Vertex numbers of the file.  The mesh the operators use is compact: a vertex no face
+uses is dropped (it would have no area, so the mass matrix would be singular) and
+duplicates are merged, so vertex i of the mesh need not be vertex i of the file.  The
+mesh carries the map back: :attr:`Mesh.file_vertices` (for each mesh vertex its file
+index; for merged vertices the first), :attr:`Mesh.n_file_vertices` and
+:attr:`Mesh.file_to_mesh` (for each file vertex its mesh vertex, -1 where no face uses
+it).  Every vertex number a user sees or types (picks, ``--vertex``, CSV rows, sessions,
+exports) is the file's: convert with :meth:`Mesh.mesh_vertex`, :meth:`Mesh.file_vertex`
+and :meth:`Mesh.to_file_field`.  Without a map (nothing dropped) the maps are the
+identity.
 """
 
 from __future__ import annotations
@@ -97,6 +108,13 @@ class Mesh:
     faces : array_like, shape (m, 3)
         Vertex indices of each triangle; converted to int64.
 
+    report : MeshReport, optional
+        What loading found and repaired.
+    file_map : array_like, shape (n_file,), optional
+        For each vertex of the file the mesh was read from, its vertex in this mesh, or
+        -1 where the file's vertex is used by no face (see :attr:`file_to_mesh`).  Every
+        mesh vertex must appear.  None: the mesh's numbering is the file's.
+
     Raises
     ------
     MeshError
@@ -104,7 +122,9 @@ class Mesh:
         range, a face repeats a vertex or has zero area.
     """
 
-    def __init__(self, vertices, faces, report: MeshReport | None = None):
+    def __init__(
+        self, vertices, faces, report: MeshReport | None = None, file_map: np.ndarray | None = None
+    ):
         try:
             v = np.array(vertices, dtype=np.float64, copy=True)
             f_raw = np.asarray(faces)
@@ -145,6 +165,19 @@ class Mesh:
                 f"{int(np.flatnonzero(degenerate)[0])}); repair_mesh (or load_mesh) collapses them"
             )
         self.report = report if report is not None else MeshReport()
+        self._file_map = None
+        if file_map is not None:
+            fm = np.array(file_map, dtype=np.int64, copy=True).reshape(-1)
+            n = len(v)
+            if fm.size and (fm.min() < -1 or fm.max() >= n):
+                raise MeshError("file_map refers to vertices the mesh does not have")
+            hit = np.zeros(n, dtype=bool)
+            hit[fm[fm >= 0]] = True
+            if not hit.all():
+                raise MeshError("file_map leaves a mesh vertex without a vertex of the file")
+            if not (len(fm) == n and np.array_equal(fm, np.arange(n))):
+                fm.setflags(write=False)
+                self._file_map = fm
 
     # ------------------------------------------------------------------ basics
     @property
@@ -167,6 +200,107 @@ class Mesh:
 
     def __repr__(self) -> str:
         return f"Mesh(n_vertices={self.n_vertices}, n_faces={self.n_faces})"
+
+    # --------------------------------------------------- the file's numbering
+    @property
+    def file_map(self) -> np.ndarray | None:
+        """:attr:`file_to_mesh`, or None where the numbering is the file's (identity):
+        pass it as ``file_map`` to a new Mesh with the same vertices in the same order."""
+        return self._file_map
+
+    @property
+    def renumbered(self) -> bool:
+        """True if vertex i of this mesh is not always vertex i of the file."""
+        return self._file_map is not None
+
+    @property
+    def n_file_vertices(self) -> int:
+        """Number of vertices in the file (used or not)."""
+        return self.n_vertices if self._file_map is None else len(self._file_map)
+
+    @property
+    def file_to_mesh(self) -> np.ndarray:
+        """(n_file,) int64: each file vertex's mesh vertex, -1 where no face uses it
+        (merged duplicates share their mesh vertex)."""
+        if self._file_map is None:
+            return np.arange(self.n_vertices)
+        return self._file_map
+
+    @cached_property
+    def _first_file_vertex(self) -> np.ndarray:
+        fm = self._file_map
+        out = np.full(self.n_vertices, len(fm), dtype=np.int64)
+        used = np.flatnonzero(fm >= 0)
+        np.minimum.at(out, fm[used], used)
+        out.setflags(write=False)
+        return out
+
+    @property
+    def file_vertices(self) -> np.ndarray:
+        """(n,) int64: each mesh vertex's index in the file (for merged duplicates the
+        first of them)."""
+        if self._file_map is None:
+            return np.arange(self.n_vertices)
+        return self._first_file_vertex
+
+    def file_vertex(self, index: int) -> int:
+        """The file's number of mesh vertex ``index`` (the first of merged duplicates)."""
+        index = int(index)
+        if not 0 <= index < self.n_vertices:
+            raise MeshError(
+                f"mesh vertex {index} does not exist (the mesh has "
+                f"{_plural(self.n_vertices, 'vertex')})"
+            )
+        return index if self._file_map is None else int(self._first_file_vertex[index])
+
+    def mesh_vertex(self, file_index: int) -> int:
+        """The mesh vertex of vertex ``file_index`` of the file.
+
+        Raises
+        ------
+        MeshError
+            If the file has no such vertex, or no face uses it (it was dropped, so
+            distances and modes are undefined there).
+        """
+        file_index = int(file_index)
+        n = self.n_file_vertices
+        if not 0 <= file_index < n:
+            raise MeshError(
+                f"vertex {file_index} is not in the file (it has {_plural(n, 'vertex')}, "
+                f"numbered 0 to {n - 1})"
+            )
+        if self._file_map is None:
+            return file_index
+        mesh_index = int(self._file_map[file_index])
+        if mesh_index < 0:
+            raise MeshError(
+                f"vertex {file_index} of the file is used by no face; its distances are undefined"
+            )
+        return mesh_index
+
+    def to_file_field(self, values) -> np.ndarray:
+        """A per-vertex array (n, ...) in the file's numbering (n_file, ...): float, NaN
+        at file vertices no face uses; merged duplicates share their value."""
+        a = np.asarray(values)
+        if a.shape[:1] != (self.n_vertices,):
+            raise ValueError(
+                f"expected {self.n_vertices} values (one per mesh vertex), got shape {a.shape}"
+            )
+        if self._file_map is None:
+            return a.astype(np.float64) if not np.issubdtype(a.dtype, np.floating) else a
+        fm = self._file_map
+        out = np.full((len(fm), *a.shape[1:]), np.nan, dtype=np.result_type(a.dtype, np.float64))
+        used = fm >= 0
+        out[used] = a[fm[used]]
+        return out
+
+    def file_map_after(self, new_of_old: np.ndarray) -> np.ndarray | None:
+        """The ``file_map`` of a mesh made from this one whose vertex ``new_of_old[i]``
+        is this mesh's vertex i (-1 for vertices it does not keep)."""
+        new_of_old = np.asarray(new_of_old, dtype=np.int64)
+        fm = self.file_to_mesh
+        out = np.where(fm >= 0, new_of_old[np.maximum(fm, 0)], -1)
+        return out
 
     @cached_property
     def hash(self) -> str:
@@ -301,6 +435,17 @@ class Mesh:
         return None
 
 
+_LISTED = 10  # vertex numbers a report lists before "and N more"
+
+
+def _listing(items: list[str], total: int) -> str:
+    """'vertex 3' or 'vertices 3, 7 and 2 more'."""
+    text = ", ".join(items)
+    if total > len(items):
+        text += f" and {total - len(items)} more"
+    return ("vertex " if total == 1 else "vertices ") + text
+
+
 def _unique_index_rows(rows: np.ndarray, **kwargs):
     """``np.unique(rows, axis=0, **kwargs)`` for non-negative integer rows, through one
     int64 key per row: a 1-D sort, about 20 times faster than the row-wise unique (3.6 s
@@ -336,7 +481,7 @@ def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
     new_v = v[first[order]]
-    return new_v, rank[inverse][f], len(v) - len(new_v)
+    return new_v, rank[inverse][f], len(v) - len(new_v), rank[inverse]
 
 
 def _double_areas(v: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -425,10 +570,12 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
     or none can be collapsed.
 
     Returns (faces, number of flipped edges, number of collapsed edges, faces removed
-    along the boundary, largest move, faces still of zero area).
+    along the boundary, largest move, faces still of zero area, (n,) vertex each vertex
+    was merged into: itself where none).
     """
     n = len(v)
     f = f.copy()
+    merged_into = np.arange(n)
     collapsed, flipped, dropped, largest = 0, 0, 0, 0.0
     for _ in range(max_rounds):
         zero = np.flatnonzero(0.5 * _double_areas(v, f) <= min_area)
@@ -519,10 +666,11 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
             break
         collapsed += merged
         dropped += int(drop.sum())
+        merged_into = remap[merged_into]
         f = remap[f[~drop]]
         f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
     left = int((0.5 * _double_areas(v, f) <= min_area).sum()) if len(f) else 0
-    return f, flipped, collapsed, dropped, largest, left
+    return f, flipped, collapsed, dropped, largest, left, merged_into
 
 
 def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
@@ -593,6 +741,12 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     drop unreferenced vertices, make the orientation consistent per component where
     possible.
 
+    The result is compact (no vertex without a face, so the mass matrix is positive
+    definite) and carries the map to the file's numbering (``vertices`` is the file's):
+    :attr:`Mesh.file_vertices`, :attr:`Mesh.file_to_mesh`; merged duplicates and
+    vertices merged by a collapse map to the vertex they were merged into, unreferenced
+    ones to -1.  The report names vertices by the file's numbers.
+
     Returns
     -------
     Mesh
@@ -617,9 +771,18 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if diag == 0:
         raise MeshError("all vertices coincide: the mesh has no extent")
 
-    v, f, merged = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
+    n_file = len(v)
+    v, f, merged, file_map = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
     if merged:
-        report.add(f"Merged {_plural(merged, 'duplicate vertex')}.")
+        first = np.full(len(v), n_file, dtype=np.int64)
+        np.minimum.at(first, file_map, np.arange(n_file))
+        dup = np.flatnonzero(first[file_map] != np.arange(n_file))
+        pairs = [f"{int(i)} into {int(first[file_map[i]])}" for i in dup[:_LISTED]]
+        report.add(
+            f"Merged {_plural(merged, 'duplicate vertex')} (the file's "
+            + _listing(pairs, len(dup))
+            + ")."
+        )
 
     repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
     if repeated.any():
@@ -633,9 +796,10 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     min_area = 1e-14 * diag**2
     n_collapsed = 0
     if len(f) and np.any(0.5 * _double_areas(v, f) <= min_area):
-        f, n_flipped, n_collapsed, dropped, largest, left = _collapse_zero_area_faces(
+        f, n_flipped, n_collapsed, dropped, largest, left, merged_into = _collapse_zero_area_faces(
             v, f, min_area
         )
+        file_map = merged_into[file_map]
         if n_flipped:
             report.add(
                 f"Flipped the longest edge of {_plural(n_flipped, 'degenerate (zero-area) face')}"
@@ -666,11 +830,17 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     used = np.zeros(len(v), dtype=bool)
     used[f.ravel()] = True
     if not used.all():
-        remap = np.cumsum(used) - 1
-        unreferenced = int((~used).sum()) - n_collapsed  # merged ones are said above
-        if unreferenced > 0:
-            report.add(f"Removed {_plural(unreferenced, 'unreferenced vertex')}.")
+        remap = np.where(used, np.cumsum(used) - 1, -1)
+        file_map = remap[file_map]
         v, f = v[used], remap[f]
+    unreferenced = np.flatnonzero(file_map < 0)  # merged ones are said above
+    if len(unreferenced):
+        report.add(
+            f"Removed {_plural(len(unreferenced), 'unreferenced vertex')} (no face uses "
+            "them; the file's "
+            + _listing([str(int(i)) for i in unreferenced[:_LISTED]], len(unreferenced))
+            + "; vertex numbers shown stay the file's)."
+        )
 
     f, flipped, orientable = _orient_faces(f)
     if flipped:
@@ -678,7 +848,7 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if not orientable:
         report.add("The surface is not orientable, so some faces disagree in orientation.")
 
-    mesh = Mesh(v, f, report=report)
+    mesh = Mesh(v, f, report=report, file_map=file_map)
     summary = (
         f"{_plural(mesh.n_vertices, 'vertex')}, {_plural(mesh.n_faces, 'face')}, "
         f"{_plural(mesh.n_components, 'component')}"
