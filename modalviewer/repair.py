@@ -180,6 +180,11 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         Hausdorff distance between the two surfaces, at their vertices (both relative
         to the bounding-box diagonal).
 
+        Where nothing was changed the result keeps the input's map to the file's vertex
+        numbers (:attr:`~modalviewer.core.mesh.Mesh.file_to_mesh`); a repaired mesh has
+        new vertex numbers (MeshLab renumbers, removes and adds vertices), so it has no
+        map (its numbering is its own) and its report says so.
+
     Raises
     ------
     MeshError
@@ -200,7 +205,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         worst_quality_before=float(q0.min()),
     )
     if report.below_min_quality_before == 0:
-        out = Mesh(v0, f0, report=report)
+        out = Mesh(v0, f0, report=report, file_map=mesh.file_map)
         report.triangles_after = mesh.n_faces
         report.below_min_quality_after = 0
         report.worst_quality_after = report.worst_quality_before
@@ -302,6 +307,10 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     report.seconds = time.perf_counter() - started
     if progress is not None:
         progress("done", 1.0)
+    report.add(
+        "The repair numbers the vertices anew: vertex numbers (picks, --vertex, CSV rows, "
+        "sessions) are now the repaired mesh's, not the file's."
+    )
     report.messages.insert(
         0,
         f"Changed {report.triangles_changed} of {_plural(report.triangles_before, 'triangle')}"

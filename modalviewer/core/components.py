@@ -47,7 +47,9 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
 
     ``vertices`` (n_c,) are the component's vertex indices in ``mesh``: row i of the
     component's arrays belongs to vertex ``vertices[i]`` of ``mesh`` (ascending, so the
-    component keeps the original vertex order).
+    component keeps the original vertex order).  Each component keeps the map to the
+    file's vertex numbers (:attr:`~modalviewer.core.mesh.Mesh.file_to_mesh`): the file's
+    vertices of other components map to -1 in it.
     """
     labels = mesh.component_labels
     face_label = labels[mesh.faces[:, 0]]
@@ -60,14 +62,17 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
         remap = np.full(mesh.n_vertices, -1, dtype=np.int64)
         remap[vertices] = np.arange(len(vertices))
         faces = remap[mesh.faces[face_label == c]]
-        out.append((Mesh(mesh.vertices[vertices], faces), vertices))
+        out.append(
+            (Mesh(mesh.vertices[vertices], faces, file_map=mesh.file_map_after(remap)), vertices)
+        )
     return out
 
 
 def largest_component(mesh: Mesh) -> Mesh:
     """A new mesh of the component with the largest area; ``result.report`` says what
     was removed (the input's report messages come first).  A mesh with one component is
-    returned as a copy with the report saying so."""
+    returned as a copy with the report saying so.  Vertex numbers stay the file's
+    (the removed components' vertices are, for the result, used by no face)."""
     report = MeshReport(source=mesh.report.source, messages=list(mesh.report.messages))
     parts = split_components(mesh)
     kept, vertices = parts[0]
@@ -83,7 +88,7 @@ def largest_component(mesh: Mesh) -> Mesh:
             f"{_plural(len(parts) - 1, 'component')} with {_plural(dropped_v, 'vertex')} "
             f"and {_plural(dropped_f, 'face')}."
         )
-    return Mesh(kept.vertices, kept.faces, report=report)
+    return Mesh(kept.vertices, kept.faces, report=report, file_map=kept.file_map)
 
 
 @dataclass

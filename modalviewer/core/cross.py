@@ -85,7 +85,7 @@ def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
     if not (np.isfinite(area) and area > 0):
         raise ValueError(f"the target area must be a positive number, got {area}")
     factor = np.sqrt(area / mesh.total_area)
-    return Mesh(mesh.vertices * factor, mesh.faces, report=mesh.report)
+    return Mesh(mesh.vertices * factor, mesh.faces, report=mesh.report, file_map=mesh.file_map)
 
 
 def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:

@@ -110,7 +110,9 @@ class _Side:
             # differently in the last bit), so the main window's unit-area spectra and
             # this pair's share their disk cache entries
             m = self.mesh
-            self.unit_mesh = Mesh(m.vertices * (1.0 / np.sqrt(m.total_area)), m.faces, m.report)
+            self.unit_mesh = Mesh(
+                m.vertices * (1.0 / np.sqrt(m.total_area)), m.faces, m.report, m.file_map
+            )
         return self.unit_mesh
 
 

@@ -116,7 +116,8 @@ def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
     job_path, out_path = _temp_path(".pickle"), _temp_path(".pickle")
     try:
         with open(job_path, "wb") as fh:
-            pickle.dump((name, np.asarray(mesh.vertices), np.asarray(mesh.faces), mesh.report), fh)
+            job = (name, np.asarray(mesh.vertices), np.asarray(mesh.faces), mesh.report)
+            pickle.dump((*job, mesh.file_map), fh)  # the map to the file's vertex numbers
         _run_child(
             ["modalviewer.viewer.repair_main", job_path, out_path], progress, cancel, "repair"
         )

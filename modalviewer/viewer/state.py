@@ -279,7 +279,12 @@ class ViewerState:
         if not rescale:
             return self.mesh
         factor = 1.0 / np.sqrt(self.mesh.total_area)
-        return Mesh(self.mesh.vertices * factor, self.mesh.faces, report=self.mesh.report)
+        return Mesh(
+            self.mesh.vertices * factor,
+            self.mesh.faces,
+            report=self.mesh.report,
+            file_map=self.mesh.file_map,
+        )
 
     # ---------------------------------------------------------- spectra
     def add_spectrum(self, key: SpectrumKey, spec: Spectrum, table=None) -> None:
