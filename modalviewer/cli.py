@@ -102,7 +102,13 @@ def build_parser() -> argparse.ArgumentParser:
         "distance", help="distance from a vertex to all vertices (of a second mesh with --to)"
     )
     d.add_argument("mesh")
-    d.add_argument("--vertex", type=int, required=True)
+    d.add_argument(
+        "--vertex",
+        type=int,
+        required=True,
+        help="the vertex's number in the file (0-based, counting every vertex of the file, "
+        "also ones no face uses), as the viewer shows it",
+    )
     d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
     d.add_argument("-k", type=int, default=100)
     marked = d.add_mutually_exclusive_group()
@@ -126,7 +132,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument("--size", type=_size, default=(1024, 768))
     d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
-    d.add_argument("--csv", default=None, help="write vertex,distance rows")
+    d.add_argument(
+        "--csv",
+        default=None,
+        help="write vertex,distance rows: one per vertex of the file, numbered as in the "
+        "file, the distance empty where no face uses the vertex",
+    )
     d.add_argument(
         "--to",
         default=None,
@@ -239,9 +250,8 @@ def _run(args) -> int:
         _wrote(args.output, f"{_png(args.output)}, mode {args.mode}")
         win.close()
         return 0
-    # distance
-    if not 0 <= args.vertex < mesh.n_vertices:
-        raise ValueError(f"--vertex must be between 0 and {mesh.n_vertices - 1}")
+    # distance: --vertex and every vertex number printed or written are the file's
+    vertex = _mesh_vertex(mesh, args.vertex)
     if args.share is not None and not 0 < args.share <= 1:
         raise ValueError("--share is a share of the surface's area, in (0, 1]")
     if args.threshold is not None and not 0 < args.threshold < np.inf:
@@ -251,15 +261,15 @@ def _run(args) -> int:
     if args.rescale:
         raise ValueError("--rescale applies to two meshes (with --to)")
     spec = _cached_spectrum(mesh, KINDS[args.kind], args.k)
-    d = mv.multiscale_distance(spec, args.vertex)
+    d = mv.multiscale_distance(spec, vertex)
     marked = _threshold(args, mesh, d)
     if args.csv:
-        _write_csv(args.csv, d, f"{args.kind} distance from vertex {args.vertex}")
+        _write_csv(args.csv, mesh, d, f"{args.kind} distance from vertex {args.vertex}")
     if args.output:
         app, win = _window(args.size)
         win.set_mesh(mesh, Path(args.mesh))
         win.state.add_spectrum(win.state.compute_settings.key(spec.operator, spec.k), spec)
-        win.pick_vertex(args.vertex)
+        win.pick_vertex(vertex)
         display = "continuous" if marked is None else "threshold"
         fraction = None if marked is None else marked[0] / float(d.max())
         win.show_distance(args.kind, display=display, threshold=fraction)
@@ -269,7 +279,7 @@ def _run(args) -> int:
     order = np.argsort(d)[1:6]
     print(
         f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "
-        + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
+        + ", ".join(f"{mesh.file_vertex(i)} ({d[i]:.3g})" for i in order)
     )
     if marked is not None:
         print(
@@ -355,16 +365,27 @@ class _warnings_printed:
         return False
 
 
-def _write_csv(path, d: np.ndarray, what: str) -> None:
-    np.savetxt(
-        path,
-        np.column_stack([np.arange(len(d)), d]),
-        delimiter=",",
-        header="vertex,distance",
-        comments="",
-        fmt=["%d", "%.10g"],
-    )
-    _wrote(path, f"CSV, {len(d)} rows vertex,distance: {what}")
+def _mesh_vertex(mesh, number: int) -> int:
+    """The mesh vertex of ``--vertex number`` (the file's numbering)."""
+    from .core.mesh import MeshError
+
+    try:
+        return mesh.mesh_vertex(number)
+    except MeshError as exc:
+        raise ValueError(f"--vertex {number}: {exc}") from None
+
+
+def _write_csv(path, mesh, d: np.ndarray, what: str) -> None:
+    """Rows ``vertex,distance``, one per vertex of ``mesh``'s file in the file's numbering;
+    the distance is empty at a file vertex no face uses (merged duplicates share theirs)."""
+    values = mesh.to_file_field(d)
+    with open(path, "w", encoding="utf-8") as fh:
+        fh.write("vertex,distance\n")
+        for i, x in enumerate(values.tolist()):
+            fh.write(f"{i},{x:.10g}\n" if x == x else f"{i},\n")
+    unused = int(np.isnan(values).sum())
+    note = f", {unused} empty (vertices no face uses)" if unused else ""
+    _wrote(path, f"CSV, {len(values)} rows vertex,distance{note}: {what}")
 
 
 def _cached_spectrum(mesh, operator: str, k: int):
@@ -399,13 +420,18 @@ def _distance_to(args, mesh_a) -> int:
         tables = mv.CrossTables(spec_a, spec_b)
     for warning in caught:
         sys.stderr.write(f"modalviewer: warning: {warning.message} (or pass --rescale)\n")
-    d = tables.a_to_b(args.vertex)
-    best = int(np.argmin(d))
-    back = int(np.argmin(tables.b_to_a(best)))
+    vertex = _mesh_vertex(mesh_a, args.vertex)  # the file's numbers in, and out below
+    d = tables.a_to_b(vertex)
+    best_mesh = int(np.argmin(d))
+    back_mesh = int(np.argmin(tables.b_to_a(best_mesh)))
+    best, back = mesh_b.file_vertex(best_mesh), mesh_a.file_vertex(back_mesh)
     marked = _threshold(args, mesh_b, d)
     if args.csv:
         _write_csv(
-            args.csv, d, f"{args.kind} distance from vertex {args.vertex} of A to B's vertices"
+            args.csv,
+            mesh_b,
+            d,
+            f"{args.kind} distance from vertex {args.vertex} of A to B's vertices",
         )
     if args.output:
         from .cross_figure import Panel, render_panels
@@ -416,13 +442,13 @@ def _distance_to(args, mesh_a) -> int:
             Panel(
                 mesh_a,
                 f"{Path(args.mesh).name}: vertex {args.vertex}",
-                args.vertex,
+                vertex,
                 face_marker=True,
             ),
             Panel(
                 mesh_b,
                 f"{Path(args.to).name}: {label} distance, best match {best}",
-                marker=best,
+                marker=best_mesh,
                 distances=d,
                 display=display,
                 threshold=1.0 if marked is None else min(1.0, marked[0] / float(d.max())),
@@ -438,17 +464,17 @@ def _distance_to(args, mesh_a) -> int:
     print(
         f"{args.kind} distance from vertex {args.vertex} of {Path(args.mesh).name} to "
         f"{Path(args.to).name} (scales {tables.times[0]:.4g} .. {tables.times[-1]:.4g}): "
-        f"max {d.max():.6g}; best match {best} ({d[best]:.3g}), "
-        + ("mutual" if back == args.vertex else f"not mutual (its best match on A is {back})")
+        f"max {d.max():.6g}; best match {best} ({d[best_mesh]:.3g}), "
+        + ("mutual" if back_mesh == vertex else f"not mutual (its best match on A is {back})")
         + "; nearest "
-        + ", ".join(f"{i} ({d[i]:.3g})" for i in order)
+        + ", ".join(f"{mesh_b.file_vertex(i)} ({d[i]:.3g})" for i in order)
     )
     if marked is not None:
         # between two meshes even the best match is at a distance above zero
         print(
             f"threshold {marked[0]:.6g} ({marked[0] / d.max():.3g} of the largest distance): "
             f"{100 * marked[1]:.2f} % of {Path(args.to).name}'s area is at most that far (the "
-            f"best match is at {d[best] / d.max():.3g} of the largest)"
+            f"best match is at {d[best_mesh] / d.max():.3g} of the largest)"
         )
     return 0
 
