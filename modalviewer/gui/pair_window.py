@@ -337,9 +337,11 @@ class PairWindow(QtWidgets.QWidget):
         match = p.best_match()
         if match is not None:
             side, w, dist = match
-            text = f"Best match on {side.upper()}: vertex {w} (distance {dist:.3g})"
+            fw = p.mesh(side).file_vertex(w)  # the files' vertex numbers
+            text = f"Best match on {side.upper()}: vertex {fw} (distance {dist:.3g})"
             back = p.back_match()
-            text += "; mutual" if back == p.picked[1] else f"; not mutual (back: vertex {back})"
+            fb = p.mesh(p.picked[0]).file_vertex(back)
+            text += "; mutual" if back == p.picked[1] else f"; not mutual (back: vertex {fb})"
         elif p.picked is None:
             text = "Click a point on A or on B."
         else:

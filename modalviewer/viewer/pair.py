@@ -463,20 +463,24 @@ class PairState:
             return plain
         _, w, dist = self.best_match()
         note = f"\n{self.note}" if self.note else ""
+        # labels give the files' vertex numbers; markers are mesh indices
+        fv = self.mesh(from_side).file_vertex(v)
         if from_side == side:
             back = self.back_match()
-            mutual = "mutual" if back == v else f"not mutual: back to vertex {back} (yellow)"
+            fb, fw = self.mesh(side).file_vertex(back), self.mesh(other(side)).file_vertex(w)
+            mutual = "mutual" if back == v else f"not mutual: back to vertex {fb} (yellow)"
             return PairView(
                 None,
                 "plain",
                 None,
                 v,
                 None if back == v else back,
-                f"{head}\npicked vertex {v}\nbest match on {other(side).upper()}: vertex {w}"
+                f"{head}\npicked vertex {fv}\nbest match on {other(side).upper()}: vertex {fw}"
                 f"\n{mutual}{note}",
             )
         d = self.distance_on(side)
-        source = f"from vertex {v} of {from_side.upper()}"
+        fw = self.mesh(side).file_vertex(w)
+        source = f"from vertex {fv} of {from_side.upper()}"
         if self.distance_display == "threshold":
             thr, share = self.threshold(side, d)
             similar = f"{name.lower()} < {thr:.3g} ({100 * share:.1f} %)"
@@ -487,7 +491,7 @@ class PairState:
                 w,
                 None,
                 f"{head}\nblue: {name.lower()} < {thr:.3g}, {100 * share:.1f} % of "
-                f"{side.upper()}\n{source}; best match vertex {w}{note}",
+                f"{side.upper()}\n{source}; best match vertex {fw}{note}",
                 f"{name} < {thr:.3g}",
                 [similar, "the rest"],
             )
@@ -498,6 +502,6 @@ class PairState:
             w,
             None,
             f"{head}\n{name} {source}: white 0 to red {float(d.max()):.3g}\n"
-            f"best match: vertex {w} (d = {dist:.3g}){note}",
+            f"best match: vertex {fw} (d = {dist:.3g}){note}",
             name,
         )

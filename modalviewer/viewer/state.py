@@ -14,7 +14,8 @@ changed the state (the GUI thread in the viewer):
 - ``spectra(operator)``: a spectrum of ``operator`` was added or replaced.
 - ``display()``: what is drawn changed (:class:`Display`), including the threshold.
 - ``style()``: isolines, colouring of 3D modes, colour bar, render style.
-- ``pick()``: the picked vertex changed.
+- ``pick()``: the picked vertex changed (:attr:`ViewerState.picked` is the mesh's index;
+  what is shown and saved is :attr:`ViewerState.picked_file_vertex`, the file's number).
 - ``compute_settings()``: operator, k, weights or options of the next computation.
 - ``scale_range()``: the distance scale range (t1, t2) changed.
 - ``animation()``: playing, amplitude or speed changed.
@@ -484,7 +485,26 @@ class ViewerState:
         ops = self.operators_computed()
         return ops[0] if ops else None
 
+    @property
+    def picked_file_vertex(self) -> int | None:
+        """The picked vertex's number in the file (what the viewer shows and sessions
+        store); :attr:`picked` is the mesh's (compact) index the computations use."""
+        if self.picked is None or self.mesh is None:
+            return None
+        return self.mesh.file_vertex(self.picked)
+
+    def set_pick_file_vertex(self, file_index: int | None) -> None:
+        """Pick vertex ``file_index`` of the file (MeshError, a ValueError, for one no
+        face uses or the file does not have)."""
+        if file_index is not None:
+            if self.mesh is None:
+                raise ValueError("no mesh is loaded")
+            file_index = self.mesh.mesh_vertex(file_index)
+        self.set_pick(file_index)
+
     def set_pick(self, vertex: int | None) -> None:
+        """Pick mesh vertex ``vertex`` (the mesh's index, as a click finds it; see
+        :meth:`set_pick_file_vertex` for the file's numbers)."""
         if vertex is not None:
             if self.mesh is None:
                 raise ValueError("no mesh is loaded")
@@ -778,7 +798,7 @@ class ViewerState:
             dist = self.distance_map()
             if dist is None:
                 return f"{name}: {self._missing_distance_reason(d.distance_kind)}"
-            source = f"from vertex {self.picked}"
+            source = f"from vertex {self.picked_file_vertex}"
             source += self.preview_note(operator_for_distance(d.distance_kind))
             if d.distance_display == "threshold":
                 thr = self.threshold_value(dist)
@@ -824,7 +844,7 @@ class ViewerState:
                 names = sorted({operator_info(key.operator).label for key in self.computing})
                 text += f"; computing {', '.join(names)} (Esc cancels)"
                 if self.picked is not None:
-                    text += f"; the map of vertex {self.picked} follows"
+                    text += f"; the map of vertex {self.picked_file_vertex} follows"
             elif not self.spectra:
                 text += "; compute a spectrum (Ctrl+R) or click the surface"
         return text

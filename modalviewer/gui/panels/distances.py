@@ -163,7 +163,9 @@ class DistancesPanel(QtWidgets.QWidget):
             self.pick_label.setText("Click the surface to pick a vertex.")
         else:
             x, y, z = state.mesh.vertices[state.picked]
-            self.pick_label.setText(f"Picked vertex {state.picked} at ({x:.4g}, {y:.4g}, {z:.4g})")
+            self.pick_label.setText(
+                f"Picked vertex {state.picked_file_vertex} at ({x:.4g}, {y:.4g}, {z:.4g})"
+            )
         self._update_range_placeholders()
         self._update_signature_plot()
 
