@@ -6,6 +6,11 @@ displayed: the display, pick, threshold, scale range, isolines, colouring, colou
 and camera.  Restoring it draws the same picture.  A mesh whose file changed on disk is
 opened all the same, with a note; what no longer fits (a picked vertex beyond the new
 mesh) is dropped with a note.
+
+Vertex numbers are the file's (version 2): ``picked`` is the picked vertex's number in
+the mesh file, whatever loading dropped or merged (see
+:attr:`modalviewer.core.mesh.Mesh.file_to_mesh`).  Version 1 sessions stored the
+mesh's compact index; they are read as such.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from .jobs import Job
 from .state import ComputeSettings, Display, SpectrumKey, ViewerState
 
 FORMAT = "modalviewer-session"
-VERSION = 1
+VERSION = 2  # 2: "picked" is the file's vertex number (1: the loaded mesh's index)
 
 
 class SessionError(ValueError):
@@ -55,12 +60,13 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
             "relative_path": relative,
             "hash": state.mesh.hash,
             "vertices": state.mesh.n_vertices,
+            "file_vertices": state.mesh.n_file_vertices,
             "repairs": list(state.mesh_repairs),
         },
         "spectra": [asdict(key) for key in state.spectra],
         "compute_settings": asdict(state.compute_settings),
         "display": asdict(state.display),
-        "picked": state.picked,
+        "picked": state.picked_file_vertex,  # the file's number
         "t_range": list(state.t_range) if state.t_range else None,
         "style": {
             "isolines": state.style.isolines,
@@ -155,7 +161,12 @@ def restore_session(model, path) -> Restored:
     if data.get("t_range"):
         state.set_scale_range(tuple(data["t_range"]))
     picked = data.get("picked")
-    if picked is not None:
+    if picked is not None and int(data.get("version", 1)) >= 2:
+        try:  # the file's vertex number
+            state.set_pick_file_vertex(int(picked))
+        except ValueError as exc:
+            out.notes.append(f"the picked vertex {picked}: {exc}; pick again")
+    elif picked is not None:  # version 1: the index in the mesh as loaded then
         if 0 <= int(picked) < mesh.n_vertices:
             state.set_pick(int(picked))
         else:

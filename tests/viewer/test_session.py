@@ -38,7 +38,7 @@ def test_a_restored_session_shows_the_same_picture(tmp_path):
     s.camera = {"position": [1, 2, 3], "focal_point": [0, 0, 0], "view_up": [0, 1, 0]}
     path = save_session(s, tmp_path / "a.json")
     data = json.loads(path.read_text())
-    assert data["version"] == 1 and data["mesh"]["hash"] == first.state.mesh.hash
+    assert data["version"] == 2 and data["mesh"]["hash"] == first.state.mesh.hash
 
     second = _model(tmp_path)  # same cache: the spectrum comes back from disk
     restored = restore_session(second, path)
