@@ -71,7 +71,11 @@ def save_screenshot(
 
 
 def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Path:
-    """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply."""
+    """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply.
+
+    The points are the mesh's: the file's vertices in the file's order, less those no
+    face uses (merged duplicates once).  Where that numbering differs from the file's,
+    a point-data array ``file_vertex`` gives each point's vertex number in the file."""
     import pyvista as pv
 
     path = Path(path)
@@ -82,6 +86,8 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
     poly = pv.PolyData(np.array(mesh.vertices), faces)
     for name, values in fields.items():
         poly.point_data[array_name(name)] = np.asarray(values)
+    if mesh.renumbered:
+        poly.point_data["file_vertex"] = np.asarray(mesh.file_vertices)
     return atomic_write(path, lambda tmp: poly.save(tmp, binary=True))
 
 
