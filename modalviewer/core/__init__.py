@@ -20,6 +20,7 @@ from .cross import (
 from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
 from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
+from .local_signature import local_signature
 from .mesh import Mesh, MeshError, MeshReport, repair_mesh
 from .pipeline import ZeroModesWarning, compute_spectrum
 from .shells import normal_shells_hessian, shells_hessian
@@ -53,6 +54,7 @@ __all__ = [
     "ZeroModesWarning",
     "default_times",
     "load_spectrum",
+    "local_signature",
     "mass_matrix",
     "modified_dirichlet_matrix",
     "multiscale_distance",
