@@ -121,6 +121,7 @@ class CompareWindow(QtWidgets.QWidget):
     def show_distance(self) -> None:
         """Each kind's distance from the main window's picked vertex."""
         vertex = self.state.picked
+        shown = self.state.picked_file_vertex  # the titles give the file's number
         display = self.state.display
         # every kind marks the share of the surface the main window's map marks (without
         # one, the share its threshold maps keep: DEFAULT_THRESHOLD_SHARE at first)
@@ -148,11 +149,11 @@ class CompareWindow(QtWidgets.QWidget):
                 scene.show_threshold(d, thr, name=_label(item))
                 marked = 100.0 * self.state.surface_share(d, thr)
                 title.setText(
-                    f"{_label(item)} from vertex {vertex}: blue < {thr:.3g} ({marked:.1f} %)" + mark
+                    f"{_label(item)} from vertex {shown}: blue < {thr:.3g} ({marked:.1f} %)" + mark
                 )
             else:
                 scene.show_field(d, "sequential", name=_label(item))
-                title.setText(f"{_label(item)} from vertex {vertex}{mark}")
+                title.setText(f"{_label(item)} from vertex {shown}{mark}")
         self.render_all()
 
     def refresh(self) -> None:

@@ -198,7 +198,8 @@ class DistancesPanel(QtWidgets.QWidget):
             logx=True,
             markers=False,
             title=(
-                f"Signature of vertex {state.picked} ({OPERATOR_INFO[operator].short_label}"
+                f"Signature of vertex {state.picked_file_vertex} "
+                f"({OPERATOR_INFO[operator].short_label}"
                 f"{', preview' if spec.is_preview else ''})"
             ),
         )

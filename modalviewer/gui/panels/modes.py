@@ -182,7 +182,8 @@ def _what_is_shown(state: ViewerState) -> str:
     d = state.display
     if d.kind == "distance":
         how = "threshold map" if d.distance_display == "threshold" else "map"
-        return f"the {DISTANCE_KINDS[d.distance_kind].lower()} {how} from vertex {state.picked}"
+        name = DISTANCE_KINDS[d.distance_kind].lower()
+        return f"the {name} {how} from vertex {state.picked_file_vertex}"
     if d.kind == "signature":
         return f"the {DISTANCE_KINDS[d.distance_kind].split()[0].lower()} signature"
     if d.kind == "curvature":
