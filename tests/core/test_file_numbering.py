@@ -76,3 +76,21 @@ def test_derived_meshes_keep_the_map():
     assert np.all(big.file_to_mesh[len(v) :] == -1)
     (_, _), (part, _) = split_components(two)
     assert np.array_equal(part.file_vertices, np.arange(len(v), len(v2)))
+
+
+def test_fix_slivers_keeps_the_map_when_nothing_changes_and_says_when_it_renumbers():
+    from modalviewer.core.primitives import add_slivers
+    from modalviewer.repair import fix_slivers
+
+    base = icosphere(1)
+    v, f, where, dup = padded(base)
+    m = repair_mesh(v, f)
+    same = fix_slivers(m)
+    assert np.array_equal(same.file_to_mesh, m.file_to_mesh)
+    pytest.importorskip("pymeshlab")
+    sv, sf = add_slivers(icosphere(2), needles=5, caps=5, eps=1e-8, seed=2)
+    sm = repair_mesh(np.vstack([[[9.0, 9.0, 9.0]], sv]), sf + 1)
+    assert sm.renumbered
+    fixed = fix_slivers(sm)
+    assert not fixed.renumbered and fixed.n_file_vertices == fixed.n_vertices
+    assert "numbers the vertices anew" in str(fixed.report)

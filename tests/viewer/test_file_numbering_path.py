@@ -158,3 +158,17 @@ def test_field_export_names_the_files_vertices(files, tmp_path):
     poly = pv.read(out)
     np.testing.assert_array_equal(poly.point_data["file_vertex"], where)
     np.testing.assert_allclose(poly.point_data["hks_distance"], d)
+
+
+def test_cli_distance_to_a_second_mesh_in_file_numbers(files, tmp_path, monkeypatch, capsys):
+    padded, compact, where, dup, unused = files
+    monkeypatch.setenv("MODALVIEWER_CACHE", str(tmp_path / "cache"))
+    pick = int(where[40])
+    csv = tmp_path / "ab.csv"
+    argv = ["distance", str(compact), "--vertex", "40", "--to", str(padded), "--kind", "hks"]
+    assert main([*argv, "-k", str(K), "--csv", str(csv)]) == 0
+    out = capsys.readouterr().out
+    assert f"best match {pick} (" in out and "mutual" in out and "not mutual" not in out
+    rows = [line.split(",") for line in csv.read_text().splitlines()[1:]]
+    assert len(rows) == len(where) + len(unused) + 1
+    assert [int(r[0]) for r in rows if r[1] == ""] == unused
