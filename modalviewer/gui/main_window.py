@@ -5,7 +5,7 @@ The state lives in :class:`~modalviewer.viewer.model.ViewerModel` (``win.model``
 interface; each does what the matching click does, through the model::
 
     win.open_mesh(path); win.compute("shells", k=50, wait=True); win.show_mode(7)
-    win.pick_vertex(123); win.show_distance("vibration", display="threshold", threshold=0.2)
+    win.pick_file_vertex(123); win.show_distance("vibration", display="threshold", threshold=0.2)
     win.export_screenshot("fig.png", scale=2, transparent=True)
     win.save_session("s.json"); win.open_session("s.json", wait=True)
 """
@@ -546,8 +546,21 @@ class MainWindow(QtWidgets.QMainWindow):
         if vertex is not None:
             self.pick_vertex(vertex)
 
+    def pick_file_vertex(self, number: int) -> None:
+        """Pick vertex ``number`` of the mesh file (the number the viewer shows, as
+        ``distance --vertex`` takes it); an error message for one no face uses."""
+        if self.state.mesh is None:
+            return
+        try:
+            index = self.state.mesh.mesh_vertex(number)
+        except ValueError as exc:
+            self.show_error(str(exc))
+            return
+        self.pick_vertex(index)
+
     def pick_vertex(self, index: int) -> None:
-        """Pick vertex ``index`` (as a click on it does): marker and distance map."""
+        """Pick mesh vertex ``index`` (as a click on it does): marker and distance map.
+        ``index`` is the loaded mesh's (compact) index; see :meth:`pick_file_vertex`."""
         if self.state.mesh is None:
             return
         try:
