@@ -80,3 +80,24 @@ def test_bad_arguments_are_refused():
         mv.local_signature(mesh, "laplacian", mesh.n_vertices, [1.0])
     with pytest.raises(ValueError):
         mv.local_signature(mesh, "laplacian", 0, [-1.0])
+
+
+@pytest.mark.parametrize("operator", OPERATORS)
+@pytest.mark.parametrize("include_zero", [False, True])
+def test_with_a_spectrum_the_sum_is_still_over_all_modes(operator, include_zero):
+    mesh = torus(10, 6)
+    spec = mv.compute_spectrum(mesh, operator, k=40)
+    vertices = [0, 7, mesh.n_vertices - 1]
+    times = _times(mesh, operator)
+    expected = _dense_signature(mesh, operator, vertices, times, include_zero)
+    got = mv.local_signature(
+        mesh, operator, vertices, times, include_zero=include_zero, spectrum=spec
+    )
+    np.testing.assert_allclose(got, expected, rtol=1e-6, atol=0)
+
+
+def test_a_spectrum_of_another_operator_is_refused():
+    mesh = icosphere(1)
+    spec = mv.compute_spectrum(mesh, "laplacian", k=10)
+    with pytest.raises(ValueError, match="this mesh and operator"):
+        mv.local_signature(mesh, "shells", 0, [1.0], spectrum=spec)
