@@ -165,9 +165,7 @@ def compute_spectrum(
             _all_zero_message(k, result, nulls, lam_typical), ZeroModesWarning, stacklevel=2
         )
     # modes above the accuracy well-shaped meshes reach: how close to rounding are they?
-    loose = np.flatnonzero(
-        nonzero & (result.residuals > min(WELL_SHAPED_RESIDUAL, RESIDUAL_LIMIT))
-    )
+    loose = np.flatnonzero(nonzero & (result.residuals > min(WELL_SHAPED_RESIDUAL, RESIDUAL_LIMIT)))
     floors_loose = (
         rounding_floors(K, mass, result.eigenvalues[loose], result.vectors[:, loose])
         if loose.size
