@@ -28,10 +28,11 @@ from ..core.files import atomic_write
 from ..core.laplacian import vertex_normals
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
+from ..readers import DamagedFileError
 from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairState, PairView
-from .dialogs import file_message
+from .dialogs import ask_action, file_message
 from .scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
@@ -648,12 +649,24 @@ def _camera_frame(camera) -> tuple[np.ndarray, float, np.ndarray]:
     return np.column_stack([np.cross(up, back), up, back]), distance, focal
 
 
-def _load(main, path) -> Mesh | None:
+def _load(main, path, strict: bool = True) -> Mesh | None:
     from ..io import load_mesh
 
     path = Path(path)
     try:
-        return load_mesh(path)
+        return load_mesh(path, strict=strict)
+    except DamagedFileError as exc:  # as the main window: name the place, offer to go on
+        message = file_message(path, str(exc)).split("; the file is damaged")[0]
+        main.last_error = message
+        main.statusBar().showMessage(message, 10000)
+        if ask_action(
+            main,
+            "Damaged file",
+            f"{message}.\n\nThe file is damaged or truncated. Open anyway loads the "
+            "records that are whole and reports what was dropped.",
+            "Open anyway",
+        ):
+            return _load(main, path, strict=False)
     except MeshError as exc:
         main.show_error(file_message(path, str(exc)), "Cannot open mesh")
     except OSError as exc:

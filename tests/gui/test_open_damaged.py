@@ -53,3 +53,17 @@ def test_open_anyway_is_the_default_and_loads_the_whole_records(
     assert mesh.n_faces == n_faces - 31
     report = str(mesh.report)
     assert f"the file ends in face element {n_faces - 31} of the {n_faces}" in report
+
+
+def test_a_damaged_second_mesh_is_named_and_open_anyway_loads_it(window, monkeypatch, tmp_path):
+    from modalviewer.core.primitives import icosphere
+
+    window.set_mesh(icosphere(2))
+    path, n_faces = _truncated_ply(tmp_path / "cut_second.ply")
+    assert window.open_second_mesh(path, wait=False) is None
+    assert window.last_error.startswith("cut_second.ply: element 'face' ")
+    monkeypatch.setenv("MODALVIEWER_ASSUME_YES", "1")  # the dialog's answer: Open anyway
+    pair = window.open_second_mesh(path, wait=False)
+    assert pair is not None
+    assert pair.pair.mesh("b").n_faces == n_faces - 31
+    pair.close()
