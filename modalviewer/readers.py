@@ -101,6 +101,29 @@ def _check_indices(faces: list, n_vertices: int, damage: _Damage, place) -> list
     return kept
 
 
+def _without_unplaced(vertices: np.ndarray, polygons: list, unplaced: list, damage) -> list:
+    """The faces that use none of the ``unplaced`` vertices (whose records were
+    incomplete: ``strict=False`` only).  Those vertices stay, used by no face, so that the
+    vertices after them keep the file's numbers; they are put outside the bounding box of
+    the others, where no repair can take them for a duplicate of a real vertex."""
+    if not unplaced:
+        return polygons
+    placed = np.delete(vertices, unplaced, axis=0)
+    if len(placed):
+        low, high = placed.min(axis=0), placed.max(axis=0)
+        outside = high + (high - low).max() + 1.0
+    else:
+        outside = np.zeros(3)
+    vertices[unplaced] = outside + np.arange(len(unplaced))[:, None]
+    bad = np.zeros(len(vertices), dtype=bool)
+    bad[unplaced] = True
+    kept = [p for p in polygons if not bad[p].any()]
+    if len(kept) < len(polygons):
+        dropped = count_text(len(polygons) - len(kept), "face", "faces")
+        damage.note("faces", f"{dropped} using a vertex whose record was incomplete dropped")
+    return kept
+
+
 def _triangles(polygons: list) -> np.ndarray:
     if polygons and all(len(p) == 3 for p in polygons):
         return np.array(polygons, dtype=np.int64).reshape(-1, 3)
@@ -148,6 +171,7 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
         _check_last_line(text, damage, ("v", "f"))
         return MeshFile(fast[0], fast[1], damage.notes)
     vertices: list = []
+    unplaced: list = []
     polygons: list = []
     face_lines: list = []
     for number, line in enumerate(text.splitlines(), start=1):
@@ -159,7 +183,8 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
                 xyz = []
             if len(xyz) < 3:
                 damage(f"line {number}", f"the vertex record '{line.strip()[:40]}' is incomplete")
-                continue
+                unplaced.append(len(vertices))
+                xyz = [np.nan] * 3
             vertices.append(xyz)
         elif line[:2] == "f " or line[:2] == "f\t":
             words = line.split()[1:]
@@ -177,6 +202,7 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
     polygons = _check_indices(polygons, len(vertices), damage, lambda i: f"line {face_lines[i]}")
     _check_last_line(text, damage, ("v", "f"))
     v = np.array(vertices, dtype=np.float64).reshape(-1, 3)
+    polygons = _without_unplaced(v, polygons, unplaced, damage)
     return MeshFile(v, _triangles(polygons), damage.notes)
 
 
@@ -203,7 +229,7 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
         n_vertices, n_faces = int(head[0]), int(head[1])
     except (ValueError, IndexError):
         raise MeshError(f"{path.name}: the OFF counts line is not 'vertices faces edges'") from None
-    vertices = []
+    vertices, unplaced = [], []
     for i in range(n_vertices):
         if i >= len(rest):
             damage(
@@ -219,6 +245,7 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
             xyz = []
         if len(xyz) < 3:
             damage(f"line {number} (vertex {i})", "the vertex record is incomplete")
+            unplaced.append(i)
             xyz = [np.nan] * 3
         vertices.append(xyz)
     polygons, places = [], []
@@ -245,10 +272,7 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
     polygons = _check_indices(polygons, len(vertices), damage, lambda i: places[i])
     _check_last_line(text, damage, "")
     v = np.array(vertices, dtype=np.float64).reshape(-1, 3)
-    keep = np.all(np.isfinite(v), axis=1) if not strict else None
-    if keep is not None and not keep.all():
-        # vertices whose record was incomplete: faces using them are dropped too
-        polygons = [p for p in polygons if keep[p].all()]
+    polygons = _without_unplaced(v, polygons, unplaced, damage)
     return MeshFile(v, _triangles(polygons), damage.notes)
 
 
@@ -386,7 +410,7 @@ def _ply_ascii(name, count, props, lines, line_index, damage):
                 f"line {number} ({name} element {i})",
                 f"the {name} record is incomplete or not numbers",
             )
-            continue
+            row = dict.fromkeys(columns)  # a placeholder keeps the later rows' numbers
         for prop in columns:
             columns[prop].append(row[prop])
     return columns, line_index, count
@@ -406,7 +430,7 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
                 lines.append((number + header_lines + 1, words))
         _check_last_line(body.decode("ascii", "replace"), damage, "")
     cursor = 0
-    vertices, polygons = None, []
+    vertices, polygons, unplaced = None, [], []
     for name, count, props in elements:
         if fmt == "ascii":
             columns, cursor, rows = _ply_ascii(name, count, props, lines, cursor, damage)
@@ -416,8 +440,9 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
             missing = [c for c in "xyz" if c not in columns]
             if missing:
                 raise MeshError(f"{path.name}: the PLY vertices have no '{missing[0]}' property")
+            unplaced = [i for i, x in enumerate(columns["x"]) if x is None]
             vertices = np.column_stack(
-                [np.asarray(columns[c], dtype=np.float64).reshape(-1) for c in "xyz"]
+                [np.array(columns[c], dtype=np.float64).reshape(-1) for c in "xyz"]
             )
         elif name in ("face", "tristrips"):
             key = next((p for p, _ in props if p in _FACE_LISTS), None)
@@ -425,11 +450,12 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
                 raise MeshError(f"{path.name}: the PLY {name} element has no vertex_indices list")
             lists = columns[key]
             if name == "tristrips":
-                polygons += [list(t) for s in lists for t in strips_to_triangles(np.asarray(s))]
+                strips = [np.asarray(s) for s in lists if s is not None]
+                polygons += [list(t) for s in strips for t in strips_to_triangles(s)]
             elif isinstance(lists, np.ndarray):
                 polygons = lists  # the fast path's (m, 3) array
             else:
-                polygons += [list(p) for p in lists]
+                polygons += [list(p) for p in lists if p is not None]
         if rows < count:
             break  # the data ended: no later element can be read
     if vertices is None:
@@ -449,6 +475,7 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
         damage(f"face {i}", "the face has fewer than three corners")
     polygons = [p for p in polygons if len(p) >= 3]
     polygons = _check_indices(polygons, n, damage, lambda i: f"face {i}")
+    polygons = _without_unplaced(vertices, polygons, unplaced, damage)
     return MeshFile(vertices, _triangles(polygons), damage.notes)
 
 

@@ -198,3 +198,33 @@ def test_unused_vertices_keep_the_files_numbering(tmp_path, fmt, where):
     assert any("3 vertices of the file are used by no face" in n for n in notes), notes
     mesh = mv.load_mesh(path)
     assert "3 vertices of the file are used by no face" in str(mesh.report)
+
+
+@pytest.mark.parametrize("fmt", ["obj", "off", "ply-ascii"])
+def test_strict_false_keeps_the_numbers_after_an_incomplete_vertex_record(tmp_path, fmt):
+    v, f = _plate()
+    ext, write = FORMATS[fmt]
+    data = write(v, f).decode()
+    broken = 20  # vertex 20's record loses its last two numbers
+    record = {"obj": "v {:.17g} {:.17g} {:.17g}", "off": "{:.17g} {:.17g} {:.17g}"}.get(
+        fmt, "{:.17g} {:.17g} {:.17g}"
+    )
+    whole = record.format(*v[broken])
+    assert data.count(whole) == 1
+    data = data.replace(whole, whole.rsplit(" ", 2)[0])
+    path = tmp_path / f"broken{ext}"
+    path.write_text(data)
+    with pytest.raises(mv.MeshError, match="incomplete"):
+        mv.load_mesh(path)
+    vertices, faces, notes = read_file(path, strict=False)
+    assert len(vertices) == len(v)  # every later vertex keeps its number
+    others = np.arange(len(v)) != broken
+    assert np.array_equal(vertices[others], v[others])
+    using = np.any(f == broken, axis=1)
+    assert np.array_equal(faces, f[~using])
+    mesh = mv.load_mesh(path, strict=False)
+    assert mesh.n_faces == len(f) - using.sum()
+    assert mesh.n_vertices == len(np.unique(f[~using]))
+    assert f"{using.sum()} faces using a vertex whose record was incomplete dropped" in str(
+        mesh.report
+    )
