@@ -58,6 +58,10 @@ class _Damage:
             )
         self.notes.append(f"{where}: {what}")
 
+    def ends_early(self, where: str, read: int, announced: str) -> None:
+        """The data end after ``read`` of the ``announced`` records ("128 faces")."""
+        self(where, f"the file ends after {read} of the {announced} its header announces")
+
     def note(self, where: str, what: str) -> None:
         """A doubt that is no error: kept in the notes, strict or not."""
         self.notes.append(f"{where}: {what}")
@@ -232,11 +236,7 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
     vertices, unplaced = [], []
     for i in range(n_vertices):
         if i >= len(rest):
-            damage(
-                f"vertex {i}",
-                f"the file ends after {i} of the "
-                f"{count_text(n_vertices, 'vertex', 'vertices')} its header announces",
-            )
+            damage.ends_early(f"vertex {i}", i, count_text(n_vertices, "vertex", "vertices"))
             break
         number, words = rest[i]
         try:
@@ -252,11 +252,7 @@ def _read_off(path: Path, strict: bool) -> MeshFile:
     face_rows = rest[n_vertices:] if len(rest) > n_vertices else []
     for i in range(n_faces):
         if i >= len(face_rows):
-            damage(
-                f"face {i}",
-                f"the file ends after {i} of the "
-                f"{count_text(n_faces, 'face', 'faces')} its header announces",
-            )
+            damage.ends_early(f"face {i}", i, count_text(n_faces, "face", "faces"))
             break
         number, words = face_rows[i]
         try:
@@ -334,10 +330,7 @@ def _ply_binary(name, count, props, body, offset, order, damage):
         available = (len(body) - offset) // dtype.itemsize if dtype.itemsize else count
         rows = min(count, max(available, 0))
         if rows < count:
-            damage(
-                f"element '{name}' {rows}",
-                f"the file ends after {rows} of the {count} {name} elements its header announces",
-            )
+            damage.ends_early(f"element '{name}' {rows}", rows, f"{count} {name} elements")
         arr = np.frombuffer(body, dtype=dtype, count=rows, offset=offset)
         return {p: arr[p] for p, _ in props}, offset + dtype.itemsize * rows, rows
     # elements with lists: a fast path for the usual 'list uchar int' of triangles only
@@ -385,10 +378,7 @@ def _ply_ascii(name, count, props, lines, line_index, damage):
     columns: dict = {p: [] for p, _ in props}
     for i in range(count):
         if line_index >= len(lines):
-            damage(
-                f"element '{name}' {i}",
-                f"the file ends after {i} of the {count} {name} elements its header announces",
-            )
+            damage.ends_early(f"element '{name}' {i}", i, f"{count} {name} elements")
             return columns, line_index, i
         number, words = lines[line_index]
         line_index += 1
@@ -492,11 +482,8 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
             raise MeshError(f"{path.name}: too short for a binary STL file ({len(data)} bytes)")
         rows = (len(data) - 84) // 50
         if rows < binary_count:
-            damage(
-                f"triangle {rows}",
-                f"the file ends after {rows} of the "
-                f"{count_text(binary_count, 'triangle', 'triangles')} its header announces",
-            )
+            announced = count_text(binary_count, "triangle", "triangles")
+            damage.ends_early(f"triangle {rows}", rows, announced)
         rows = min(rows, binary_count)
         dtype = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
         arr = np.frombuffer(data, dtype=dtype, count=rows, offset=84)

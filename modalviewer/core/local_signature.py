@@ -61,8 +61,9 @@ def _quadrature(
 ) -> np.ndarray:
     """(T,) ``b^T exp(-t A) b`` for each t by Lanczos quadrature on the shifted inverse
     ``B``: the Ritz values ``mu`` of ``B`` stand for ``x = 1/mu - sigma`` of ``A``, so
-    the steps needed do not grow with the stiffest mode (``A``'s largest eigenvalue
-    reaches 4e13 for the 3D shells of a 13k-vertex hand).  No reorthogonalisation: the
+    the steps needed do not grow with the stiffest mode (the membrane stiffness of small
+    triangles makes ``A``'s largest eigenvalue huge for the 3D shells).  No
+    reorthogonalisation: the
     Gauss rule of finite-precision Lanczos still converges to the quadratic form.
     A value has settled when it changes by less than ``rtol`` of itself plus ``known``
     (the part of the signature already summed from a spectrum)."""

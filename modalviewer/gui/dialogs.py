@@ -42,6 +42,21 @@ def ask_action(parent, title: str, text: str, action: str) -> bool:
     return box.clickedButton() is chosen
 
 
+def offer_open_anyway(window, path, error: Exception) -> bool:
+    """Name the damage of a file that did not load (status bar, ``window.last_error``)
+    and ask whether to load its whole records; True for "Open anyway" (the default)."""
+    message = file_message(path, str(error)).split("; the file is damaged")[0]
+    window.last_error = message
+    window.statusBar().showMessage(message, 10000)
+    return ask_action(
+        window,
+        "Damaged file",
+        f"{message}.\n\nThe file is damaged or truncated. Open anyway loads the "
+        "records that are whole and reports what was dropped.",
+        "Open anyway",
+    )
+
+
 class ScreenshotDialog(QtWidgets.QDialog):
     """File, size multiplier, transparent background, colour bar and legend."""
 

@@ -36,7 +36,7 @@ from ..viewer.model import (
 from ..viewer.state import SpectrumKey, percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
-from .dialogs import ask, ask_action, file_message
+from .dialogs import ask, file_message, offer_open_anyway
 from .export import save_field_mesh, save_screenshot
 from .pair_window import PairWindow, open_pair_window
 from .panels import (
@@ -310,18 +310,7 @@ class MainWindow(QtWidgets.QMainWindow):
             mesh = load_mesh(path, strict=strict)
         except DamagedFileError as exc:
             QtWidgets.QApplication.restoreOverrideCursor()
-            message = file_message(path, str(exc)).split("; the file is damaged")[0]
-            self.last_error = message
-            self.statusBar().showMessage(message, 10000)
-            if ask_action(
-                self,
-                "Damaged file",
-                f"{message}.\n\nThe file is damaged or truncated. Open anyway loads the "
-                "records that are whole and reports what was dropped.",
-                "Open anyway",
-            ):
-                return self.open_mesh(path, strict=False)
-            return False
+            return offer_open_anyway(self, path, exc) and self.open_mesh(path, strict=False)
         except MeshError as exc:  # e.g. a point cloud: the message names the file
             self.show_error(file_message(path, str(exc)), "Cannot open mesh")
             return False

@@ -32,7 +32,7 @@ from ..readers import DamagedFileError
 from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairState, PairView
-from .dialogs import ask_action, file_message
+from .dialogs import file_message, offer_open_anyway
 from .scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
@@ -656,16 +656,7 @@ def _load(main, path, strict: bool = True) -> Mesh | None:
     try:
         return load_mesh(path, strict=strict)
     except DamagedFileError as exc:  # as the main window: name the place, offer to go on
-        message = file_message(path, str(exc)).split("; the file is damaged")[0]
-        main.last_error = message
-        main.statusBar().showMessage(message, 10000)
-        if ask_action(
-            main,
-            "Damaged file",
-            f"{message}.\n\nThe file is damaged or truncated. Open anyway loads the "
-            "records that are whole and reports what was dropped.",
-            "Open anyway",
-        ):
+        if offer_open_anyway(main, path, exc):
             return _load(main, path, strict=False)
     except MeshError as exc:
         main.show_error(file_message(path, str(exc)), "Cannot open mesh")
