@@ -29,5 +29,30 @@ def window(qtbot):
 
 
 @pytest.fixture
+def answer_next_dialog(qtbot, monkeypatch):
+    """``answer(delay_ms)`` lets the next modal dialog really open (no
+    MODALVIEWER_NO_DIALOGS), presses Enter on it (its default button) after ``delay_ms``
+    and returns the dict that then holds its ``title``, ``default`` button and ``text``."""
+    from qtpy import QtCore, QtWidgets
+
+    monkeypatch.delenv("MODALVIEWER_NO_DIALOGS")
+
+    def answer(delay_ms: int = 200) -> dict:
+        asked = {}
+
+        def press_enter():
+            box = QtWidgets.QApplication.activeModalWidget()
+            asked["title"] = box.windowTitle()
+            asked["default"] = box.defaultButton().text().replace("&", "")
+            asked["text"] = box.text()
+            qtbot.keyClick(box, QtCore.Qt.Key.Key_Return)
+
+        QtCore.QTimer.singleShot(delay_ms, press_enter)
+        return asked
+
+    return answer
+
+
+@pytest.fixture
 def spot_path():
     return ASSETS / "spot.obj"

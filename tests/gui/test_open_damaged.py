@@ -2,7 +2,6 @@
 (the default button) loads its whole records with a report of what was dropped."""
 
 import numpy as np
-from qtpy import QtCore, QtWidgets
 
 from modalviewer.core.primitives import grid_plate
 
@@ -32,20 +31,10 @@ def test_a_damaged_file_is_named_and_not_loaded_without_asking(window, tmp_path)
 
 
 def test_open_anyway_is_the_default_and_loads_the_whole_records(
-    window, qtbot, monkeypatch, tmp_path
+    window, answer_next_dialog, tmp_path
 ):
-    monkeypatch.delenv("MODALVIEWER_NO_DIALOGS")  # the real dialog
     path, n_faces = _truncated_ply(tmp_path / "cut_scan.ply")
-    asked = {}
-
-    def answer():
-        box = QtWidgets.QApplication.activeModalWidget()
-        asked["title"] = box.windowTitle()
-        asked["default"] = box.defaultButton().text().replace("&", "")
-        asked["text"] = box.text()
-        qtbot.keyClick(box, QtCore.Qt.Key.Key_Return)  # Enter: the default button
-
-    QtCore.QTimer.singleShot(300, answer)
+    asked = answer_next_dialog(300)  # the real dialog, answered by Enter
     assert window.open_mesh(path) is True
     assert asked["title"] == "Damaged file" and asked["default"] == "Open anyway"
     assert "cut_scan.ply" in asked["text"]

@@ -2,7 +2,6 @@
 one default threshold share everywhere."""
 
 import pytest
-from qtpy import QtCore, QtWidgets
 
 from modalviewer.core.primitives import icosphere
 from modalviewer.viewer.state import DEFAULT_THRESHOLD_SHARE
@@ -27,19 +26,9 @@ def test_a_point_cloud_as_the_second_mesh_names_the_file(window, tmp_path):
     assert window.last_error.startswith("second_points.obj: ")
 
 
-def test_compare_asks_with_yes_as_the_default(window, qtbot, monkeypatch):
-    monkeypatch.delenv("MODALVIEWER_NO_DIALOGS")  # the real question
+def test_compare_asks_with_yes_as_the_default(window, qtbot, answer_next_dialog):
     window.set_mesh(icosphere(2))
-    asked = {}
-
-    def answer():
-        box = QtWidgets.QApplication.activeModalWidget()
-        asked["title"] = box.windowTitle()
-        asked["default"] = box.defaultButton().text().replace("&", "")
-        asked["text"] = box.text()
-        qtbot.keyClick(box, QtCore.Qt.Key.Key_Return)  # Enter: the default answer
-
-    QtCore.QTimer.singleShot(200, answer)
+    asked = answer_next_dialog(200)  # the real question, answered by Enter
     assert window.open_comparison(["laplacian", "modified_dirichlet"], wait=False) is None
     assert asked["title"] == "Compare" and "Compute now?" in asked["text"]
     assert asked["default"] == "Yes"
