@@ -2,7 +2,7 @@
 
 Panels side by side in one PNG: mesh A with the picked vertex, then mesh B coloured by
 a distance from that vertex with its best match marked.  Each panel is drawn off-screen
-by the viewer's :class:`~modalviewer.gui.scene.MeshScene` (the same surface, colour
+by the viewer's :class:`~modalviewer.scene.mesh_scene.MeshScene` (the same surface, colour
 maps and marker as the viewer's distance display: white = similar, red = the largest
 distance; or blue where the distance is below the threshold) and captioned.  Used by
 ``modalviewer distance A --to B -o fig.png`` and ``scripts/hand_correspondence.py``.
@@ -69,7 +69,7 @@ def _plotter(size):
 def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
     """(h, w, 3) image of one panel, captioned."""
     from .core.laplacian import vertex_normals
-    from .gui.scene import MeshScene
+    from .scene.mesh_scene import MeshScene
 
     plotter = _plotter(size)
     try:

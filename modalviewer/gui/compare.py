@@ -14,7 +14,7 @@ from qtpy import QtWidgets
 
 from ..core.files import atomic_write
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
-from .scene import MeshScene
+from ..scene.mesh_scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
 

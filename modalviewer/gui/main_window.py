@@ -37,7 +37,7 @@ from ..viewer.state import SpectrumKey, percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
 from .dialogs import ask, file_message, offer_open_anyway
-from .export import save_field_mesh, save_screenshot
+from ..scene.export import save_field_mesh, save_screenshot
 from .pair_window import PairWindow, open_pair_window
 from .panels import (
     AnimationPanel,

@@ -33,7 +33,7 @@ from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairState, PairView
 from .dialogs import file_message, offer_open_anyway
-from .scene import MeshScene
+from ..scene.mesh_scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
 
@@ -540,7 +540,7 @@ class PairWindow(QtWidgets.QWidget):
     # =========================================================== export
     def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
         """Each view rendered at ``scale`` with its legend and colour bar drawn on."""
-        from .overlay import draw_overlay
+        from ..scene.overlay import draw_overlay
 
         images = []
         for side in SIDES:

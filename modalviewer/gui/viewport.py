@@ -15,7 +15,7 @@ import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtGui, QtWidgets
 
-from .scene import view_angle_on_smaller_side
+from ..scene.mesh_scene import view_angle_on_smaller_side
 
 CLICK_SLOP = 4  # pixels a press may move and still count as a click
 

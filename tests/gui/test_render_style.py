@@ -37,7 +37,7 @@ def view():
 
 
 def _scene(view, mesh, style="paper"):
-    from modalviewer.gui.scene import MeshScene
+    from modalviewer.scene.mesh_scene import MeshScene
 
     scene = MeshScene(view.plotter, mesh, vertex_normals(mesh), style=style)
     scene.reset_camera()
@@ -45,14 +45,14 @@ def _scene(view, mesh, style="paper"):
 
 
 def _export(view, path, **kwargs):
-    from modalviewer.gui.export import save_screenshot
+    from modalviewer.scene.export import save_screenshot
 
     out = save_screenshot(view, path, **kwargs)
     return np.asarray(Image.open(out))
 
 
 def _measure(view, scene, field, tmp_path):
-    from modalviewer.gui.render_metrics import saturation, white_level, zero_band_masks
+    from modalviewer.scene.render_metrics import saturation, white_level, zero_band_masks
 
     scene.show_field(field, "diverging", isolines=0)
     img = _export(view, tmp_path / f"{scene.style}.png")[:, :, :3]
@@ -78,7 +78,7 @@ def test_paper_style_white_zero_and_saturated_colours(view, spot_mode, tmp_path)
 
 def test_paper_style_darkens_toward_silhouettes(view, spot_mode, tmp_path):
     """Shape stays readable: surfaces seen at a grazing angle render clearly darker."""
-    from modalviewer.gui.render_metrics import _flat_render, facing
+    from modalviewer.scene.render_metrics import _flat_render, facing
 
     mesh, field, _ = spot_mode
     scene = _scene(view, mesh, "paper")
@@ -205,7 +205,7 @@ def test_zero_line_of_a_low_mode_on_a_fine_mesh_is_kept(view):
 
 @pytest.mark.parametrize("umask", [0o022, 0o027])
 def test_exported_files_get_the_umask_permissions(view, spot_mode, tmp_path, umask):
-    from modalviewer.gui.export import save_field_mesh
+    from modalviewer.scene.export import save_field_mesh
 
     mesh, field, _ = spot_mode
     _scene(view, mesh)
@@ -267,7 +267,7 @@ def test_a_long_legend_wraps_inside_the_export(view, spot_mode, tmp_path):
 
 
 def test_wrap_text_breaks_at_spaces_within_the_width():
-    from modalviewer.gui.overlay import wrap_text
+    from modalviewer.scene.overlay import wrap_text
 
     text = "aaa bbb ccc ddd\nee"
     wrapped = wrap_text(text, len, 7)
@@ -280,7 +280,7 @@ def test_wrap_text_breaks_at_spaces_within_the_width():
 def test_a_narrow_picture_keeps_the_swatch_labels_inside():
     """Found in a 168-pixel-wide export of a threshold map: the swatch label read
     "vibration distance < 0", its value cut off at the right edge.  Labels now wrap."""
-    from modalviewer.gui.overlay import FONT_PX, ColorBar, Overlay, draw_overlay
+    from modalviewer.scene.overlay import FONT_PX, ColorBar, Overlay, draw_overlay
 
     w, h = 168, 400
     bar = ColorBar(

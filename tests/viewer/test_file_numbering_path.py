@@ -149,7 +149,7 @@ def test_sessions_store_file_numbers_and_read_old_ones(files, tmp_path):
 
 def test_field_export_names_the_files_vertices(files, tmp_path):
     pv = pytest.importorskip("pyvista")
-    from modalviewer.gui.export import save_field_mesh
+    from modalviewer.scene.export import save_field_mesh
 
     padded, _, where, _, _ = files
     model = _model(tmp_path)

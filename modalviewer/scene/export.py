@@ -1,4 +1,4 @@
-"""Writing screenshots and per-vertex fields atomically (temporary file, then rename),
+"""Pictures and per-vertex fields written atomically (temporary file, then rename),
 with the permissions of the user's umask."""
 
 from __future__ import annotations
@@ -21,30 +21,16 @@ def _check_folder(path: Path) -> None:
         raise OSError(f"the folder {folder} is not writable; choose another one")
 
 
-def save_screenshot(
-    viewport,
-    path: Path,
-    scale: int = 1,
-    transparent: bool = False,
-    legend: bool = True,
-    colorbar: bool | None = None,
-    scene=None,
-) -> Path:
-    """Render the viewport's plotter to a PNG at ``scale`` times its size.
+def grab(plotter, scene=None, scale: int = 1, transparent: bool = False,
+         legend: bool = True, colorbar: bool | None = None) -> np.ndarray:
+    """The plotter's view rendered at ``scale`` times its size, (h, w, 3 or 4) uint8.
 
     The scene's legend (if ``legend`` and the scene has one) and colour bar (as shown on
     screen when ``colorbar`` is None, else forced on or off; a two-swatch legend for
     threshold maps) are drawn onto the image at the same scale, also on a transparent
-    background.  ``scene`` defaults to the scene drawn on the viewport's plotter."""
-    from PIL import Image
-
+    background.  ``scene`` defaults to the scene drawn on the plotter."""
     from .overlay import draw_overlay
 
-    path = Path(path)
-    if path.suffix.lower() != ".png":
-        path = path.with_suffix(".png")
-    _check_folder(path)
-    plotter = viewport.plotter
     scale = int(max(1, scale))
     if scene is None:
         scene = getattr(plotter, "_modalviewer_scene", None)
@@ -66,8 +52,60 @@ def save_screenshot(
     img = np.ascontiguousarray(img)
     if overlay:
         img = draw_overlay(img, overlay, scale * getattr(scene, "overlay_scale", 1.0))
+    return img
+
+
+def side_by_side(images: list[np.ndarray], gap: int = 0, transparent: bool = False):
+    """``images`` left to right on one canvas (white, or transparent), ``gap`` pixels
+    apart, aligned at the top."""
+    channels = 4 if transparent else 3
+    height = max(img.shape[0] for img in images)
+    width = sum(img.shape[1] for img in images) + gap * (len(images) - 1)
+    canvas = np.zeros((height, width, channels), np.uint8)
+    if not transparent:
+        canvas[:] = 255
+    x = 0
+    for img in images:
+        if img.shape[2] < channels:
+            img = np.dstack([img, np.full(img.shape[:2], 255, np.uint8)])
+        canvas[: img.shape[0], x : x + img.shape[1]] = img[:, :, :channels]
+        x += img.shape[1] + gap
+    return canvas
+
+
+def png_path(path) -> Path:
+    """``path`` with a .png suffix, its folder created and checked writable."""
+    path = Path(path)
+    if path.suffix.lower() != ".png":
+        path = path.with_suffix(".png")
+    _check_folder(path)
+    return path
+
+
+def save_png(path, img: np.ndarray) -> Path:
+    """Write ``img`` to ``path`` (.png added if missing) atomically; returns the path."""
+    from PIL import Image
+
+    path = png_path(path)
     atomic_write(path, lambda tmp: Image.fromarray(img).save(tmp, format="PNG"))
     return path
+
+
+def save_screenshot(
+    viewport,
+    path: Path,
+    scale: int = 1,
+    transparent: bool = False,
+    legend: bool = True,
+    colorbar: bool | None = None,
+    scene=None,
+) -> Path:
+    """Render the viewport's (or plotter's) view to a PNG at ``scale`` times its size,
+    with legend and colour bar as :func:`grab` draws them; written atomically."""
+    plotter = getattr(viewport, "plotter", viewport)
+    path = png_path(path)
+    img = grab(plotter, scene, scale, transparent, legend, colorbar)
+    return save_png(path, img)
 
 
 def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Path:
