@@ -1,0 +1,230 @@
+"""The performance tables, made from ``benchmarks/results/*.json``.
+
+``docs/performance.md`` marks each generated table with a pair of comments::
+
+    <!-- table: spectra -->
+    | ... the table ... |
+    <!-- end table -->
+
+At build time (Sphinx's ``source-read`` event) every marked block is replaced by the table
+made from the JSON results now in ``benchmarks/results``, so the HTML pages always show
+the measured numbers.  The tables of ``make bench`` and of the preview benchmark are made
+by the benchmark scripts' own functions (``benchmarks.run.table``,
+``benchmarks.run.stage_table``, ``benchmarks.preview.table``), the others here.
+
+Run as a script, it rewrites the marked blocks of ``docs/performance.md`` in place (the
+copy GitHub shows)::
+
+    .venv/bin/python docs/_ext/benchmark_tables.py
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+RESULTS = ROOT / "benchmarks" / "results"
+PAGE = ROOT / "docs" / "performance.md"
+
+MARKED = re.compile(r"(<!-- table: ([\w-]+) -->\n)(.*?)(<!-- end table -->)", re.S)
+
+
+def load(name: str):
+    """One results file of benchmarks/results, by its name without ``.json``."""
+    return json.loads((RESULTS / f"{name}.json").read_text())
+
+
+def _benchmarks():
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks import preview, run
+
+    return run, preview
+
+
+def spectra_table(rows: list[dict]) -> str:
+    """``make bench``'s spectra table (``benchmarks.run.table``)."""
+    return _benchmarks()[0].table(rows)
+
+
+def stage_table(rows: list[dict]) -> str:
+    """``make bench``'s table of the solver's stages (``benchmarks.run.stage_table``)."""
+    return _benchmarks()[0].stage_table(rows)
+
+
+def preview_table(rows: list[dict]) -> str:
+    """The preview benchmark's table (``benchmarks.preview.table``)."""
+    return _benchmarks()[1].table(rows)
+
+
+#: The paper's Table 1 (Chinese dragon, 2.66 GHz MacBook Pro, MUMPS, vibration modes, 300
+#: modes), seconds: vertices -> (Hessian, eigenproblem, signature at all vertices).
+PAPER_TABLE_1 = {"10k": (1, 58, 4), "50k": (4, 326, 30), "130k": (11, 1122, 100)}
+
+
+def paper_table(rows: list[dict]) -> str:
+    """The paper's Table 1 beside the 300-mode Discrete Shells rows of ``make bench``."""
+    lines = [
+        "| vertices | Hessian (paper / here) | eigenproblem (paper / here) "
+        "| signature at all vertices (paper / here) |",
+        "|" + " --- |" * 4,
+    ]
+    for mesh, (hessian, eigen, signature) in PAPER_TABLE_1.items():
+        here = [r for r in rows if (r["mesh"], r["operator"], r["k"]) == (mesh, "shells", 300)]
+        if not here:
+            continue
+        r = here[0]
+        lines.append(
+            f"| {mesh} | {hessian} s / {r['assembly_s']:.2f} s | {eigen} s / {r['eigen_s']:.1f} s "
+            f"| {signature} s / {r['signature_s']:.2f} s |"
+        )
+    return "\n".join(lines)
+
+
+#: The viewer benchmark's targets, per row of the table.
+VIEWER_ROWS = [
+    ("compute (child process)", lambda r: f"{r['compute_s']:.1f} s", "-"),
+    (
+        "longest event-loop gap while computing (10 ms timer, view idle)",
+        lambda r: f"{r['longest_event_loop_gap_ms']:.0f} ms",
+        "100 ms",
+    ),
+    ("Cancel to stopped", lambda r: f"{r['cancel_s']:.2f} s", "1 s"),
+    (
+        "reopen the cached spectrum (signature table ready after)",
+        lambda r: f"{r['cached_reopen_s']:.2f} s ({r['table_ready_after_reopen_s']:.2f} s)",
+        "1 s",
+    ),
+    ("mode switch with isolines, app (median / max)", lambda r: _ms(r["mode_switch"], 1), "60 ms"),
+    ("animation frame, app (median / max)", lambda r: _ms(r["animation_frame"], 2), "10 ms"),
+    (
+        "pick to distance map, app (median / max)",
+        lambda r: _ms(r["pick_to_distance_map"], 1),
+        "30 ms",
+    ),
+    ("first pick", lambda r: f"{r['first_pick_with_table_ms']:.0f} ms", "30 ms"),
+    ("threshold-slider step, app (median / max)", lambda r: _ms(r["threshold_step"], 2), "10 ms"),
+    ("draw (software rendering, 1280 x 900 window)", lambda r: _ms(r["draw"], 0), "-"),
+]
+
+
+def _ms(timing: dict, digits: int) -> str:
+    return f"{timing['median_ms']:.{digits}f} / {timing['max_ms']:.{digits}f} ms"
+
+
+def viewer_table(columns: list[tuple[str, dict]]) -> str:
+    """One column per run of ``benchmarks.interactive``: (heading, its JSON)."""
+    lines = [
+        "| measure | " + " | ".join(h for h, _ in columns) + " | target |",
+        "|" + " --- |" * (len(columns) + 2),
+    ]
+    for label, cell, target in VIEWER_ROWS:
+        lines.append(f"| {label} | " + " | ".join(cell(r) for _, r in columns) + f" | {target} |")
+    return "\n".join(lines)
+
+
+def _e(x: float) -> str:
+    """1.2e-08 -> 1.2e-8."""
+    mantissa, exponent = f"{x:.1e}".split("e")
+    return f"{mantissa}e{int(exponent)}"
+
+
+def _method(method: str) -> str:
+    if method.startswith("edge flips and collapses"):
+        return "flips and collapses"
+    if method.startswith("isotropic remeshing"):
+        return "local remeshing"
+    return method
+
+
+def slivers_table(data: dict) -> str:
+    """``benchmarks.slivers``'s repairs by ``fix_slivers`` (distances relative to the
+    bounding-box diagonal)."""
+    lines = [
+        "| mesh | vertices | repair | triangles changed | below quality 0.05 | worst quality "
+        "| largest vertex move / surface distance | time |",
+        "|" + " --- |" * 8,
+    ]
+    for r in data["fix_slivers"]:
+        before, after = r["worst_quality"]
+        lines.append(
+            f"| {r['mesh']} | {r['vertices']} | {_method(r['method'])} "
+            f"| {r['triangles_changed']} of {r['triangles_before']} "
+            f"| {r['below_0.05'][0]} -> {r['below_0.05'][1]} | {_e(before)} -> {after:.2g} "
+            f"| {_e(r['max_vertex_shift'])} / {_e(r['max_deviation'])} "
+            f"| {r['seconds']:.{2 if r['seconds'] < 1 else 1}f} s |"
+        )
+    return "\n".join(lines)
+
+
+#: Every generated table: its name in the page's markers -> (JSON files, the table).
+TABLES = {
+    "spectra": (["latest"], lambda: spectra_table(load("latest"))),
+    "paper": (["latest"], lambda: paper_table(load("latest"))),
+    "stages": (["latest"], lambda: stage_table(load("latest"))),
+    "preview": (["preview"], lambda: preview_table(load("preview"))),
+    "viewer": (
+        [
+            "interactive_130k_shells",
+            "interactive_130k_modified_dirichlet",
+            "interactive_130k_modified_dirichlet_desktop",
+        ],
+        lambda: viewer_table(
+            [
+                ("shells", load("interactive_130k_shells")),
+                ("E_D^N", load("interactive_130k_modified_dirichlet")),
+                ("E_D^N, desktop view", load("interactive_130k_modified_dirichlet_desktop")),
+            ]
+        ),
+    ),
+    "slivers": (["slivers"], lambda: slivers_table(load("slivers"))),
+}
+
+
+def render(name: str) -> str:
+    """The table ``name`` of TABLES, as Markdown."""
+    return TABLES[name][1]()
+
+
+def fill(text: str) -> str:
+    """``text`` with every marked block replaced by its table made now."""
+
+    def replace(match: re.Match) -> str:
+        name = match.group(2)
+        if name not in TABLES:
+            raise KeyError(f"no benchmark table named {name!r} (known: {', '.join(TABLES)})")
+        return f"{match.group(1)}{render(name)}\n{match.group(4)}"
+
+    return MARKED.sub(replace, text)
+
+
+def _source_read(app, docname: str, source: list[str]) -> None:
+    if "<!-- table: " in source[0]:
+        source[0] = fill(source[0])
+
+
+def _outdated(app, env, added, changed, removed) -> list[str]:
+    """Pages with tables are read again on every build: the JSON results may have changed."""
+    return [name for name in env.found_docs if name == "performance" and name not in changed]
+
+
+def setup(app):
+    app.connect("source-read", _source_read)
+    app.connect("env-get-outdated", _outdated)
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
+
+
+def main() -> int:
+    text = PAGE.read_text()
+    new = fill(text)
+    if new != text:
+        PAGE.write_text(new)
+        print(f"wrote {PAGE.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,92 @@
+"""Sphinx configuration of the modalviewer documentation (``make docs``).
+
+The Markdown pages are read by MyST; the API reference (``api.rst``) is written at build
+time from ``modalviewer.__all__`` by ``_ext/api_page.py``; the performance tables are
+made from ``benchmarks/results/*.json`` by the ``benchmark_tables`` extension.  The build
+runs with ``-W``: every warning is an error, and the few suppressed below say why.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parent
+ROOT = DOCS.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(DOCS / "_ext"))
+
+# Importing the viewer's classes for autodoc must not need a display.
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+import api_page  # noqa: E402
+
+import modalviewer  # noqa: E402
+
+project = "modalviewer"
+release = version = modalviewer.__version__
+copyright = "modalviewer"
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "benchmark_tables",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "_generated", "_ext"]
+
+# MyST: anchors for headings down to ####, spelled as GitHub spells them, so the pages'
+# links such as how-it-works.md#preview-spectra work on GitHub and in the HTML alike.
+myst_heading_anchors = 4
+myst_enable_extensions = ["colon_fence", "attrs_inline"]
+
+# autodoc and napoleon: the docstrings are numpy style (Parameters / Returns sections).
+autodoc_member_order = "bysource"
+autodoc_typehints = "description"
+autodoc_default_options = {"undoc-members": False}
+napoleon_google_docstring = False
+napoleon_numpy_docstring = True
+napoleon_use_rtype = False
+# The dataclasses list their fields in an "Attributes" section and autodoc documents the
+# same fields as members; as :ivar: fields the section does not describe them a second time
+# (which Sphinx reports as duplicate object descriptions).
+napoleon_use_ivar = True
+
+html_theme = "furo"
+html_title = f"modalviewer {release}"
+
+
+_LITERAL = re.compile(r"(``.*?``|`[^`]*`)")
+_HTML_ANCHOR = re.compile(r'<a id="([\w-]+)"></a>')
+
+
+def _plain_text_bars(app, what, name, obj, options, lines) -> None:
+    """Docstrings write norms as plain text, ``|K u - lambda M u|``; reStructuredText reads
+    ``|...|`` as a substitution reference, and modalviewer defines none.  Outside literals,
+    a bar is escaped so it is shown as written."""
+    for i, line in enumerate(lines):
+        parts = _LITERAL.split(line)
+        lines[i] = "".join(
+            part if j % 2 else part.replace("|", "\\|") for j, part in enumerate(parts)
+        )
+
+
+def _html_anchors(app, docname, source) -> None:
+    """The pages mark a few list items with ``<a id="..."></a>`` for links such as
+    viewer-guide.md#sessions (GitHub keeps the id); MyST does not see ids in raw HTML, so
+    for the HTML build each becomes MyST's inline anchor ``[]{#...}``."""
+    source[0] = _HTML_ANCHOR.sub(r"[]{#\1}", source[0])
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _plain_text_bars)
+    app.connect("source-read", _html_anchors)
+
+
+# The API reference's list of names, from modalviewer.__all__ at build time.
+api_page.write_api_page(DOCS / "_generated" / "api.inc")
