@@ -33,6 +33,7 @@ extensions = [
     "myst_parser",
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
+    "docstrings",
     "benchmark_tables",
 ]
 
@@ -61,19 +62,7 @@ html_theme = "furo"
 html_title = f"modalviewer {release}"
 
 
-_LITERAL = re.compile(r"(``.*?``|`[^`]*`)")
 _HTML_ANCHOR = re.compile(r'<a id="([\w-]+)"></a>')
-
-
-def _plain_text_bars(app, what, name, obj, options, lines) -> None:
-    """Docstrings write norms as plain text, ``|K u - lambda M u|``; reStructuredText reads
-    ``|...|`` as a substitution reference, and modalviewer defines none.  Outside literals,
-    a bar is escaped so it is shown as written."""
-    for i, line in enumerate(lines):
-        parts = _LITERAL.split(line)
-        lines[i] = "".join(
-            part if j % 2 else part.replace("|", "\\|") for j, part in enumerate(parts)
-        )
 
 
 def _html_anchors(app, docname, source) -> None:
@@ -84,7 +73,6 @@ def _html_anchors(app, docname, source) -> None:
 
 
 def setup(app):
-    app.connect("autodoc-process-docstring", _plain_text_bars)
     app.connect("source-read", _html_anchors)
 
 

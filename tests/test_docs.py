@@ -109,3 +109,25 @@ def test_sphinx_build_has_no_warnings(tmp_path):
     for name in modalviewer.__all__:
         assert f'id="modalviewer.{name}"' in api, name
     shutil.rmtree(out)
+
+
+def test_docstring_entries_become_napoleon_fields():
+    import docstrings
+
+    lines = [
+        "Parameters",
+        "----------",
+        "k : number of modes; capped at the number of unknowns.",
+        "vertices : array_like, shape (n, 3)",
+        "    Vertex positions.",
+        "",
+        "Returns",
+        "-------",
+        "The spectrum, |K u - lambda M u| small.",
+    ]
+    out = docstrings.normalise_sections(lines)
+    assert out[2:4] == ["k", "    number of modes; capped at the number of unknowns."]
+    assert out[4:6] == lines[3:5]  # numpy style (a type, its text below) stays
+    assert (
+        docstrings.escape_bars(out)[-1] == ":returns: The spectrum, \\|K u - lambda M u\\| small."
+    )
