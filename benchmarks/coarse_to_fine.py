@@ -26,8 +26,7 @@ sys.path.insert(0, str(ROOT))
 
 import modalviewer as mv  # noqa: E402
 from benchmarks.run import make_mesh, save_result  # noqa: E402
-from modalviewer.coarsen import decimated_copy  # noqa: E402
-from modalviewer.core.coarse import transfer_spectrum  # noqa: E402
+from modalviewer.coarsen import decimated_copy, transfer_spectrum  # noqa: E402
 
 
 def run(size: str, operator: str, k: int) -> dict:

@@ -54,8 +54,7 @@ def _method(size: str, operator: str, k: int, method: str) -> dict:
     c0 = time.process_time()
     extra = {}
     if method == "coarse-to-fine":
-        from modalviewer.coarsen import decimated_copy
-        from modalviewer.core.coarse import transfer_spectrum
+        from modalviewer.coarsen import decimated_copy, transfer_spectrum
 
         coarse = decimated_copy(mesh)
         spec = transfer_spectrum(mv.compute_spectrum(coarse, operator, k=k), coarse, mesh)

@@ -21,10 +21,8 @@ Every run is deterministic (fixed start block); every result carries its residua
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -33,6 +31,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 from .factor import SPDSolver
+from .products import column_block_products
 
 __all__ = [
     "Cancelled",
@@ -129,23 +128,6 @@ class EigenResult:
     """The first ``null_dim`` pairs are the given exact null vectors (eigenvalue 0)."""
 
 
-def _sparse_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice, np.ndarray]]:
-    """``(cols, K @ Y[:, cols])`` for consecutive blocks of ``width`` columns.
-
-    scipy's sparse products run on one core (and release the GIL): a few blocks at a
-    time go to a thread each, so only that many (N, width) products exist at once.
-    50k shells, K times 300 columns: 1.0 s on one thread, 0.6 s on two.
-    """
-    workers = max(1, min(4, os.cpu_count() or 1))
-    starts = list(range(0, Y.shape[1], width))
-    with ThreadPoolExecutor(workers) as pool:
-        for first in range(0, len(starts), workers):
-            batch = starts[first : first + workers]
-            products = pool.map(lambda start: K @ Y[:, start : start + width], batch)
-            for start, KY in zip(batch, products, strict=True):
-                yield slice(start, start + width), KY
-
-
 def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
     """Boolean mask (k,) of the zero modes, the one rule for masks, signatures and
     residual checks.
@@ -191,7 +173,7 @@ def relative_residuals(
     scale = np.abs(lam).copy()
     scale[zero_modes(lam, lam_scale, null_dim)] = _lam_max(lam, lam_scale)
     out = np.empty(X.shape[1])
-    for cols, KX in _sparse_products(K, X):  # (N, 32) temporaries, not three (N, k) ones
+    for cols, KX in column_block_products(K, X):  # (N, 32) temporaries, not three (N, k) ones
         MX = mass_diag[:, None] * X[:, cols]
         R = KX - MX * lam[None, cols]
         out[cols] = np.linalg.norm(R, axis=0) / (scale[cols] * np.linalg.norm(MX, axis=0))
@@ -206,7 +188,7 @@ def rounding_floors(K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray) ->
     floors 0.6 to 2.2e-4, residuals 0.2 to 0.6 times them)."""
     K_abs = abs(sp.csr_matrix(K))
     out = np.empty(X.shape[1])
-    for cols, KX in _sparse_products(K_abs, np.abs(X)):
+    for cols, KX in column_block_products(K_abs, np.abs(X)):
         MX = mass_diag[:, None] * X[:, cols]
         out[cols] = np.linalg.norm(KX, axis=0) / np.linalg.norm(MX, axis=0)
     return np.finfo(float).eps * out / np.maximum(np.abs(lam), np.finfo(float).tiny)
@@ -752,7 +734,7 @@ def _rayleigh_ritz_in_place(K, inv_sqrt_m: np.ndarray, Y: np.ndarray) -> np.ndar
         B, d = np.eye(Y.shape[1]), np.ones(Y.shape[1])
     Y *= inv_sqrt_m[:, None]
     G = np.empty_like(B)
-    for cols, KY in _sparse_products(K, Y):  # (N, 32) temporaries
+    for cols, KY in column_block_products(K, Y):  # (N, 32) temporaries
         G[:, cols] = Y.T @ KY
     G = d[:, None] * G * d[None, :]
     lam, W = la.eigh(0.5 * (G + G.T), 0.5 * (B + B.T))

@@ -28,11 +28,11 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from .assembly import operator_matrices
 from .factor import SPDSolver
 from .mesh import Mesh
 from .nullspace import null_space
 from .operators import operator_info
-from .pipeline import operator_matrices
 from .spectrum import Spectrum
 from .validate import check_times, check_vertices
 

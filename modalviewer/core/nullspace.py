@@ -1,4 +1,4 @@
-"""The exactly known null spaces of the four operators, per connected component.
+"""The exactly known null spaces of the operators, per connected component.
 
 Each operator's energy is a sum over the mesh's connected components, so its null space
 is the direct sum of the components' null spaces.  What is known exactly:
@@ -20,7 +20,8 @@ operator               null vectors per component
 
 Other null vectors can exist (a Discrete Shells component whose pieces meet at a single
 vertex can rotate them about it); they are not deflated and the eigensolver finds them
-like any other mode.
+like any other mode.  Each operator's rule (:attr:`.operators.OperatorInfo.null_space_rule`)
+and its words (:attr:`.operators.OperatorInfo.null_space`) are in the registry.
 
 Every candidate is checked numerically on the assembled matrix before it is used: it
 must satisfy ``|K z| <= NULL_RTOL * | |K| |z| |`` (the rounding bound of the product,
@@ -41,19 +42,13 @@ import scipy.sparse as sp
 
 from .laplacian import vertex_normals
 from .mesh import Mesh
+from .operators import operator_info
 
 __all__ = ["NullSpace", "null_space", "NULL_RTOL"]
 
 NULL_RTOL = 1e-10
 """A candidate null vector z is accepted if ``|K z| <= NULL_RTOL * | |K| |z| |``: exact
 null vectors reach 1e-16 to 1e-14 (rounding in the assembly and the product)."""
-
-_KIND = {
-    "laplacian": "constants",
-    "modified_dirichlet": "constants of flat components",
-    "shells": "rigid motions",
-    "shells_normal": "normal rigid motions of flat components",
-}
 
 
 @dataclass(frozen=True)
@@ -83,8 +78,9 @@ class NullSpace:
         """One sentence on the zero modes a spectrum of this operator starts with."""
         d, c = self.dimension, self.n_components
         comps = f"{c} connected component{'s' if c != 1 else ''}"
+        kind = operator_info(self.operator).null_space
         if d == 0:
-            return f"{comps}; no exactly known zero modes ({_KIND[self.operator]}: none)."
+            return f"{comps}; no exactly known zero modes ({kind}: none)."
         with_null = self.per_component[self.per_component > 0]
         counts = np.unique(with_null)
         if len(with_null) == c and len(counts) == 1:
@@ -97,7 +93,7 @@ class NullSpace:
             else (f"the first {d} modes are exact zero modes")
         )
         return (
-            f"{comps}: {first} ({_KIND[self.operator]}, {where}), "
+            f"{comps}: {first} ({kind}, {where}), "
             "computed directly, not by iteration."
         )
 
@@ -136,17 +132,19 @@ def _mass_orthonormal(B: np.ndarray, w: np.ndarray, rtol: float = 1e-10) -> np.n
 def _candidates(mesh: Mesh, operator: str, mass: np.ndarray, normals):
     """Per component: (rows of the unknowns, Mass-orthonormal dense candidate columns)."""
     x = mesh.vertices
+    info = operator_info(operator)
+    rule, per_vertex = info.null_space_rule, info.unknowns_per_vertex
     for verts in _component_vertices(mesh):
-        m = mass[verts] if operator != "shells" else mass[3 * verts]
-        if operator == "laplacian":
+        m = mass[per_vertex * verts]
+        if rule == "constants":
             yield verts, _mass_orthonormal(np.ones((len(verts), 1)), m)
-        elif operator == "shells":
+        elif rule == "rigid motions":
             fields = _rigid_fields(x[verts], m)  # (p, 3, 6), rows 3i+c
             rows = (3 * verts[:, None] + np.arange(3)).ravel()
             yield rows, _mass_orthonormal(fields.reshape(-1, 6), np.repeat(m, 3))
-        else:
+        else:  # "normal translations", "normal rigid motions"
             fields = _rigid_fields(x[verts], m)
-            if operator == "modified_dirichlet":
+            if rule == "normal translations":
                 fields = fields[:, :, :3]  # f N constant: translations only
             N = normals[verts]
             along = np.einsum("pc,pcj->pj", N, fields)  # normal component f = N . r
@@ -172,15 +170,14 @@ def null_space(
 
     Parameters
     ----------
-    K, mass : the operator's matrix and diagonal mass (``pipeline.operator_matrices``);
+    K, mass : the operator's matrix and diagonal mass (``assembly.operator_matrices``);
         every candidate is checked against K.
     normals : the vertex normals the operator was built with (E_D^N, normal shells);
         default: the area-weighted ones the operators use.
     """
-    if operator not in _KIND:
-        raise ValueError(f"unknown operator {operator!r}")
+    info = operator_info(operator)  # a ValueError naming the known operators
     mass = np.asarray(mass, dtype=np.float64)
-    if operator in ("modified_dirichlet", "shells_normal") and normals is None:
+    if info.null_space_needs_normals and normals is None:
         normals = vertex_normals(mesh)
     rows, cols, vals = [], [], []
     component = []

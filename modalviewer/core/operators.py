@@ -1,22 +1,71 @@
 """The one list of operators modalviewer computes spectra of, and what each one is.
 
-Every other module (pipeline, viewer, CLI, plots) asks this registry for an operator's
-label, the number of unknowns per vertex, the distance it defines and its cost, instead
-of keeping its own list.
+Every per-operator fact lives here: the label, the number of unknowns per vertex, the
+function that assembles the matrix, the exactly known null space, the preview's reduced
+space and from which size a preview pays, the signature and distance the spectrum
+defines, and the cost.  Every other module (pipeline, preview, null space, viewer, CLI,
+plots) asks this registry instead of keeping its own list or comparing operator names,
+so a new operator is one more :class:`OperatorInfo` in :data:`OPERATOR_INFO`.
+
+This module imports nothing of the package: the assembly functions are named by
+``"module:function"`` inside :mod:`modalviewer.core` and imported when first used.
 """
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
 
 __all__ = [
     "OperatorInfo",
+    "SpaceSettings",
     "OPERATOR_INFO",
     "OPERATOR_NAMES",
     "DISTANCE_KINDS",
+    "NULL_SPACE_RULES",
+    "distance_word",
     "operator_info",
     "operator_for_distance",
 ]
+
+
+@dataclass(frozen=True)
+class SpaceSettings:
+    """How the reduced space of a preview is built for one operator
+    (:mod:`.preview`, :mod:`.reduced_space`)."""
+
+    samples_min: int
+    samples_per_mode: float
+    degree: int
+    """Polynomials times each partition-of-unity function: 1 = linear, 2 = quadratic."""
+    radius_factor: float
+    exact_sampling: bool
+    """Farthest-point sampling over all vertices (an even covering, so the support
+    radius is not set by one badly covered corner) instead of over random candidates."""
+    smoothing: bool
+    """The two-level step after the Galerkin projection (see
+    :func:`.preview._two_level_step`)."""
+    refine: bool = False
+    """Subspace iteration with the fine operator where the estimate is above
+    :data:`.preview.REFINE_ABOVE` (see :func:`.preview.preview_spectrum`)."""
+
+    def samples(self, k: int) -> int:
+        return max(self.samples_min, int(self.samples_per_mode * k))
+
+
+NULL_SPACE_RULES: dict[str, str] = {
+    "constants": "the constant per component (scalar fields)",
+    "rigid motions": "the six rigid motions per component (3-vector fields)",
+    "normal translations": "f with f N a translation: the constant of flat components",
+    "normal rigid motions": "f with f N a rigid motion: the affine functions of flat components",
+}
+"""How :func:`.nullspace.null_space` builds an operator's candidate null vectors; the
+two ``normal`` rules need the vertex normals."""
+
+RADIUS_FACTOR = 2.0
+"""Support radius of the reduced space's basis functions in units of the sampling's
+covering radius (the largest distance from a vertex to its nearest sample): the default
+of :func:`.reduced_space.reduced_basis` and of the scalar operators' previews."""
 
 
 @dataclass(frozen=True)
@@ -30,6 +79,16 @@ class OperatorInfo:
     distance_kind : the multi-scale distance this operator's spectrum defines, or None.
     nonzeros_per_row : typical non-zeros per row of K (for memory and time estimates).
     has_weights : whether the bending and membrane weights apply.
+    assemble : ``"module:function"`` in :mod:`modalviewer.core` that assembles K:
+        ``function(mesh)``, or ``function(mesh, bending, membrane)`` with weights
+        (:meth:`stiffness`).
+    null_space : the exactly known null vectors in words.
+    null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
+    preview : the preview's reduced space (:class:`SpaceSettings`).
+    preview_min_unknowns : with the Preview option, problems with at least this many
+        unknowns show a preview spectrum while the exact one is computed.
+    signature_word : the signature (and distance) its spectrum defines, in words
+        ("heat kernel"), or None.
     """
 
     name: str
@@ -39,6 +98,17 @@ class OperatorInfo:
     distance_kind: str | None
     nonzeros_per_row: int
     has_weights: bool
+    assemble: str
+    null_space: str
+    null_space_rule: str
+    preview: SpaceSettings
+    preview_min_unknowns: int
+    signature_word: str | None = None
+
+    @property
+    def vector(self) -> bool:
+        """True for 3-vector (displacement) fields, False for scalar fields."""
+        return self.unknowns_per_vertex == 3
 
     def unknowns(self, n_vertices: int) -> int:
         return self.unknowns_per_vertex * int(n_vertices)
@@ -46,31 +116,117 @@ class OperatorInfo:
     def nonzeros(self, n_vertices: int) -> int:
         return self.unknowns(n_vertices) * self.nonzeros_per_row
 
+    def preview_min_vertices(self) -> int:
+        """The fewest vertices whose problem reaches :attr:`preview_min_unknowns`."""
+        return -(-self.preview_min_unknowns // self.unknowns_per_vertex)
+
+    @property
+    def null_space_needs_normals(self) -> bool:
+        return self.null_space_rule.startswith("normal")
+
+    def stiffness(self, mesh, bending: float = 1.0, membrane: float = 1.0):
+        """The operator's sparse matrix K on ``mesh`` (the function :attr:`assemble`)."""
+        module, function = self.assemble.split(":")
+        assemble = getattr(importlib.import_module(f"modalviewer.core.{module}"), function)
+        if self.has_weights:
+            return assemble(mesh, bending, membrane)
+        return assemble(mesh)
+
+
+# Preview spaces.  Without smoothing the space itself must be fine (10k spot, Galerkin
+# alone: 200 / 300 samples, largest error 2.0 / 1.4 %); the support radius comes from the
+# covering radius of random-candidate sampling, which the 130k plate's lowest 50
+# eigenvalues need (0.24 % largest error against 1.1 % with an even sampling and 2
+# spacings).
+_SCALAR_SPACE = SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False)
+
+# Bending energies need quadratic precision, and the Galerkin error of smooth spaces
+# stays near 5 % median on the 130k plate for 60 to 300 samples (membrane locking on
+# the bumps), which the two-level step (see preview._two_level_step) removes.  130k
+# plate, 100 modes, lowest 50 non-zero eigenvalues, largest / median error: normal
+# shells, 200 samples 0.48 % / 0.18 % (3.6 s; 100 samples 1.5 %, radius 1.5: 2.5 %);
+# shells, 100 samples, radius factor 1.8: 0.66 % / 0.27 %.  A radius factor of 1.5 (a
+# smaller overlap of the supports: the projection 1.8 -> 1.1 s, 5.5 s in all) leaves
+# 1.7 % / 0.8 % there but doubles the error on curved meshes (spot Loop-subdivided
+# twice: 108 % / 22 % against 45 % / 13 %; the 10k spot's lowest distance correlation
+# 0.17 against 0.78).  Linear functions leave shells errors of 69 % (150 samples).
+_NORMAL_SHELLS_SPACE = SpaceSettings(200, 2.0, 2, RADIUS_FACTOR, False, True)
+
+# Curved meshes with thin parts lock the 3D shells' smooth space: the cow (46k, 100
+# modes) 1057 % largest / 59 % median error, its tail's two modes missing.  Two
+# subspace-iteration steps bring it to 2.4 % / 0.1 % at 0.15 of the exact time.  The
+# scalar operators' exact spectra take 3 to 4 s at 50k, about what a preview and its
+# refinement would (cow Laplacian 2.2 s, normal shells 3.3 s against 4.2 and 3.7 s), so
+# they are shown unrefined and the exact spectrum follows.
+_SHELLS_SPACE = SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True)
+
+# preview_min_unknowns: below it the exact spectrum comes about as fast as the preview
+# would (100 modes; README "Preview spectra"): normal shells 2.5 s against 3.6 s at 50k
+# vertices, 5.2 s against 12.0 s at 130k; 3D shells, refined on curved meshes, 8.9 s
+# against 15.2 s at 50k (the spot), 7.8 s against 44.4 s on the 130k plate; Laplacian
+# 0.8 s against 2.8 s at 50k.
 
 OPERATOR_INFO: dict[str, OperatorInfo] = {
     info.name: info
     for info in (
-        OperatorInfo("laplacian", "Laplacian (cotan)", "Laplacian", 1, "hks", 7, False),
+        OperatorInfo(
+            "laplacian",
+            "Laplacian (cotan)",
+            "Laplacian",
+            unknowns_per_vertex=1,
+            distance_kind="hks",
+            nonzeros_per_row=7,
+            has_weights=False,
+            assemble="laplacian:stiffness_matrix",
+            null_space="constants",
+            null_space_rule="constants",
+            preview=_SCALAR_SPACE,
+            preview_min_unknowns=30_000,
+            signature_word="heat kernel",
+        ),
         OperatorInfo(
             "modified_dirichlet",
             "Modified Dirichlet energy E_D^N",
             "E_D^N",
-            1,
-            "feature",
-            7,
-            False,
+            unknowns_per_vertex=1,
+            distance_kind="feature",
+            nonzeros_per_row=7,
+            has_weights=False,
+            assemble="dirichlet:modified_dirichlet_matrix",
+            null_space="constants of flat components",
+            null_space_rule="normal translations",
+            preview=_SCALAR_SPACE,
+            preview_min_unknowns=30_000,
+            signature_word="feature",
         ),
         OperatorInfo(
-            "shells", "Discrete Shells (3D vibrations)", "Shells 3D", 3, "vibration", 42, True
+            "shells",
+            "Discrete Shells (3D vibrations)",
+            "Shells 3D",
+            unknowns_per_vertex=3,
+            distance_kind="vibration",
+            nonzeros_per_row=42,
+            has_weights=True,
+            assemble="shells:shells_hessian",
+            null_space="rigid motions",
+            null_space_rule="rigid motions",
+            preview=_SHELLS_SPACE,
+            preview_min_unknowns=300_000,
+            signature_word="vibration",
         ),
         OperatorInfo(
             "shells_normal",
             "Discrete Shells, normal variations",
             "Shells normal",
-            1,
-            None,
-            19,
-            True,
+            unknowns_per_vertex=1,
+            distance_kind=None,
+            nonzeros_per_row=19,
+            has_weights=True,
+            assemble="shells:normal_shells_hessian",
+            null_space="normal rigid motions of flat components",
+            null_space_rule="normal rigid motions",
+            preview=_NORMAL_SHELLS_SPACE,
+            preview_min_unknowns=100_000,
         ),
     )
 }
@@ -100,3 +256,9 @@ def operator_for_distance(kind: str) -> str:
         if info.distance_kind == kind:
             return info.name
     raise ValueError(f"unknown distance kind {kind!r}; choose one of {', '.join(DISTANCE_KINDS)}")
+
+
+def distance_word(kind: str) -> str:
+    """Distance ``kind`` in lower-case words ("heat kernel" for ``"hks"``)."""
+    word = operator_info(operator_for_distance(kind)).signature_word
+    return word if word is not None else kind

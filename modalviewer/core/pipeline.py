@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 
-from .dirichlet import modified_dirichlet_matrix
+from .assembly import operator_matrices
 from .eigen import (
     CancelFn,
     EigenError,
@@ -17,12 +17,11 @@ from .eigen import (
     typical_eigenvalue,
     zero_modes,
 )
-from .laplacian import lumped_masses, stiffness_matrix
 from .mesh import Mesh
 from .nullspace import null_space
 from .operators import operator_info
-from .shells import normal_shells_hessian, shells_hessian
-from .spectrum import OPERATORS, Spectrum
+from .preview import compute_preview, preview_possible
+from .spectrum import Spectrum
 from .validate import check_count
 
 __all__ = [
@@ -82,20 +81,6 @@ def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
     )
 
 
-def operator_matrices(mesh: Mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):
-    """(K, mass_diag) of the eigenproblem ``K phi = lambda diag(mass) phi``."""
-    m = lumped_masses(mesh)
-    if operator == "laplacian":
-        return stiffness_matrix(mesh), m
-    if operator == "modified_dirichlet":
-        return modified_dirichlet_matrix(mesh), m
-    if operator == "shells":
-        return shells_hessian(mesh, bending, membrane), np.repeat(m, 3)
-    if operator == "shells_normal":
-        return normal_shells_hessian(mesh, bending, membrane), m
-    raise ValueError(f"unknown operator {operator!r}; choose one of {', '.join(OPERATORS)}")
-
-
 def compute_spectrum(
     mesh: Mesh,
     operator: str,
@@ -110,7 +95,7 @@ def compute_spectrum(
 
     Parameters
     ----------
-    operator : "laplacian" | "modified_dirichlet" | "shells" | "shells_normal".
+    operator : one of :data:`.operators.OPERATOR_NAMES`.
     k : number of modes, an integer >= 1 (Python or numpy; not a float or a bool);
         capped at the number of unknowns.
     bending, membrane : Discrete Shells weights (ignored by the scalar energies).
@@ -119,7 +104,9 @@ def compute_spectrum(
     accuracy : "exact" (default) or "preview": a Rayleigh-Ritz approximation in a reduced
         space of smooth functions on the same mesh (:mod:`.preview`), seconds instead of
         minutes on big meshes; ``spec.is_preview`` is then True and
-        ``spec.estimated_error`` holds its estimated relative eigenvalue error.
+        ``spec.estimated_error`` holds its estimated relative eigenvalue error.  A mesh
+        too small for a reduced space of 3 k functions (:func:`.preview.preview_possible`)
+        gets the exact spectrum instead, which is quick there (``is_preview`` False).
 
     Returns
     -------
@@ -133,9 +120,7 @@ def compute_spectrum(
     k = check_count(k, "k")
     if accuracy not in ("exact", "preview"):
         raise ValueError(f"accuracy must be 'exact' or 'preview', got {accuracy!r}")
-    if accuracy == "preview":
-        from .preview import compute_preview
-
+    if accuracy == "preview" and preview_possible(mesh, operator, k):
         return compute_preview(mesh, operator, k, bending, membrane, progress, cancel)
 
     def report(stage: str, fraction: float) -> None:
@@ -187,8 +172,8 @@ def compute_spectrum(
     n = mesh.n_vertices
     modes = result.vectors
     per_vertex = operator_info(operator).unknowns_per_vertex
-    if per_vertex == 3:
-        modes = modes.reshape(n, 3, k)
+    if per_vertex > 1:
+        modes = modes.reshape(n, per_vertex, k)
     if progress is not None:
         progress("done", 1.0)
     return Spectrum(

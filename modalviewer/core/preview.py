@@ -27,11 +27,11 @@ from __future__ import annotations
 
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
+from .assembly import operator_matrices
 from .eigen import (
     CancelFn,
     Cancelled,
@@ -43,9 +43,10 @@ from .eigen import (
 )
 from .factor import SPDSolver
 from .mesh import Mesh
+from .nullspace import null_space
+from .operators import OPERATOR_INFO, SpaceSettings, operator_info
 from .products import row_blocks, threaded_product, threaded_transpose_product
 from .reduced_space import (
-    RADIUS_FACTOR,
     ReducedBasis,
     max_samples,
     reduced_basis,
@@ -56,65 +57,28 @@ from .spectrum import Spectrum
 __all__ = [
     "SpaceSettings",
     "SPACE_SETTINGS",
+    "preview_possible",
     "preview_spectrum",
     "estimated_errors",
     "compute_preview",
 ]
 
 
-@dataclass(frozen=True)
-class SpaceSettings:
-    """How the reduced space of a preview is built for one operator."""
-
-    samples_min: int
-    samples_per_mode: float
-    degree: int
-    """Polynomials times each partition-of-unity function: 1 = linear, 2 = quadratic."""
-    radius_factor: float
-    exact_sampling: bool
-    """Farthest-point sampling over all vertices (an even covering, so the support
-    radius is not set by one badly covered corner) instead of over random candidates."""
-    smoothing: bool
-    """The two-level step after the Galerkin projection (see :func:`_two_level_step`)."""
-    refine: bool = False
-    """Subspace iteration with the fine operator where the estimate is above
-    :data:`REFINE_ABOVE` (see :func:`preview_spectrum`)."""
-
-    def samples(self, k: int) -> int:
-        return max(self.samples_min, int(self.samples_per_mode * k))
-
-
-SPACE_SETTINGS = {
-    # Without smoothing the space itself must be fine (10k spot, Galerkin alone: 200 / 300
-    # samples, largest error 2.0 / 1.4 %); the support radius comes from the covering
-    # radius of random-candidate sampling, which the 130k plate's lowest 50 eigenvalues
-    # need (0.24 % largest error against 1.1 % with an even sampling and 2 spacings).
-    "laplacian": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
-    "modified_dirichlet": SpaceSettings(300, 3.0, 1, RADIUS_FACTOR, False, False),
-    # Bending energies need quadratic precision, and the Galerkin error of smooth spaces
-    # stays near 5 % median on the 130k plate for 60 to 300 samples (membrane locking on
-    # the bumps), which the two-level step (see _two_level_step) removes.  130k plate,
-    # 100 modes, lowest 50 non-zero eigenvalues, largest / median error: normal shells,
-    # 200 samples 0.48 % / 0.18 % (3.6 s; 100 samples 1.5 %, radius 1.5: 2.5 %); shells,
-    # 100 samples, radius factor 1.8: 0.66 % / 0.27 %.  A radius factor of 1.5 (a smaller
-    # overlap of the supports: the projection 1.8 -> 1.1 s, 5.5 s in all) leaves 1.7 % /
-    # 0.8 % there but doubles the error on curved meshes (spot Loop-subdivided twice:
-    # 108 % / 22 % against 45 % / 13 %; the 10k spot's lowest distance correlation 0.17
-    # against 0.78).  Linear functions leave shells errors of 69 % (150 samples).
-    "shells_normal": SpaceSettings(200, 2.0, 2, RADIUS_FACTOR, False, True),
-    # Curved meshes with thin parts lock the 3D shells' smooth space: the cow (46k,
-    # 100 modes) 1057 % largest / 59 % median error, its tail's two modes missing.  Two
-    # subspace-iteration steps bring it to 2.4 % / 0.1 % at 0.15 of the exact time.  The
-    # scalar operators' exact spectra take 3 to 4 s at 50k, about what a preview and its
-    # refinement would (cow Laplacian 2.2 s, normal shells 3.3 s against 4.2 and 3.7 s),
-    # so they are shown unrefined and the exact spectrum follows.
-    "shells": SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True),
+SPACE_SETTINGS: dict[str, SpaceSettings] = {
+    name: info.preview for name, info in OPERATOR_INFO.items()
 }
+"""How the reduced space is built per operator (:attr:`.operators.OperatorInfo.preview`)."""
 
 
 MAX_NULL_COLUMNS = 96
 """Exact null vectors (:mod:`.nullspace`) are added to the reduced space up to this
 many (a mesh of many components, e.g. a broken scan, has six rigid motions each)."""
+
+
+_IN_EVERY_SPACE = ("constants", "rigid motions")
+"""Null-space rules (:data:`.operators.NULL_SPACE_RULES`) whose vectors every reduced
+space of a connected mesh holds: the partition of unity sums to the constant, and the
+3-vector spaces hold the translations and the rotation columns."""
 
 
 def _null_space_complement(mesh, operator, K, mass, basis: ReducedBasis, Mr) -> np.ndarray | None:
@@ -129,9 +93,7 @@ def _null_space_complement(mesh, operator, K, mass, basis: ReducedBasis, Mr) -> 
     Mass-orthonormalised, and parts below 1e-8 of the vector are dropped (already
     contained).
     """
-    from .nullspace import null_space
-
-    if mesh.n_components == 1 and operator in ("laplacian", "shells"):
+    if mesh.n_components == 1 and operator_info(operator).null_space_rule in _IN_EVERY_SPACE:
         return None
     Z = null_space(mesh, operator, K, mass).vectors
     if Z.shape[1] == 0 or Z.shape[1] > MAX_NULL_COLUMNS:
@@ -622,7 +584,7 @@ def preview_spectrum(
     mass = np.asarray(mass, dtype=np.float64)
     seconds = {}
     t = time.perf_counter()
-    settings = SPACE_SETTINGS[operator]
+    settings = operator_info(operator).preview
     if smoothing is None:
         smoothing = settings.smoothing
     if refine is None:
@@ -661,7 +623,7 @@ def preview_spectrum(
     seconds["prolongation"] = time.perf_counter() - t
     lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
     galerkin = lam
-    precondition = _jacobi_blocks(K, 3 if operator == "shells" else 1)
+    precondition = _jacobi_blocks(K, operator_info(operator).unknowns_per_vertex)
     if smoothing:
         t = time.perf_counter()
         report("preview: smoothing", 0.8)
@@ -705,6 +667,15 @@ def preview_spectrum(
     return lam, U, res, info
 
 
+def preview_possible(mesh: Mesh, operator: str, k: int) -> bool:
+    """Whether ``mesh`` holds a reduced space of at least 3 k functions for ``operator``
+    (:func:`max_samples`); smaller meshes get the exact spectrum, quick there."""
+    info = operator_info(operator)
+    degree = info.preview.degree
+    functions = max_samples(mesh.n_vertices, degree) * scalar_functions_per_sample(degree)
+    return functions * info.unknowns_per_vertex >= 3 * int(k)
+
+
 def compute_preview(
     mesh: Mesh,
     operator: str,
@@ -719,15 +690,9 @@ def compute_preview(
     ``parameters["preview"]`` holds the reduced space, timings and estimated errors
     (``spec.is_preview``, ``spec.estimated_error``).
 
-    A mesh too small for a reduced space of 3 k functions (:func:`max_samples`) gets
-    the exact spectrum instead, which is quick there (``is_preview`` False)."""
-    from .pipeline import compute_spectrum, operator_matrices
-
-    degree = SPACE_SETTINGS[operator].degree
-    functions = max_samples(mesh.n_vertices, degree) * scalar_functions_per_sample(degree)
-    if functions * (3 if operator == "shells" else 1) < 3 * int(k):
-        return compute_spectrum(mesh, operator, k, bending, membrane, progress, cancel)
-
+    For meshes where :func:`preview_possible` holds; ``compute_spectrum`` computes the
+    exact spectrum of the others."""
+    per_vertex = operator_info(operator).unknowns_per_vertex
     started = time.perf_counter()
     if cancel is not None and cancel():
         raise Cancelled()
@@ -741,15 +706,15 @@ def compute_preview(
     )
     n = mesh.n_vertices
     modes = np.ascontiguousarray(U)
-    if operator == "shells":
-        modes = modes.reshape(n, 3, -1)
+    if per_vertex > 1:
+        modes = modes.reshape(n, per_vertex, -1)
     if progress is not None:
         progress("done", 1.0)
     return Spectrum(
         eigenvalues=lam,
         modes=modes,
         operator=operator,
-        mass=mass[::3] if operator == "shells" else mass,
+        mass=mass[::per_vertex],
         residuals=res,
         mesh_hash=mesh.hash,
         parameters={

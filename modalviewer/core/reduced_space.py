@@ -36,6 +36,7 @@ from scipy.spatial import cKDTree
 
 from .laplacian import vertex_normals
 from .mesh import Mesh
+from .operators import RADIUS_FACTOR, operator_info
 from .products import row_blocks, threaded_product, threaded_transpose_product
 
 __all__ = [
@@ -53,11 +54,7 @@ __all__ = [
 DEFAULT_SAMPLES = 200
 """Samples (centres of basis functions) of :func:`reduced_basis` when none are given;
 :func:`.preview.preview_spectrum` takes its own per operator from
-:data:`.preview.SPACE_SETTINGS`."""
-
-RADIUS_FACTOR = 2.0
-"""Support radius of the basis functions in units of the sampling's covering radius (the
-largest distance from a vertex to its nearest sample)."""
+:attr:`.operators.OperatorInfo.preview`."""
 
 
 def farthest_point_samples(
@@ -370,13 +367,14 @@ def reduced_basis(
 ) -> ReducedBasis:
     """The reduced space of ``operator`` (see :class:`ReducedBasis`).
 
-    For ``"shells"`` every scalar function times e_x, e_y, e_z, and the three rotations
-    as dense columns; for the scalar operators the scalar functions alone.
+    For 3-vector operators (:attr:`.operators.OperatorInfo.vector`, the shells) every
+    scalar function times e_x, e_y, e_z, and the three rotations as dense columns; for
+    the scalar operators the scalar functions alone.
     ``candidates``: see :func:`farthest_point_samples`.
     """
     centers = farthest_point_samples(mesh.vertices, samples, candidates=candidates, seed=seed)
     P, r = partition_of_unity_basis(mesh, centers, radius_factor, enrich)
-    vector = operator == "shells"
+    vector = operator_info(operator).vector
     info = {
         "samples": int(len(centers)),
         "support_radius": r,

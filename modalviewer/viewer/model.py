@@ -14,11 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..coarsen import COARSE_FRACTION
 from ..core.cache import SpectrumCache
-from ..core.coarse import estimate_cost
+from ..core.cost import estimate_cost
 from ..core.eigen import Cancelled
 from ..core.mesh import Mesh
-from ..core.operators import operator_info
+from ..core.operators import OPERATOR_INFO, operator_info
 from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
@@ -30,18 +31,10 @@ PROCESS_THRESHOLD = 20000
 """Problems with at least this many unknowns are computed in a separate process
 (sparse factorisations hold the GIL; a process also cancels at once)."""
 
-PREVIEW_MIN_UNKNOWNS = {
-    "laplacian": 30_000,
-    "modified_dirichlet": 30_000,
-    "shells_normal": 100_000,
-    "shells": 300_000,
-}
+PREVIEW_MIN_UNKNOWNS = {name: info.preview_min_unknowns for name, info in OPERATOR_INFO.items()}
 """With the Preview option, problems with at least this many unknowns show a preview
-spectrum while the exact one is computed.  Below, the exact spectrum comes about as fast
-as the preview would (100 modes; README "Preview spectra"): normal shells 2.5 s against
-3.6 s at 50k vertices, 5.2 s against 12.0 s at 130k; 3D shells, refined on curved meshes,
-8.9 s against 15.2 s at 50k (the spot), 7.8 s against 44.4 s on the 130k plate;
-Laplacian 0.8 s against 2.8 s at 50k."""
+spectrum while the exact one is computed
+(:attr:`~modalviewer.core.operators.OperatorInfo.preview_min_unknowns`)."""
 
 
 def preview_min_vertices(operator: str) -> int:
@@ -49,10 +42,6 @@ def preview_min_vertices(operator: str) -> int:
     (:data:`PREVIEW_MIN_UNKNOWNS` in vertices)."""
     per_vertex = operator_info(operator).unknowns_per_vertex
     return -(-PREVIEW_MIN_UNKNOWNS.get(operator, 0) // per_vertex)
-
-
-COARSE_FRACTION = 0.2
-"""Share of the vertices the Coarse-to-fine copy keeps."""
 
 
 class ComputeRefused(ValueError):
@@ -362,14 +351,9 @@ def _compute(mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cance
     info = operator_info(key.operator)
     weights = (key.bending, key.membrane)
     if key.coarse:
-        from ..coarsen import decimated_copy
-        from ..core.coarse import transfer_spectrum
+        from ..coarsen import coarse_to_fine_spectrum
 
-        progress("decimating", 0.0)
-        coarse = decimated_copy(mesh, COARSE_FRACTION)
-        k = min(key.k, info.unknowns(coarse.n_vertices))
-        spec = compute_spectrum(coarse, key.operator, k, *weights, progress, cancel)
-        return transfer_spectrum(spec, coarse, mesh)
+        return coarse_to_fine_spectrum(mesh, key.operator, key.k, *weights, progress, cancel)
     if info.unknowns(mesh.n_vertices) >= PROCESS_THRESHOLD:
         from .process import compute_in_process
 
