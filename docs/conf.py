@@ -72,8 +72,23 @@ def _html_anchors(app, docname, source) -> None:
     source[0] = _HTML_ANCHOR.sub(r"[]{#\1}", source[0])
 
 
+def _changelog_link(app, docname, source) -> None:
+    """docs/index.md links ../CHANGELOG.md, the file GitHub shows; in the HTML build the
+    link goes to the page changelog.md, which includes that file."""
+    if docname == "index":
+        source[0] = source[0].replace("](../CHANGELOG.md)", "](changelog.md)")
+
+
+def _api_outdated(app, env, added, changed, removed) -> list[str]:
+    """The API page is read again on every build: autodoc does not notice edited docstrings,
+    and the exported names may have changed."""
+    return ["api"] if "api" in env.found_docs and "api" not in changed else []
+
+
 def setup(app):
     app.connect("source-read", _html_anchors)
+    app.connect("source-read", _changelog_link)
+    app.connect("env-get-outdated", _api_outdated)
 
 
 # The API reference's list of names, from modalviewer.__all__ at build time.
