@@ -31,8 +31,9 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.run import make_mesh, save_result  # noqa: E402
 from modalviewer.core.cache import SpectrumCache  # noqa: E402
+from modalviewer.core.operators import OPERATOR_INFO  # noqa: E402
 
-KIND = {"shells": "vibration", "modified_dirichlet": "feature", "laplacian": "hks"}
+KIND = {name: info.distance_kind for name, info in OPERATOR_INFO.items() if info.distance_kind}
 
 
 def _stats(values) -> dict:

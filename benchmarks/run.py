@@ -36,9 +36,10 @@ sys.path.insert(0, str(ROOT))
 import modalviewer as mv  # noqa: E402
 from modalviewer.core.demo_shapes import bumpy_plate  # noqa: E402
 from modalviewer.core.eigen import solve_lowest  # noqa: E402
-from modalviewer.core.memory import prepare_compute_process  # noqa: E402
 from modalviewer.core.nullspace import null_space  # noqa: E402
+from modalviewer.core.operators import operator_info  # noqa: E402
 from modalviewer.core.pipeline import operator_matrices  # noqa: E402
+from modalviewer.processes.memory import prepare_compute_process  # noqa: E402
 
 
 def make_mesh(size: str) -> mv.Mesh:
@@ -87,13 +88,15 @@ def _ours(size: str, operator: str, k: int) -> dict:
     nulls = null_space(mesh, operator, K, mass)
     result = solve_lowest(K, mass, k, null_space=nulls.vectors)
     t_eigen = time.perf_counter() - t0
-    shells = operator == "shells"
-    modes = result.vectors.reshape(mesh.n_vertices, 3, k) if shells else result.vectors
+    per_vertex = operator_info(operator).unknowns_per_vertex
+    modes = result.vectors
+    if per_vertex > 1:
+        modes = modes.reshape(mesh.n_vertices, per_vertex, k)
     spec = mv.Spectrum(
         result.eigenvalues,
         modes,
         operator,
-        mass[::3] if shells else mass,
+        mass[::per_vertex],
         result.residuals,
         parameters={"null_space_dimension": result.null_dim},
     )
@@ -134,7 +137,7 @@ def _baseline_row(size: str, operator: str, k: int, shift: float) -> dict:
 
 def _in_child(fn, *args):
     """``fn(*args)`` in a fresh process with the memory settings of the viewer's and the
-    command line's computation processes (``core.memory``)."""
+    command line's computation processes (``processes.memory``)."""
     import multiprocessing as mp
 
     with mp.get_context("spawn").Pool(1, initializer=prepare_compute_process) as pool:

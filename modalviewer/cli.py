@@ -14,7 +14,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.operators import DISTANCE_KINDS, OPERATOR_NAMES, operator_for_distance
+from .core.operators import (
+    DISTANCE_KINDS,
+    OPERATOR_NAMES,
+    distance_word,
+    operator_for_distance,
+)
 from .viewer.state import DEFAULT_THRESHOLD_SHARE
 
 COMMANDS = ("compute", "render", "distance", "figures")
@@ -194,9 +199,9 @@ def _run(args) -> int:
         print(f"{len(made)} figures written to {args.output}")
         return 0
     if args.command == "compute":
-        from .core.memory import prepare_compute_process
+        from .processes.memory import prepare_compute_process
 
-        prepare_compute_process()  # this process exists to compute (see core.memory)
+        prepare_compute_process()  # this process exists to compute (see processes.memory)
         mesh = _load(args.mesh, args.fix_slivers)
         with _warnings_printed():
             spec = mv.compute_spectrum(
@@ -436,7 +441,7 @@ def _distance_to(args, mesh_a) -> int:
     if args.output:
         from .cross_figure import Panel, render_panels
 
-        label = {"vibration": "vibration", "feature": "feature", "hks": "heat kernel"}[args.kind]
+        label = distance_word(args.kind)
         display = "continuous" if marked is None else "threshold"
         panels = [
             Panel(

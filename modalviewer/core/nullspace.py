@@ -92,10 +92,7 @@ class NullSpace:
             if d == 1
             else (f"the first {d} modes are exact zero modes")
         )
-        return (
-            f"{comps}: {first} ({kind}, {where}), "
-            "computed directly, not by iteration."
-        )
+        return f"{comps}: {first} ({kind}, {where}), computed directly, not by iteration."
 
 
 def _component_vertices(mesh: Mesh) -> list[np.ndarray]:

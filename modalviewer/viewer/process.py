@@ -89,7 +89,7 @@ def _temp_path(suffix: str) -> str:
 def compute_in_process(
     mesh, operator, k, bending, membrane, out_path, progress, cancel, accuracy="exact"
 ):
-    """Run ``modalviewer.core.job_main`` in a child Python; returns the Spectrum read back
+    """Run ``modalviewer.processes.job_main`` in a child Python; returns the Spectrum read back
     from ``out_path``; the child's error message is raised as RuntimeError."""
     params = {
         "operator": operator,
@@ -101,9 +101,8 @@ def compute_in_process(
     job_path = _temp_path(".npz")
     try:
         np.savez(job_path, vertices=mesh.vertices, faces=mesh.faces, params=json.dumps(params))
-        _run_child(
-            ["modalviewer.core.job_main", job_path, str(out_path)], progress, cancel, "computation"
-        )
+        argv = ["modalviewer.processes.job_main", job_path, str(out_path)]
+        _run_child(argv, progress, cancel, "computation")
     finally:
         Path(job_path).unlink(missing_ok=True)
     progress("reading the result", 0.98)

@@ -1,10 +1,11 @@
-"""A spectrum computation in a child process: ``python -m modalviewer.core.job_main JOB OUT``.
+"""A spectrum computation in a child process.
 
-JOB.npz holds ``vertices``, ``faces`` and a JSON ``params`` (operator, k, bending,
-membrane).  Progress goes to stdout as JSON lines ``{"stage": ..., "fraction": ...}``,
-the result to OUT.npz (written atomically), a failure to stdout as ``{"error": ...}``
-with exit code 1.  A separate process keeps the viewer's event loop free (sparse
-factorisations hold the GIL) and is terminated at once to cancel.
+``python -m modalviewer.processes.job_main JOB OUT``: JOB.npz holds ``vertices``,
+``faces`` and a JSON ``params`` (operator, k, bending, membrane).  Progress goes to
+stdout as JSON lines ``{"stage": ..., "fraction": ...}``, the result to OUT.npz (written
+atomically), a failure to stdout as ``{"error": ...}`` with exit code 1.  A separate
+process keeps the viewer's event loop free (sparse factorisations hold the GIL) and is
+terminated at once to cancel.
 """
 
 from __future__ import annotations
@@ -23,12 +24,12 @@ def _emit(payload: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     job_path, out_path = argv
+    from ..core.mesh import Mesh
+    from ..core.pipeline import compute_spectrum
+    from ..core.spectrum import save_spectrum
     from .memory import prepare_compute_process
-    from .mesh import Mesh
-    from .pipeline import compute_spectrum
-    from .spectrum import save_spectrum
 
-    prepare_compute_process()  # this process exists to compute (see core.memory)
+    prepare_compute_process()  # this process exists to compute (see processes.memory)
     try:
         with np.load(job_path, allow_pickle=False) as job:
             vertices, faces = job["vertices"], job["faces"]

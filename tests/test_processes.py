@@ -1,4 +1,4 @@
-"""Memory settings of computation processes (core.memory)."""
+"""Memory settings of computation processes (modalviewer.processes.memory)."""
 
 import subprocess
 import sys
@@ -9,7 +9,7 @@ import pytest
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
 def test_the_memory_settings_take_effect_in_a_fresh_process():
     code = (
-        "from modalviewer.core.memory import prepare_compute_process\n"
+        "from modalviewer.processes.memory import prepare_compute_process\n"
         "import numpy as np\n"
         "ok = prepare_compute_process()\n"
         "a = np.ones((4000, 4000)); del a\n"  # 128 MB from the heap, kept
@@ -23,7 +23,7 @@ def test_the_memory_settings_take_effect_in_a_fresh_process():
 
 
 def test_the_viewer_child_process_computes_with_the_memory_settings(tmp_path):
-    """The viewer's child process (core.job_main) computes with the settings on and
+    """The viewer's child process (processes.job_main) computes with the settings on and
     still writes its spectrum."""
     import numpy as np
 
@@ -39,7 +39,7 @@ def test_the_viewer_child_process_computes_with_the_memory_settings(tmp_path):
     )
     out = tmp_path / "out.npz"
     run = subprocess.run(
-        [sys.executable, "-m", "modalviewer.core.job_main", str(job), str(out)],
+        [sys.executable, "-m", "modalviewer.processes.job_main", str(job), str(out)],
         capture_output=True,
         text=True,
         timeout=120,
