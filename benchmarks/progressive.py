@@ -81,11 +81,11 @@ def run(size: str, operator: str, k: int) -> dict:
     win.pick_vertex(vertex)
     win.show_distance(display="threshold")  # a first threshold map marks a tenth
     app.processEvents()
-    preview_map = state.distance_map().copy()
+    preview_map = state.derived.distance_map().copy()
     stem = f"progressive_{size}" + ("" if operator == "laplacian" else f"_{operator}")
     win.export_screenshot(ROOT / "benchmarks" / "results" / f"{stem}_preview.png")
     display_before = state.display
-    share_before = state.threshold_share()
+    share_before = state.derived.marked_share()
     waiting_gaps, gaps[:] = list(gaps), []  # the gaps while nothing but waiting ran
     last[0] = time.perf_counter()
     while state.spectrum(operator).is_preview:
@@ -95,11 +95,11 @@ def run(size: str, operator: str, k: int) -> dict:
     app.processEvents()
     timer.stop()
     exact = state.spectrum(operator)
-    exact_map = state.distance_map()
+    exact_map = state.derived.distance_map()
     # the threshold follows the map to keep its share of the surface: compared as a share
     kept = replace(state.display, threshold=display_before.threshold) == display_before
     out["display_kept"] = bool(kept and state.picked == vertex)
-    out["threshold_share_preview_exact"] = [share_before, state.threshold_share()]
+    out["threshold_share_preview_exact"] = [share_before, state.derived.marked_share()]
     out["distance_correlation_preview_exact"] = float(np.corrcoef(preview_map, exact_map)[0, 1])
     nonzero = ~exact.zero_mode_mask()
     rel = (preview.eigenvalues[nonzero][:50] - exact.eigenvalues[nonzero][:50]) / np.abs(

@@ -297,7 +297,7 @@ def _run(args) -> int:
 def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
     """(distance, share of ``mesh``'s area where ``d`` is at most it) of ``--share`` or
     ``--threshold``, or None without either: the share turned into a distance as the
-    viewer's threshold display does (by area, ``ViewerState.threshold_for_share``)."""
+    viewer's threshold display does (by area, ``DerivedValues.threshold_for_share``)."""
     if args.share is None and args.threshold is None:
         return None
     from .viewer.state import ViewerState
@@ -307,8 +307,8 @@ def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
     if args.threshold is not None:
         value = float(args.threshold)
     else:
-        value = state.threshold_for_share(args.share, d) * float(d.max())
-    return value, state.surface_share(d, value)
+        value = state.derived.threshold_for_share(args.share, d) * float(d.max())
+    return value, state.derived.surface_share(d, value)
 
 
 class _Unavailable(Exception):

@@ -46,7 +46,7 @@ class CompareWindow(QtWidgets.QWidget):
             viewport = make_viewport(self, force_offscreen)
             column.addWidget(viewport.widget, 1)
             layout.addLayout(column, 1)
-            scene = MeshScene(viewport.plotter, self.state.mesh, self.state.normals)
+            scene = MeshScene(viewport.plotter, self.state.mesh, self.state.derived.normals)
             if camera is None:
                 camera = viewport.plotter.renderer.GetActiveCamera()
                 camera.DeepCopy(main.plotter.renderer.GetActiveCamera())
@@ -105,7 +105,7 @@ class CompareWindow(QtWidgets.QWidget):
                 title.setText(f"{_label(item)}: no spectrum")
                 continue
             j = int(np.clip(self.mode_index, 0, spec.k - 1))
-            scalar, disp = self.state.mode_fields(spec, j)
+            scalar, disp = self.state.derived.mode_fields(spec, j)
             scene.show_field(
                 scalar,
                 "diverging",
@@ -125,12 +125,12 @@ class CompareWindow(QtWidgets.QWidget):
         display = self.state.display
         # every kind marks the share of the surface the main window's map marks (without
         # one, the share its threshold maps keep: DEFAULT_THRESHOLD_SHARE at first)
-        share = self.state.threshold_share()
-        if share is None and display.threshold_by_share:
-            share = self.state.share_target
+        share = self.state.derived.marked_share()
+        if share is None and display.keep_share:
+            share = display.threshold_share
         for item, scene, title in zip(self.items, self.scenes, self.titles, strict=True):
             scene.show_marker(vertex)
-            d = self.state.distance_map(item) if vertex is not None else None
+            d = self.state.derived.distance_map(item) if vertex is not None else None
             if d is None:
                 need = (
                     "pick a vertex in the main window"
@@ -145,9 +145,9 @@ class CompareWindow(QtWidgets.QWidget):
                 if share is None:
                     thr = display.threshold * float(d.max())
                 else:
-                    thr = self.state.threshold_for_share(share, d) * float(d.max())
+                    thr = self.state.derived.threshold_for_share(share, d) * float(d.max())
                 scene.show_threshold(d, thr, name=_label(item))
-                marked = 100.0 * self.state.surface_share(d, thr)
+                marked = 100.0 * self.state.derived.surface_share(d, thr)
                 title.setText(
                     f"{_label(item)} from vertex {shown}: blue < {thr:.3g} ({marked:.1f} %)" + mark
                 )

@@ -33,7 +33,8 @@ from ..viewer.model import (
     repair_unavailable,
     residual_text,
 )
-from ..viewer.state import SpectrumKey, percent_text
+from ..viewer.state import SpectrumKey
+from ..viewer.wording import percent_text
 from . import menus, window_settings
 from .compare import CompareWindow
 from .dialogs import ask, file_message, offer_open_anyway
@@ -605,11 +606,11 @@ class MainWindow(QtWidgets.QMainWindow):
                 )
             return None
         self.state.set_display(kind="distance")
-        return self.state.distance_map()
+        return self.state.derived.distance_map()
 
     def distance_map(self, kind: str) -> np.ndarray | None:
         """Distance of ``kind`` from the picked vertex, or None if its spectrum is missing."""
-        return self.state.distance_map(kind)
+        return self.state.derived.distance_map(kind)
 
     def set_threshold(self, fraction: float) -> float:
         """Move the threshold (fraction of the largest distance); returns the app's time in s."""
@@ -622,7 +623,7 @@ class MainWindow(QtWidgets.QMainWindow):
     def show_signature(self, sample: int) -> None:
         """Colour by the signature at scale sample ``sample`` of the distance kind's spectrum."""
         operator = operator_for_distance(self.state.display.distance_kind)
-        if not self.state.has_signatures(operator):
+        if not self.state.derived.has_signatures(operator):
             self.statusBar().showMessage(
                 f"Compute the {OPERATOR_INFO[operator].label} spectrum first (with non-zero "
                 "modes).",
@@ -874,7 +875,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     @property
     def last_distance(self) -> np.ndarray | None:
-        return self.state.distance_map() if self.state.display.kind == "distance" else None
+        return self.state.derived.distance_map() if self.state.display.kind == "distance" else None
 
     @property
     def frame_times(self) -> list[float]:

@@ -1,4 +1,4 @@
-"""The 3D view of the viewer state: draws ``state.field()``, the pick, the animation.
+"""The 3D view of the viewer state: draws ``state.derived.field()``, the pick, the animation.
 
 It observes :class:`~modalviewer.viewer.state.ViewerState` and keeps nothing the state
 does not say, except VTK objects and the animation clock.  Only the GUI thread runs it.
@@ -12,7 +12,9 @@ from dataclasses import replace
 import numpy as np
 from qtpy import QtCore
 
-from ..viewer.state import Field, ViewerState
+from ..viewer import wording
+from ..viewer.derived import Field
+from ..viewer.state import ViewerState
 from .scene import MeshScene
 
 
@@ -51,7 +53,7 @@ class SceneView(QtCore.QObject):
         mesh = self.state.mesh
         if mesh is not None:
             self.scene = MeshScene(
-                self.plotter, mesh, self.state.normals, style=self.state.style.render
+                self.plotter, mesh, self.state.derived.normals, style=self.state.style.render
             )
             self._show_outline(mesh)
             self.reset_camera()
@@ -85,12 +87,12 @@ class SceneView(QtCore.QObject):
             and d.distance_display == "threshold"
             and self.field is not None
             and self.field.colormap == "threshold"
-            and self.state.distance_map() is not None
+            and self.state.derived.distance_map() is not None
         ):
-            thr = self.state.threshold_value()
+            thr = self.state.derived.threshold_value()
             self.scene.set_threshold(thr)
             self.field.threshold = thr
-            self.field.legend = self.state.legend()
+            self.field.legend = wording.legend(self.state)
         else:
             self._draw_field()
             self._drawn = signature
@@ -98,7 +100,7 @@ class SceneView(QtCore.QObject):
         self.viewport.request_render()
 
     def _draw_field(self) -> None:
-        field = self.state.field()
+        field = self.state.derived.field()
         self.field = field
         scene = self.scene
         scene.set_displacement_scale(0.0)
@@ -161,13 +163,13 @@ class SceneView(QtCore.QObject):
         scene.set_legend(field.legend)
         if field.colormap == "threshold":
             d = self.state.display
-            dist = self.state.distance_map()
-            thr = self.state.threshold_value(dist)
-            share = 100.0 * self.state.surface_share(dist, thr)
+            dist = self.state.derived.distance_map()
+            thr = self.state.derived.threshold_value(dist)
+            share = 100.0 * self.state.derived.surface_share(dist, thr)
             from ..core.operators import DISTANCE_KINDS
 
             similar = f"{DISTANCE_KINDS[d.distance_kind].lower()} < {thr:.3g} ({share:.1f} %)"
-            similar += self.state.display_mark()
+            similar += wording.display_mark(self.state)
             scene.set_colorbar(field.title, labels=[similar, "the rest"])
         else:
             scene.set_colorbar(field.title, clim=field.clim)

@@ -69,6 +69,7 @@ class ViewerModel:
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None):
         self.state = ViewerState()
+        self.derived = self.state.derived  # the values computed from the state
         self.jobs = JobQueue(dispatch)
         self.cache = cache or SpectrumCache()
         self.jobs.events.finished.connect(self._on_job_finished)

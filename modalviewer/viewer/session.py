@@ -171,7 +171,10 @@ def restore_session(model, path) -> Restored:
             state.set_pick(int(picked))
         else:
             out.notes.append(f"the picked vertex {picked} is not on this mesh; pick again")
-    display = Display(**_known(Display, data.get("display")))
+    saved_display = dict(data.get("display") or {})
+    if "threshold_by_share" in saved_display:  # the name keep_share had in older files
+        saved_display.setdefault("keep_share", saved_display.pop("threshold_by_share"))
+    display = Display(**_known(Display, saved_display))
     for raw in data.get("spectra") or []:
         key = SpectrumKey(**_known(SpectrumKey, raw))
         saved = state.compute_settings

@@ -3,16 +3,28 @@
 :class:`ViewerState` is the single source of truth of the viewer.  The 3D scene, every
 panel, the status bar and the plots observe its events and redraw from it; they keep
 no state of their own.  Input (a click, a slider, a script, the CLI) goes through its
-setters, which validate, store and emit.  Everything shown can be derived from it:
-:meth:`ViewerState.field` is the per-vertex picture, :meth:`ViewerState.legend` its
-legend and :meth:`ViewerState.summary` the status line.
+setters, which validate, store and emit.  Everything shown is derived from it: the
+values computed from it (the per-vertex picture :meth:`.derived.DerivedValues.field`,
+distances, signature tables, normals) live in :attr:`ViewerState.derived`, a
+:class:`~.derived.DerivedValues` created on first use (``ViewerModel.derived`` is the
+same object), and the words (legends, the status line, notes) are the functions of
+:mod:`.wording`.
+
+A setter changes only what it is given, with one exception, the threshold rule
+(:meth:`ViewerState._match_threshold`): a threshold map marks the share
+:attr:`Display.threshold_share` of the surface's area; with :attr:`Display.keep_share`
+a new map (another pick, kind, scale range or spectrum) gets the threshold fraction that
+marks that share; a fraction the caller sets (``set_display(threshold=...)``) sets the
+share it marks, and a share the caller sets (``set_display(threshold_share=...)``) the
+fraction that marks it.
 
 Events (``state.events.<name>.connect(callback)``), all emitted on the thread that
 changed the state (the GUI thread in the viewer):
 
 - ``mesh()``: a new mesh (or none) is loaded; spectra, pick and display were reset.
 - ``spectra(operator)``: a spectrum of ``operator`` was added or replaced.
-- ``display()``: what is drawn changed (:class:`Display`), including the threshold.
+- ``display()``: what is drawn changed (:class:`Display`), including the threshold
+  (also when the threshold rule gave a new map its fraction).
 - ``style()``: isolines, colouring of 3D modes, colour bar, render style.
 - ``pick()``: the picked vertex changed (:attr:`ViewerState.picked` is the mesh's index;
   what is shown and saved is :attr:`ViewerState.picked_file_vertex`, the file's number).
@@ -24,42 +36,28 @@ changed the state (the GUI thread in the viewer):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 from psygnal import Signal, SignalGroup
 
-from ..core.curvature import total_curvature
-from ..core.laplacian import lumped_masses, vertex_normals
-from ..core.mesh import Mesh, _plural
-from ..core.operators import (
-    DISTANCE_KINDS,
-    OPERATOR_INFO,
-    operator_for_distance,
-    operator_info,
-)
-from ..core.signatures import SignatureTable, signature
+from ..core.mesh import Mesh
+from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance, operator_info
 from ..core.spectrum import Spectrum
-from .mode_scalar import default_vector_coloring, smoothed_normals, vector_mode_scalar
+from .derived import DerivedValues
 
 DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature")
 DISTANCE_DISPLAYS = ("continuous", "threshold")
 DEFAULT_THRESHOLD_SHARE = 0.1
 """Share of the surface a first threshold map marks similar (the paper's maps mark a few
 per cent to a tenth)."""
+NEXT_MAP = "next map"
+""":attr:`ViewerState.threshold_map` after a fraction was set with no threshold map on
+screen: the next threshold map keeps the fraction (and measures its share)."""
 SHELL_COLORINGS = ("auto", "normal", "magnitude")
 RENDER_STYLES = ("paper", "shaded")
-
-
-def percent_text(fraction: float) -> str:
-    """A relative error as a short percentage: "< 0.01 %", "0.24 %", "2.2 %", "21 %",
-    "135 %" (with a no-break space, so a wrapped legend keeps number and sign together);
-    below 0.01 % the digits would only show how converged a mode is, not its error."""
-    value = 100.0 * float(fraction)
-    if 0 < value < 0.01:
-        return "<\u00a00.01\u00a0%"
-    return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
 
 
 def default_k(n_vertices: int) -> int:
@@ -126,8 +124,11 @@ class Display:
     distance_kind : "vibration" | "feature" | "hks" (also picks the signature's spectrum).
     distance_display : "continuous" | "threshold".
     threshold : threshold as a fraction of the largest distance (0..1].
-    threshold_by_share : the threshold map keeps the share of the surface it marks when
-        its distances change (another pick, a new spectrum), instead of the fraction.
+    threshold_share : the share (0..1) of the surface's area the threshold map marks;
+        without ``keep_share``, the share the fraction marked on the last threshold map.
+    keep_share : a new threshold map (another pick, kind, scale range or spectrum)
+        marks ``threshold_share`` of the surface (its fraction is set to match), instead
+        of keeping the fraction; see :meth:`ViewerState._match_threshold`.
     signature_sample : index of the scale a signature is shown at (0..99).
     """
 
@@ -137,32 +138,13 @@ class Display:
     distance_kind: str = "vibration"
     distance_display: str = "continuous"
     threshold: float = 0.2
-    threshold_by_share: bool = True
+    threshold_share: float = DEFAULT_THRESHOLD_SHARE
+    keep_share: bool = True
     signature_sample: int = 50
 
     def blank(self) -> Display:
         """This display as a newly loaded mesh shows it: nothing, other choices kept."""
         return replace(self, kind="none", operator=None, mode=0)
-
-
-@dataclass
-class Field:
-    """A per-vertex picture derived from the state, ready for the scene to draw.
-
-    colormap : "diverging" (blue / white / orange), "sequential" (white to red),
-    "threshold" (blue = similar) or "plain" (no field: the grey surface).
-    threshold : for "threshold": values (the distances) up to it are blue.
-    """
-
-    values: np.ndarray
-    colormap: str
-    isolines: int = 0
-    displacement: np.ndarray | None = None
-    clim: tuple[float, float] | None = None
-    title: str = ""
-    legend: str = ""
-    share_similar: float | None = None
-    threshold: float | None = None
 
 
 def _take_signs(spec: Spectrum, preview: Spectrum) -> None:
@@ -209,19 +191,6 @@ class Animation:
     speed: int = 30  # tenths of a radian per second
 
 
-@dataclass
-class _Derived:
-    """Values computed from the state and kept until it changes (not part of it)."""
-
-    normals: np.ndarray | None = None
-    smooth_normals: np.ndarray | None = None
-    auto_coloring: str | None = None
-    tables: dict = field(default_factory=dict)
-    distance: dict = field(default_factory=dict)
-    curvature: np.ndarray | None = None
-    vertex_areas: np.ndarray | None = None
-
-
 class ViewerState:
     """The viewer's state; see the module docstring for its events."""
 
@@ -240,11 +209,17 @@ class ViewerState:
         self.style = _Style()
         self.animation = Animation()
         self.camera: dict | None = None
-        self._derived = _Derived()
-        # the share of the surface threshold maps mark, and the map it was last set for
-        self._share_target = DEFAULT_THRESHOLD_SHARE
-        self._share_map: tuple | None = None
-        self._fraction_set = False  # a threshold was set while no map was on screen
+        self.threshold_map: tuple | str | None = None
+        """The distance map (:meth:`.derived.DerivedValues.map_identity`) on which
+        ``display.threshold`` and ``display.threshold_share`` were last matched; None
+        before the first (it gets the share), :data:`NEXT_MAP` after a fraction was set
+        while no threshold map was on screen (the next one keeps it)."""
+
+    @cached_property
+    def derived(self) -> DerivedValues:
+        """The values computed from this state (:class:`~.derived.DerivedValues`),
+        created on first use; ``ViewerModel.derived`` is the same object."""
+        return DerivedValues(self)
 
     # ------------------------------------------------------------- mesh
     def set_mesh(
@@ -258,19 +233,13 @@ class ViewerState:
         self.spectra.clear()
         self._latest.clear()
         self.computing.clear()
-        self._derived = _Derived()
         if mesh is not None:
-            self._derived.normals = vertex_normals(mesh)
             self.compute_settings = replace(self.compute_settings, k=default_k(mesh.n_vertices))
         self.picked = None
         self.animation.playing = False
         self.display = self.display.blank()
         self.camera = None
         self.events.mesh.emit()
-
-    @property
-    def normals(self) -> np.ndarray | None:
-        return self._derived.normals
 
     def compute_mesh(self, key: SpectrumKey | None = None) -> Mesh:
         """The mesh a spectrum is computed on: the loaded one, or a copy of unit area."""
@@ -307,13 +276,9 @@ class ViewerState:
         self._latest[key.operator] = key
         if self.display.kind == "mode" and self.display.operator == key.operator:
             self.display = replace(self.display, mode=min(self.display.mode, spec.k - 1))
-        stale = [k for k in self._derived.tables if k[0] == key.operator]
-        for k in stale:
-            del self._derived.tables[k]
-        self._derived.distance.clear()
         if table is not None:
-            self._derived.tables[(key.operator, id(spec), table.t_range)] = table
-        self._sync_threshold()
+            self.derived.keep_table(spec, table)
+        self._match_threshold()
         self.events.spectra.emit(key.operator)
         if self.display.kind in ("mode", "distance", "signature"):
             if self.display_operator() == key.operator:
@@ -392,16 +357,6 @@ class ViewerState:
             self.style.render = style
             self.events.style.emit()
 
-    def vector_coloring(self) -> str:
-        """The colouring of 3D modes in effect: the chosen one, or for "auto" the
-        magnitude on meshes with sharp features and the normal component elsewhere
-        (see :mod:`modalviewer.viewer.mode_scalar`)."""
-        if self.style.shell_coloring != "auto":
-            return self.style.shell_coloring
-        if self._derived.auto_coloring is None:
-            self._derived.auto_coloring = default_vector_coloring(self.mesh)
-        return self._derived.auto_coloring
-
     def set_colorbar(self, on: bool) -> None:
         if bool(on) != self.style.colorbar:
             self.style.colorbar = bool(on)
@@ -428,8 +383,7 @@ class ViewerState:
             t_range = (t1, t2)
         if t_range != self.t_range:
             self.t_range = t_range
-            self._derived.distance.clear()
-            self._sync_threshold()
+            self._match_threshold()
             self.events.scale_range.emit()
             if self.display.kind in ("distance", "signature"):
                 self.events.display.emit()
@@ -459,12 +413,16 @@ class ViewerState:
         new = replace(
             new,
             threshold=float(np.clip(new.threshold, 1e-4, 1.0)),
+            threshold_share=float(np.clip(new.threshold_share, 0.0, 1.0)),
             signature_sample=int(np.clip(new.signature_sample, 0, 99)),
         )
         if new == self.display:
             return
         self.display = new
-        self._sync_threshold(set_by_user="threshold" in changes)
+        self._match_threshold(
+            fraction_set="threshold" in changes,
+            share_set="threshold_share" in changes,
+        )
         if new.kind != "mode" and self.animation.playing:
             self.animation = replace(self.animation, playing=False)
             self.events.animation.emit()
@@ -513,7 +471,7 @@ class ViewerState:
                 raise ValueError(f"Vertex {vertex} does not exist (0..{self.mesh.n_vertices - 1}).")
         if vertex != self.picked:
             self.picked = vertex
-            self._sync_threshold()
+            self._match_threshold()
             self.events.pick.emit()
             if self.display.kind == "distance":
                 self.events.display.emit()
@@ -539,312 +497,39 @@ class ViewerState:
         key = self._latest.get(operator) if operator else None
         return key is not None and key.coarse and key in self.spectra
 
-    def approximation_mark(self, operator: str | None) -> str:
-        """ " (preview)", " (coarse-to-fine)" or "": what titles and lists add to the
-        spectrum shown for ``operator`` when it is an approximation."""
-        spec = self.spectrum(operator)
-        if spec is not None and spec.is_preview:
-            return " (preview)"
-        if self.is_coarse(operator):
-            return " (coarse-to-fine)"
-        return ""
+    def _match_threshold(self, fraction_set: bool = False, share_set: bool = False) -> None:
+        """The threshold rule: match ``display.threshold`` (a fraction of the largest
+        distance) and ``display.threshold_share`` (the share of the surface's area it
+        marks) on the threshold map on screen.
 
-    def display_mark(self) -> str:
-        """:meth:`approximation_mark` of the spectrum the picture is made of."""
-        return self.approximation_mark(self.display_operator())
-
-    def preview_note(self, operator: str | None) -> str:
-        """ " (preview spectrum; the exact one follows)", " (preview spectrum)" or "" for
-        the spectrum shown for ``operator``."""
-        spec = self.spectrum(operator)
-        if spec is None:
-            return ""
-        if not spec.is_preview:
-            return " (coarse-to-fine spectrum)" if self.is_coarse(operator) else ""
-        if self.exact_follows(operator):
-            return " (preview spectrum; the exact one follows)"
-        return " (preview spectrum)"
-
-    # ---------------------------------------------------- derived values
-    def has_signatures(self, operator: str) -> bool:
-        """Whether ``operator``'s spectrum exists and has non-zero modes (signatures
-        leave zero modes out)."""
-        spec = self.spectrum(operator)
-        return spec is not None and not spec.zero_mode_mask().all()
-
-    def table(self, operator: str) -> SignatureTable:
-        """The signature table of ``operator``'s spectrum over the current scale range."""
-        spec = self.spectrum(operator)
-        if spec is None:
-            raise ValueError(f"no spectrum of {operator!r} has been computed")
-        key = (operator, id(spec), self.t_range)
-        table = self._derived.tables.get(key)
-        if table is None:
-            table = SignatureTable(spec, t_range=self.t_range)
-            self._derived.tables[key] = table
-        return table
-
-    def distance_map(self, kind: str | None = None) -> np.ndarray | None:
-        """Distance of ``kind`` from the picked vertex, or None if a spectrum is missing."""
-        kind = kind or self.display.distance_kind
-        operator = operator_for_distance(kind)
-        spec = self.spectrum(operator)
-        if self.picked is None or spec is None or spec.zero_mode_mask().all():
-            return None
-        key = (kind, self.picked, self.t_range, id(self.spectrum(operator)))
-        d = self._derived.distance.get(key)
-        if d is None:
-            d = self.table(operator).distance_from(self.picked)
-            self._derived.distance = {key: d}
-        return d
-
-    def threshold_value(self, d: np.ndarray | None = None) -> float | None:
-        """The absolute threshold of the display's distance (fraction x largest)."""
-        d = self.distance_map() if d is None else d
-        if d is None:
-            return None
-        return self.display.threshold * float(d.max())
-
-    def vertex_areas(self) -> np.ndarray:
-        """(n,) lumped vertex areas: shares "of the surface" are shares of its area (on a
-        mesh of uneven density the vertices' share is not: 18.8 % of a cow's vertices
-        held 5.7 % of its area)."""
-        if self._derived.vertex_areas is None:
-            self._derived.vertex_areas = lumped_masses(self.mesh)
-        return self._derived.vertex_areas
-
-    def surface_share(self, d: np.ndarray, value: float) -> float:
-        """The share (0..1) of the surface's area where ``d`` is at most ``value``."""
-        areas = self.vertex_areas()
-        return float(areas[d <= value].sum() / areas.sum())
-
-    @property
-    def share_target(self) -> float:
-        """The share (0..1) of the surface threshold maps mark similar: the one last set,
-        :data:`DEFAULT_THRESHOLD_SHARE` at first."""
-        return self._share_target
-
-    def threshold_share(self) -> float | None:
-        """The share (0..1) of the surface the threshold map on screen marks similar, or
-        None without one."""
-        d = self.distance_map()
-        if self.display.distance_display != "threshold" or d is None:
-            return None
-        return self.surface_share(d, self.threshold_value(d))
-
-    def _map_identity(self) -> tuple | None:
-        """What the distance map on screen is made of (kind, vertex, scales, spectrum)."""
-        spec = self.spectrum(operator_for_distance(self.display.distance_kind))
-        if spec is None or self.picked is None:
-            return None
-        return (self.display.distance_kind, self.picked, self.t_range, id(spec))
-
-    def _sync_threshold(self, set_by_user: bool = False) -> None:
-        """Keep a threshold map's share of the surface when its distances change.
-
-        With ``threshold_by_share``, a threshold map on screen that the threshold was not
-        set for (another vertex, kind, scale range or spectrum, or a first map) gets the
-        threshold that marks the share last set (:data:`DEFAULT_THRESHOLD_SHARE` at
-        first); the distances are so
-        skewed that one fraction of the largest marks 95 % from one vertex and 10 % from
-        another.  A threshold set by the user (or any, by value; also one set before its
-        map is on screen, as ``show_distance(threshold=...)`` does) sets that share.
-        Emits nothing: the caller's event redraws."""
+        The distances are so skewed that one fraction of the largest marks 95 % of the
+        surface from one vertex and 10 % from another, so with ``keep_share`` a threshold
+        map that was not matched yet (another vertex, kind, scale range or spectrum, or a
+        first map) gets the fraction that marks ``threshold_share``
+        (:data:`DEFAULT_THRESHOLD_SHARE` at first).  A fraction the caller set
+        (``fraction_set``; also one set before its map is on screen, as
+        ``show_distance(threshold=...)`` does), or any fraction without ``keep_share``,
+        sets the share it marks instead; a share the caller set (``share_set``) sets the
+        fraction.  Every setter that changes the map calls this before emitting; it is
+        the only place a setter changes display fields it was not given.  Emits nothing:
+        the caller's event redraws."""
         d = self.display
         on_screen = d.kind == "distance" and d.distance_display == "threshold"
-        dist = self.distance_map() if on_screen else None  # no distances for other pictures
+        dist = self.derived.distance_map() if on_screen else None  # none for other pictures
         if dist is None:
-            # (a request's "display unchanged" test must not see a change here); a
-            # fraction set for a map still to come is kept for it
-            self._fraction_set |= set_by_user
+            # a fraction or share set for a map still to come is kept for it (and the
+            # display stays as given: a request's "display unchanged" test must not see
+            # a change here)
+            if fraction_set:
+                self.threshold_map = NEXT_MAP
+            elif share_set:
+                self.threshold_map = None
             return
-        identity = self._map_identity()
-        if set_by_user or self._fraction_set or not d.threshold_by_share:
-            self._fraction_set = False
-            self._share_target = self.surface_share(dist, d.threshold * float(dist.max()))
-        elif identity != self._share_map:
-            self.display = replace(d, threshold=self.threshold_for_share(self._share_target, dist))
-        self._share_map = identity
-
-    def threshold_for_share(self, share: float, d: np.ndarray | None = None) -> float:
-        """The threshold fraction that marks ``share`` (0..1) of the surface similar."""
-        d = self.distance_map() if d is None else d
-        if d is None or d.max() <= 0:
-            return float(share)
-        order = np.argsort(d, kind="stable")
-        areas = self.vertex_areas()[order]
-        cumulative = np.cumsum(areas) / areas.sum()
-        i = int(np.searchsorted(cumulative, float(np.clip(share, 0.0, 1.0)) - 1e-12))
-        value = float(d[order[min(i, len(order) - 1)]])
-        return float(np.clip(value / float(d.max()), 1e-4, 1.0))
-
-    def mode_fields(self, spec: Spectrum, j: int) -> tuple[np.ndarray, np.ndarray]:
-        """(scalar to colour (n,), displacement (n, 3) scaled to a peak of 1) of mode j."""
-        phi = spec.mode(j)
-        if spec.is_vector:
-            coloring = self.vector_coloring()
-            if coloring == "normal" and self._derived.smooth_normals is None:
-                self._derived.smooth_normals = smoothed_normals(self.mesh)
-            scalar = vector_mode_scalar(phi, self._derived.smooth_normals, coloring)
-            disp = phi
-        else:
-            scalar = phi
-            disp = phi[:, None] * self.normals
-        peak = float(np.max(np.linalg.norm(disp, axis=1))) or 1.0
-        return scalar, disp / peak
-
-    def curvature(self) -> np.ndarray:
-        if self._derived.curvature is None:
-            self._derived.curvature = total_curvature(self.mesh)
-        return self._derived.curvature
-
-    def field(self) -> Field | None:
-        """The picture the display asks for, or None if it cannot be drawn (yet)."""
-        if self.mesh is None:
-            return None
-        d = self.display
-        n = self.mesh.n_vertices
-        plain = Field(np.zeros(n), "plain")
-        mark = self.display_mark()
-        if d.kind == "mode":
-            spec = self.spectrum(d.operator)
-            if spec is None:
-                return plain
-            j = int(np.clip(d.mode, 0, spec.k - 1))
-            scalar, disp = self.mode_fields(spec, j)
-            magnitude = spec.is_vector and self.vector_coloring() == "magnitude"
-            return Field(
-                scalar,
-                "sequential" if magnitude else "diverging",
-                isolines=self.style.isolines,
-                displacement=disp,
-                title=f"{operator_info(d.operator).short_label} mode {j}{mark}",
-                legend=self.legend(),
-            )
-        if d.kind == "distance":
-            dist = self.distance_map()
-            if dist is None:
-                return plain
-            name = DISTANCE_KINDS[d.distance_kind]
-            if d.distance_display == "threshold":
-                thr = self.threshold_value(dist)
-                return Field(
-                    dist,
-                    "threshold",
-                    threshold=thr,
-                    title=f"{name} < {thr:.3g}{mark}",
-                    legend=self.legend(),
-                    share_similar=self.surface_share(dist, thr),
-                )
-            return Field(dist, "sequential", title=name + mark, legend=self.legend())
-        if d.kind == "signature":
-            operator = operator_for_distance(d.distance_kind)
-            spec = self.spectrum(operator)
-            if not self.has_signatures(operator):
-                return plain
-            t = self.signature_time()
-            _, values = signature(spec, [t])
-            return Field(
-                values[:, 0],
-                "sequential",
-                isolines=self.style.isolines,
-                title=f"signature t = {t:.3g}{mark}",
-                legend=self.legend(),
-            )
-        if d.kind == "curvature":
-            curvature = self.curvature()
-            hi = float(np.percentile(curvature, 98)) or 1.0
-            return Field(
-                curvature,
-                "sequential",
-                clim=(0.0, hi),
-                title="curvature",
-                legend=self.legend(),
-            )
-        return plain
-
-    def signature_time(self) -> float:
-        table = self.table(operator_for_distance(self.display.distance_kind))
-        return float(
-            table.times[int(np.clip(self.display.signature_sample, 0, len(table.times) - 1))]
-        )
-
-    # ------------------------------------------------------------- words
-    def legend(self) -> str:
-        """One or two lines naming what the surface shows, with its numbers."""
-        d = self.display
-        if self.mesh is None or d.kind == "none":
-            return ""
-        if d.kind == "mode":
-            spec = self.spectrum(d.operator)
-            if spec is None:
-                return ""
-            j = int(np.clip(d.mode, 0, spec.k - 1))
-            lam = float(spec.eigenvalues[j])
-            zero = spec.zero_mode_mask()[j]
-            value = "0 (zero mode)" if zero else f"{lam:.4g}"
-            if spec.is_preview:
-                value += f" (preview; estimated error {percent_text(spec.estimated_error)})"
-            elif self.is_coarse(d.operator):
-                value += " (coarse-to-fine: approximate)"
-            colours = "blue +, white 0, orange -"
-            if spec.is_vector and self.vector_coloring() == "magnitude":
-                colours = "white 0 to red: displacement magnitude"
-            elif spec.is_vector:
-                colours += " (normal component, smoothed normals)"
-            return f"{operator_info(d.operator).label}, mode {j}: lambda = {value}\n{colours}"
-        if d.kind == "distance":
-            name = DISTANCE_KINDS[d.distance_kind]
-            dist = self.distance_map()
-            if dist is None:
-                return f"{name}: {self._missing_distance_reason(d.distance_kind)}"
-            source = f"from vertex {self.picked_file_vertex}"
-            source += self.preview_note(operator_for_distance(d.distance_kind))
-            if d.distance_display == "threshold":
-                thr = self.threshold_value(dist)
-                share = 100.0 * self.surface_share(dist, thr)
-                return f"blue: {name.lower()} < {thr:.3g}, {share:.1f} % of the surface\n{source}"
-            t1, t2 = self.scale_limits()
-            return (
-                f"{name} {source}: white 0 to red {float(dist.max()):.3g}\n"
-                f"scales t = {t1:.3g} .. {t2:.3g}"
-            )
-        if d.kind == "signature":
-            operator = operator_for_distance(d.distance_kind)
-            if not self.has_signatures(operator):
-                return ""
-            word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
-            return f"{word[d.distance_kind]} signature at t = {self.signature_time():.3g}"
-        if d.kind == "curvature":
-            return "Curvature sqrt(k1^2 + k2^2), white 0 to red (98th percentile)"
-        return ""
-
-    def _missing_distance_reason(self, kind: str) -> str:
-        if self.picked is None:
-            return "pick a vertex"
-        spec = self.spectrum(operator_for_distance(kind))
-        if spec is None:
-            return f"needs the {operator_info(operator_for_distance(kind)).label} spectrum"
-        return "the spectrum has no non-zero modes; compute more modes"
-
-    def scale_limits(self) -> tuple[float, float]:
-        """(t1, t2) the distances and signatures use: the chosen range or the default."""
-        table = self.table(operator_for_distance(self.display.distance_kind))
-        return float(table.times[0]), float(table.times[-1])
-
-    def summary(self) -> str:
-        """The status line: the current display's live numbers, on one line."""
-        if self.mesh is None:
-            return "Open a mesh to begin (File > Open, Ctrl+O)."
-        text = self.legend().replace("\n", "; ")
-        if not text:
-            m = self.mesh
-            text = f"{_plural(m.n_vertices, 'vertex')}, {_plural(m.n_faces, 'face')}"
-            if self.computing and not self.spectra:
-                names = sorted({operator_info(key.operator).label for key in self.computing})
-                text += f"; computing {', '.join(names)} (Esc cancels)"
-                if self.picked is not None:
-                    text += f"; the map of vertex {self.picked_file_vertex} follows"
-            elif not self.spectra:
-                text += "; compute a spectrum (Ctrl+R) or click the surface"
-        return text
+        identity = self.derived.map_identity()
+        if fraction_set or self.threshold_map == NEXT_MAP or not d.keep_share:
+            share = self.derived.surface_share(dist, d.threshold * float(dist.max()))
+            self.display = replace(d, threshold_share=share)
+        elif share_set or identity != self.threshold_map:
+            fraction = self.derived.threshold_for_share(d.threshold_share, dist)
+            self.display = replace(d, threshold=fraction)
+        self.threshold_map = identity

@@ -9,7 +9,8 @@ import pytest
 from qtpy import QtCore, QtGui, QtWidgets
 
 from modalviewer.core.laplacian import lumped_masses
-from modalviewer.viewer.state import percent_text
+from modalviewer.viewer import wording
+from modalviewer.viewer.wording import percent_text
 
 pytestmark = pytest.mark.gui
 
@@ -180,7 +181,7 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     assert again.shape == image.shape
     differ = np.mean(np.any(np.abs(again.astype(int) - image.astype(int)) > 8, axis=2))
     assert differ < 0.002, differ
-    assert second.status_line.text() == second.state.summary()
+    assert second.status_line.text() == wording.summary(second.state)
     assert "feature distance" in second.status_line.text()
     # M shows the mode last shown before the distance, as before the restart
     assert second.modes_panel.mode_spin.value() == 7
@@ -378,7 +379,7 @@ def test_a_narrow_status_line_elides_its_text(window, spot_path, qtbot):
     window.compute("laplacian", k=20, wait=True)
     window.show_mode(3)
     line = window.status_line
-    assert line.toolTip() == line.text() == window.state.summary()
+    assert line.toolTip() == line.text() == wording.summary(window.state)
     line.setFixedWidth(160)
     qtbot.wait(50)
     img = line.grab().toImage()
@@ -526,11 +527,11 @@ def test_another_distance_kind_keeps_the_share_of_the_threshold_map(window, spot
     window.show_distance(kind="hks", display="threshold")
     panel = window.distances_panel
     panel.threshold_slider.setValue(120)  # by share: 12 % of the surface
-    before = window.state.threshold_share()
+    before = window.state.derived.marked_share()
     assert before == pytest.approx(0.12, abs=0.01)
     panel.kind_combo.setCurrentIndex(panel.kind_combo.findData("feature"))
     assert window.state.display.distance_kind == "feature"
-    assert window.state.threshold_share() == pytest.approx(before, abs=0.005)
+    assert window.state.derived.marked_share() == pytest.approx(before, abs=0.005)
     compare = window.open_comparison(["hks", "feature"])
     shares = [title.text().split("(")[-1] for title in compare.titles]
     assert all(text.startswith("12.") for text in shares), shares

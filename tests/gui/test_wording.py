@@ -39,12 +39,12 @@ def test_compare_asks_with_yes_as_the_default(window, qtbot, answer_next_dialog)
 def test_compare_marks_the_default_threshold_share_without_a_main_map(window):
     assert DEFAULT_THRESHOLD_SHARE == pytest.approx(0.1)
     window.set_mesh(icosphere(3))
-    assert window.state.share_target == DEFAULT_THRESHOLD_SHARE
+    assert window.state.display.threshold_share == DEFAULT_THRESHOLD_SHARE
     # compare: the main window's distance map is not computed (vibration, no shells),
     # so the views mark the default share, not a fraction of their largest distance
     window.state.set_pick(7)
     window.state.set_display(distance_kind="vibration", distance_display="threshold")
-    assert window.state.threshold_share() is None
+    assert window.state.derived.marked_share() is None
     compare = window.open_comparison(["hks", "feature"])
     for title in compare.titles:
         marked = float(title.text().split("(")[-1].split("%")[0])

@@ -11,7 +11,7 @@ import pytest
 from modalviewer.cli import main
 from modalviewer.core.cache import SpectrumCache
 from modalviewer.core.primitives import icosphere
-from modalviewer.viewer import ViewerModel
+from modalviewer.viewer import ViewerModel, wording
 from modalviewer.viewer.session import restore_session, save_session
 
 K = 20
@@ -64,7 +64,7 @@ def _distance(model, path, pick_file_vertex):
     model.jobs.wait(model.request_spectrum("laplacian", k=K))
     model.state.set_pick_file_vertex(pick_file_vertex)
     model.state.set_display(kind="distance", distance_kind="hks")
-    return model.state.distance_map()
+    return model.state.derived.distance_map()
 
 
 def test_load_pick_distance_in_file_numbers(files, tmp_path):
@@ -76,7 +76,7 @@ def test_load_pick_distance_in_file_numbers(files, tmp_path):
     assert mesh.n_file_vertices == len(where) + len(unused) + 1
     assert np.array_equal(mesh.file_vertices, where)
     assert model.state.picked == 40 and model.state.picked_file_vertex == pick
-    assert f"from vertex {pick}" in model.state.legend()
+    assert f"from vertex {pick}" in wording.legend(model.state)
 
     ref = _distance(_model(tmp_path), compact, 40)
     np.testing.assert_allclose(d, ref, rtol=1e-9, atol=1e-12)
@@ -134,7 +134,9 @@ def test_sessions_store_file_numbers_and_read_old_ones(files, tmp_path):
         other.jobs.wait(job)
     assert restored.notes == []
     assert other.state.picked == 40 and other.state.picked_file_vertex == pick
-    np.testing.assert_array_equal(other.state.distance_map(), model.state.distance_map())
+    np.testing.assert_array_equal(
+        other.state.derived.distance_map(), model.state.derived.distance_map()
+    )
 
     # a version-1 session stored the mesh's index
     data.update(version=1, picked=40)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from modalviewer.core.cache import SpectrumCache
-from modalviewer.viewer import ViewerModel
+from modalviewer.viewer import ViewerModel, wording
 from modalviewer.viewer.session import SessionError, restore_session, save_session
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
@@ -34,7 +34,7 @@ def test_a_restored_session_shows_the_same_picture(tmp_path):
     s.set_scale_range((0.01, 2.0))
     s.set_pick(321)
     s.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
-    s.set_display(threshold=s.threshold_for_share(0.15))
+    s.set_display(threshold=s.derived.threshold_for_share(0.15))
     s.camera = {"position": [1, 2, 3], "focal_point": [0, 0, 0], "view_up": [0, 1, 0]}
     path = save_session(s, tmp_path / "a.json")
     data = json.loads(path.read_text())
@@ -47,8 +47,8 @@ def test_a_restored_session_shows_the_same_picture(tmp_path):
     assert restored.notes == []
     assert t.display == s.display and t.picked == 321 and t.t_range == (0.01, 2.0)
     assert t.style.isolines == 7 and t.camera == s.camera
-    np.testing.assert_array_equal(t.field().values, s.field().values)
-    assert t.legend() == s.legend()
+    np.testing.assert_array_equal(t.derived.field().values, s.derived.field().values)
+    assert wording.legend(t) == wording.legend(s)
 
 
 def test_a_session_whose_mesh_changed_says_so_and_opens_what_it_can(tmp_path):

@@ -11,7 +11,7 @@ import pytest
 
 from modalviewer.core.cache import SpectrumCache
 from modalviewer.core.primitives import icosphere
-from modalviewer.viewer import ViewerModel
+from modalviewer.viewer import ViewerModel, wording
 from modalviewer.viewer.jobs import CANCELLED, DONE, FAILED, JobQueue
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
@@ -148,8 +148,8 @@ def test_a_threshold_map_keeps_its_share_of_the_surface(model):
     areas = lumped_masses(state.mesh)
 
     def marked() -> float:  # share of the area, computed here
-        d = state.distance_map()
-        return float(areas[d <= state.threshold_value(d)].sum() / areas.sum())
+        d = state.derived.distance_map()
+        return float(areas[d <= state.derived.threshold_value(d)].sum() / areas.sum())
 
     # threshold display chosen first; the pick starts the computation
     state.set_display(distance_kind="hks", distance_display="threshold")
@@ -157,8 +157,8 @@ def test_a_threshold_map_keeps_its_share_of_the_surface(model):
     model.jobs.wait(model.request_spectrum("laplacian", k=30))
     state.set_display(kind="distance")
     assert marked() == pytest.approx(DEFAULT_THRESHOLD_SHARE, abs=0.005)
-    assert state.threshold_share() == pytest.approx(marked(), abs=1e-12)
-    state.set_display(threshold=state.threshold_for_share(0.25))
+    assert state.derived.marked_share() == pytest.approx(marked(), abs=1e-12)
+    state.set_display(threshold=state.derived.threshold_for_share(0.25))
     assert marked() == pytest.approx(0.25, abs=0.005)
     for vertex in (2000, 2900, 5):
         state.set_pick(vertex)
@@ -166,17 +166,17 @@ def test_a_threshold_map_keeps_its_share_of_the_surface(model):
     model.jobs.wait(model.request_spectrum("laplacian", k=40))  # another spectrum
     assert marked() == pytest.approx(0.25, abs=0.005)
     # another kind whose spectrum is computed after the switch
-    state.set_display(threshold=state.threshold_for_share(0.36))
+    state.set_display(threshold=state.derived.threshold_for_share(0.36))
     state.set_display(distance_kind="feature")
-    assert state.distance_map() is None
+    assert state.derived.distance_map() is None
     model.jobs.wait(model.request_spectrum("modified_dirichlet", k=30))
     assert marked() == pytest.approx(0.36, abs=0.005)
     # by value: the fraction of the largest distance stays
-    state.set_display(threshold_by_share=False, threshold=0.5)
+    state.set_display(keep_share=False, threshold=0.5)
     state.set_pick(100)
     assert state.display.threshold == 0.5
     # a fraction asked for before its map is on screen is kept for it
-    state.set_display(threshold_by_share=True, kind="none")
+    state.set_display(keep_share=True, kind="none")
     state.set_display(distance_kind="hks", threshold=0.3)
     state.set_display(kind="distance")
     assert state.display.threshold == 0.3
@@ -195,13 +195,13 @@ def test_legend_and_summary_follow_the_threshold(model):
 
     areas = lumped_masses(state.mesh)
     for share in (0.05, 0.2, 0.6):
-        state.set_display(threshold=state.threshold_for_share(share))
-        d = state.distance_map()
-        marked = float(areas[d <= state.threshold_value()].sum() / areas.sum())
+        state.set_display(threshold=state.derived.threshold_for_share(share))
+        d = state.derived.distance_map()
+        marked = float(areas[d <= state.derived.threshold_value()].sum() / areas.sum())
         assert marked == pytest.approx(share, abs=0.01)
-        assert f"{100 * marked:.1f} % of the surface" in state.summary()
-        assert f"{100 * marked:.1f} % of the surface" in state.legend()
-        field = state.field()
+        assert f"{100 * marked:.1f} % of the surface" in wording.summary(state)
+        assert f"{100 * marked:.1f} % of the surface" in wording.legend(state)
+        field = state.derived.field()
         assert field.colormap == "threshold"
         np.testing.assert_array_equal(field.values, d)
         assert field.share_similar == pytest.approx(marked, abs=1e-12)
@@ -209,16 +209,16 @@ def test_legend_and_summary_follow_the_threshold(model):
 
 def test_field_is_derived_from_the_state(model):
     state = model.state
-    assert state.field().colormap == "plain"
+    assert state.derived.field().colormap == "plain"
     model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
     assert state.display.mode == 1  # the first non-zero mode: mode 0 is constant
-    field = state.field()
+    field = state.derived.field()
     spec = state.spectrum("laplacian")
     np.testing.assert_allclose(field.values, spec.mode(1), rtol=0, atol=0)
     assert field.colormap == "diverging" and field.isolines == state.style.isolines
-    assert "Laplacian (cotan), mode 1" in state.legend()
+    assert "Laplacian (cotan), mode 1" in wording.legend(state)
     state.set_display(kind="curvature")
-    assert state.field().clim[0] == 0.0
+    assert state.derived.field().clim[0] == 0.0
 
 
 def test_display_validation_and_clipping(model):
@@ -257,18 +257,18 @@ def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeyp
     model.jobs.wait(preview_job)
     spec = state.spectrum("laplacian")
     assert spec.is_preview and state.display.kind == "mode"
-    assert "preview" in state.legend() and "preview" in state.summary()
+    assert "preview" in wording.legend(state) and "preview" in wording.summary(state)
     # the user moves on while the exact spectrum is computed
     state.show_mode(4)
     state.set_pick(300)
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
-    preview_map = state.distance_map().copy()
+    preview_map = state.derived.distance_map().copy()
     model.jobs.wait(exact_job)
     exact = state.spectrum("laplacian")
     assert not exact.is_preview and exact is exact_job.result[0]
     assert state.display.kind == "distance" and state.picked == 300  # kept on screen
-    assert "preview" not in state.legend()
-    exact_map = state.distance_map()
+    assert "preview" not in wording.legend(state)
+    exact_map = state.derived.distance_map()
     assert not np.array_equal(exact_map, preview_map)  # redrawn from the exact spectrum
     assert np.corrcoef(exact_map, preview_map)[0, 1] > 0.9
     # the exact modes take the preview's signs, so the colours on screen do not swap
@@ -323,8 +323,8 @@ def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monk
     # the map's legend says the same as the Modes panel (it promised the exact one)
     state.set_pick(300)
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
-    assert "(preview spectrum)" in state.legend()
-    assert "follows" not in state.legend()
+    assert "(preview spectrum)" in wording.legend(state)
+    assert "follows" not in wording.legend(state)
     # asked again (Ctrl+R), the exact spectrum follows the preview on screen again; the
     # picture's legend is redrawn (a display event), and the map stays when it arrives
     redraws = []
@@ -332,12 +332,12 @@ def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monk
     again = model.request_spectrum("laplacian", k=20, show=True)
     assert again.preview_job is None and not again.done
     assert state.exact_follows("laplacian") is True
-    assert "(preview spectrum; the exact one follows)" in state.legend()
+    assert "(preview spectrum; the exact one follows)" in wording.legend(state)
     assert redraws
     # a finished exact spectrum ends the pending state too
     model.jobs.wait(again)
     assert state.display.kind == "distance" and state.display.distance_display == "threshold"
-    assert "follows" not in state.legend() and "preview" not in state.legend()
+    assert "follows" not in wording.legend(state) and "preview" not in wording.legend(state)
     assert not state.spectrum("laplacian").is_preview
     assert state.exact_follows("laplacian") is False
 
@@ -354,7 +354,7 @@ def test_the_3d_shells_get_a_preview_on_big_meshes(model, monkeypatch):
     model.jobs.wait(exact.preview_job)
     spec = state.spectrum("shells")
     assert spec.is_preview and spec.is_vector and int(spec.zero_mode_mask().sum()) == 6
-    assert state.shows_preview() and state.field().title.endswith("(preview)")
+    assert state.shows_preview() and state.derived.field().title.endswith("(preview)")
     model.jobs.wait(exact)
     assert not state.spectrum("shells").is_preview and not state.shows_preview()
 
@@ -393,13 +393,13 @@ def test_a_preview_is_marked_in_every_title_of_the_picture(model, monkeypatch):
     exact = model.request_spectrum("laplacian", k=20, show=True)
     model.jobs.wait(exact.preview_job)
     assert state.shows_preview()
-    assert state.field().title.endswith("(preview)")
+    assert state.derived.field().title.endswith("(preview)")
     state.set_pick(300)
     for display in ("threshold", "continuous"):
         state.set_display(kind="distance", distance_kind="hks", distance_display=display)
-        assert state.field().title.endswith("(preview)")
+        assert state.derived.field().title.endswith("(preview)")
     model.jobs.wait(exact)
-    assert not state.shows_preview() and "preview" not in state.field().title
+    assert not state.shows_preview() and "preview" not in state.derived.field().title
 
 
 def test_a_new_spectrum_of_an_operator_replaces_its_other_keys(model):
@@ -417,7 +417,7 @@ def test_a_new_spectrum_of_an_operator_replaces_its_other_keys(model):
 
 
 def test_percent_text_is_short_and_never_in_exponent_notation():
-    from modalviewer.viewer.state import percent_text
+    from modalviewer.viewer.wording import percent_text
 
     assert percent_text(0.0024) == "0.24\u00a0%"
     assert percent_text(0.0217) == "2.2\u00a0%"
@@ -453,14 +453,14 @@ def test_a_coarse_to_fine_spectrum_is_marked_as_approximate(model):
     state.set_compute_settings(coarse=True)
     job = model.request_spectrum("laplacian", k=12, show=True)
     model.jobs.wait(job)
-    assert state.is_coarse("laplacian") and state.display_mark() == " (coarse-to-fine)"
-    assert state.field().title.endswith("(coarse-to-fine)")
-    assert "(coarse-to-fine: approximate)" in state.legend()
+    assert state.is_coarse("laplacian") and wording.display_mark(state) == " (coarse-to-fine)"
+    assert state.derived.field().title.endswith("(coarse-to-fine)")
+    assert "(coarse-to-fine: approximate)" in wording.legend(state)
     state.set_compute_settings(coarse=False)
     exact = model.request_spectrum("laplacian", k=12, show=True)
     model.jobs.wait(exact)
-    assert not state.is_coarse("laplacian") and state.display_mark() == ""
-    assert "coarse" not in state.legend()
+    assert not state.is_coarse("laplacian") and wording.display_mark(state) == ""
+    assert "coarse" not in wording.legend(state)
 
 
 def test_asking_again_for_the_spectrum_on_screen_keeps_the_mode(model):
@@ -488,14 +488,14 @@ def test_the_status_line_says_what_is_computing_before_any_spectrum(model):
     click) was computed the status line still said "compute a spectrum (Ctrl+R) or click
     the surface"."""
     state = model.state
-    assert "compute a spectrum (Ctrl+R)" in state.summary()
+    assert "compute a spectrum (Ctrl+R)" in wording.summary(state)
     state.set_pick(100)
     job = model.request_spectrum("shells", k=12)
-    assert "computing Discrete Shells" in state.summary()
-    assert "the map of vertex 100 follows" in state.summary()
-    assert "Ctrl+R" not in state.summary()
+    assert "computing Discrete Shells" in wording.summary(state)
+    assert "the map of vertex 100 follows" in wording.summary(state)
+    assert "Ctrl+R" not in wording.summary(state)
     model.jobs.wait(job)
-    assert not state.computing and "computing" not in state.summary()
+    assert not state.computing and "computing" not in wording.summary(state)
     cancelled = model.request_spectrum("laplacian", k=12)
     model.jobs.cancel(cancelled)
     model.jobs.wait(cancelled)

@@ -75,9 +75,7 @@ class DistancesPanel(QtWidgets.QWidget):
         self.kind_combo.currentIndexChanged.connect(self._on_kind)
         self.display_combo.currentIndexChanged.connect(self._on_display)
         self.threshold_slider.valueChanged.connect(self._on_slider)
-        self.by_share_check.toggled.connect(
-            lambda on: self.state.set_display(threshold_by_share=bool(on))
-        )
+        self.by_share_check.toggled.connect(lambda on: self.state.set_display(keep_share=bool(on)))
         self.t1_edit.editingFinished.connect(self._on_range)
         self.t2_edit.editingFinished.connect(self._on_range)
         self.distance_button.clicked.connect(self.showDistanceRequested)
@@ -95,7 +93,7 @@ class DistancesPanel(QtWidgets.QWidget):
     # ------------------------------------------------------------- input
     def _on_kind(self, _index: int) -> None:
         """Another distance kind (a threshold map keeps its share of the surface: see
-        :meth:`ViewerState.set_display`)."""
+        :meth:`ViewerState._match_threshold`)."""
         self.state.set_display(distance_kind=self.kind_combo.currentData())
         if self.state.display.kind == "distance":
             self.showDistanceRequested.emit()
@@ -108,7 +106,7 @@ class DistancesPanel(QtWidgets.QWidget):
     def _on_slider(self, value: int) -> None:
         position = value / SLIDER_STEPS
         if self.by_share_check.isChecked():
-            fraction = self.state.threshold_for_share(position)
+            fraction = self.state.derived.threshold_for_share(position)
         else:
             fraction = position
         self.state.set_display(threshold=fraction)
@@ -138,24 +136,24 @@ class DistancesPanel(QtWidgets.QWidget):
             self.scale_slider,
             self.by_share_check,
         ):
-            self.by_share_check.setChecked(d.threshold_by_share)
+            self.by_share_check.setChecked(d.keep_share)
             select_data(self.kind_combo, d.distance_kind)
             select_data(self.display_combo, d.distance_display)
             self.scale_slider.setValue(d.signature_sample)
-            dist = state.distance_map()
+            dist = state.derived.distance_map()
             if dist is not None and self.by_share_check.isChecked():
-                position = state.surface_share(dist, d.threshold * float(dist.max()))
+                position = state.derived.surface_share(dist, d.threshold * float(dist.max()))
             else:
                 position = d.threshold
             self.threshold_slider.setValue(max(1, int(round(position * SLIDER_STEPS))))
         self.threshold_slider.setEnabled(d.distance_display == "threshold")
         if dist is not None:
             thr = d.threshold * float(dist.max())
-            share = 100.0 * state.surface_share(dist, thr)
+            share = 100.0 * state.derived.surface_share(dist, thr)
             self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
         elif state.picked is not None:
             self.threshold_label.setText("The map follows when its spectrum is computed")
-        elif d.threshold_by_share:
+        elif d.keep_share:
             self.threshold_label.setText("Marks a share of the surface once a vertex is picked")
         else:
             self.threshold_label.setText(f"{d.threshold:.3g} of the largest distance")
@@ -171,11 +169,11 @@ class DistancesPanel(QtWidgets.QWidget):
 
     def _update_range_placeholders(self) -> None:
         operator = operator_for_distance(self.state.display.distance_kind)
-        if not self.state.has_signatures(operator):
+        if not self.state.derived.has_signatures(operator):
             self.t1_edit.setPlaceholderText("default")
             self.t2_edit.setPlaceholderText("default")
             return
-        table = self.state.table(operator)
+        table = self.state.derived.table(operator)
         self.t1_edit.setPlaceholderText(f"default {table.times[0]:.4g}")
         self.t2_edit.setPlaceholderText(f"default {table.times[-1]:.4g}")
         if self.state.t_range is None:
@@ -187,10 +185,10 @@ class DistancesPanel(QtWidgets.QWidget):
         state = self.state
         operator = operator_for_distance(state.display.distance_kind)
         spec = state.spectrum(operator)
-        if not state.has_signatures(operator) or state.picked is None:
+        if not state.derived.has_signatures(operator) or state.picked is None:
             self.signature_plot.set_data([], [], title="Signature of the picked vertex")
             return
-        table = state.table(operator)
+        table = state.derived.table(operator)
         times, values = signature(spec, table.times, vertices=[state.picked])
         self.signature_plot.set_data(
             times,

@@ -6,7 +6,8 @@ import numpy as np
 from qtpy import QtCore, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
-from ...viewer.state import ViewerState, percent_text
+from ...viewer.state import ViewerState
+from ...viewer.wording import approximation_mark, percent_text
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, describe, quiet, select_data
 
@@ -105,7 +106,7 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
             self.spectrum_combo.clear()
             for name in computed:
-                info, mark = OPERATOR_INFO[name], state.approximation_mark(name)
+                info, mark = OPERATOR_INFO[name], approximation_mark(state, name)
                 # marked: the short name, so the mark is not cut off in a narrow panel
                 self.spectrum_combo.addItem((info.short_label if mark else info.label) + mark, name)
                 index = self.spectrum_combo.count() - 1
@@ -163,7 +164,7 @@ class ModesPanel(QtWidgets.QWidget):
                 "Compute for the exact spectrum)."
             )
         self.eigen_label.setText(text)
-        approximate = state.approximation_mark(op)
+        approximate = approximation_mark(state, op)
         self.spectrum_plot.set_data(
             np.arange(spec.k),
             np.where(zero, 0.0, spec.eigenvalues),

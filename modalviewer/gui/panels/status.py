@@ -5,10 +5,11 @@ from __future__ import annotations
 from qtpy import QtCore, QtGui, QtWidgets
 
 from ...viewer.state import ViewerState
+from ...viewer.wording import summary
 
 
 class StatusLine(QtWidgets.QLabel):
-    """A permanent status-bar label showing ``state.summary()``."""
+    """A permanent status-bar label showing :func:`~modalviewer.viewer.wording.summary`."""
 
     def __init__(self, state: ViewerState, parent=None):
         super().__init__(parent)
@@ -27,7 +28,7 @@ class StatusLine(QtWidgets.QLabel):
         self.update_from_state()
 
     def update_from_state(self, *_args) -> None:
-        text = self.state.summary()
+        text = summary(self.state)
         self.setText(text)
         self.setToolTip(text)
 

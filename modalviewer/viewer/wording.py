@@ -1,0 +1,136 @@
+"""The viewer's words: legends, the status line, preview notes and marks (no Qt, no VTK).
+
+Every function reads a :class:`~.state.ViewerState` and, where it needs numbers computed
+from it (distances, signature scales), its :class:`~.derived.DerivedValues`
+(``state.derived`` when not given).  Nothing here changes or caches anything.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..core.mesh import _plural
+from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
+
+if TYPE_CHECKING:
+    from .derived import DerivedValues
+    from .state import ViewerState
+
+
+def percent_text(fraction: float) -> str:
+    """A relative error as a short percentage: "< 0.01 %", "0.24 %", "2.2 %", "21 %",
+    "135 %" (with a no-break space, so a wrapped legend keeps number and sign together);
+    below 0.01 % the digits would only show how converged a mode is, not its error."""
+    value = 100.0 * float(fraction)
+    if 0 < value < 0.01:
+        return "<\u00a00.01\u00a0%"
+    return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
+
+
+def approximation_mark(state: ViewerState, operator: str | None) -> str:
+    """ " (preview)", " (coarse-to-fine)" or "": what titles and lists add to the
+    spectrum shown for ``operator`` when it is an approximation."""
+    spec = state.spectrum(operator)
+    if spec is not None and spec.is_preview:
+        return " (preview)"
+    if state.is_coarse(operator):
+        return " (coarse-to-fine)"
+    return ""
+
+
+def display_mark(state: ViewerState) -> str:
+    """:func:`approximation_mark` of the spectrum the picture is made of."""
+    return approximation_mark(state, state.display_operator())
+
+
+def preview_note(state: ViewerState, operator: str | None) -> str:
+    """ " (preview spectrum; the exact one follows)", " (preview spectrum)",
+    " (coarse-to-fine spectrum)" or "" for the spectrum shown for ``operator``."""
+    spec = state.spectrum(operator)
+    if spec is None:
+        return ""
+    if not spec.is_preview:
+        return " (coarse-to-fine spectrum)" if state.is_coarse(operator) else ""
+    if state.exact_follows(operator):
+        return " (preview spectrum; the exact one follows)"
+    return " (preview spectrum)"
+
+
+def missing_distance_reason(state: ViewerState, kind: str) -> str:
+    """Why there is no distance map of ``kind``: what to do to get one."""
+    if state.picked is None:
+        return "pick a vertex"
+    operator = operator_for_distance(kind)
+    if state.spectrum(operator) is None:
+        return f"needs the {operator_info(operator).label} spectrum"
+    return "the spectrum has no non-zero modes; compute more modes"
+
+
+def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
+    """One or two lines naming what the surface shows, with its numbers."""
+    derived = derived if derived is not None else state.derived
+    d = state.display
+    if state.mesh is None or d.kind == "none":
+        return ""
+    if d.kind == "mode":
+        spec = state.spectrum(d.operator)
+        if spec is None:
+            return ""
+        j = int(np.clip(d.mode, 0, spec.k - 1))
+        lam = float(spec.eigenvalues[j])
+        zero = spec.zero_mode_mask()[j]
+        value = "0 (zero mode)" if zero else f"{lam:.4g}"
+        if spec.is_preview:
+            value += f" (preview; estimated error {percent_text(spec.estimated_error)})"
+        elif state.is_coarse(d.operator):
+            value += " (coarse-to-fine: approximate)"
+        colours = "blue +, white 0, orange -"
+        if spec.is_vector and derived.vector_coloring() == "magnitude":
+            colours = "white 0 to red: displacement magnitude"
+        elif spec.is_vector:
+            colours += " (normal component, smoothed normals)"
+        return f"{operator_info(d.operator).label}, mode {j}: lambda = {value}\n{colours}"
+    if d.kind == "distance":
+        name = DISTANCE_KINDS[d.distance_kind]
+        dist = derived.distance_map()
+        if dist is None:
+            return f"{name}: {missing_distance_reason(state, d.distance_kind)}"
+        source = f"from vertex {state.picked_file_vertex}"
+        source += preview_note(state, operator_for_distance(d.distance_kind))
+        if d.distance_display == "threshold":
+            thr = derived.threshold_value(dist)
+            share = 100.0 * derived.surface_share(dist, thr)
+            return f"blue: {name.lower()} < {thr:.3g}, {share:.1f} % of the surface\n{source}"
+        t1, t2 = derived.scale_limits()
+        return (
+            f"{name} {source}: white 0 to red {float(dist.max()):.3g}\n"
+            f"scales t = {t1:.3g} .. {t2:.3g}"
+        )
+    if d.kind == "signature":
+        if not derived.has_signatures(operator_for_distance(d.distance_kind)):
+            return ""
+        word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
+        return f"{word[d.distance_kind]} signature at t = {derived.signature_time():.3g}"
+    if d.kind == "curvature":
+        return "Curvature sqrt(k1^2 + k2^2), white 0 to red (98th percentile)"
+    return ""
+
+
+def summary(state: ViewerState, derived: DerivedValues | None = None) -> str:
+    """The status line: the current display's live numbers, on one line."""
+    if state.mesh is None:
+        return "Open a mesh to begin (File > Open, Ctrl+O)."
+    text = legend(state, derived).replace("\n", "; ")
+    if not text:
+        m = state.mesh
+        text = f"{_plural(m.n_vertices, 'vertex')}, {_plural(m.n_faces, 'face')}"
+        if state.computing and not state.spectra:
+            names = sorted({operator_info(key.operator).label for key in state.computing})
+            text += f"; computing {', '.join(names)} (Esc cancels)"
+            if state.picked is not None:
+                text += f"; the map of vertex {state.picked_file_vertex} follows"
+        elif not state.spectra:
+            text += "; compute a spectrum (Ctrl+R) or click the surface"
+    return text
