@@ -1,7 +1,8 @@
 """modalviewer: modal shape analysis beyond the Laplacian.
 
-The public API re-exports the numerical core (numpy/scipy only).  Importing this
-package never imports Qt or VTK; the viewer lives in ``modalviewer.gui``.
+The public API re-exports the numerical core (numpy/scipy only) and
+:class:`~modalviewer.viewer.Viewer`, the viewer without a window (loaded on first use).
+Importing this package never imports Qt or VTK; the windows live in ``modalviewer.gui``.
 
 >>> import modalviewer as mv
 >>> mesh = mv.load_mesh("assets/bumpy_plate.obj")          # doctest: +SKIP
@@ -25,4 +26,12 @@ from .io import load_mesh  # noqa: E402
 from .repair import SliverReport, fix_slivers  # noqa: E402
 
 __version__ = "0.1.0"
-__all__ = [*_core_all, "load_mesh", "fix_slivers", "SliverReport"]
+__all__ = [*_core_all, "load_mesh", "fix_slivers", "SliverReport", "Viewer"]  # noqa: F405
+
+
+def __getattr__(name):
+    if name == "Viewer":  # the viewer's model and jobs load only when asked for
+        from .viewer import Viewer
+
+        return Viewer
+    raise AttributeError(f"module 'modalviewer' has no attribute {name!r}")

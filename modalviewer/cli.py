@@ -7,7 +7,6 @@ Bad arguments and bad files give a one-line error and exit code 2 (usage) or 1
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -165,25 +164,14 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def _window(size):
-    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-    os.environ.setdefault("MODALVIEWER_NO_DIALOGS", "1")
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    from qtpy import QtWidgets
+def _viewer(mesh, path):
+    """A :class:`~modalviewer.viewer.Viewer` showing ``mesh`` (no window, no Qt: its
+    pictures are drawn off screen by the same scene the window draws)."""
+    from .viewer import Viewer
 
-    from .gui.main_window import MainWindow
-
-    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
-    win = MainWindow(force_offscreen=True)
-    for dock in win.findChildren(QtWidgets.QDockWidget):
-        dock.hide()
-    win.menuBar().hide()
-    win.statusBar().hide()
-    win.resize(*size)
-    win.show()
-    app.processEvents()
-    return app, win
+    viewer = Viewer()
+    viewer.set_mesh(mesh, Path(path))
+    return viewer
 
 
 def _run(args) -> int:
@@ -243,17 +231,19 @@ def _run(args) -> int:
         return 0
     mesh = _load(args.mesh, args.fix_slivers)
     if args.command == "render":
-        app, win = _window(args.size)
-        win.set_mesh(mesh, Path(args.mesh))
-        win.state.set_isolines(args.isolines)
-        spec = win.compute(args.operator, k=args.k, wait=True)
+        viewer = _viewer(mesh, args.mesh)
+        viewer.state.set_isolines(args.isolines)
+        with _warnings_printed():
+            spec = viewer.compute(args.operator, k=args.k, wait=True)
         if not 0 <= args.mode < spec.k:
             raise ValueError(f"--mode must be between 0 and {spec.k - 1}")
-        win.show_mode(args.mode)
-        win.export_screenshot(args.output, transparent=args.transparent)
+        viewer.show_mode(args.mode)
+        written = viewer.export_screenshot(
+            args.output, transparent=args.transparent, size=args.size
+        )
+        viewer.close()
         print(f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}")
-        _wrote(args.output, f"{_png(args.output)}, mode {args.mode}")
-        win.close()
+        _wrote(written, f"{_png(written)}, mode {args.mode}")
         return 0
     # distance: --vertex and every vertex number printed or written are the file's
     vertex = _mesh_vertex(mesh, args.vertex)
@@ -271,16 +261,17 @@ def _run(args) -> int:
     if args.csv:
         _write_csv(args.csv, mesh, d, f"{args.kind} distance from vertex {args.vertex}")
     if args.output:
-        app, win = _window(args.size)
-        win.set_mesh(mesh, Path(args.mesh))
-        win.state.add_spectrum(win.state.compute_settings.key(spec.operator, spec.k), spec)
-        win.pick_vertex(vertex)
-        display = "continuous" if marked is None else "threshold"
-        fraction = None if marked is None else marked[0] / float(d.max())
-        win.show_distance(args.kind, display=display, threshold=fraction)
-        win.export_screenshot(args.output)
-        win.close()
-        _wrote(args.output, f"{_png(args.output)}, {args.kind} distance map")
+        viewer = _viewer(mesh, args.mesh)
+        viewer.state.add_spectrum(viewer.state.compute_settings.key(spec.operator, spec.k), spec)
+        viewer.state.set_display(distance_kind=args.kind)
+        viewer.pick_vertex(vertex)
+        if marked is None:
+            viewer.show_distance(args.kind, display="continuous")
+        else:
+            viewer.show_distance(args.kind, display="threshold", threshold=marked[0])
+        written = viewer.export_screenshot(args.output, size=args.size)
+        viewer.close()
+        _wrote(written, f"{_png(written)}, {args.kind} distance map")
     order = np.argsort(d)[1:6]
     print(
         f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "

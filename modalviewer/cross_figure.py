@@ -10,8 +10,6 @@ distance; or blue where the distance is below the threshold) and captioned.  Use
 
 from __future__ import annotations
 
-import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -33,45 +31,21 @@ class Panel:
     distances: np.ndarray | None = None
     display: str = "continuous"
     threshold: float = 0.2
-    azimuth: float = 0.0  # degrees, added to the viewer's default view
+    azimuth: float = 0.0  # degrees about the up axis, from the viewer's first view
     elevation: float = 0.0
-    face_marker: bool = False  # turned about y so the marker faces the camera
-
-
-def _caption(img: np.ndarray, text: str) -> np.ndarray:
-    from PIL import Image, ImageDraw, ImageFont
-
-    height = max(24, img.shape[0] // 20)
-    band = Image.new("RGB", (img.shape[1], height), "white")
-    draw = ImageDraw.Draw(band)
-    size = int(height * 0.6)
-    try:
-        font = ImageFont.load_default(size=size)
-        while size > 8 and draw.textlength(text, font=font) > img.shape[1] - 16:
-            size -= 1
-            font = ImageFont.load_default(size=size)
-    except TypeError:  # Pillow < 10.1: a fixed bitmap font
-        font = ImageFont.load_default()
-    draw.text((8, height // 6), text, fill="black", font=font)
-    return np.vstack([np.asarray(band), img[:, :, :3]])
-
-
-def _plotter(size):
-    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista as pv
-
-    plotter = pv.Plotter(off_screen=True, window_size=list(size))
-    plotter.set_background("white")
-    return plotter
+    face_marker: bool = False  # turned about the up axis so the marker faces the camera
 
 
 def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
     """(h, w, 3) image of one panel, captioned."""
     from .core.laplacian import vertex_normals
+    from .scene.comparison import caption
+    from .scene.export import grab
     from .scene.mesh_scene import MeshScene
+    from .scene.offscreen import offscreen_plotter
+    from .viewer.camera import Camera
 
-    plotter = _plotter(size)
+    plotter = offscreen_plotter(size)
     try:
         normals = vertex_normals(panel.mesh)
         scene = MeshScene(plotter, panel.mesh, normals)
@@ -85,46 +59,34 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
             else:
                 scene.show_field(d, "sequential", isolines=0, name="distance")
         scene.show_marker(panel.marker)
-        # the viewer's first view: looking down -z, y up, turned a little
-        azimuth, elevation = 25.0 + panel.azimuth, 15.0 + panel.elevation
+        # the viewer's first view of the mesh, turned about its up axis by ``azimuth``
+        # (or until the marker faces the camera) and tilted by ``elevation``
+        first = scene.canonical_camera()
+        scene.set_camera(first)
+        camera = plotter.camera
+        azimuth = panel.azimuth
         if panel.face_marker and panel.marker is not None:
-            # turn about the y axis until the marker's normal points at the camera (a
-            # normal along y, like a fingertip's, is seen from the default view)
-            nx, _, nz = normals[panel.marker]
-            if np.hypot(nx, nz) > 0.3:
-                azimuth = float(np.degrees(np.arctan2(nx, nz)))
-        plotter.view_xy()
-        plotter.camera.Azimuth(azimuth)
-        plotter.camera.Elevation(elevation)
-        plotter.camera.OrthogonalizeViewUp()
-        plotter.reset_camera()
-        plotter.render()
-        image = np.asarray(plotter.screenshot(None, return_img=True))[:, :, :3]
+            to_camera = np.asarray(first.direction)
+            up = np.asarray(first.up)
+            n = normals[panel.marker] - np.dot(normals[panel.marker], up) * up
+            if np.linalg.norm(n) > 0.3:
+                side = np.cross(up, to_camera)
+                azimuth = float(np.degrees(np.arctan2(np.dot(n, side), np.dot(n, to_camera))))
+        camera.Azimuth(azimuth)
+        camera.Elevation(panel.elevation)
+        camera.OrthogonalizeViewUp()
+        scene.set_camera(
+            Camera(tuple(camera.position), tuple(camera.focal_point), tuple(camera.up))
+        )
+        image = grab(plotter, scene)[:, :, :3]
     finally:
         plotter.close()
-    return _caption(image, panel.title)
+    return caption(image, panel.title)
 
 
 def render_panels(panels: list[Panel], path, size=(640, 560)) -> Path:
     """Render ``panels`` left to right, each ``size`` pixels, into one PNG at ``path``
     (written atomically)."""
-    from PIL import Image
+    from .scene.export import save_png, side_by_side
 
-    images = [render_panel(panel, size) for panel in panels]
-    height = max(img.shape[0] for img in images)
-    canvas = np.full((height, sum(img.shape[1] for img in images), 3), 255, np.uint8)
-    x = 0
-    for img in images:
-        canvas[: img.shape[0], x : x + img.shape[1]] = img
-        x += img.shape[1]
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
-        Image.fromarray(canvas).save(tmp, format="PNG")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return save_png(path, side_by_side([render_panel(panel, size) for panel in panels]))

@@ -1,13 +1,15 @@
-"""The main window: wires the viewer model to the docks, the 3D view and the menus.
+"""The main window: wires a :class:`~modalviewer.viewer.Viewer` to the docks, the 3D view
+and the menus.
 
-The state lives in :class:`~modalviewer.viewer.model.ViewerModel` (``win.model``,
-``win.state``); panels and the scene observe it.  The methods below are the scripting
-interface; each does what the matching click does, through the model::
+The viewer (``win.viewer``) owns the state, the jobs and the cache; panels and the
+scene observe its state, and the window shows its messages.  The window's scripting
+methods are the viewer's (each a one-line delegation), so a script drives the window as
+it drives a :class:`~modalviewer.viewer.Viewer`::
 
+    win = MainWindow()          # creates the QApplication it needs, off screen if no display
     win.open_mesh(path); win.compute("shells", k=50, wait=True); win.show_mode(7)
-    win.pick_file_vertex(123); win.show_distance("vibration", display="threshold", threshold=0.2)
+    win.pick_file_vertex(123); win.show_distance("vibration", display="threshold", share=0.1)
     win.export_screenshot("fig.png", scale=2, transparent=True)
-    win.save_session("s.json"); win.open_session("s.json", wait=True)
 """
 
 from __future__ import annotations
@@ -16,29 +18,20 @@ import logging
 import os
 from pathlib import Path
 
-import numpy as np
 from qtpy import QtCore, QtWidgets
 
 from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh, MeshError
-from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
+from ..core.operators import OPERATOR_INFO
 from ..core.spectrum import Spectrum
 from ..readers import DamagedFileError
-from ..viewer.jobs import DONE, Job
-from ..viewer.model import (
-    ComputeRefused,
-    ViewerModel,
-    cost_estimate,
-    repair_for_failure,
-    repair_unavailable,
-    residual_text,
-)
+from ..viewer.jobs import Job
 from ..viewer.state import SpectrumKey
-from ..viewer.wording import percent_text
+from ..viewer.viewer import ComputeError, Viewer
 from . import menus, window_settings
+from .application import ensure_application
 from .compare import CompareWindow
 from .dialogs import ask, file_message, offer_open_anyway
-from ..scene.export import save_field_mesh, save_screenshot
 from .pair_window import PairWindow, open_pair_window
 from .panels import (
     AnimationPanel,
@@ -52,33 +45,28 @@ from .qt_dispatch import QtDispatcher
 from .scene_view import SceneView
 from .viewport import make_viewport
 
+__all__ = ["ComputeError", "MainWindow"]
+
 log = logging.getLogger("modalviewer")
-
-LONG_WAIT_SECONDS = 30.0
-"""Requests expected to take longer (and showing nothing meanwhile) say so when they
-start."""
-
 
 MIN_VIEW_SIZE = (320, 240)
 """The smallest the 3D view gets, in pixels; the window's minimum width follows."""
 
 
-class ComputeError(RuntimeError):
-    """A computation started from the scripting API failed; the message is for users."""
-
-
 class MainWindow(QtWidgets.QMainWindow):
-    """The modalviewer main window."""
+    """The modalviewer main window, showing ``viewer`` (a new :class:`Viewer` if None)."""
 
     meshLoaded = QtCore.Signal(str)
     spectrumReady = QtCore.Signal(str)
 
     def __init__(
         self,
+        viewer: Viewer | None = None,
         force_offscreen: bool | None = None,
         cache: SpectrumCache | None = None,
         remember_settings: bool | None = None,
     ):
+        ensure_application()
         super().__init__()
         self.setWindowTitle("modalviewer")
         self.setAcceptDrops(True)
@@ -88,16 +76,15 @@ class MainWindow(QtWidgets.QMainWindow):
             if remember_settings is None
             else bool(remember_settings)
         )
+        self.viewer = viewer if viewer is not None else Viewer(cache=cache)
         self.dispatcher = QtDispatcher(self)
-        self.model = ViewerModel(cache=cache, dispatch=self.dispatcher)
-        self.state = self.model.state
-        self.cache = self.model.cache
-        self.last_error: str | None = None
-        self.message_box: QtWidgets.QMessageBox | None = None  # the last one opened
-        self.sliver_failure: SpectrumKey | None = None  # failed on slivers, to retry
-        self.compare: CompareWindow | None = None
         self._waits: list[QtCore.QEventLoop] = []
-        self._cancel_note = ""  # what Esc cancelled, said again when the next job starts
+        self.viewer.use_event_loop(self.dispatcher, self.wait_for)
+        self.model = self.viewer.model
+        self.state = self.viewer.state
+        self.cache = self.viewer.cache
+        self.message_box: QtWidgets.QMessageBox | None = None  # the last one opened
+        self.compare: CompareWindow | None = None
 
         self.viewport = make_viewport(self, force_offscreen)
         self.plotter = self.viewport.plotter
@@ -109,6 +96,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.viewport.widget.installEventFilter(self)
         self.viewport.clicked.connect(self._on_view_clicked)
         self.scene_view = SceneView(self.state, self.viewport, self)
+        self.viewer.attach_picture(self.scene_view)
 
         self.compute_panel = ComputePanel(self.state)
         self.compute_panel.computeRequested.connect(lambda: self.compute(wait=False))
@@ -127,7 +115,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.state.events.mesh.connect(self._on_mesh)
         self.state.events.spectra.connect(self.spectrumReady.emit)
         self.model.jobs.events.changed.connect(self._on_job_changed)
-        self.model.jobs.events.finished.connect(self._on_job_finished)
+        messages = self.viewer.events
+        messages.status.connect(lambda text, msec: self.statusBar().showMessage(text, msec))
+        messages.error.connect(self._show_error_box)
+        messages.info.connect(self._show_info_box)
+        messages.sliver_failure.connect(self._offer_sliver_fix)
         window_settings.restore(self)
         # preferences are written a second after they change, not only on a clean quit
         self._settings_timer = QtCore.QTimer(self)
@@ -140,6 +132,9 @@ class MainWindow(QtWidgets.QMainWindow):
             self.state.events.animation,
         ):
             event.connect(lambda *_: self._settings_timer.start())
+        if self.state.mesh is not None:  # a viewer already in use: show what it shows
+            self.scene_view.drawing.sync()
+            self._on_mesh()
 
     # ================================================================== UI
     def _build_docks(self) -> None:
@@ -207,16 +202,20 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ============================================================ messages
     def show_error(self, message: str, title: str = "modalviewer") -> None:
-        """A non-blocking warning dialog with a human message; the app keeps running."""
-        self.last_error = message
-        log.warning("%s", message)
+        """A non-blocking warning dialog with a human message (the viewer's
+        ``last_error``); the app keeps running."""
+        self.viewer.report_error(message, title)
+
+    def _show_error_box(self, title: str, message: str) -> None:
         self.statusBar().showMessage(message, 10000)
-        if os.environ.get("MODALVIEWER_NO_DIALOGS"):
-            return
-        self._open_box(QtWidgets.QMessageBox.Icon.Warning, title, message)
+        if not os.environ.get("MODALVIEWER_NO_DIALOGS"):
+            self._open_box(QtWidgets.QMessageBox.Icon.Warning, title, message)
 
     def show_info(self, message: str, title: str = "modalviewer") -> None:
         """A non-blocking information dialog (and the status bar)."""
+        self._show_info_box(title, message)
+
+    def _show_info_box(self, title: str, message: str) -> None:
         log.info("%s", message)
         self.statusBar().showMessage(message.replace("\n", " "), 20000)
         if not os.environ.get("MODALVIEWER_NO_DIALOGS"):
@@ -269,16 +268,6 @@ class MainWindow(QtWidgets.QMainWindow):
                 return True
         return super().eventFilter(obj, event)
 
-    def step_mode(self, step: int) -> None:
-        d = self.state.display
-        operator = d.operator if d.kind == "mode" else self.modes_panel.spectrum_combo.currentData()
-        if operator is None or self.state.spectrum(operator) is None:
-            return
-        self.state.show_mode((d.mode if d.kind == "mode" else 0) + step, operator)
-
-    def toggle_animation(self) -> None:
-        self.state.set_animation(playing=not self.state.animation.playing)
-
     # ============================================================= loading
     def dragEnterEvent(self, event):  # noqa: N802
         if event.mimeData().hasUrls():
@@ -306,9 +295,7 @@ class MainWindow(QtWidgets.QMainWindow):
         path = Path(path)
         QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.CursorShape.WaitCursor)
         try:
-            from ..io import load_mesh
-
-            mesh = load_mesh(path, strict=strict)
+            self.viewer.open_mesh(path, strict=strict)
         except DamagedFileError as exc:
             QtWidgets.QApplication.restoreOverrideCursor()
             return offer_open_anyway(self, path, exc) and self.open_mesh(path, strict=False)
@@ -322,86 +309,24 @@ class MainWindow(QtWidgets.QMainWindow):
             return False
         finally:
             QtWidgets.QApplication.restoreOverrideCursor()
-        self.set_mesh(mesh, path)
         window_settings.remember_file(self, path.resolve())
         return True
 
     def set_mesh(self, mesh: Mesh, path: Path | None = None) -> None:
-        """Show ``mesh``; the previous mesh's spectra are dropped, its jobs cancelled."""
-        if self.compare is not None:
-            self.compare.close()
-        self.model.set_mesh(mesh, path)
+        self.viewer.set_mesh(mesh, path)
 
     def _on_mesh(self) -> None:
+        if self.compare is not None:
+            self.compare.close()
         mesh, path = self.state.mesh, self.state.mesh_path
         name = path.name if path else "mesh"
         self.setWindowTitle(f"modalviewer - {name}" if mesh is not None else "modalviewer")
-        if mesh is not None:
-            self.statusBar().showMessage(str(mesh.report), 15000)
         self.meshLoaded.emit(str(path) if path else "")
 
-    # =========================================================== computing
-    def compute(
-        self, operator: str | None = None, k: int | None = None, wait: bool = True, then=None
-    ):
-        """Compute a spectrum in the background (cached on disk) and show it when ready.
-
-        With ``wait=True`` the call returns this request's Spectrum once ready (the event
-        loop keeps running meanwhile) and raises ComputeError if this request failed or
-        was cancelled.  ``then`` is called with the spectrum when it arrives.
-        """
-        if self.state.mesh is None:
-            self.show_error("Open a mesh first.")
-            if wait:
-                raise ComputeError("Open a mesh first.")
-            return None
-        changes = {}
-        if operator is not None:
-            changes["operator"] = operator
-        if k is not None:
-            changes["k"] = int(k)
-        if changes:
-            self.state.set_compute_settings(**changes)
-        return self._run(self._request(None, None, show=True), wait, then)
-
-    def _request(self, operator, k, show) -> Job | None:
-        try:
-            job = self.model.request_spectrum(operator, k, show=show)
-        except ComputeRefused as exc:
-            self.show_error(str(exc), "Computation too large")
-            return None
-        note = self._long_wait_note(job)
-        if note:
-            self.statusBar().showMessage(f"{job.description}: {note}.", 20000)
-        return job
-
-    def _long_wait_note(self, job: Job) -> str:
-        """ "this will take about ..." for a request expected to take long with nothing on
-        screen meanwhile (a click on the surface starts one for the vibration distance);
-        "" otherwise (with a preview the wait is for its exact spectrum, behind a
-        picture)."""
-        if job.done or getattr(job, "preview_job", None) is not None:
-            return ""
-        seconds, _ = cost_estimate(job.spectrum_key, self.state.mesh.n_vertices)
-        if seconds <= LONG_WAIT_SECONDS:
-            return ""
-        about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
-        faster = "" if job.spectrum_key.coarse else "; Coarse-to-fine is much faster"
-        return f"this will take about {about} (Esc cancels{faster})"
-
-    def _run(self, job: Job | None, wait: bool, then=None):
-        if job is None:
-            if wait:
-                raise ComputeError(self.last_error or "the computation was refused")
-            return None
-        if then is not None:
-            job.then(lambda j: then(j.result[0]) if j.status == DONE else None)
-        if not wait:
-            return None
-        self.wait_for(job)
-        if job.status != DONE:
-            raise ComputeError(job.error or job.status)
-        return job.result[0]
+    # ================================================ scripting (the Viewer)
+    def compute(self, operator=None, k=None, wait: bool = True, then=None):
+        """:meth:`Viewer.compute <modalviewer.viewer.Viewer.compute>`."""
+        return self.viewer.compute(operator, k, wait, then)
 
     def wait_for(self, job: Job) -> Job:
         """Run the event loop until ``job`` (and only it) has ended."""
@@ -417,30 +342,61 @@ class MainWindow(QtWidgets.QMainWindow):
         return job
 
     def cancel_computation(self) -> None:
-        """Cancel the running computation, and the exact spectrum waiting behind its
-        preview; other queued requests keep their turn (the status bar says how many, and
-        that Ctrl+Shift+Esc cancels them too, also when the next one starts)."""
-        if self.model.jobs.running is None:
-            self.statusBar().showMessage("No computation running.", 3000)
-            return
-        self.model.cancel_running()
-        left = {
-            getattr(job, "spectrum_key", None) or job.key
-            for job in self.model.jobs.jobs
-            if not job.done and not job.cancel_requested
-        }
-        plural = "s" if len(left) > 1 else ""
-        self._cancel_note = (
-            f"Cancelled; {len(left)} more request{plural} queued (Ctrl+Shift+Esc cancels all)"
-            if left
-            else ""
-        )
-        self.statusBar().showMessage(self._cancel_note or "Cancelling...", 5000)
+        self.viewer.cancel_computation()
 
     def cancel_all(self) -> None:
-        self.model.jobs.cancel_all()
+        self.viewer.cancel_all()
 
-    def _on_job_changed(self, job: Job) -> None:
+    def show_mode(self, index: int, operator: str | None = None) -> None:
+        self.viewer.show_mode(index, operator)
+
+    def step_mode(self, step: int) -> None:
+        self.viewer.step_mode(step)
+
+    def toggle_animation(self) -> None:
+        self.viewer.toggle_animation()
+
+    def set_animating(self, on: bool) -> None:
+        self.viewer.set_animating(on)
+
+    def animation_frame(self, phase: float) -> float:
+        """Move the surface to the given phase (radians); returns the app's time in s."""
+        return self.scene_view.animation_frame(phase)
+
+    def pick_file_vertex(self, number: int) -> None:
+        try:
+            self.viewer.pick_file_vertex(number)
+        except ValueError as exc:
+            self.show_error(str(exc))
+
+    def pick_vertex(self, index: int) -> None:
+        try:
+            self.viewer.pick_vertex(index)
+        except ValueError as exc:
+            self.show_error(str(exc))
+
+    def show_distance(self, kind=None, display=None, share=None, threshold=None):
+        return self.viewer.show_distance(kind, display, share, threshold)
+
+    def distance_map(self, kind: str):
+        return self.viewer.distance_map(kind)
+
+    def set_threshold(self, fraction: float) -> float:
+        return self.viewer.set_threshold(fraction)
+
+    def show_signature(self, sample: int) -> None:
+        self.viewer.show_signature(sample)
+
+    def show_curvature(self) -> None:
+        self.viewer.show_curvature()
+
+    def _on_view_clicked(self, x: float, y: float) -> None:
+        scene = self.scene
+        vertex = scene.vertex_at_display(x, y) if scene is not None else None
+        if vertex is not None:
+            self.pick_vertex(vertex)
+
+    def _on_job_changed(self, _job: Job) -> None:
         running = self.model.jobs.running
         self.progress.setVisible(running is not None)
         self.cancel_button.setVisible(running is not None)
@@ -451,190 +407,6 @@ class MainWindow(QtWidgets.QMainWindow):
             stage = running.stage if len(running.stage) <= 20 else running.stage[:19] + "…"
             self.progress.setFormat(f"{stage} %p %{more}")  # as in the Computations list
             self.progress.setToolTip(f"{running.description}: {running.stage}")
-            if job is running and job.stage == "starting":
-                self.statusBar().showMessage(self._starting_message(job))
-
-    def _starting_message(self, job: Job) -> str:
-        """ "Computing ...", after the preview shown before it (with its estimated error)
-        or with the reason a big request gets no preview; after an Esc that left other
-        requests queued, first what it cancelled."""
-        key = getattr(job, "spectrum_key", None)
-        preview = getattr(job, "preview_job", False)
-        text = f"Computing {job.description}..."
-        if key is not None and preview is None:
-            note = self.model.no_preview_note(key)
-            if note:
-                text = f"Computing {job.description}; {note}."
-        elif preview and preview.status == DONE:
-            error = percent_text(preview.result[0].estimated_error)
-            text = f"Preview shown (estimated error {error}); computing the exact spectrum..."
-        note, self._cancel_note = self._cancel_note, ""
-        return f"{note}. {text}" if note else text
-
-    def _on_job_finished(self, job: Job) -> None:
-        result = job.result
-        spectrum = isinstance(result, tuple) and result and isinstance(result[0], Spectrum)
-        if job.status == DONE and not spectrum:
-            # a repair (whose own callback then shows its report) or other work
-            self.statusBar().showMessage(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
-        elif job.status == DONE:
-            spec = result[0]
-            quality = (
-                f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
-                if spec.is_preview
-                else residual_text(spec)
-            )
-            self.statusBar().showMessage(
-                f"{job.description} in {job.seconds:.1f} s; {quality}.", 15000
-            )
-        elif job.status == "failed":
-            log.error("computation failed: %s\n%s", job.error, job.details)
-            key = getattr(job, "spectrum_key", None)
-            mesh = self.state.mesh
-            if (
-                key is not None
-                and mesh is not None
-                and job.owner == mesh.hash
-                and repair_for_failure(job.error) == "fix_slivers"
-            ):
-                self._offer_sliver_fix(job, key)
-            else:
-                self.show_error(f"The computation failed: {job.error}", "Computation failed")
-        elif job.status == "cancelled":
-            self.statusBar().showMessage(f"{job.description}: {job.error or 'cancelled'}.", 5000)
-
-    # =============================================================== modes
-    def show_mode(self, index: int, operator: str | None = None) -> None:
-        """Colour the surface by mode ``index`` (of ``operator``, default: the spectrum
-        shown or last computed)."""
-        op = operator or self.current_operator
-        if op is None or self.state.spectrum(op) is None:
-            return
-        self.state.show_mode(index, op)
-
-    def _show_current_mode(self) -> None:
-        """Back to the mode last shown (M), or the first non-zero mode."""
-        d = self.state.display
-        op = d.operator if self.state.spectrum(d.operator) is not None else self.current_operator
-        if op is not None:
-            mode = d.mode if op == d.operator else self.state.first_nonzero_mode(op)
-            self.show_mode(mode, op)
-
-    def set_animating(self, on: bool) -> None:
-        self.state.set_animation(playing=on)
-
-    def animation_frame(self, phase: float) -> float:
-        """Move the surface to the given phase (radians); returns the app's time in s."""
-        return self.scene_view.animation_frame(phase)
-
-    # ============================================================ distances
-    def _on_view_clicked(self, x: float, y: float) -> None:
-        scene = self.scene
-        if scene is None:
-            return
-        vertex = scene.vertex_at_display(x, y)
-        if vertex is not None:
-            self.pick_vertex(vertex)
-
-    def pick_file_vertex(self, number: int) -> None:
-        """Pick vertex ``number`` of the mesh file (the number the viewer shows, as
-        ``distance --vertex`` takes it); an error message for one no face uses."""
-        if self.state.mesh is None:
-            return
-        try:
-            index = self.state.mesh.mesh_vertex(number)
-        except ValueError as exc:
-            self.show_error(str(exc))
-            return
-        self.pick_vertex(index)
-
-    def pick_vertex(self, index: int) -> None:
-        """Pick mesh vertex ``index`` (as a click on it does): marker and distance map.
-        ``index`` is the loaded mesh's (compact) index; see :meth:`pick_file_vertex`."""
-        if self.state.mesh is None:
-            return
-        try:
-            self.state.set_pick(index)
-        except ValueError as exc:
-            self.show_error(str(exc))
-            return
-        self.show_distance()
-
-    def show_distance(
-        self, kind: str | None = None, display: str | None = None, threshold: float | None = None
-    ) -> np.ndarray | None:
-        """Distance map from the picked vertex.
-
-        kind: "vibration" | "feature" | "hks"; display: "continuous" | "threshold";
-        threshold: as a fraction of the largest distance (0..1).  A missing spectrum is
-        computed in the background; the map appears when it is ready (unless the
-        display was changed meanwhile).
-        """
-        changes = {}
-        if kind is not None:
-            changes["distance_kind"] = kind
-        if display is not None:
-            changes["distance_display"] = display
-        if threshold is not None:
-            changes["threshold"] = float(threshold)
-        if changes:
-            self.state.set_display(**changes)
-        if self.state.mesh is None:
-            return None
-        if self.state.picked is None:
-            self.statusBar().showMessage("Click the surface to pick a vertex first.", 5000)
-            return None
-        kind = self.state.display.distance_kind
-        operator = operator_for_distance(kind)
-        if self.state.spectrum(operator) is None:
-            job = self._request(operator, None, show=False)
-            if job is not None:
-                before = self.state.display
-
-                def show_when_ready(j: Job) -> None:
-                    if j.status == DONE and self.state.display == before:
-                        self.state.set_display(kind="distance")
-
-                preview = getattr(job, "preview_job", None)
-                if preview is not None:  # the map from the preview first
-                    preview.then(show_when_ready)
-                job.then(show_when_ready)
-                note = self._long_wait_note(job)
-                self.statusBar().showMessage(
-                    f"Computing the spectrum for the {DISTANCE_KINDS[kind].lower()}"
-                    + (f"; {note}." if note else "...")
-                )
-            return None
-        self.state.set_display(kind="distance")
-        return self.state.derived.distance_map()
-
-    def distance_map(self, kind: str) -> np.ndarray | None:
-        """Distance of ``kind`` from the picked vertex, or None if its spectrum is missing."""
-        return self.state.derived.distance_map(kind)
-
-    def set_threshold(self, fraction: float) -> float:
-        """Move the threshold (fraction of the largest distance); returns the app's time in s."""
-        import time
-
-        started = time.perf_counter()
-        self.state.set_display(threshold=float(fraction))
-        return time.perf_counter() - started
-
-    def show_signature(self, sample: int) -> None:
-        """Colour by the signature at scale sample ``sample`` of the distance kind's spectrum."""
-        operator = operator_for_distance(self.state.display.distance_kind)
-        if not self.state.derived.has_signatures(operator):
-            self.statusBar().showMessage(
-                f"Compute the {OPERATOR_INFO[operator].label} spectrum first (with non-zero "
-                "modes).",
-                5000,
-            )
-            return
-        self.state.set_display(kind="signature", signature_sample=int(sample))
-
-    def show_curvature(self) -> None:
-        if self.state.mesh is not None:
-            self.state.set_display(kind="curvature")
 
     # ========================================================= shape pair
     def open_second_mesh(self, path, wait: bool = True, k: int | None = None) -> PairWindow:
@@ -654,42 +426,23 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.state.mesh is None:
             self.show_error("Open a mesh first.")
             return None
-        needed = [operator_for_distance(i) if i in DISTANCE_KINDS else i for i in items]
-        missing = [op for op in dict.fromkeys(needed) if self.state.spectrum(op) is None]
+        missing = self.viewer.missing_for(items)
         if missing and not wait:
-            k = self.state.compute_settings.k
-            n = self.state.mesh.n_vertices
-            settings_ = self.state.compute_settings
-            total = sum(cost_estimate(settings_.key(op), n)[0] for op in missing)
             names = ", ".join(OPERATOR_INFO[op].label for op in missing)
             question = (
-                f"The comparison needs {names} ({k} modes each; at least "
-                f"{max(total, 1):.0f} s on an idle machine). "
-                "Compute now? The main view is not changed."
+                f"The comparison needs {names} ({self.state.compute_settings.k} modes each; "
+                f"at least {max(self.viewer.comparison_cost(missing), 1):.0f} s on an idle "
+                "machine). Compute now? The main view is not changed."
             )
-            if not ask(self, "Compare", question, default_yes=True):  # asked for by the menu
+            if not ask(self, "Compare", question, default_yes=True):
                 return None
-        jobs = [self._request(op, None, show=False) for op in missing]
-        if any(job is None for job in jobs):
+        items = list(items)
+        if not wait:
+            self.viewer.prepare_comparison(
+                items, wait=False, then=lambda: self._show_comparison(items)
+            )
             return None
-        if missing and not wait:
-            pending = {job.id for job in jobs}
-            items = list(items)
-
-            def open_when_ready(j: Job) -> None:
-                pending.discard(j.id)
-                if j.status != DONE:
-                    pending.clear()
-                elif not pending and all(x.status == DONE for x in jobs):
-                    self._show_comparison(items)
-
-            for job in jobs:
-                job.then(open_when_ready)
-            return None
-        for job in jobs:
-            self.wait_for(job)
-            if job.status != DONE:
-                raise ComputeError(job.error or job.status)
+        self.viewer.prepare_comparison(items, wait=True)
         return self._show_comparison(items)
 
     def _show_comparison(self, items) -> CompareWindow:
@@ -700,56 +453,31 @@ class MainWindow(QtWidgets.QMainWindow):
         self.compare.refresh()
         return self.compare
 
-    # ============================================================== export
-    def export_screenshot(
-        self, path, scale: int = 1, transparent: bool = False, colorbar: bool | None = None
-    ) -> Path:
-        """Save the view as PNG (atomically); returns the path.  ``colorbar``: include
-        the colour bar and legend (None: as on screen)."""
-        if colorbar is not None:
-            self.state.set_colorbar(colorbar)
-        return save_screenshot(
-            self.viewport, Path(path), scale=scale, transparent=transparent, scene=self.scene
-        )
+    # ===================================================== export, repairs
+    def export_screenshot(self, path, scale: int = 1, transparent: bool = False, colorbar=None):
+        """:meth:`Viewer.export_screenshot <modalviewer.viewer.Viewer.export_screenshot>`
+        of this window's view."""
+        return self.viewer.export_screenshot(path, scale, transparent, colorbar)
 
-    def current_field(self) -> tuple[str, np.ndarray] | None:
-        """(name, per-vertex values) of what the surface shows, or None without a mesh."""
-        scene = self.scene
-        if scene is None:
-            return None
-        return (scene.field_name or "field"), np.array(scene.surface.point_data["field"])
+    def current_field(self):
+        return self.viewer.current_field()
 
     def export_field(self, path) -> Path:
-        field = self.current_field()
-        if field is None:
-            raise ValueError("nothing to export: open a mesh first")
-        name, values = field
-        return save_field_mesh(Path(path), self.state.mesh, {name: values})
+        return self.viewer.export_field(path)
 
-    # ============================================================ repairs
     def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
-        """Apply repair ``name`` ("fix_slivers", "largest_component") to the loaded mesh in
-        the background; the repaired mesh replaces it and its report is shown."""
         try:
-            job = self.model.repair(name)
+            return self.viewer.repair_mesh(name, wait)
         except ValueError as exc:
             self.show_error(str(exc))
             return None
-        job.then(self._on_repaired)
-        if not wait:
-            return None
-        self.wait_for(job)
-        if job.status != DONE:
-            raise ComputeError(job.error or job.status)
-        return job.result
 
-    def _offer_sliver_fix(self, job: Job, key: SpectrumKey) -> None:
-        """The failure of ``key`` on sliver triangles, with a "Fix slivers and retry"
-        button (the default); without dialogs, :meth:`fix_slivers_and_retry` does it."""
-        self.sliver_failure = key
-        message = f"The computation failed: {job.error}"
-        self.last_error = message
-        log.warning("%s", message)
+    def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
+        return self.viewer.fix_slivers_and_retry(key, wait)
+
+    def _offer_sliver_fix(self, key: SpectrumKey, message: str) -> None:
+        """A failure on sliver triangles, with a "Fix slivers and retry" button (the
+        default)."""
         self.statusBar().showMessage(message, 10000)
         if os.environ.get("MODALVIEWER_NO_DIALOGS"):
             return
@@ -761,87 +489,27 @@ class MainWindow(QtWidgets.QMainWindow):
             ("Fix slivers and retry", lambda: self.fix_slivers_and_retry(key)),
         )
 
-    def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
-        """Fix the loaded mesh's slivers (as Mesh > Fix slivers), show the repair's report
-        and request again the spectrum ``key`` (default: the last one whose factorisation
-        failed on slivers).  Without pymeshlab a dialog says how to install it.  Returns
-        the repair job (None if none started); with ``wait`` also waits for the spectrum
-        and returns it."""
-        key = key or self.sliver_failure
-        if key is None:
-            self.statusBar().showMessage("No computation failed on sliver triangles.", 5000)
-            return None
-        missing = repair_unavailable("fix_slivers")
-        if missing:
-            self.show_error(missing, "Fix slivers")
-            return None
-        try:
-            job = self.model.repair("fix_slivers")
-        except ValueError as exc:
-            self.show_error(str(exc))
-            return None
-        retried: list[Job | None] = []
-
-        def retry(j: Job) -> None:
-            # a failed repair is shown as any failed job (_on_job_finished)
-            if j.status != DONE or self.state.mesh is not j.result:
-                return  # failed, cancelled, or another mesh was opened meanwhile
-            self.sliver_failure = None
-            self.show_info(
-                f"{j.result.report}\n\nComputing {key.describe()} again...", "Slivers fixed"
-            )
-            self.state.set_compute_settings(operator=key.operator, k=key.k)
-            retried.append(self._request(key.operator, key.k, show=True))
-
-        job.then(retry)
-        if not wait:
-            return job
-        self.wait_for(job)
-        if job.status != DONE or not retried:
-            raise ComputeError(job.error or job.status)
-        return self._run(retried[0], wait=True)
-
-    def _on_repaired(self, job: Job) -> None:
-        if job.status == DONE:
-            self.statusBar().showMessage(str(job.result.report), 20000)
-        elif job.status == "failed":
-            self.show_error(f"{job.description} failed: {job.error}", "Repair failed")
-
-    # =============================================================== cache
     def clear_cache(self) -> int:
-        """Delete every cached spectrum; returns the bytes freed."""
-        size = self.cache.clear()
-        self.statusBar().showMessage(f"Cache cleared: {size / 2**20:.0f} MB freed.", 8000)
-        return size
+        return self.viewer.clear_cache()
 
     # ============================================================ sessions
     def save_session(self, path) -> Path:
-        """Write the session (mesh, spectra, display, pick, camera) to a JSON file."""
-        from ..viewer.session import save_session
-
-        self.state.camera = self.scene_view.current_camera()
-        return save_session(self.state, path)
+        return self.viewer.save_session(path)
 
     def open_session(self, path, wait: bool = True) -> list[str]:
-        """Restore a session; returns the notes on what could not be restored as saved.
-
-        With ``wait`` the call returns once every spectrum is loaded or recomputed and
-        the picture is drawn."""
-        from ..viewer.session import SessionError, restore_session
+        """Restore a session (:meth:`Viewer.open_session
+        <modalviewer.viewer.Viewer.open_session>`); a file that cannot be restored is
+        reported and its message returned as the only note."""
+        from ..viewer.session import SessionError
 
         try:
-            restored = restore_session(self.model, path)
+            notes = self.viewer.open_session(path, wait)
         except (SessionError, MeshError, OSError) as exc:
             self.show_error(f"Cannot open the session: {exc}", "Cannot open session")
             return [str(exc)]
         if self.state.mesh_path is not None and self.remember_settings:
             window_settings.remember_file(self, Path(self.state.mesh_path).resolve())
-        if wait:
-            for job in restored.jobs:
-                self.wait_for(job)
-        if restored.notes:
-            self.statusBar().showMessage("; ".join(restored.notes), 15000)
-        return restored.notes
+        return notes
 
     # ==================================================== read-only views
     @property
@@ -854,16 +522,11 @@ class MainWindow(QtWidgets.QMainWindow):
 
     @property
     def spectra(self) -> dict[str, Spectrum]:
-        """The latest spectrum of each computed operator (a copy; the state owns them)."""
-        return {op: self.state.spectrum(op) for op in self.state.operators_computed()}
+        return self.viewer.spectra
 
     @property
     def current_operator(self) -> str | None:
-        """The operator of the mode shown, else the one chosen in the Modes panel."""
-        d = self.state.display
-        if d.kind == "mode":
-            return d.operator
-        return self.modes_panel.spectrum_combo.currentData()
+        return self.viewer.current_operator
 
     @property
     def display(self) -> str:
@@ -874,8 +537,20 @@ class MainWindow(QtWidgets.QMainWindow):
         return self.state.picked
 
     @property
-    def last_distance(self) -> np.ndarray | None:
-        return self.state.derived.distance_map() if self.state.display.kind == "distance" else None
+    def last_distance(self):
+        return self.viewer.last_distance
+
+    @property
+    def last_error(self) -> str | None:
+        return self.viewer.last_error
+
+    @last_error.setter
+    def last_error(self, message: str | None) -> None:
+        self.viewer.last_error = message
+
+    @property
+    def sliver_failure(self) -> SpectrumKey | None:
+        return self.viewer.sliver_failure
 
     @property
     def frame_times(self) -> list[float]:

@@ -105,7 +105,7 @@ def build_menus(win) -> None:
     ]
     let_shortcuts_through(win, steps)
     _action(win, m, "Play / pause animation", win.toggle_animation, "P")
-    _action(win, m, "Show &mode", win._show_current_mode, "M")
+    _action(win, m, "Show &mode", win.viewer.show_current_mode, "M")
     _action(win, m, "Show &distance", lambda: win.show_distance(), "D")
     _action(win, m, "Show &curvature sqrt(k1^2 + k2^2)", win.show_curvature, "C")
     win.colorbar_action = _action(

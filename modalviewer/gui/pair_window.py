@@ -29,11 +29,12 @@ from ..core.laplacian import vertex_normals
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
+from ..scene.mesh_scene import MeshScene
 from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairState, PairView
+from ..viewer.viewer import LONG_WAIT_SECONDS
 from .dialogs import file_message, offer_open_anyway
-from ..scene.mesh_scene import MeshScene
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
 
@@ -500,10 +501,11 @@ class PairWindow(QtWidgets.QWidget):
         key = self.pair.key()
         missing = [s for s in SIDES if self.pair.spectrum(s) is None]
         seconds = sum(cost_estimate(key, self.pair.mesh(s).n_vertices)[0] for s in missing)
-        if missing and seconds > 300:
+        if missing and seconds > LONG_WAIT_SECONDS:
+            about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
             self.status.setText(
                 f"Computing the {operator_info(key.operator).label} spectra of both meshes "
-                f"takes about {seconds / 60:.0f} min (Cancel stops it)."
+                f"takes about {about} (Cancel stops it)."
             )
         jobs = self.pair.request()
         self._on_jobs()

@@ -21,8 +21,14 @@ def _check_folder(path: Path) -> None:
         raise OSError(f"the folder {folder} is not writable; choose another one")
 
 
-def grab(plotter, scene=None, scale: int = 1, transparent: bool = False,
-         legend: bool = True, colorbar: bool | None = None) -> np.ndarray:
+def grab(
+    plotter,
+    scene=None,
+    scale: int = 1,
+    transparent: bool = False,
+    legend: bool = True,
+    colorbar: bool | None = None,
+) -> np.ndarray:
     """The plotter's view rendered at ``scale`` times its size, (h, w, 3 or 4) uint8.
 
     The scene's legend (if ``legend`` and the scene has one) and colour bar (as shown on

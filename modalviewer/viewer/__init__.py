@@ -1,17 +1,24 @@
-"""The viewer's state, jobs and sessions, without Qt or VTK (``gui`` observes them)."""
+"""The viewer without a window: :class:`Viewer` (the scripting API the windows, the command
+line and notebooks share), its state, jobs and sessions.  No Qt and no VTK here: pictures
+are drawn by ``modalviewer.scene``, windows in ``modalviewer.gui`` observe the state."""
 
-from .jobs import Job, JobQueue, ManualDispatcher
+from .jobs import Job, JobQueue, ManualDispatcher, RepairJob, SpectrumJob
 from .model import ComputeRefused, ViewerModel
 from .state import ComputeSettings, Display, SpectrumKey, ViewerState
+from .viewer import ComputeError, Viewer
 
 __all__ = [
+    "ComputeError",
     "ComputeRefused",
     "ComputeSettings",
     "Display",
     "Job",
     "JobQueue",
     "ManualDispatcher",
+    "RepairJob",
+    "SpectrumJob",
     "SpectrumKey",
     "ViewerModel",
     "ViewerState",
+    "Viewer",
 ]

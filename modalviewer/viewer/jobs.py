@@ -75,13 +75,11 @@ class Job:
         """Ask the job to stop; a queued job is dropped when its turn comes."""
         self._cancel.set()
 
-    @classmethod
-    def ended(cls, result, key: Hashable, description: str, owner: Hashable = None) -> Job:
-        """A job that has ended already with ``result`` (a request answered at once)."""
-        job = cls(None, key, description, owner)
-        job.status, job.stage, job.fraction, job.result = DONE, "done", 1.0, result
-        job._done.set()
-        return job
+    def end_now(self, result) -> Job:
+        """Mark this (never queued) job ended with ``result``: a request answered at once."""
+        self.status, self.stage, self.fraction, self.result = DONE, "done", 1.0, result
+        self._done.set()
+        return self
 
     def then(self, callback: Callable[[Job], None]) -> Job:
         """Call ``callback(job)`` on the owner's thread once the job has ended (at once
@@ -95,6 +93,43 @@ class Job:
     def join(self, timeout: float | None = None) -> bool:
         """Block until the worker thread has finished (not until callbacks ran)."""
         return self._done.wait(timeout)
+
+
+class SpectrumJob(Job):
+    """A job computing (or loading) the spectrum ``spectrum_key`` of the loaded mesh; its
+    result is ``(Spectrum, SignatureTable or None)``.
+
+    ``preview_job``: the preview computed first for the same request (the exact
+    spectrum follows it), or None; ``is_preview``: this job computes a preview."""
+
+    def __init__(
+        self,
+        fn: Callable | None,
+        key: Hashable,
+        description: str,
+        owner: Hashable,
+        spectrum_key,
+        preview_job: SpectrumJob | None = None,
+        is_preview: bool = False,
+    ):
+        super().__init__(fn, key, description, owner)
+        self.spectrum_key = spectrum_key
+        self.preview_job = preview_job
+        self.is_preview = is_preview
+
+    @property
+    def spectrum(self):
+        """The spectrum once the job is done, else None."""
+        return self.result[0] if self.status == DONE and self.result else None
+
+
+class RepairJob(Job):
+    """A job applying the repair ``repair`` (a name of ``modalviewer.viewer.model.REPAIRS``)
+    to a mesh; its result is the repaired Mesh."""
+
+    def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable, repair: str):
+        super().__init__(fn, key, description, owner)
+        self.repair = repair
 
 
 class JobEvents(SignalGroup):
@@ -136,18 +171,16 @@ class JobQueue:
         self.jobs: list[Job] = []  # queued and running, in order
 
     # -------------------------------------------------------------- public
-    def submit(
-        self, fn: Callable, key: Hashable, description: str, owner: Hashable = None, **attributes
-    ) -> Job:
-        """Queue ``fn``; an identical queued or running request is returned instead.
-        ``attributes`` are set on a new job before it can start (its observers see them
-        from its first event on)."""
-        for job in self.jobs:
-            if job.key == key and not job.cancel_requested:
-                return job
-        job = Job(fn, key, description, owner)
-        for name, value in attributes.items():
-            setattr(job, name, value)
+    def submit(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None) -> Job:
+        """Queue ``fn`` as a plain :class:`Job`; see :meth:`add`."""
+        return self.add(Job(fn, key, description, owner))
+
+    def add(self, job: Job) -> Job:
+        """Queue ``job``; an identical queued or running request (same ``key``) is
+        returned instead, and ``job`` is dropped."""
+        for queued in self.jobs:
+            if queued.key == job.key and not queued.cancel_requested:
+                return queued
         self.jobs.append(job)
         self.events.changed.emit(job)
         self._start_next()

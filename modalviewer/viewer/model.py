@@ -23,7 +23,7 @@ from ..core.operators import OPERATOR_INFO, operator_info
 from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
-from .jobs import DONE, Job, JobQueue
+from .jobs import DONE, Job, JobQueue, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
@@ -92,11 +92,14 @@ class ViewerModel:
         if name not in REPAIRS:
             raise ValueError(f"unknown repair {name!r}; choose one of {', '.join(REPAIRS)}")
         mesh, path, done = state.mesh, state.mesh_path, list(state.mesh_repairs)
-        job = self.jobs.submit(
-            lambda progress, cancel: repair_in_process(name, mesh, progress, cancel),
-            ("repair", mesh.hash, name),
-            REPAIRS[name],
-            mesh.hash,
+        job = self.jobs.add(
+            RepairJob(
+                lambda progress, cancel: repair_in_process(name, mesh, progress, cancel),
+                ("repair", mesh.hash, name),
+                REPAIRS[name],
+                mesh.hash,
+                repair=name,
+            )
         )
 
         def replace_mesh(j: Job) -> None:
@@ -131,7 +134,7 @@ class ViewerModel:
 
     def request_spectrum(
         self, operator: str | None = None, k: int | None = None, show: bool = False
-    ) -> Job:
+    ) -> SpectrumJob:
         """A job computing (or loading from the cache) ``operator``'s spectrum.
 
         Uses the current compute settings for what is not given.  If the spectrum is
@@ -146,8 +149,8 @@ class ViewerModel:
         key = state.compute_settings.key(operator, k)
         display_at_request = state.display
         if state.has_spectrum(key):
-            job = Job.ended((state.spectra[key], None), key, key.describe(), state.mesh.hash)
-            job.spectrum_key = key
+            job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
+            job.end_now((state.spectra[key], None))
             if show and state.display_operator() != key.operator:
                 # asked again for the spectrum on screen: the mode or map stays
                 self._show_first_mode(key.operator)
@@ -156,25 +159,23 @@ class ViewerModel:
         if refusal:
             raise ComputeRefused(refusal)
         if self._wants_preview(key):
-            preview = self.jobs.submit(
-                self._work(key, preview=True),
-                (state.mesh.hash, key, "preview"),
-                f"preview of {key.describe()}",
-                state.mesh.hash,
-                spectrum_key=key,
+            preview = self.jobs.add(
+                SpectrumJob(
+                    self._work(key, preview=True),
+                    (state.mesh.hash, key, "preview"),
+                    f"preview of {key.describe()}",
+                    state.mesh.hash,
+                    key,
+                    is_preview=True,
+                )
             )
             if show:
                 preview.then(self._shower(key, display_at_request))
         else:
             preview = None
         work = self._work(key)
-        job = self.jobs.submit(
-            work,
-            (state.mesh.hash, key),
-            key.describe(),
-            state.mesh.hash,
-            spectrum_key=key,
-            preview_job=preview,
+        job = self.jobs.add(
+            SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key, preview)
         )
         # while it runs, behind a preview (this request's, or one kept from an earlier
         # request whose exact computation was cancelled) the exact spectrum follows
@@ -200,9 +201,10 @@ class ViewerModel:
         running = self.jobs.running
         if running is None:
             return
-        key = getattr(running, "spectrum_key", None)
+        key = running.spectrum_key if isinstance(running, SpectrumJob) else None
         for job in list(self.jobs.jobs):
-            if job is running or (key is not None and getattr(job, "spectrum_key", None) == key):
+            same = key is not None and isinstance(job, SpectrumJob) and job.spectrum_key == key
+            if job is running or same:
                 self.jobs.cancel(job)
 
     def _wants_preview(self, key: SpectrumKey) -> bool:
@@ -284,8 +286,10 @@ class ViewerModel:
 
     def _on_job_finished(self, job: Job) -> None:
         mesh = self.state.mesh
-        key = getattr(job, "spectrum_key", None)
-        if job.status != DONE or key is None or mesh is None or job.owner != mesh.hash:
+        if not isinstance(job, SpectrumJob):
+            return
+        key = job.spectrum_key
+        if job.status != DONE or mesh is None or job.owner != mesh.hash:
             return
         spec, table = job.result
         if not self.state.has_spectrum(key) or self.state.spectra[key] is not spec:

@@ -36,7 +36,7 @@ from ..core.laplacian import lumped_masses
 from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
 from ..core.spectrum import Spectrum
-from .jobs import CANCELLED, DONE, Job, JobQueue
+from .jobs import CANCELLED, DONE, Job, JobQueue, SpectrumJob
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
     DISTANCE_DISPLAYS,
@@ -293,11 +293,14 @@ class PairState:
             job = self._pending.get(slot)
             if job is None or job.done:
                 self._failed.pop(slot, None)
-                job = self.jobs.submit(
-                    self._work(side, key),
-                    (s.mesh.hash, key),
-                    f"{key.describe()} of {side.upper()} ({s.name})",
-                    self.owner(side),
+                job = self.jobs.add(
+                    SpectrumJob(
+                        self._work(side, key),
+                        (s.mesh.hash, key),
+                        f"{key.describe()} of {side.upper()} ({s.name})",
+                        self.owner(side),
+                        key,
+                    )
                 )
                 self._pending[slot] = job
                 job.then(lambda j, slot=slot: self._on_job(slot, j))

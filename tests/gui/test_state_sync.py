@@ -185,7 +185,7 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     assert "feature distance" in second.status_line.text()
     # M shows the mode last shown before the distance, as before the restart
     assert second.modes_panel.mode_spin.value() == 7
-    second._show_current_mode()
+    second.viewer.show_current_mode()
     assert second.state.display.kind == "mode" and second.state.display.mode == 7
     second.close()
 
@@ -275,7 +275,7 @@ def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
     assert window.open_mesh(path)
     assert window.mesh.n_components == 3
     errors = []
-    window.show_error = lambda *args, **kwargs: errors.append(args)
+    window.viewer.events.error.connect(lambda *args: errors.append(args))
     window.repair_mesh("largest_component", wait=False)
     job = window.model.jobs.jobs[-1] if window.model.jobs.jobs else None
     qtbot.waitUntil(lambda: window.mesh.n_components == 1, timeout=30000)
@@ -484,9 +484,9 @@ def test_a_click_that_starts_a_long_computation_says_how_long(window, spot_path,
     """Found under Xvfb: a click with the default vibration distance started a 3D
     shells computation of 40 s or more at 130k vertices with only "Computing ..." on
     screen (the long-wait note came from 5 min on and was overwritten)."""
-    from modalviewer.gui import main_window
+    from modalviewer.viewer import viewer
 
-    monkeypatch.setattr(main_window, "LONG_WAIT_SECONDS", 0.0)
+    monkeypatch.setattr(viewer, "LONG_WAIT_SECONDS", 0.0)
     window.open_mesh(spot_path)
     window.state.set_display(distance_kind="vibration")
     window.pick_vertex(100)

@@ -1,0 +1,64 @@
+"""A comparison (:class:`~modalviewer.viewer.comparison.Comparison`) drawn off screen:
+its views side by side in one image, each captioned with its title, all seen by the
+same camera (the mesh's canonical first view unless one is given)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .export import grab, save_png, side_by_side
+from .mesh_scene import MeshScene
+from .offscreen import offscreen_plotter
+from .view import draw_field
+
+VIEW_SIZE = (480, 480)
+"""Pixels of each view unless a size is given."""
+
+
+def caption(img: np.ndarray, text: str) -> np.ndarray:
+    """``img`` with ``text`` written in a white band above it."""
+    from PIL import Image, ImageDraw
+
+    from .overlay import FONT_PX, _font, wrap_text
+
+    width = img.shape[1]
+    probe = ImageDraw.Draw(Image.new("RGB", (1, 1)))
+    font = _font(FONT_PX)
+    text = wrap_text(text, lambda t: probe.textlength(t, font=font), width - 16)
+    lines = text.count("\n") + 1
+    band = Image.new("RGB", (width, int(lines * FONT_PX * 1.35 + 12)), "white")
+    ImageDraw.Draw(band).multiline_text((8, 6), text, fill="black", font=font)
+    rgb = np.asarray(band)
+    if img.shape[2] == 4:
+        rgb = np.dstack([rgb, np.full(rgb.shape[:2], 255, np.uint8)])
+    return np.vstack([rgb, img])
+
+
+def comparison_images(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -> list:
+    """One captioned image per view of ``comparison`` (``camera``: a
+    :class:`~modalviewer.viewer.camera.Camera`, default the mesh's canonical view)."""
+    state = comparison.state
+    images = []
+    for view in comparison.views():
+        plotter = offscreen_plotter(size)
+        try:
+            scene = MeshScene(plotter, state.mesh, state.derived.normals, style=state.style.render)
+            draw_field(scene, view.field)
+            scene.show_marker(view.marker)
+            scene.set_camera(camera or scene.canonical_camera())
+            images.append(caption(grab(plotter, scene, scale=scale), view.title))
+        finally:
+            plotter.close()
+    return images
+
+
+def comparison_image(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -> np.ndarray:
+    """The views of ``comparison`` side by side (see :func:`comparison_images`)."""
+    return side_by_side(comparison_images(comparison, size, camera, scale), gap=4 * scale)
+
+
+def save_comparison(comparison, path, size=VIEW_SIZE, camera=None, scale: int = 1) -> Path:
+    """Write :func:`comparison_image` to a PNG atomically; returns its path."""
+    return save_png(path, comparison_image(comparison, size, camera, scale))

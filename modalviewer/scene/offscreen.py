@@ -1,0 +1,81 @@
+"""The viewer's picture without a window: a :class:`~.view.StateScene` on an off-screen
+pyvista plotter (EGL where there is no display, no Qt).
+
+:meth:`modalviewer.viewer.Viewer.export_screenshot` uses it when no window shows the
+viewer, and so do ``modalviewer render``, ``modalviewer distance -o`` and
+``modalviewer figures``: the same surface, colours, isolines, legend, colour bar and
+first camera as the window.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .platform import prepare_offscreen
+from .view import StateScene
+
+DEFAULT_SIZE = (1024, 768)
+"""Pixels of an off-screen picture unless a size is given."""
+
+
+def offscreen_plotter(size=DEFAULT_SIZE):
+    """A white-background pyvista plotter rendering off screen, ready to render."""
+    prepare_offscreen()
+    import pyvista as pv
+
+    from .mesh_scene import view_angle_on_smaller_side
+
+    plotter = pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])
+    plotter.set_background("white")
+    renderer = plotter.renderer
+    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))
+    return plotter
+
+
+class OffscreenRenderer:
+    """Draws ``state`` off screen at ``size`` pixels; follows the state as a window does
+    (a new mesh gets the canonical first view)."""
+
+    def __init__(self, state, size=DEFAULT_SIZE):
+        self.state = state
+        self.plotter = offscreen_plotter(size)
+        self.drawing = StateScene(state, self.plotter)
+        if state.mesh is not None:  # the state's present, as a window opened now shows it
+            self.drawing.sync()
+
+    @property
+    def scene(self):
+        return self.drawing.scene
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return tuple(int(x) for x in self.plotter.window_size)
+
+    def resize(self, size) -> None:
+        """Change the picture's size; the camera is fitted again if the mesh was in view."""
+        size = (int(size[0]), int(size[1]))
+        if size != self.size:
+            self.plotter.window_size = list(size)
+            self.drawing.reset_camera()
+
+    def image(self, scale: int = 1, transparent: bool = False, colorbar: bool | None = None):
+        """The picture as an (h, w, 3 or 4) uint8 array, legend and colour bar drawn on."""
+        from .export import grab
+
+        return grab(
+            self.plotter, self.scene, scale=scale, transparent=transparent, colorbar=colorbar
+        )
+
+    def screenshot(
+        self, path, scale: int = 1, transparent: bool = False, colorbar: bool | None = None
+    ) -> Path:
+        """Write the picture to a PNG (atomically); returns its path."""
+        from .export import save_png
+
+        return save_png(path, np.ascontiguousarray(self.image(scale, transparent, colorbar)))
+
+    def close(self) -> None:
+        self.drawing.close()
+        self.plotter.close()

@@ -1,0 +1,263 @@
+"""The 3D picture of the viewer state: draws ``state.derived.field()``, the pick, the legend.
+
+:class:`StateScene` observes a :class:`~modalviewer.viewer.state.ViewerState` and keeps
+nothing the state does not say, except VTK objects.  It draws on any pyvista plotter:
+the window's view (``modalviewer.gui.scene_view`` adds the animation clock) and the
+off-screen plotter of :class:`~.offscreen.OffscreenRenderer` run the same code, so an
+export from a script shows what the window shows.  Only the thread that owns the
+plotter runs it.  No Qt.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from ..viewer import wording
+from ..viewer.derived import Field
+from ..viewer.state import ViewerState
+from .mesh_scene import MeshScene
+
+
+def draw_field(scene: MeshScene, field: Field | None) -> None:
+    """Colour ``scene``'s surface by ``field`` (None or "plain": the grey surface); no
+    render.  The one way a :class:`~modalviewer.viewer.derived.Field` becomes a picture,
+    in the main view, the compare views and off screen."""
+    if field is None or field.colormap == "plain":
+        scene.show_plain()
+    elif field.colormap == "threshold":
+        scene.show_threshold(field.values, field.threshold, name=field.title)
+    else:
+        scene.show_field(
+            field.values,
+            field.colormap,
+            clim=field.clim,
+            isolines=field.isolines,
+            displacement=field.displacement,
+            name=field.title,
+        )
+
+
+class StateScene:
+    """Keeps a :class:`MeshScene` on ``plotter`` in step with ``state``.
+
+    ``request_render()`` is called after every change (the window's view schedules a
+    repaint; off screen nothing is needed, an export renders).  ``on_animation`` is
+    called when the state starts or stops the animation (the window runs its clock)."""
+
+    def __init__(self, state: ViewerState, plotter, request_render=None, on_animation=None):
+        self.state = state
+        self.plotter = plotter
+        self.request_render = request_render or (lambda: None)
+        self.on_animation = on_animation
+        self.scene: MeshScene | None = None
+        self.field: Field | None = None
+        self.outline_actor = None
+        self._drawn = None  # (display, style, pick, spectra ids) the picture was drawn for
+        state.events.mesh.connect(self._on_mesh)
+        state.events.display.connect(self.redraw)
+        state.events.style.connect(self.redraw)
+        state.events.pick.connect(self._on_pick)
+        state.events.animation.connect(self._on_animation)
+        state.events.camera.connect(self._apply_camera)
+
+    # -------------------------------------------------------------- mesh
+    def sync(self) -> None:
+        """Draw the state as it is now (a scene attached to a state already in use): the
+        mesh in its first view, then the field, the pick and a camera the state sets."""
+        self._on_mesh()
+        self.redraw()
+        self._on_pick()
+        self._apply_camera()
+
+    def close(self) -> None:
+        """Stop observing the state and drop the actors."""
+        events = self.state.events
+        for event, slot in (
+            (events.mesh, self._on_mesh),
+            (events.display, self.redraw),
+            (events.style, self.redraw),
+            (events.pick, self._on_pick),
+            (events.animation, self._on_animation),
+            (events.camera, self._apply_camera),
+        ):
+            event.disconnect(slot)
+        if self.scene is not None:
+            self.scene.remove()
+            self.scene = None
+
+    def _on_mesh(self) -> None:
+        if self.on_animation is not None:
+            self.on_animation(False)
+        if self.scene is not None:
+            self.scene.remove()
+            self.scene = None
+        self.field = None
+        self._drawn = None
+        mesh = self.state.mesh
+        if mesh is not None:
+            self.scene = MeshScene(
+                self.plotter, mesh, self.state.derived.normals, style=self.state.style.render
+            )
+            self._show_outline(mesh)
+            self.reset_camera()
+        self._update_colorbar()
+        self.request_render()
+
+    # ------------------------------------------------------------- field
+    def _signature(self):
+        state = self.state
+        d = state.display
+        spec = state.spectrum(state.display_operator())
+        return (
+            replace(d, threshold=0.0),
+            (state.style.isolines, state.style.shell_coloring, state.style.render),
+            state.picked if d.kind == "distance" else None,
+            id(spec),
+            state.t_range,
+        )
+
+    def redraw(self) -> None:
+        """Draw what the state displays (a threshold move only recolours)."""
+        if self.scene is None:
+            return
+        signature = self._signature()
+        d = self.state.display
+        if self.scene.style != self.state.style.render:
+            self.scene.set_style(self.state.style.render)
+        if (
+            self._drawn == signature
+            and d.kind == "distance"
+            and d.distance_display == "threshold"
+            and self.field is not None
+            and self.field.colormap == "threshold"
+            and self.state.derived.distance_map() is not None
+        ):
+            thr = self.state.derived.threshold_value()
+            self.scene.set_threshold(thr)
+            self.field.threshold = thr
+            self.field.legend = wording.legend(self.state)
+        else:
+            self._draw_field()
+            self._drawn = signature
+        self._update_colorbar()
+        self.request_render()
+
+    def _draw_field(self) -> None:
+        field = self.state.derived.field()
+        self.field = field
+        self.scene.set_displacement_scale(0.0)
+        draw_field(self.scene, field)
+
+    def _show_outline(self, mesh) -> None:
+        """The mesh's boundary as thin grey lines: in the paper style a surface facing
+        the viewer is as white as the background, so an open mesh (a plate) seen from
+        the front had no visible edge.  Hidden while a mode vibrates (it would stay put)."""
+        import pyvista as pv
+
+        self.plotter.remove_actor("outline", render=False)
+        self.outline_actor = None
+        boundary = mesh.edges[mesh.edge_face_counts == 1]
+        if len(boundary) == 0:
+            return
+        cells = np.column_stack([np.full(len(boundary), 2), boundary]).ravel()
+        lines = pv.PolyData(np.asarray(mesh.vertices, dtype=np.float64), lines=cells)
+        self.outline_actor = self.plotter.add_mesh(
+            lines,
+            color=(0.45, 0.45, 0.45),
+            line_width=1.5,
+            name="outline",
+            render=False,
+            reset_camera=False,
+            show_scalar_bar=False,
+        )
+
+    def _on_pick(self) -> None:
+        if self.scene is not None:
+            self.scene.show_marker(self.state.picked)
+            self.request_render()
+
+    # ------------------------------------------------------------ legend
+    def _update_colorbar(self) -> None:
+        """Legend and colour bar as the style asks (both on or both off), titles in
+        words; a threshold map gets a two-swatch legend that follows the threshold."""
+        scene, field = self.scene, self.field
+        if scene is None:
+            return
+        if field is None or field.colormap == "plain" or not self.state.style.colorbar:
+            scene.set_legend(None)
+            scene.set_colorbar(None)
+            return
+        scene.set_legend(field.legend)
+        if field.colormap == "threshold":
+            d = self.state.display
+            dist = self.state.derived.distance_map()
+            thr = self.state.derived.threshold_value(dist)
+            share = 100.0 * self.state.derived.surface_share(dist, thr)
+            from ..core.operators import DISTANCE_KINDS
+
+            similar = f"{DISTANCE_KINDS[d.distance_kind].lower()} < {thr:.3g} ({share:.1f} %)"
+            similar += wording.display_mark(self.state)
+            scene.set_colorbar(field.title, labels=[similar, "the rest"])
+        else:
+            scene.set_colorbar(field.title, clim=field.clim)
+
+    # ------------------------------------------------------------ camera
+    def reset_camera(self) -> None:
+        """The mesh's canonical view, fitted to the window (R)."""
+        if self.scene is not None:
+            self.scene.reset_camera()
+            self.request_render()
+
+    def camera_preset(self, name: str) -> None:
+        """View from a side ("+x" ... "-z"), "isometric" or "canonical"."""
+        if self.scene is not None:
+            self.scene.apply_camera_preset(name)
+            self.request_render()
+
+    def _apply_camera(self) -> None:
+        camera = self.state.camera
+        if camera is None or self.scene is None:
+            return
+        from ..viewer.camera import Camera
+
+        self.scene.set_camera(
+            Camera(
+                tuple(camera["position"]), tuple(camera["focal_point"]), tuple(camera["view_up"])
+            ),
+            fit=bool(camera.get("fit", False)),
+        )
+        self.request_render()
+
+    def current_camera(self) -> dict:
+        """The camera as plain data (for sessions)."""
+        cam = self.plotter.camera
+        return {
+            "position": [float(x) for x in cam.position],
+            "focal_point": [float(x) for x in cam.focal_point],
+            "view_up": [float(x) for x in cam.up],
+        }
+
+    # --------------------------------------------------------- animation
+    def _on_animation(self) -> None:
+        playing = self.state.animation.playing and self.scene is not None
+        if self.outline_actor is not None:
+            self.outline_actor.SetVisibility(not self.state.animation.playing)
+        if not playing and self.scene is not None:
+            self.scene.set_displacement_scale(0.0)
+            self.request_render()
+        if self.on_animation is not None:
+            self.on_animation(playing)
+
+    def animation_frame(self, phase: float) -> float:
+        """Move the surface to ``phase`` (radians) of the vibration; returns the time
+        this took in s."""
+        started = time.perf_counter()
+        amplitude = (
+            self.state.animation.amplitude / 100.0 * 0.25 * self.state.mesh.bounding_box_diagonal
+        )
+        self.scene.set_displacement_scale(amplitude * np.sin(phase))
+        self.request_render()
+        return time.perf_counter() - started

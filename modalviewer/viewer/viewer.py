@@ -1,0 +1,746 @@
+"""The Viewer: everything the modalviewer window does, scripted without a window (no Qt).
+
+A :class:`Viewer` owns the state, the model (jobs and spectrum cache) and, when asked for
+a picture with no window attached, an off-screen renderer of the same scene the window
+draws.  Scripts, notebooks, the command line and the windows all drive it::
+
+    import modalviewer as mv
+
+    viewer = mv.Viewer()
+    viewer.open_mesh("bunny.obj")
+    viewer.compute("shells", k=50)                 # waits; returns the Spectrum
+    viewer.show_mode(7)
+    viewer.export_screenshot("mode7.png", scale=2)
+    viewer.pick_file_vertex(123)
+    viewer.show_distance("vibration", display="threshold", share=0.1)
+    name, values = viewer.current_field()
+
+A window (``modalviewer.gui.MainWindow(viewer=viewer)``) attaches to a Viewer and only
+wires widgets to it: what a click does, the matching method here does.
+
+Messages for the user (what a status bar shows, errors a dialog shows) are emitted as
+``viewer.events.status(text, milliseconds)``, ``viewer.events.error(title, text)`` and
+``viewer.events.info(title, text)``; without a window nothing listens and scripts get
+return values and exceptions instead.  ``viewer.events.sliver_failure(key, text)``:
+a computation failed on sliver triangles and :meth:`Viewer.fix_slivers_and_retry` may
+help (the window offers it as a button).
+
+Waiting: without a window, jobs run in worker threads and their results are handed
+back to the calling thread while a ``wait`` call waits (:class:`~.jobs.ManualDispatcher`).
+A window replaces the dispatcher by its event loop (:meth:`Viewer.use_event_loop`).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+import numpy as np
+from psygnal import Signal, SignalGroup
+
+from ..core.cache import SpectrumCache
+from ..core.mesh import Mesh
+from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
+from ..core.spectrum import Spectrum
+from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
+from .model import (
+    ComputeRefused,
+    ViewerModel,
+    cost_estimate,
+    repair_for_failure,
+    repair_unavailable,
+    residual_text,
+)
+from .state import SpectrumKey
+from .wording import percent_text
+
+log = logging.getLogger("modalviewer")
+
+LONG_WAIT_SECONDS = 30.0
+"""Requests expected to take longer (and showing nothing meanwhile) say so when they
+start, with how long they will take and how to cancel."""
+
+
+class ComputeError(RuntimeError):
+    """A computation asked for by a script failed or was cancelled; the message says why."""
+
+
+class ViewerMessages(SignalGroup):
+    status = Signal(str, int)  # text, milliseconds to show it (0: until replaced)
+    error = Signal(str, str)  # title, text
+    info = Signal(str, str)  # title, text
+    sliver_failure = Signal(object, str)  # SpectrumKey, text
+
+
+class Viewer:
+    """The viewer without a window; see the module docstring.
+
+    cache : where spectra are kept on disk (default: ``$MODALVIEWER_CACHE`` or the
+        user's cache folder).
+    dispatch, waiter : how results of worker threads reach this thread and how a
+        ``wait`` waits; the defaults suit scripts (see :meth:`use_event_loop`).
+    """
+
+    def __init__(self, cache: SpectrumCache | None = None, dispatch=None, waiter=None):
+        self.model = ViewerModel(cache=cache, dispatch=dispatch or ManualDispatcher())
+        self.state = self.model.state
+        self.jobs = self.model.jobs
+        self.cache = self.model.cache
+        self.events = ViewerMessages()
+        self.last_error: str | None = None
+        self.sliver_failure: SpectrumKey | None = None  # failed on slivers, to retry
+        self._waiter = waiter
+        self._cancel_note = ""  # what a cancel left queued, said when the next job starts
+        self._renderer = None  # the off-screen picture, made on the first export
+        self._picture = None  # a window's picture source (see attach_picture)
+        self.jobs.events.changed.connect(self._on_job_changed)
+        self.jobs.events.finished.connect(self._on_job_finished)
+        self.state.events.mesh.connect(self._on_mesh)
+
+    def __repr__(self) -> str:
+        mesh = self.state.mesh
+        what = "no mesh" if mesh is None else f"{mesh.n_vertices} vertices"
+        spectra = ", ".join(self.state.operators_computed()) or "no spectra"
+        return f"<Viewer {what}; {spectra}; showing {self.state.display.kind}>"
+
+    # ============================================================ plumbing
+    def use_event_loop(self, dispatch, waiter) -> None:
+        """Hand worker results to ``dispatch`` (a window's event loop) from now on and
+        wait with ``waiter(job)``; results already handed back are delivered first."""
+        old = self.jobs.dispatch
+        self.jobs.dispatch = dispatch
+        self._waiter = waiter
+        if isinstance(old, ManualDispatcher):
+            old.process()
+
+    def attach_picture(self, source) -> None:
+        """Exports and sessions take their picture and camera from ``source`` (a window's
+        view: ``source.plotter``, ``source.scene``, ``source.current_camera()``) instead
+        of an off-screen renderer; None detaches it."""
+        self._picture = source
+        if source is not None and self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def wait_for(self, job: Job, timeout: float | None = None) -> Job:
+        """Wait until ``job`` has ended (its callbacks have run)."""
+        if job.done:
+            return job
+        if self._waiter is not None:
+            return self._waiter(job)
+        return self.jobs.wait(job, timeout)
+
+    def _status(self, text: str, msec: int = 0) -> None:
+        self.events.status.emit(text, msec)
+
+    def report_error(self, text: str, title: str = "modalviewer") -> None:
+        """Tell the user ``text`` (a window shows a dialog); kept as :attr:`last_error`."""
+        self._error(text, title)
+
+    def _error(self, text: str, title: str = "modalviewer") -> None:
+        self.last_error = text
+        log.warning("%s", text)
+        self.events.error.emit(title, text)
+
+    # ============================================================== meshes
+    @property
+    def mesh(self) -> Mesh | None:
+        return self.state.mesh
+
+    def open_mesh(self, path, strict: bool = True) -> Mesh:
+        """Load a mesh file and show it.  Raises ``modalviewer.DamagedFileError`` for a
+        damaged or truncated file (``strict=False`` loads its whole records and reports
+        what was dropped), ``MeshError`` for other unusable meshes, ``OSError`` if the
+        file cannot be read."""
+        return self.model.open_mesh(Path(path), strict=strict)
+
+    def set_mesh(self, mesh: Mesh, path=None) -> None:
+        """Show ``mesh``; the previous mesh's spectra are dropped and its jobs cancelled."""
+        self.model.set_mesh(mesh, path)
+
+    def _on_mesh(self) -> None:
+        if self.state.mesh is not None:  # what loading or a repair found and changed
+            self._status(str(self.state.mesh.report), 15000)
+
+    def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
+        """Apply repair ``name`` ("fix_slivers", "largest_component") to the loaded mesh in
+        the background; the repaired mesh replaces it (its report says what changed).
+        With ``wait`` returns the repaired mesh (ComputeError if the repair failed)."""
+        job = self.model.repair(name)
+        job.then(self._on_repaired)
+        if not wait:
+            return None
+        self.wait_for(job)
+        if job.status != DONE:
+            raise ComputeError(job.error or job.status)
+        return job.result
+
+    def _on_repaired(self, job: Job) -> None:
+        if job.status == DONE:
+            self._status(str(job.result.report), 20000)
+        elif job.status == FAILED:
+            self._error(f"{job.description} failed: {job.error}", "Repair failed")
+
+    def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
+        """Fix the loaded mesh's slivers (as Mesh > Fix slivers), report it and request
+        again the spectrum ``key`` (default: the last one whose factorisation failed on
+        slivers).  Returns the repair job (None if none started: without pymeshlab the
+        error says how to install it); with ``wait`` waits and returns the spectrum."""
+        key = key or self.sliver_failure
+        if key is None:
+            self._status("No computation failed on sliver triangles.", 5000)
+            return None
+        missing = repair_unavailable("fix_slivers")
+        if missing:
+            self._error(missing, "Fix slivers")
+            return None
+        try:
+            job = self.model.repair("fix_slivers")
+        except ValueError as exc:
+            self._error(str(exc))
+            return None
+        retried: list[SpectrumJob] = []
+
+        def retry(j: Job) -> None:
+            # a failed repair is reported as any failed job (_on_job_finished)
+            if j.status != DONE or self.state.mesh is not j.result:
+                return  # failed, cancelled, or another mesh was opened meanwhile
+            self.sliver_failure = None
+            self.events.info.emit(
+                "Slivers fixed", f"{j.result.report}\n\nComputing {key.describe()} again..."
+            )
+            self.state.set_compute_settings(operator=key.operator, k=key.k)
+            job_ = self._request(key.operator, key.k, show=True)
+            if job_ is not None:
+                retried.append(job_)
+
+        job.then(retry)
+        if not wait:
+            return job
+        self.wait_for(job)
+        if job.status != DONE or not retried:
+            raise ComputeError(job.error or self.last_error or job.status)
+        return self._finish(retried[0], wait=True)
+
+    # ============================================================= spectra
+    @property
+    def spectra(self) -> dict[str, Spectrum]:
+        """The latest spectrum of each computed operator."""
+        return {op: self.state.spectrum(op) for op in self.state.operators_computed()}
+
+    def compute(
+        self, operator: str | None = None, k: int | None = None, wait: bool = True, then=None
+    ) -> Spectrum | None:
+        """Compute a spectrum in the background (cached on disk) and show its first
+        non-zero mode when it arrives (unless the display changed meanwhile).
+
+        Returns this request's Spectrum with ``wait=True`` (ComputeError if it failed,
+        was cancelled or was too large to start); ``then`` is
+        called with the spectrum when it arrives.
+        """
+        if self.state.mesh is None:
+            self._error("Open a mesh first.")
+            if wait:
+                raise ComputeError("Open a mesh first.")
+            return None
+        changes = {}
+        if operator is not None:
+            changes["operator"] = operator
+        if k is not None:
+            changes["k"] = int(k)
+        if changes:
+            self.state.set_compute_settings(**changes)
+        job = self._request(None, None, show=True)
+        if job is None and wait:
+            raise ComputeError(self.last_error or "the computation was refused")
+        return self._finish(job, wait, then)
+
+    def request_spectrum(self, operator: str, k: int | None = None, show: bool = False):
+        """The job computing (or loading) ``operator``'s spectrum, or None (with an
+        error message) if it is too large to start."""
+        return self._request(operator, k, show)
+
+    def _request(self, operator, k, show) -> SpectrumJob | None:
+        try:
+            job = self.model.request_spectrum(operator, k, show=show)
+        except ComputeRefused as exc:
+            self._error(str(exc), "Computation too large")
+            return None
+        note = self.long_wait_note(job)
+        if note:
+            self._status(f"{job.description}: {note}.", 20000)
+        return job
+
+    def _finish(self, job: SpectrumJob | None, wait: bool, then=None) -> Spectrum | None:
+        if job is None:
+            return None
+        if then is not None:
+            job.then(lambda j: then(j.result[0]) if j.status == DONE else None)
+        if not wait:
+            return None
+        self.wait_for(job)
+        if job.status != DONE:
+            raise ComputeError(job.error or job.status)
+        return job.result[0]
+
+    def long_wait_note(self, job: SpectrumJob) -> str:
+        """ "this will take about ..." for a request expected to take long with nothing on
+        screen meanwhile; "" otherwise (behind a preview the wait is behind a picture)."""
+        if job.done or job.preview_job is not None:
+            return ""
+        seconds, _ = cost_estimate(job.spectrum_key, self.state.mesh.n_vertices)
+        if seconds <= LONG_WAIT_SECONDS:
+            return ""
+        about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+        faster = "" if job.spectrum_key.coarse else "; Coarse-to-fine is much faster"
+        return f"this will take about {about} (Esc cancels{faster})"
+
+    def cancel_computation(self) -> None:
+        """Cancel the running computation and the exact spectrum waiting behind its
+        preview; other queued requests keep their turn (the message says how many)."""
+        if self.jobs.running is None:
+            self._status("No computation running.", 3000)
+            return
+        self.model.cancel_running()
+        left = {
+            job.spectrum_key if isinstance(job, SpectrumJob) else job.key
+            for job in self.jobs.jobs
+            if not job.done and not job.cancel_requested
+        }
+        plural = "s" if len(left) > 1 else ""
+        self._cancel_note = (
+            f"Cancelled; {len(left)} more request{plural} queued (Ctrl+Shift+Esc cancels all)"
+            if left
+            else ""
+        )
+        self._status(self._cancel_note or "Cancelling...", 5000)
+
+    def cancel_all(self) -> None:
+        """Cancel every queued and running computation."""
+        self.jobs.cancel_all()
+
+    def clear_cache(self) -> int:
+        """Delete every cached spectrum; returns the bytes freed."""
+        size = self.cache.clear()
+        self._status(f"Cache cleared: {size / 2**20:.0f} MB freed.", 8000)
+        return size
+
+    @property
+    def running_job(self) -> Job | None:
+        return self.jobs.running
+
+    @property
+    def busy(self) -> bool:
+        return self.jobs.busy
+
+    def _on_job_changed(self, job: Job) -> None:
+        running = self.jobs.running
+        if running is not None and job is running and job.stage == "starting":
+            self._status(self.starting_message(job))
+
+    def starting_message(self, job: Job) -> str:
+        """ "Computing ...", after the preview shown before it (with its estimated error)
+        or with the reason a big request gets no preview; after a cancel that left other
+        requests queued, first what it cancelled."""
+        text = f"Computing {job.description}..."
+        if isinstance(job, SpectrumJob) and not job.is_preview:
+            preview = job.preview_job
+            if preview is None:
+                note = self.model.no_preview_note(job.spectrum_key)
+                if note:
+                    text = f"Computing {job.description}; {note}."
+            elif preview.status == DONE:
+                error = percent_text(preview.result[0].estimated_error)
+                text = f"Preview shown (estimated error {error}); computing the exact spectrum..."
+        note, self._cancel_note = self._cancel_note, ""
+        return f"{note}. {text}" if note else text
+
+    def _on_job_finished(self, job: Job) -> None:
+        if job.status == DONE and isinstance(job, SpectrumJob):
+            spec = job.result[0]
+            quality = (
+                f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
+                if spec.is_preview
+                else residual_text(spec)
+            )
+            self._status(f"{job.description} in {job.seconds:.1f} s; {quality}.", 15000)
+        elif job.status == DONE and not isinstance(job, RepairJob):
+            self._status(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
+        elif job.status == FAILED:
+            log.error("computation failed: %s\n%s", job.error, job.details)
+            mesh = self.state.mesh
+            if isinstance(job, RepairJob):
+                return  # reported by its own callback (_on_repaired)
+            if (
+                isinstance(job, SpectrumJob)
+                and mesh is not None
+                and job.owner == mesh.hash
+                and repair_for_failure(job.error) == "fix_slivers"
+            ):
+                self.sliver_failure = job.spectrum_key
+                self.last_error = f"The computation failed: {job.error}"
+                log.warning("%s", self.last_error)
+                self.events.sliver_failure.emit(job.spectrum_key, self.last_error)
+            else:
+                self._error(f"The computation failed: {job.error}", "Computation failed")
+        elif job.status == CANCELLED:
+            self._status(f"{job.description}: {job.error or 'cancelled'}.", 5000)
+
+    # =============================================================== modes
+    @property
+    def current_operator(self) -> str | None:
+        """The operator of the mode shown or last shown, else the first one computed."""
+        d = self.state.display
+        if d.operator is not None and self.state.spectrum(d.operator) is not None:
+            return d.operator
+        computed = self.state.operators_computed()
+        return computed[0] if computed else None
+
+    def show_mode(self, index: int, operator: str | None = None) -> None:
+        """Colour the surface by mode ``index`` of ``operator`` (default: the spectrum
+        shown or last shown)."""
+        op = operator or self.current_operator
+        if op is None or self.state.spectrum(op) is None:
+            return
+        self.state.show_mode(index, op)
+
+    def step_mode(self, step: int) -> None:
+        """The next (``step`` = 1) or previous (-1) mode of the current spectrum."""
+        d = self.state.display
+        op = self.current_operator
+        if op is None:
+            return
+        self.state.show_mode((d.mode if d.kind == "mode" and d.operator == op else 0) + step, op)
+
+    def show_current_mode(self) -> None:
+        """Back to the mode last shown, or the current spectrum's first non-zero mode."""
+        d = self.state.display
+        op = self.current_operator
+        if op is not None:
+            mode = d.mode if op == d.operator else self.state.first_nonzero_mode(op)
+            self.show_mode(mode, op)
+
+    def set_animating(self, on: bool) -> None:
+        self.state.set_animation(playing=bool(on))
+
+    def toggle_animation(self) -> None:
+        self.state.set_animation(playing=not self.state.animation.playing)
+
+    # ======================================================== picks, maps
+    @property
+    def picked(self) -> int | None:
+        return self.state.picked
+
+    def pick_file_vertex(self, number: int) -> None:
+        """Pick vertex ``number`` of the mesh file (the number the viewer shows, as
+        ``modalviewer distance --vertex`` takes it); ValueError for one no face uses."""
+        if self.state.mesh is None:
+            return
+        self.pick_vertex(self.state.mesh.mesh_vertex(number))
+
+    def pick_vertex(self, index: int) -> None:
+        """Pick mesh vertex ``index`` (the loaded mesh's compact index, as a click on it
+        does): marker and distance map (see :meth:`pick_file_vertex`)."""
+        if self.state.mesh is None:
+            return
+        self.state.set_pick(index)
+        self.show_distance()
+
+    def show_distance(
+        self,
+        kind: str | None = None,
+        display: str | None = None,
+        share: float | None = None,
+        threshold: float | None = None,
+    ) -> np.ndarray | None:
+        """Distance map from the picked vertex; returns it (None until it is ready).
+
+        kind : "vibration" | "feature" | "hks".
+        display : "continuous" | "threshold".
+        share : a threshold map marking this share (0..1] of the surface's area similar.
+        threshold : a threshold map at this absolute distance (marks distance <= it).
+
+        A missing spectrum is computed in the background; the map appears when it is
+        ready (unless the display changed meanwhile).
+        """
+        if share is not None and threshold is not None:
+            raise ValueError("give either share (of the area) or threshold (a distance)")
+        if share is not None and not 0.0 < float(share) <= 1.0:
+            raise ValueError(f"share is a share of the surface's area, in (0, 1]: {share}")
+        if threshold is not None and not 0.0 <= float(threshold) < np.inf:
+            raise ValueError(f"threshold is a distance, at least 0: {threshold}")
+        changes = {}
+        if kind is not None:
+            if kind not in DISTANCE_KINDS:
+                raise ValueError(f"unknown distance {kind!r}; choose one of {list(DISTANCE_KINDS)}")
+            changes["distance_kind"] = kind
+        if display is not None:
+            changes["distance_display"] = display
+        if share is not None or threshold is not None:
+            changes.setdefault("distance_display", "threshold")
+        if changes:
+            self.state.set_display(**changes)
+        if self.state.mesh is None:
+            return None
+        if self.state.picked is None:
+            if share is not None:  # the first map will mark it
+                self.state.set_display(threshold_share=float(share), keep_share=True)
+            self._status("Click the surface to pick a vertex first.", 5000)
+            return None
+        kind = self.state.display.distance_kind
+        operator = operator_for_distance(kind)
+        if self.state.spectrum(operator) is None:
+            job = self._request(operator, None, show=False)
+            if job is not None:
+                before = self.state.display
+
+                def show_when_ready(j: Job) -> None:
+                    if j.status == DONE and self.state.display == before:
+                        self._show_map(share, threshold)
+
+                if job.preview_job is not None:  # the map from the preview first
+                    job.preview_job.then(show_when_ready)
+                job.then(show_when_ready)
+                note = self.long_wait_note(job)
+                self._status(
+                    f"Computing the spectrum for the {DISTANCE_KINDS[kind].lower()}"
+                    + (f"; {note}." if note else "...")
+                )
+            return None
+        return self._show_map(share, threshold)
+
+    def _show_map(self, share: float | None, threshold: float | None) -> np.ndarray | None:
+        """Show the distance map of the display's kind, at ``share`` of the area or at the
+        absolute distance ``threshold`` if given."""
+        changes: dict = {"kind": "distance"}
+        d = self.state.derived.distance_map()
+        if threshold is not None and d is not None:
+            changes["threshold"] = min(1.0, float(threshold) / (float(d.max()) or 1.0))
+        if share is not None:
+            changes.update(threshold_share=float(share), keep_share=True)
+        self.state.set_display(**changes)
+        return self.state.derived.distance_map()
+
+    def distance_map(self, kind: str) -> np.ndarray | None:
+        """Distance of ``kind`` from the picked vertex, or None if its spectrum is missing."""
+        return self.state.derived.distance_map(kind)
+
+    @property
+    def last_distance(self) -> np.ndarray | None:
+        return self.state.derived.distance_map() if self.state.display.kind == "distance" else None
+
+    def set_threshold(self, fraction: float) -> float:
+        """Move the threshold (a fraction of the largest distance); returns the time the
+        viewer took, in s."""
+        started = time.perf_counter()
+        self.state.set_display(threshold=float(fraction))
+        return time.perf_counter() - started
+
+    def show_signature(self, sample: int) -> None:
+        """Colour by the signature at scale sample ``sample`` of the distance kind's
+        spectrum."""
+        operator = operator_for_distance(self.state.display.distance_kind)
+        if not self.state.derived.has_signatures(operator):
+            self._status(
+                f"Compute the {OPERATOR_INFO[operator].label} spectrum first (with non-zero "
+                "modes).",
+                5000,
+            )
+            return
+        self.state.set_display(kind="signature", signature_sample=int(sample))
+
+    def show_curvature(self) -> None:
+        """Colour by the total curvature."""
+        if self.state.mesh is not None:
+            self.state.set_display(kind="curvature")
+
+    @property
+    def display(self) -> str:
+        return self.state.display.kind
+
+    # ============================================================ pictures
+    def current_field(self) -> tuple[str, np.ndarray] | None:
+        """(name, per-vertex values) of what the surface shows, or None without a mesh.
+        Without a field (a fresh mesh) the values are zeros."""
+        if self.state.mesh is None:
+            return None
+        field = self.state.derived.field()
+        if field is None or field.colormap == "plain":
+            return "field", np.zeros(self.state.mesh.n_vertices)
+        return (field.title or "field"), np.asarray(field.values, dtype=np.float64)
+
+    def export_field(self, path) -> Path:
+        """Write the mesh with the field shown as point data (.vtp or .ply)."""
+        from ..scene.export import save_field_mesh
+
+        field = self.current_field()
+        if field is None:
+            raise ValueError("nothing to export: open a mesh first")
+        name, values = field
+        return save_field_mesh(Path(path), self.state.mesh, {name: values})
+
+    def renderer(self, size=None):
+        """The off-screen renderer drawing this viewer (made on first use; ``size``
+        (width, height) in pixels, default 1024x768)."""
+        from ..scene.offscreen import DEFAULT_SIZE, OffscreenRenderer
+
+        if self._renderer is None:
+            self._renderer = OffscreenRenderer(self.state, size or DEFAULT_SIZE)
+        elif size is not None:
+            self._renderer.resize(size)
+        return self._renderer
+
+    def export_screenshot(
+        self,
+        path,
+        scale: int = 1,
+        transparent: bool = False,
+        colorbar: bool | None = None,
+        size=None,
+    ) -> Path:
+        """Save the picture as PNG (atomically); returns the path.
+
+        With a window attached, its view as on screen; otherwise the same scene drawn
+        off screen at ``size`` (width, height; default 1024x768).  ``colorbar``: with
+        the colour bar and legend (None: as the state says)."""
+        from ..scene.export import save_screenshot
+
+        if colorbar is not None:
+            self.state.set_colorbar(colorbar)
+        if self._picture is not None:
+            return save_screenshot(
+                self._picture.plotter,
+                Path(path),
+                scale=scale,
+                transparent=transparent,
+                scene=self._picture.scene,
+            )
+        return self.renderer(size).screenshot(path, scale=scale, transparent=transparent)
+
+    def image(self, scale: int = 1, transparent: bool = False, size=None) -> np.ndarray:
+        """The picture as an (h, w, 3 or 4) uint8 array (for notebooks)."""
+        if self._picture is not None:
+            from ..scene.export import grab
+
+            return grab(self._picture.plotter, self._picture.scene, scale, transparent)
+        return self.renderer(size).image(scale, transparent)
+
+    def animation_frame(self, phase: float, size=None) -> float:
+        """Move the picture's surface to ``phase`` (radians) of the vibration shown (a
+        still of the animation, kept until the display changes); returns the time this
+        took in s."""
+        source = self._picture or self.renderer(size)
+        drawing = getattr(source, "drawing", source)
+        return drawing.animation_frame(phase)
+
+    def current_camera(self) -> dict | None:
+        """The camera of the picture (window or off screen) as plain data."""
+        source = self._picture or self._renderer
+        if source is None:
+            return self.state.camera
+        drawing = getattr(source, "drawing", source)
+        return drawing.current_camera()
+
+    def close(self) -> None:
+        """Cancel the jobs and free the off-screen renderer."""
+        self.jobs.cancel_all(reason="the viewer was closed")
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    # ============================================================ sessions
+    def save_session(self, path) -> Path:
+        """Write the session (mesh, spectra, display, pick, camera) to a JSON file."""
+        from .session import save_session
+
+        camera = self.current_camera()
+        if camera is not None:
+            self.state.camera = camera
+        return save_session(self.state, path)
+
+    def open_session(self, path, wait: bool = True) -> list[str]:
+        """Restore a session; returns the notes on what could not be restored as saved.
+        With ``wait`` the call returns once every spectrum is loaded or recomputed.
+        Raises SessionError, MeshError or OSError for a file that cannot be restored."""
+        from .session import restore_session
+
+        restored = restore_session(self.model, path)
+        if wait:
+            for job in restored.jobs:
+                self.wait_for(job)
+        if restored.notes:
+            self._status("; ".join(restored.notes), 15000)
+        return restored.notes
+
+    # ========================================================== comparison
+    def missing_for(self, items: list[str]) -> list[str]:
+        """The operators whose spectra a comparison of ``items`` (operators or distance
+        kinds) needs and the state does not have."""
+        needed = [operator_for_distance(i) if i in DISTANCE_KINDS else i for i in items]
+        return [op for op in dict.fromkeys(needed) if self.state.spectrum(op) is None]
+
+    def comparison_cost(self, operators: list[str]) -> float:
+        """Seconds the spectra of ``operators`` are expected to take on this mesh."""
+        settings = self.state.compute_settings
+        n = self.state.mesh.n_vertices
+        return sum(cost_estimate(settings.key(op), n)[0] for op in operators)
+
+    def prepare_comparison(self, items: list[str], wait: bool = True, then=None):
+        """Request the spectra a comparison of ``items`` needs; with ``wait`` return once
+        they are in (ComputeError if one failed), else call ``then()`` when they are.
+        Returns the jobs (None if a request was refused)."""
+        jobs = [self._request(op, None, show=False) for op in self.missing_for(items)]
+        if any(job is None for job in jobs):
+            if wait:
+                raise ComputeRefused(self.last_error or "the computation was refused")
+            return None
+        if wait:
+            for job in jobs:
+                self.wait_for(job)
+                if job.status != DONE:
+                    raise ComputeError(job.error or job.status)
+            return jobs
+        pending = {job.id for job in jobs}
+
+        def ready(j: Job) -> None:
+            pending.discard(j.id)
+            if j.status != DONE:
+                pending.clear()
+            elif not pending and all(x.status == DONE for x in jobs) and then is not None:
+                then()
+
+        if not jobs and then is not None:
+            then()
+        for job in jobs:
+            job.then(ready)
+        return jobs
+
+    def comparison(self, items: list[str], wait: bool = True):
+        """A :class:`~.comparison.Comparison` of two or three operators or distance
+        kinds on the loaded mesh; missing spectra are computed first (with ``wait``; the
+        display of this viewer is not changed)."""
+        from .comparison import Comparison
+
+        if self.state.mesh is None:
+            raise ComputeError("Open a mesh first.")
+        comparison = Comparison(self.state, items)
+        self.prepare_comparison(items, wait=wait)
+        return comparison
+
+    def export_comparison(self, comparison, path, size=None, scale: int = 1) -> Path:
+        """Write the views of ``comparison`` (a Comparison, or a list of items) side by
+        side to a PNG, each ``size`` (width, height) pixels, seen from the camera of this
+        viewer's picture; returns the path."""
+        from ..scene.comparison import VIEW_SIZE, save_comparison
+        from .camera import Camera
+
+        if not hasattr(comparison, "views"):
+            comparison = self.comparison(comparison)
+        cam = self.current_camera()
+        camera = None
+        if cam is not None:
+            camera = Camera(
+                tuple(cam["position"]), tuple(cam["focal_point"]), tuple(cam["view_up"])
+            )
+        return save_comparison(comparison, path, size or VIEW_SIZE, camera, scale)

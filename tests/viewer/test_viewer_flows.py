@@ -1,0 +1,180 @@
+"""The scripted flows of the window (tests/gui/test_state_sync.py) against a
+:class:`modalviewer.viewer.Viewer` with no window.
+
+``tests/test_headless.py`` runs this file again in a process where Qt cannot be
+imported, so every flow here is known to need no Qt.  Pictures are drawn off screen
+by the viewer's own scene and their pixels checked.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import modalviewer as mv
+from modalviewer.core.laplacian import lumped_masses
+from modalviewer.viewer import ComputeError, Viewer, wording
+
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+
+
+@pytest.fixture
+def spot_path():
+    return ASSETS / "spot.obj"
+
+
+@pytest.fixture
+def viewer(tmp_path):
+    v = Viewer(cache=mv.core.cache.SpectrumCache(tmp_path / "cache"))
+    yield v
+    v.close()
+
+
+def _colours(img: np.ndarray) -> dict[str, int]:
+    """Pixel counts of the paper's blue and orange (diverging ends, threshold blue)."""
+    rgb = img[:, :, :3].astype(int)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    return {
+        "blue": int(np.sum((b > r + 60) & (b > g + 20))),
+        "orange": int(np.sum((r > b + 80) & (g > b + 20))),
+    }
+
+
+def test_a_waiting_compute_returns_its_own_spectrum(viewer, spot_path):
+    """A request queued meanwhile keeps its turn and its own result."""
+    viewer.open_mesh(spot_path)
+    first = viewer.compute("shells", k=20, wait=False)
+    assert first is None and viewer.busy
+    spec = viewer.compute("laplacian", k=37)
+    assert spec.operator == "laplacian" and spec.k == 37
+    while viewer.busy:
+        viewer.wait_for(viewer.running_job or viewer.jobs.jobs[0])
+    assert viewer.spectra["shells"].k == 20
+
+
+def test_a_mode_picture_is_the_mode_in_the_paper_colours(viewer, spot_path, tmp_path):
+    viewer.open_mesh(spot_path)
+    spec = viewer.compute("laplacian", k=12)
+    residual = spec.residuals[~spec.zero_mode_mask()].max()
+    assert residual < 1e-6
+    viewer.show_mode(6)
+    name, values = viewer.current_field()
+    assert "mode 6" in name
+    np.testing.assert_allclose(values, spec.mode(6), rtol=0, atol=1e-12)
+    path = viewer.export_screenshot(tmp_path / "mode", size=(400, 300))
+    assert path.suffix == ".png"
+    from PIL import Image
+
+    img = np.asarray(Image.open(path))
+    assert img.shape[:2] == (300, 400)
+    counts = _colours(img)
+    assert counts["blue"] > 500 and counts["orange"] > 500, counts
+    clear = viewer.image(transparent=True)
+    assert clear.shape[2] == 4 and clear[0, -1, 3] == 0  # the background corner
+
+
+def test_a_pick_shows_the_distance_and_the_share_it_marks(viewer, spot_path):
+    viewer.open_mesh(spot_path)
+    viewer.compute("modified_dirichlet", k=30)
+    viewer.pick_vertex(1000)
+    areas = lumped_masses(viewer.mesh)
+    for share in (0.05, 0.2, 0.6):
+        d = viewer.show_distance("feature", display="threshold", share=share)
+        assert viewer.state.display.kind == "distance"
+        expected = mv.multiscale_distance(viewer.spectra["modified_dirichlet"], 1000)
+        np.testing.assert_allclose(d, expected, rtol=1e-10, atol=1e-12)
+        thr = viewer.state.display.threshold * d.max()
+        marked = areas[d <= thr].sum() / areas.sum()
+        assert marked == pytest.approx(share, abs=0.01)
+        assert f"{100 * marked:.1f} % of the surface" in wording.legend(viewer.state)
+    # an absolute distance: the map marks exactly where d <= it
+    d = viewer.show_distance(threshold=0.5 * d.max())
+    assert viewer.state.display.threshold == pytest.approx(0.5)
+    img = viewer.image(size=(400, 300))
+    assert _colours(img)["blue"] > 1000
+
+
+def test_a_comparison_never_changes_the_display(viewer, spot_path, tmp_path):
+    viewer.open_mesh(spot_path)
+    viewer.compute("modified_dirichlet", k=20)
+    viewer.state.set_display(distance_kind="feature")
+    viewer.pick_vertex(50)
+    viewer.show_distance("feature", display="threshold", share=0.1)
+    before = viewer.state.display
+    compare = viewer.comparison(["laplacian", "modified_dirichlet"])
+    assert "laplacian" in viewer.spectra and viewer.state.display == before
+    assert compare.mode_index == 1  # the first non-zero mode, not the constant mode 0
+    views = compare.views()
+    assert views[0].title.startswith("Laplacian: mode 1,")
+    assert np.ptp(views[0].field.values) > 0
+    compare.step(+1)
+    assert compare.mode_index == 2 and "mode 2," in compare.views()[1].title
+    out = viewer.export_comparison(compare, tmp_path / "pair.png", size=(300, 300))
+    from PIL import Image
+
+    img = np.asarray(Image.open(out))
+    assert img.shape[1] == 2 * 300 + 4
+    with pytest.raises(ValueError, match="operators with operators"):
+        viewer.comparison(["laplacian", "hks"])
+
+
+def test_a_session_restores_the_same_picture(tmp_path, spot_path):
+    cache = mv.core.cache.SpectrumCache(tmp_path / "cache")
+    first = Viewer(cache=cache)
+    first.open_mesh(spot_path)
+    first.compute("modified_dirichlet", k=30)
+    first.show_mode(7)
+    first.state.set_isolines(5)
+    first.pick_vertex(1234)
+    first.show_distance("feature", display="threshold", share=0.25)
+    image = first.image(size=(500, 400))
+    name, values = first.current_field()
+    session = first.save_session(tmp_path / "s.json")
+    first.close()
+
+    second = Viewer(cache=cache)
+    assert second.open_session(session) == []
+    again_name, again = second.current_field()
+    assert again_name == name
+    np.testing.assert_allclose(again, values, rtol=0, atol=1e-12)
+    picture = second.image(size=(500, 400))
+    differ = np.mean(np.any(np.abs(picture.astype(int) - image.astype(int)) > 8, axis=2))
+    assert differ < 0.002, differ
+    assert "feature distance" in wording.summary(second.state)
+    second.show_current_mode()
+    assert second.state.display.kind == "mode" and second.state.display.mode == 7
+    second.close()
+
+
+def test_messages_instead_of_dialogs(viewer, spot_path):
+    statuses, errors = [], []
+    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    viewer.events.error.connect(lambda title, text: errors.append((title, text)))
+    with pytest.raises(ComputeError, match="Open a mesh first"):
+        viewer.compute("laplacian", k=5)
+    assert errors == [("modalviewer", "Open a mesh first.")]
+    viewer.open_mesh(spot_path)
+    assert any("2930 vertices" in s for s in statuses)  # the mesh's report
+    viewer.cancel_computation()
+    assert statuses[-1] == "No computation running."
+    viewer.compute("laplacian", k=10)
+    assert statuses[-1].startswith("Laplacian (cotan), 10 modes in ")
+    assert "largest relative residual" in statuses[-1]
+    assert viewer.clear_cache() > 0
+    viewer.pick_file_vertex(5)
+    assert viewer.picked == viewer.mesh.mesh_vertex(5)
+    with pytest.raises(ValueError):
+        viewer.show_distance(share=1.5)
+
+
+def test_keep_the_largest_component(viewer, tmp_path):
+    from modalviewer.core.primitives import icosphere, torus
+
+    big, small = torus(24, 10), icosphere(1)
+    big = mv.Mesh(3.0 * big.vertices, big.faces)
+    vertices = np.vstack([big.vertices, small.vertices + (6.0, 0.0, 0.0)])
+    faces = np.vstack([big.faces, small.faces + big.n_vertices])
+    viewer.set_mesh(mv.Mesh(vertices, faces))
+    assert viewer.mesh.n_components == 2
+    repaired = viewer.repair_mesh("largest_component")
+    assert viewer.mesh is repaired and repaired.n_vertices == big.n_vertices
