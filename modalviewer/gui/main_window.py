@@ -32,17 +32,12 @@ from . import menus, window_settings
 from .application import ensure_application
 from .compare import CompareWindow
 from .dialogs import ask, file_message, offer_open_anyway
+from .docks import build_docks
 from .pair_window import PairWindow, open_pair_window
-from .panels import (
-    AnimationPanel,
-    ComputePanel,
-    DistancesPanel,
-    JobsPanel,
-    ModesPanel,
-    StatusLine,
-)
+from .panels import AnimationPanel, ComputePanel, DistancesPanel, JobsPanel, ModesPanel
 from .qt_dispatch import QtDispatcher
 from .scene_view import SceneView
+from .status_bar import StatusBarWidgets
 from .viewport import make_viewport
 
 __all__ = ["ComputeError", "MainWindow"]
@@ -55,6 +50,9 @@ MIN_VIEW_SIZE = (320, 240)
 
 class MainWindow(QtWidgets.QMainWindow):
     """The modalviewer main window, showing ``viewer`` (a new :class:`Viewer` if None)."""
+
+    STATUS_LINE_WIDTH = StatusBarWidgets.STATUS_LINE_WIDTH
+    STATUS_LINE_WIDTH_BESIDE_MESSAGE = StatusBarWidgets.STATUS_LINE_WIDTH_BESIDE_MESSAGE
 
     meshLoaded = QtCore.Signal(str)
     spectrumReady = QtCore.Signal(str)
@@ -108,13 +106,16 @@ class MainWindow(QtWidgets.QMainWindow):
         self.distances_panel.showSignatureRequested.connect(
             lambda: self.show_signature(self.state.display.signature_sample)
         )
-        self._build_docks()
+        build_docks(self)
         menus.build_menus(self)
-        self._build_status_bar()
+        self.status_widgets = StatusBarWidgets(self.statusBar(), self.state, self.model.jobs)
+        self.status_widgets.cancel_button.clicked.connect(self.cancel_computation)
+        self.status_line = self.status_widgets.status_line
+        self.progress = self.status_widgets.progress
+        self.cancel_button = self.status_widgets.cancel_button
 
         self.state.events.mesh.connect(self._on_mesh)
         self.state.events.spectra.connect(self.spectrumReady.emit)
-        self.model.jobs.events.changed.connect(self._on_job_changed)
         messages = self.viewer.events
         messages.status.connect(lambda text, msec: self.statusBar().showMessage(text, msec))
         messages.error.connect(self._show_error_box)
@@ -135,70 +136,6 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.state.mesh is not None:  # a viewer already in use: show what it shows
             self.scene_view.drawing.sync()
             self._on_mesh()
-
-    # ================================================================== UI
-    def _build_docks(self) -> None:
-        area = QtCore.Qt.DockWidgetArea
-        compute = QtWidgets.QWidget()
-        lay = QtWidgets.QVBoxLayout(compute)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.addWidget(self.compute_panel)
-        lay.addWidget(QtWidgets.QLabel("<b>Computations</b>"))
-        lay.addWidget(self.jobs_panel)
-        lay.addStretch(1)
-        self._add_dock("Compute", compute, area.LeftDockWidgetArea)
-        modes = QtWidgets.QWidget()
-        lay = QtWidgets.QVBoxLayout(modes)
-        lay.setContentsMargins(0, 0, 0, 0)
-        lay.addWidget(self.modes_panel)
-        lay.addWidget(self.animation_panel)
-        self._add_dock("Modes", modes, area.RightDockWidgetArea)
-        self._add_dock("Distances and signatures", self.distances_panel, area.RightDockWidgetArea)
-
-    def _add_dock(self, title: str, widget: QtWidgets.QWidget, area) -> QtWidgets.QDockWidget:
-        dock = QtWidgets.QDockWidget(title, self)
-        dock.setMaximumWidth(340)
-        dock.setObjectName(title.replace(" ", "_"))
-        scroll = QtWidgets.QScrollArea()
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(widget)
-        # wide enough for its contents (no sideways scrolling; labels wrap)
-        scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-        needed = widget.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width()
-        scroll.setMinimumWidth(min(340, needed + 4))
-        dock.setWidget(scroll)
-        self.addDockWidget(area, dock)
-        return dock
-
-    def _build_status_bar(self) -> None:
-        bar = self.statusBar()
-        self.status_line = StatusLine(self.state)
-        self.status_line.setMaximumWidth(self.STATUS_LINE_WIDTH)
-        bar.addPermanentWidget(self.status_line)
-        self.progress = QtWidgets.QProgressBar()
-        self.progress.setFixedWidth(260)
-        self.progress.setRange(0, 1000)
-        self.progress.hide()
-        self.cancel_button = QtWidgets.QPushButton("Cancel")
-        self.cancel_button.setToolTip("Cancel the running computation (Esc)")
-        self.cancel_button.clicked.connect(self.cancel_computation)
-        self.cancel_button.hide()
-        bar.addPermanentWidget(self.progress)
-        bar.addPermanentWidget(self.cancel_button)
-        # the message shares the bar with the status line: while one is shown the status
-        # line (elided, whole in its tooltip) gives it room; whole message on hover
-        bar.messageChanged.connect(self._on_status_message)
-
-    STATUS_LINE_WIDTH = 620
-    """Widest the status line gets; :data:`STATUS_LINE_WIDTH_BESIDE_MESSAGE` while a
-    temporary message is shown, which needs the room more (what is computing and why)."""
-    STATUS_LINE_WIDTH_BESIDE_MESSAGE = 300
-
-    def _on_status_message(self, text: str) -> None:
-        self.statusBar().setToolTip(text)
-        self.status_line.setMaximumWidth(
-            self.STATUS_LINE_WIDTH_BESIDE_MESSAGE if text else self.STATUS_LINE_WIDTH
-        )
 
     # ============================================================ messages
     def show_error(self, message: str, title: str = "modalviewer") -> None:
@@ -395,18 +332,6 @@ class MainWindow(QtWidgets.QMainWindow):
         vertex = scene.vertex_at_display(x, y) if scene is not None else None
         if vertex is not None:
             self.pick_vertex(vertex)
-
-    def _on_job_changed(self, _job: Job) -> None:
-        running = self.model.jobs.running
-        self.progress.setVisible(running is not None)
-        self.cancel_button.setVisible(running is not None)
-        if running is not None:
-            self.progress.setValue(int(1000 * running.fraction))
-            queued = len(self.model.jobs.jobs) - 1
-            more = f" (+{queued} queued)" if queued else ""
-            stage = running.stage if len(running.stage) <= 20 else running.stage[:19] + "…"
-            self.progress.setFormat(f"{stage} %p %{more}")  # as in the Computations list
-            self.progress.setToolTip(f"{running.description}: {running.stage}")
 
     # ========================================================= shape pair
     def open_second_mesh(self, path, wait: bool = True, k: int | None = None) -> PairWindow:

@@ -1,0 +1,47 @@
+"""The main window's docks: Compute (with the computations list), Modes (with the
+animation) and Distances and signatures, each scrolling inside a dock."""
+
+from __future__ import annotations
+
+from qtpy import QtCore, QtWidgets
+
+DOCK_WIDTH = 340
+"""Widest a dock gets, in pixels."""
+
+
+def build_docks(win) -> None:
+    """Put ``win``'s panels (``compute_panel``, ``jobs_panel``, ``modes_panel``,
+    ``animation_panel``, ``distances_panel``) into its docks."""
+    area = QtCore.Qt.DockWidgetArea
+    compute = QtWidgets.QWidget()
+    lay = QtWidgets.QVBoxLayout(compute)
+    lay.setContentsMargins(0, 0, 0, 0)
+    lay.addWidget(win.compute_panel)
+    lay.addWidget(QtWidgets.QLabel("<b>Computations</b>"))
+    lay.addWidget(win.jobs_panel)
+    lay.addStretch(1)
+    add_dock(win, "Compute", compute, area.LeftDockWidgetArea)
+    modes = QtWidgets.QWidget()
+    lay = QtWidgets.QVBoxLayout(modes)
+    lay.setContentsMargins(0, 0, 0, 0)
+    lay.addWidget(win.modes_panel)
+    lay.addWidget(win.animation_panel)
+    add_dock(win, "Modes", modes, area.RightDockWidgetArea)
+    add_dock(win, "Distances and signatures", win.distances_panel, area.RightDockWidgetArea)
+
+
+def add_dock(win, title: str, widget: QtWidgets.QWidget, area) -> QtWidgets.QDockWidget:
+    """A dock titled ``title`` holding ``widget`` in a vertical scroll area, wide enough
+    for the widget's contents (no sideways scrolling; labels wrap)."""
+    dock = QtWidgets.QDockWidget(title, win)
+    dock.setMaximumWidth(DOCK_WIDTH)
+    dock.setObjectName(title.replace(" ", "_"))
+    scroll = QtWidgets.QScrollArea()
+    scroll.setWidgetResizable(True)
+    scroll.setWidget(widget)
+    scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+    needed = widget.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width()
+    scroll.setMinimumWidth(min(DOCK_WIDTH, needed + 4))
+    dock.setWidget(scroll)
+    win.addDockWidget(area, dock)
+    return dock
