@@ -32,7 +32,7 @@ from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
 from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
-from ..viewer.pair import SIDES, PairState, PairView
+from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS
 from .dialogs import file_message, offer_open_anyway
 from .viewport import make_viewport
@@ -66,20 +66,7 @@ class PairWindow(QtWidgets.QWidget):
         state_a = main.state
         if state_a.mesh is None:
             raise PairError("Open a mesh first (it becomes mesh A).")
-        kind = state_a.display.distance_kind
-        weights = (state_a.compute_settings.bending, state_a.compute_settings.membrane)
-        self.pair = PairState(
-            main.model.jobs,
-            main.model.cache,
-            state_a.mesh,
-            mesh_b,
-            state_a.mesh_path,
-            path_b,
-            state_a=state_a,
-            k=k,
-            weights=weights,
-            kind=kind,
-        )
+        self.pair = main.viewer.pair(mesh_b, k=k, wait=False, path=path_b)
         self._closed = False
         self._syncing = False
         self._link = None
@@ -378,14 +365,15 @@ class PairWindow(QtWidgets.QWidget):
         link is made (after opening or R: the same direction, each about its own mesh's
         centre), so turning, zooming or panning one view does the same to the other.
         Free cameras: turn B by hand to line it up with A (a rotated copy), then link."""
+        self.pair.set_linked(on)
         self.link_check.blockSignals(True)
-        self.link_check.setChecked(bool(on))
+        self.link_check.setChecked(self.pair.linked)
         self.link_check.blockSignals(False)
         self._link = self._make_link() if on else None
 
     @property
     def linked(self) -> bool:
-        return self.link_check.isChecked()
+        return self.pair.linked
 
     def _make_link(self):
         """(Q, s, focal A, focal B): the similarity x_B = focal_B + s Q (x_A - focal_A)

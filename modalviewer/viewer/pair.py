@@ -89,6 +89,7 @@ class PairEvents(SignalGroup):
     spectra = Signal()
     display = Signal()
     message = Signal(str)
+    linked = Signal(bool)  # the cameras were linked or freed
 
 
 class _Side:
@@ -155,6 +156,7 @@ class PairState:
         self.distance_display = "continuous"
         self.share = DEFAULT_THRESHOLD_SHARE  # of the other mesh's area, threshold display
         self.picked: tuple[str, int] | None = None
+        self.linked = True  # the two views' cameras move together
         self.note = ""  # a warning about the current pair (scale), shown in legends
         self._spectra: dict[tuple[str, str, SpectrumKey], Spectrum] = {}
         self._pending: dict[tuple[str, str, SpectrumKey], Job] = {}
@@ -162,6 +164,12 @@ class PairState:
         self._tables: tuple | None = None  # (ids of both spectra, CrossTables or error)
         self._distance: tuple | None = None  # (tables id, pick, distances)
         self._back: tuple | None = None  # (tables id, side, best match, back match)
+
+    def set_linked(self, on: bool) -> None:
+        """Link the two views' cameras (they keep their relative viewpoint) or free them."""
+        if bool(on) != self.linked:
+            self.linked = bool(on)
+            self.events.linked.emit(self.linked)
 
     # ----------------------------------------------------------- meshes
     def mesh(self, side: str) -> Mesh:

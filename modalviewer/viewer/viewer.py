@@ -744,3 +744,49 @@ class Viewer:
                 tuple(cam["position"]), tuple(cam["focal_point"]), tuple(cam["view_up"])
             )
         return save_comparison(comparison, path, size or VIEW_SIZE, camera, scale)
+
+    # ========================================================== shape pair
+    def pair(self, mesh_b, k: int | None = None, wait: bool = True, strict: bool = True, path=None):
+        """A :class:`~.pair.PairState`: this viewer's mesh as A and ``mesh_b`` (a Mesh or
+        a file) as B, for distances between the two shapes (``pair.pick("a", v)``,
+        ``pair.distance_on("b")``, ``pair.best_match()``).  The distance kind and the
+        Discrete Shells weights are this viewer's; ``k`` modes per spectrum (default 100,
+        fewer on tiny meshes).  With ``wait`` the spectra of both meshes are in when it
+        returns (ComputeError if one failed).  ``path``: the file a given Mesh was read
+        from (its name labels B)."""
+        from ..io import load_mesh
+        from .pair import PairState
+
+        state = self.state
+        if state.mesh is None:
+            raise ComputeError("Open a mesh first (it becomes mesh A).")
+        path_b = Path(path) if path is not None else None
+        if not isinstance(mesh_b, Mesh):
+            path_b = Path(mesh_b)
+            mesh_b = load_mesh(path_b, strict=strict)
+        settings = state.compute_settings
+        pair = PairState(
+            self.jobs,
+            self.cache,
+            state.mesh,
+            mesh_b,
+            state.mesh_path,
+            path_b,
+            state_a=state,
+            k=k,
+            weights=(settings.bending, settings.membrane),
+            kind=state.display.distance_kind,
+        )
+        if wait:
+            self.wait_for_pair(pair)
+        return pair
+
+    def wait_for_pair(self, pair) -> None:
+        """Request the spectra ``pair``'s distance kind needs and wait for them
+        (ComputeError with the reason if one could not be computed)."""
+        for job in pair.request():
+            self.wait_for(job)
+            if job.status != DONE:
+                raise ComputeError(pair.failure() or job.error or job.status)
+        if not pair.ready():
+            raise ComputeError(pair.failure() or "the spectra are not in")

@@ -178,3 +178,29 @@ def test_keep_the_largest_component(viewer, tmp_path):
     assert viewer.mesh.n_components == 2
     repaired = viewer.repair_mesh("largest_component")
     assert viewer.mesh is repaired and repaired.n_vertices == big.n_vertices
+
+
+def test_a_shape_pair_without_a_window(viewer, tmp_path):
+    """Mesh A as loaded, mesh B a rotated, scaled copy: the best match of a vertex on B
+    is the vertex itself or its mirror image (the shapes' spectra do not see a rotation,
+    and unit-area rescaling removes the scale)."""
+    from modalviewer.core.primitives import icosphere
+
+    a = icosphere(2)
+    c, s = np.cos(0.7), np.sin(0.7)
+    rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    bumpy = a.vertices * (1.0 + 0.2 * a.vertices[:, [0]] ** 2)  # not a round sphere
+    viewer.set_mesh(mv.Mesh(bumpy, a.faces))
+    b = mv.Mesh(bumpy @ rotation.T * 1.3, a.faces)
+    viewer.state.set_display(distance_kind="hks")
+    pair = viewer.pair(b, k=30)
+    assert pair.ready() and pair.linked
+    pair.pick("a", 5)
+    d = pair.distance_on("b")
+    assert d.shape == (b.n_vertices,)
+    side, match, _ = pair.best_match()
+    assert side == "b"
+    # the vertex itself or one mirrored by the shape's symmetry: as far from the x axis
+    assert abs(b.vertices[match, 2]) == pytest.approx(abs(b.vertices[5, 2]), abs=0.05)
+    pair.set_linked(False)
+    assert not pair.linked
