@@ -127,7 +127,7 @@ def run(size: str, operator: str, k: int, desktop: bool = False) -> dict:
 
     rng = np.random.default_rng(0)
     kind = KIND[operator]
-    win.show_distance(kind, display="threshold", threshold=0.2)
+    win.show_distance(kind, display="threshold", share=0.2)
     picks = []
     for v in rng.integers(0, mesh.n_vertices, 11):
         t0 = time.perf_counter()

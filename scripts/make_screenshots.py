@@ -36,7 +36,7 @@ def main() -> int:
     win.pick_vertex(2000)
     win.show_distance("vibration", display="continuous")
     win.export_screenshot(OUT / "viewer_vibration_distance.png", colorbar=True)
-    win.show_distance("vibration", display="threshold", threshold=0.15)
+    win.show_distance("vibration", display="threshold", share=0.15)
     win.export_screenshot(OUT / "viewer_vibration_threshold.png", colorbar=True)
     win.close()
     return 0

@@ -32,7 +32,7 @@ def test_2_the_modes_panel_does_not_name_a_mode_that_is_not_shown(window, spot_p
     window.show_mode(31)
     assert window.modes_panel.eigen_label.text().startswith("lambda_31 = ")
     window.pick_vertex(700)
-    window.show_distance("vibration", display="threshold", threshold=0.3)
+    window.show_distance("vibration", display="threshold", share=0.3)
     qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
     label = window.modes_panel.eigen_label.text()
     assert "lambda_31" not in label and label.startswith("Not shown")
@@ -48,7 +48,7 @@ def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
     window.compute("modified_dirichlet", k=20, wait=True)
     window.state.set_display(distance_kind="feature")  # a pick then needs no new spectrum
     window.pick_vertex(50)
-    window.show_distance("feature", display="threshold", threshold=0.2)
+    window.show_distance("feature", display="threshold", share=0.2)
     before = window.state.display
     # the menu's Ctrl+1 with the question answered No: nothing starts
     assert window.open_comparison(["laplacian", "modified_dirichlet"], wait=False) is None
@@ -118,7 +118,7 @@ def test_5_status_and_legend_follow_the_threshold_slider(window, spot_path):
     window.open_mesh(spot_path)
     window.compute("modified_dirichlet", k=30, wait=True)
     window.pick_vertex(1000)
-    d = window.show_distance("feature", display="threshold", threshold=0.5)
+    d = window.show_distance("feature", display="threshold", share=0.5)
     slider = window.distances_panel.threshold_slider
     for position in (50, 200, 600):  # share of the surface, in thousandths
         slider.setValue(position)  # what dragging does
@@ -164,7 +164,7 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     first.show_mode(7)
     first.state.set_isolines(5)
     first.pick_vertex(1234)
-    first.show_distance("feature", display="threshold", threshold=0.25)
+    first.show_distance("feature", display="threshold", share=0.25)
     first.plotter.camera.Azimuth(70)
     first.plotter.camera.Elevation(20)
     image = first.viewport.render_now()

@@ -127,7 +127,7 @@ def test_threshold_display_and_slider(window, spot_path):
     window.open_mesh(spot_path)
     window.compute("modified_dirichlet", k=30, wait=True)
     window.pick_vertex(100)
-    d = window.show_distance("feature", display="threshold", threshold=0.1)
+    d = window.show_distance("feature", display="threshold", share=0.1)
     assert d is not None
     low = _classify(window.viewport.render_now())["blue"]
     window.distances_panel.by_share_check.setChecked(False)  # linear in the largest
@@ -286,7 +286,7 @@ def test_export_field_as_vtp(window, spot_path, tmp_path):
     np.testing.assert_allclose(back.point_data[name], spec.mode(3))
     # a threshold map's title holds "<", which VTK wrote unescaped into the XML
     window.pick_vertex(700)
-    d = window.show_distance("hks", display="threshold", threshold=0.3)
+    d = window.show_distance("hks", display="threshold", share=0.3)
     out = window.export_field(tmp_path / "map.vtp")
     back = pv.read(out)
     name = back.point_data.keys()[0]
