@@ -312,7 +312,7 @@ def _load(path, fix_slivers: bool = False):
     import modalviewer as mv
 
     if fix_slivers:  # before reading: a missing package is found out at once
-        from .viewer.model import REPAIR_PACKAGES
+        from .repair import REPAIR_PACKAGES
 
         module, command = REPAIR_PACKAGES["fix_slivers"]
         try:
@@ -491,7 +491,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except (ValueError, OSError, RuntimeError, MemoryError) as exc:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        from .viewer.model import repair_for_failure
+        from .repair import repair_for_failure
 
         if _BAR["open"]:
             sys.stderr.write("\n")

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .viewer.state import DEFAULT_THRESHOLD_FRACTION
+
 
 @dataclass
 class Panel:
@@ -30,7 +32,7 @@ class Panel:
     marker: int | None = None
     distances: np.ndarray | None = None
     display: str = "continuous"
-    threshold: float = 0.2
+    threshold: float = DEFAULT_THRESHOLD_FRACTION
     azimuth: float = 0.0  # degrees about the up axis, from the viewer's first view
     elevation: float = 0.0
     face_marker: bool = False  # turned about the up axis so the marker faces the camera

@@ -18,14 +18,9 @@ import weakref
 from pathlib import Path
 
 from ..core.operators import OPERATOR_NAMES
+from ..scene.platform import has_display
 
 log = logging.getLogger("modalviewer")
-
-
-def _has_display() -> bool:
-    if sys.platform != "linux":
-        return True
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
 def _commands_epilog() -> str:
@@ -67,19 +62,14 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(levelname)s %(name)s: %(message)s")
-    headless = args.screenshot is not None or not _has_display()
+    headless = args.screenshot is not None or not has_display()
     if headless and "QT_QPA_PLATFORM" not in os.environ:
         os.environ["QT_QPA_PLATFORM"] = "offscreen"
-    if not _has_display():  # render with EGL directly instead of trying X first
-        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    from qtpy import QtWidgets
-
+    from .application import ensure_application
     from .main_window import MainWindow
     from .paths import DEFAULT_MESH, SCREENSHOTS
 
-    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication(sys.argv[:1])
-    app.setApplicationName("modalviewer")
-    app.setOrganizationName("modalviewer")
+    app = ensure_application()
     window = MainWindow()
 
     window_ref = weakref.ref(window)

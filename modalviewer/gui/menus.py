@@ -7,7 +7,7 @@ import html
 
 from qtpy import QtCore, QtGui, QtWidgets
 
-from ..viewer.model import REPAIRS
+from ..repair import REPAIRS
 from . import file_dialogs
 from .pair_window import open_second_mesh_dialog
 

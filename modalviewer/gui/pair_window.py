@@ -17,14 +17,12 @@ window's own display and pick are never changed.  Scripting::
 from __future__ import annotations
 
 import logging
-import os
 from pathlib import Path
 
 import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtWidgets
 
-from ..core.files import atomic_write
 from ..core.laplacian import vertex_normals
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
@@ -530,58 +528,26 @@ class PairWindow(QtWidgets.QWidget):
     # =========================================================== export
     def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
         """Each view rendered at ``scale`` with its legend and colour bar drawn on."""
-        from ..scene.overlay import draw_overlay
+        from ..scene.export import grab
 
         images = []
         for side in SIDES:
-            viewport, scene = self.viewports[side], self.scenes[side]
+            viewport = self.viewports[side]
             if hasattr(viewport, "render_now"):
                 viewport.render_now()  # an off-screen view sizes its plotter here
-            plotter = viewport.plotter
-            overlay = scene.overlay(legend=True)
-            hidden = [a for a in scene.overlay_actors() if a.GetVisibility()]
-            for actor in hidden:
-                actor.SetVisibility(False)
-            try:
-                plotter.render()
-                img = plotter.screenshot(
-                    None, transparent_background=transparent, return_img=True, scale=scale
-                )
-            finally:
-                for actor in hidden:
-                    actor.SetVisibility(True)
-            img = np.ascontiguousarray(img)
-            if overlay:
-                img = draw_overlay(img, overlay, scale * scene.overlay_scale)
-            images.append(img)
+            images.append(grab(viewport.plotter, self.scenes[side], scale, transparent))
         return images
 
     def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
         """Both views side by side, with their legends, in one PNG written atomically."""
-        from PIL import Image
+        from ..scene.export import png_path, save_png, side_by_side
 
-        path = Path(path)
-        if path.suffix.lower() != ".png":
-            path = path.with_suffix(".png")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if not os.access(path.parent, os.W_OK):
-            raise OSError(f"the folder {path.parent} is not writable; choose another one")
-        images = self.grab_images(int(max(1, scale)), transparent)
-        channels = 4 if transparent else 3
-        gap = 4 * int(max(1, scale))
-        height = max(img.shape[0] for img in images)
-        width = sum(img.shape[1] for img in images) + gap
-        canvas = np.zeros((height, width, channels), np.uint8)
-        if not transparent:
-            canvas[:] = 255
-        x = 0
-        for img in images:
-            if img.shape[2] < channels:
-                img = np.dstack([img, np.full(img.shape[:2], 255, np.uint8)])
-            canvas[: img.shape[0], x : x + img.shape[1]] = img[:, :, :channels]
-            x += img.shape[1] + gap
+        path = png_path(path)  # checked before rendering
+        scale = int(max(1, scale))
+        images = self.grab_images(scale, transparent)
+        canvas = side_by_side(images, gap=4 * scale, transparent=transparent)
         self.render_all()
-        return atomic_write(path, lambda tmp: Image.fromarray(canvas).save(tmp, format="PNG"))
+        return save_png(path, canvas)
 
     def _export_dialog(self) -> None:
         from .file_dialogs import pair_screenshot_dialog

@@ -124,7 +124,7 @@ class SpectrumJob(Job):
 
 
 class RepairJob(Job):
-    """A job applying the repair ``repair`` (a name of ``modalviewer.viewer.model.REPAIRS``)
+    """A job applying the repair ``repair`` (a name of ``modalviewer.repair.REPAIRS``)
     to a mesh; its result is the repaired Mesh."""
 
     def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable, repair: str):

@@ -110,7 +110,7 @@ def compute_in_process(
 
 
 def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
-    """Repair ``name`` (see :data:`modalviewer.viewer.model.REPAIRS`) of ``mesh`` in a
+    """Repair ``name`` (see :data:`modalviewer.repair.REPAIRS`) of ``mesh`` in a
     child Python; returns the repaired Mesh with its report."""
     job_path, out_path = _temp_path(".pickle"), _temp_path(".pickle")
     try:
@@ -118,7 +118,7 @@ def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
             job = (name, np.asarray(mesh.vertices), np.asarray(mesh.faces), mesh.report)
             pickle.dump((*job, mesh.file_map), fh)  # the map to the file's vertex numbers
         _run_child(
-            ["modalviewer.viewer.repair_main", job_path, out_path], progress, cancel, "repair"
+            ["modalviewer.processes.repair_main", job_path, out_path], progress, cancel, "repair"
         )
         with open(out_path, "rb") as fh:
             return pickle.load(fh)  # written by our own child process just now

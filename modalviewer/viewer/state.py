@@ -53,6 +53,9 @@ DISTANCE_DISPLAYS = ("continuous", "threshold")
 DEFAULT_THRESHOLD_SHARE = 0.1
 """Share of the surface a first threshold map marks similar (the paper's maps mark a few
 per cent to a tenth)."""
+DEFAULT_THRESHOLD_FRACTION = 0.2
+"""A threshold as a fraction of the largest distance, where none was set and no share
+applies (a map drawn without ``keep_share``)."""
 NEXT_MAP = "next map"
 """:attr:`ViewerState.threshold_map` after a fraction was set with no threshold map on
 screen: the next threshold map keeps the fraction (and measures its share)."""
@@ -137,7 +140,7 @@ class Display:
     mode: int = 0
     distance_kind: str = "vibration"
     distance_display: str = "continuous"
-    threshold: float = 0.2
+    threshold: float = DEFAULT_THRESHOLD_FRACTION
     threshold_share: float = DEFAULT_THRESHOLD_SHARE
     keep_share: bool = True
     signature_sample: int = 50

@@ -43,15 +43,9 @@ from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ..core.spectrum import Spectrum
+from ..repair import repair_for_failure, repair_unavailable
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
-from .model import (
-    ComputeRefused,
-    ViewerModel,
-    cost_estimate,
-    repair_for_failure,
-    repair_unavailable,
-    residual_text,
-)
+from .model import ComputeRefused, ViewerModel, cost_estimate, residual_text
 from .state import SpectrumKey
 from .wording import percent_text
 

@@ -180,7 +180,7 @@ def test_fix_slivers_falls_back_to_local_remeshing(slivered_sphere, monkeypatch)
     # MeshLab's T-vertex collapses do not check the link condition; where they would
     # change the topology (on a 143k-vertex iso-surface with 11k slivers they made edges
     # non-manifold), the slivers' neighbourhood is remeshed instead
-    from modalviewer import repair
+    from modalviewer.repair import slivers as repair
 
     sphere, bad = slivered_sphere
     monkeypatch.setattr(repair, "_METHODS", {"remesh": repair._METHODS["remesh"]})

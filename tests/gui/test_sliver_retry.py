@@ -8,7 +8,7 @@ from qtpy import QtWidgets
 
 import modalviewer as mv
 from modalviewer.core.primitives import add_slivers, icosphere
-from modalviewer.viewer.model import repair_for_failure
+from modalviewer.repair import repair_for_failure
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""A mesh repair in a child process: ``python -m modalviewer.viewer.repair_main IN OUT``.
+"""A mesh repair in a child process: ``python -m modalviewer.processes.repair_main IN OUT``.
 
 IN is a pickle of (repair name, vertices, faces, report, file_map) written by
 :func:`modalviewer.viewer.process.repair_in_process`; OUT receives the repaired Mesh
@@ -20,7 +20,7 @@ def _emit(payload: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     job_path, out_path = sys.argv[1:] if argv is None else argv
     from ..core.mesh import Mesh
-    from .model import apply_repair
+    from ..repair import apply_repair
 
     try:
         with open(job_path, "rb") as fh:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.mesh import Mesh, MeshError, MeshReport, _plural
+from ..core.mesh import Mesh, MeshError, MeshReport, _plural
 
 __all__ = ["SliverReport", "fix_slivers"]
 
