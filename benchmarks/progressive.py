@@ -34,8 +34,10 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.run import make_mesh, save_result  # noqa: E402
 from modalviewer.core.cache import SpectrumCache  # noqa: E402
+from modalviewer.core.operators import OPERATOR_INFO  # noqa: E402
 
-KIND = {"modified_dirichlet": "feature", "laplacian": "hks", "shells": "vibration"}
+KIND = {name: info.distance_kind for name, info in OPERATOR_INFO.items() if info.distance_kind}
+"""The distance each operator's spectrum defines (the registry's)."""
 
 
 def run(size: str, operator: str, k: int) -> dict:
