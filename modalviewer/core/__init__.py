@@ -26,6 +26,7 @@ from .pipeline import ZeroModesWarning, compute_spectrum
 from .shells import normal_shells_hessian, shells_hessian
 from .signatures import SignatureTable, default_times, multiscale_distance, signature
 from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, save_spectrum
+from .truncation import k_for_truncation, truncation_error
 
 __all__ = [
     "CrossTables",
@@ -64,5 +65,7 @@ __all__ = [
     "shells_hessian",
     "signature",
     "stiffness_matrix",
+    "k_for_truncation",
+    "truncation_error",
     "vertex_normals",
 ]
