@@ -59,3 +59,18 @@ def test_the_pair_starts_at_the_main_windows_default_share(tmp_path):
     sphere = icosphere(2)
     pair = PairState(JobQueue(), SpectrumCache(tmp_path), sphere, sphere, k=10)
     assert pair.share == DEFAULT_THRESHOLD_SHARE  # was 0.05 against the main window's 0.1
+
+
+def test_a_continuous_map_names_the_share_its_threshold_map_will_mark(window, spot_path):
+    """Under Xvfb: with the continuous map on screen the threshold label read "(73.0 % of
+    surface)" (the default fraction 0.2 of the largest distance), and switching to the
+    threshold display then marked 10 %: the label now says what the threshold map marks."""
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=20, wait=True)
+    window.state.set_display(distance_kind="hks")
+    window.pick_vertex(1008)
+    assert window.state.display.distance_display == "continuous"
+    label = window.distances_panel.threshold_label.text()
+    assert "(10.0 % of surface)" in label, label
+    window.show_distance(display="threshold")
+    assert "(10.0 % of surface)" in window.distances_panel.threshold_label.text()

@@ -141,14 +141,19 @@ class DistancesPanel(QtWidgets.QWidget):
             select_data(self.display_combo, d.distance_display)
             self.scale_slider.setValue(d.signature_sample)
             dist = state.derived.distance_map()
+            # the fraction a threshold map of these distances uses: with keep_share, until
+            # the map is drawn as one, the fraction that marks the kept share
+            fraction = d.threshold
+            if dist is not None and d.keep_share and d.distance_display != "threshold":
+                fraction = state.derived.threshold_for_share(d.threshold_share, dist)
             if dist is not None and self.by_share_check.isChecked():
-                position = state.derived.surface_share(dist, d.threshold * float(dist.max()))
+                position = state.derived.surface_share(dist, fraction * float(dist.max()))
             else:
-                position = d.threshold
+                position = fraction
             self.threshold_slider.setValue(max(1, int(round(position * SLIDER_STEPS))))
         self.threshold_slider.setEnabled(d.distance_display == "threshold")
         if dist is not None:
-            thr = d.threshold * float(dist.max())
+            thr = fraction * float(dist.max())
             share = 100.0 * state.derived.surface_share(dist, thr)
             self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
         elif state.picked is not None:
