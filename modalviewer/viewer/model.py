@@ -10,6 +10,7 @@ asked to (``show=True``) and the display has not changed since the request.
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +64,43 @@ def cost_estimate(key: SpectrumKey, n_vertices: int) -> tuple[float, float]:
     n_solved = round(COARSE_FRACTION * n_vertices) if key.coarse else n_vertices
     n = info.unknowns(n_solved)
     return estimate_cost(n, min(key.k, n), info.nonzeros(n_solved))
+
+
+MEMORY_SHARE = 0.75
+"""Computations expected to need more than this share of the physical memory are refused
+before they start."""
+
+
+def largest_k_that_fits(key: SpectrumKey, n_vertices: int, available: int) -> int:
+    """The most modes of ``key``'s operator (its other settings kept) whose expected memory
+    stays within :data:`MEMORY_SHARE` of ``available`` bytes; 0 if not even one does."""
+    limit = MEMORY_SHARE * available
+    lo, hi = 0, max(1, key.k)
+    while lo < hi:  # the memory estimate grows with k
+        mid = (lo + hi + 1) // 2
+        if cost_estimate(replace(key, k=mid), n_vertices)[1] <= limit:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+def what_fits(key: SpectrumKey, n_vertices: int, available: int) -> str:
+    """What would fit instead of ``key``: fewer modes, Coarse-to-fine, or neither."""
+    k = largest_k_that_fits(key, n_vertices, available)
+    coarse = replace(key, coarse=True)
+    coarse_fits = not key.coarse and cost_estimate(coarse, n_vertices)[1] <= (
+        MEMORY_SHARE * available
+    )
+    options = []
+    if k >= 1:
+        options.append(f"at most {k} modes fit")
+    if coarse_fits:
+        options.append(f"{key.k} modes with Coarse-to-fine (a decimated copy) fit")
+    if not options:
+        return "Not even one mode fits: use a coarser mesh or a machine with more memory."
+    text = "; ".join(options)
+    return text[0].upper() + text[1:] + "."
 
 
 class ViewerModel:
@@ -124,12 +162,12 @@ class ViewerModel:
         mesh = self.state.mesh
         seconds, needed = cost_estimate(key, mesh.n_vertices)
         available = physical_memory()
-        if available and needed > 0.75 * available:
+        if available and needed > MEMORY_SHARE * available:
             return (
                 f"{operator_info(key.operator).label} with {key.k} modes on "
                 f"{mesh.n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory "
                 f"and {seconds / 60:.0f} min; this machine has {available / 2**30:.1f} GiB. "
-                "Compute fewer modes, or tick Coarse-to-fine to compute on a decimated copy."
+                + what_fits(key, mesh.n_vertices, available)
             )
         return None
 

@@ -346,6 +346,7 @@ def test_too_large_computation_is_refused_up_front(window, spot_path, monkeypatc
     with pytest.raises(main_window.ComputeError, match="GiB of memory"):
         window.compute("shells", k=300, wait=True)
     assert "Coarse-to-fine" in window.last_error and not window.busy
+    assert "modes fit" in window.last_error
 
 
 def test_closing_during_a_computation_stops_it(qtbot, tmp_path):

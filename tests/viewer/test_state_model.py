@@ -500,3 +500,30 @@ def test_the_status_line_says_what_is_computing_before_any_spectrum(model):
     model.jobs.cancel(cancelled)
     model.jobs.wait(cancelled)
     assert not state.computing
+
+
+def test_a_refusal_says_what_would_fit(monkeypatch):
+    """A request too large for the machine names the most modes that fit (checked
+    against the estimate itself) and whether Coarse-to-fine fits."""
+    from modalviewer.core.primitives import icosphere
+    from modalviewer.viewer import model as model_module
+
+    m = model_module.ViewerModel()
+    m.set_mesh(icosphere(4))
+    key = m.state.compute_settings.key("shells", 300)
+    n = m.state.mesh.n_vertices
+    from dataclasses import replace
+
+    # memory for about 150 of the 300 modes asked for
+    needed = model_module.cost_estimate(replace(key, k=150), n)[1]
+    available = int(needed / model_module.MEMORY_SHARE)
+    monkeypatch.setattr(model_module, "physical_memory", lambda: available)
+    message = m.refusal(key)
+    k = model_module.largest_k_that_fits(key, n, available)
+    assert 1 <= k < 300 and f"at most {k} modes fit" in message.lower()
+    limit = model_module.MEMORY_SHARE * available
+    assert model_module.cost_estimate(replace(key, k=k), n)[1] <= limit
+    assert model_module.cost_estimate(replace(key, k=k + 1), n)[1] > limit
+    assert "Coarse-to-fine" in message
+    monkeypatch.setattr(model_module, "physical_memory", lambda: 1024)
+    assert "Not even one mode fits" in m.refusal(key)
