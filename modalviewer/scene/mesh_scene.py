@@ -23,6 +23,10 @@ WHITE = np.array([1.0, 1.0, 1.0])
 ORANGE = np.array([0.96, 0.55, 0.12])
 RED = np.array([0.78, 0.08, 0.08])
 SIMILAR_BLUE = np.array([0.20, 0.45, 0.85])
+# The rest shape behind a deformed mode: a translucent grey copy (faint but visible on
+# the white background of the paper style).
+GHOST_GREY = (0.55, 0.55, 0.6)
+GHOST_OPACITY = 0.18
 
 
 def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
@@ -211,12 +215,14 @@ class MeshScene:
         self._zero_rest = None
         self._zero_disp = None
         self.marker_actor = None
+        self.ghost_actor = None  # the rest shape, faint, behind a displaced surface
         self.picker = vtkCellPicker()
         self.picker.SetTolerance(1e-4)
         self.picker.PickFromListOn()
         self.picker.AddPickList(self.surface_actor)
         self.field_name = ""
         self.clim = (0.0, 1.0)
+        self.clipped = (False, False)  # values beyond the low / high end of clim
         self.kind = "plain"
         self.threshold: float | None = None  # of a map made by show_threshold
         self.style = ""
@@ -265,11 +271,14 @@ class MeshScene:
         isolines: int = 0,
         displacement: np.ndarray | None = None,
         name: str = "",
+        clipped: tuple[bool, bool] = (False, False),
     ) -> None:
         """Colour the surface by ``values`` (n,).
 
         kind: "diverging" (symmetric about zero, orange/white/blue), "sequential"
         (white to red), "threshold" (values are 0/1: blue/white) or "plain".
+        clim: the colour range (values beyond it take the end colours); ``clipped``
+        (low, high) says which ends values lie beyond (the colour bar marks them).
         isolines: number of isolines (the zero level drawn bold for diverging fields).
         displacement: (n, 3) shape of the animation, carried along by the isolines.
         """
@@ -294,6 +303,7 @@ class MeshScene:
         self._mapper.scalar_range = clim
         self._mapper.ScalarVisibilityOn()
         self.clim = clim
+        self.clipped = (bool(clipped[0]), bool(clipped[1]))
         self.kind = kind
         self.field_name = name
         self._overlay_changed()
@@ -427,6 +437,7 @@ class MeshScene:
         self.surface.point_data["field"] = values
         hi = float(np.max(values)) or 1.0
         self.clim = (0.0, hi)
+        self.clipped = (False, False)
         self._mapper.scalar_range = self.clim
         self._mapper.SetInterpolateScalarsBeforeMapping(True)
         self._mapper.ScalarVisibilityOn()
@@ -497,7 +508,7 @@ class MeshScene:
         if self.kind == "threshold":
             labels = self.colorbar_labels or [self.colorbar_title, "the rest"]
             return ColorBar("", colors, (0.0, 1.0), "swatches", labels[:2])
-        return ColorBar(self.colorbar_title, colors, tuple(self.clim))
+        return ColorBar(self.colorbar_title, colors, tuple(self.clim), clipped=self.clipped)
 
     def overlay(self, legend: bool = True, colorbar: bool | None = None) -> Overlay:
         """Legend and colour bar for an export: the legend if ``legend`` and set; the
@@ -599,6 +610,35 @@ class MeshScene:
             if rest is not None:
                 self._move(line, rest, d, s)
 
+    def set_ghost(self, visible: bool) -> None:
+        """Show the rest shape as a faint translucent grey copy (behind a surface drawn
+        displaced, :meth:`set_displacement_scale`), or hide it; no render."""
+        if self.ghost_actor is None:
+            if not visible:
+                return
+            faces = np.hstack([np.full((self.mesh.n_faces, 1), 3), self.mesh.faces]).ravel()
+            rest = pv.PolyData(self.rest_points.copy(), faces)
+            rest.point_data["Normals"] = self.normals
+            rest.GetPointData().SetNormals(rest.GetPointData().GetArray("Normals"))
+            self.ghost_actor = self.plotter.add_mesh(
+                rest,
+                color=GHOST_GREY,
+                opacity=GHOST_OPACITY,
+                interpolation="phong",
+                name="ghost",
+                render=False,
+                reset_camera=False,
+                show_scalar_bar=False,
+                scalars=None,
+                pickable=False,
+            )
+            self.ghost_actor.mapper.ScalarVisibilityOff()
+        self.ghost_actor.SetVisibility(bool(visible))
+
+    @property
+    def ghost_visible(self) -> bool:
+        return self.ghost_actor is not None and bool(self.ghost_actor.GetVisibility())
+
     @staticmethod
     def _move(poly: pv.PolyData, rest: np.ndarray, disp: np.ndarray, s: float) -> None:
         """In place: points = rest + s * disp, then flag the VTK points as modified."""
@@ -647,7 +687,7 @@ class MeshScene:
         )
 
     def remove(self) -> None:
-        for name in ("surface", "iso_actor", "zero_actor", "marker"):
+        for name in ("surface", "iso_actor", "zero_actor", "marker", "ghost"):
             self.plotter.remove_actor(name, render=False)
         for actor in self.overlay_actors():
             self.plotter.renderer.RemoveViewProp(actor)

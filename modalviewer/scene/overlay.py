@@ -18,13 +18,16 @@ MARGIN_PX = 10
 class ColorBar:
     """A colour bar: ``kind`` "continuous" (a gradient through ``colors`` from clim[0] to
     clim[1], labelled at both ends and at 0 when the range straddles it) or "swatches"
-    (one square per colour, labelled by ``labels``)."""
+    (one square per colour, labelled by ``labels``).  ``clipped`` (low, high): values lie
+    beyond that end of a continuous bar; the end gets an arrow head in its colour and its
+    label a "<" or ">"."""
 
     title: str
     colors: list = field(default_factory=list)  # RGB in [0, 1]
     clim: tuple[float, float] = (0.0, 1.0)
     kind: str = "continuous"
     labels: list = field(default_factory=list)
+    clipped: tuple[bool, bool] = (False, False)
 
 
 @dataclass
@@ -141,12 +144,24 @@ def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.nd
                     [xa, y0, x0 + width * (i + 1) / n, y1], fill=_rgba(rgb[i]), outline=None
                 )
             draw.rectangle([x0, y0, x0 + width, y1], outline=black, width=max(1, round(s)))
+            # arrow heads past clipped ends (matplotlib's "extend"), in the end's colour
+            tip = 0.8 * height
+            for end, x_end, sign in ((0, x0, -1.0), (1, x0 + width, 1.0)):
+                if bar.clipped[end]:
+                    draw.polygon(
+                        [(x_end, y0), (x_end + sign * tip, 0.5 * (y0 + y1)), (x_end, y1)],
+                        fill=_rgba(rgb[-1 if end else 0]),
+                        outline=black,
+                        width=max(1, round(s)),
+                    )
             lo, hi = bar.clim
             ticks = [(lo, 0.0), (hi, 1.0)]
             if lo < 0 < hi:
                 ticks.append((0.0, (0.0 - lo) / (hi - lo)))
             for value, pos in ticks:
                 text = colorbar_label(value)
+                if pos in (0.0, 1.0) and bar.clipped[int(pos)]:
+                    text = ("> " if pos else "< ") + text
                 tw = draw.textlength(text, font=font)
                 x = np.clip(x0 + pos * width - 0.5 * tw, 0, w - tw)
                 draw.text((x, y_labels), text, fill=black, font=font)

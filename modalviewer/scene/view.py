@@ -22,9 +22,11 @@ from .mesh_scene import MeshScene
 
 
 def draw_field(scene: MeshScene, field: Field | None) -> None:
-    """Colour ``scene``'s surface by ``field`` (None or "plain": the grey surface); no
+    """Colour ``scene``'s surface by ``field`` (None or "plain": the grey surface), drawn
+    displaced by ``field.deformation`` with the rest shape's ghost as the field says; no
     render.  The one way a :class:`~modalviewer.viewer.derived.Field` becomes a picture,
     in the main view, the compare views and off screen."""
+    scene.set_displacement_scale(0.0)
     if field is None or field.colormap == "plain":
         scene.show_plain()
     elif field.colormap == "threshold":
@@ -37,7 +39,12 @@ def draw_field(scene: MeshScene, field: Field | None) -> None:
             isolines=field.isolines,
             displacement=field.displacement,
             name=field.title,
+            clipped=field.clipped,
         )
+    deformation = field.deformation if field is not None else 0.0
+    if deformation:
+        scene.set_displacement_scale(deformation)
+    scene.set_ghost(bool(field is not None and field.ghost))
 
 
 class StateScene:
@@ -148,13 +155,29 @@ class StateScene:
     def _draw_field(self) -> None:
         field = self.state.derived.field()
         self.field = field
-        self.scene.set_displacement_scale(0.0)
         draw_field(self.scene, field)
+        if self.state.animation.playing:
+            self.scene.set_displacement_scale(0.0)  # the next frame moves it
+        self._show_outline_if_due()
+        self.scene.show_marker(self.state.picked)  # on the surface as drawn
+
+    def _show_outline_if_due(self) -> None:
+        """The boundary outline stays at the rest shape: shown on a still rest shape
+        and with the ghost of a deformed one."""
+        if self.outline_actor is None:
+            return
+        field = self.field
+        deformed = field is not None and field.deformation > 0
+        still = not self.state.animation.playing
+        self.outline_actor.SetVisibility(
+            (still and not deformed) or (field is not None and field.ghost)
+        )
 
     def _show_outline(self, mesh) -> None:
         """The mesh's boundary as thin grey lines: in the paper style a surface facing
         the viewer is as white as the background, so an open mesh (a plate) seen from
-        the front had no visible edge.  Hidden while a mode vibrates (it would stay put)."""
+        the front had no visible edge.  Hidden while a mode vibrates or is drawn deformed
+        (it would stay put), unless the rest shape's ghost is shown."""
         import pyvista as pv
 
         self.plotter.remove_actor("outline", render=False)
@@ -243,10 +266,14 @@ class StateScene:
     # --------------------------------------------------------- animation
     def _on_animation(self) -> None:
         playing = self.state.animation.playing and self.scene is not None
-        if self.outline_actor is not None:
-            self.outline_actor.SetVisibility(not self.state.animation.playing)
+        self._show_outline_if_due()
         if not playing and self.scene is not None:
-            self.scene.set_displacement_scale(0.0)
+            # still: the deformed shape at the amplitude (or the rest shape)
+            deformation = self.state.derived.deformation()
+            if self.field is not None:
+                self.field.deformation = deformation
+            self.scene.set_displacement_scale(deformation)
+            self.scene.show_marker(self.state.picked)
             self.request_render()
         if self.on_animation is not None:
             self.on_animation(playing)
@@ -255,9 +282,7 @@ class StateScene:
         """Move the surface to ``phase`` (radians) of the vibration; returns the time
         this took in s."""
         started = time.perf_counter()
-        amplitude = (
-            self.state.animation.amplitude / 100.0 * 0.25 * self.state.mesh.bounding_box_diagonal
-        )
+        amplitude = self.state.derived.amplitude_length()
         self.scene.set_displacement_scale(amplitude * np.sin(phase))
         self.request_render()
         return time.perf_counter() - started

@@ -1,10 +1,10 @@
 """Values computed from the viewer's state and kept until it changes (no Qt, no VTK).
 
 :class:`DerivedValues` holds every cached value the viewer computes from a
-:class:`~.state.ViewerState`: vertex normals, smoothed normals, the automatic colouring
-of 3D modes, curvature, vertex areas, signature tables, the distance map of the pick, and
-:meth:`DerivedValues.field`, the per-vertex picture the scene draws.  None of it is part
-of the state: it can be dropped and recomputed at any time.
+:class:`~.state.ViewerState`: vertex normals, smoothed normals, the scale a deformed 3D
+mode is drawn at, colour ranges, curvature, vertex areas, signature tables, the distance
+map of the pick, and :meth:`DerivedValues.field`, the per-vertex picture the scene
+draws.  None of it is part of the state: it can be dropped and recomputed at any time.
 
 Ownership: each state has one, created on first use as :attr:`ViewerState.derived
 <.state.ViewerState.derived>` (the state's threshold rule needs the distances, and the
@@ -32,7 +32,10 @@ from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_inf
 from ..core.signatures import SignatureTable, signature
 from ..core.spectrum import Spectrum
 from . import wording
-from .mode_scalar import default_vector_coloring, smoothed_normals, vector_mode_scalar
+from .mode_scalar import smoothed_normals, vector_mode_scalar
+
+ROBUST_PERCENTILE = 99.0
+"""The robust colour range ends at this area-weighted percentile of |value|."""
 
 if TYPE_CHECKING:
     from .state import ViewerState
@@ -45,6 +48,12 @@ class Field:
     colormap : "diverging" (blue / white / orange), "sequential" (white to red),
     "threshold" (blue = similar) or "plain" (no field: the grey surface).
     threshold : for "threshold": values (the distances) up to it are blue.
+    displacement : (n, 3) the mode's shape, its largest vector of length 1.
+    deformation : the scale the surface is drawn displaced by, rest + deformation *
+        displacement (a deformed 3D mode; 0: the rest shape); the animation replaces it.
+    ghost : draw the rest shape faint behind the displaced surface.
+    clim : the colour range; ``clipped`` (low, high): values lie beyond that end (drawn
+        in the end's colour, marked on the colour bar); ``color_range`` the range's rule.
     """
 
     values: np.ndarray
@@ -56,6 +65,20 @@ class Field:
     legend: str = ""
     share_similar: float | None = None
     threshold: float | None = None
+    deformation: float = 0.0
+    ghost: bool = False
+    clipped: tuple[bool, bool] = (False, False)
+    color_range: str = ""
+
+
+def robust_limit(values: np.ndarray, weights: np.ndarray, percent: float = ROBUST_PERCENTILE):
+    """The ``percent`` area-weighted percentile of |values|: the smallest |value| that at
+    least ``percent`` % of the total weight lies at or below."""
+    a = np.abs(np.asarray(values, dtype=np.float64))
+    order = np.argsort(a, kind="stable")
+    cumulative = np.cumsum(np.asarray(weights, dtype=np.float64)[order])
+    i = int(np.searchsorted(cumulative, percent / 100.0 * cumulative[-1]))
+    return float(a[order[min(i, len(a) - 1)]])
 
 
 class DerivedValues:
@@ -118,12 +141,62 @@ class DerivedValues:
         return self._mesh_value("smooth_normals", smoothed_normals)
 
     def vector_coloring(self) -> str:
-        """The colouring of 3D modes in effect: the chosen one, or for "auto" the
-        magnitude on meshes with sharp features and the normal component elsewhere
-        (see :mod:`modalviewer.viewer.mode_scalar`)."""
-        if self.state.style.shell_coloring != "auto":
-            return self.state.style.shell_coloring
-        return self._mesh_value("auto_coloring", default_vector_coloring)
+        """The scalar colouring 3D modes: "normal" (component) or "magnitude" (also of
+        the deformed shape)."""
+        coloring = self.state.style.shell_coloring
+        return "magnitude" if coloring == "deformed" else coloring
+
+    def amplitude_length(self) -> float:
+        """The largest displacement of a mode drawn displaced (deformed or animated):
+        ``animation.amplitude`` percent of a quarter of the bounding-box diagonal."""
+        mesh = self.state.mesh
+        if mesh is None:
+            return 0.0
+        return self.state.animation.amplitude / 100.0 * 0.25 * mesh.bounding_box_diagonal
+
+    def deformation(self) -> float:
+        """The scale a still picture displaces the surface by: :meth:`amplitude_length`
+        for a 3D mode shown "deformed", else 0 (the rest shape)."""
+        state = self.state
+        d = state.display
+        if d.kind != "mode" or state.style.shell_coloring != "deformed":
+            return 0.0
+        spec = state.spectrum(d.operator)
+        return self.amplitude_length() if spec is not None and spec.is_vector else 0.0
+
+    def color_range(self, values: np.ndarray, colormap: str) -> tuple[tuple, tuple, str]:
+        """(clim, clipped (low, high), rule) of ``values`` drawn with ``colormap``
+        ("diverging": symmetric about 0; else from 0) under ``style.color_range``; the
+        rule is the one applied ("auto" resolved: robust except for modes)."""
+        style, values = self.state.style, np.asarray(values, dtype=np.float64)
+        rule = style.color_range
+        if rule == "auto":
+            rule = "symmetric" if self.state.display.kind == "mode" else "robust"
+        if rule == "limits" and style.color_limits is not None:
+            lo, hi = style.color_limits
+        else:
+            if rule == "robust":
+                a = robust_limit(values, self.vertex_areas())
+            else:
+                rule = "symmetric"
+                a = float(np.max(np.abs(values))) if values.size else 0.0
+            a = a or 1.0
+            lo, hi = (-a, a) if colormap == "diverging" else (0.0, a)
+        tol = 1e-12 * max(abs(lo), abs(hi))
+        clipped = (
+            bool(values.size and values.min() < lo - tol),
+            bool(values.size and values.max() > hi + tol),
+        )
+        return (float(lo), float(hi)), clipped, rule
+
+    def _ranged(self, field: Field) -> Field:
+        """``field`` with its colour range, and the range named in its legend."""
+        field.clim, field.clipped, field.color_range = self.color_range(
+            field.values, field.colormap
+        )
+        note = wording.range_note(field.color_range, field.clim, field.clipped)
+        field.legend = f"{field.legend}\n{note}" if field.legend else note
+        return field
 
     def curvature(self) -> np.ndarray:
         """(n,) total curvature sqrt(k1^2 + k2^2) of the mesh."""
@@ -253,13 +326,17 @@ class DerivedValues:
             j = int(np.clip(d.mode, 0, spec.k - 1))
             scalar, disp = self.mode_fields(spec, j)
             magnitude = spec.is_vector and self.vector_coloring() == "magnitude"
-            return Field(
-                scalar,
-                "sequential" if magnitude else "diverging",
-                isolines=state.style.isolines,
-                displacement=disp,
-                title=f"{operator_info(d.operator).short_label} mode {j}{mark}",
-                legend=wording.legend(state, self),
+            return self._ranged(
+                Field(
+                    scalar,
+                    "sequential" if magnitude else "diverging",
+                    isolines=state.style.isolines,
+                    displacement=disp,
+                    deformation=self.deformation(),
+                    ghost=state.style.ghost and self.deformation() > 0,
+                    title=f"{operator_info(d.operator).short_label} mode {j}{mark}",
+                    legend=wording.legend(state, self),
+                )
             )
         if d.kind == "distance":
             dist = self.distance_map()
@@ -276,28 +353,31 @@ class DerivedValues:
                     legend=wording.legend(state, self),
                     share_similar=self.surface_share(dist, thr),
                 )
-            return Field(dist, "sequential", title=name + mark, legend=wording.legend(state, self))
+            return self._ranged(
+                Field(dist, "sequential", title=name + mark, legend=wording.legend(state, self))
+            )
         if d.kind == "signature":
             operator = operator_for_distance(d.distance_kind)
             if not self.has_signatures(operator):
                 return plain
             t = self.signature_time()
             _, values = signature(state.spectrum(operator), [t])
-            return Field(
-                values[:, 0],
-                "sequential",
-                isolines=state.style.isolines,
-                title=f"signature t = {t:.3g}{mark}",
-                legend=wording.legend(state, self),
+            return self._ranged(
+                Field(
+                    values[:, 0],
+                    "sequential",
+                    isolines=state.style.isolines,
+                    title=f"signature t = {t:.3g}{mark}",
+                    legend=wording.legend(state, self),
+                )
             )
         if d.kind == "curvature":
-            curvature = self.curvature()
-            hi = float(np.percentile(curvature, 98)) or 1.0
-            return Field(
-                curvature,
-                "sequential",
-                clim=(0.0, hi),
-                title="curvature",
-                legend=wording.legend(state, self),
+            return self._ranged(
+                Field(
+                    self.curvature(),
+                    "sequential",
+                    title="curvature",
+                    legend=wording.legend(state, self),
+                )
             )
         return plain

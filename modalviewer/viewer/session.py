@@ -73,6 +73,9 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
             "shell_coloring": state.style.shell_coloring,
             "colorbar": state.style.colorbar,
             "render": state.style.render,
+            "ghost": state.style.ghost,
+            "color_range": state.style.color_range,
+            "color_limits": list(state.style.color_limits) if state.style.color_limits else None,
         },
         "animation": {"amplitude": state.animation.amplitude, "speed": state.animation.speed},
         "camera": state.camera,
@@ -154,6 +157,9 @@ def restore_session(model, path) -> Restored:
     state.set_shell_coloring(str(style.get("shell_coloring", state.style.shell_coloring)))
     state.set_colorbar(bool(style.get("colorbar", True)))
     state.set_render_style(str(style.get("render", "paper")))
+    state.set_ghost(bool(style.get("ghost", True)))
+    limits = style.get("color_limits")
+    state.set_color_range(str(style.get("color_range", "auto")), limits)
     anim = data.get("animation") or {}
     state.set_animation(**_known(type(state.animation), anim))
     settings = ComputeSettings(**_known(ComputeSettings, data.get("compute_settings")))

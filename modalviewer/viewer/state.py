@@ -25,7 +25,8 @@ changed the state (the GUI thread in the viewer):
 - ``spectra(operator)``: a spectrum of ``operator`` was added or replaced.
 - ``display()``: what is drawn changed (:class:`Display`), including the threshold
   (also when the threshold rule gave a new map its fraction).
-- ``style()``: isolines, colouring of 3D modes, colour bar, render style.
+- ``style()``: isolines, how 3D modes are shown, the rest-shape ghost, the colour range,
+  colour bar, render style.
 - ``pick()``: the picked vertex changed (:attr:`ViewerState.picked` is the mesh's index;
   what is shown and saved is :attr:`ViewerState.picked_file_vertex`, the file's number).
 - ``compute_settings()``: operator, k, weights or options of the next computation.
@@ -59,7 +60,16 @@ applies (a map drawn without ``keep_share``)."""
 NEXT_MAP = "next map"
 """:attr:`ViewerState.threshold_map` after a fraction was set with no threshold map on
 screen: the next threshold map keeps the fraction (and measures its share)."""
-SHELL_COLORINGS = ("auto", "normal", "magnitude")
+SHELL_COLORINGS = ("deformed", "normal", "magnitude")
+"""How a 3D vibration mode is shown: "deformed" (the surface displaced by the mode at the
+amplitude, coloured by the displacement magnitude), "normal" (its normal component
+against smoothed normals on the rest shape) or "magnitude" (its magnitude on the rest
+shape).  Sessions and settings holding the former "auto" get "deformed"."""
+COLOR_RANGES = ("auto", "symmetric", "robust", "limits")
+"""Colour ranges: "symmetric" about the largest |value| (sequential fields: 0 to the
+largest value), "robust" (the 99th area-weighted percentile of |value|, beyond it
+clipped), "limits" (:attr:`_Style.color_limits`), "auto" (robust for distances,
+signatures and curvature, where one extreme dominates; symmetric for modes)."""
 RENDER_STYLES = ("paper", "shaded")
 
 
@@ -182,7 +192,10 @@ class ViewerEvents(SignalGroup):
 @dataclass
 class _Style:
     isolines: int = 12
-    shell_coloring: str = "auto"  # auto: magnitude on meshes with sharp features
+    shell_coloring: str = "deformed"  # 3D modes: one of SHELL_COLORINGS
+    ghost: bool = True  # the rest shape, faint, behind a deformed 3D mode
+    color_range: str = "auto"  # one of COLOR_RANGES
+    color_limits: tuple[float, float] | None = None  # (low, high) of the "limits" range
     render: str = "paper"  # paper: white zero, saturated colours; shaded: light kit
     colorbar: bool = True  # legend and colour bar, on screen and in exports
 
@@ -190,7 +203,9 @@ class _Style:
 @dataclass
 class Animation:
     playing: bool = False
-    amplitude: int = 8  # percent of a quarter of the bounding-box diagonal
+    # largest displacement of a mode, in percent of a quarter of the bounding-box diagonal
+    # (40: a tenth of the diagonal), of the deformed shape and of the animation's peak
+    amplitude: int = 40
     speed: int = 30  # tenths of a radian per second
 
 
@@ -347,10 +362,36 @@ class ViewerState:
             self.events.style.emit()
 
     def set_shell_coloring(self, coloring: str) -> None:
+        """How 3D modes are shown, one of :data:`SHELL_COLORINGS` ("auto" -> "deformed")."""
+        coloring = "deformed" if coloring == "auto" else coloring
         if coloring not in SHELL_COLORINGS:
             raise ValueError(f"colouring must be one of {SHELL_COLORINGS}")
         if coloring != self.style.shell_coloring:
             self.style.shell_coloring = coloring
+            self.events.style.emit()
+
+    def set_ghost(self, on: bool) -> None:
+        """Show the rest shape as a faint ghost behind a deformed 3D mode."""
+        if bool(on) != self.style.ghost:
+            self.style.ghost = bool(on)
+            self.events.style.emit()
+
+    def set_color_range(self, mode: str, limits: tuple[float, float] | None = None) -> None:
+        """The colour range, one of :data:`COLOR_RANGES`; ``limits`` (low < high) sets
+        :attr:`_Style.color_limits` ("limits" needs them, given now or before)."""
+        if mode not in COLOR_RANGES:
+            raise ValueError(f"colour range must be one of {COLOR_RANGES}")
+        if limits is not None:
+            lo, hi = (float(x) for x in limits)
+            if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+                raise ValueError("colour limits need low < high")
+            limits = (lo, hi)
+        else:
+            limits = self.style.color_limits
+        if mode == "limits" and limits is None:
+            raise ValueError("the 'limits' colour range needs limits (low, high)")
+        if (mode, limits) != (self.style.color_range, self.style.color_limits):
+            self.style.color_range, self.style.color_limits = mode, limits
             self.events.style.emit()
 
     def set_render_style(self, style: str) -> None:

@@ -87,7 +87,11 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         elif state.is_coarse(d.operator):
             value += " (coarse-to-fine: approximate)"
         colours = "blue +, white 0, orange -"
-        if spec.is_vector and derived.vector_coloring() == "magnitude":
+        if spec.is_vector and state.style.shell_coloring == "deformed":
+            colours = "deformed shape, white 0 to red: displacement magnitude"
+            if state.style.ghost:
+                colours += "; grey: rest shape"
+        elif spec.is_vector and derived.vector_coloring() == "magnitude":
             colours = "white 0 to red: displacement magnitude"
         elif spec.is_vector:
             colours += " (normal component, smoothed normals)"
@@ -114,8 +118,26 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
         return f"{word[d.distance_kind]} signature at t = {derived.signature_time():.3g}"
     if d.kind == "curvature":
-        return "Curvature sqrt(k1^2 + k2^2), white 0 to red (98th percentile)"
+        return "Curvature sqrt(k1^2 + k2^2), white 0 to red"
     return ""
+
+
+def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool]) -> str:
+    """The legend's line naming the colour range ``rule`` ("symmetric", "robust",
+    "limits") of ``clim`` and the clipped ends."""
+    from .derived import ROBUST_PERCENTILE
+
+    lo, hi = clim
+    if rule == "robust":
+        text = f"robust range: {ROBUST_PERCENTILE:g}th percentile of |value| by area"
+    elif rule == "limits":
+        text = f"range: limits {lo:.3g} .. {hi:.3g}"
+    else:
+        text = "range: the largest |value|"
+    ends = [f"< {lo:.3g}"] * clipped[0] + [f"> {hi:.3g}"] * clipped[1]
+    if ends:
+        text += f" ({' and '.join(ends)} clipped)"
+    return text
 
 
 def summary(state: ViewerState, derived: DerivedValues | None = None) -> str:
