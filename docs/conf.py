@@ -35,6 +35,12 @@ extensions = [
     "sphinx.ext.napoleon",
     "docstrings",
     "benchmark_tables",
+    # The gallery runs examples/gallery/*.py and shows the PNGs each writes with the
+    # viewer's own renderer.  sphinx-gallery would need a custom image scraper for
+    # those files (it collects matplotlib figures) and rewrites the scripts into its
+    # own page layout; the small extension in _ext/gallery.py runs each script in a
+    # temporary folder and re-runs only scripts whose text changed.
+    "gallery",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
