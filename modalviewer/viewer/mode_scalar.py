@@ -1,5 +1,5 @@
 """The scalar that colours a mode: the mode itself for scalar operators; for 3D vibration
-modes (Discrete Shells) its normal component or its magnitude.
+modes (Discrete Shells) its magnitude or its normal component.
 
 Choice, measured by the roughness of the coloured scalar f, its Rayleigh quotient
 f^T S f / f^T M f under the cotan Laplacian (Discrete Shells modes 6-15):
@@ -15,12 +15,10 @@ f^T S f / f^T M f under the cotan Laplacian (Discrete Shells modes 6-15):
 - On a mesh with sharp features the normal itself turns by up to 90 degrees across an
   edge, so any normal component changes quickly there; the magnitude |Phi| does not
   (machined part: 0.11-0.31, as smooth as the mode's x, y, z components, 0.26-0.73).
-  :func:`default_vector_coloring` therefore proposes the magnitude when the edges with a
-  dihedral angle above ``SHARP_DEGREES`` are at least ``SHARP_LENGTH`` times as long
-  as the square root of the surface area (a measure that does not change with the mesh
-  resolution: a box 5.0 at 3.6k, 14k and 57k vertices; machined part 9.9, double torus
-  10.0), and the normal component elsewhere (spot 1.3, homer 1.4, folded plate 0.7,
-  the hands 0.14).
+
+The viewer draws 3D modes as the deformed shape by default (the surface displaced by the
+mode, coloured by |Phi|: :meth:`.derived.DerivedValues.deformation`); these colourings
+on the rest shape are the options.
 """
 
 from __future__ import annotations
@@ -33,8 +31,6 @@ from ..core.laplacian import lumped_masses, stiffness_matrix, vertex_normals
 from ..core.mesh import Mesh
 
 NORMAL_SMOOTHING = 2.0  # diffusion radius in mean edge lengths
-SHARP_DEGREES = 40.0
-SHARP_LENGTH = 3.0
 
 
 def mean_edge_length(mesh: Mesh) -> float:
@@ -79,26 +75,3 @@ def mode_scalar(spec, j: int, normals: np.ndarray, coloring: str = "normal") -> 
     :func:`vector_mode_scalar` for 3D modes (``normals`` from :func:`smoothed_normals`)."""
     phi = spec.mode(j)
     return vector_mode_scalar(phi, normals, coloring) if spec.is_vector else np.asarray(phi)
-
-
-def sharp_edge_length(mesh: Mesh, degrees: float = SHARP_DEGREES) -> float:
-    """Total length of the interior edges whose dihedral angle (between the two face
-    normals) exceeds ``degrees``, divided by the square root of the surface area."""
-    v, f = mesh.vertices, mesh.faces
-    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    area = 0.5 * float(np.linalg.norm(n, axis=1).sum())
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-    face = np.tile(np.arange(len(f)), 3)
-    order = np.lexsort((edges[:, 1], edges[:, 0]))
-    edges, face = edges[order], face[order]
-    pair = np.flatnonzero(np.all(edges[1:] == edges[:-1], axis=1)) + 1  # interior edges
-    cos = np.einsum("ij,ij->i", n[face[pair]], n[face[pair - 1]])
-    sharp = pair[cos < np.cos(np.radians(degrees))]
-    length = np.linalg.norm(v[edges[sharp, 0]] - v[edges[sharp, 1]], axis=1).sum()
-    return float(length) / max(np.sqrt(area), 1e-300)
-
-
-def default_vector_coloring(mesh: Mesh) -> str:
-    """ "magnitude" on meshes with sharp features, else "normal" (see the module text)."""
-    return "magnitude" if sharp_edge_length(mesh) >= SHARP_LENGTH else "normal"

@@ -8,8 +8,6 @@ from modalviewer.core.laplacian import lumped_masses, stiffness_matrix, vertex_n
 from modalviewer.core.mesh import Mesh
 from modalviewer.core.primitives import icosphere
 from modalviewer.viewer.mode_scalar import (
-    default_vector_coloring,
-    sharp_edge_length,
     smoothed_normals,
     vector_mode_scalar,
 )
@@ -57,15 +55,3 @@ def test_normal_component_against_smoothed_normals_is_smoother_at_sharp_edges():
     assert np.allclose(magnitude, np.linalg.norm(phi, axis=1))
     with pytest.raises(ValueError, match="unknown colouring"):
         vector_mode_scalar(phi, None, "curl")
-
-
-def test_default_colouring_is_the_magnitude_on_meshes_with_sharp_features():
-    # the 12 box edges, 18 long, over the square root of the area 13: 4.99 at any
-    # resolution
-    for edge in (0.12, 0.06):
-        box = _box(edge=edge)
-        assert sharp_edge_length(box) == pytest.approx(18.0 / np.sqrt(13.0), rel=1e-9)
-        assert default_vector_coloring(box) == "magnitude"
-    sphere = icosphere(3)
-    assert sharp_edge_length(sphere) == 0.0
-    assert default_vector_coloring(sphere) == "normal"
