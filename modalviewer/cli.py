@@ -191,6 +191,7 @@ def _run(args) -> int:
 
         prepare_compute_process()  # this process exists to compute (see processes.memory)
         mesh = _load(args.mesh, args.fix_slivers)
+        _refuse_if_too_large(mesh, args.operator, args.k, args.preview)
         with _warnings_printed():
             spec = mv.compute_spectrum(
                 mesh,
@@ -300,6 +301,28 @@ def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
     else:
         value = state.derived.threshold_for_share(args.share, d) * float(d.max())
     return value, state.derived.surface_share(d, value)
+
+
+def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
+    """The viewer's memory check before an exact computation starts: a ValueError saying
+    what would fit where it would need more than its share of this machine's memory."""
+    if preview:
+        return
+    from .viewer.model import MEMORY_SHARE, cost_estimate, physical_memory, what_fits
+    from .viewer.state import ComputeSettings
+
+    key = ComputeSettings().key(operator, k)
+    seconds, needed = cost_estimate(key, mesh.n_vertices)
+    available = physical_memory()
+    if available and needed > MEMORY_SHARE * available:
+        fits = what_fits(key, mesh.n_vertices, available).replace(
+            "with Coarse-to-fine (a decimated copy)", "on a decimated copy of the mesh"
+        )
+        raise ValueError(
+            f"{operator} with {k} modes on {mesh.n_vertices} vertices needs about "
+            f"{needed / 2**30:.1f} GiB of memory; this machine has "
+            f"{available / 2**30:.1f} GiB. {fits}"
+        )
 
 
 class _Unavailable(Exception):

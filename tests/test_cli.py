@@ -234,3 +234,27 @@ def test_help_lists_the_subcommands():
     assert out.returncode == 0, out.stderr
     for command in COMMANDS:
         assert f"\n  {command} " in out.stdout, out.stdout
+
+
+def test_compute_refuses_what_does_not_fit_and_says_what_would(tmp_path, monkeypatch, capsys):
+    """As in the viewer: an exact computation expected to need more than its share of the
+    machine's memory is refused before it starts, with the most modes that fit."""
+    from modalviewer import cli
+    from modalviewer.viewer import model
+
+    monkeypatch.setattr(model, "physical_memory", lambda: 64 * 2**20)  # 64 MiB
+    code = cli.main(
+        [
+            "compute",
+            str(ASSETS / "spot.obj"),
+            "--operator",
+            "shells",
+            "-k",
+            "300",
+            "-o",
+            str(tmp_path / "s.npz"),
+        ]
+    )
+    err = capsys.readouterr().err
+    assert code == 1 and "GiB of memory" in err and "modes fit" in err
+    assert not (tmp_path / "s.npz").exists()
