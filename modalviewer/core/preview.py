@@ -460,45 +460,66 @@ error lies in the modes just above them, which the estimate does not see (bumpy 
 the tests, 20 modes: 0.9 % measured, 0.05 % estimated)."""
 
 
+ROW_CHUNK = 16384
+"""Rows per chunk of the refinement's dense (N, c) x (c, c) products: each is written
+in place chunk by chunk, so no second (N, c) array is alive at once."""
+
+
+def _rows(n: int):
+    return (slice(i, min(i + ROW_CHUNK, n)) for i in range(0, n, ROW_CHUNK))
+
+
 def _subspace_step(
     K,
     mass: np.ndarray,
     solver,
     lam: np.ndarray,
     U: np.ndarray,
-    KU: np.ndarray,
     keep: int | None = None,
 ):
     """Rayleigh-Ritz in ``span [U, S M U]`` with ``S = (K - shift M)^-1`` (shift below
     the spectrum; ``solver`` holds its factorisation): one step of shifted subspace
     iteration that keeps U in the space, so no Ritz value rises.  (lam, U) are Ritz
-    pairs (``U^T K U = diag(lam)``, U Mass-orthonormal), ``KU = K U``.
+    pairs (``U^T K U = diag(lam)``, U Mass-orthonormal).
 
     Subspace iteration multiplies each mode's share by ``1 / (lam - shift)``, so modes a
-    smooth space misses (a cow's tail swinging, ten times below the preview's lowest
-    value) come in after one step.  Returns (lam, X, KX): ``keep`` pairs (default: as
-    many as U has columns), X Mass-orthonormal.
+    smooth space misses come in after one step.  Returns (lam, X): ``keep`` pairs
+    (default: as many as U has columns), X Mass-orthonormal.
 
-    Dense (N, c) x (c, c) products dominate after the solve, so there are few: one
+    Memory: besides U, at most two (N, c) arrays are alive (the new directions Y and
+    ``K Y``); the dense (N, c) x (c, c) products are done in place by row chunks.  One
     Gram-Schmidt pass against U (directions left with less than 1e-6 of their norm are
     dropped, so the pass leaves U and the rest orthogonal to about 1e-10), U's own block
-    of the projected K from lam, and ``K X`` as a sparse product."""
+    of the projected K from lam."""
     import scipy.linalg as la
 
     c = U.shape[1] if keep is None else int(keep)
-    MU = mass[:, None] * U
-    Y = solver.solve(MU)
+    n = U.shape[0]
+    Y = solver.solve(mass[:, None] * U)
     # unit Mass norm first: a zero mode's column is 1/|shift| times larger than the rest
-    Y /= np.sqrt(np.einsum("ij,ij->j", Y, mass[:, None] * Y))
-    Y -= U @ (MU.T @ Y)
-    del MU
+    Y /= np.sqrt(np.einsum("ij,ij,i->j", Y, Y, mass))
+    UtMY = np.zeros((U.shape[1], Y.shape[1]))
+    for rows in _rows(n):
+        UtMY += U[rows].T @ (mass[rows, None] * Y[rows])
+    for rows in _rows(n):
+        Y[rows] -= U[rows] @ UtMY
     # converged pairs give directions already in U: dropped
-    norms = np.sqrt(np.einsum("ij,ij->j", Y, mass[:, None] * Y))
-    Y = Y[:, norms > 1e-6] / norms[norms > 1e-6]
-    gram = Y.T @ (mass[:, None] * Y)
+    norms = np.sqrt(np.einsum("ij,ij,i->j", Y, Y, mass))
+    ok = norms > 1e-6
+    if ok.all():
+        Y /= norms
+    else:
+        Y = Y[:, ok] / norms[ok]
+    gram = np.zeros((Y.shape[1], Y.shape[1]))
+    for rows in _rows(n):
+        gram += Y[rows].T @ (mass[rows, None] * Y[rows])
     w, E = np.linalg.eigh(0.5 * (gram + gram.T))
     live = w > 1e-10 * max(float(w.max(initial=0.0)), 1e-300)
-    Y = Y @ (E[:, live] / np.sqrt(w[live]))
+    T = E[:, live] / np.sqrt(w[live])
+    width = T.shape[1]
+    for rows in _rows(n):  # Y <- Y T in place (T has at most as many columns as Y)
+        Y[rows, :width] = Y[rows] @ T
+    Y = Y[:, :width]
     KY = threaded_product(K, Y)
     H_uy = U.T @ KY
     H_yy = Y.T @ KY
@@ -507,8 +528,9 @@ def _subspace_step(
     lam, C = la.eigh(H, subset_by_index=[0, min(c, H.shape[0]) - 1])
     u = U.shape[1]
     X = U @ C[:u]
-    X += Y @ C[u:]
-    return lam, X, threaded_product(K, X)
+    for rows in _rows(n):
+        X[rows] += Y[rows] @ C[u:]
+    return lam, X
 
 
 REFINE_GUARD = 0.25
@@ -644,13 +666,17 @@ def preview_spectrum(
         c, lam_b = lam.shape[0], lam
         # guard vectors: the last wanted pairs converge at the rate lam_c / lam_(c+guard)
         block = max(c, min(c + max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)), K.shape[0] // 2))
+        if solver is not None:
+            del KU, basis, Kr, Mr  # not needed while refining; K U is made again after
         while solver is not None and refinement["steps"] < REFINE_STEPS:
             report("preview: refining", 0.94 + 0.02 * refinement["steps"])
-            lam_b, U, KU = _subspace_step(K, mass, solver, lam_b, U, KU, keep=block)
+            lam_b, U = _subspace_step(K, mass, solver, lam_b, U, keep=block)
             refinement["steps"] += 1
+        del solver  # the factor, before K U is formed
         lam = lam_b[:c]
-        U, KU = U[:, :c], KU[:, :c]
         if refinement["steps"]:
+            U = np.ascontiguousarray(U[:, :c])
+            KU = threaded_product(K, U)
             res, eta = _residual_norms(KU, mass, lam, U, lam_scale, precondition)
             est, scale = estimated_errors(K, mass, lam, U, KU, precondition, eta, lam_scale)
         seconds["refinement"] = time.perf_counter() - t
