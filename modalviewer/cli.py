@@ -65,6 +65,34 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _view(text: str):
+    from .viewer.camera import parse_view
+
+    try:
+        return parse_view(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _camera_arguments(parser) -> None:
+    from .viewer.camera import UP_CHOICES
+
+    parser.add_argument(
+        "--up",
+        choices=UP_CHOICES,
+        default="auto",
+        help="the mesh's up axis (auto: +Z where the mesh clearly stands on the XY plane, else +Y)",
+    )
+    parser.add_argument(
+        "--view",
+        type=_view,
+        default="canonical",
+        metavar="VIEW",
+        help="camera: canonical (the viewer's first view), +x, -x, +y, -y, +z, -z (from "
+        "that side), iso, or AZ,EL (degrees about the up axis and toward it from the front)",
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="modalviewer", description="Headless modal shape analysis.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -95,6 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--isolines", type=int, default=12)
     r.add_argument("--size", type=_size, default=(1024, 768))
     r.add_argument("--transparent", action="store_true")
+    _camera_arguments(r)
     r.add_argument("-o", "--output", required=True)
     r.add_argument(
         "--fix-slivers",
@@ -136,6 +165,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument("--size", type=_size, default=(1024, 768))
     d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
+    _camera_arguments(d)
     d.add_argument(
         "--csv",
         default=None,
@@ -239,6 +269,7 @@ def _run(args) -> int:
         if not 0 <= args.mode < spec.k:
             raise ValueError(f"--mode must be between 0 and {spec.k - 1}")
         viewer.show_mode(args.mode)
+        viewer.set_view(args.view, up=args.up)
         written = viewer.export_screenshot(
             args.output, transparent=args.transparent, size=args.size
         )
@@ -270,6 +301,7 @@ def _run(args) -> int:
             viewer.show_distance(args.kind, display="continuous")
         else:
             viewer.show_distance(args.kind, display="threshold", threshold=marked[0])
+        viewer.set_view(args.view, up=args.up)
         written = viewer.export_screenshot(args.output, size=args.size)
         viewer.close()
         _wrote(written, f"{_png(written)}, {args.kind} distance map")

@@ -69,6 +69,7 @@ class StateScene:
         state.events.pick.connect(self._on_pick)
         state.events.animation.connect(self._on_animation)
         state.events.camera.connect(self._apply_camera)
+        state.events.up_axis.connect(self._on_up_axis)
 
     # -------------------------------------------------------------- mesh
     def sync(self) -> None:
@@ -89,6 +90,7 @@ class StateScene:
             (events.pick, self._on_pick),
             (events.animation, self._on_animation),
             (events.camera, self._apply_camera),
+            (events.up_axis, self._on_up_axis),
         ):
             event.disconnect(slot)
         if self.scene is not None:
@@ -109,6 +111,7 @@ class StateScene:
                 self.plotter, mesh, self.state.derived.normals, style=self.state.style.render
             )
             self._show_outline(mesh)
+            self.scene.up_axis = self.state.derived.up_axis()
             self.reset_camera()
         self._update_colorbar()
         self.request_render()
@@ -124,6 +127,7 @@ class StateScene:
             state.picked if d.kind == "distance" else None,
             id(spec),
             state.t_range,
+            state.style.log_signature,
         )
 
     def redraw(self) -> None:
@@ -233,6 +237,12 @@ class StateScene:
         if self.scene is not None:
             self.scene.reset_camera()
             self.request_render()
+
+    def _on_up_axis(self) -> None:
+        """A chosen up axis: the canonical view for it."""
+        if self.scene is not None:
+            self.scene.up_axis = self.state.derived.up_axis()
+            self.reset_camera()
 
     def camera_preset(self, name: str) -> None:
         """View from a side ("+x" ... "-z"), "isometric" or "canonical"."""

@@ -265,6 +265,145 @@ def preset_view(vertices, name: str, up=None) -> Camera:
     return look_from(vertices, direction, screen_up)
 
 
+UP_CHOICES = ("auto", *AXES)
+"""What an up axis can be set to: "auto" (:func:`detect_up`) or an axis."""
+FLAT_ASPECT = 0.35  # a shape thinner than this along z (a plate) gets no +Z claim
+SUPPORT_SLICE = 0.04  # the bottom slice of the extent the supports (legs) are found in
+BASE_SLICE = 0.01  # the bottom slice a flat base lies in
+BASE_SHARE = 0.02  # share of the area a flat base must hold
+BASE_NORMAL = 0.985  # |n . axis| of a face lying flat
+BASE_SPAN = 0.5  # share of the horizontal extents a base must span
+
+
+def _supports(v: np.ndarray, f: np.ndarray, axis: int) -> int:
+    """The number of separate pieces (connected by the mesh's edges) of the surface in
+    the bottom ``SUPPORT_SLICE`` of its extent along ``axis``: the feet it stands on."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+
+    x = v[:, axis]
+    low = x <= x.min() + SUPPORT_SLICE * max(float(np.ptp(x)), 1e-300)
+    index = np.full(len(v), -1)
+    index[low] = np.arange(int(low.sum()))
+    edges = np.vstack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    edges = edges[low[edges[:, 0]] & low[edges[:, 1]]]
+    n = int(low.sum())
+    graph = sp.coo_matrix((np.ones(len(edges)), (index[edges[:, 0]], index[edges[:, 1]])), (n, n))
+    return int(connected_components(graph, directed=False)[0])
+
+
+def _flat_base(v: np.ndarray, f: np.ndarray, axis: int) -> float:
+    """The share of the surface's area lying flat (normal along ``axis``) in the bottom
+    ``BASE_SLICE`` of its extent along ``axis``: a base it stands on; 0 unless the base
+    spans at least ``BASE_SPAN`` of the extent along both other axes."""
+    x0, x1, x2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    n = np.cross(x1 - x0, x2 - x0)
+    area = np.linalg.norm(n, axis=1)
+    total = float(area.sum()) or 1.0
+    x = v[:, axis]
+    low = x <= x.min() + BASE_SLICE * max(float(np.ptp(x)), 1e-300)
+    flat = np.abs(n[:, axis]) >= BASE_NORMAL * np.maximum(area, 1e-300)
+    base = flat & low[f].all(axis=1)
+    if not base.any():
+        return 0.0
+    others = [a for a in range(3) if a != axis]
+    span = np.ptp(v[f[base].ravel()][:, others], axis=0)
+    if np.any(span < BASE_SPAN * np.ptp(v[:, others], axis=0)):
+        return 0.0
+    return float(area[base].sum() / total)
+
+
+def _has_boundary(f: np.ndarray) -> bool:
+    e = np.sort(np.vstack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return bool((counts == 1).any())
+
+
+def detect_up(vertices, faces=None) -> str | None:
+    """ "+z" when the mesh clearly stands on the XY plane (a Z-up file), else None (no
+    claim: the default +Y applies).  Conservative: a mesh thin along z (a plate, less
+    than ``FLAT_ASPECT`` of its largest extent) or standing on three or more feet along
+    y makes no claim; otherwise +Z is claimed when the bottom of the extent along z is
+    three or more separate pieces (feet, legs), or, for a closed surface, when a flat
+    base at the bottom along z spanning half its width and depth holds at least
+    ``BASE_SHARE`` of the area and such a base along y less than a quarter of that."""
+    if faces is None or len(faces) == 0:
+        return None
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces)
+    extent = np.ptp(v, axis=0)
+    if extent[2] < FLAT_ASPECT * float(extent.max()):
+        return None
+    legs_z, legs_y = _supports(v, f, 2), _supports(v, f, 1)
+    if legs_y >= 3:  # it stands on feet along y: Y-up
+        return None
+    if legs_z >= 3:
+        return "+z"
+    if _has_boundary(f):  # an open sheet lying flat in part (a folded plate) has no base
+        return None
+    base_z, base_y = _flat_base(v, f, 2), _flat_base(v, f, 1)
+    if base_z >= BASE_SHARE and base_y < 0.25 * base_z:
+        return "+z"
+    return None
+
+
+def up_axis_of(vertices, faces=None, chosen: str | None = None) -> str:
+    """The up axis in effect: ``chosen`` (an axis name) unless it is None or "auto",
+    then :func:`detect_up`'s claim, or :data:`DEFAULT_UP`."""
+    if chosen not in (None, "auto"):
+        return chosen
+    return detect_up(vertices, faces) or DEFAULT_UP
+
+
+def orbit_view(vertices, azimuth: float, elevation: float, up=None) -> Camera:
+    """The camera at ``azimuth`` degrees about the up axis and ``elevation`` degrees
+    toward it, both from the front: the axis after the up axis (+Z for +Y up, +X for +Z
+    up, +Y for +X up; negated with the up axis).  Azimuth 90 looks from the right."""
+    up_vec = _up_vector(up)
+    k = int(np.argmax(np.abs(up_vec)))
+    front = np.zeros(3)
+    front[(k + 1) % 3] = 1.0 if up_vec[k] > 0 else -1.0
+    right = np.cross(up_vec, front)
+    a, e = np.radians(float(azimuth)), np.radians(float(elevation))
+    if abs(abs(float(elevation)) - 90.0) < 1e-9:
+        return preset_view(vertices, "+" + "xyz"[k] if e * up_vec[k] > 0 else "-" + "xyz"[k], up)
+    direction = np.cos(e) * (np.cos(a) * front + np.sin(a) * right) + np.sin(e) * up_vec
+    return look_from(vertices, direction, up_vec)
+
+
+def parse_view(text: str) -> str | tuple[float, float]:
+    """A view as the CLI's ``--view`` gives it: "canonical", a preset ("+x" ... "-z",
+    "iso" or "isometric"), or "AZ,EL" in degrees; ValueError otherwise."""
+    key = str(text).strip().lower()
+    if key in ("canonical", "isometric", *AXES):
+        return key
+    if key == "iso":
+        return "isometric"
+    parts = key.split(",")
+    if len(parts) == 2:
+        try:
+            az, el = (float(p) for p in parts)
+        except ValueError:
+            pass
+        else:
+            if np.isfinite(az) and np.isfinite(el) and -90.0 <= el <= 90.0:
+                return az, el
+    raise ValueError(
+        f"unknown view {text!r}: use canonical, {', '.join(AXES)}, iso or AZ,EL in degrees "
+        "(elevation -90 .. 90)"
+    )
+
+
+def view_camera(vertices, faces, view, up=None) -> Camera:
+    """The camera of a :func:`parse_view` result (or its text) with up axis ``up``."""
+    view = parse_view(view) if isinstance(view, str) else view
+    if view == "canonical":
+        return canonical_view(vertices, faces, up=up)
+    if isinstance(view, str):
+        return preset_view(vertices, view, up=up)
+    return orbit_view(vertices, view[0], view[1], up=up)
+
+
 def canonical_camera(mesh, up=None) -> dict:
     """:func:`canonical_view` of a :class:`~modalviewer.core.mesh.Mesh` as a dict
     (position, focal_point, view_up)."""

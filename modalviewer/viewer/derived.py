@@ -92,6 +92,7 @@ class DerivedValues:
         self._tables: dict[str, tuple[Spectrum, tuple | None, SignatureTable]] = {}
         # ((kind, vertex, t_range), spectrum, distances) of the last distance map
         self._distance: tuple | None = None
+        self._truncation: tuple | None = None  # (key, spectrum, (error, k))
         state.events.mesh.connect(self._drop_all)
         state.events.spectra.connect(self._drop_stale_spectra)
         state.events.scale_range.connect(self._drop_distances)
@@ -102,6 +103,7 @@ class DerivedValues:
         self._per_mesh = {}
         self._tables = {}
         self._distance = None
+        self._truncation = None
 
     def _drop_stale_spectra(self, operator: str = "") -> None:
         for op, (spec, _, _) in list(self._tables.items()):
@@ -229,10 +231,61 @@ class DerivedValues:
         return table
 
     def signature_time(self) -> float:
-        """The scale t the signature display is shown at."""
+        """The scale t the signature display is shown at: the typed one
+        (``display.signature_time``), or the scale of ``display.signature_sample``."""
         display = self.state.display
+        if display.signature_time is not None:
+            return float(display.signature_time)
         table = self.table(operator_for_distance(display.distance_kind))
         return float(table.times[int(np.clip(display.signature_sample, 0, len(table.times) - 1))])
+
+    def nearest_sample(self, t: float) -> int:
+        """The index of the table's scale nearest to ``t`` (in log scale): where the
+        slider stands for a typed scale."""
+        table = self.table(operator_for_distance(self.state.display.distance_kind))
+        return int(np.argmin(np.abs(np.log(table.times) - np.log(float(t)))))
+
+    def signature_values(self, operator: str, t: float) -> np.ndarray:
+        """(n,) the signature of ``operator`` at scale ``t``, or with
+        ``style.log_signature`` its log10 over its smallest value (0 at the smallest)."""
+        _, values = signature(self.state.spectrum(operator), [t])
+        values = values[:, 0]
+        if self.state.style.log_signature:
+            positive = values[values > 0]
+            floor = float(positive.min()) if positive.size else 1.0
+            values = np.log10(np.maximum(values, floor) / floor)
+        return values
+
+    def truncation(self, operator: str | None = None, t: float | None = None):
+        """(estimated truncation error (0..1), k suggested for below
+        :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`) of the signature of
+        ``operator`` (the display's) at scale ``t`` (the one shown); see
+        :mod:`modalviewer.core.truncation`.  None without signatures."""
+        from ..core.truncation import TRUNCATION_LEVEL, k_for_truncation, truncation_error
+
+        operator = operator or operator_for_distance(self.state.display.distance_kind)
+        if not self.has_signatures(operator):
+            return None
+        spec = self.state.spectrum(operator)
+        t = self.signature_time() if t is None else float(t)
+        key = ("truncation", id(spec), t)
+        if self._truncation is None or self._truncation[0] != key:
+            error = float(truncation_error(spec, [t])[0])
+            k = k_for_truncation(spec, t) if error > TRUNCATION_LEVEL else spec.k
+            self._truncation = (key, spec, (error, k))
+        return self._truncation[2]
+
+    def up_axis(self) -> str:
+        """The up axis in effect: the chosen one (``state.up_axis``), else the one
+        detected on the mesh where confident (:func:`.camera.detect_up`), else +Y."""
+        from .camera import DEFAULT_UP, detect_up
+
+        if self.state.up_axis is not None:
+            return self.state.up_axis
+        if self.state.mesh is None:
+            return DEFAULT_UP
+        detected = self._mesh_value("up", lambda m: detect_up(m.vertices, m.faces))
+        return detected or DEFAULT_UP
 
     def scale_limits(self) -> tuple[float, float]:
         """(t1, t2) the distances and signatures use: the chosen range or the default."""
@@ -361,7 +414,7 @@ class DerivedValues:
             if not self.has_signatures(operator):
                 return plain
             t = self.signature_time()
-            _, values = signature(state.spectrum(operator), [t])
+            values = self.signature_values(operator, t)[:, None]
             return self._ranged(
                 Field(
                     values[:, 0],

@@ -33,6 +33,8 @@ changed the state (the GUI thread in the viewer):
 - ``scale_range()``: the distance scale range (t1, t2) changed.
 - ``animation()``: playing, amplitude or speed changed.
 - ``camera()``: a camera was set through the state (a preset, a restored session).
+- ``up_axis()``: the up axis was chosen (:attr:`ViewerState.up_axis`); the scene turns to
+  the canonical view for it.
 """
 
 from __future__ import annotations
@@ -143,6 +145,7 @@ class Display:
         marks ``threshold_share`` of the surface (its fraction is set to match), instead
         of keeping the fraction; see :meth:`ViewerState._match_threshold`.
     signature_sample : index of the scale a signature is shown at (0..99).
+    signature_time : a scale t typed for the signature, or None: the sample's scale.
     """
 
     kind: str = "none"
@@ -154,10 +157,21 @@ class Display:
     threshold_share: float = DEFAULT_THRESHOLD_SHARE
     keep_share: bool = True
     signature_sample: int = 50
+    signature_time: float | None = None
 
     def blank(self) -> Display:
         """This display as a newly loaded mesh shows it: nothing, other choices kept."""
         return replace(self, kind="none", operator=None, mode=0)
+
+
+def _scale(t) -> float | None:
+    """A typed signature scale: None, or a positive finite float (ValueError else)."""
+    if t is None:
+        return None
+    t = float(t)
+    if not (np.isfinite(t) and t > 0):
+        raise ValueError("the signature scale t must be positive and finite")
+    return t
 
 
 def _take_signs(spec: Spectrum, preview: Spectrum) -> None:
@@ -187,6 +201,7 @@ class ViewerEvents(SignalGroup):
     scale_range = Signal()
     animation = Signal()
     camera = Signal()
+    up_axis = Signal()
 
 
 @dataclass
@@ -198,6 +213,7 @@ class _Style:
     color_limits: tuple[float, float] | None = None  # (low, high) of the "limits" range
     render: str = "paper"  # paper: white zero, saturated colours; shaded: light kit
     colorbar: bool = True  # legend and colour bar, on screen and in exports
+    log_signature: bool = False  # signatures coloured by log10(S / smallest S)
 
 
 @dataclass
@@ -227,6 +243,9 @@ class ViewerState:
         self.style = _Style()
         self.animation = Animation()
         self.camera: dict | None = None
+        self.up_axis: str | None = None
+        """The chosen up axis ("+x" ... "-z"), or None: automatic (detected where
+        confident, else +Y; :meth:`.derived.DerivedValues.up_axis` is the one in effect)."""
         self.threshold_map: tuple | str | None = None
         """The distance map (:meth:`.derived.DerivedValues.map_identity`) on which
         ``display.threshold`` and ``display.threshold_share`` were last matched; None
@@ -257,6 +276,7 @@ class ViewerState:
         self.animation.playing = False
         self.display = self.display.blank()
         self.camera = None
+        self.up_axis = None
         self.events.mesh.emit()
 
     def compute_mesh(self, key: SpectrumKey | None = None) -> Mesh:
@@ -432,6 +452,24 @@ class ViewerState:
             if self.display.kind in ("distance", "signature"):
                 self.events.display.emit()
 
+    def set_up_axis(self, axis: str | None) -> None:
+        """Choose the up axis ("+x", "-x", "+y", "-y", "+z", "-z"; None or "auto": the
+        detected one); the scene turns to the canonical view for it."""
+        from .camera import AXES
+
+        axis = None if axis in (None, "auto") else str(axis).lower()
+        if axis is not None and axis not in AXES:
+            raise ValueError(f"up axis must be auto or one of {', '.join(AXES)}")
+        if axis != self.up_axis:
+            self.up_axis = axis
+            self.events.up_axis.emit()
+
+    def set_log_signature(self, on: bool) -> None:
+        """Colour signatures by log10 of the signature over its smallest value."""
+        if bool(on) != self.style.log_signature:
+            self.style.log_signature = bool(on)
+            self.events.style.emit()
+
     def set_camera(self, camera: dict | None) -> None:
         """Set the camera (position, focal_point, view_up, parallel_scale); the scene
         applies it.  The scene also stores the user's camera here before a session is
@@ -442,6 +480,8 @@ class ViewerState:
     # ---------------------------------------------------------- display
     def set_display(self, **changes) -> None:
         """Change what is shown; fields of :class:`Display`.  Validated before storing."""
+        if "signature_sample" in changes and "signature_time" not in changes:
+            changes["signature_time"] = None  # a sample chosen replaces a typed scale
         new = replace(self.display, **changes)
         if new.kind not in DISPLAY_KINDS:
             raise ValueError(f"display kind must be one of {DISPLAY_KINDS}")
@@ -459,6 +499,7 @@ class ViewerState:
             threshold=float(np.clip(new.threshold, 1e-4, 1.0)),
             threshold_share=float(np.clip(new.threshold_share, 0.0, 1.0)),
             signature_sample=int(np.clip(new.signature_sample, 0, 99)),
+            signature_time=_scale(new.signature_time),
         )
         if new == self.display:
             return

@@ -544,6 +544,20 @@ class Viewer:
             return
         self.state.set_display(kind="signature", signature_sample=int(sample))
 
+    def show_signature_at(self, t: float) -> None:
+        """Colour by the signature at the scale ``t`` itself (any positive scale; the
+        signature is summed at ``t``, not at the nearest sample)."""
+        operator = operator_for_distance(self.state.display.distance_kind)
+        if not self.state.derived.has_signatures(operator):
+            self.show_signature(0)  # says what to compute
+            return
+        t = float(t)
+        self.state.set_display(
+            kind="signature",
+            signature_sample=self.state.derived.nearest_sample(t),
+            signature_time=t,
+        )
+
     def show_curvature(self) -> None:
         """Colour by the total curvature."""
         if self.state.mesh is not None:
@@ -627,6 +641,24 @@ class Viewer:
         source = self._picture or self.renderer(size)
         drawing = getattr(source, "drawing", source)
         return drawing.animation_frame(phase)
+
+    def set_view(self, view="canonical", up=None) -> dict | None:
+        """Turn the camera to ``view``: "canonical", a preset ("+x" ... "-z",
+        "isometric"/"iso") or (azimuth, elevation) in degrees about the up axis (also as
+        "AZ,EL"); ``up`` ("auto", "+x" ... "-z") chooses the up axis first.  Returns
+        the camera set (position, focal_point, view_up), None without a mesh."""
+        from .camera import parse_view, view_camera
+
+        view = parse_view(view) if isinstance(view, str) else tuple(float(x) for x in view)
+        if up is not None:
+            self.state.set_up_axis(up)
+        mesh = self.state.mesh
+        if mesh is None:
+            return None
+        camera = view_camera(mesh.vertices, mesh.faces, view, up=self.state.derived.up_axis())
+        data = {**camera.as_dict(), "fit": True}
+        self.state.set_camera(data)
+        return data
 
     def current_camera(self) -> dict | None:
         """The camera of the picture (window or off screen) as plain data."""

@@ -116,7 +116,11 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         if not derived.has_signatures(operator_for_distance(d.distance_kind)):
             return ""
         word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
-        return f"{word[d.distance_kind]} signature at t = {derived.signature_time():.3g}"
+        text = f"{word[d.distance_kind]} signature at t = {derived.signature_time():.3g}"
+        if state.style.log_signature:
+            text += ", log10(S / smallest S)"
+        note = truncation_note(state, derived)
+        return f"{text}\n{note}" if note else text
     if d.kind == "curvature":
         return "Curvature sqrt(k1^2 + k2^2), white 0 to red"
     return ""
@@ -138,6 +142,24 @@ def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool])
     if ends:
         text += f" ({' and '.join(ends)} clipped)"
     return text
+
+
+def truncation_note(state: ViewerState, derived: DerivedValues | None = None) -> str:
+    """ "truncation: about 12 % of the signature is missing (k = 100; k = 340 for
+    < 5 %)" when the estimated truncation error of the signature shown exceeds
+    :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`, else ""."""
+    from ..core.truncation import TRUNCATION_LEVEL
+
+    derived = derived if derived is not None else state.derived
+    found = derived.truncation()
+    if found is None or found[0] <= TRUNCATION_LEVEL:
+        return ""
+    error, k = found
+    spec = state.spectrum(operator_for_distance(state.display.distance_kind))
+    return (
+        f"truncation: about {percent_text(error)} of the signature is missing (k = "
+        f"{spec.k}; k = {k} for < {percent_text(TRUNCATION_LEVEL)})"
+    )
 
 
 def summary(state: ViewerState, derived: DerivedValues | None = None) -> str:
