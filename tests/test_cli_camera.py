@@ -1,0 +1,85 @@
+"""The command line's camera: ``render`` and ``distance -o`` take --up and --view."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import modalviewer as mv
+
+ASSETS = Path(__file__).resolve().parents[1] / "assets"
+
+
+def _run(*args):
+    return subprocess.run(
+        [sys.executable, "-m", "modalviewer", *map(str, args)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+
+
+@pytest.fixture(scope="module")
+def z_up_cow(tmp_path_factory):
+    """spot turned to Z-up (a quarter turn about X)."""
+    mesh = mv.load_mesh(ASSETS / "spot.obj")
+    v = mesh.vertices
+    v = np.column_stack([v[:, 0], -v[:, 2], v[:, 1]])
+    path = tmp_path_factory.mktemp("zup") / "spot_z_up.obj"
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in v]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in mesh.faces]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _render(mesh, out, *extra):
+    r = _run("render", mesh, "--mode", 2, "-k", 6, "--size", "160x120", "-o", out, *extra)
+    assert r.returncode == 0, r.stderr
+    return np.asarray(Image.open(out).convert("L"), dtype=float)
+
+
+def _differ(a, b):
+    return float(np.mean(np.abs(a - b) > 30))
+
+
+def test_up_and_view_change_the_picture(z_up_cow, tmp_path):
+    auto = _render(z_up_cow, tmp_path / "auto.png")
+    explicit = _render(z_up_cow, tmp_path / "z.png", "--up", "+z")
+    y_up = _render(z_up_cow, tmp_path / "y.png", "--up", "+y")
+    side = _render(z_up_cow, tmp_path / "side.png", "--view", "+y")
+    angled = _render(z_up_cow, tmp_path / "angled.png", "--view", "90,20")
+    assert _differ(auto, explicit) < 0.001  # auto found +Z
+    assert _differ(auto, y_up) > 0.02
+    assert _differ(auto, side) > 0.02
+    assert _differ(side, angled) > 0.02
+
+
+def test_distance_takes_the_view_too(tmp_path):
+    common = ("distance", ASSETS / "demo_machined_part.obj", "--vertex", 5, "--kind", "hks")
+    common += ("-k", 10, "--size", "160x120")
+    pictures = []
+    for view in ("canonical", "iso", "+y"):
+        out = tmp_path / f"{view}.png"
+        r = _run(*common, "-o", out, "--view", view)
+        assert r.returncode == 0, r.stderr
+        pictures.append(np.asarray(Image.open(out).convert("L"), dtype=float))
+    assert _differ(pictures[0], pictures[1]) > 0.02
+    assert _differ(pictures[1], pictures[2]) > 0.02
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (("--view", "top"), "unknown view 'top'"),
+        (("--view", "10,95"), "unknown view"),
+        (("--up", "z"), "invalid choice: 'z'"),
+    ],
+)
+def test_bad_views_and_up_axes_are_one_line_errors(args, message, tmp_path):
+    r = _run("render", ASSETS / "demo_plate.obj", "--mode", 1, "-o", tmp_path / "x.png", *args)
+    assert r.returncode == 2
+    errors = [line for line in r.stderr.splitlines() if line.startswith("modalviewer: error")]
+    assert len(errors) == 1 and message in errors[0], r.stderr
