@@ -106,6 +106,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.distances_panel.showSignatureRequested.connect(
             lambda: self.show_signature(self.state.display.signature_sample)
         )
+        self.distances_panel.exactCurveRequested.connect(self.viewer.request_exact_curve)
         build_docks(self)
         menus.build_menus(self)
         self.status_widgets = StatusBarWidgets(self.statusBar(), self.state, self.model.jobs)

@@ -141,6 +141,7 @@ def build_menus(win) -> None:
         ("isometric", "Isometric", "Alt+7"),
     ):
         _action(win, views, label, lambda _=False, n=name: win.scene_view.camera_preset(n), key)
+    _up_axis_menu(win, m)
     m.addSeparator()
     _action(
         win,
@@ -211,3 +212,43 @@ Everywhere (the single letters not while typing in a field)
   Ctrl+O / Ctrl+E       open a mesh / export a screenshot
   Ctrl+S / Ctrl+Shift+O save / open a session
   Ctrl+Q                quit"""
+
+
+def _up_axis_menu(win, menu) -> None:
+    """View > Up axis: Automatic (detected +Z where confident, else +Y) or an axis,
+    remembered per file; R returns to the canonical view for it."""
+    from . import window_settings
+
+    up = menu.addMenu("&Up axis")
+    group = QtGui.QActionGroup(win)
+    win.up_axis_actions = {}
+    for axis, label in (
+        (None, "&Automatic"),
+        ("+x", "+X"),
+        ("-x", "-X"),
+        ("+y", "+Y"),
+        ("-y", "-Y"),
+        ("+z", "+Z"),
+        ("-z", "-Z"),
+    ):
+        action = up.addAction(label)
+        action.setCheckable(True)
+        group.addAction(action)
+        action.triggered.connect(lambda _=False, a=axis: window_settings.choose_up_axis(win, a))
+        win.up_axis_actions[axis] = action
+
+    def update() -> None:
+        state = win.state
+        detected = state.derived.up_axis() if state.mesh is not None else None
+        automatic = win.up_axis_actions[None]
+        shown = state.up_axis is None and detected
+        automatic.setText(f"&Automatic ({detected.upper()})" if shown else "&Automatic")
+        win.up_axis_actions[state.up_axis].setChecked(True)
+
+    def on_mesh() -> None:
+        window_settings.restore_up_axis(win)
+        update()
+
+    win.state.events.mesh.connect(on_mesh)
+    win.state.events.up_axis.connect(update)
+    update()

@@ -38,6 +38,8 @@ class LinePlot(QtWidgets.QWidget):
         self.highlight: int | None = None
         self.logx = False
         self.markers = True
+        self.second: np.ndarray | None = None  # a second curve over the same x (dashed)
+        self.second_label = ""
         self.setMinimumHeight(140)
 
     def set_data(
@@ -52,8 +54,16 @@ class LinePlot(QtWidgets.QWidget):
         self.highlight = highlight
         self.logx = logx
         self.markers = markers
+        self.second, self.second_label = None, ""
         if title is not None:
             self.title = title
+        self.update()
+
+    def set_second(self, y, label: str = "") -> None:
+        """A second curve over the same x, drawn dashed in orange and named ``label``
+        (bottom left); None removes it."""
+        self.second = None if y is None else np.asarray(y, dtype=float)
+        self.second_label = label if y is not None else ""
         self.update()
 
     def set_highlight(self, index: int | None) -> None:
@@ -64,7 +74,8 @@ class LinePlot(QtWidgets.QWidget):
         x = np.log10(self.x) if self.logx else self.x
         y = self.y
         x0, x1 = float(x.min()), float(x.max())
-        y0, y1 = float(y.min()), float(y.max())
+        both = y if self.second is None else np.concatenate([y, self.second])
+        y0, y1 = float(both.min()), float(both.max())
         # room for the longer of the two axis labels (e.g. "-4.75e-08" for a zero mode)
         metrics = self.fontMetrics()
         scale = max(abs(y0), abs(y1))
@@ -76,6 +87,11 @@ class LinePlot(QtWidgets.QWidget):
             y1 = y0 + 1
         px = rect.left() + (x - x0) / (x1 - x0) * rect.width()
         py = rect.bottom() - (y - y0) / (y1 - y0) * rect.height()
+        self._second_py = (
+            None
+            if self.second is None
+            else rect.bottom() - (self.second - y0) / (y1 - y0) * rect.height()
+        )
         return rect, px, py, (y0, y1)
 
     def x_ticks(self, rect=None) -> list[tuple[float, float]]:
@@ -138,6 +154,15 @@ class LinePlot(QtWidgets.QWidget):
         for a, b in zip(px[1:], py[1:], strict=True):
             path.lineTo(a, b)
         p.drawPath(path)
+        if self._second_py is not None and len(self._second_py) == len(px):
+            pen = QtGui.QPen(QtGui.QColor(230, 120, 20), 1.5)
+            pen.setStyle(QtCore.Qt.PenStyle.DashLine)
+            p.setPen(pen)
+            second = QtGui.QPainterPath(QtCore.QPointF(px[0], self._second_py[0]))
+            for a, b in zip(px[1:], self._second_py[1:], strict=True):
+                second.lineTo(a, b)
+            p.drawPath(second)
+            p.drawText(rect.left() + 4, rect.bottom() - 4, self.second_label)
         if self.markers and len(px) <= 400:
             p.setBrush(QtGui.QColor(40, 90, 180))
             for a, b in zip(px, py, strict=True):

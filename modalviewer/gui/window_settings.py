@@ -111,3 +111,56 @@ def remember_file(win, path: Path) -> None:
     win.settings.setValue("files/recent", recent[:10])
     win.settings.setValue("files/last_dir", str(path.parent))
     rebuild_recent(win)
+
+
+UP_AXES_KEY = "files/up_axes"
+"""QSettings key of the up axes chosen per file: a JSON object, path -> axis."""
+UP_AXES_KEPT = 200  # files whose up axis is remembered (the most recently chosen)
+
+
+def _up_axes(win) -> dict[str, str]:
+    import json
+
+    try:
+        value = json.loads(str(win.settings.value(UP_AXES_KEY, "{}")))
+    except ValueError:
+        return {}
+    return {str(k): str(v) for k, v in value.items()} if isinstance(value, dict) else {}
+
+
+def remembered_up_axis(win, path) -> str | None:
+    """The up axis chosen for the file ``path`` (View > Up axis), or None: automatic."""
+    from ..viewer.camera import AXES
+
+    if path is None or not win.remember_settings:
+        return None
+    axis = _up_axes(win).get(str(Path(path).resolve()))
+    return axis if axis in AXES else None
+
+
+def remember_up_axis(win, path, axis: str | None) -> None:
+    """Remember ``axis`` (None: automatic, forgotten) for the file ``path``."""
+    import json
+
+    if path is None or not win.remember_settings:
+        return
+    key = str(Path(path).resolve())
+    axes = {k: v for k, v in _up_axes(win).items() if k != key}
+    if axis is not None:
+        axes[key] = axis
+    kept = dict(list(axes.items())[-UP_AXES_KEPT:])
+    win.settings.setValue(UP_AXES_KEY, json.dumps(kept))
+
+
+def choose_up_axis(win, axis: str | None) -> None:
+    """View > Up axis: set the state's up axis (the view turns to the canonical one for
+    it) and remember it for the file shown."""
+    win.state.set_up_axis(axis)
+    remember_up_axis(win, win.state.mesh_path, win.state.up_axis)
+
+
+def restore_up_axis(win) -> None:
+    """A newly loaded file gets the up axis chosen for it before, if any."""
+    axis = remembered_up_axis(win, win.state.mesh_path)
+    if axis is not None and win.state.mesh is not None:
+        win.state.set_up_axis(axis)

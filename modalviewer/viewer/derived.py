@@ -92,7 +92,8 @@ class DerivedValues:
         self._tables: dict[str, tuple[Spectrum, tuple | None, SignatureTable]] = {}
         # ((kind, vertex, t_range), spectrum, distances) of the last distance map
         self._distance: tuple | None = None
-        self._truncation: tuple | None = None  # (key, spectrum, (error, k))
+        self._truncation: dict = {}  # (spectrum id, t) -> (spectrum, (error, k))
+        self._exact_curve: tuple | None = None  # (curve_key(), times, values)
         state.events.mesh.connect(self._drop_all)
         state.events.spectra.connect(self._drop_stale_spectra)
         state.events.scale_range.connect(self._drop_distances)
@@ -103,7 +104,8 @@ class DerivedValues:
         self._per_mesh = {}
         self._tables = {}
         self._distance = None
-        self._truncation = None
+        self._truncation = {}
+        self._exact_curve = None
 
     def _drop_stale_spectra(self, operator: str = "") -> None:
         for op, (spec, _, _) in list(self._tables.items()):
@@ -268,12 +270,46 @@ class DerivedValues:
             return None
         spec = self.state.spectrum(operator)
         t = self.signature_time() if t is None else float(t)
-        key = ("truncation", id(spec), t)
-        if self._truncation is None or self._truncation[0] != key:
+        key = (id(spec), t)
+        kept = self._truncation.get(key)
+        if kept is None or kept[0] is not spec:
             error = float(truncation_error(spec, [t])[0])
             k = k_for_truncation(spec, t) if error > TRUNCATION_LEVEL else spec.k
-            self._truncation = (key, spec, (error, k))
-        return self._truncation[2]
+            if len(self._truncation) > 16:
+                self._truncation = {}
+            kept = self._truncation[key] = (spec, (error, k))
+        return kept[1]
+
+    # ------------------------------------------- the picked vertex's curve
+    def curve_key(self) -> tuple | None:
+        """What the picked vertex's signature curve is made of (operator, spectrum id,
+        vertex, scale range), or None without one."""
+        state = self.state
+        operator = operator_for_distance(state.display.distance_kind)
+        if state.picked is None or not self.has_signatures(operator):
+            return None
+        return (operator, id(state.spectrum(operator)), state.picked, state.t_range)
+
+    def curve_truncation(self) -> float | None:
+        """The estimated truncation error of the picked vertex's curve at its smallest
+        scale (where it is largest), or None without a curve."""
+        key = self.curve_key()
+        if key is None:
+            return None
+        return self.truncation(key[0], float(self.table(key[0]).times[0]))[0]
+
+    def exact_curve(self) -> np.ndarray | None:
+        """(T,) the picked vertex's signature over the table's scales summed over all
+        modes (:func:`~modalviewer.core.local_signature.local_signature`), once a job has
+        computed it (:meth:`.viewer.Viewer.request_exact_curve`), else None."""
+        key = self.curve_key()
+        if key is None or self._exact_curve is None or self._exact_curve[0] != key:
+            return None
+        return self._exact_curve[2]
+
+    def keep_exact_curve(self, key: tuple, times: np.ndarray, values: np.ndarray) -> None:
+        """Keep the exact curve computed for ``key`` (:meth:`curve_key`)."""
+        self._exact_curve = (key, np.asarray(times), np.asarray(values))
 
     def up_axis(self) -> str:
         """The up axis in effect: the chosen one (``state.up_axis``), else the one

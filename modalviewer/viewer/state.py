@@ -33,6 +33,8 @@ changed the state (the GUI thread in the viewer):
 - ``scale_range()``: the distance scale range (t1, t2) changed.
 - ``animation()``: playing, amplitude or speed changed.
 - ``camera()``: a camera was set through the state (a preset, a restored session).
+- ``signature_curve()``: the picked vertex's exact signature curve was computed
+  (:meth:`.derived.DerivedValues.exact_curve`).
 - ``up_axis()``: the up axis was chosen (:attr:`ViewerState.up_axis`); the scene turns to
   the canonical view for it.
 """
@@ -202,6 +204,7 @@ class ViewerEvents(SignalGroup):
     animation = Signal()
     camera = Signal()
     up_axis = Signal()
+    signature_curve = Signal()
 
 
 @dataclass

@@ -642,6 +642,53 @@ class Viewer:
         drawing = getattr(source, "drawing", source)
         return drawing.animation_frame(phase)
 
+    def request_exact_curve(self, wait: bool = False) -> Job | None:
+        """Sum the picked vertex's signature curve (over the scales of the distance
+        kind's table) over all modes, by :func:`~modalviewer.core.local_signature.
+        local_signature` with the spectrum shown (one factorisation of the operator,
+        then a few Lanczos steps per scale), as a job in the queue, off this thread;
+        the result is :meth:`.derived.DerivedValues.exact_curve` and
+        ``state.events.signature_curve`` says it arrived.  None if there is no curve,
+        its spectrum is a preview, or the exact curve is already in."""
+        from ..core.local_signature import local_signature
+
+        state, derived = self.state, self.state.derived
+        key = derived.curve_key()
+        if key is None or derived.exact_curve() is not None:
+            return None
+        operator, _, vertex, _ = key
+        spec = state.spectrum(operator)
+        spectrum_key = state.spectrum_key(operator)
+        if spec.is_preview or spectrum_key.coarse:
+            return None
+        mesh = state.compute_mesh(spectrum_key)
+        times = derived.table(operator).times.copy()
+
+        def run(progress, cancel):
+            progress("exact signature", 0.0)
+            return local_signature(
+                mesh,
+                operator,
+                [vertex],
+                times,
+                bending=spectrum_key.bending,
+                membrane=spectrum_key.membrane,
+                spectrum=spec,
+            )[0]
+
+        number = state.picked_file_vertex
+        job = self.jobs.submit(
+            run, ("exact curve", *key), f"exact signature of vertex {number}", owner=state.mesh.hash
+        )
+
+        def arrived(j: Job) -> None:
+            if j.status == DONE:
+                derived.keep_exact_curve(key, times, j.result)
+                state.events.signature_curve.emit()
+
+        job.then(arrived)
+        return self.wait_for(job) if wait else job
+
     def set_view(self, view="canonical", up=None) -> dict | None:
         """Turn the camera to ``view``: "canonical", a preset ("+x" ... "-z",
         "isometric"/"iso") or (azimuth, elevation) in degrees about the up axis (also as

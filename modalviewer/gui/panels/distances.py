@@ -25,6 +25,7 @@ class DistancesPanel(QtWidgets.QWidget):
 
     showDistanceRequested = QtCore.Signal()
     showSignatureRequested = QtCore.Signal()
+    exactCurveRequested = QtCore.Signal()
 
     def __init__(self, state: ViewerState, parent=None):
         super().__init__(parent)
@@ -69,6 +70,18 @@ class DistancesPanel(QtWidgets.QWidget):
         self.scale_slider.setRange(0, 99)
         self.scale_slider.setToolTip("Show the signature at this scale")
         form.addRow("Signature at scale", self.scale_slider)
+        self.scale_edit = QtWidgets.QLineEdit()
+        self.scale_edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
+        self.scale_edit.setToolTip(
+            "Type a scale t: the signature is summed at t itself (the slider shows the "
+            "nearest sample)"
+        )
+        self.log_check = QtWidgets.QCheckBox("Log colours")
+        self.log_check.setToolTip("Colour the signature by log10(S / smallest S)")
+        scale_row = QtWidgets.QHBoxLayout()
+        scale_row.addWidget(self.scale_edit, 1)
+        scale_row.addWidget(self.log_check)
+        form.addRow("t", scale_row)
         self.signature_plot = LinePlot("Signature of the picked vertex", "t (log)", "S_t")
         form.addRow(self.signature_plot)
 
@@ -80,6 +93,10 @@ class DistancesPanel(QtWidgets.QWidget):
         self.t2_edit.editingFinished.connect(self._on_range)
         self.distance_button.clicked.connect(self.showDistanceRequested)
         self.scale_slider.valueChanged.connect(self._on_scale)
+        self.scale_edit.editingFinished.connect(self._on_scale_typed)
+        self.log_check.toggled.connect(lambda on: self.state.set_log_signature(bool(on)))
+        state.events.style.connect(self._update_log_check)
+        state.events.signature_curve.connect(self._update_signature_plot)
         for event in (
             state.events.display,
             state.events.pick,
@@ -124,6 +141,26 @@ class DistancesPanel(QtWidgets.QWidget):
     def _on_scale(self, value: int) -> None:
         self.state.set_display(signature_sample=value)
         self.showSignatureRequested.emit()
+
+    def _on_scale_typed(self) -> None:
+        """A typed scale t: the signature at t itself (not the nearest sample)."""
+        try:
+            t = float(self.scale_edit.text())
+        except ValueError:
+            return
+        operator = operator_for_distance(self.state.display.distance_kind)
+        if t <= 0 or not self.state.derived.has_signatures(operator):
+            self.showSignatureRequested.emit()  # says what is missing
+            return
+        self.state.set_display(
+            kind="signature",
+            signature_sample=self.state.derived.nearest_sample(t),
+            signature_time=t,
+        )
+
+    def _update_log_check(self) -> None:
+        with quiet(self.log_check):
+            self.log_check.setChecked(self.state.style.log_signature)
 
     # ------------------------------------------------------------ output
     def update_from_state(self, *_args) -> None:
@@ -170,7 +207,19 @@ class DistancesPanel(QtWidgets.QWidget):
                 f"Picked vertex {state.picked_file_vertex} at ({x:.4g}, {y:.4g}, {z:.4g})"
             )
         self._update_range_placeholders()
+        self._update_scale_edit()
         self._update_signature_plot()
+
+    def _update_scale_edit(self) -> None:
+        """The box shows the scale t the signature is (or would be) shown at."""
+        operator = operator_for_distance(self.state.display.distance_kind)
+        if self.scale_edit.hasFocus():
+            return
+        with quiet(self.scale_edit):
+            if self.state.derived.has_signatures(operator):
+                self.scale_edit.setText(f"{self.state.derived.signature_time():.4g}")
+            else:
+                self.scale_edit.clear()
 
     def _update_range_placeholders(self) -> None:
         operator = operator_for_distance(self.state.display.distance_kind)
@@ -206,3 +255,19 @@ class DistancesPanel(QtWidgets.QWidget):
                 f"{', preview' if spec.is_preview else ''})"
             ),
         )
+        self._show_exact_curve()
+
+    def _show_exact_curve(self) -> None:
+        """Where the truncation estimate of the curve is large, the curve summed over all
+        modes (a job, off the GUI thread) dashed beside it."""
+        from ...core.truncation import TRUNCATION_LEVEL
+
+        derived = self.state.derived
+        error = derived.curve_truncation()
+        if error is None or error <= TRUNCATION_LEVEL:
+            return
+        exact = derived.exact_curve()
+        if exact is None:
+            self.exactCurveRequested.emit()
+            return
+        self.signature_plot.set_second(exact, "dashed: all modes")
