@@ -74,6 +74,18 @@ def test_performance_page_marks_tables_and_its_copy_is_current():
     assert benchmark_tables.fill(text) == text
 
 
+def test_performance_plots_are_drawn_from_the_json_and_marked_on_the_page(tmp_path):
+    text = (DOCS / "performance.md").read_text()
+    names = benchmark_tables.PLOT_MARK.findall(text)
+    assert sorted(names) == sorted(benchmark_tables.PLOTS_MADE)
+    paths = benchmark_tables.draw_plots(tmp_path)
+    assert sorted(p.name for p in paths) == sorted(f"{n}.png" for n in names)
+    assert all(p.stat().st_size > 10_000 for p in paths)
+    page = benchmark_tables.with_plots(text)
+    assert "<!-- plot: " not in page
+    assert ":::{figure} _generated/plots/spectra.png" in page
+
+
 @pytest.mark.slow
 def test_sphinx_build_has_no_warnings(tmp_path):
     if (

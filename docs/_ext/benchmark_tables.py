@@ -12,8 +12,13 @@ the measured numbers.  The tables of ``make bench`` and of the preview benchmark
 by the benchmark scripts' own functions (``benchmarks.run.table``,
 ``benchmarks.run.stage_table``, ``benchmarks.preview.table``), the others here.
 
+The plots of time and peak memory against mesh size are drawn with matplotlib from the
+same files into ``docs/_generated/plots/`` when a build starts; the page marks each with
+``<!-- plot: spectra -->`` (invisible on GitHub), which the HTML build replaces by the
+image.
+
 Run as a script, it rewrites the marked blocks of ``docs/performance.md`` in place (the
-copy GitHub shows)::
+copy GitHub shows) and draws the plots::
 
     .venv/bin/python docs/_ext/benchmark_tables.py
 """
@@ -28,8 +33,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "benchmarks" / "results"
 PAGE = ROOT / "docs" / "performance.md"
+PLOTS = ROOT / "docs" / "_generated" / "plots"
 
 MARKED = re.compile(r"(<!-- table: ([\w-]+) -->\n)(.*?)(<!-- end table -->)", re.S)
+PLOT_MARK = re.compile(r"^<!-- plot: ([\w-]+) -->$", re.M)
 
 
 def load(name: str):
@@ -201,9 +208,148 @@ def fill(text: str) -> str:
     return MARKED.sub(replace, text)
 
 
+#: The operators' names in the plots' legends.
+LABELS = {"laplacian": "Laplacian", "shells": "Discrete Shells", "modified_dirichlet": "E_D^N"}
+
+
+def _axes(ax, ylabel: str, title: str, vertices) -> None:
+    """Log-log axes with the meshes' vertex counts as the x ticks and plain numbers."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xticks(sorted(set(vertices)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:,.0f}".replace(",", " ")))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.yaxis.set_major_locator(LogLocator(subs=(1, 2, 5)))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:g}"))
+    ax.yaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("vertices")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+
+
+def _legend(fig, ax) -> None:
+    """One legend for both panels, right of them."""
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside right upper", fontsize=8)
+
+
+def _series(ax, rows: list[dict], key, label: str, style: str, color) -> None:
+    """One line of ``key(row)`` (None: no point) against the rows' vertex counts."""
+    points = sorted((r["vertices"], key(r)) for r in rows if key(r) is not None)
+    if points:
+        x, y = zip(*points, strict=True)
+        ax.plot(x, y, style, color=color, label=label, markersize=5)
+
+
+def spectra_plot(rows: list[dict], path: Path) -> Path:
+    """``make bench``'s 300-mode rows: eigensolver time and peak memory against the
+    number of vertices, per operator, beside plain scipy (the baseline) where it ran."""
+    import matplotlib.pyplot as plt
+
+    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(10, 3.4), layout="constrained")
+    for i, op in enumerate(sorted({r["operator"] for r in rows})):
+        mine = [r for r in rows if r["operator"] == op and r["k"] == 300]
+        color = f"C{i}"
+        name = LABELS.get(op, op)
+        _series(t_ax, mine, lambda r: r["eigen_s"], name, "o-", color)
+        _series(t_ax, mine, lambda r: r.get("baseline_eigen_s"), f"{name}, scipy", "s--", color)
+        _series(m_ax, mine, lambda r: r["peak_mb"], name, "o-", color)
+        _series(m_ax, mine, lambda r: r.get("baseline_peak_mb"), f"{name}, scipy", "s--", color)
+    vertices = [r["vertices"] for r in rows]
+    _axes(t_ax, "eigenproblem (s)", "300 modes: time", vertices)
+    _axes(m_ax, "peak memory (MB)", "300 modes: peak memory", vertices)
+    _legend(fig, t_ax)
+    return _save(fig, path)
+
+
+def preview_plot(rows: list[dict], path: Path) -> Path:
+    """The preview benchmark: wall time and peak memory of the exact spectrum, the
+    preview and coarse-to-fine against the number of vertices, per operator."""
+    import matplotlib.pyplot as plt
+
+    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(10, 3.4), layout="constrained")
+    methods = [
+        ("exact", "o-", lambda r: r["exact_s"], lambda r: r["exact_peak_mb"]),
+        ("preview", "^--", lambda r: r["preview"]["seconds"], lambda r: r["preview"]["peak_mb"]),
+        (
+            "coarse-to-fine",
+            "v:",
+            lambda r: r["coarse-to-fine"]["seconds"],
+            lambda r: r["coarse-to-fine"]["peak_mb"],
+        ),
+    ]
+    for i, op in enumerate(sorted({r["operator"] for r in rows})):
+        mine = [r for r in rows if r["operator"] == op]
+        for method, style, seconds, memory in methods:
+            label = f"{LABELS.get(op, op)}, {method}"
+            _series(t_ax, mine, seconds, label, style, f"C{i}")
+            _series(m_ax, mine, memory, label, style, f"C{i}")
+    k = sorted({r["k"] for r in rows})
+    vertices = [r["vertices"] for r in rows]
+    _axes(t_ax, "time (s)", f"{', '.join(map(str, k))} modes: time", vertices)
+    _axes(m_ax, "peak memory (MB)", f"{', '.join(map(str, k))} modes: peak memory", vertices)
+    _legend(fig, t_ax)
+    return _save(fig, path)
+
+
+def _save(fig, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+#: Every generated plot: its name in the page's markers -> (JSON files, draw to a path).
+PLOTS_MADE = {
+    "spectra": (["latest"], lambda path: spectra_plot(load("latest"), path)),
+    "preview": (["preview"], lambda path: preview_plot(load("preview"), path)),
+}
+
+#: The text under each plot's image on the HTML page.
+PLOT_CAPTIONS = {
+    "spectra": "Eigenproblem time and peak memory against mesh size, 300 modes "
+    "(benchmarks/results/latest.json; dashed: plain scipy).",
+    "preview": "Exact spectrum, preview and coarse-to-fine: time and peak memory against "
+    "mesh size (benchmarks/results/preview.json).",
+}
+
+
+def draw_plots(folder: Path = PLOTS) -> list[Path]:
+    """Draw every plot of PLOTS_MADE into ``folder`` (``<name>.png``)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    return [draw(folder / f"{name}.png") for name, (_, draw) in PLOTS_MADE.items()]
+
+
+def with_plots(text: str) -> str:
+    """``text`` with every ``<!-- plot: name -->`` line replaced by its image."""
+
+    def replace(match: re.Match) -> str:
+        name = match.group(1)
+        if name not in PLOTS_MADE:
+            raise KeyError(f"no benchmark plot named {name!r} (known: {', '.join(PLOTS_MADE)})")
+        return (
+            f":::{{figure}} _generated/plots/{name}.png\n:alt: {PLOT_CAPTIONS[name]}\n\n"
+            f"{PLOT_CAPTIONS[name]}\n:::"
+        )
+
+    return PLOT_MARK.sub(replace, text)
+
+
+def _builder_inited(app) -> None:
+    draw_plots()
+
+
 def _source_read(app, docname: str, source: list[str]) -> None:
     if "<!-- table: " in source[0]:
         source[0] = fill(source[0])
+    if "<!-- plot: " in source[0]:
+        source[0] = with_plots(source[0])
 
 
 def _outdated(app, env, added, changed, removed) -> list[str]:
@@ -212,6 +358,7 @@ def _outdated(app, env, added, changed, removed) -> list[str]:
 
 
 def setup(app):
+    app.connect("builder-inited", _builder_inited)
     app.connect("source-read", _source_read)
     app.connect("env-get-outdated", _outdated)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
@@ -223,6 +370,8 @@ def main() -> int:
     if new != text:
         PAGE.write_text(new)
         print(f"wrote {PAGE.relative_to(ROOT)}")
+    for path in draw_plots():
+        print(f"wrote {path.relative_to(ROOT)}")
     return 0
 
 
