@@ -52,13 +52,13 @@ ZERO_NOISE_RTOL = 1e-12
 """Eigenvalues below this times the typical eigenvalue size (median diag(K) / mass) are
 zero modes whatever else was computed: rounding noise of undeflated null vectors is
 about 1e-16 to 1e-13 of it, while the first non-zero eigenvalue of a bending energy
-falls like h^4 against it (4e-9 of it on a 107k-vertex closed mesh, shells; 1e-8 of it
-flagged four genuine vibrations there as zero modes)."""
+falls like h^4 against it, so a larger factor would take the first vibrations of fine
+meshes for zero modes (see "Zero modes, one rule" in docs/how-it-works.md)."""
 
 BASIS_EXTRA = 0.6
 """The Krylov basis holds (1 + BASIS_EXTRA) times the working number of pairs: more
-converges in fewer operator applications but costs memory (at 130k vertices, shells,
-300 modes: 1.7 GB for the basis) and orthogonalisation time; 0.6 measured best."""
+converges in fewer operator applications but costs memory and orthogonalisation time
+(the basis sizes and the choice: "Iteration" in docs/how-it-works.md)."""
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
 
@@ -70,8 +70,8 @@ DEFLATED_SHIFT_RTOL = 1e-10
 """The shift's relative size when the exactly known null vectors are deflated (every
 solve is projected, so their amplification does no harm).  The shift must stay small
 against the first non-zero eigenvalue, which it compresses the spectrum towards: the
-median diagonal ratio grows like 1/h^4 for bending energies, and at 130k vertices
-(bumpy plate, shells) 1e-6 of it is 77 times the first non-zero eigenvalue, 1e-10 0.8 %."""
+median diagonal ratio grows like 1/h^4 for bending energies (the sizes on the benchmark
+meshes: "Known null spaces" in docs/how-it-works.md)."""
 
 ProgressFn = Callable[[str, float], None]
 CancelFn = Callable[[], bool]

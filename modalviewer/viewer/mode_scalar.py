@@ -1,20 +1,20 @@
 """The scalar that colours a mode: the mode itself for scalar operators; for 3D vibration
 modes (Discrete Shells) its magnitude or its normal component.
 
-Choice, measured by the roughness of the coloured scalar f, its Rayleigh quotient
-f^T S f / f^T M f under the cotan Laplacian (Discrete Shells modes 6-15):
-
 - The normal component is taken against *smoothed* vertex normals: the area-weighted
   normals diffused by one implicit heat step of radius ``NORMAL_SMOOTHING`` mean edge
   lengths, then normalised.  At a sharp edge the plain vertex normals jump from one face
   orientation to the other within one ring of triangles, and so does the component of a
   smooth displacement along them: jagged isolines and small loops along the edges.  The
-  smoothed normals turn over a few triangles; the roughness drops 2.5 to 3 times (machined
-  part: 4.2-7.8 -> 1.6-2.7; spot: 79-134 -> 32-57).  It stays signed, so the colouring
-  keeps the zero line where the surface does not move along its normal.
+  smoothed normals turn over a few triangles, so the coloured scalar is smoother.  It
+  stays signed, so the colouring keeps the zero line where the surface does not move
+  along its normal.
 - On a mesh with sharp features the normal itself turns by up to 90 degrees across an
-  edge, so any normal component changes quickly there; the magnitude |Phi| does not
-  (machined part: 0.11-0.31, as smooth as the mode's x, y, z components, 0.26-0.73).
+  edge, so any normal component changes quickly there; the magnitude |Phi| does not: it
+  is as smooth as the mode's x, y, z components.
+
+How much smoother each choice is (the Rayleigh quotient of the coloured scalar under the
+cotan Laplacian) is in the viewer guide, "How the pictures are drawn".
 
 The viewer draws 3D modes as the deformed shape by default (the surface displaced by the
 mode, coloured by |Phi|: :meth:`.derived.DerivedValues.deformation`); these colourings
@@ -48,8 +48,8 @@ def smoothed_normals(mesh: Mesh, radius: float | None = None) -> np.ndarray:
     if r <= 0:
         return normals
     m = lumped_masses(mesh)
-    # symmetric positive definite: a Cholesky factorisation (PARDISO where available:
-    # 0.1 s at 130k vertices against 1.8 s for SuperLU's LU, in the GUI thread)
+    # symmetric positive definite: a Cholesky factorisation (PARDISO where available),
+    # fast enough for the GUI thread at 130k vertices, unlike SuperLU's LU
     system = sp.diags(m) + r * r * stiffness_matrix(mesh)
     smooth = SPDSolver(system).solve(m[:, None] * normals)
     norm = np.linalg.norm(smooth, axis=1, keepdims=True)
