@@ -1,0 +1,181 @@
+"""How 3D vibration modes and colour ranges are drawn: the deformed shape with the rest
+shape's ghost, and the symmetric, robust and typed colour ranges (off screen, no Qt)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from modalviewer.core.laplacian import lumped_masses
+from modalviewer.scene.overlay import ColorBar, Overlay, draw_overlay
+from modalviewer.viewer import Viewer
+
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
+SIZE = (400, 300)
+
+
+@pytest.fixture(scope="module")
+def machined():
+    v = Viewer()
+    v.open_mesh(ASSETS / "demo_machined_part.obj")
+    v.state.set_colorbar(False)
+    v.compute("shells", k=16)
+    v.show_mode(8)
+    yield v
+    v.close()
+
+
+def _silhouette(viewer) -> np.ndarray:
+    return viewer.image(transparent=True, size=SIZE)[..., 3] > 0
+
+
+def test_a_deformed_mode_export_differs_from_the_rest_shape(machined):
+    state = machined.state
+    assert state.style.shell_coloring == "deformed"  # the default
+    state.set_ghost(False)
+    deformed = _silhouette(machined)
+    state.set_shell_coloring("normal")
+    try:
+        rest = _silhouette(machined)
+        assert state.derived.field().deformation == 0.0
+    finally:
+        state.set_shell_coloring("deformed")
+        state.set_ghost(True)
+    changed = np.logical_xor(deformed, rest).sum() / np.logical_or(deformed, rest).sum()
+    assert changed > 0.05, changed  # 17.5 % for mode 8 at the default amplitude
+
+
+def test_the_amplitude_sets_the_largest_displacement(machined):
+    state = machined.state
+    diagonal = state.mesh.bounding_box_diagonal
+    scene = machined.renderer(SIZE).scene
+    largest = np.linalg.norm(scene.surface.points - scene.rest_points, axis=1).max()
+    assert largest == pytest.approx(0.1 * diagonal, rel=1e-6)  # the default: a tenth
+    state.set_animation(amplitude=20)
+    try:
+        largest = np.linalg.norm(scene.surface.points - scene.rest_points, axis=1).max()
+        assert largest == pytest.approx(0.05 * diagonal, rel=1e-6)
+        field = state.derived.field()
+        assert field.colormap == "sequential"  # coloured by the displacement magnitude
+        np.testing.assert_allclose(
+            field.values,
+            np.linalg.norm(field.displacement, axis=1)
+            * (np.linalg.norm(state.spectrum("shells").mode(8), axis=1).max()),
+        )
+    finally:
+        state.set_animation(amplitude=40)
+
+
+def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
+    state = machined.state
+    state.set_ghost(True)
+    with_ghost = machined.image(size=SIZE).astype(int)
+    scene = machined.renderer(SIZE).scene
+    assert scene.ghost_visible
+    assert "grey: rest shape" in state.derived.field().legend
+    state.set_ghost(False)
+    try:
+        without = machined.image(size=SIZE).astype(int)
+        assert not scene.ghost_visible
+    finally:
+        state.set_ghost(True)
+    changed = (np.abs(with_ghost - without).max(axis=2) > 8).mean()
+    assert changed > 0.02, changed  # 11 % of the picture
+    # a mode on the rest shape has no ghost
+    state.set_shell_coloring("magnitude")
+    try:
+        machined.image(size=SIZE)
+        assert not scene.ghost_visible
+    finally:
+        state.set_shell_coloring("deformed")
+
+
+def test_old_settings_asking_for_automatic_get_the_deformed_shape(machined):
+    state = machined.state
+    state.set_shell_coloring("normal")
+    state.set_shell_coloring("auto")
+    assert state.style.shell_coloring == "deformed"
+
+
+def _weighted_percentile(values, weights, percent):
+    a = np.abs(values)
+    order = np.argsort(a)
+    share = np.cumsum(weights[order]) / weights.sum()
+    return a[order][np.argmax(share >= percent / 100.0)]
+
+
+@pytest.fixture(scope="module")
+def spot():
+    v = Viewer()
+    v.open_mesh(ASSETS / "spot.obj")
+    v.compute("shells", k=30)
+    v.pick_vertex(2000)
+    v.show_distance("vibration", display="continuous")
+    yield v
+    v.close()
+
+
+def test_the_robust_range_clips_at_the_99th_area_weighted_percentile(spot):
+    state = spot.state
+    assert state.style.color_range == "auto"  # robust for distances
+    field = state.derived.field()
+    d = state.derived.distance_map()
+    hi = _weighted_percentile(d, lumped_masses(state.mesh), 99.0)
+    assert field.clim == (0.0, pytest.approx(hi, rel=1e-12))
+    assert hi < d.max()
+    assert field.clipped == (False, True)
+    assert "robust range: 99th percentile" in field.legend
+    assert f"> {hi:.3g} clipped" in field.legend
+    scene = spot.renderer(SIZE).scene
+    spot.image(size=SIZE)
+    bar = scene.colorbar()
+    assert bar.clipped == (False, True) and bar.clim[1] == pytest.approx(hi)
+    # the symmetric range: up to the largest value, nothing clipped
+    state.set_color_range("symmetric")
+    try:
+        field = state.derived.field()
+        assert field.clim == (0.0, pytest.approx(d.max()))
+        assert field.clipped == (False, False)
+        spot.image(size=SIZE)
+        assert scene.colorbar().clipped == (False, False)
+    finally:
+        state.set_color_range("auto")
+
+
+def test_the_colour_bar_marks_clipped_ends():
+    blank = np.full((120, 400, 3), 255, np.uint8)
+    colors = [np.array([1.0, 1.0, 1.0]), np.array([0.78, 0.08, 0.08])]
+    plain = draw_overlay(blank, Overlay(None, ColorBar("d", colors, (0.0, 1.0))))
+    marked = draw_overlay(
+        blank, Overlay(None, ColorBar("d", colors, (0.0, 1.0), clipped=(False, True)))
+    )
+    both = draw_overlay(
+        blank, Overlay(None, ColorBar("d", colors, (0.0, 1.0), clipped=(True, True)))
+    )
+    # the bar spans the middle half: an arrow head beyond its right end, then its left
+    right = slice(301, 312)
+    left = slice(88, 99)
+    assert (plain[:, right] != marked[:, right]).any()
+    assert (plain[:, left] == marked[:, left]).all()
+    assert (marked[:, left] != both[:, left]).any()
+    red = np.all(np.abs(marked[:, right].astype(int) - [199, 20, 20]) < 30, axis=-1)
+    assert red.sum() > 10  # the arrow head in the end's colour
+
+
+def test_typed_colour_limits(spot):
+    state = spot.state
+    d = state.derived.distance_map()
+    lo, hi = 0.2 * d.max(), 0.6 * d.max()
+    state.set_color_range("limits", (lo, hi))
+    try:
+        field = state.derived.field()
+        assert field.clim == (pytest.approx(lo), pytest.approx(hi))
+        assert field.clipped == (True, True)
+        assert f"range: limits {lo:.3g} .. {hi:.3g}" in field.legend
+        spot.image(size=SIZE)
+        assert spot.renderer(SIZE).scene.clim == pytest.approx((lo, hi))
+    finally:
+        state.set_color_range("auto")
+    assert state.style.color_limits == (lo, hi)  # kept for the next "limits"
+    with pytest.raises(ValueError, match="low < high"):
+        state.set_color_range("limits", (1.0, 1.0))
