@@ -133,8 +133,7 @@ def _kron_projection(K: sp.csr_matrix, Ps: sp.csr_matrix) -> sp.csr_matrix:
     """``kron(Ps, I3)^T K kron(Ps, I3)`` for a symmetric (3n, 3n) K in vertex-major
     order: block (a, b) of every 3 x 3 entry is ``Ps^T K_ab Ps`` with ``K_ab = K[a::3,
     b::3]``; the six with a <= b are computed (two threads), the others are their
-    transposes.  A third fewer multiply-adds than through the 3n rows (130k shells,
-    1803 functions: 1.5 s against 2.7-3.6 s)."""
+    transposes: a third fewer multiply-adds than through the 3n rows."""
     PsT = Ps.T.tocsr()
     pairs = [(a, b) for a in range(3) for b in range(a, 3)]
 
@@ -435,8 +434,7 @@ def estimated_errors(
     ``r^T K^-1 r`` (:func:`_cg_energies`); the others take their preconditioned
     residual norm ``eta = r^T D^-1 r`` times c, the median of ``r^T e / eta`` over those
     modes.  The estimate is therefore a lower estimate that approaches the first-order
-    error from below: measured on the benchmark meshes the largest estimate is 0.4 to
-    1.0 times the largest error (the README's preview table).
+    error from below (how close it comes: "Preview spectra" in docs/how-it-works.md).
     """
     out = np.zeros(len(lam))
     nz = np.flatnonzero(~zero_modes(lam, lam_scale) & (eta > 0))
@@ -456,8 +454,7 @@ is refined by subspace iteration with the fine operator (:func:`_subspace_step`)
 
 REFINE_STEPS = 2
 """Subspace-iteration steps of a refinement.  Always both: after one step the last pairs'
-error lies in the modes just above them, which the estimate does not see (bumpy plate of
-the tests, 20 modes: 0.9 % measured, 0.05 % estimated)."""
+error lies in the modes just above them, which the estimate does not see."""
 
 
 ROW_CHUNK = 16384
@@ -535,17 +532,16 @@ def _subspace_step(
 
 REFINE_GUARD = 0.25
 """Guard vectors of the refinement, as a fraction of the modes wanted (at least
-:data:`REFINE_GUARD_MIN`): with 25 beyond 100 the cow's largest error after two steps
-falls from 8.1 % to 2.2 %."""
+:data:`REFINE_GUARD_MIN`): the wanted modes converge faster when the iteration carries a
+few more."""
 
 REFINE_GUARD_MIN = 5
 
 REFINE_SHIFT = 0.01
 """The refinement's shift: this fraction of the lowest non-zero preview eigenvalue below
 zero.  Subspace iteration multiplies a mode's share by ``1 / (lam - shift)``, so a
-shift near zero brings in modes far below the preview's values (the cow's tail, 0.061
-against 0.711), where a shift scaled by the operator's diagonal (``-6.3`` on the cow)
-would not."""
+shift near zero brings in modes far below the preview's values (modes of thin parts the
+smooth space misses), where a shift scaled by the operator's diagonal would not."""
 
 
 def _factor_below(K, mass: np.ndarray, lam: np.ndarray, lam_scale: float):

@@ -143,30 +143,40 @@ def _near_along_surface(
     straight: np.ndarray,
     cover: float,
 ) -> np.ndarray:
-    """(P,) mask of the (centre, vertex) pairs ``(ci, vi)`` (``straight`` apart in
-    space) to keep: in a ball that reaches parts of the surface far from its centre along
-    the surface, only the vertices connected to the centre through edges inside the ball.
+    """Which (centre, vertex) pairs of the balls to keep: in a ball that reaches parts of
+    the surface far from its centre along the surface, only the vertices connected to the
+    centre through edges inside the ball.
 
-    A ball around a cow's tail also holds part of the leg the tail lies against; the leg
-    is not connected to the tail inside the ball, so it gets no part of the tail's
-    function, which would couple the two.  The cut runs where the function already
-    vanishes, at the ball's boundary, so the functions stay as smooth as the balls' (a
-    cut along a path length leaves jumps: 13 % largest error on the hairpin strip of the
-    tests against 1.1 %).
+    Parts that touch in space but not along the surface (a thin part lying against
+    another) then share no function, which would couple them.  The cut runs at the ball's
+    boundary, where the function vanishes anyway, so the functions stay as smooth as the
+    balls'.  Only the balls a cheap test flags are searched: every vertex belongs to the
+    cell of the centre nearest to it along the edges (one multi-source Dijkstra run over
+    :func:`_surface_graph`), the distance between two cells is the shortest path through
+    neighbouring centres, and a ball is searched when that distance from the centre's
+    cell to one of its vertices' cells is more than :data:`PATH_FACTOR` times their
+    straight distance plus ``cover``.  Parts that meet only at a vertex are apart in the
+    graph; that vertex belongs to both.  A vertex that would lose every function keeps
+    its pairs.  Costs and the tests: "Supports cut along the surface" in
+    docs/how-it-works.md.
 
-    The graph search costs about a millisecond per ball at 130k vertices (0.25 s for the
-    Laplacian's 300), so a cheaper test (0.1 s) picks the balls that need it: every
-    vertex belongs to the cell of the centre nearest to it along the edges (one
-    multi-source Dijkstra run over :func:`_surface_graph`), the distance
-    between two cells is the shortest path through neighbouring centres, and a ball is
-    searched when that distance from the centre's cell to one of its vertices' cells is
-    more than :data:`PATH_FACTOR` times (their straight distance + ``cover``, the
-    covering radius).  On one sheet of surface the path is about as long as the straight
-    line; from the tail to the leg it runs over the body.
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface.
+    centers : ndarray of int, shape (m,)
+        The sample vertices, the balls' centres.
+    ci, vi : ndarray of int, shape (P,)
+        Each pair's centre (an index into ``centers``) and vertex.
+    straight : ndarray of float, shape (P,)
+        The pairs' distances in space.
+    cover : float
+        The covering radius of the samples.
 
-    Parts that meet only at a vertex are apart in the graph (:func:`_surface_graph`);
-    that vertex belongs to both.  A vertex that would lose every function keeps its
-    pairs.
+    Returns
+    -------
+    ndarray of bool, shape (P,)
+        True for the pairs to keep.
     """
     from scipy.sparse.csgraph import dijkstra
 
