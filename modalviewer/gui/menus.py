@@ -126,6 +126,17 @@ def build_menus(win) -> None:
     win.state.events.style.connect(
         lambda: win.shaded_action.setChecked(win.state.style.render == "shaded")
     )
+    win.ghost_action = _action(
+        win,
+        m,
+        "Rest shape &ghost behind deformed modes",
+        lambda on: win.state.set_ghost(on),
+        "G",
+    )
+    win.ghost_action.setCheckable(True)
+    win.ghost_action.setChecked(win.state.style.ghost)
+    win.state.events.style.connect(lambda: win.ghost_action.setChecked(win.state.style.ghost))
+    build_color_range_menu(win, m.addMenu("Colour &range"))
     panels = m.addMenu("&Panels")
     for dock in win.findChildren(QtWidgets.QDockWidget):
         panels.addAction(dock.toggleViewAction())  # a closed panel comes back from here
@@ -164,6 +175,54 @@ def build_menus(win) -> None:
     _action(win, m, "&About", lambda: about(win))
 
 
+COLOR_RANGE_ITEMS = (
+    ("auto", "&Automatic (robust for distances, signatures, curvature)"),
+    ("symmetric", "&Symmetric: the largest value"),
+    ("robust", "&Robust: 99th percentile by area, beyond it clipped"),
+    ("limits", "Typed &limits..."),
+)
+
+
+def build_color_range_menu(win, menu) -> None:
+    """The colour range as radio items following ``state.style.color_range``; "Typed
+    limits..." asks for low and high."""
+    group = QtGui.QActionGroup(menu)
+    actions = {}
+    for rule, label in COLOR_RANGE_ITEMS:
+        if rule == "limits":
+            slot = lambda _=False: ask_color_limits(win)  # noqa: E731
+        else:
+            slot = lambda _=False, r=rule: win.state.set_color_range(r)  # noqa: E731
+        action = _action(win, menu, label, slot)
+        action.setCheckable(True)
+        group.addAction(action)
+        actions[rule] = action
+
+    def follow() -> None:
+        actions[win.state.style.color_range].setChecked(True)
+
+    follow()
+    win.state.events.style.connect(follow)
+    win.color_range_actions = actions
+
+
+def ask_color_limits(win) -> None:
+    """Ask for the colour limits ("low high"), starting from the range on screen."""
+    st = win.state
+    field = st.derived.field()
+    lo, hi = st.style.color_limits or (field.clim if field and field.clim else (0.0, 1.0))
+    text, ok = QtWidgets.QInputDialog.getText(
+        win, "Colour limits", "Low and high value:", text=f"{lo:.6g} {hi:.6g}"
+    )
+    if ok:
+        try:
+            low, high = (float(x) for x in text.replace(",", " ").split())
+            st.set_color_range("limits", (low, high))
+        except ValueError:
+            QtWidgets.QMessageBox.warning(win, "Colour limits", "Type two numbers, low < high.")
+    win.color_range_actions[st.style.color_range].setChecked(True)
+
+
 def about(win) -> None:
     from .. import __version__
 
@@ -200,6 +259,7 @@ Everywhere (the single letters not while typing in a field)
   M / D / C             show the mode / the distance / the curvature
   B                     colour bar and legend on or off
   Shift+S               shaded look on or off
+  G                     rest shape ghost behind a deformed 3D mode on or off
   R                     canonical view
   Alt+1 .. Alt+6        view from +X, -X, +Y, -Y, +Z, -Z
   Alt+7                 isometric view

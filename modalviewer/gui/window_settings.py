@@ -46,13 +46,16 @@ def restore(win) -> None:
         win.restoreState(state)
     st = win.state
     st.set_isolines(int(s.value("view/isolines", 12)))
-    coloring = str(s.value("view/shell_color", "auto"))
-    st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "auto")
+    coloring = str(s.value("view/shell_color", "deformed"))  # a former "auto": deformed
+    st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "deformed")
+    st.set_ghost(_flag(s, "view/ghost", True))
     style = str(s.value("view/style", "paper"))
     st.set_render_style(style if style in RENDER_STYLES else "paper")
     st.set_colorbar(_flag(s, "view/colorbar", True))
     st.set_animation(
-        amplitude=int(s.value("view/amplitude", 8)), speed=int(s.value("view/speed", 30))
+        # the largest displacement of the deformed shape and of the animation
+        amplitude=int(s.value("view/mode_amplitude", 40)),
+        speed=int(s.value("view/speed", 30)),
     )
     operator = str(s.value("compute/operator", "modified_dirichlet"))
     st.set_compute_settings(
@@ -74,11 +77,12 @@ def save(win) -> None:
     s.setValue("window/geometry", win.saveGeometry())
     s.setValue("window/state", win.saveState())
     s.setValue("view/isolines", st.style.isolines)
-    s.setValue("view/amplitude", st.animation.amplitude)
+    s.setValue("view/mode_amplitude", st.animation.amplitude)
     s.setValue("view/speed", st.animation.speed)
     s.setValue("view/shell_color", st.style.shell_coloring)
     s.setValue("view/style", st.style.render)
     s.setValue("view/colorbar", _flag_text(st.style.colorbar))
+    s.setValue("view/ghost", _flag_text(st.style.ghost))
     c = st.compute_settings
     s.setValue("compute/operator", c.operator)
     s.setValue("compute/bending", c.bending)

@@ -453,7 +453,7 @@ def test_a_combo_box_names_its_whole_item_in_its_tooltip(window):
     box.setCurrentIndex(index)
     assert box.toolTip() == box.itemText(index) == "Discrete Shells, normal variations"
     colours = window.modes_panel.color_combo  # a box with a purpose keeps it below
-    assert colours.toolTip() == colours.currentText() + "\nScalar shown for 3D vibration modes"
+    assert colours.toolTip() == colours.currentText() + "\nHow 3D vibration modes are shown"
 
 
 def test_esc_says_what_stays_queued_also_once_the_next_job_starts(window, spot_path):

@@ -83,6 +83,7 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     window.open_mesh(spot_path)
     window.compute("shells", k=12, wait=True)
     window.show_mode(8)
+    window.state.set_shell_coloring("normal")  # a still picture on the rest shape
     rest = np.array(window.scene.surface.points)
     before = window.viewport.render_now()
     window.animation_panel.play_button.click()
@@ -98,6 +99,16 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     window.animation_panel.play_button.click()
     assert not window.scene_view.timer.isActive()
     np.testing.assert_allclose(window.scene.surface.points, rest)
+    # the deformed shape: still at the amplitude, the animation swings about the rest
+    window.state.set_shell_coloring("deformed")
+    peak = np.linalg.norm(window.scene.surface.points - rest, axis=1).max()
+    assert peak == pytest.approx(0.1 * window.mesh.bounding_box_diagonal, rel=1e-6)
+    window.animation_panel.play_button.click()
+    window.animation_frame(0.0)
+    np.testing.assert_allclose(window.scene.surface.points, rest)
+    window.animation_panel.play_button.click()
+    peak = np.linalg.norm(window.scene.surface.points - rest, axis=1).max()
+    assert peak == pytest.approx(0.1 * window.mesh.bounding_box_diagonal, rel=1e-6)
 
 
 def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot):

@@ -20,7 +20,10 @@ class AnimationPanel(QtWidgets.QWidget):
         self.play_button.setToolTip("Animate the mode (Space)")
         self.amp_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
         self.amp_slider.setRange(0, 100)
-        self.amp_slider.setToolTip("Amplitude: percent of a quarter of the bounding box")
+        self.amp_slider.setToolTip(
+            "Largest displacement of the deformed shape and the animation: percent of a "
+            "quarter of the bounding-box diagonal (40: a tenth of the diagonal)"
+        )
         self.speed_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
         self.speed_slider.setRange(1, 100)
         form.addRow(self.play_button)

@@ -43,19 +43,29 @@ class ModesPanel(QtWidgets.QWidget):
         lay.addWidget(self.spectrum_plot)
         form = QtWidgets.QFormLayout()
         self.color_combo = combo()
-        self.color_combo.addItem("Automatic", "auto")
-        self.color_combo.setItemData(
-            0,
-            "Magnitude on meshes with sharp features, else the normal component",
-            QtCore.Qt.ItemDataRole.ToolTipRole,
-        )
-        self.color_combo.addItem("Normal component", "normal")
-        self.color_combo.addItem("Magnitude", "magnitude")
-        describe(self.color_combo, "Scalar shown for 3D vibration modes")
+        for label, data, tip in (
+            (
+                "Deformed shape",
+                "deformed",
+                "The surface displaced by the mode (Amplitude), coloured by the "
+                "displacement magnitude; the rest shape as a grey ghost (G)",
+            ),
+            (
+                "Normal component on rest shape",
+                "normal",
+                "The displacement along smoothed normals, signed, on the rest shape",
+            ),
+            ("Magnitude on rest shape", "magnitude", "|displacement| on the rest shape"),
+        ):
+            self.color_combo.addItem(label, data)
+            self.color_combo.setItemData(
+                self.color_combo.count() - 1, tip, QtCore.Qt.ItemDataRole.ToolTipRole
+            )
+        describe(self.color_combo, "How 3D vibration modes are shown")
         self.iso_spin = QtWidgets.QSpinBox()
         self.iso_spin.setRange(0, 60)
         self.iso_spin.setToolTip("Number of isolines (0: none)")
-        form.addRow("Colour 3D modes by", self.color_combo)
+        form.addRow("Show 3D modes as", self.color_combo)
         form.addRow("Isolines", self.iso_spin)
         lay.addLayout(form)
 
