@@ -20,13 +20,21 @@ import os as _os
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
+from .collection import open_collection  # noqa: E402 (numpy only; Dask loads in run_batch)
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
 from .io import load_mesh  # noqa: E402
 from .repair import SliverReport, fix_slivers  # noqa: E402
 
 __version__ = "0.1.0"
-__all__ = [*_core_all, "load_mesh", "fix_slivers", "SliverReport", "Viewer"]  # noqa: F405
+__all__ = [  # noqa: F405
+    *_core_all,  # noqa: F405
+    "load_mesh",
+    "fix_slivers",
+    "SliverReport",
+    "Viewer",
+    "open_collection",
+]
 
 
 def __getattr__(name):
