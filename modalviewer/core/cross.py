@@ -81,6 +81,23 @@ def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
 
     Only the size changes (vertices times ``sqrt(area / mesh.total_area)``); faces and
     the load report are kept.  Rescale both meshes of a comparison to the same area.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface.
+    area : float
+        The total area of the copy, positive.
+
+    Returns
+    -------
+    Mesh
+        The scaled copy.
+
+    Raises
+    ------
+    ValueError
+        If ``area`` is not a positive finite number.
     """
     area = float(area)
     if not (np.isfinite(area) and area > 0):
@@ -113,10 +130,28 @@ def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
 def common_times(
     spec_a: Spectrum, spec_b: Spectrum, t_range: TRange = None, samples: int = 100
 ) -> np.ndarray:
-    """(samples,) log-spaced scales shared by both spectra.
+    """Log-spaced scales shared by both spectra: ``t_range`` if given, else the
+    intersection of the two default ranges (see the module docstring).
 
-    ``t_range`` (t1, t2) if given, else the intersection of the two default ranges
-    (see the module docstring).  Raises ValueError if they do not overlap.
+    Parameters
+    ----------
+    spec_a, spec_b : Spectrum
+        The two spectra.
+    t_range : (float, float), optional
+        The scales (t1, t2).
+    samples : int
+        The number of scales, at least 2.
+
+    Returns
+    -------
+    ndarray, shape (samples,)
+        The scales, ascending.
+
+    Raises
+    ------
+    ValueError
+        If the default ranges do not overlap (the meshes differ too much in size: rescale
+        both to the same area, see :func:`rescale_to_area`, or pass ``t_range``).
     """
     samples = check_count(samples, "samples", 2)
     if t_range is None:
@@ -222,14 +257,36 @@ def cross_distance(
     samples: int = 100,
     include_zero: bool = False,
 ) -> np.ndarray:
-    """(n_b,) distance of eq. (31) from vertex ``vertex`` of A to every vertex of B.
+    """The distance of eq. (31) from vertex ``vertex`` of A to every vertex of B.
 
     Both spectra must come from the same operator (the signature kind: heat kernel for
     ``"laplacian"``, feature for ``"modified_dirichlet"``, vibration for ``"shells"``).
-    Scales: ``t_range`` or the intersection of the two default ranges, ``samples``
-    log-spaced values; each signature is normalised by its own ``Z(t)``.  Zero modes are
-    left out unless ``include_zero``.  Computed on the meshes as given: see the module
-    docstring on scale and :func:`rescale_to_area`.
+    Each signature is normalised by its own ``Z(t)``.  Computed on the meshes as given:
+    see the module docstring on scale and :func:`rescale_to_area`.
+
+    Parameters
+    ----------
+    spec_a, spec_b : Spectrum
+        The spectra of A and B.
+    vertex : int
+        A vertex of A.
+    t_range : (float, float), optional
+        The scales (default: the intersection of the two default ranges).
+    samples : int
+        The number of log-spaced scales.
+    include_zero : bool
+        Whether the signatures include the zero modes.
+
+    Returns
+    -------
+    ndarray, shape (n_b,)
+        The distance to each vertex of B.
+
+    Raises
+    ------
+    ValueError
+        If the spectra are of different operators (or shells spectra of different
+        weights), or their default scale ranges do not overlap.
     """
     v = check_vertex(vertex, spec_a.n_vertices)
     _check_pair(spec_a, spec_b)
@@ -247,7 +304,24 @@ def best_match(
     samples: int = 100,
     include_zero: bool = False,
 ) -> tuple[int, float]:
-    """The vertex of B closest to vertex ``vertex`` of A, and its distance."""
+    """The vertex of B closest to vertex ``vertex`` of A under :func:`cross_distance`.
+
+    Parameters
+    ----------
+    spec_a, spec_b : Spectrum
+        The spectra of A and B, of the same operator.
+    vertex : int
+        A vertex of A.
+    t_range, samples, include_zero
+        As for :func:`cross_distance`.
+
+    Returns
+    -------
+    vertex_b : int
+        The closest vertex of B.
+    distance : float
+        Its distance.
+    """
     d = cross_distance(spec_a, vertex, spec_b, t_range, samples, include_zero)
     w = int(np.argmin(d))
     return w, float(d[w])
@@ -275,8 +349,21 @@ def mutual_best_matches(
 
 
 def distance_ranks(distances: np.ndarray, vertices: Vertices) -> np.ndarray:
-    """1-based rank of each of ``vertices`` in a distance map: 1 + the number of
-    vertices strictly closer (rank 1 = best match, ties share the better rank)."""
+    """The rank of each of ``vertices`` in a distance map: 1 + the number of vertices
+    strictly closer (rank 1 = best match, ties share the better rank).
+
+    Parameters
+    ----------
+    distances : ndarray, shape (n,)
+        A distance map, one value per vertex.
+    vertices : int or array_like of int, shape (m,)
+        Vertex indices in ``0..n-1``.
+
+    Returns
+    -------
+    ndarray of int, shape (m,)
+        The 1-based ranks.
+    """
     d = np.asarray(distances, dtype=np.float64)
     idx = check_vertices(vertices, d.shape[0])
     return 1 + np.sum(d[None, :] < d[idx, None], axis=1)

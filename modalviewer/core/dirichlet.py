@@ -12,10 +12,26 @@ __all__ = ["modified_dirichlet_matrix"]
 
 
 def modified_dirichlet_matrix(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_matrix:
-    """A, (n, n) symmetric PSD CSR with ``A_ij = <N_i, N_j> S_ij`` (so ``A_ii = S_ii``).
+    """The matrix A of the modified Dirichlet energy E_D^N, ``A_ij = <N_i, N_j> S_ij`` (so
+    ``A_ii = S_ii``), with S the cotan stiffness matrix.
 
-    ``normals`` defaults to the area-weighted unit vertex normals.  Requires a
-    consistently oriented, edge-manifold mesh (normals are otherwise ambiguous).
+    Parameters
+    ----------
+    mesh : Mesh
+        A consistently oriented, edge-manifold surface (normals are otherwise ambiguous),
+        n vertices.
+    normals : ndarray, shape (n, 3), optional
+        Unit vertex normals (default: the area-weighted ones of :func:`vertex_normals`).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n, n)
+        Symmetric positive semi-definite.
+
+    Raises
+    ------
+    MeshError
+        If the mesh is not consistently oriented or not edge-manifold.
     """
     problem = mesh.shell_problem()
     if problem:

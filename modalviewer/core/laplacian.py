@@ -27,9 +27,18 @@ def face_cotangents(mesh: Mesh) -> np.ndarray:
 
 
 def stiffness_matrix(mesh: Mesh) -> sp.csr_matrix:
-    """Cotan stiffness matrix S, (n, n) symmetric PSD CSR; units of (length)^0.
+    """The cotan stiffness matrix S (the Laplacian's energy ``f^T S f``); units of
+    (length)^0.  Boundary edges get one cotangent term (natural / Neumann conditions).
 
-    Boundary edges get one cotangent term (natural / Neumann conditions).
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface, n vertices.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n, n)
+        Symmetric positive semi-definite; its null space holds the constants.
     """
     f = mesh.faces
     n = mesh.n_vertices
@@ -47,7 +56,19 @@ def stiffness_matrix(mesh: Mesh) -> sp.csr_matrix:
 
 
 def mass_matrix(mesh: Mesh) -> sp.dia_matrix:
-    """Lumped (barycentric) mass M, (n, n) diagonal; m_i = 1/3 of the area around i."""
+    """The lumped (barycentric) mass matrix M: ``m_i`` is a third of the area of the
+    triangles around vertex i.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface, n vertices.
+
+    Returns
+    -------
+    scipy.sparse.dia_matrix, shape (n, n)
+        Diagonal, positive where a vertex has a triangle of non-zero area.
+    """
     return sp.diags(lumped_masses(mesh), format="dia")
 
 
@@ -59,10 +80,25 @@ def lumped_masses(mesh: Mesh) -> np.ndarray:
 
 
 def vertex_normals(mesh: Mesh, weighting: str = "area") -> np.ndarray:
-    """(n, 3) unit vertex normals.
+    """Unit vertex normals.
 
-    ``weighting="area"`` (default) sums the unnormalised face normals N_T;
-    ``"angle"`` weights unit face normals by the corner angle.
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface, n vertices.
+    weighting : {"area", "angle"}
+        ``"area"`` sums the unnormalised face normals (area-weighted); ``"angle"`` weights
+        unit face normals by the corner angle.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        One unit normal per vertex.
+
+    Raises
+    ------
+    ValueError
+        For another ``weighting``.
     """
     f = mesh.faces
     nt = mesh.face_normals_unnormalized

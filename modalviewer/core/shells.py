@@ -228,12 +228,24 @@ def _gram(G: sp.csr_matrix) -> sp.csr_matrix:
 
 
 def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
-    """Hessian of the Discrete Shells energy at rest (Lemma 1), (3n, 3n) PSD CSR.
+    """The Hessian H of the Discrete Shells energy at rest (Lemma 1).
 
-    Vertex-major dof order ``3 * i + c``.  Pair it with ``kron(M, I3)`` as mass.
-    Units: bending part ~ 1 / length^2, membrane part ~ 1 / length^1 (hence the
-    spectrum depends on the mesh's absolute size).  Assembled as ``G^T G`` of
-    :func:`weighted_gradient_matrix` (one sparse product on two threads).
+    Degrees of freedom in vertex-major order ``3 * i + c``; pair it with ``kron(M, I3)`` as
+    mass.  The bending part scales like 1 / length^2 and the membrane part like
+    1 / length, so the spectrum depends on the mesh's absolute size.  Assembled as
+    ``G^T G`` of :func:`weighted_gradient_matrix` (one sparse product on two threads).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface, n vertices.
+    bending, membrane : float
+        The weights of the bending and the membrane (stretching) energy.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (3n, 3n)
+        Symmetric positive semi-definite; its null space holds the rigid motions.
     """
     return _gram(weighted_gradient_matrix(mesh, bending, membrane))
 
@@ -248,7 +260,20 @@ def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_m
 
 
 def normal_shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
-    """H_N = P^T H P, (n, n): the shells Hessian restricted to normal variations, with P
-    of :func:`normal_projection` (assembled as ``(G P)^T (G P)``)."""
+    """``H_N = P^T H P``: the shells Hessian restricted to normal variations ``f N``, with P
+    of :func:`normal_projection` (assembled as ``(G P)^T (G P)``).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface, n vertices.
+    bending, membrane : float
+        The weights of the bending and the membrane energy.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n, n)
+        Symmetric positive semi-definite.
+    """
     G_N = weighted_gradient_matrix(mesh, bending, membrane, normals=vertex_normals(mesh))
     return _gram(G_N)

@@ -25,7 +25,28 @@ def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
 
 
 def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False) -> np.ndarray:
-    """(T,) log-spaced scales from 4 ln 10 / lambda_max to 4 ln 10 / lambda_min (non-zero)."""
+    """Log-spaced scales from ``4 ln 10 / lambda_max`` to ``4 ln 10 / lambda_min`` (the
+    largest and the smallest non-zero eigenvalue used).
+
+    Parameters
+    ----------
+    spec : Spectrum
+        The spectrum whose eigenvalues set the range.
+    samples : int
+        The number of scales T.
+    include_zero : bool
+        Whether zero modes count (they do not change the range).
+
+    Returns
+    -------
+    ndarray, shape (T,)
+        The scales, ascending.
+
+    Raises
+    ------
+    ValueError
+        If the spectrum has no non-zero modes.
+    """
     samples = check_count(samples, "samples", 2)
     lam = spec.eigenvalues[~spec.zero_mode_mask()]
     if lam.size == 0:
@@ -41,15 +62,33 @@ def signature(
     include_zero: bool = False,
     vertices: int | Sequence[int] | np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Signature at every vertex (or at ``vertices``) and scale.
+    """The signature ``sum_j exp(-lambda_j t) |phi_j(v)|^2`` at every vertex (or at
+    ``vertices``) and scale: the heat kernel signature for the Laplacian, the feature
+    signature for E_D^N, the vibration signature for the Discrete Shells.
 
-    ``times`` must be positive and finite, ``vertices`` integer indices in
-    ``0..n-1`` (TypeError, ValueError or IndexError otherwise).
+    Parameters
+    ----------
+    spec : Spectrum
+        The spectrum, n vertices.
+    times : float or array_like of float, optional
+        Positive, finite scales (default: :func:`default_times`).
+    include_zero : bool
+        Whether the sum includes the zero modes.
+    vertices : int or array_like of int, optional
+        Vertex indices in ``0..n-1`` (default: every vertex).
 
     Returns
     -------
-    times : (T,) the scales (default: :func:`default_times`).
-    values : (n, T), or (len(vertices), T), ``sum_j exp(-lambda_j t) |phi_j(v)|^2``.
+    times : ndarray, shape (T,)
+        The scales.
+    values : ndarray, shape (n, T) or (len(vertices), T)
+        The signature of each vertex at each scale.
+
+    Raises
+    ------
+    TypeError, ValueError, IndexError
+        For scales that are not positive and finite, or vertices that are not integer
+        indices of the mesh.
     """
     mask = _used(spec, include_zero)
     times = default_times(spec, include_zero=include_zero) if times is None else times
@@ -143,10 +182,33 @@ def multiscale_distance(
     samples: int = 100,
     include_zero: bool = False,
 ) -> np.ndarray:
-    """(n,) distance delta_[t1,t2](vertex, w) of eq. (31) to every vertex w.
+    """The multi-scale distance ``delta_[t1,t2](vertex, w)`` of eq. (31) to every vertex w.
 
-    A Riemann sum over ``samples`` log-spaced scales in ``t_range`` (default:
-    :func:`default_times`), each difference normalised by ``Z(t) = sum_j exp(-lambda_j t)``.
+    A Riemann sum over ``samples`` log-spaced scales in ``t_range``, each difference of
+    signatures normalised by ``Z(t) = sum_j exp(-lambda_j t)``.
+
+    Parameters
+    ----------
+    spec : Spectrum
+        The spectrum, n vertices.
+    vertex : int
+        The vertex the distances are measured from.
+    t_range : (float, float), optional
+        The scales (t1, t2) (default: the range of :func:`default_times`).
+    samples : int
+        The number of scales of the sum.
+    include_zero : bool
+        Whether the signatures include the zero modes.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The distance from ``vertex`` to each vertex (0 at ``vertex`` itself).
+
+    Raises
+    ------
+    ValueError
+        If the spectrum has no non-zero modes.
     """
     vertex = check_vertex(vertex, spec.n_vertices)
     return SignatureTable(spec, t_range, samples, include_zero).distance_from(vertex)

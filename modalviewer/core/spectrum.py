@@ -131,7 +131,21 @@ def _atomic_write(path: Path, write) -> None:
 
 
 def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
-    """Write ``spec`` to ``path`` (.npz) atomically, with mesh hash and parameters."""
+    """Write ``spec`` to ``path`` as ``.npz`` (atomically: a half-written file never
+    replaces a good one), with its mesh hash and parameters.
+
+    Parameters
+    ----------
+    spec : Spectrum
+        The spectrum to save.
+    path : str or os.PathLike
+        The file to write.
+
+    Raises
+    ------
+    OSError
+        If the file cannot be written.
+    """
     meta = {
         "format": "modalviewer-spectrum",
         "version": FORMAT_VERSION,
@@ -160,9 +174,28 @@ def load_spectrum(
 ) -> Spectrum:
     """Read a spectrum written by :func:`save_spectrum`.
 
-    If ``mesh`` (a :class:`Mesh`) or ``mesh_hash`` (its ``mesh.hash``, a keyword) is
-    given, a spectrum of another mesh raises SpectrumFileError.  A string passed as
-    ``mesh`` raises TypeError: pass a hash as ``mesh_hash=``.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The ``.npz`` file.
+    mesh : Mesh, optional
+        The mesh the spectrum must belong to.
+    mesh_hash : str, optional
+        Instead of ``mesh``: its ``mesh.hash`` (a keyword).
+
+    Returns
+    -------
+    Spectrum
+        The spectrum as saved.
+
+    Raises
+    ------
+    SpectrumFileError
+        If the file is not a readable spectrum file (or has inconsistent shapes, NaN or
+        infinite values), or belongs to another mesh than ``mesh`` / ``mesh_hash``.
+    TypeError
+        If ``mesh`` is not a Mesh (a string passed as ``mesh``: pass a hash as
+        ``mesh_hash=``), or both are given.
     """
     if mesh is not None:
         if isinstance(mesh, (str, bytes)):
