@@ -19,7 +19,7 @@ from .core.operators import (
     distance_word,
     operator_for_distance,
 )
-from .viewer.state import DEFAULT_THRESHOLD_SHARE
+from .viewer.state import DEFAULT_THRESHOLD_SHARE, SHELL_COLORINGS
 
 COMMANDS = ("compute", "render", "distance", "figures")
 OPERATORS = OPERATOR_NAMES
@@ -121,6 +121,13 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--mode", type=int, required=True)
     r.add_argument("-k", type=int, default=None)
     r.add_argument("--isolines", type=int, default=12)
+    r.add_argument(
+        "--show",
+        choices=SHELL_COLORINGS,
+        default="deformed",
+        help="3D vibration modes (shells): the deformed shape over the rest shape's ghost "
+        "(default), or the normal component or the magnitude on the rest shape",
+    )
     r.add_argument("--size", type=_size, default=(1024, 768))
     r.add_argument("--transparent", action="store_true")
     _camera_arguments(r)
@@ -264,6 +271,7 @@ def _run(args) -> int:
     if args.command == "render":
         viewer = _viewer(mesh, args.mesh)
         viewer.state.set_isolines(args.isolines)
+        viewer.state.set_shell_coloring(args.show)
         with _warnings_printed():
             spec = viewer.compute(args.operator, k=args.k, wait=True)
         if not 0 <= args.mode < spec.k:

@@ -179,3 +179,19 @@ def test_typed_colour_limits(spot):
     assert state.style.color_limits == (lo, hi)  # kept for the next "limits"
     with pytest.raises(ValueError, match="low < high"):
         state.set_color_range("limits", (1.0, 1.0))
+
+
+def test_cli_render_draws_a_shells_mode_deformed(tmp_path):
+    from PIL import Image
+
+    from modalviewer.cli import main
+
+    masks = {}
+    for show in ("deformed", "normal"):
+        out = tmp_path / f"{show}.png"
+        argv = ["render", str(ASSETS / "demo_machined_part.obj"), "--operator", "shells"]
+        argv += ["--mode", "8", "-k", "16", "--size", "400x300", "--transparent"]
+        assert main([*argv, "--show", show, "-o", str(out)]) == 0
+        masks[show] = np.asarray(Image.open(out))[..., 3] > 0
+    a, b = masks["deformed"], masks["normal"]
+    assert np.logical_xor(a, b).sum() / np.logical_or(a, b).sum() > 0.05
