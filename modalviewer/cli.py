@@ -21,7 +21,7 @@ from .core.operators import (
 )
 from .viewer.state import DEFAULT_THRESHOLD_SHARE, SHELL_COLORINGS
 
-COMMANDS = ("compute", "render", "distance", "figures")
+COMMANDS = ("compute", "render", "distance", "figures", "batch", "similar")
 OPERATORS = OPERATOR_NAMES
 KINDS = {kind: operator_for_distance(kind) for kind in DISTANCE_KINDS}
 
@@ -198,6 +198,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     f = sub.add_parser("figures", help="rebuild the paper's figures on the demo meshes")
     f.add_argument("-o", "--output", default="screenshots")
+    from .batch_cli import add_parsers
+
+    add_parsers(sub)  # batch, similar
     return p
 
 
@@ -217,6 +220,10 @@ def _run(args) -> int:
     if args.command in ("compute", "distance", "render"):
         if args.k is not None and args.k < 1:
             raise ValueError("-k must be at least 1")
+    if args.command in ("batch", "similar"):
+        from .batch_cli import run
+
+        return run(args)
     if args.command == "figures":
         from .figures import build_figures
 

@@ -474,6 +474,8 @@ class BatchSummary:
     computed: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
     failed: dict[str, str] = field(default_factory=dict)
+    failed_before: list[str] = field(default_factory=list)
+    """The skipped meshes that failed in an earlier run (``retry_failed`` retries them)."""
     seconds: float = 0.0
     interrupted: bool = False
 
@@ -489,6 +491,8 @@ class BatchSummary:
         )
         if self.computed:
             words += f" ({rate:.1f} meshes per minute)"
+        if self.failed_before:
+            words += f"; {len(self.failed_before)} of those done had failed before"
         return ("interrupted: " if self.interrupted else "") + words
 
 
@@ -578,6 +582,8 @@ def run_batch(
         status, known = _done(store, name, path, parameters, retry_failed)
         if status == "done":
             summary.skipped.append(name)
+            if status_failed(store, name):
+                summary.failed_before.append(name)
         else:
             todo.append((name, path, known))
     total = len(paths)
@@ -614,6 +620,13 @@ def run_batch(
         summary.seconds = time.perf_counter() - start
         rebuild_index(store)
     return summary
+
+
+def status_failed(store: Path, name: str) -> bool:
+    """Whether ``name`` is recorded as failed (and has no result)."""
+    return (store / "errors" / f"{name}.json").exists() and not (
+        store / "meshes" / f"{name}.npz"
+    ).exists()
 
 
 def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bool):

@@ -1,0 +1,162 @@
+"""The collection commands of the CLI: ``modalviewer batch`` and ``modalviewer similar``
+(:mod:`modalviewer.collection` does the work)."""
+
+from __future__ import annotations
+
+import sys
+
+from .core.operators import DISTANCE_KINDS, OPERATOR_NAMES
+
+COMMANDS = ("batch", "similar")
+
+
+def _kinds(text: str) -> list[str]:
+    import argparse
+
+    kinds = [word.strip() for word in text.split(",") if word.strip()]
+    unknown = [kind for kind in kinds if kind not in DISTANCE_KINDS]
+    if unknown:
+        raise argparse.ArgumentTypeError(
+            f"unknown signature {unknown[0]!r}; choose among {', '.join(DISTANCE_KINDS)}"
+        )
+    return kinds
+
+
+def add_parsers(sub) -> None:
+    """The ``batch`` and ``similar`` subcommands of the CLI's parser."""
+    b = sub.add_parser(
+        "batch",
+        help="spectra (and signatures) of every mesh of folders, globs or list files, "
+        "into one store, on a local or remote Dask cluster",
+    )
+    b.add_argument(
+        "sources",
+        nargs="+",
+        metavar="SOURCE",
+        help="a folder (searched recursively), a glob pattern, a mesh file, or a list "
+        "file (one path per line)",
+    )
+    b.add_argument("-o", "--output", required=True, metavar="STORE", help="the store folder")
+    b.add_argument("--operator", choices=OPERATOR_NAMES, default="laplacian")
+    b.add_argument("-k", type=int, default=50)
+    b.add_argument("--bending", type=float, default=1.0)
+    b.add_argument("--membrane", type=float, default=1.0)
+    b.add_argument(
+        "--signatures",
+        type=_kinds,
+        default=[],
+        metavar="KINDS",
+        help=f"comma-separated among {','.join(DISTANCE_KINDS)}: each signature at the "
+        "standard scales and its histogram (its operator's spectrum is computed too)",
+    )
+    where = b.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="a local Dask cluster of N worker processes (default: one per core); 0: one "
+        "mesh after another in this process, without Dask",
+    )
+    where.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="an existing Dask scheduler, e.g. tcp://host:8786 (the workers must see the "
+        "mesh paths and have modalviewer installed)",
+    )
+    b.add_argument(
+        "--memory-limit",
+        type=float,
+        default=None,
+        metavar="GB",
+        help="each local worker's memory limit (default: the machine's memory over the "
+        "workers); tasks ask for their estimated memory out of it",
+    )
+    b.add_argument("--retry-failed", action="store_true", help="retry meshes recorded as failed")
+    s = sub.add_parser(
+        "similar", help="the meshes of a store nearest to a mesh (Shape-DNA distance)"
+    )
+    s.add_argument("store")
+    s.add_argument("mesh", help="a mesh file, or the name of a mesh in the store")
+    s.add_argument("-n", type=int, default=10, help="how many to list (default 10)")
+
+
+def run(args) -> int:
+    """Run ``batch`` or ``similar``; errors propagate as in the other commands."""
+    if args.command == "batch":
+        return _batch(args)
+    return _similar(args)
+
+
+def _batch(args) -> int:
+    import os
+
+    from .cli import _Unavailable
+    from .collection import progress_bar, run_batch
+
+    if args.k < 1:
+        raise ValueError("-k must be at least 1")
+    workers = args.workers
+    if workers is None:
+        workers = os.cpu_count() or 1
+    if workers < 0:
+        raise ValueError("--workers must be 0 or more")
+    if args.memory_limit is not None and args.memory_limit <= 0:
+        raise ValueError("--memory-limit must be above 0")
+    if workers > 0 or args.scheduler:
+        try:
+            import distributed  # noqa: F401
+        except ImportError:
+            raise _Unavailable(
+                "Dask is not installed: pip install 'modalviewer[batch]' (or --workers 0: "
+                "one mesh after another in this process)"
+            ) from None
+    summary = run_batch(
+        args.sources,
+        args.output,
+        args.operator,
+        args.k,
+        args.signatures,
+        args.bending,
+        args.membrane,
+        workers=workers,
+        scheduler=args.scheduler,
+        memory_limit=None if args.memory_limit is None else int(args.memory_limit * 2**30),
+        retry_failed=args.retry_failed,
+        progress=progress_bar(),
+        log=lambda text: sys.stderr.write(f"modalviewer: note: {text}\n"),
+    )
+    for name, error in summary.failed.items():
+        print(f"failed: {name}: {error}")
+    print(f"{args.output}: {summary.text()}")
+    if summary.failed_before:
+        print("(--retry-failed retries them: " + ", ".join(summary.failed_before) + ")")
+    if summary.interrupted:
+        sys.stderr.write("modalviewer: interrupted (the store holds every finished mesh)\n")
+        return 130
+    return 1 if summary.failed else 0
+
+
+def _similar(args) -> int:
+    from pathlib import Path
+
+    from .collection import open_collection
+
+    if args.n < 1:
+        raise ValueError("-n must be at least 1")
+    collection = open_collection(args.store)
+    if not collection.names:
+        raise ValueError(f"{args.store} holds no meshes")
+    query = args.mesh
+    if query not in collection and not Path(query).exists():
+        raise ValueError(f"{query}: neither a mesh file nor a name in {args.store}")
+    ranked = collection.similar(query, args.n)
+    print(
+        f"nearest to {query} in {args.store} ({collection.operator}, {collection.k} modes; "
+        "Shape-DNA distance):"
+    )
+    width = max(len(name) for name, _ in ranked)
+    for rank, (name, distance) in enumerate(ranked, 1):
+        print(f"{rank:3d}. {name:<{width}}  {distance:.6g}")
+    return 0
