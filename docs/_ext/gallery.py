@@ -11,7 +11,8 @@ runs them all).  A script that fails, or writes no PNG, is a build warning, so a
 under ``make docs`` (``-W``).
 
 ``docs/_generated/gallery.inc`` (included by ``docs/gallery.rst``) gets, per script: the
-docstring as text, the code after it as a literal block, what it printed, and the PNGs.
+docstring as text, the code after it as a literal block, what it printed, and the PNGs,
+after a list of links to the examples.
 
 Run as a script, it runs the examples that changed and writes the page source::
 
@@ -131,7 +132,7 @@ def _indent(text: str, prefix: str = "   ") -> list[str]:
 
 def page_source(examples: list[Example], docs: Path = ROOT / "docs") -> str:
     """reStructuredText of the examples, for ``docs/gallery.rst`` to include."""
-    lines: list[str] = []
+    lines = [f"- :ref:`gallery-{ex.name}`" for ex in examples] + [""]
     for ex in examples:
         lines += [f".. _gallery-{ex.name}:", ""]
         lines += ex.docstring.splitlines() + [""]
