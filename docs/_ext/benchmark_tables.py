@@ -232,7 +232,7 @@ def _axes(ax, ylabel: str, title: str, vertices) -> None:
 
 def _legend(fig, ax) -> None:
     """One legend for both panels, right of them."""
-    fig.legend(*ax.get_legend_handles_labels(), loc="outside right upper", fontsize=8)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside right upper", fontsize=7.5)
 
 
 def _series(ax, rows: list[dict], key, label: str, style: str, color) -> None:
@@ -248,7 +248,7 @@ def spectra_plot(rows: list[dict], path: Path) -> Path:
     number of vertices, per operator, beside plain scipy (the baseline) where it ran."""
     import matplotlib.pyplot as plt
 
-    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(10, 3.4), layout="constrained")
+    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(8.6, 3.3), layout="constrained")
     for i, op in enumerate(sorted({r["operator"] for r in rows})):
         mine = [r for r in rows if r["operator"] == op and r["k"] == 300]
         color = f"C{i}"
@@ -269,7 +269,7 @@ def preview_plot(rows: list[dict], path: Path) -> Path:
     preview and coarse-to-fine against the number of vertices, per operator."""
     import matplotlib.pyplot as plt
 
-    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(10, 3.4), layout="constrained")
+    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(8.6, 3.3), layout="constrained")
     methods = [
         ("exact", "o-", lambda r: r["exact_s"], lambda r: r["exact_peak_mb"]),
         ("preview", "^--", lambda r: r["preview"]["seconds"], lambda r: r["preview"]["peak_mb"]),
@@ -298,7 +298,7 @@ def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=130)
     plt.close(fig)
     return path
 
