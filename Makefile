@@ -19,11 +19,11 @@ run: $(STAMP)
 
 test: $(STAMP)
 	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q
-	$(PY) -m ruff check modalviewer tests benchmarks scripts
-	$(PY) -m ruff format --check modalviewer tests benchmarks scripts
+	$(PY) -m ruff check modalviewer tests benchmarks scripts examples docs/_ext
+	$(PY) -m ruff format --check modalviewer tests benchmarks scripts examples docs/_ext
 
 lint: $(STAMP)
-	$(PY) -m ruff check modalviewer tests benchmarks scripts
+	$(PY) -m ruff check modalviewer tests benchmarks scripts examples docs/_ext
 
 format: $(STAMP)
 	$(PY) -m ruff format modalviewer tests benchmarks
