@@ -9,7 +9,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-ASSETS = Path(__file__).resolve().parents[1] / "assets"
+from .data import assets_dir
+
+ASSETS = assets_dir()
 FIGURE_SIZE = (900, 700)
 """Pixels of a single-view figure; comparisons are 480 x 480 per view."""
 
