@@ -77,8 +77,10 @@ __all__ = [
     "Collection",
     "CollectionError",
     "HISTOGRAM_EDGES",
+    "Neighbour",
     "find_meshes",
     "mesh_names",
+    "nearest_rows",
     "open_collection",
     "run_batch",
     "shape_dna_distance",
@@ -977,3 +979,35 @@ def open_collection(path: str | os.PathLike) -> Collection:
     """The collection at ``path`` (a store of :func:`run_batch`), CollectionError if it is
     none.  Needs numpy only."""
     return Collection(path)
+
+
+@dataclass(frozen=True)
+class Neighbour:
+    """One row of :func:`nearest_rows`: a stored mesh, its distance to the query (None
+    without one), its source file and whether that file is there to open."""
+
+    name: str
+    distance: float | None
+    source: Path
+    available: bool
+
+    @property
+    def label(self) -> str:
+        """The row in words: name, distance, and "(file missing)" if it cannot open."""
+        words = self.name if self.distance is None else f"{self.name}  ({self.distance:.4g})"
+        return words if self.available else f"{words}  (file missing: {self.source})"
+
+
+def nearest_rows(collection: Collection, mesh=None, spectrum=None, n=None) -> list[Neighbour]:
+    """The rows a list of the collection shows: nearest to ``mesh`` first (a
+    :class:`~.core.mesh.Mesh`, with its ``spectrum`` if one of the store's operator is at
+    hand; see :meth:`Collection.similar`), or every mesh by name without a mesh."""
+    if mesh is None:
+        ranked = [(name, None) for name in collection.names]
+    else:
+        ranked = collection.similar(mesh, n=n, spectrum=spectrum)
+    rows = []
+    for name, distance in ranked:
+        source = collection.source(name)
+        rows.append(Neighbour(name, distance, source, source.is_file()))
+    return rows

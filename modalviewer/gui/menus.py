@@ -9,6 +9,7 @@ from qtpy import QtCore, QtGui, QtWidgets
 
 from ..repair import REPAIRS
 from . import file_dialogs
+from .collection_dialog import open_collection_dialog
 from .pair_window import open_second_mesh_dialog
 
 
@@ -62,6 +63,13 @@ def build_menus(win) -> None:
         lambda: open_second_mesh_dialog(win),
         "Ctrl+Shift+B",
         "Open mesh B beside this mesh: a click on one shows the similar points on the other",
+    )
+    _action(
+        win,
+        m,
+        "Open co&llection...",
+        lambda: open_collection_dialog(win),
+        tip="A store of 'modalviewer batch': its shapes nearest to this mesh; one opens beside it",
     )
     m.addSeparator()
     _action(

@@ -1,0 +1,93 @@
+"""File > Open collection...: a store of ``modalviewer batch`` listed nearest to the mesh
+on screen first; the chosen shape opens beside it in the shape-pair window.  The list
+comes from :func:`modalviewer.collection.nearest_rows` (no Qt)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from qtpy import QtCore, QtWidgets
+
+from ..collection import CollectionError, nearest_rows, open_collection
+from .pair_window import open_pair_window
+
+
+class CollectionDialog(QtWidgets.QDialog):
+    """The shapes of a collection, nearest first; "Open beside" opens the selected one
+    as mesh B of the shape-pair window."""
+
+    def __init__(self, main, collection, rows):
+        super().__init__(main)
+        self.main, self.collection, self.rows = main, collection, rows
+        self.setWindowTitle(f"Collection {collection.path.name}")
+        layout = QtWidgets.QVBoxLayout(self)
+        nearest = main.state.mesh is not None
+        what = "nearest to the mesh on screen first" if nearest else "open a mesh to rank them"
+        self.header = QtWidgets.QLabel(
+            f"{len(collection.names)} shapes ({collection.operator}, {collection.k} modes), "
+            f"{what}; Shape-DNA distance"
+            + (f"; {len(collection.errors)} failed in the batch" if collection.errors else "")
+        )
+        self.header.setWordWrap(True)
+        layout.addWidget(self.header)
+        self.list = QtWidgets.QListWidget()
+        for row in rows:
+            item = QtWidgets.QListWidgetItem(row.label)
+            if not row.available:
+                item.setFlags(item.flags() & ~QtCore.Qt.ItemFlag.ItemIsEnabled)
+            self.list.addItem(item)
+        self.list.itemDoubleClicked.connect(lambda _: self.open_selected())
+        layout.addWidget(self.list)
+        buttons = QtWidgets.QDialogButtonBox(QtWidgets.QDialogButtonBox.StandardButton.Close)
+        self.open_button = buttons.addButton(
+            "Open beside", QtWidgets.QDialogButtonBox.ButtonRole.ActionRole
+        )
+        self.open_button.setEnabled(nearest)
+        self.open_button.clicked.connect(self.open_selected)
+        buttons.rejected.connect(self.reject)
+        layout.addWidget(buttons)
+        first = next((i for i, row in enumerate(rows) if row.available), None)
+        if first is not None:
+            self.list.setCurrentRow(first)
+        self.resize(520, 420)
+
+    def open_selected(self, wait: bool = False):
+        """Open the selected shape beside the mesh on screen (the pair window)."""
+        i = self.list.currentRow()
+        if i < 0 or not self.rows[i].available or self.main.state.mesh is None:
+            return None
+        return open_pair_window(self.main, self.rows[i].source, wait=wait)
+
+
+def open_collection_window(main, path) -> CollectionDialog | None:
+    """The dialog of the store at ``path``, shown; None (after a message) if it is not
+    a collection.  The distances need the mesh on screen's spectrum of the store's
+    operator: the one on screen if it has the store's k modes, else computed here."""
+    try:
+        collection = open_collection(path)
+    except (CollectionError, OSError) as exc:
+        main.show_error(str(exc), "Cannot open collection")
+        return None
+    mesh = main.state.mesh
+    QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.CursorShape.WaitCursor)
+    try:
+        rows = nearest_rows(collection, mesh, main.state.spectrum(collection.operator))
+    except (ValueError, RuntimeError, MemoryError) as exc:
+        QtWidgets.QApplication.restoreOverrideCursor()
+        main.show_error(f"Cannot rank the collection: {exc}", "Open collection")
+        return None
+    QtWidgets.QApplication.restoreOverrideCursor()
+    dialog = CollectionDialog(main, collection, rows)
+    main.collection_dialog = dialog
+    dialog.show()
+    return dialog
+
+
+def open_collection_dialog(main) -> None:
+    """File > Open collection...: choose the store folder."""
+    start = str(main.settings.value("files/collection_dir", str(Path.home())))
+    path = QtWidgets.QFileDialog.getExistingDirectory(main, "Open collection", start)
+    if path:
+        if main.remember_settings:
+            main.settings.setValue("files/collection_dir", str(Path(path).parent))
+        open_collection_window(main, path)

@@ -1,0 +1,214 @@
+"""Shape collections: ``run_batch`` on a local Dask cluster (threads, tiny meshes), the
+store it writes, resuming, failures, ``similar``, and a batch killed midway."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import modalviewer as mv
+from modalviewer import collection as coll
+from modalviewer.core import primitives
+
+distributed = pytest.importorskip("distributed")
+
+K = 8
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _write_obj(mesh, path: Path) -> None:
+    with open(path, "w") as fh:
+        for x, y, z in mesh.vertices:
+            fh.write(f"v {float(x)!r} {float(y)!r} {float(z)!r}\n")
+        for a, b, c in mesh.faces + 1:
+            fh.write(f"f {a} {b} {c}\n")
+
+
+def _rotation(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+@pytest.fixture(scope="module")
+def sources(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("meshes")
+    torus = primitives.torus(14, 7)
+    _write_obj(torus, folder / "torus.obj")
+    moved = mv.Mesh(torus.vertices @ _rotation(0.7).T + [2.0, -1.0, 0.5], torus.faces)
+    _write_obj(moved, folder / "torus_moved.obj")
+    _write_obj(primitives.icosphere(1), folder / "sphere.obj")
+    _write_obj(primitives.grid_plate(6, 5), folder / "plate.obj")
+    fat = primitives.torus(14, 7, minor=0.5)
+    _write_obj(fat, folder / "fat_torus.obj")
+    (folder / "broken.obj").write_text("v 0 0 0\nv 1 0\nf 1 2 3\n")
+    return folder
+
+
+@pytest.fixture(scope="module")
+def client():
+    with distributed.Client(
+        processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None
+    ) as c:
+        yield c
+
+
+@pytest.fixture(scope="module")
+def store(sources, client, tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("store") / "store"
+    summary = coll.run_batch([sources], path, "laplacian", K, ["hks", "vibration"], client=client)
+    assert sorted(summary.computed) == ["fat_torus", "plate", "sphere", "torus", "torus_moved"], (
+        summary
+    )
+    return path
+
+
+def _same_up_to_sign(a: np.ndarray, b: np.ndarray) -> None:
+    a, b = a.reshape(-1, a.shape[-1]), b.reshape(-1, b.shape[-1])
+    for j in range(a.shape[1]):
+        sign = 1.0 if a[:, j] @ b[:, j] >= 0 else -1.0
+        np.testing.assert_allclose(a[:, j], sign * b[:, j], atol=1e-10, rtol=0)
+
+
+def test_store_spectra_equal_compute_spectrum(store, sources):
+    c = mv.open_collection(store)
+    assert c.names == ["fat_torus", "plate", "sphere", "torus", "torus_moved"]
+    for name in ("torus", "sphere"):
+        mesh = mv.load_mesh(sources / f"{name}.obj")
+        for op in ("laplacian", "shells"):
+            direct = mv.compute_spectrum(mesh, op, K)
+            stored = c.spectrum(name, None if op == "laplacian" else op)
+            assert stored.operator == op and stored.mesh_hash == mesh.hash
+            np.testing.assert_allclose(stored.eigenvalues, direct.eigenvalues, atol=1e-10)
+            _same_up_to_sign(stored.modes, direct.modes)
+    mesh = mv.load_mesh(sources / "torus.obj")
+    times, values = c.signatures("torus")["hks"]
+    direct_times, direct_values = mv.signature(mv.compute_spectrum(mesh, "laplacian", K))
+    np.testing.assert_allclose(times, direct_times, rtol=1e-10)
+    np.testing.assert_allclose(values, direct_values, rtol=1e-8, atol=1e-12)
+    d = c.descriptors
+    assert d["shape_dna"].shape[0] == 5 and d["histogram.vibration"].shape == (5, 8, 32)
+    np.testing.assert_allclose(d["histogram.hks"].sum(axis=2), 1.0, atol=1e-12)
+    row = c.names.index("torus")
+    np.testing.assert_allclose(d["area"][row], mesh.total_area)
+
+
+def test_a_mesh_file_reads_with_numpy_alone(store):
+    with np.load(store / "meshes" / "torus.npz") as data:
+        entry = json.loads(str(data["entry"]))
+        assert data["eigenvalues"].shape == (K,)
+        assert data["modes"].shape == (entry["n_vertices"], K)
+    index = json.loads((store / "index.json").read_text())
+    assert set(index["entries"]) == {"fat_torus", "plate", "sphere", "torus", "torus_moved"}
+    assert mv.load_spectrum(store / "meshes" / "torus.npz").k == K  # a spectrum file too
+
+
+def test_a_broken_file_is_recorded_not_fatal(store):
+    c = mv.open_collection(store)
+    assert list(c.errors) == ["broken"]
+    assert "broken.obj" in c.errors["broken"]
+    record = json.loads((store / "errors" / "broken.json").read_text())
+    assert record["source"].endswith("broken.obj")
+
+
+def test_resume_recomputes_nothing(store, sources, client, monkeypatch):
+    calls = []
+    compute = coll._compute
+
+    def counted(*args):
+        calls.append(args[1])
+        return compute(*args)
+
+    monkeypatch.setattr(coll, "_compute", counted)
+    params = dict(operator="laplacian", k=K, signatures=["vibration", "hks"], client=client)
+    summary = coll.run_batch([sources], store, **params)
+    assert calls == [] and summary.computed == [] and len(summary.skipped) == 6
+    assert summary.failed_before == ["broken"]
+    # a touched file is read again, but its geometry hash says it is done
+    os.utime(sources / "sphere.obj", ns=(time.time_ns(), time.time_ns()))
+    summary = coll.run_batch([sources], store, **params)
+    assert calls == [] and summary.computed == [] and "sphere" in summary.skipped
+    # other parameters are another key: recomputed
+    other = tmp = store.parent / "store_k6"
+    summary = coll.run_batch([sources / "sphere.obj"], tmp, "laplacian", 6, client=client)
+    assert calls == ["laplacian"] and summary.computed == ["sphere"]
+    assert mv.open_collection(other).spectrum("sphere").k == 6
+
+
+def test_similar_puts_the_shape_first_and_its_rigid_copy_second(store, sources):
+    c = mv.open_collection(store)
+    ranked = c.similar("torus", n=3)
+    assert [name for name, _ in ranked[:2]] == ["torus", "torus_moved"]
+    assert ranked[0][1] == 0.0 and ranked[1][1] < 1e-6 < ranked[2][1]
+    from_file = c.similar(str(sources / "torus_moved.obj"), n=None)
+    assert [name for name, _ in from_file[:2]] == ["torus_moved", "torus"]
+    assert len(from_file) == 5
+    # a mesh not in the store: its spectrum is computed with the store's parameters
+    outside = primitives.torus(14, 7)
+    outside = mv.Mesh(outside.vertices * 1.0 + [0.0, 0.0, 5.0], outside.faces)
+    assert c.name_of(outside.hash) is None
+    assert {name for name, _ in c.similar(outside, n=2)} == {"torus", "torus_moved"}
+
+
+def test_cli_similar_and_batch_with_a_local_worker_process(store, sources, tmp_path):
+    from modalviewer.cli import main
+
+    assert main(["similar", str(store), str(sources / "torus.obj"), "-n", "2"]) == 0
+    out = tmp_path / "cli_store"
+    files = [str(sources / "sphere.obj"), str(sources / "plate.obj")]
+    result = subprocess.run(
+        [sys.executable, "-m", "modalviewer", "batch", *files, "-o", str(out), "-k", "6"]
+        + ["--workers", "1"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
+    )
+    assert result.returncode == 0, result.stderr
+    assert "2 computed" in result.stdout and "2/2 meshes" in result.stderr
+    assert mv.open_collection(out).names == ["plate", "sphere"]
+
+
+def test_cli_errors_are_one_line(sources, tmp_path, capsys):
+    from modalviewer.cli import main
+
+    assert main(["batch", str(tmp_path / "nothing"), "-o", str(tmp_path / "s")]) == 1
+    assert main(["similar", str(tmp_path), "x.obj"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert all(line.startswith("modalviewer: error:") for line in err), err
+
+
+def test_a_killed_batch_leaves_a_readable_store(tmp_path):
+    folder = tmp_path / "many"
+    folder.mkdir()
+    rng = np.random.default_rng(1)
+    sphere = primitives.icosphere(3)
+    for i in range(12):
+        v = sphere.vertices * (1.0 + 0.2 * rng.standard_normal(3))
+        _write_obj(mv.Mesh(v, sphere.faces), folder / f"blob{i:02d}.obj")
+    out = tmp_path / "store"
+    command = [sys.executable, "-m", "modalviewer", "batch", str(folder), "-o", str(out)]
+    command += ["--operator", "shells", "-k", "20", "--workers", "0"]
+    process = subprocess.Popen(
+        command, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and not list((out / "meshes").glob("*.npz")):
+        time.sleep(0.01)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    c = mv.open_collection(out)  # no index.json yet: rebuilt from the files
+    assert 1 <= len(c.names) < 12
+    for name in c.names:
+        assert c.spectrum(name).k == 20
+    done = set(c.names)
+    summary = coll.run_batch([folder], out, "shells", 20, workers=0)
+    assert set(summary.skipped) == done and len(summary.computed) == 12 - len(done)
+    assert len(mv.open_collection(out).names) == 12
