@@ -7,13 +7,13 @@ settings make them cheaper:
 
 - glibc hands every big array to the kernel and back (``mmap``/``munmap``), so each new
   one starts on fresh pages.  Serving big arrays from the heap and not trimming it lets
-  a process reuse what it freed (:func:`keep_freed_memory`): the first touch of a fresh
-  313 MB array takes 0.7 s there, of a reused one 0.06 s.
+  a process reuse what it freed (:func:`keep_freed_memory`), whose pages are already
+  mapped.
 - numpy advises the kernel to back big arrays with transparent huge pages, and the
-  kernel compacts memory to find them: 130k shells preview, 1.0-1.1 s of system time in
-  the faults of three fresh (N, 100) arrays against 0.2 s with normal pages, and 7.5
-  against 6.5 s in all (:func:`no_huge_page_advice`; the exact 100-mode solve there,
-  44.4 against 43.7 s, does not depend on it).
+  kernel compacts memory to find them, which makes the page faults of fresh arrays
+  several times slower (:func:`no_huge_page_advice`).
+
+What each setting saves and costs: "Memory" in docs/how-it-works.md.
 
 :func:`prepare_compute_process` applies both.  Only for processes that exist to compute
 (the viewer's child processes, the command line, the benchmarks): memory goes back to

@@ -207,9 +207,8 @@ class DerivedValues:
         return self._mesh_value("curvature", total_curvature)
 
     def vertex_areas(self) -> np.ndarray:
-        """(n,) lumped vertex areas: shares "of the surface" are shares of its area (on a
-        mesh of uneven density the vertices' share is not: 18.8 % of a cow's vertices
-        held 5.7 % of its area)."""
+        """(n,) lumped vertex areas: shares "of the surface" are shares of its area, not
+        of its vertices, which differ on a mesh of uneven density."""
         return self._mesh_value("vertex_areas", lumped_masses)
 
     # ----------------------------------------------------- signatures
