@@ -43,13 +43,23 @@ def _plural(count: int, word: str) -> str:
 
 
 def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
-    """The connected components as ``(mesh, vertices)`` pairs, largest area first.
+    """The connected components, largest area first.
 
-    ``vertices`` (n_c,) are the component's vertex indices in ``mesh``: row i of the
-    component's arrays belongs to vertex ``vertices[i]`` of ``mesh`` (ascending, so the
-    component keeps the original vertex order).  Each component keeps the map to the
-    file's vertex numbers (:attr:`~modalviewer.core.mesh.Mesh.file_to_mesh`): the file's
-    vertices of other components map to -1 in it.
+    Each component keeps the map to the file's vertex numbers
+    (:attr:`~modalviewer.core.mesh.Mesh.file_to_mesh`): the file's vertices of other
+    components map to -1 in it.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface, n vertices.
+
+    Returns
+    -------
+    list of (Mesh, ndarray of int, shape (n_c,))
+        Per component its mesh and its vertex indices in ``mesh``: row i of the
+        component's arrays belongs to vertex ``vertices[i]`` of ``mesh`` (ascending, so
+        the component keeps the original vertex order).
     """
     labels = mesh.component_labels
     face_label = labels[mesh.faces[:, 0]]
@@ -69,10 +79,23 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
 
 
 def largest_component(mesh: Mesh) -> Mesh:
-    """A new mesh of the component with the largest area; ``result.report`` says what
-    was removed (the input's report messages come first).  A mesh with one component is
-    returned as a copy with the report saying so.  Vertex numbers stay the file's
-    (the removed components' vertices are, for the result, used by no face)."""
+    """A new mesh of the component with the largest area.
+
+    Vertex numbers stay the file's (the removed components' vertices are, for the
+    result, used by no face).
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface.
+
+    Returns
+    -------
+    Mesh
+        The largest component; ``result.report`` says what was removed (the input's report
+        messages come first).  A mesh with one component is returned as a copy, with the
+        report saying so.
+    """
     report = MeshReport(source=mesh.report.source, messages=list(mesh.report.messages))
     parts = split_components(mesh)
     kept, vertices = parts[0]
@@ -126,9 +149,30 @@ def compute_spectrum_per_component(
     min_vertices: int = 1,
 ) -> list[ComponentSpectrum]:
     """k modes of each connected component with at least ``min_vertices`` vertices,
-    largest area first (arguments as :func:`~modalviewer.core.pipeline.compute_spectrum`;
-    k is capped at each component's unknowns).  Progress runs from 0 to 1 over all
-    components, weighted by their vertex counts."""
+    largest area first.
+
+    Parameters
+    ----------
+    mesh : Mesh
+        The surface.
+    operator, bending, membrane, progress, cancel
+        As for :func:`~modalviewer.core.pipeline.compute_spectrum`; progress runs from 0 to
+        1 over all components, weighted by their vertex counts.
+    k : int
+        Modes per component, capped at each component's unknowns.
+    min_vertices : int
+        Smaller components are left out.
+
+    Returns
+    -------
+    list of ComponentSpectrum
+        One per component computed, largest area first.
+
+    Raises
+    ------
+    ValueError
+        If no component has at least ``min_vertices`` vertices.
+    """
     k = check_count(k, "k")
     min_vertices = check_count(min_vertices, "min_vertices", 0)
     parts = [(m, v) for m, v in split_components(mesh) if m.n_vertices >= min_vertices]

@@ -340,9 +340,25 @@ def mutual_best_matches(
 
     For each ``v`` in ``vertices_a``: ``w`` = the vertex of B closest to ``v``, then
     ``v'`` = the vertex of A closest to ``w``; the pair is mutual if ``v' == v``.
-    Without ``vertices_b`` both searches run over all vertices; with it, ``w`` is
-    searched among ``vertices_b`` and ``v'`` among ``vertices_a`` (matching two sets of
-    picked points, e.g. landmarks, to each other).
+
+    Parameters
+    ----------
+    spec_a, spec_b : Spectrum
+        The spectra of A and B, of the same operator.
+    vertices_a : int or array_like of int, shape (p,)
+        The picked vertices of A.
+    vertices_b : int or array_like of int, optional
+        Without it both searches run over all vertices; with it, ``w`` is searched among
+        ``vertices_b`` and ``v'`` among ``vertices_a`` (matching two sets of picked points,
+        e.g. landmarks, to each other).
+    t_range, samples, include_zero
+        As for :func:`cross_distance`.
+
+    Returns
+    -------
+    Matches
+        The matches, their distances, the matches back and which are mutual, each of
+        shape (p,).
     """
     tables = CrossTables(spec_a, spec_b, t_range, samples, include_zero)
     return tables.mutual_best_matches(vertices_a, vertices_b)
