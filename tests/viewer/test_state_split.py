@@ -138,7 +138,8 @@ def test_the_wording_functions_give_the_legends_they_gave_as_state_methods(tmp_p
     state.show_mode(5, "laplacian")
     mode_text = "Laplacian (cotan), mode 5: lambda = 10.75\nblue +, white 0, orange -"
     assert wording.legend(state, model.derived) == mode_text
-    assert model.derived.field().legend == mode_text
+    # the picture's legend also names the colour range
+    assert model.derived.field().legend == mode_text + "\nrange: the largest |value|"
     assert wording.summary(state) == mode_text.replace("\n", "; ")
     state.set_pick(100)
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
