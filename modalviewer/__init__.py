@@ -16,7 +16,9 @@ import os as _os
 # OpenBLAS about 0.1 s), so each slows the other down; the eigensolver alternates
 # between them hundreds of times.  Measured on the 10k shells benchmark (35k unknowns,
 # 300 modes, 2 cores): 23.0 s with the defaults, 16.4 s with these.  Set before numpy
-# loads OpenBLAS; an explicit setting in the environment wins.
+# loads OpenBLAS; an explicit setting in the environment wins.  When numpy was imported
+# first, the OpenBLAS timeout comes too late: the eigensolver then runs OpenBLAS on one
+# thread at run time (core/threads.py), whatever the import order.
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 

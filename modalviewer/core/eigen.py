@@ -32,6 +32,7 @@ import scipy.sparse as sp
 
 from .factor import SPDSolver
 from .products import column_block_products
+from .threads import single_blas_thread
 
 __all__ = [
     "Cancelled",
@@ -217,6 +218,7 @@ def _gershgorin_max(K: sp.csr_matrix, mass_diag: np.ndarray) -> float:
     return float(np.max(row_abs / mass_diag))
 
 
+@single_blas_thread
 def solve_lowest(
     K: sp.spmatrix,
     mass_diag: np.ndarray,
