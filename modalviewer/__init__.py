@@ -25,13 +25,24 @@ _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 from .collection import open_collection  # noqa: E402 (numpy only; Dask loads in run_batch)
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
+from .data import asset_path  # noqa: E402
+from .interop import as_mesh, operator_matrices, to_pyvista  # noqa: E402
 from .io import load_mesh  # noqa: E402
+from .plotting import Picture, add_to_plotter, plot, view  # noqa: E402
 from .repair import SliverReport, fix_slivers  # noqa: E402
 
 __version__ = "0.1.0"
 __all__ = [  # noqa: F405
     *_core_all,  # noqa: F405
     "load_mesh",
+    "as_mesh",
+    "asset_path",
+    "operator_matrices",
+    "to_pyvista",
+    "plot",
+    "view",
+    "add_to_plotter",
+    "Picture",
     "fix_slivers",
     "SliverReport",
     "Viewer",

@@ -1,9 +1,14 @@
-"""Reading meshes from files, with repair and a report (OBJ, PLY, STL, OFF, VTK, VTP).
+"""Reading meshes from files, with repair and a report (OBJ, PLY, STL, OFF, VTK, VTP,
+and whatever meshio reads).
 
 OBJ, PLY, STL and OFF are read by :mod:`modalviewer.readers`, which keeps every vertex
 in the file's order and refuses damaged or truncated files with a message naming the
 place.  VTK and VTP files are read with pyvista, imported only when such a file is
-opened, so that ``import modalviewer`` stays free of VTK.
+opened, so that ``import modalviewer`` stays free of VTK.  Other files (Gmsh ``.msh``,
+``.vtu``, ``.xdmf``, Medit ``.mesh``, Abaqus ``.inp``, Exodus ``.e``, Nastran ``.bdf``,
+``.med``, ``.su2``, ...: every extension of ``meshio.extension_to_filetypes``) are read
+with meshio where it is installed (``pip install modalviewer[meshio]``), their triangle
+cells kept and quads and polygons triangulated.
 """
 
 from __future__ import annotations
@@ -39,6 +44,8 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
     """
     path = Path(path)
     ext = path.suffix.lower()
+    if ext not in SUPPORTED_EXTENSIONS and ext in _meshio_extensions():
+        return _read_meshio(path)
     if ext not in SUPPORTED_EXTENSIONS:
         raise MeshError(
             f"{path.name}: unsupported file type '{ext or '(none)'}'; "
@@ -67,6 +74,32 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
             f"{path.name}: no vertices found in this {ext[1:].upper()} file; "
             "the file may be damaged, truncated or of another type"
         )
+    return vertices, faces, notes
+
+
+def _meshio_extensions() -> tuple[str, ...]:
+    """The extensions meshio reads, () without meshio."""
+    try:
+        import meshio
+    except ImportError:
+        return ()
+    return tuple(meshio.extension_to_filetypes)
+
+
+def _read_meshio(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    import meshio
+
+    from .interop import arrays_of
+
+    if not path.is_file():
+        raise MeshError(f"{path}: no such file")
+    try:
+        data = meshio.read(path)
+    except Exception as exc:  # meshio raises its own errors, and others, on bad files
+        raise MeshError(f"{path.name}: meshio could not read it ({exc})") from None
+    vertices, faces, notes = arrays_of(data)
+    if len(vertices) == 0:
+        raise MeshError(f"{path.name}: no vertices found in this file")
     return vertices, faces, notes
 
 
@@ -100,9 +133,16 @@ def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
     """
     path = Path(path)
     vertices, faces, notes = read_file(path, strict=strict)
+    return mesh_from_arrays(vertices, faces, path.name, repair=repair, notes=notes)
+
+
+def mesh_from_arrays(vertices, faces, source: str, repair: bool = True, notes=()) -> Mesh:
+    """The :class:`Mesh` of raw arrays read from ``source`` (a name for messages), with
+    the repair and report of :func:`load_mesh`; ``notes`` are added to the report."""
+    vertices = np.asarray(vertices)
     if len(faces) == 0:
         raise MeshError(
-            f"{path.name}: the file contains "
+            f"{source}: the file contains "
             f"{count_text(len(vertices), 'vertex', 'vertices')} but "
             "no faces: a point "
             "cloud is not a surface (reconstruct a surface from it first), or the file is "
@@ -110,13 +150,13 @@ def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
         )
     try:
         if repair:
-            mesh = repair_mesh(vertices, faces, source=path.name)
+            mesh = repair_mesh(vertices, faces, source=source)
         else:
-            mesh = Mesh(vertices, faces, report=MeshReport(source=path.name))
+            mesh = Mesh(vertices, faces, report=MeshReport(source=source))
     except MeshError as exc:
-        if str(exc).startswith(path.name + ":"):
+        if str(exc).startswith(source + ":"):
             raise
-        raise MeshError(f"{path.name}: {exc}") from None
+        raise MeshError(f"{source}: {exc}") from None
     for note in notes:
         mesh.report.add(_sentence(note))
     return mesh

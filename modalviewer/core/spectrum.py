@@ -31,7 +31,11 @@ class Spectrum:
     Attributes
     ----------
     eigenvalues : (k,) ascending, units 1/time^2 for vibrations (frequency = sqrt).
-    modes : (n, k), or (n, 3, k) for ``"shells"``; Mass-orthonormal.
+    modes : (n, k), or (n, 3, k) for ``"shells"``; M-orthonormal: with the columns
+        ``Phi = modes.reshape(-1, k)`` and ``M`` the lumped mass (``mass``, repeated for
+        each component of a vector mode), ``Phi.T @ M @ Phi`` is the identity, so a mode's
+        values scale with 1 / sqrt(area).  :meth:`euclidean_modes` gives unit-length
+        columns instead.
     operator : one of ``OPERATORS``.
     mass : (n,) lumped vertex masses used for orthonormality.
     residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
@@ -109,6 +113,14 @@ class Spectrum:
     def mode(self, j: int) -> np.ndarray:
         """Mode j: (n,) for scalar operators, (n, 3) for ``"shells"``."""
         return self.modes[..., j]
+
+    def euclidean_modes(self) -> np.ndarray:
+        """The modes scaled to Euclidean length 1 (each column of ``modes.reshape(-1, k)``
+        has norm 1), same shape as ``modes``; a new array.  They are orthogonal in the
+        mass inner product, not in the Euclidean one."""
+        flat = self.modes.reshape(-1, self.k)
+        norms = np.linalg.norm(flat, axis=0)
+        return (flat / np.where(norms > 0, norms, 1.0)).reshape(self.modes.shape)
 
     def squared_modes(self, vertices=None) -> np.ndarray:
         """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes); only the rows of

@@ -1,0 +1,157 @@
+"""Meshes in from other libraries, matrices and point data out.
+
+* :func:`as_mesh`: ``(V, F)`` arrays, a ``trimesh.Trimesh``, a ``pyvista.PolyData`` (or
+  any pyvista data set: its surface) or a ``meshio.Mesh`` as a :class:`~.core.mesh.Mesh`,
+  through the same repair and report as :func:`~modalviewer.io.load_mesh`.  The vertex
+  numbering of the object is the file numbering of the mesh (``mesh.file_vertices``).
+* :func:`operator_matrices`: the sparse ``(K, M)`` of an operator's eigenproblem.
+* :func:`to_pyvista`: the mesh with modes and fields as point arrays.
+
+None of these imports trimesh, pyvista or meshio: an object is recognised by its type's
+module, and pyvista is imported by :func:`to_pyvista` only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from .core.assembly import operator_matrices as _operator_matrices
+from .core.mesh import Mesh
+from .core.spectrum import Spectrum
+
+__all__ = ["as_mesh", "operator_matrices", "to_pyvista", "arrays_of"]
+
+
+def _module(obj) -> str:
+    return type(obj).__module__.split(".")[0]
+
+
+def _fan(cells: np.ndarray) -> np.ndarray:
+    """Polygons (m, p) as triangles (m * (p - 2), 3), fanned from each first vertex."""
+    p = cells.shape[1]
+    return np.concatenate([cells[:, [0, i, i + 1]] for i in range(1, p - 1)])
+
+
+def _from_pyvista(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    import pyvista as pv
+
+    notes = []
+    if not isinstance(data, pv.PolyData):
+        data = data.extract_surface()
+        notes.append("the data set's outer surface is used")
+    if data.n_cells and not data.is_all_triangles:
+        data = data.triangulate()
+        notes.append("polygons were triangulated (the vertices are kept as they are)")
+    faces = np.asarray(data.faces).reshape(-1, 4)[:, 1:] if data.n_cells else np.zeros((0, 3))
+    return np.asarray(data.points, dtype=np.float64), faces.astype(np.int64), notes
+
+
+def _from_meshio(m) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    triangles, notes = [], []
+    for block in m.cells:
+        data = np.asarray(block.data)
+        if block.type == "triangle":
+            triangles.append(data)
+        elif block.type in ("quad", "polygon") or block.type.startswith("polygon"):
+            triangles.append(_fan(data))
+            notes.append(f"{len(data)} {block.type} cells were triangulated")
+        elif block.type not in ("vertex", "line"):
+            notes.append(f"{len(data)} {block.type} cells are not surface cells and were skipped")
+    faces = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
+    points = np.asarray(m.points, dtype=np.float64)
+    if points.ndim == 2 and points.shape[1] == 2:  # a planar mesh: z = 0
+        points = np.column_stack([points, np.zeros(len(points))])
+    return points, faces.astype(np.int64), notes
+
+
+def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(vertices, triangles, notes) of any object :func:`as_mesh` accepts."""
+    if isinstance(obj, Mesh):
+        return obj.vertices, obj.faces, []
+    module = _module(obj)
+    if module == "trimesh":
+        return np.asarray(obj.vertices, np.float64), np.asarray(obj.faces, np.int64), []
+    if module == "pyvista" or module == "vtkmodules":
+        if module == "vtkmodules":
+            import pyvista as pv
+
+            obj = pv.wrap(obj)
+        return _from_pyvista(obj)
+    if module == "meshio":
+        return _from_meshio(obj)
+    if isinstance(obj, (tuple, list)) and len(obj) == 2:
+        return np.asarray(obj[0]), np.asarray(obj[1]), []
+    raise TypeError(
+        "as_mesh takes a Mesh, a (vertices, faces) pair of arrays, a trimesh.Trimesh, a "
+        f"pyvista.PolyData or a meshio.Mesh, not {type(obj).__name__}"
+    )
+
+
+def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
+    """A :class:`Mesh` from arrays or another library's mesh object.
+
+    ``obj``: a :class:`Mesh` (returned as it is), ``(vertices (n, 3), faces (m, 3))``, a
+    ``trimesh.Trimesh``, a ``pyvista.PolyData`` (other pyvista data sets: their outer
+    surface; polygons are triangulated, which ``mesh.report`` says) or a ``meshio.Mesh``
+    (its triangle cells; quads and polygons are triangulated, volume cells skipped).
+    ``repair`` as in :func:`~modalviewer.io.load_mesh`; ``name`` names the mesh in the
+    report (default: the object's type).  Vertex i of the object is file vertex i of the
+    mesh: :meth:`Mesh.mesh_vertex` and :meth:`Mesh.to_file_field` convert, and without a
+    repair that drops or merges vertices the numbering is the same.
+    """
+    if isinstance(obj, Mesh):
+        return obj
+    from .io import mesh_from_arrays
+
+    vertices, faces, notes = arrays_of(obj)
+    source = name or ("arrays" if isinstance(obj, (tuple, list)) else type(obj).__name__)
+    return mesh_from_arrays(vertices, faces, source, repair=repair, notes=notes)
+
+
+def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):
+    """``(K, M)``: the sparse matrices of ``operator``'s eigenproblem ``K x = lambda M x``.
+
+    K (scipy.sparse CSR, symmetric positive semi-definite; its null space is the one
+    ``spec.null_space_dimension`` counts) and M, the lumped mass: a diagonal matrix
+    (scipy.sparse DIA) of the vertex areas, repeated for each unknown of a vertex.  The
+    unknowns are per vertex, ``(n,)``, or for vector modes (``spec.is_vector``, e.g.
+    ``"shells"``) ``(3 n,)`` ordered x, y, z per vertex, as ``spec.modes`` reshaped.
+    ``scipy.sparse.linalg.eigsh(K, k, M, sigma=-s)`` for a small ``s > 0`` gives the
+    spectrum :func:`~modalviewer.compute_spectrum` computes (up to the signs and bases of
+    eigenspaces).
+    """
+    K, mass = _operator_matrices(as_mesh(mesh), operator, bending, membrane)
+    return sp.csr_matrix(K), sp.diags_array(np.asarray(mass, dtype=np.float64), format="dia")
+
+
+def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = None):
+    """A ``pyvista.PolyData`` of ``mesh`` with point arrays.
+
+    ``spectrum``: each mode as ``"mode_<j>"`` ((n,), or (n, 3) for vector modes) and the
+    vertex masses as ``"mass"``; the eigenvalues go to ``field_data["eigenvalues"]``.
+    ``fields``: a dict name -> (n,) or (n, c) per-vertex array.  Points are the mesh's
+    vertices in the mesh's numbering (``mesh.file_vertices`` maps to the input's).
+    """
+    import pyvista as pv
+
+    mesh = as_mesh(mesh)
+    n = mesh.n_vertices
+    faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
+    poly = pv.PolyData(np.array(mesh.vertices), faces)
+    if spectrum is not None:
+        if spectrum.n_vertices != n:
+            raise ValueError(
+                f"the spectrum has {spectrum.n_vertices} vertices, the mesh {n}: it belongs "
+                "to another mesh"
+            )
+        for j in range(spectrum.k):
+            poly.point_data[f"mode_{j}"] = np.ascontiguousarray(spectrum.mode(j))
+        poly.point_data["mass"] = np.asarray(spectrum.mass)
+        poly.field_data["eigenvalues"] = np.asarray(spectrum.eigenvalues)
+    for name, values in (fields or {}).items():
+        values = np.asarray(values)
+        if len(values) != n:
+            raise ValueError(f"field {name!r} has {len(values)} values, the mesh {n} vertices")
+        poly.point_data[str(name)] = values
+    return poly

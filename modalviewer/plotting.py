@@ -1,0 +1,236 @@
+"""Pictures in scripts and notebooks: :func:`plot`, :func:`view`, :func:`add_to_plotter`.
+
+:func:`plot` draws what the viewer would show with the renderer of ``modalviewer
+render`` (a :class:`~modalviewer.viewer.Viewer` and its off-screen renderer: same
+colours, isolines, legend, colour bar and first camera) and returns a :class:`Picture`,
+which Jupyter shows inline.  :func:`view` opens the desktop viewer on in-memory data.
+:func:`add_to_plotter` adds a mode or a distance map, in the viewer's colours, to a
+``pyvista.Plotter`` of one's own.  All import pyvista (and :func:`view` Qt) when called.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .core.spectrum import Spectrum
+from .interop import as_mesh
+
+__all__ = ["Picture", "plot", "view", "add_to_plotter"]
+
+DEFAULT_PLOT_SIZE = (800, 600)
+
+
+class Picture:
+    """An image: ``.array`` the (h, w, 3) or (h, w, 4) uint8 pixels; shown inline by
+    Jupyter (``_repr_png_``); :meth:`save` writes a PNG."""
+
+    def __init__(self, array: np.ndarray):
+        self.array = np.ascontiguousarray(array)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return self.array.shape
+
+    def _repr_png_(self) -> bytes:
+        import io
+
+        from PIL import Image
+
+        out = io.BytesIO()
+        Image.fromarray(self.array).save(out, format="PNG")
+        return out.getvalue()
+
+    def save(self, path) -> Path:
+        """Write the picture to ``path`` as PNG (atomically); returns the path."""
+        from .scene.export import save_png
+
+        return save_png(Path(path), self.array)
+
+    def __repr__(self) -> str:
+        return f"Picture({self.array.shape[1]}x{self.array.shape[0]})"
+
+
+def _field_of(field, n: int):
+    """(name, values) of ``field``: an array, a (name, array) pair or a one-item dict."""
+    if isinstance(field, dict):
+        if not field:
+            raise ValueError("fields is empty")
+        name, values = next(iter(field.items()))
+    elif isinstance(field, tuple) and len(field) == 2 and isinstance(field[0], str):
+        name, values = field
+    else:
+        name, values = "field", field
+    values = np.asarray(values, dtype=np.float64)
+    if values.shape != (n,):
+        raise ValueError(f"a field has one value per mesh vertex, ({n},); got {values.shape}")
+    return str(name), values
+
+
+def _custom_field(name: str, values: np.ndarray):
+    """The viewer's :class:`~modalviewer.viewer.derived.Field` for user values:
+    diverging colours for signed values, sequential (white to red) otherwise."""
+    from .viewer.derived import Field
+
+    signed = float(values.min()) < 0.0 < float(values.max())
+    return Field(values, "diverging" if signed else "sequential", title=name)
+
+
+def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
+    from .core.operators import operator_for_distance
+    from .viewer import Viewer
+
+    viewer = Viewer()
+    viewer.set_mesh(mesh)
+    if spectrum is not None:
+        viewer.state.add_spectrum(
+            viewer.state.compute_settings.key(spectrum.operator, spectrum.k), spectrum
+        )
+    if vertex is not None:
+        needed = operator_for_distance(kind)
+        if viewer.state.spectrum(needed) is None:
+            viewer.compute(needed, k=k, wait=True)
+        viewer.state.set_display(distance_kind=kind)
+        viewer.state.set_pick(mesh.mesh_vertex(int(vertex)))
+        viewer.show_distance(kind, display="continuous")
+    elif spectrum is not None:
+        j = viewer.state.first_nonzero_mode(spectrum.operator) if mode is None else int(mode)
+        if not 0 <= j < spectrum.k:
+            raise ValueError(f"mode must be between 0 and {spectrum.k - 1}, got {mode}")
+        viewer.show_mode(j, spectrum.operator)
+    return viewer
+
+
+def plot(
+    mesh,
+    spectrum: Spectrum | None = None,
+    mode: int | None = None,
+    field=None,
+    kind: str = "vibration",
+    vertex: int | None = None,
+    screenshot=None,
+    size=DEFAULT_PLOT_SIZE,
+    k: int = 50,
+    transparent: bool = False,
+) -> Picture:
+    """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`.
+
+    mesh : anything :func:`~modalviewer.as_mesh` takes (a file path too).
+    spectrum, mode : show mode ``mode`` of ``spectrum`` (default its first non-zero one).
+    field : per-vertex values to colour by instead: an (n,) array, a ``(name, values)``
+        pair or a dict (its first item); signed values in the modes' diverging colours,
+        others white to red.
+    vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
+        ``vertex`` (the input's vertex number); a spectrum of the kind's operator is used
+        if given, otherwise ``k`` modes are computed (cached on disk as in the viewer).
+    screenshot : also write the PNG there.  size : (width, height) in pixels.
+    """
+    if isinstance(mesh, (str, Path)):
+        from .io import load_mesh
+
+        mesh = load_mesh(mesh)
+    mesh = as_mesh(mesh)
+    viewer = _prepared_viewer(mesh, spectrum, mode, vertex, kind, k)
+    try:
+        renderer = viewer.renderer(size)
+        if field is not None:
+            from .scene.view import draw_field
+
+            name, values = _field_of(field, mesh.n_vertices)
+            draw_field(renderer.scene, _custom_field(name, values))
+        picture = Picture(renderer.image(transparent=transparent))
+    finally:
+        viewer.close()
+    if screenshot is not None:
+        picture.save(screenshot)
+    return picture
+
+
+def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: bool = True):
+    """Open the desktop viewer on in-memory data; returns the window (``.viewer`` its
+    :class:`~modalviewer.viewer.Viewer`).
+
+    With ``block=True`` (default) it returns when the window closes; with ``block=False``
+    at once (in a notebook kernel with ``%gui qt``, or a script that runs the Qt event
+    loop).  ``spectrum`` goes into the viewer's spectra (its first non-zero mode shown);
+    ``fields`` (a dict name -> per-vertex array) colours the surface by its first field
+    as the window opens; choosing a mode or a distance in the window replaces it.
+    """
+    if isinstance(mesh_or_arrays, (str, Path)):
+        from .io import load_mesh
+
+        mesh_or_arrays = load_mesh(mesh_or_arrays)
+    mesh = as_mesh(mesh_or_arrays)
+    from .gui.application import ensure_application
+    from .gui.main_window import MainWindow
+    from .viewer import Viewer
+
+    app = ensure_application()
+    viewer = Viewer()
+    window = MainWindow(viewer=viewer)
+    viewer.set_mesh(mesh)
+    if spectrum is not None:
+        viewer.state.add_spectrum(
+            viewer.state.compute_settings.key(spectrum.operator, spectrum.k), spectrum
+        )
+        viewer.show_mode(viewer.state.first_nonzero_mode(spectrum.operator), spectrum.operator)
+    window.show()
+    if fields:
+        from .scene.view import draw_field
+
+        name, values = _field_of(fields, mesh.n_vertices)
+        scene = window.viewer._picture.scene if window.viewer._picture is not None else None
+        if scene is not None:
+            draw_field(scene, _custom_field(name, values))
+            window.plotter.render()
+    if block:
+        app.exec()
+    return window
+
+
+def add_to_plotter(
+    plotter,
+    mesh,
+    values_or_spectrum,
+    mode: int | None = None,
+    vertex: int | None = None,
+    isolines: int = 0,
+    name: str = "",
+):
+    """Add ``mesh`` coloured as the viewer colours it to ``plotter`` (a
+    ``pyvista.Plotter``); returns the :class:`~modalviewer.scene.mesh_scene.MeshScene`
+    holding its actors.
+
+    values_or_spectrum : per-vertex values ((n,); signed: the modes' diverging colours,
+        otherwise white to red) or a :class:`Spectrum`: its mode ``mode`` (default the
+        first non-zero one; vector modes by their normal component, as the viewer), or
+        with ``vertex`` the multiscale distance from that vertex (the input's number).
+    """
+    from .core.laplacian import vertex_normals
+    from .core.signatures import multiscale_distance
+    from .scene.mesh_scene import MeshScene
+
+    mesh = as_mesh(mesh)
+    normals = vertex_normals(mesh)
+    scene = MeshScene(plotter, mesh, normals)
+    if isinstance(values_or_spectrum, Spectrum):
+        spec = values_or_spectrum
+        if vertex is not None:
+            values = multiscale_distance(spec, mesh.mesh_vertex(int(vertex)))
+            scene.show_field(values, "sequential", isolines=isolines, name=name or "distance")
+            return scene
+        from .viewer.mode_scalar import mode_scalar, smoothed_normals
+
+        if mode is None:
+            nonzero = np.flatnonzero(~spec.zero_mode_mask())
+            mode = int(nonzero[0]) if nonzero.size else 0
+        values = mode_scalar(spec, int(mode), smoothed_normals(mesh) if spec.is_vector else normals)
+        scene.show_field(values, "diverging", isolines=isolines, name=name or f"mode {mode}")
+        return scene
+    values = np.asarray(values_or_spectrum, dtype=np.float64)
+    if values.shape != (mesh.n_vertices,):
+        raise ValueError(f"one value per mesh vertex, ({mesh.n_vertices},); got {values.shape}")
+    signed = float(values.min()) < 0.0 < float(values.max())
+    scene.show_field(values, "diverging" if signed else "sequential", isolines=isolines, name=name)
+    return scene
