@@ -195,3 +195,34 @@ def test_cli_render_draws_a_shells_mode_deformed(tmp_path):
         masks[show] = np.asarray(Image.open(out))[..., 3] > 0
     a, b = masks["deformed"], masks["normal"]
     assert np.logical_xor(a, b).sum() / np.logical_or(a, b).sum() > 0.05
+
+
+def test_sessions_keep_the_mode_display_and_colour_range(spot, tmp_path):
+    import json
+
+    state = spot.state
+    state.set_ghost(False)
+    state.set_color_range("limits", (0.0, 2.0))
+    path = spot.save_session(tmp_path / "s.json")
+    state.set_ghost(True)
+    state.set_color_range("auto")
+    data = json.loads(path.read_text())
+    assert data["style"]["ghost"] is False and data["style"]["color_limits"] == [0.0, 2.0]
+    again = Viewer()
+    try:
+        again.open_session(path)
+        assert again.state.style.ghost is False
+        assert again.state.style.color_range == "limits"
+        assert again.state.style.color_limits == (0.0, 2.0)
+        # a session from before: "auto" colouring, no ghost or colour range saved
+        data["style"] = {"isolines": 12, "shell_coloring": "auto", "render": "paper"}
+        path.write_text(json.dumps(data))
+        again.open_session(path)
+        style = again.state.style
+        assert (style.shell_coloring, style.ghost, style.color_range) == (
+            "deformed",
+            True,
+            "auto",
+        )
+    finally:
+        again.close()
