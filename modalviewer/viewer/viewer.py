@@ -143,10 +143,30 @@ class Viewer:
         return self.state.mesh
 
     def open_mesh(self, path, strict: bool = True) -> Mesh:
-        """Load a mesh file and show it.  Raises ``modalviewer.DamagedFileError`` for a
-        damaged or truncated file (``strict=False`` loads its whole records and reports
-        what was dropped), ``MeshError`` for other unusable meshes, ``OSError`` if the
-        file cannot be read."""
+        """Load a mesh file and show it.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            An OBJ, PLY, OFF or STL file.
+        strict : bool
+            With False, a damaged or truncated file loads its whole records and the mesh's
+            report says what was dropped.
+
+        Returns
+        -------
+        Mesh
+            The loaded (and repaired) mesh.
+
+        Raises
+        ------
+        modalviewer.readers.DamagedFileError
+            For a damaged or truncated file with ``strict=True``.
+        MeshError
+            For other unusable meshes.
+        OSError
+            If the file cannot be read.
+        """
         return self.model.open_mesh(Path(path), strict=strict)
 
     def set_mesh(self, mesh: Mesh, path=None) -> None:
@@ -226,12 +246,31 @@ class Viewer:
     def compute(
         self, operator: str | None = None, k: int | None = None, wait: bool = True, then=None
     ) -> Spectrum | None:
-        """Compute a spectrum in the background (cached on disk) and show its first
-        non-zero mode when it arrives (unless the display changed meanwhile).
+        """Compute a spectrum in the background (cached on disk) and show its first non-zero
+        mode when it arrives (unless the display changed meanwhile).
 
-        Returns this request's Spectrum with ``wait=True`` (ComputeError if it failed,
-        was cancelled or was too large to start); ``then`` is
-        called with the spectrum when it arrives.
+        Parameters
+        ----------
+        operator : str, optional
+            ``"laplacian"``, ``"modified_dirichlet"``, ``"shells"`` or ``"shells_normal"``
+            (default: the compute settings' operator).
+        k : int, optional
+            The number of modes (default: the compute settings').
+        wait : bool
+            Return once the spectrum is in.
+        then : callable, optional
+            Called with the spectrum when it arrives.
+
+        Returns
+        -------
+        Spectrum or None
+            With ``wait=True`` this request's spectrum; otherwise None.
+
+        Raises
+        ------
+        ComputeError
+            With ``wait=True``, if no mesh is open, or the computation failed, was cancelled or
+            was too large to start.
         """
         if self.state.mesh is None:
             self._error("Open a mesh first.")
@@ -448,15 +487,32 @@ class Viewer:
         share: float | None = None,
         threshold: float | None = None,
     ) -> np.ndarray | None:
-        """Distance map from the picked vertex; returns it (None until it is ready).
+        """The distance map from the picked vertex, shown on the surface.
 
-        kind : "vibration" | "feature" | "hks".
-        display : "continuous" | "threshold".
-        share : a threshold map marking this share (0..1] of the surface's area similar.
-        threshold : a threshold map at this absolute distance (marks distance <= it).
+        A missing spectrum is computed in the background; the map appears when it is ready
+        (unless the display changed meanwhile).
 
-        A missing spectrum is computed in the background; the map appears when it is
-        ready (unless the display changed meanwhile).
+        Parameters
+        ----------
+        kind : {"vibration", "feature", "hks"}, optional
+            The distance (default: the display's).
+        display : {"continuous", "threshold"}, optional
+            A continuous map (white to red) or a threshold map (blue where similar).
+        share : float, optional
+            A threshold map marking this share (0..1] of the surface's area similar.
+        threshold : float, optional
+            A threshold map at this absolute distance (marks distance <= it).
+
+        Returns
+        -------
+        ndarray, shape (n,) or None
+            The distance to every vertex; None until it is ready (or without a pick).
+
+        Raises
+        ------
+        ValueError
+            For both ``share`` and ``threshold``, a share outside (0, 1], a negative threshold
+            or an unknown kind.
         """
         if share is not None and threshold is not None:
             raise ValueError("give either share (of the area) or threshold (a distance)")
@@ -607,11 +663,29 @@ class Viewer:
         colorbar: bool | None = None,
         size=None,
     ) -> Path:
-        """Save the picture as PNG (atomically); returns the path.
+        """Save the picture as PNG (atomically).
 
-        With a window attached, its view as on screen; otherwise the same scene drawn
-        off screen at ``size`` (width, height; default 1024x768).  ``colorbar``: with
-        the colour bar and legend (None: as the state says)."""
+        With a window attached, its view as on screen; otherwise the same scene drawn off
+        screen.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The PNG to write.
+        scale : int
+            Magnification: the PNG is ``scale`` times the picture's width and height.
+        transparent : bool
+            A transparent background.
+        colorbar : bool, optional
+            With the colour bar and legend (None: as the state says).
+        size : (int, int), optional
+            (width, height) of the off-screen picture, default 1024 x 768.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
         from ..scene.export import save_screenshot
 
         if colorbar is not None:
@@ -802,9 +876,26 @@ class Viewer:
         return comparison
 
     def export_comparison(self, comparison, path, size=None, scale: int = 1) -> Path:
-        """Write the views of ``comparison`` (a Comparison, or a list of items) side by
-        side to a PNG, each ``size`` (width, height) pixels, seen from the camera of this
-        viewer's picture; returns the path."""
+        """Write the views of ``comparison`` side by side to a PNG, seen from the camera of
+        this viewer's picture.
+
+        Parameters
+        ----------
+        comparison : Comparison or list of str
+            A :meth:`comparison`, or its items (two or three operators or distance kinds; their
+            missing spectra are computed first).
+        path : str or os.PathLike
+            The PNG to write.
+        size : (int, int), optional
+            (width, height) of each view in pixels.
+        scale : int
+            Magnification: each view is ``scale`` times ``size``.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
         from ..scene.comparison import VIEW_SIZE, save_comparison
         from .camera import Camera
 
@@ -820,13 +911,35 @@ class Viewer:
 
     # ========================================================== shape pair
     def pair(self, mesh_b, k: int | None = None, wait: bool = True, strict: bool = True, path=None):
-        """A :class:`~.pair.PairState`: this viewer's mesh as A and ``mesh_b`` (a Mesh or
-        a file) as B, for distances between the two shapes (``pair.pick("a", v)``,
-        ``pair.distance_on("b")``, ``pair.best_match()``).  The distance kind and the
-        Discrete Shells weights are this viewer's; ``k`` modes per spectrum (default 100,
-        fewer on tiny meshes).  With ``wait`` the spectra of both meshes are in when it
-        returns (ComputeError if one failed).  ``path``: the file a given Mesh was read
-        from (its name labels B)."""
+        """Distances between two shapes: this viewer's mesh as A and ``mesh_b`` as B.
+
+        Use the result with ``pair.pick("a", v)``, ``pair.distance_on("b")`` and
+        ``pair.best_match()``.  The distance kind and the Discrete Shells weights are this
+        viewer's.
+
+        Parameters
+        ----------
+        mesh_b : Mesh, str or os.PathLike
+            Mesh B, or its file.
+        k : int, optional
+            Modes per spectrum (default 100, fewer on tiny meshes).
+        wait : bool
+            Return once the spectra of both meshes are in.
+        strict : bool
+            As for :meth:`open_mesh`, for a file.
+        path : str or os.PathLike, optional
+            The file a given Mesh was read from (its name labels B).
+
+        Returns
+        -------
+        PairState
+            The two meshes, their spectra and the pick.
+
+        Raises
+        ------
+        ComputeError
+            If no mesh is open, or (with ``wait``) a spectrum could not be computed.
+        """
         from ..io import load_mesh
         from .pair import PairState
 
