@@ -116,6 +116,8 @@ def plot(
 ) -> Picture:
     """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`.
 
+    Parameters
+    ----------
     mesh : anything :func:`~modalviewer.as_mesh` takes (a file path too).
     spectrum, mode : show mode ``mode`` of ``spectrum`` (default its first non-zero one).
     field : per-vertex values to colour by instead: an (n,) array, a ``(name, values)``
@@ -124,7 +126,8 @@ def plot(
     vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
         ``vertex`` (the input's vertex number); a spectrum of the kind's operator is used
         if given, otherwise ``k`` modes are computed (cached on disk as in the viewer).
-    screenshot : also write the PNG there.  size : (width, height) in pixels.
+    screenshot : also write the PNG there.
+    size : (width, height) in pixels.
     """
     if isinstance(mesh, (str, Path)):
         from .io import load_mesh
