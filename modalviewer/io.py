@@ -95,8 +95,12 @@ def _read_meshio(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
         raise MeshError(f"{path}: no such file")
     try:
         data = meshio.read(path)
-    except Exception as exc:  # meshio raises its own errors, and others, on bad files
-        raise MeshError(f"{path.name}: meshio could not read it ({exc})") from None
+    except (Exception, SystemExit) as exc:  # meshio may even exit on an unreadable file
+        detail = f" ({exc})" if str(exc) and not isinstance(exc, SystemExit) else ""
+        raise MeshError(
+            f"{path.name}: meshio could not read it{detail}; the file may be damaged, "
+            "truncated or of another type"
+        ) from None
     vertices, faces, notes = arrays_of(data)
     if len(vertices) == 0:
         raise MeshError(f"{path.name}: no vertices found in this file")

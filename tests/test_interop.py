@@ -1,0 +1,200 @@
+"""Arrays in and out: as_mesh, load_mesh through meshio, operator_matrices, to_pyvista,
+euclidean_modes, plot, add_to_plotter, view, and the library without Qt and pyvista."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+import modalviewer as mv
+
+ROOT = Path(__file__).resolve().parents[1]
+ASSETS = ROOT / "assets"
+
+
+@pytest.fixture(autouse=True)
+def _isolated(tmp_path, monkeypatch):
+    monkeypatch.setenv("MODALVIEWER_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("MODALVIEWER_SETTINGS", str(tmp_path / "settings.ini"))
+    monkeypatch.setenv("MODALVIEWER_NO_DIALOGS", "1")
+
+
+@pytest.fixture(scope="module")
+def plate():
+    return mv.load_mesh(ASSETS / "demo_plate.obj")
+
+
+@pytest.fixture(scope="module")
+def spot():
+    return mv.load_mesh(ASSETS / "spot.obj")
+
+
+def _same(mesh, vertices, faces):
+    np.testing.assert_allclose(mesh.vertices, vertices, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(mesh.faces, faces)
+
+
+def test_arrays_round_trip_keeps_the_numbering(plate):
+    v, f = np.array(plate.vertices), np.array(plate.faces)
+    mesh = mv.as_mesh((v, f))
+    _same(mesh, v, f)
+    np.testing.assert_array_equal(mesh.file_vertices, np.arange(len(v)))
+    assert mv.as_mesh(mesh) is mesh
+    assert "arrays" in str(mesh.report)
+
+
+def test_arrays_are_repaired_and_reported(plate):
+    v = np.vstack([plate.vertices, [[9.0, 9.0, 9.0]]])  # a vertex no face uses
+    mesh = mv.as_mesh((v, plate.faces), name="mine")
+    assert mesh.n_vertices == plate.n_vertices
+    assert mesh.file_to_mesh[-1] == -1
+    assert str(mesh.report).startswith("mine:")
+    with pytest.raises(mv.MeshError, match="no faces"):
+        mv.as_mesh((v, np.zeros((0, 3), int)))
+    with pytest.raises(TypeError, match="as_mesh takes"):
+        mv.as_mesh(42)
+
+
+def test_trimesh_round_trip(plate):
+    trimesh = pytest.importorskip("trimesh")
+    tm = trimesh.Trimesh(plate.vertices, plate.faces, process=False)
+    _same(mv.as_mesh(tm), plate.vertices, plate.faces)
+
+
+def test_pyvista_round_trip_and_triangulation(plate):
+    pv = pytest.importorskip("pyvista")
+    poly = mv.to_pyvista(plate)
+    _same(mv.as_mesh(poly), plate.vertices, plate.faces)
+    quads = pv.Plane(i_resolution=3, j_resolution=2)  # 12 points, 6 quads
+    mesh = mv.as_mesh(quads)
+    assert mesh.n_faces == 12 and mesh.n_vertices == 12
+    np.testing.assert_allclose(mesh.vertices, quads.points, atol=1e-12)
+    assert "triangulated" in str(mesh.report)
+
+
+def test_meshio_round_trip_and_files(plate, tmp_path):
+    meshio = pytest.importorskip("meshio")
+    m = meshio.Mesh(plate.vertices, [("triangle", plate.faces)])
+    _same(mv.as_mesh(m), plate.vertices, plate.faces)
+    for ext in (".vtu", ".msh"):
+        path = tmp_path / f"plate{ext}"
+        meshio.write(path, m) if ext == ".vtu" else meshio.write(path, m, file_format="gmsh22")
+        loaded = mv.load_mesh(path)
+        _same(loaded, plate.vertices, plate.faces)
+        assert loaded.report.source == path.name
+    quad = meshio.Mesh(
+        np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]]), [("quad", [[0, 1, 2, 3]])]
+    )
+    mesh = mv.as_mesh(quad)
+    assert mesh.n_faces == 2 and "triangulated" in str(mesh.report)
+    bad = tmp_path / "bad.vtu"
+    bad.write_text("not a mesh")
+    with pytest.raises(mv.MeshError, match="bad.vtu"):
+        mv.load_mesh(bad)
+
+
+@pytest.mark.parametrize("operator, k", [("laplacian", 12), ("shells", 14)])
+def test_operator_matrices_give_the_spectrum_through_eigsh(plate, operator, k):
+    spec = mv.compute_spectrum(plate, operator, k=k)
+    K, M = mv.operator_matrices(plate, operator)
+    assert sp.issparse(K) and sp.issparse(M) and M.format == "dia"
+    np.testing.assert_allclose(M.diagonal()[:: 3 if spec.is_vector else 1], spec.mass)
+    assert abs(K - K.T).max() <= 1e-12 * abs(K).max()
+    lam, _ = spla.eigsh(K, k, M, sigma=-1e-3 * spec.eigenvalues[-1])
+    lam = np.sort(lam)
+    nonzero = ~spec.zero_mode_mask()
+    np.testing.assert_allclose(lam[nonzero], spec.eigenvalues[nonzero], rtol=1e-8)
+    assert np.all(np.abs(lam[~nonzero]) < 1e-8 * spec.eigenvalues[-1])
+    phi = spec.modes.reshape(-1, spec.k)  # M-orthonormal, as documented
+    np.testing.assert_allclose(phi.T @ (M @ phi), np.eye(spec.k), atol=1e-8)
+    unit = spec.euclidean_modes().reshape(-1, spec.k)
+    np.testing.assert_allclose(np.linalg.norm(unit, axis=0), 1.0, rtol=1e-12)
+    assert spec.euclidean_modes().shape == spec.modes.shape
+
+
+def test_to_pyvista_arrays(plate):
+    pytest.importorskip("pyvista")
+    scalar = mv.compute_spectrum(plate, "laplacian", k=5)
+    vector = mv.compute_spectrum(plate, "shells", k=8)
+    z = plate.vertices[:, 2]
+    poly = mv.to_pyvista(plate, scalar, fields={"z": z})
+    assert poly.n_points == plate.n_vertices and poly.n_cells == plate.n_faces
+    np.testing.assert_array_equal(poly.point_data["mode_3"], scalar.modes[:, 3])
+    np.testing.assert_array_equal(poly.point_data["z"], z)
+    np.testing.assert_array_equal(poly.field_data["eigenvalues"], scalar.eigenvalues)
+    poly = mv.to_pyvista(plate, vector)
+    assert poly.point_data["mode_7"].shape == (plate.n_vertices, 3)
+    np.testing.assert_array_equal(poly.point_data["mode_7"], vector.modes[:, :, 7])
+    with pytest.raises(ValueError, match="values"):
+        mv.to_pyvista(plate, fields={"short": z[:-1]})
+
+
+def _hues(img):
+    rgb = img[..., :3].astype(int)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    orange = (r > g + 40) & (g > b + 40)  # the modes' negative end, (0.96, 0.55, 0.12)
+    blue = (b > r + 60) & (b > g + 30)  # their positive end, (0.16, 0.38, 0.78)
+    return int(orange.sum()), int(blue.sum())
+
+
+def test_plot_returns_the_viewers_picture(spot, tmp_path):
+    pytest.importorskip("pyvista")
+    spec = mv.compute_spectrum(spot, "laplacian", k=8)
+    pic = mv.plot(spot, spec, mode=4, size=(320, 240), screenshot=tmp_path / "m.png")
+    assert pic.array.shape == (240, 320, 3) and pic.array.dtype == np.uint8
+    orange, blue = _hues(pic.array)
+    assert orange > 200 and blue > 200
+    assert (tmp_path / "m.png").stat().st_size > 1000
+    assert pic._repr_png_().startswith(b"\x89PNG")
+    field = mv.plot(spot, field={"height": spot.vertices[:, 1]}, size=(320, 240))
+    red = (field.array[..., 0].astype(int) > field.array[..., 2].astype(int) + 60).sum()
+    assert red > 200  # white to red
+    dist = mv.plot(spot, spec, vertex=0, size=(320, 240), k=8)
+    assert not np.array_equal(dist.array, field.array)
+
+
+def test_add_to_plotter(spot):
+    pv = pytest.importorskip("pyvista")
+    spec = mv.compute_spectrum(spot, "laplacian", k=6)
+    plotter = pv.Plotter(off_screen=True, window_size=[320, 240])
+    scene = mv.add_to_plotter(plotter, spot, spec, mode=3)
+    np.testing.assert_allclose(scene.surface.point_data["field"], spec.modes[:, 3])
+    orange, blue = _hues(plotter.screenshot())
+    assert orange > 50 and blue > 50  # both ends of the diverging colours, seen from +z
+    plotter.close()
+
+
+def test_view_without_blocking_returns_the_window(spot):
+    pytest.importorskip("PySide6")
+    spec = mv.compute_spectrum(spot, "laplacian", k=6)
+    window = mv.view(spot, spectrum=spec, fields={"x": spot.vertices[:, 0]}, block=False)
+    try:
+        assert window.viewer.mesh is not None
+        assert window.viewer.mesh.n_vertices == spot.n_vertices
+        assert window.viewer.state.spectrum("laplacian") is spec
+    finally:
+        window.close()
+
+
+def test_the_library_works_without_qt_and_pyvista():
+    code = """
+import sys
+for name in ("PySide6", "pyvista", "vtk", "vtkmodules", "qtpy", "pyvistaqt", "pymeshlab"):
+    sys.modules[name] = None
+import modalviewer as mv
+mesh = mv.load_mesh(mv.asset_path("demo_plate.obj"))
+spec = mv.compute_spectrum(mesh, "modified_dirichlet", k=5)
+mesh2 = mv.as_mesh((mesh.vertices, mesh.faces))
+K, M = mv.operator_matrices(mesh2, "laplacian")
+assert spec.k == 5 and K.shape == M.shape
+print("ok")
+"""
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip().endswith("ok")
