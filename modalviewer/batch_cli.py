@@ -26,8 +26,7 @@ def add_parsers(sub) -> None:
     """The ``batch`` and ``similar`` subcommands of the CLI's parser."""
     b = sub.add_parser(
         "batch",
-        help="spectra (and signatures) of every mesh of folders, globs or list files, "
-        "into one store, on a local or remote Dask cluster",
+        help="spectra and signatures of a whole dataset into one store (on Dask)",
     )
     b.add_argument(
         "sources",
