@@ -683,7 +683,7 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
             processes=True,
             memory_limit=memory_limit,
             resources={"memory": memory_limit} if memory_limit else None,
-            dashboard_address=None,
+            dashboard_address=":0",
             env={
                 name: threads
                 for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")

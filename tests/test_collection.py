@@ -55,7 +55,7 @@ def sources(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def client():
     with distributed.Client(
-        processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None
+        processes=False, n_workers=1, threads_per_worker=2, dashboard_address=":0"
     ) as c:
         yield c
 
@@ -212,3 +212,45 @@ def test_a_killed_batch_leaves_a_readable_store(tmp_path):
     summary = coll.run_batch([folder], out, "shells", 20, workers=0)
     assert set(summary.skipped) == done and len(summary.computed) == 12 - len(done)
     assert len(mv.open_collection(out).names) == 12
+
+
+def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
+    """A worker offering less memory than two meshes' estimates runs them one at a time,
+    though it has two threads."""
+    import threading
+
+    running, most = [0], [0]
+    lock = threading.Lock()
+    compute = coll._compute
+
+    def counted(*args):
+        with lock:
+            running[0] += 1
+            most[0] = max(most[0], running[0])
+        try:
+            time.sleep(0.05)
+            return compute(*args)
+        finally:
+            with lock:
+                running[0] -= 1
+
+    monkeypatch.setattr(coll, "_compute", counted)
+    mesh = mv.load_mesh(sources / "torus.obj")
+    assert coll.vertex_count_hint(sources / "torus.obj") == mesh.n_vertices
+    need = coll.memory_estimate(mesh.n_vertices, coll._parameters("laplacian", K, [], 1, 1))
+    with distributed.Client(
+        processes=False,
+        n_workers=1,
+        threads_per_worker=2,
+        resources={"memory": int(1.5 * need)},
+        dashboard_address=":0",
+    ) as client:
+        assert coll._memory_resource(client) == int(1.5 * need)
+        summary = coll.run_batch(
+            [sources / f"{n}.obj" for n in ("torus", "torus_moved", "fat_torus")],
+            tmp_path / "store",
+            "laplacian",
+            K,
+            client=client,
+        )
+    assert len(summary.computed) == 3 and most[0] == 1
