@@ -1,0 +1,28 @@
+"""examples/quickstart.ipynb runs from top to bottom and its pictures come out."""
+
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOK = ROOT / "examples" / "quickstart.ipynb"
+
+
+def test_the_quickstart_notebook_executes(tmp_path, monkeypatch):
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+    pytest.importorskip("ipykernel")
+    pytest.importorskip("pyvista")
+    monkeypatch.setenv("MODALVIEWER_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("QT_QPA_PLATFORM", "offscreen")
+    nb = nbformat.read(NOTEBOOK, as_version=4)
+    client = nbclient.NotebookClient(
+        nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
+    )
+    client.execute()
+    outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    pictures = [o for o in outputs if "image/png" in o.get("data", {})]
+    assert len(pictures) >= 3
+    text = "".join(o.get("text", "") for o in outputs)
+    assert "best match: vertex" in text
