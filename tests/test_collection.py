@@ -254,3 +254,27 @@ def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
             client=client,
         )
     assert len(summary.computed) == 3 and most[0] == 1
+
+
+def test_sources_folders_globs_and_list_files(sources, tmp_path):
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    for folder in ("a", "b"):
+        (tmp_path / folder / "torus.obj").write_bytes((sources / "torus.obj").read_bytes())
+    listing = tmp_path / "list.txt"
+    listing.write_text("# two files\na/torus.obj\n\nb/torus.obj\n")
+    paths = coll.find_meshes([listing, str(tmp_path / "*" / "torus.obj"), sources / "plate.obj"])
+    assert [p.name for p in paths] == ["torus.obj", "torus.obj", "plate.obj"]
+    assert coll.mesh_names(paths) == ["a--torus", "b--torus", "plate"]
+    with pytest.raises(ValueError, match="no such file"):
+        coll.find_meshes([tmp_path / "missing"])
+
+
+def test_import_modalviewer_loads_no_dask_and_no_qt():
+    code = (
+        "import sys, modalviewer as mv; mv.open_collection; "
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in "
+        "('dask', 'distributed', 'PySide6', 'qtpy')))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0 and out.stdout.strip() == "[]", out.stderr
