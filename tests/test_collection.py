@@ -278,3 +278,20 @@ def test_import_modalviewer_loads_no_dask_and_no_qt():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 0 and out.stdout.strip() == "[]", out.stderr
+
+
+def test_an_existing_scheduler_without_memory_resources(sources, tmp_path):
+    notes = []
+    with distributed.LocalCluster(
+        processes=False, n_workers=1, threads_per_worker=1, dashboard_address=":0"
+    ) as cluster:
+        summary = coll.run_batch(
+            [sources / "sphere.obj", sources / "plate.obj"],
+            tmp_path / "store",
+            "laplacian",
+            K,
+            scheduler=cluster.scheduler_address,
+            log=notes.append,
+        )
+    assert sorted(summary.computed) == ["plate", "sphere"]
+    assert len(notes) == 1 and "without memory estimates" in notes[0]
