@@ -41,14 +41,7 @@ def installed(tmp_path_factory):
     purelib = Path(
         _run(python, "-c", "import sysconfig; print(sysconfig.get_path('purelib'))").stdout.strip()
     )
-    here = [
-        p
-        for p in {
-            sysconfig.get_path("purelib"),
-            sysconfig.get_path("platlib"),
-            *site.getsitepackages(),
-        }
-    ]
+    here = {sysconfig.get_path("purelib"), sysconfig.get_path("platlib"), *site.getsitepackages()}
     (purelib / "outer_packages.pth").write_text("\n".join(sorted(here)) + "\n")
     _run(*pip, "--python", python, "install", "--quiet", "--no-deps", "--no-build-isolation", wheel)
     return wheel, python, work
