@@ -925,7 +925,7 @@ class Collection:
         if name is not None:
             row = self.names.index(name)
             return self.descriptors["shape_dna"][row], mesh.hash
-        if spectrum is None or spectrum.operator != self.operator or spectrum.k < self.k:
+        if not self.spectrum_fits(spectrum):
             from .core.pipeline import compute_spectrum
 
             spectrum = compute_spectrum(
@@ -934,6 +934,26 @@ class Collection:
         else:
             spectrum = _first_modes(spectrum, self.k)
         return shape_dna(spectrum, mesh.total_area), mesh.hash
+
+    def spectrum_fits(self, spectrum: Spectrum | None) -> bool:
+        """Whether ``spectrum`` can stand for the store's: its operator and weights, exact
+        (not a preview), at least its k modes."""
+        if spectrum is None or spectrum.operator != self.operator or spectrum.is_preview:
+            return False
+        if spectrum.k < min(
+            self.k, spectrum.n_vertices * operator_info(self.operator).unknowns_per_vertex
+        ):
+            return False
+        if operator_info(self.operator).has_weights:
+            for weight in ("bending", "membrane"):
+                if float(spectrum.parameters.get(weight, 1.0)) != float(self.info[weight]):
+                    return False
+        return True
+
+    def needs_spectrum(self, mesh, spectrum: Spectrum | None = None) -> bool:
+        """Whether ranking by ``mesh`` must compute its spectrum first: the store does not
+        hold its geometry and ``spectrum`` does not fit (:meth:`spectrum_fits`)."""
+        return self.name_of(mesh.hash) is None and not self.spectrum_fits(spectrum)
 
     def similar(self, query, n: int | None = 10, spectrum: Spectrum | None = None):
         """The stored meshes nearest to ``query`` by Shape-DNA distance

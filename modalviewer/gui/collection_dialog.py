@@ -9,6 +9,7 @@ from pathlib import Path
 from qtpy import QtCore, QtWidgets
 
 from ..collection import CollectionError, nearest_rows, open_collection
+from ..core.operators import operator_info
 from .pair_window import open_pair_window
 
 
@@ -62,16 +63,43 @@ class CollectionDialog(QtWidgets.QDialog):
 def open_collection_window(main, path) -> CollectionDialog | None:
     """The dialog of the store at ``path``, shown; None (after a message) if it is not
     a collection.  The distances need the mesh on screen's spectrum of the store's
-    operator: the one on screen if it has the store's k modes, else computed here."""
+    operator: the stored one if the store holds the mesh, else the one on screen if it
+    has the store's k modes; else the viewer computes it in the background and the
+    dialog opens when it is in (None is returned then)."""
     try:
         collection = open_collection(path)
     except (CollectionError, OSError) as exc:
         main.show_error(str(exc), "Cannot open collection")
         return None
     mesh = main.state.mesh
+    spectrum = main.state.spectrum(collection.operator)
+    weights = operator_info(collection.operator).has_weights and (
+        collection.info["bending"],
+        collection.info["membrane"],
+    ) != (1.0, 1.0)
+    if mesh is not None and collection.needs_spectrum(mesh, spectrum) and not weights:
+        # the viewer computes it in the background (and caches it); the list follows
+        main.statusBar().showMessage(
+            f"Computing the {collection.operator} spectrum ({collection.k} modes) to rank "
+            f"{collection.path.name}...",
+            8000,
+        )
+        main.compute(
+            collection.operator,
+            collection.k,
+            wait=False,
+            then=lambda spec: _show(main, collection, mesh, spec),
+        )
+        return None
+    return _show(main, collection, mesh, spectrum)
+
+
+def _show(main, collection, mesh, spectrum) -> CollectionDialog | None:
+    if mesh is not main.state.mesh:  # another mesh was opened meanwhile
+        return None
     QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.CursorShape.WaitCursor)
     try:
-        rows = nearest_rows(collection, mesh, main.state.spectrum(collection.operator))
+        rows = nearest_rows(collection, mesh, spectrum)
     except (ValueError, RuntimeError, MemoryError) as exc:
         QtWidgets.QApplication.restoreOverrideCursor()
         main.show_error(f"Cannot rank the collection: {exc}", "Open collection")

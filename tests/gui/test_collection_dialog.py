@@ -45,6 +45,27 @@ def test_open_collection_lists_nearest_and_opens_beside(window, tmp_path):
     dialog.close()
 
 
+def test_a_mesh_outside_the_store_is_ranked_once_its_spectrum_is_in(window, qtbot, tmp_path):
+    from modalviewer.gui.collection_dialog import open_collection_window
+
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    _write_obj(primitives.torus(14, 7), folder / "torus.obj")
+    _write_obj(primitives.grid_plate(6, 5), folder / "plate.obj")
+    store = tmp_path / "store"
+    coll.run_batch([folder], store, "laplacian", 8, workers=0)
+    outside = tmp_path / "moved_torus.obj"
+    torus = primitives.torus(14, 7)
+    _write_obj(mv.Mesh(torus.vertices + [0.0, 0.0, 3.0], torus.faces), outside)
+    assert window.open_mesh(outside)
+    assert open_collection_window(window, store) is None  # the spectrum is computed first
+    qtbot.waitUntil(lambda: getattr(window, "collection_dialog", None) is not None, timeout=30000)
+    dialog = window.collection_dialog
+    assert dialog.list.item(0).text().startswith("torus")
+    assert window.state.spectrum("laplacian").k >= 8
+    dialog.close()
+
+
 def test_not_a_collection_is_a_message(window, tmp_path):
     from modalviewer.gui.collection_dialog import open_collection_window
 
