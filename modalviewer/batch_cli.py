@@ -111,6 +111,10 @@ def _batch(args) -> int:
                 "Dask is not installed: pip install 'modalviewer[batch]' (or --workers 0: "
                 "one mesh after another in this process)"
             ) from None
+    import logging
+
+    # Dask's own log lines (a cancelled task on Ctrl+C, ...) would break the progress line
+    logging.getLogger("distributed").setLevel(logging.ERROR)
     summary = run_batch(
         args.sources,
         args.output,
@@ -126,6 +130,8 @@ def _batch(args) -> int:
         progress=progress_bar(),
         log=lambda text: sys.stderr.write(f"modalviewer: note: {text}\n"),
     )
+    if summary.interrupted:
+        sys.stderr.write("\n")  # the progress line stopped short
     for name, error in summary.failed.items():
         print(f"failed: {name}: {error}")
     print(f"{args.output}: {summary.text()}")

@@ -58,6 +58,7 @@ from __future__ import annotations
 import glob
 import hashlib
 import json
+import logging
 import os
 import sys
 import time
@@ -690,6 +691,8 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
             },
         )
         client = distributed.Client(cluster)
+        if logging.getLogger("distributed").getEffectiveLevel() >= logging.ERROR:
+            client.run(_quiet_logs)  # the local workers follow this process's quiet log
     try:
         capacity = _memory_resource(client)
         if capacity is None:
@@ -726,6 +729,11 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
             client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _quiet_logs() -> None:
+    """Dask's log on errors only (a worker's lines on Ctrl+C: cancelled tasks)."""
+    logging.getLogger("distributed").setLevel(logging.ERROR)
 
 
 def _memory_resource(client) -> int | None:
