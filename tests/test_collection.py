@@ -48,6 +48,14 @@ def sources(tmp_path_factory) -> Path:
     _write_obj(primitives.grid_plate(6, 5), folder / "plate.obj")
     fat = primitives.torus(14, 7, minor=0.5)
     _write_obj(fat, folder / "fat_torus.obj")
+    rng = np.random.default_rng(3)  # no symmetry: every eigenvalue simple, modes unique
+    sphere = primitives.icosphere(2)
+    v = (
+        sphere.vertices
+        * [1.0, 1.3, 0.8]
+        * (1.0 + 0.05 * rng.standard_normal((len(sphere.vertices), 1)))
+    )
+    _write_obj(mv.Mesh(v, sphere.faces), folder / "blob.obj")
     (folder / "broken.obj").write_text("v 0 0 0\nv 1 0\nf 1 2 3\n")
     return folder
 
@@ -64,9 +72,14 @@ def client():
 def store(sources, client, tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("store") / "store"
     summary = coll.run_batch([sources], path, "laplacian", K, ["hks", "vibration"], client=client)
-    assert sorted(summary.computed) == ["fat_torus", "plate", "sphere", "torus", "torus_moved"], (
-        summary
-    )
+    assert sorted(summary.computed) == [
+        "blob",
+        "fat_torus",
+        "plate",
+        "sphere",
+        "torus",
+        "torus_moved",
+    ], summary
     return path
 
 
@@ -77,26 +90,41 @@ def _same_up_to_sign(a: np.ndarray, b: np.ndarray) -> None:
         np.testing.assert_allclose(a[:, j], sign * b[:, j], atol=1e-10, rtol=0)
 
 
+def _same_eigenspaces(a, b) -> None:
+    """Equal projectors U U^T onto each cluster of equal eigenvalues (the last cluster
+    only if the k modes hold all of it: it is cut off by k otherwise)."""
+    lam = a.eigenvalues
+    scale = max(abs(lam).max(), 1.0)
+    cuts = [0, *(np.flatnonzero(np.diff(lam) > 1e-6 * scale) + 1)]
+    for start, end in zip(cuts[:-1], cuts[1:], strict=True):
+        ua = a.modes[..., start:end].reshape(-1, end - start)
+        ub = b.modes[..., start:end].reshape(-1, end - start)
+        np.testing.assert_allclose(ua @ ua.T, ub @ ub.T, atol=1e-9)
+
+
 def test_store_spectra_equal_compute_spectrum(store, sources):
     c = mv.open_collection(store)
-    assert c.names == ["fat_torus", "plate", "sphere", "torus", "torus_moved"]
-    for name in ("torus", "sphere"):
+    assert c.names == ["blob", "fat_torus", "plate", "sphere", "torus", "torus_moved"]
+    for name in c.names:
         mesh = mv.load_mesh(sources / f"{name}.obj")
         for op in ("laplacian", "shells"):
             direct = mv.compute_spectrum(mesh, op, K)
             stored = c.spectrum(name, None if op == "laplacian" else op)
             assert stored.operator == op and stored.mesh_hash == mesh.hash
             np.testing.assert_allclose(stored.eigenvalues, direct.eigenvalues, atol=1e-10)
-            _same_up_to_sign(stored.modes, direct.modes)
-    mesh = mv.load_mesh(sources / "torus.obj")
-    times, values = c.signatures("torus")["hks"]
+            if name == "blob":  # simple eigenvalues: each mode unique up to sign
+                _same_up_to_sign(stored.modes, direct.modes)
+            else:  # symmetric shapes: the same eigenspaces
+                _same_eigenspaces(stored, direct)
+    mesh = mv.load_mesh(sources / "blob.obj")
+    times, values = c.signatures("blob")["hks"]
     direct_times, direct_values = mv.signature(mv.compute_spectrum(mesh, "laplacian", K))
     np.testing.assert_allclose(times, direct_times, rtol=1e-10)
     np.testing.assert_allclose(values, direct_values, rtol=1e-8, atol=1e-12)
     d = c.descriptors
-    assert d["shape_dna"].shape[0] == 5 and d["histogram.vibration"].shape == (5, 8, 32)
+    assert d["shape_dna"].shape[0] == 6 and d["histogram.vibration"].shape == (6, 8, 32)
     np.testing.assert_allclose(d["histogram.hks"].sum(axis=2), 1.0, atol=1e-12)
-    row = c.names.index("torus")
+    row = c.names.index("blob")
     np.testing.assert_allclose(d["area"][row], mesh.total_area)
 
 
@@ -106,7 +134,7 @@ def test_a_mesh_file_reads_with_numpy_alone(store):
         assert data["eigenvalues"].shape == (K,)
         assert data["modes"].shape == (entry["n_vertices"], K)
     index = json.loads((store / "index.json").read_text())
-    assert set(index["entries"]) == {"fat_torus", "plate", "sphere", "torus", "torus_moved"}
+    assert set(index["entries"]) == {"blob", "fat_torus", "plate", "sphere", "torus", "torus_moved"}
     assert mv.load_spectrum(store / "meshes" / "torus.npz").k == K  # a spectrum file too
 
 
@@ -129,7 +157,7 @@ def test_resume_recomputes_nothing(store, sources, client, monkeypatch):
     monkeypatch.setattr(coll, "_compute", counted)
     params = dict(operator="laplacian", k=K, signatures=["vibration", "hks"], client=client)
     summary = coll.run_batch([sources], store, **params)
-    assert calls == [] and summary.computed == [] and len(summary.skipped) == 6
+    assert calls == [] and summary.computed == [] and len(summary.skipped) == 7
     assert summary.failed_before == ["broken"]
     # a touched file is read again, but its geometry hash says it is done
     os.utime(sources / "sphere.obj", ns=(time.time_ns(), time.time_ns()))
@@ -149,7 +177,7 @@ def test_similar_puts_the_shape_first_and_its_rigid_copy_second(store, sources):
     assert ranked[0][1] == 0.0 and ranked[1][1] < 1e-6 < ranked[2][1]
     from_file = c.similar(str(sources / "torus_moved.obj"), n=None)
     assert [name for name, _ in from_file[:2]] == ["torus_moved", "torus"]
-    assert len(from_file) == 5
+    assert len(from_file) == 6
     # a mesh not in the store: its spectrum is computed with the store's parameters
     outside = primitives.torus(14, 7)
     outside = mv.Mesh(outside.vertices * 1.0 + [0.0, 0.0, 5.0], outside.faces)
