@@ -466,6 +466,13 @@ def _prepare_store(store: Path, parameters: dict) -> None:
             raise CollectionError(f"{store} is not a modalviewer collection")
         if old == info:
             return
+        if any((store / "meshes").glob("*.npz")) or any((store / "errors").glob("*.json")):
+            raise CollectionError(
+                f"{store} holds {old.get('operator')} spectra, k={old.get('k')}, "
+                f"signatures {','.join(old.get('signatures', [])) or 'none'}, weights "
+                f"{old.get('bending')}/{old.get('membrane')}: other parameters need "
+                "another store"
+            )
     _write_json(header, info)
 
 
@@ -570,7 +577,8 @@ def run_batch(
     A mesh whose stored key (geometry hash and parameters) is current is skipped, as is
     a recorded failure of the same file and parameters unless ``retry_failed``.  Each
     result is written when it arrives; a failure is recorded in ``errors/`` and the
-    batch goes on.  The index is rebuilt at the end (also when interrupted).
+    batch goes on.  The index is rebuilt at the end (also when interrupted).  A store
+    holds one set of parameters: other ones raise CollectionError if it holds results.
     """
     store = Path(store)
     parameters = _parameters(operator, k, signatures, bending, membrane)

@@ -163,7 +163,9 @@ def test_resume_recomputes_nothing(store, sources, client, monkeypatch):
     os.utime(sources / "sphere.obj", ns=(time.time_ns(), time.time_ns()))
     summary = coll.run_batch([sources], store, **params)
     assert calls == [] and summary.computed == [] and "sphere" in summary.skipped
-    # other parameters are another key: recomputed
+    # other parameters: another store (one holds one set of parameters)
+    with pytest.raises(coll.CollectionError, match="other parameters need another store"):
+        coll.run_batch([sources], store, "laplacian", K + 1, client=client)
     other = tmp = store.parent / "store_k6"
     summary = coll.run_batch([sources / "sphere.obj"], tmp, "laplacian", 6, client=client)
     assert calls == ["laplacian"] and summary.computed == ["sphere"]
