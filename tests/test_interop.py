@@ -176,6 +176,8 @@ def test_view_without_blocking_returns_the_window(spot):
         assert window.viewer.mesh is not None
         assert window.viewer.mesh.n_vertices == spot.n_vertices
         assert window.viewer.state.spectrum("laplacian") is spec
+        scene = window.viewer._picture.scene  # the window's surface shows the field
+        np.testing.assert_allclose(scene.surface.point_data["field"], spot.vertices[:, 0])
     finally:
         window.close()
 
