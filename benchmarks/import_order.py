@@ -1,13 +1,16 @@
 """The eigensolver's time with numpy imported before modalviewer and after it.
 
-    python -m benchmarks.import_order [--runs 3] [--k 100] [--label current]
+    python -m benchmarks.import_order [--runs 3] [--k 100] [--label current] [--compare]
 
 Each measurement runs in a fresh process on the 10k benchmark mesh (spot midpoint-
 subdivided once, ~11.7k vertices): ``numpy_first`` imports numpy (and runs one BLAS
 call) before ``import modalviewer``, ``modalviewer_first`` imports modalviewer first.
 The thread settings are not in the environment of the children, so what counts is only
 what modalviewer sets itself.  Results (the median of the runs, and every run) go to
-benchmarks/results/import_order.json under ``--label``; earlier labels are kept.
+benchmarks/results/import_order.json under ``--label``; earlier labels are kept, with the
+load average of the machine before and after.  ``--compare`` alternates each run with
+one without the run-time limit (``MODALVIEWER_SINGLE_BLAS_THREAD=0``, the environment
+variables alone), so both see the same load; those rows have ``"limit": false``.
 """
 
 from __future__ import annotations
@@ -41,8 +44,10 @@ def child(order: str, operator: str, k: int) -> None:
     print(json.dumps({"seconds": spec.parameters["seconds_total"], "n": mesh.n_vertices}))
 
 
-def measure(order: str, operator: str, k: int) -> dict:
+def measure(order: str, operator: str, k: int, limit: bool | None = None) -> dict:
     env = {k_: v for k_, v in os.environ.items() if k_ not in THREAD_VARIABLES}
+    if limit is not None:
+        env["MODALVIEWER_SINGLE_BLAS_THREAD"] = "1" if limit else "0"
     out = subprocess.run(
         [sys.executable, "-m", "benchmarks.import_order", "--child", order, operator, str(k)],
         cwd=ROOT,
@@ -60,28 +65,43 @@ def main() -> None:
     p.add_argument("--k", type=int, default=100)
     p.add_argument("--operators", nargs="+", default=["laplacian", "shells"])
     p.add_argument("--label", default="current")
+    p.add_argument("--compare", action="store_true", help="also without the run-time limit")
     p.add_argument("--child", nargs=3, metavar=("ORDER", "OPERATOR", "K"))
     args = p.parse_args()
     if args.child:
         child(args.child[0], args.child[1], int(args.child[2]))
         return
     rows = []
+    load_before = os.getloadavg()[0]
+    limits = (True, False) if args.compare else (None,)
     for operator in args.operators:
         for order in ORDERS:
-            runs = [measure(order, operator, args.k) for _ in range(args.runs)]
-            seconds = [r["seconds"] for r in runs]
-            row = {
-                "operator": operator,
-                "order": order,
-                "k": args.k,
-                "n_vertices": runs[0]["n"],
-                "median_seconds": round(statistics.median(seconds), 3),
-                "runs": [round(s, 3) for s in seconds],
-            }
-            rows.append(row)
-            print(f"{operator:10s} {order:18s} {row['median_seconds']:7.2f} s  {row['runs']}")
+            runs = {lim: [] for lim in limits}
+            for _ in range(args.runs):
+                for lim in limits:
+                    runs[lim].append(measure(order, operator, args.k, lim))
+            for lim, found in runs.items():
+                seconds = [r["seconds"] for r in found]
+                row = {
+                    "operator": operator,
+                    "order": order,
+                    "limit": lim is not False,
+                    "k": args.k,
+                    "n_vertices": found[0]["n"],
+                    "median_seconds": round(statistics.median(seconds), 3),
+                    "runs": [round(s, 3) for s in seconds],
+                }
+                rows.append(row)
+                print(
+                    f"{operator:10s} {order:18s} limit={row['limit']!s:5s} "
+                    f"{row['median_seconds']:7.2f} s  {row['runs']}"
+                )
     results = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
-    results[args.label] = {"cpus": os.cpu_count(), "rows": rows}
+    results[args.label] = {
+        "cpus": os.cpu_count(),
+        "load_average": [round(load_before, 2), round(os.getloadavg()[0], 2)],
+        "rows": rows,
+    }
     RESULTS.write_text(json.dumps(results, indent=2) + "\n")
 
 
