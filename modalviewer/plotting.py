@@ -120,9 +120,10 @@ def plot(
     ----------
     mesh : anything :func:`~modalviewer.as_mesh` takes (a file path too).
     spectrum, mode : show mode ``mode`` of ``spectrum`` (default its first non-zero one).
-    field : per-vertex values to colour by instead: an (n,) array, a ``(name, values)``
-        pair or a dict (its first item); signed values in the modes' diverging colours,
-        others white to red.
+    field : per-vertex values to colour by instead: an (n,) array in the mesh's vertex
+        order (``mesh.n_vertices``; :meth:`Mesh.file_vertices` maps to the input's), a
+        ``(name, values)`` pair or a dict (its first item); signed values in the modes'
+        diverging colours, others white to red.
     vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
         ``vertex`` (the input's vertex number); a spectrum of the kind's operator is used
         if given, otherwise ``k`` modes are computed (cached on disk as in the viewer).
