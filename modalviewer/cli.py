@@ -475,6 +475,12 @@ def _distance_to(args, mesh_a) -> int:
 
     import modalviewer as mv
 
+    if args.up != "auto" or args.view != "canonical":
+        # each panel of the two-mesh picture turns to face its marker
+        raise ValueError(
+            "--up and --view apply to one mesh's picture; with --to each mesh is shown "
+            "from its first view, turned to face the picked vertex and its best match"
+        )
     mesh_b = _load(args.to, args.fix_slivers)
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)

@@ -83,3 +83,14 @@ def test_bad_views_and_up_axes_are_one_line_errors(args, message, tmp_path):
     assert r.returncode == 2
     errors = [line for line in r.stderr.splitlines() if line.startswith("modalviewer: error")]
     assert len(errors) == 1 and message in errors[0], r.stderr
+
+
+def test_distance_to_a_second_mesh_refuses_up_and_view(tmp_path, capsys):
+    """The two-mesh picture turns each panel to its marker: --up/--view are refused there
+    with a one-line error instead of being ignored."""
+    from modalviewer import cli
+
+    spot = str(Path(__file__).resolve().parents[1] / "assets" / "spot.obj")
+    code = cli.main(["distance", spot, "--vertex", "5", "--to", spot, "--view", "+x", "-k", "10"])
+    err = capsys.readouterr().err
+    assert code == 1 and "--up and --view apply to one mesh" in err
