@@ -1013,7 +1013,24 @@ def _first_modes(spec: Spectrum, k: int) -> Spectrum:
 
 def open_collection(path: str | os.PathLike) -> Collection:
     """The collection at ``path`` (a store of :func:`run_batch`), CollectionError if it is
-    none.  Needs numpy only."""
+    none.  Needs numpy only.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The store's folder, as ``modalviewer batch -o`` wrote it.
+
+    Returns
+    -------
+    Collection
+        ``names``, ``spectrum(name)``, ``signatures(name)``, ``descriptors``, ``errors``,
+        ``similar(...)``.
+
+    Raises
+    ------
+    CollectionError
+        If ``path`` is not a collection.
+    """
     return Collection(path)
 
 

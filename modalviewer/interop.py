@@ -99,6 +99,26 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     report (default: the object's type).  Vertex i of the object is file vertex i of the
     mesh: :meth:`Mesh.mesh_vertex` and :meth:`Mesh.to_file_field` convert, and without a
     repair that drops or merges vertices the numbering is the same.
+
+    Parameters
+    ----------
+    obj : Mesh, tuple of arrays, trimesh.Trimesh, pyvista.DataSet or meshio.Mesh
+        The mesh; arrays as ``(vertices (n, 3), faces (m, 3))``.
+    repair : bool
+        As in :func:`~modalviewer.io.load_mesh`.
+    name : str
+        The name the report gives the mesh.
+
+    Returns
+    -------
+    Mesh
+
+    Raises
+    ------
+    MeshError
+        For an object that holds no triangle surface.
+    TypeError
+        For an object of another kind.
     """
     if isinstance(obj, Mesh):
         return obj
@@ -120,6 +140,21 @@ def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float
     ``scipy.sparse.linalg.eigsh(K, k, M, sigma=-s)`` for a small ``s > 0`` gives the
     spectrum :func:`~modalviewer.compute_spectrum` computes (up to the signs and bases of
     eigenspaces).
+
+    Parameters
+    ----------
+    mesh : Mesh
+    operator : str
+        ``"laplacian"``, ``"modified_dirichlet"``, ``"shells"`` or ``"shells_normal"``.
+    bending, membrane : float
+        The Discrete Shells weights (ignored by the other operators).
+
+    Returns
+    -------
+    K : scipy.sparse.csr_matrix of shape (N, N)
+        Symmetric positive semi-definite.
+    M : scipy.sparse.dia_matrix of shape (N, N)
+        The lumped mass; N is n, or 3 n for vector modes.
     """
     K, mass = _operator_matrices(as_mesh(mesh), operator, bending, membrane)
     return sp.csr_matrix(K), sp.diags_array(np.asarray(mass, dtype=np.float64), format="dia")
@@ -132,6 +167,16 @@ def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = Non
     vertex masses as ``"mass"``; the eigenvalues go to ``field_data["eigenvalues"]``.
     ``fields``: a dict name -> (n,) or (n, c) per-vertex array.  Points are the mesh's
     vertices in the mesh's numbering (``mesh.file_vertices`` maps to the input's).
+
+    Parameters
+    ----------
+    mesh : Mesh
+    spectrum : Spectrum, optional
+    fields : dict of str to array_like of shape (n,) or (n, c), optional
+
+    Returns
+    -------
+    pyvista.PolyData
     """
     import pyvista as pv
 

@@ -130,6 +130,21 @@ def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
     uses are reported (in an OBJ file they are the trace of a file cut between two
     face records).
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        An OBJ, OFF, PLY, STL or VTK/VTP file, or any surface format meshio reads.
+    repair : bool
+        Merge, drop and orient as above (default), or only validate.
+    strict : bool
+        Refuse damaged files (default), or load their whole records.
+
+    Returns
+    -------
+    Mesh
+        Vertices (n, 3) and faces (m, 3), with ``mesh.report`` and the file's numbering
+        (``mesh.file_vertices``).
+
     Raises
     ------
     MeshError

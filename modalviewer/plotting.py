@@ -160,6 +160,19 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     loop).  ``spectrum`` goes into the viewer's spectra (its first non-zero mode shown);
     ``fields`` (a dict name -> per-vertex array) colours the surface by its first field
     as the window opens; choosing a mode or a distance in the window replaces it.
+
+    Parameters
+    ----------
+    mesh_or_arrays : Mesh, (vertices, faces) or another library's mesh
+        Anything :func:`~modalviewer.as_mesh` accepts.
+    spectrum : Spectrum, optional
+    fields : dict of str to array_like of shape (n,), optional
+    block : bool
+
+    Returns
+    -------
+    modalviewer.gui.MainWindow
+        The window; ``window.viewer`` is its Viewer.
     """
     if isinstance(mesh_or_arrays, (str, Path)):
         from .io import load_mesh
@@ -210,6 +223,22 @@ def add_to_plotter(
         otherwise white to red) or a :class:`Spectrum`: its mode ``mode`` (default the
         first non-zero one; vector modes by their normal component, as the viewer), or
         with ``vertex`` the multiscale distance from that vertex (the input's number).
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter
+    mesh : Mesh
+    values_or_spectrum : array_like of shape (n,) or Spectrum
+    mode : int, optional
+    vertex : int, optional
+    isolines : int
+        Number of isolines (0: none).
+    name : str
+        The colour bar's title.
+
+    Returns
+    -------
+    modalviewer.scene.mesh_scene.MeshScene
     """
     from .core.laplacian import vertex_normals
     from .core.signatures import multiscale_distance
