@@ -68,15 +68,6 @@ def _field_of(field, n: int):
     return str(name), values
 
 
-def _custom_field(name: str, values: np.ndarray):
-    """The viewer's :class:`~modalviewer.viewer.derived.Field` for user values:
-    diverging colours for signed values, sequential (white to red) otherwise."""
-    from .viewer.derived import Field
-
-    signed = float(values.min()) < 0.0 < float(values.max())
-    return Field(values, "diverging" if signed else "sequential", title=name)
-
-
 def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
     from .core.operators import operator_for_distance
     from .viewer import Viewer
@@ -137,13 +128,10 @@ def plot(
     mesh = as_mesh(mesh)
     viewer = _prepared_viewer(mesh, spectrum, mode, vertex, kind, k)
     try:
-        renderer = viewer.renderer(size)
         if field is not None:
-            from .scene.view import draw_field
-
             name, values = _field_of(field, mesh.n_vertices)
-            draw_field(renderer.scene, _custom_field(name, values))
-        picture = Picture(renderer.image(transparent=transparent))
+            viewer.show_field(name, values)
+        picture = Picture(viewer.image(transparent=transparent, size=size))
     finally:
         viewer.close()
     if screenshot is not None:
@@ -158,8 +146,8 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     With ``block=True`` (default) it returns when the window closes; with ``block=False``
     at once (in a notebook kernel with ``%gui qt``, or a script that runs the Qt event
     loop).  ``spectrum`` goes into the viewer's spectra (its first non-zero mode shown);
-    ``fields`` (a dict name -> per-vertex array) colours the surface by its first field
-    as the window opens; choosing a mode or a distance in the window replaces it.
+    ``fields`` (a dict name -> per-vertex array) are the viewer's fields
+    (``window.viewer.show_field(name)`` shows another); the window opens on the first.
 
     Parameters
     ----------
@@ -192,15 +180,12 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
             viewer.state.compute_settings.key(spectrum.operator, spectrum.k), spectrum
         )
         viewer.show_mode(viewer.state.first_nonzero_mode(spectrum.operator), spectrum.operator)
-    window.show()
     if fields:
-        from .scene.view import draw_field
-
-        name, values = _field_of(fields, mesh.n_vertices)
-        scene = window.viewer._picture.scene if window.viewer._picture is not None else None
-        if scene is not None:
-            draw_field(scene, _custom_field(name, values))
-            window.plotter.render()
+        _field_of(fields, mesh.n_vertices)  # checked as plot checks them
+        for name, values in fields.items():
+            viewer.state.add_field(name, values)
+        viewer.show_field(next(iter(fields)))
+    window.show()
     if block:
         app.exec()
     return window

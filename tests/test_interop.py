@@ -171,13 +171,17 @@ def test_add_to_plotter(spot):
 def test_view_without_blocking_returns_the_window(spot):
     pytest.importorskip("PySide6")
     spec = mv.compute_spectrum(spot, "laplacian", k=6)
-    window = mv.view(spot, spectrum=spec, fields={"x": spot.vertices[:, 0]}, block=False)
+    fields = {"x": spot.vertices[:, 0], "y": spot.vertices[:, 1]}
+    window = mv.view(spot, spectrum=spec, fields=fields, block=False)
     try:
         assert window.viewer.mesh is not None
         assert window.viewer.mesh.n_vertices == spot.n_vertices
         assert window.viewer.state.spectrum("laplacian") is spec
-        scene = window.viewer._picture.scene  # the window's surface shows the field
-        np.testing.assert_allclose(scene.surface.point_data["field"], spot.vertices[:, 0])
+        # the window's surface shows the first field, and the others are the viewer's
+        np.testing.assert_allclose(window.scene.surface.point_data["field"], fields["x"])
+        window.viewer.show_field("y")
+        np.testing.assert_allclose(window.scene.surface.point_data["field"], fields["y"])
+        assert window.status_line.text().startswith("y: blue +, white 0, orange -")
     finally:
         window.close()
 

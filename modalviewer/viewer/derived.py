@@ -468,4 +468,16 @@ class DerivedValues:
                     legend=wording.legend(state, self),
                 )
             )
+        if d.kind == "field" and d.field in state.fields:
+            values = state.fields[d.field]
+            signed = float(values.min()) < 0.0 < float(values.max())
+            return self._ranged(
+                Field(
+                    values,
+                    "diverging" if signed else "sequential",
+                    isolines=state.style.isolines,
+                    title=d.field,
+                    legend=wording.legend(state, self),
+                )
+            )
         return plain

@@ -53,7 +53,7 @@ from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distanc
 from ..core.spectrum import Spectrum
 from .derived import DerivedValues
 
-DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature")
+DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature", "field")
 DISTANCE_DISPLAYS = ("continuous", "threshold")
 DEFAULT_THRESHOLD_SHARE = 0.1
 """Share of the surface a first threshold map marks similar (the paper's maps mark a few
@@ -148,6 +148,8 @@ class Display:
         of keeping the fraction; see :meth:`ViewerState._match_threshold`.
     signature_sample : index of the scale a signature is shown at (0..99).
     signature_time : a scale t typed for the signature, or None: the sample's scale.
+    field : the name of the per-vertex field shown with kind "field" (one of
+        :attr:`ViewerState.fields`: values a script gave).
     """
 
     kind: str = "none"
@@ -160,10 +162,11 @@ class Display:
     keep_share: bool = True
     signature_sample: int = 50
     signature_time: float | None = None
+    field: str | None = None
 
     def blank(self) -> Display:
         """This display as a newly loaded mesh shows it: nothing, other choices kept."""
-        return replace(self, kind="none", operator=None, mode=0)
+        return replace(self, kind="none", operator=None, mode=0, field=None)
 
 
 def _scale(t) -> float | None:
@@ -238,6 +241,7 @@ class ViewerState:
         self.mesh_repairs: list[str] = []  # repairs applied after loading, in order
         self.compute_settings = ComputeSettings()
         self.spectra: dict[SpectrumKey, Spectrum] = {}
+        self.fields: dict[str, np.ndarray] = {}  # per-vertex values a script gave
         self._latest: dict[str, SpectrumKey] = {}
         self.computing: set[SpectrumKey] = set()  # spectra being computed or queued
         self.display = Display()
@@ -271,6 +275,7 @@ class ViewerState:
         self.mesh_repairs = list(repairs or [])
         self.mesh_path = Path(path) if path is not None else None
         self.spectra.clear()
+        self.fields.clear()
         self._latest.clear()
         self.computing.clear()
         if mesh is not None:
@@ -492,6 +497,8 @@ class ViewerState:
             raise ValueError(f"distance kind must be one of {tuple(DISTANCE_KINDS)}")
         if new.distance_display not in DISTANCE_DISPLAYS:
             raise ValueError(f"distance display must be one of {DISTANCE_DISPLAYS}")
+        if new.kind == "field" and new.field not in self.fields:
+            raise ValueError(f"no field {new.field!r}; add it with add_field(name, values)")
         if new.kind == "mode":
             spec = self.spectrum(new.operator)
             if spec is None:
@@ -515,6 +522,27 @@ class ViewerState:
             self.animation = replace(self.animation, playing=False)
             self.events.animation.emit()
         self.events.display.emit()
+
+    def add_field(self, name: str, values) -> None:
+        """Keep the per-vertex ``values`` ((n,), finite) as the field ``name``, shown with
+        ``set_display(kind="field", field=name)``; a field of that name is replaced (and
+        redrawn if it is on screen).  The fields belong to the mesh: a new mesh drops them."""
+        if self.mesh is None:
+            raise ValueError("no mesh is loaded")
+        name = str(name)
+        if not name:
+            raise ValueError("a field needs a name")
+        values = np.array(values, dtype=np.float64)
+        if values.shape != (self.mesh.n_vertices,):
+            raise ValueError(
+                f"field {name!r} has shape {values.shape}; the mesh has "
+                f"{self.mesh.n_vertices} vertices: give one value per vertex"
+            )
+        if not np.all(np.isfinite(values)):
+            raise ValueError(f"field {name!r} has values that are not finite")
+        self.fields[name] = values
+        if self.display.kind == "field" and self.display.field == name:
+            self.events.display.emit()
 
     def show_mode(self, index: int, operator: str | None = None) -> None:
         op = operator or self.display.operator or self._first_computed()

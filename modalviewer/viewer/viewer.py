@@ -614,6 +614,15 @@ class Viewer:
             signature_time=t,
         )
 
+    def show_field(self, name: str, values=None) -> None:
+        """Colour the surface by a per-vertex field of your own: ``values`` ((n,), one
+        per vertex of the loaded mesh) kept as the field ``name`` (see
+        :meth:`~.state.ViewerState.add_field`), or, without ``values``, a field given
+        before.  Signed values get the modes' colours, others white to red."""
+        if values is not None:
+            self.state.add_field(name, values)
+        self.state.set_display(kind="field", field=str(name))
+
     def show_curvature(self) -> None:
         """Colour by the total curvature."""
         if self.state.mesh is not None:

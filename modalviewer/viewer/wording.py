@@ -123,6 +123,11 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         return f"{text}\n{note}" if note else text
     if d.kind == "curvature":
         return "Curvature sqrt(k1^2 + k2^2), white 0 to red"
+    if d.kind == "field" and d.field in state.fields:
+        values = state.fields[d.field]
+        signed = float(values.min()) < 0.0 < float(values.max())
+        colours = "blue +, white 0, orange -" if signed else "white to red"
+        return f"{d.field}: {colours}"
     return ""
 
 

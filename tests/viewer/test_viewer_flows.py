@@ -204,3 +204,27 @@ def test_a_shape_pair_without_a_window(viewer, tmp_path):
     assert abs(b.vertices[match, 2]) == pytest.approx(abs(b.vertices[5, 2]), abs=0.05)
     pair.set_linked(False)
     assert not pair.linked
+
+
+def test_a_field_of_your_own(viewer, spot_path):
+    """Values a script gives are a display of the state: shown, named in the legend,
+    exported, replaced, and dropped with the mesh."""
+    viewer.open_mesh(spot_path)
+    height = viewer.mesh.vertices[:, 1].copy()
+    viewer.show_field("height", height)
+    assert viewer.state.display.kind == "field"
+    name, values = viewer.current_field()
+    assert name == "height"
+    np.testing.assert_array_equal(values, height)
+    assert wording.legend(viewer.state).startswith("height: blue +, white 0, orange -")
+    counts = _colours(viewer.image(size=(400, 300)))
+    assert counts["blue"] > 500 and counts["orange"] > 500, counts
+    viewer.state.add_field("height", height - height.min())  # replaced, redrawn
+    assert viewer.current_field()[1].min() == 0.0
+    assert "white to red" in wording.legend(viewer.state)
+    with pytest.raises(ValueError, match="one value per vertex"):
+        viewer.show_field("bad", height[:-1])
+    with pytest.raises(ValueError, match="no field"):
+        viewer.show_field("missing")
+    viewer.open_mesh(spot_path)
+    assert viewer.state.fields == {} and viewer.state.display.kind == "none"
