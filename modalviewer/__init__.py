@@ -28,7 +28,7 @@ from .core import __all__ as _core_all  # noqa: E402
 from .data import asset_path  # noqa: E402
 from .interop import as_mesh, operator_matrices, to_pyvista  # noqa: E402
 from .io import load_mesh  # noqa: E402
-from .plotting import Picture, add_to_plotter, plot, view  # noqa: E402
+from .plotting import InteractivePicture, Picture, add_to_plotter, plot, view  # noqa: E402
 from .repair import SliverReport, fix_slivers  # noqa: E402
 
 __version__ = "0.1.0"
@@ -43,6 +43,7 @@ __all__ = [  # noqa: F405
     "view",
     "add_to_plotter",
     "Picture",
+    "InteractivePicture",
     "fix_slivers",
     "SliverReport",
     "Viewer",

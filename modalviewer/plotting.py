@@ -17,7 +17,7 @@ import numpy as np
 from .core.spectrum import Spectrum
 from .interop import as_mesh
 
-__all__ = ["Picture", "plot", "view", "add_to_plotter"]
+__all__ = ["Picture", "InteractivePicture", "plot", "view", "add_to_plotter"]
 
 DEFAULT_PLOT_SIZE = (800, 600)
 
@@ -50,6 +50,53 @@ class Picture:
 
     def __repr__(self) -> str:
         return f"Picture({self.array.shape[1]}x{self.array.shape[0]})"
+
+
+class InteractivePicture:
+    """The viewer's 3D scene as a standalone web page (vtk.js: turn, zoom and pan in the
+    browser, no kernel or server needed), shown inline by Jupyter (``_repr_html_``, in an
+    iframe) and in docs built from executed notebooks; :meth:`save` writes the page.
+    ``legend``: the picture's legend (lines), written above the view."""
+
+    def __init__(self, html: str, legend: str = "", size=DEFAULT_PLOT_SIZE):
+        self.html = html
+        self.legend = legend
+        self.size = (int(size[0]), int(size[1]))
+
+    def _repr_html_(self) -> str:
+        import html as html_module
+
+        page = html_module.escape(self.html, quote=True)
+        legend = html_module.escape(self.legend).replace("\n", "<br>")
+        w, h = self.size
+        return (
+            f'<div style="font-family:sans-serif;font-size:13px">{legend}</div>'
+            f'<iframe srcdoc="{page}" width="{w}" height="{h}" '
+            'style="border:none" sandbox="allow-scripts"></iframe>'
+        )
+
+    def save(self, path) -> Path:
+        """Write the page to ``path`` (.html), atomically; returns the path."""
+        from .core.files import atomic_write
+
+        path = Path(path)
+        if path.suffix.lower() not in (".html", ".htm"):
+            path = path.with_suffix(".html")
+        return atomic_write(path, lambda tmp: Path(tmp).write_text(self.html, encoding="utf-8"))
+
+    def __repr__(self) -> str:
+        return f"InteractivePicture({len(self.html) / 2**20:.1f} MB page)"
+
+
+NOTEBOOK_EXTRA = "pip install 'modalviewer[notebook]'"
+"""The command installing what :func:`plot` needs for ``interactive=True``."""
+
+
+def interactive_available() -> bool:
+    """Whether the page export (trame-pyvista and trame-vtk) is installed."""
+    import importlib.util
+
+    return all(importlib.util.find_spec(m) is not None for m in ("trame_pyvista", "trame_vtk"))
 
 
 def _field_of(field, n: int):
@@ -104,8 +151,12 @@ def plot(
     size=DEFAULT_PLOT_SIZE,
     k: int = 50,
     transparent: bool = False,
-) -> Picture:
-    """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`.
+    interactive: bool = False,
+) -> Picture | InteractivePicture:
+    """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`; with
+    ``interactive``, the same scene as an :class:`InteractivePicture` to turn in the
+    notebook (it needs the ``notebook`` extra; without it a :class:`Picture`, with a
+    warning saying how to install it).
 
     Parameters
     ----------
@@ -118,8 +169,9 @@ def plot(
     vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
         ``vertex`` (the input's vertex number); a spectrum of the kind's operator is used
         if given, otherwise ``k`` modes are computed (cached on disk as in the viewer).
-    screenshot : also write the PNG there.
+    screenshot : also write the PNG there (the page, .html, for an interactive one).
     size : (width, height) in pixels.
+    interactive : a page with the 3D scene instead of an image.
     """
     if isinstance(mesh, (str, Path)):
         from .io import load_mesh
@@ -131,12 +183,40 @@ def plot(
         if field is not None:
             name, values = _field_of(field, mesh.n_vertices)
             viewer.show_field(name, values)
-        picture = Picture(viewer.image(transparent=transparent, size=size))
+        if interactive and not interactive_available():
+            import warnings
+
+            warnings.warn(
+                f"an interactive picture needs trame-pyvista and trame-vtk: {NOTEBOOK_EXTRA}; "
+                "showing an image instead",
+                stacklevel=2,
+            )
+            interactive = False
+        if interactive:
+            picture = _interactive(viewer, size)
+        else:
+            picture = Picture(viewer.image(transparent=transparent, size=size))
     finally:
         viewer.close()
     if screenshot is not None:
         picture.save(screenshot)
     return picture
+
+
+def _interactive(viewer, size) -> InteractivePicture:
+    """The off-screen renderer's scene (surface, isolines, marker; the same actors an
+    image is made of) exported as a standalone vtk.js page."""
+    import tempfile
+
+    renderer = viewer.renderer(size)
+    renderer.plotter.render()
+    with tempfile.TemporaryDirectory(prefix="modalviewer-page-") as folder:
+        out = Path(folder) / "scene.html"
+        renderer.plotter.trame.export_html(str(out))
+        html = out.read_text(encoding="utf-8")
+    field = viewer.state.derived.field()
+    legend = field.legend if field is not None else ""
+    return InteractivePicture(html, legend, size)
 
 
 def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: bool = True):

@@ -204,3 +204,50 @@ print("ok")
     )
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip().endswith("ok")
+
+
+def test_an_interactive_plot_is_the_same_scene_as_a_page(spot, tmp_path):
+    """plot(interactive=True): the viewer's scene exported as a standalone vtk.js page,
+    shown by Jupyter in an iframe; the page holds the surface's points and the mode's
+    values, and the legend is written above it."""
+    import base64
+    import json
+    import re
+    import zipfile
+    from io import BytesIO
+
+    spec = mv.compute_spectrum(spot, "laplacian", k=8)
+    page = mv.plot(spot, spec, mode=3, interactive=True, size=(500, 400))
+    assert isinstance(page, mv.InteractivePicture)
+    html = page._repr_html_()
+    assert "<iframe" in html and 'width="500"' in html and "mode 3" in html
+    out = page.save(tmp_path / "mode3")
+    assert out.suffix == ".html" and out.stat().st_size > 100_000
+    # the exported scene: a base64 zip whose index holds vtk.js arrays (base64 of their
+    # bytes); the surface's points and the mode's values are among them
+    arrays = []
+    for blob in re.findall(r"[A-Za-z0-9+/=]{10000,}", page.html):
+        try:
+            with zipfile.ZipFile(BytesIO(base64.b64decode(blob))) as z:
+                index = json.loads(z.read("index.json"))
+        except (zipfile.BadZipFile, ValueError, KeyError):
+            continue
+        for entry in index.get("hashes", {}).values():
+            if entry.get("type") == "Float64Array":
+                arrays.append(np.frombuffer(base64.b64decode(entry["content"]), np.float64))
+            elif entry.get("type") == "Float32Array":
+                arrays.append(np.frombuffer(base64.b64decode(entry["content"]), np.float32))
+    n = spot.n_vertices
+    points = [a for a in arrays if a.size == 3 * n]
+    assert any(np.allclose(a.reshape(n, 3), spot.vertices) for a in points)
+    values = [a for a in arrays if a.size == n]
+    assert any(np.allclose(a, spec.mode(3), atol=1e-6) for a in values)
+
+
+def test_an_interactive_plot_without_the_extra_is_an_image_with_a_warning(spot, monkeypatch):
+    from modalviewer import plotting
+
+    monkeypatch.setattr(plotting, "interactive_available", lambda: False)
+    with pytest.warns(UserWarning, match=r"modalviewer\[notebook\]"):
+        picture = mv.plot(spot, field=spot.vertices[:, 1], interactive=True, size=(200, 150))
+    assert isinstance(picture, mv.Picture) and picture.shape[:2] == (150, 200)
