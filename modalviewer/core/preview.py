@@ -462,6 +462,12 @@ ROW_CHUNK = 16384
 in place chunk by chunk, so no second (N, c) array is alive at once."""
 
 
+SOLVE_COLUMNS = 32
+"""Right-hand sides per solve of the refinement: the solver copies its right-hand sides
+and solutions (Fortran order), so a block of this many columns keeps those copies
+small beside the (N, c) arrays."""
+
+
 def _rows(n: int):
     return (slice(i, min(i + ROW_CHUNK, n)) for i in range(0, n, ROW_CHUNK))
 
@@ -492,7 +498,10 @@ def _subspace_step(
 
     c = U.shape[1] if keep is None else int(keep)
     n = U.shape[0]
-    Y = solver.solve(mass[:, None] * U)
+    Y = np.empty((n, U.shape[1]))
+    for j in range(0, U.shape[1], SOLVE_COLUMNS):  # the solver's copies stay small
+        cols = slice(j, min(j + SOLVE_COLUMNS, U.shape[1]))
+        Y[:, cols] = solver.solve(mass[:, None] * U[:, cols])
     # unit Mass norm first: a zero mode's column is 1/|shift| times larger than the rest
     Y /= np.sqrt(np.einsum("ij,ij,i->j", Y, Y, mass))
     UtMY = np.zeros((U.shape[1], Y.shape[1]))
@@ -656,14 +665,13 @@ def preview_spectrum(
     if refine and est.max(initial=0.0) > REFINE_ABOVE:
         t = time.perf_counter()
         report("preview: refining (factorising)", 0.92)
+        del KU, basis, Kr, Mr  # not needed while refining; K U is made again after
         solver = _factor_below(K, mass, lam, lam_scale)
         if solver is None:  # keep the preview as it is
             refinement["failed"] = "the operator could not be factorised below its spectrum"
         c, lam_b = lam.shape[0], lam
         # guard vectors: the last wanted pairs converge at the rate lam_c / lam_(c+guard)
         block = max(c, min(c + max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)), K.shape[0] // 2))
-        if solver is not None:
-            del KU, basis, Kr, Mr  # not needed while refining; K U is made again after
         while solver is not None and refinement["steps"] < REFINE_STEPS:
             report("preview: refining", 0.94 + 0.02 * refinement["steps"])
             lam_b, U = _subspace_step(K, mass, solver, lam_b, U, keep=block)
