@@ -1,0 +1,93 @@
+"""Preview against exact spectra on a curved mesh with thin parts (spot Loop-subdivided):
+time, peak memory and the preview's eigenvalue errors, each run in its own process.
+
+    python -m benchmarks.curved --levels 2 3 --operators laplacian shells -k 100
+
+Writes ``benchmarks/results/curved.json``.  Each (level, operator, accuracy) runs in a
+fresh Python process so its peak resident memory is its own; the exact run comes first
+and the preview's lowest 50 non-zero eigenvalues are compared with it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.run import save_result  # noqa: E402
+
+CHILD = """
+import json, resource, sys, time
+import numpy as np, trimesh
+import modalviewer as mv
+level, operator, accuracy, k = int(sys.argv[1]), sys.argv[2], sys.argv[3], int(sys.argv[4])
+spot = mv.load_mesh(mv.asset_path("spot.obj"))
+v, f = trimesh.remesh.subdivide_loop(spot.vertices, spot.faces, iterations=level)
+mesh = mv.Mesh(v, f)
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+t = time.perf_counter()
+spec = mv.compute_spectrum(mesh, operator, k, accuracy=accuracy)
+seconds = time.perf_counter() - t
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+nonzero = spec.eigenvalues[~spec.zero_mode_mask()]
+print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds, "peak_mb": peak,
+                  "mesh_mb": before, "eigenvalues": [float(x) for x in nonzero],
+                  "estimated_error": float(spec.estimated_error) if spec.is_preview else 0.0,
+                  "refinement_steps": int(spec.parameters.get("preview", {})
+                                          .get("refinement", {}).get("steps", 0))}))
+"""
+
+
+def run(level: int, operator: str, accuracy: str, k: int) -> dict:
+    out = subprocess.run(
+        [sys.executable, "-c", CHILD, str(level), operator, accuracy, str(k)],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=ROOT,
+    )
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--levels", type=int, nargs="+", default=[2, 3])
+    p.add_argument("--operators", nargs="+", default=["laplacian", "shells"])
+    p.add_argument("-k", type=int, default=100)
+    args = p.parse_args(argv)
+    rows = []
+    for level in args.levels:
+        for operator in args.operators:
+            exact = run(level, operator, "exact", args.k)
+            preview = run(level, operator, "preview", args.k)
+            m = min(50, len(exact["eigenvalues"]), len(preview["eigenvalues"]))
+            lam = exact["eigenvalues"][:m]
+            errors = [abs(a - b) / b for a, b in zip(preview["eigenvalues"][:m], lam, strict=True)]
+            row = {
+                "mesh": f"spot Loop x{level}",
+                "vertices": exact["vertices"],
+                "operator": operator,
+                "k": args.k,
+                "exact_seconds": round(exact["seconds"], 2),
+                "preview_seconds": round(preview["seconds"], 2),
+                "time_ratio": round(preview["seconds"] / exact["seconds"], 3),
+                "exact_peak_mb": round(exact["peak_mb"]),
+                "preview_peak_mb": round(preview["peak_mb"]),
+                "memory_ratio": round(preview["peak_mb"] / exact["peak_mb"], 3),
+                "largest_error_lowest_50": round(max(errors), 5),
+                "estimated_error": round(preview["estimated_error"], 5),
+                "refinement_steps": preview["refinement_steps"],
+            }
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    save_result("curved", {"rows": rows})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
