@@ -167,6 +167,23 @@ def slivers_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def curved_table(data: dict) -> str:
+    """``benchmarks.curved``: preview against exact on a curved mesh with thin parts."""
+    lines = [
+        "| mesh | vertices | operator | exact s | preview s | / exact | exact MB | preview MB "
+        "| / exact | eig. error max (lowest 50) | refinement steps |",
+        "|" + " --- |" * 11,
+    ]
+    for r in data["rows"]:
+        lines.append(
+            f"| {r['mesh']} | {r['vertices']} | {r['operator']} | {r['exact_seconds']:.1f} "
+            f"| {r['preview_seconds']:.1f} | {r['time_ratio']:.2f} | {r['exact_peak_mb']} "
+            f"| {r['preview_peak_mb']} | {r['memory_ratio']:.2f} "
+            f"| {100 * r['largest_error_lowest_50']:.2g} % | {r['refinement_steps']} |"
+        )
+    return "\n".join(lines)
+
+
 #: Every generated table: its name in the page's markers -> (JSON files, the table).
 TABLES = {
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),
@@ -188,6 +205,7 @@ TABLES = {
         ),
     ),
     "slivers": (["slivers"], lambda: slivers_table(load("slivers"))),
+    "curved": (["curved"], lambda: curved_table(load("curved"))),
 }
 
 
