@@ -79,6 +79,7 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
         },
         "animation": {"amplitude": state.animation.amplitude, "speed": state.animation.speed},
         "camera": state.camera,
+        "up_axis": state.up_axis,  # None: the detected one
     }
 
 
@@ -166,6 +167,10 @@ def restore_session(model, path) -> Restored:
     state.set_compute_settings(**asdict(settings))
     if data.get("t_range"):
         state.set_scale_range(tuple(data["t_range"]))
+    try:
+        state.set_up_axis(data.get("up_axis"))
+    except ValueError as exc:
+        out.notes.append(f"the up axis: {exc}")
     picked = data.get("picked")
     if picked is not None and int(data.get("version", 1)) >= 2:
         try:  # the file's vertex number

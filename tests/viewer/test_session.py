@@ -97,3 +97,25 @@ def test_session_files_get_the_umask_permissions(tmp_path):
         os.umask(old)
     assert (path.stat().st_mode & 0o777) == 0o644
     assert not list(tmp_path.glob(".perm.json.*"))  # no temporary file left
+
+
+def test_a_session_keeps_the_chosen_up_axis(tmp_path):
+    mesh_path = tmp_path / "spot.obj"
+    shutil.copy(ASSETS / "spot.obj", mesh_path)
+    first = _model(tmp_path)
+    first.open_mesh(mesh_path)
+    first.state.set_up_axis("+z")
+    path = save_session(first.state, tmp_path / "up.json")
+    assert json.loads(path.read_text())["up_axis"] == "+z"
+    second = _model(tmp_path)
+    restored = restore_session(second, path)
+    assert restored.notes == [] and second.state.up_axis == "+z"
+    # an automatic axis stays automatic; a damaged value is a note, not a failure
+    first.state.set_up_axis(None)
+    data = json.loads(save_session(first.state, tmp_path / "auto.json").read_text())
+    assert data["up_axis"] is None
+    data["up_axis"] = "sideways"
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    third = _model(tmp_path)
+    restored = restore_session(third, tmp_path / "bad.json")
+    assert third.state.up_axis is None and any("up axis" in n for n in restored.notes)
