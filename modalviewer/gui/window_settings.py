@@ -10,7 +10,7 @@ from pathlib import Path
 from qtpy import QtCore, QtGui
 
 from ..core.operators import OPERATOR_INFO
-from ..viewer.state import RENDER_STYLES, SHELL_COLORINGS
+from ..viewer.state import COLOR_RANGES, RENDER_STYLES, SHELL_COLORINGS
 
 
 def settings() -> QtCore.QSettings:
@@ -52,6 +52,8 @@ def restore(win) -> None:
     style = str(s.value("view/style", "paper"))
     st.set_render_style(style if style in RENDER_STYLES else "paper")
     st.set_colorbar(_flag(s, "view/colorbar", True))
+    _restore_color_range(st, s)
+    st.set_log_signature(_flag(s, "view/log_signature", False))
     st.set_animation(
         # the largest displacement of the deformed shape and of the animation
         amplitude=int(s.value("view/mode_amplitude", 40)),
@@ -69,6 +71,23 @@ def restore(win) -> None:
     rebuild_recent(win)
 
 
+def _restore_color_range(st, s) -> None:
+    """The colour range rule and typed limits as saved; a damaged entry gives the default
+    (the automatic range), never an error at start-up."""
+    rule = str(s.value("view/color_range", "auto"))
+    try:
+        low, high = (float(x) for x in str(s.value("view/color_limits", "")).split())
+        limits = (low, high)
+    except ValueError:
+        limits = None
+    if rule not in COLOR_RANGES or (rule == "limits" and limits is None):
+        rule = "auto"
+    try:
+        st.set_color_range(rule, limits)
+    except ValueError:
+        st.set_color_range("auto")
+
+
 def save(win) -> None:
     """Remember window layout, view and compute preferences (desktop runs only)."""
     if not win.remember_settings:
@@ -83,6 +102,10 @@ def save(win) -> None:
     s.setValue("view/style", st.style.render)
     s.setValue("view/colorbar", _flag_text(st.style.colorbar))
     s.setValue("view/ghost", _flag_text(st.style.ghost))
+    s.setValue("view/color_range", st.style.color_range)
+    limits = st.style.color_limits
+    s.setValue("view/color_limits", "" if limits is None else f"{limits[0]!r} {limits[1]!r}")
+    s.setValue("view/log_signature", _flag_text(st.style.log_signature))
     c = st.compute_settings
     s.setValue("compute/operator", c.operator)
     s.setValue("compute/bending", c.bending)

@@ -434,6 +434,8 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
 
     window.state.set_compute_settings(coarse=True, preview=False, operator="laplacian")
     window.state.set_colorbar(False)
+    window.state.set_color_range("limits", (-0.5, 2.0))
+    window.state.set_log_signature(True)
     window.remember_settings = True  # as on a desktop
     window_settings.save(window)
     again = MainWindow()
@@ -441,6 +443,9 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     c = again.state.compute_settings
     assert c.coarse is True and c.preview is False and c.operator == "laplacian"
     assert again.state.style.colorbar is False
+    assert again.state.style.color_range == "limits"
+    assert again.state.style.color_limits == (-0.5, 2.0)
+    assert again.state.style.log_signature is True
     assert not again.colorbar_action.isChecked()
     assert again.compute_panel.coarse_check.isChecked()
     assert not again.compute_panel.preview_check.isChecked()
