@@ -355,21 +355,14 @@ def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
     what would fit where it would need more than its share of this machine's memory."""
     if preview:
         return
-    from .viewer.model import MEMORY_SHARE, cost_estimate, physical_memory, what_fits
+    from .viewer.model import memory_refusal
     from .viewer.state import ComputeSettings
 
-    key = ComputeSettings().key(operator, k)
-    seconds, needed = cost_estimate(key, mesh.n_vertices)
-    available = physical_memory()
-    if available and needed > MEMORY_SHARE * available:
-        fits = what_fits(key, mesh.n_vertices, available).replace(
-            "with Coarse-to-fine (a decimated copy)", "on a decimated copy of the mesh"
-        )
-        raise ValueError(
-            f"{operator} with {k} modes on {mesh.n_vertices} vertices needs about "
-            f"{needed / 2**30:.1f} GiB of memory; this machine has "
-            f"{available / 2**30:.1f} GiB. {fits}"
-        )
+    refusal = memory_refusal(
+        ComputeSettings().key(operator, k), mesh.n_vertices, coarse="on a decimated copy"
+    )
+    if refusal:
+        raise ValueError(refusal)
 
 
 class _Unavailable(Exception):

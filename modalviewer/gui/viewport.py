@@ -15,7 +15,7 @@ import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtGui, QtWidgets
 
-from ..scene.mesh_scene import view_angle_on_smaller_side
+from ..scene.mesh_scene import fit_smaller_side
 
 CLICK_SLOP = 4  # pixels a press may move and still count as a click
 
@@ -26,12 +26,6 @@ def qt_opengl_available() -> bool:
         return False
     ctx = QtGui.QOpenGLContext()
     return bool(ctx.create())
-
-
-def fit_smaller_side(renderer) -> None:
-    """Before every render, let the camera's view angle apply to the smaller side of the
-    view (:func:`.scene.view_angle_on_smaller_side`)."""
-    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))
 
 
 class _ClickMixin:

@@ -168,6 +168,13 @@ def view_angle_on_smaller_side(renderer) -> None:
         camera.SetUseHorizontalViewAngle(narrow)
 
 
+def fit_smaller_side(renderer) -> None:
+    """Before every render, let the camera's view angle apply to the smaller side of the
+    view (:func:`view_angle_on_smaller_side`): the window's views and the off-screen
+    plotter alike."""
+    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))
+
+
 class MeshScene:
     """Owns the actors of one mesh on a pyvista plotter."""
 

@@ -25,12 +25,11 @@ def offscreen_plotter(size=DEFAULT_SIZE):
     prepare_offscreen()
     import pyvista as pv
 
-    from .mesh_scene import view_angle_on_smaller_side
+    from .mesh_scene import fit_smaller_side
 
     plotter = pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])
     plotter.set_background("white")
-    renderer = plotter.renderer
-    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))
+    fit_smaller_side(plotter.renderer)
     return plotter
 
 

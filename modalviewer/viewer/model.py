@@ -85,22 +85,41 @@ def largest_k_that_fits(key: SpectrumKey, n_vertices: int, available: int) -> in
     return lo
 
 
-def what_fits(key: SpectrumKey, n_vertices: int, available: int) -> str:
-    """What would fit instead of ``key``: fewer modes, Coarse-to-fine, or neither."""
+COARSE_WORDS = "with Coarse-to-fine (a decimated copy)"
+"""How :func:`what_fits` names Coarse-to-fine (the viewer's option)."""
+
+
+def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = COARSE_WORDS) -> str:
+    """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``),
+    or neither."""
     k = largest_k_that_fits(key, n_vertices, available)
-    coarse = replace(key, coarse=True)
-    coarse_fits = not key.coarse and cost_estimate(coarse, n_vertices)[1] <= (
-        MEMORY_SHARE * available
-    )
+    coarse_needs = cost_estimate(replace(key, coarse=True), n_vertices)[1]
+    coarse_fits = not key.coarse and coarse_needs <= MEMORY_SHARE * available
     options = []
     if k >= 1:
         options.append(f"at most {k} modes fit")
     if coarse_fits:
-        options.append(f"{key.k} modes with Coarse-to-fine (a decimated copy) fit")
+        options.append(f"{key.k} modes {coarse} fit")
     if not options:
         return "Not even one mode fits: use a coarser mesh or a machine with more memory."
     text = "; ".join(options)
     return text[0].upper() + text[1:] + "."
+
+
+def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS) -> str | None:
+    """A message if computing ``key`` on ``n_vertices`` would need more than
+    :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
+    The viewer's refusals and ``modalviewer compute`` say the same."""
+    seconds, needed = cost_estimate(key, n_vertices)
+    available = physical_memory()
+    if available and needed > MEMORY_SHARE * available:
+        return (
+            f"{operator_info(key.operator).label} with {key.k} modes on "
+            f"{n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory "
+            f"and {seconds / 60:.0f} min; this machine has {available / 2**30:.1f} GiB. "
+            + what_fits(key, n_vertices, available, coarse)
+        )
+    return None
 
 
 class ViewerModel:
@@ -158,18 +177,8 @@ class ViewerModel:
 
     # ------------------------------------------------------------ spectra
     def refusal(self, key: SpectrumKey) -> str | None:
-        """A message if the computation would need more than 3/4 of this machine's memory."""
-        mesh = self.state.mesh
-        seconds, needed = cost_estimate(key, mesh.n_vertices)
-        available = physical_memory()
-        if available and needed > MEMORY_SHARE * available:
-            return (
-                f"{operator_info(key.operator).label} with {key.k} modes on "
-                f"{mesh.n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory "
-                f"and {seconds / 60:.0f} min; this machine has {available / 2**30:.1f} GiB. "
-                + what_fits(key, mesh.n_vertices, available)
-            )
-        return None
+        """:func:`memory_refusal` of ``key`` on the loaded mesh."""
+        return memory_refusal(key, self.state.mesh.n_vertices)
 
     def request_spectrum(
         self, operator: str | None = None, k: int | None = None, show: bool = False
