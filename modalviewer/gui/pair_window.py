@@ -28,10 +28,9 @@ from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
-from ..viewer.jobs import DONE
 from ..viewer.model import cost_estimate
 from ..viewer.pair import SIDES, PairView
-from ..viewer.viewer import LONG_WAIT_SECONDS
+from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from .dialogs import file_message, offer_open_anyway
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
@@ -500,13 +499,12 @@ class PairWindow(QtWidgets.QWidget):
     def wait(self, timeout: float | None = None) -> None:
         """Run the event loop until this window's spectra for the current kind are in;
         raises PairError if one could not be computed."""
-        for job in self.request():
-            self.main.wait_for(job)
-            if job.status != DONE:
-                raise PairError(self.pair.failure() or job.error or job.status)
+        self.request()  # the window's status says what is computed and for how long
+        try:
+            self.main.viewer.wait_for_pair(self.pair)
+        except ComputeError as exc:
+            raise PairError(str(exc)) from None
         QtWidgets.QApplication.processEvents()
-        if not self.pair.ready():
-            raise PairError(self.pair.failure() or "the spectra are not in")
 
     # ========================================================== results
     def distance_on_b(self) -> np.ndarray | None:
