@@ -309,7 +309,7 @@ def _run(args) -> int:
         _write_csv(args.csv, mesh, d, f"{args.kind} distance from vertex {args.vertex}")
     if args.output:
         viewer = _viewer(mesh, args.mesh)
-        viewer.state.add_spectrum(viewer.state.compute_settings.key(spec.operator, spec.k), spec)
+        viewer.add_spectrum(spec)
         viewer.state.set_display(distance_kind=args.kind)
         viewer.pick_vertex(vertex)
         if marked is None:

@@ -122,9 +122,7 @@ def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
     viewer = Viewer()
     viewer.set_mesh(mesh)
     if spectrum is not None:
-        viewer.state.add_spectrum(
-            viewer.state.compute_settings.key(spectrum.operator, spectrum.k), spectrum
-        )
+        viewer.add_spectrum(spectrum)
     if vertex is not None:
         needed = operator_for_distance(kind)
         if viewer.state.spectrum(needed) is None:
@@ -256,9 +254,7 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     window = MainWindow(viewer=viewer)
     viewer.set_mesh(mesh)
     if spectrum is not None:
-        viewer.state.add_spectrum(
-            viewer.state.compute_settings.key(spectrum.operator, spectrum.k), spectrum
-        )
+        viewer.add_spectrum(spectrum)
         viewer.show_mode(viewer.state.first_nonzero_mode(spectrum.operator), spectrum.operator)
     if fields:
         _field_of(fields, mesh.n_vertices)  # checked as plot checks them

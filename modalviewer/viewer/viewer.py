@@ -243,6 +243,13 @@ class Viewer:
         """The latest spectrum of each computed operator."""
         return {op: self.state.spectrum(op) for op in self.state.operators_computed()}
 
+    def add_spectrum(self, spectrum: Spectrum) -> None:
+        """Put a spectrum computed elsewhere (``modalviewer.compute_spectrum``, a file)
+        into the viewer, as the spectrum of its operator and k under the current compute
+        settings; it must belong to the loaded mesh."""
+        key = self.state.compute_settings.key(spectrum.operator, spectrum.k)
+        self.state.add_spectrum(key, spectrum)
+
     def compute(
         self, operator: str | None = None, k: int | None = None, wait: bool = True, then=None
     ) -> Spectrum | None:
