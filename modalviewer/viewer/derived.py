@@ -359,6 +359,15 @@ class DerivedValues:
             return None
         return self.state.display.threshold * float(d.max())
 
+    def map_fraction(self, d: np.ndarray) -> float:
+        """The fraction of the largest distance a threshold map of ``d`` uses: the
+        display's, or, with ``keep_share`` while the map is not drawn as a threshold map
+        (the state matches the fraction only then), the one marking the kept share."""
+        display = self.state.display
+        if display.keep_share and display.distance_display != "threshold":
+            return self.threshold_for_share(display.threshold_share, d)
+        return display.threshold
+
     def surface_share(self, d: np.ndarray, value: float) -> float:
         """The share (0..1) of the surface's area where ``d`` is at most ``value``."""
         areas = self.vertex_areas()

@@ -178,11 +178,7 @@ class DistancesPanel(QtWidgets.QWidget):
             select_data(self.display_combo, d.distance_display)
             self.scale_slider.setValue(d.signature_sample)
             dist = state.derived.distance_map()
-            # the fraction a threshold map of these distances uses: with keep_share, until
-            # the map is drawn as one, the fraction that marks the kept share
-            fraction = d.threshold
-            if dist is not None and d.keep_share and d.distance_display != "threshold":
-                fraction = state.derived.threshold_for_share(d.threshold_share, dist)
+            fraction = d.threshold if dist is None else state.derived.map_fraction(dist)
             if dist is not None and self.by_share_check.isChecked():
                 position = state.derived.surface_share(dist, fraction * float(dist.max()))
             else:
