@@ -20,6 +20,8 @@ __all__ = [
     "row_halves",
     "threaded_product",
     "threaded_transpose_product",
+    "threaded_projection",
+    "chunked_projection",
 ]
 
 
@@ -101,6 +103,34 @@ def threaded_transpose_product(P: sp.csr_matrix, Q):
     Q = np.asarray(Q)
     with ThreadPoolExecutor(2) as pool:
         return sum(pool.map(lambda part: np.asarray(part[1].T @ Q[part[0]]), halves))
+
+
+PROJECTION_ROWS = 1 << 15
+"""Rows of K per chunk of :func:`threaded_projection`."""
+
+
+def chunked_projection(K, P, chunk: int = PROJECTION_ROWS, part: int = 0, parts: int = 1):
+    """``P^T K P`` (sparse) as the sum over chunks R of K's rows of ``P[R]^T (K[R] P)``
+    (of every ``parts``-th chunk from the ``part``-th: a share of the sum, for threads).
+    The whole product ``K P`` (more entries than P itself: each row of K gathers its
+    neighbours' rows of P) is never alive at once, only a chunk of it, so the projection
+    needs little memory beside P and the result."""
+    K = sp.csr_matrix(K)
+    P = sp.csr_matrix(P)
+    N = K.shape[0]
+    total = sp.csr_matrix((P.shape[1], P.shape[1]))
+    for start in range(part * chunk, N, parts * chunk):
+        rows = slice(start, min(start + chunk, N))
+        total = total + (P[rows].T @ (K[rows] @ P)).tocsr()
+    return total.tocsr()
+
+
+def threaded_projection(K, P, chunk: int = PROJECTION_ROWS) -> sp.csr_matrix:
+    """:func:`chunked_projection` with the chunks shared by two threads."""
+    K, P = sp.csr_matrix(K), sp.csr_matrix(P)
+    with ThreadPoolExecutor(2) as pool:
+        a, b = pool.map(lambda i: chunked_projection(K, P, chunk, i, 2), (0, 1))
+    return (a + b).tocsr()
 
 
 def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice, np.ndarray]]:

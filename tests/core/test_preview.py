@@ -456,3 +456,25 @@ def test_the_two_level_step_drops_the_residuals_of_converged_pairs(plate, monkey
     assert np.all(new >= exact - 1e-9 * scale)
     np.testing.assert_allclose(X.T @ (mass[:, None] * X), np.eye(k), atol=1e-9)
     np.testing.assert_allclose(KX, K @ X, atol=1e-9 * np.abs(KX).max())
+
+
+def test_the_basis_is_built_as_csr_with_the_values_of_its_definition():
+    """The partition-of-unity basis, built directly in CSR (no COO triplets), holds at
+    each (vertex, centre) pair phi, phi u, phi v (and phi u^2, phi u v, phi v^2 for degree
+    2) with u, v the tangent coordinates over r, and its rows of phi sum to 1."""
+    mesh = mv.load_mesh(mv.asset_path("spot.obj"))
+    centers = np.random.default_rng(2).choice(mesh.n_vertices, 60, replace=False)
+    P0, r = rs.partition_of_unity_basis(mesh, centers, enrich=0)
+    P2, r2 = rs.partition_of_unity_basis(mesh, centers, enrich=2)
+    assert r == r2 and P2.shape == (mesh.n_vertices, 6 * 60) and P2.has_sorted_indices
+    np.testing.assert_allclose(np.asarray(P0.sum(axis=1)).ravel(), 1.0, atol=1e-12)
+    t1, t2 = rs._tangents(rs.vertex_normals(mesh)[centers])
+    coo = P0.tocoo()
+    x, c = mesh.vertices[coo.row], mesh.vertices[centers[coo.col]]
+    u = np.einsum("ij,ij->i", (x - c) / r, t1[coo.col])
+    v = np.einsum("ij,ij->i", (x - c) / r, t2[coo.col])
+    D = P2.tocsr()
+    for j, poly in enumerate([np.ones_like(u), u, v, u * u, u * v, v * v]):
+        got = np.asarray(D[coo.row, 6 * coo.col + j]).ravel()
+        np.testing.assert_allclose(got, coo.data * poly, rtol=1e-12, atol=1e-15)
+    assert D.nnz == 6 * P0.nnz

@@ -36,3 +36,21 @@ def test_threaded_product_writes_into_out(K):
     np.testing.assert_allclose(out32, K @ X, rtol=1e-4, atol=1e-4)
     with pytest.raises(ValueError, match="C-contiguous"):
         threaded_product(K, X, out=np.empty((5, 301)).T)
+
+
+@pytest.mark.parametrize("chunk", [7, 64, 1 << 15])
+def test_the_chunked_projection_is_p_transpose_k_p(chunk):
+    """Summed over row chunks (several per thread, one, or a single chunk for all) it
+    equals the product through the whole ``K P``."""
+    from modalviewer.core.products import chunked_projection, threaded_projection
+
+    K = sp.random(301, 301, density=0.03, random_state=5, format="csr")
+    K = (K + K.T).tocsr()
+    P = sp.random(301, 40, density=0.1, random_state=6, format="csr")
+    expected = (P.T @ K @ P).toarray()
+    for A in (chunked_projection(K, P, chunk), threaded_projection(K, P, chunk)):
+        assert sp.issparse(A) and A.shape == (40, 40)
+        np.testing.assert_allclose(A.toarray(), expected, rtol=1e-12, atol=1e-12)
+    half = chunked_projection(K, P, chunk, part=1, parts=2).toarray()
+    other = chunked_projection(K, P, chunk, part=0, parts=2).toarray()
+    np.testing.assert_allclose(half + other, expected, rtol=1e-12, atol=1e-12)
