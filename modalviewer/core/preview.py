@@ -45,7 +45,12 @@ from .factor import SPDSolver
 from .mesh import Mesh
 from .nullspace import null_space
 from .operators import OPERATOR_INFO, SpaceSettings, operator_info
-from .products import row_blocks, threaded_product, threaded_transpose_product
+from .products import (
+    chunked_projection,
+    row_blocks,
+    threaded_product,
+    threaded_projection,
+)
 from .reduced_space import (
     ReducedBasis,
     max_samples,
@@ -132,14 +137,14 @@ def _extend(A: sp.csr_matrix, K, basis: ReducedBasis, E: np.ndarray) -> sp.csr_m
 def _kron_projection(K: sp.csr_matrix, Ps: sp.csr_matrix) -> sp.csr_matrix:
     """``kron(Ps, I3)^T K kron(Ps, I3)`` for a symmetric (3n, 3n) K in vertex-major
     order: block (a, b) of every 3 x 3 entry is ``Ps^T K_ab Ps`` with ``K_ab = K[a::3,
-    b::3]``; the six with a <= b are computed (two threads), the others are their
-    transposes: a third fewer multiply-adds than through the 3n rows."""
-    PsT = Ps.T.tocsr()
+    b::3]``; the six with a <= b are computed (two threads, each by row chunks:
+    :func:`.products.chunked_projection`), the others are their transposes: a third
+    fewer multiply-adds than through the 3n rows."""
     pairs = [(a, b) for a in range(3) for b in range(a, 3)]
 
     def block(ab: tuple[int, int]) -> sp.coo_matrix:
         a, b = ab
-        return (PsT @ (K[a::3][:, b::3].tocsr() @ Ps)).tocoo()
+        return chunked_projection(K[a::3][:, b::3], Ps).tocoo()
 
     with ThreadPoolExecutor(2) as pool:
         blocks = list(pool.map(block, pairs))
@@ -176,7 +181,7 @@ def _project(K, basis: ReducedBasis) -> sp.csr_matrix:
     if basis.components == 3:
         A = _kron_projection(K, basis.scalar)
     else:
-        A = threaded_transpose_product(basis.scalar, threaded_product(K, basis.scalar))
+        A = threaded_projection(K, basis.scalar)
     return _with_dense_columns(A, K, basis)
 
 
@@ -184,7 +189,7 @@ def _project_mass(mass: np.ndarray, basis: ReducedBasis) -> sp.csr_matrix:
     """``P^T diag(mass) P``.  With three components the mass repeats each vertex's value
     three times, so the sparse part is ``kron(Ps^T diag(m) Ps, I3)``."""
     Ps, c = basis.scalar, basis.components
-    A = threaded_transpose_product(Ps, Ps.multiply(mass[::c, None]).tocsr())
+    A = threaded_projection(sp.diags(mass[::c]).tocsr(), Ps)
     if c > 1:
         A = sp.kron(A, sp.eye(c), format="csr")
     return _with_dense_columns(A, sp.diags(mass), basis)
@@ -656,6 +661,7 @@ def preview_spectrum(
         report("preview: smoothing", 0.8)
         lam, U, KU = _two_level_step(K, mass, basis, Kr, Mr, lam, U, KU, precondition)
         seconds["smoothing"] = time.perf_counter() - t
+    del basis, Kr, Mr  # the reduced space is done with: its memory for what follows
     t = time.perf_counter()
     report("preview: estimating errors", 0.9)
     res, eta = _residual_norms(KU, mass, lam, U, lam_scale, precondition)
@@ -665,7 +671,7 @@ def preview_spectrum(
     if refine and est.max(initial=0.0) > REFINE_ABOVE:
         t = time.perf_counter()
         report("preview: refining (factorising)", 0.92)
-        del KU, basis, Kr, Mr  # not needed while refining; K U is made again after
+        del KU  # not needed while refining; K U is made again after
         solver = _factor_below(K, mass, lam, lam_scale)
         if solver is None:  # keep the preview as it is
             refinement["failed"] = "the operator could not be factorised below its spectrum"
@@ -715,13 +721,15 @@ def compute_preview(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     samples: int | None = None,
+    refine: bool | None = None,
 ) -> Spectrum:
     """``compute_spectrum(..., accuracy="preview")``: a :class:`Spectrum` whose
     ``parameters["preview"]`` holds the reduced space, timings and estimated errors
     (``spec.is_preview``, ``spec.estimated_error``).
 
     For meshes where :func:`preview_possible` holds; ``compute_spectrum`` computes the
-    exact spectrum of the others."""
+    exact spectrum of the others.  ``refine``: as in :func:`preview_spectrum` (False:
+    ``accuracy="fast preview"``)."""
     per_vertex = operator_info(operator).unknowns_per_vertex
     started = time.perf_counter()
     if cancel is not None and cancel():
@@ -732,7 +740,15 @@ def compute_preview(
     assembled = time.perf_counter()
     k = min(int(k), K.shape[0])
     lam, U, res, info = preview_spectrum(
-        mesh, operator, K, mass, k, samples=samples, progress=progress, cancel=cancel
+        mesh,
+        operator,
+        K,
+        mass,
+        k,
+        samples=samples,
+        progress=progress,
+        cancel=cancel,
+        refine=refine,
     )
     n = mesh.n_vertices
     modes = np.ascontiguousarray(U)

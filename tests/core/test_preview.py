@@ -478,3 +478,24 @@ def test_the_basis_is_built_as_csr_with_the_values_of_its_definition():
         got = np.asarray(D[coo.row, 6 * coo.col + j]).ravel()
         np.testing.assert_allclose(got, coo.data * poly, rtol=1e-12, atol=1e-15)
     assert D.nnz == 6 * P0.nnz
+
+
+def test_a_fast_preview_is_never_refined_and_says_how_far_off_it_may_be():
+    """accuracy="fast preview" is the reduced space (and the shells' two-level step)
+    alone: on the curved spot, where "preview" refines (estimate above 2 %), it keeps the
+    unrefined modes, Mass-orthonormal, with their estimate; other values are refused."""
+    mesh = mv.load_mesh(mv.asset_path("spot.obj"))
+    fast = mv.compute_spectrum(mesh, "shells", 12, accuracy="fast preview")
+    refined = mv.compute_spectrum(mesh, "shells", 12, accuracy="preview")
+    assert fast.is_preview and refined.is_preview
+    assert fast.parameters["preview"]["refinement"]["steps"] == 0
+    assert refined.parameters["preview"]["refinement"]["steps"] == 2
+    assert fast.estimated_error > pv.REFINE_ABOVE > refined.estimated_error
+    U = fast.modes.reshape(-1, 12)
+    mass = np.repeat(fast.mass, 3)
+    np.testing.assert_allclose(U.T @ (mass[:, None] * U), np.eye(12), atol=1e-9)
+    nonzero = ~fast.zero_mode_mask()
+    # Galerkin: the unrefined values lie above the refined ones
+    assert np.all(fast.eigenvalues[nonzero] >= refined.eigenvalues[nonzero] * (1 - 1e-9))
+    with pytest.raises(ValueError, match="'exact', 'preview', 'fast preview'"):
+        mv.compute_spectrum(mesh, "shells", 12, accuracy="rough")
