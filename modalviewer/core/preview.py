@@ -47,6 +47,7 @@ from .nullspace import null_space
 from .operators import OPERATOR_INFO, SpaceSettings, operator_info
 from .products import (
     chunked_projection,
+    row_block_sums,
     row_blocks,
     threaded_product,
     threaded_projection,
@@ -304,7 +305,7 @@ def _jacobi_blocks(K: sp.csr_matrix, block: int):
     return apply
 
 
-def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, precondition):
+def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, precondition):
     """Rayleigh-Ritz in ``span [P, W]``: the reduced space together with the
     block-Jacobi preconditioned residuals W of the Galerkin modes U.
 
@@ -316,32 +317,36 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
     contains P, so every Ritz value is at most the Galerkin one and still an upper bound
     of the exact eigenvalue.
 
-    Memory: first touches of fresh memory cost more than much of the arithmetic here (an
-    (N, k) array of the 130k shells is 313 MB), so only W is allocated: K W and M W go
-    into KU's and U's memory once the residuals are formed, then the new modes and their
-    products with K.  Returns (lam, X, KX) with as many pairs as U has columns.
+    Memory: only U and W, two (N, k) arrays, are alive: ``K U`` and ``K W`` are formed a
+    row block at a time (:func:`.products.row_block_sums`) for the residuals and for the
+    projections ``P^T K W`` and ``W^T K W``, and the new modes are written into U's
+    memory.  Returns (lam, X) with as many pairs as U has columns.
     """
     N, c = U.shape
     W = np.empty_like(U)
-    norms = np.zeros(c)
-    for rows in row_blocks(N):
-        R = KU[rows] - (mass[rows, None] * U[rows]) * lam[None, :]
+
+    def residuals(rows, KU):
+        R = KU - (mass[rows, None] * U[rows]) * lam[None, :]
         W[rows] = precondition(R, rows)
-        norms += np.einsum("ij,ij->j", W[rows], mass[rows, None] * W[rows])
+        return np.einsum("ij,ij->j", W[rows], mass[rows, None] * W[rows])
+
+    norms = row_block_sums(K, U, residuals)
     # unit Mass norm; residuals of (numerically) converged pairs add nothing
     norms = np.sqrt(norms)
     live = norms > 1e-10 * max(float(norms.max()), 1e-300)
     W = W[:, live] if not live.all() else W
     W /= norms[live][None, :]
-    KW = threaded_product(K, W, out=KU[:, : W.shape[1]] if live.all() else None)
-    MW = U if live.all() else np.empty_like(W)
+
+    def projections(rows, KW):
+        return basis.restrict_rows(KW, rows), W[rows].T @ KW
+
+    H_pw, H_ww = row_block_sums(K, W, projections)
+    G_pw = np.zeros_like(H_pw)
+    G_ww = np.zeros_like(H_ww)
     for rows in row_blocks(N):
-        np.multiply(mass[rows, None], W[rows], out=MW[rows])
-    H_pw = basis.restrict(KW)
-    G_pw = basis.restrict(MW)
-    H_ww = W.T @ KW
-    G_ww = W.T @ MW
-    del KW, MW
+        MW = mass[rows, None] * W[rows]
+        G_pw += basis.restrict_rows(MW, rows)
+        G_ww += W[rows].T @ MW
     H = np.block([[Kr.toarray(), H_pw], [H_pw.T, 0.5 * (H_ww + H_ww.T)]])
     G = np.block([[Mr.toarray(), G_pw], [G_pw.T, 0.5 * (G_ww + G_ww.T)]])
     new_lam, C = _dense_lowest(H, G, c)
@@ -349,27 +354,27 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, KU, preconditi
     X = basis.prolong(C[:dim], out=U)
     for rows in row_blocks(N):
         X[rows] += W[rows] @ C[dim:]
-    del W
-    KX = threaded_product(K, X, out=KU)
-    return new_lam, X, KX
+    return new_lam, X
 
 
-def _residual_norms(K_U, mass, lam, U, lam_scale, precondition):
+def _residual_norms(K, mass, lam, U, lam_scale, precondition):
     """(relative residuals ``|K u - lam M u| / |lam M u|`` (zero modes: relative to
-    lam_max), preconditioned residual norms ``r^T D^-1 r``) in one pass over row blocks
-    (D the block-Jacobi preconditioner ``precondition``)."""
+    lam_max), preconditioned residual norms ``r^T D^-1 r``) in one pass over K's row
+    blocks (D the block-Jacobi preconditioner ``precondition``; ``K U`` a block at a
+    time, no (N, k) temporaries)."""
     scale = np.abs(lam).copy()
     scale[zero_modes(lam, lam_scale)] = max(float(np.abs(lam).max()), lam_scale)
-    # in blocks of rows: (N, k) temporaries would cost more (fresh pages) than the sums
-    res2 = np.zeros(len(lam))
-    mu2 = np.zeros(len(lam))
-    eta = np.zeros(len(lam))
-    for rows in row_blocks(U.shape[0]):
+
+    def sums(rows, KU):
         MU = mass[rows, None] * U[rows]
-        R = K_U[rows] - MU * lam[None, :]
-        res2 += np.einsum("ij,ij->j", R, R)
-        mu2 += np.einsum("ij,ij->j", MU, MU)
-        eta += np.einsum("ij,ij->j", R, precondition(R, rows))
+        R = KU - MU * lam[None, :]
+        return (
+            np.einsum("ij,ij->j", R, R),
+            np.einsum("ij,ij->j", MU, MU),
+            np.einsum("ij,ij->j", R, precondition(R, rows)),
+        )
+
+    res2, mu2, eta = row_block_sums(K, U, sums)
     return np.sqrt(res2) / (scale * np.sqrt(mu2)), eta
 
 
@@ -421,7 +426,6 @@ def estimated_errors(
     mass: np.ndarray,
     lam: np.ndarray,
     U: np.ndarray,
-    KU: np.ndarray,
     precondition,
     eta: np.ndarray,
     lam_scale: float = 0.0,
@@ -446,7 +450,8 @@ def estimated_errors(
     if nz.size == 0:
         return out, 0.0
     picks = nz[np.unique(np.linspace(0, nz.size - 1, min(modes, nz.size)).round().astype(int))]
-    R = KU[:, picks] - mass[:, None] * U[:, picks] * lam[picks]
+    Up = np.ascontiguousarray(U[:, picks])
+    R = threaded_product(K, Up) - mass[:, None] * Up * lam[picks]
     energies = _cg_energies(K, R, precondition, steps)
     c = float(np.median(energies / eta[picks]))
     out[nz] = c * eta[nz] / np.abs(lam[nz])
@@ -651,7 +656,6 @@ def preview_spectrum(
     t = time.perf_counter()
     report("preview: prolonging", 0.65)
     U = basis.prolong(Y)
-    KU = threaded_product(K, U)
     seconds["prolongation"] = time.perf_counter() - t
     lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
     galerkin = lam
@@ -659,19 +663,18 @@ def preview_spectrum(
     if smoothing:
         t = time.perf_counter()
         report("preview: smoothing", 0.8)
-        lam, U, KU = _two_level_step(K, mass, basis, Kr, Mr, lam, U, KU, precondition)
+        lam, U = _two_level_step(K, mass, basis, Kr, Mr, lam, U, precondition)
         seconds["smoothing"] = time.perf_counter() - t
     del basis, Kr, Mr  # the reduced space is done with: its memory for what follows
     t = time.perf_counter()
     report("preview: estimating errors", 0.9)
-    res, eta = _residual_norms(KU, mass, lam, U, lam_scale, precondition)
-    est, scale = estimated_errors(K, mass, lam, U, KU, precondition, eta, lam_scale)
+    res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
+    est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
     seconds["estimate"] = time.perf_counter() - t
     refinement = {"steps": 0, "estimated_error_before": float(est.max(initial=0.0))}
     if refine and est.max(initial=0.0) > REFINE_ABOVE:
         t = time.perf_counter()
         report("preview: refining (factorising)", 0.92)
-        del KU  # not needed while refining; K U is made again after
         solver = _factor_below(K, mass, lam, lam_scale)
         if solver is None:  # keep the preview as it is
             refinement["failed"] = "the operator could not be factorised below its spectrum"
@@ -682,13 +685,12 @@ def preview_spectrum(
             report("preview: refining", 0.94 + 0.02 * refinement["steps"])
             lam_b, U = _subspace_step(K, mass, solver, lam_b, U, keep=block)
             refinement["steps"] += 1
-        del solver  # the factor, before K U is formed
+        del solver  # the factor, before the residuals are formed
         lam = lam_b[:c]
         if refinement["steps"]:
             U = np.ascontiguousarray(U[:, :c])
-            KU = threaded_product(K, U)
-            res, eta = _residual_norms(KU, mass, lam, U, lam_scale, precondition)
-            est, scale = estimated_errors(K, mass, lam, U, KU, precondition, eta, lam_scale)
+            res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
+            est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
         seconds["refinement"] = time.perf_counter() - t
     info.update(
         refinement=refinement,

@@ -22,6 +22,7 @@ __all__ = [
     "threaded_transpose_product",
     "threaded_projection",
     "chunked_projection",
+    "row_block_sums",
 ]
 
 
@@ -131,6 +132,45 @@ def threaded_projection(K, P, chunk: int = PROJECTION_ROWS) -> sp.csr_matrix:
     with ThreadPoolExecutor(2) as pool:
         a, b = pool.map(lambda i: chunked_projection(K, P, chunk, i, 2), (0, 1))
     return (a + b).tocsr()
+
+
+def _csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
+    """Rows ``start:stop`` of K as a matrix sharing its arrays (no copy)."""
+    p = K.indptr
+    return sp.csr_matrix(
+        (K.data[p[start] : p[stop]], K.indices[p[start] : p[stop]], p[start : stop + 1] - p[start]),
+        shape=(stop - start, K.shape[1]),
+    )
+
+
+def _add(a, b):
+    return tuple(x + y for x, y in zip(a, b, strict=True)) if isinstance(a, tuple) else a + b
+
+
+def row_block_sums(K, X: np.ndarray, fn):
+    """The sum over K's row blocks R (:data:`ROW_BLOCK` rows) of ``fn(R, K[R] @ X)``, the
+    blocks of each half of the rows on a thread of its own: a pass over ``K X`` that holds
+    no more than a block of it per thread, where ``threaded_product`` would make a whole
+    (N, k) array.  ``fn`` returns an array or a tuple of arrays (summed elementwise, in
+    block order within each half) and may write rows R of arrays of its own (the threads
+    write disjoint rows).  Halves split at a multiple of ROW_BLOCK (whole 3 x 3 blocks)."""
+    K = sp.csr_matrix(K)
+    X = np.ascontiguousarray(X)
+    N = K.shape[0]
+    middle = (N // 2 // ROW_BLOCK) * ROW_BLOCK
+
+    def half(bounds: tuple[int, int]):
+        lo, hi = bounds
+        total = None
+        for start in range(lo, hi, ROW_BLOCK):
+            stop = min(start + ROW_BLOCK, hi)
+            part = fn(slice(start, stop), np.asarray(_csr_rows(K, start, stop) @ X))
+            total = part if total is None else _add(total, part)
+        return total
+
+    with ThreadPoolExecutor(2) as pool:
+        parts = [p for p in pool.map(half, [(0, middle), (middle, N)]) if p is not None]
+    return parts[0] if len(parts) == 1 else _add(*parts)
 
 
 def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice, np.ndarray]]:

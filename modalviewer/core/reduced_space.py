@@ -389,6 +389,17 @@ class ReducedBasis:
             out = np.vstack([out, self.dense.T @ X])
         return out
 
+    def restrict_rows(self, X: np.ndarray, rows: slice) -> np.ndarray:
+        """``P[rows]^T X`` for the values X (len(rows), k) of the unknowns ``rows`` (whole
+        vertices: with three components, rows start and stop at multiples of 3)."""
+        c, k = self.components, X.shape[1]
+        vertices = slice(rows.start // c, rows.stop // c)
+        Xs = np.ascontiguousarray(X).reshape(-1, c * k)
+        out = np.asarray(self.scalar[vertices].T @ Xs).reshape(-1, k)
+        if self.dense is not None:
+            out = np.vstack([out, self.dense[rows].T @ X])
+        return out
+
     def with_dense(self, E: np.ndarray) -> ReducedBasis:
         """The basis with the dense columns E appended."""
         D = E if self.dense is None else np.hstack([self.dense, E])

@@ -54,3 +54,25 @@ def test_the_chunked_projection_is_p_transpose_k_p(chunk):
     half = chunked_projection(K, P, chunk, part=1, parts=2).toarray()
     other = chunked_projection(K, P, chunk, part=0, parts=2).toarray()
     np.testing.assert_allclose(half + other, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_row_block_sums_add_up_the_blocks_of_k_x_and_let_each_block_write_its_rows():
+    from modalviewer.core.products import ROW_BLOCK, row_block_sums
+
+    n = 2 * ROW_BLOCK + 123  # two threads, a short last block
+    K = sp.random(n, n, density=4 / n, random_state=7, format="csr")
+    X = np.random.default_rng(3).standard_normal((n, 5))
+    seen = np.zeros((n, 5))
+
+    def fn(rows, KX):
+        seen[rows] = KX
+        return KX.sum(axis=0), np.array([rows.stop - rows.start])
+
+    total, count = row_block_sums(K, X, fn)
+    np.testing.assert_allclose(seen, K @ X, atol=1e-12)
+    np.testing.assert_allclose(total, (K @ X).sum(axis=0), atol=1e-9)
+    assert count[0] == n
+    small = sp.identity(10, format="csr")  # fewer rows than a block: one thread
+    np.testing.assert_allclose(
+        row_block_sums(small, X[:10], lambda r, KX: KX.sum(0)), X[:10].sum(0)
+    )
