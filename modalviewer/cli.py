@@ -359,7 +359,10 @@ def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
     from .viewer.state import ComputeSettings
 
     refusal = memory_refusal(
-        ComputeSettings().key(operator, k), mesh.n_vertices, coarse="on a decimated copy"
+        ComputeSettings().key(operator, k),
+        mesh.n_vertices,
+        coarse="on a decimated copy",
+        preview="as a preview (--preview)",
     )
     if refusal:
         raise ValueError(refusal)

@@ -16,6 +16,8 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
+from .cost import GrowthLaw
+
 __all__ = [
     "OperatorInfo",
     "SpaceSettings",
@@ -85,8 +87,9 @@ class OperatorInfo:
     null_space : the exactly known null vectors in words.
     null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
     preview : the preview's reduced space (:class:`SpaceSettings`).
-    preview_min_unknowns : with the Preview option, problems with at least this many
-        unknowns show a preview spectrum while the exact one is computed.
+    exact_growth, preview_growth : measured time and memory of the exact solve and of
+        the fast preview against mesh size (:class:`.cost.GrowthLaw`), which predict
+        whether a preview pays.
     signature_word : the signature (and distance) its spectrum defines, in words
         ("heat kernel"), or None.
     """
@@ -102,7 +105,8 @@ class OperatorInfo:
     null_space: str
     null_space_rule: str
     preview: SpaceSettings
-    preview_min_unknowns: int
+    exact_growth: GrowthLaw
+    preview_growth: GrowthLaw
     signature_word: str | None = None
 
     @property
@@ -116,9 +120,19 @@ class OperatorInfo:
     def nonzeros(self, n_vertices: int) -> int:
         return self.unknowns(n_vertices) * self.nonzeros_per_row
 
-    def preview_min_vertices(self) -> int:
-        """The fewest vertices whose problem reaches :attr:`preview_min_unknowns`."""
-        return -(-self.preview_min_unknowns // self.unknowns_per_vertex)
+    def growth(self, accuracy: str) -> GrowthLaw:
+        """:attr:`exact_growth` ("exact") or :attr:`preview_growth` ("fast preview")."""
+        return {"exact": self.exact_growth, "fast preview": self.preview_growth}[accuracy]
+
+    def predicted_seconds(self, accuracy: str, n_vertices: int, k: int) -> float:
+        """Seconds a ``compute_spectrum(mesh, name, k, accuracy=accuracy)`` ("exact" or
+        "fast preview") on a mesh of ``n_vertices`` is predicted to take on the
+        reference machine (:meth:`growth`)."""
+        return self.growth(accuracy).seconds(n_vertices, k)
+
+    def predicted_peak_mb(self, accuracy: str, n_vertices: int) -> float:
+        """Peak memory (MB) of that computation at 100 modes."""
+        return self.growth(accuracy).peak_mb(n_vertices)
 
     @property
     def null_space_needs_normals(self) -> bool:
@@ -160,11 +174,20 @@ _NORMAL_SHELLS_SPACE = SpaceSettings(200, 2.0, 2, RADIUS_FACTOR, False, True)
 # they are shown unrefined and the exact spectrum follows.
 _SHELLS_SPACE = SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True)
 
-# preview_min_unknowns: below it the exact spectrum comes about as fast as the preview
-# would (100 modes; README "Preview spectra"): normal shells 2.5 s against 3.6 s at 50k
-# vertices, 5.2 s against 12.0 s at 130k; 3D shells, refined on curved meshes, 8.9 s
-# against 15.2 s at 50k (the spot), 7.8 s against 44.4 s on the 130k plate; Laplacian
-# 0.8 s against 2.8 s at 50k.
+# exact_growth / preview_growth: the fits of benchmarks/results/growth.json (bumpy plates
+# of 100k to 1M vertices, 100 modes) and growth_k300.json (the 337k plate, 300 modes: how
+# the time grows with k), made by `python -m benchmarks.growth`; tests/core/test_cost.py
+# checks that they are those fits.
+_GROWTH: dict[tuple[str, str], GrowthLaw] = {
+    ("laplacian", "exact"): GrowthLaw(9.218, 0.993, 465.6, 0.888, 1.147),
+    ("laplacian", "fast preview"): GrowthLaw(2.626, 0.805, 394.0, 0.782, 0.39),
+    ("modified_dirichlet", "exact"): GrowthLaw(8.991, 1.016, 452.8, 0.887, 1.08),
+    ("modified_dirichlet", "fast preview"): GrowthLaw(2.593, 0.855, 393.8, 0.79, 0.373),
+    ("shells", "exact"): GrowthLaw(46.357, 1.083, 1890.8, 0.994, 0.864),
+    ("shells", "fast preview"): GrowthLaw(11.371, 0.964, 1059.0, 0.901, 0.929),
+    ("shells_normal", "exact"): GrowthLaw(9.686, 1.443, 477.4, 0.937, 0.672),
+    ("shells_normal", "fast preview"): GrowthLaw(6.529, 0.936, 592.6, 0.79, 0.52),
+}
 
 OPERATOR_INFO: dict[str, OperatorInfo] = {
     info.name: info
@@ -181,7 +204,8 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             null_space="constants",
             null_space_rule="constants",
             preview=_SCALAR_SPACE,
-            preview_min_unknowns=30_000,
+            exact_growth=_GROWTH["laplacian", "exact"],
+            preview_growth=_GROWTH["laplacian", "fast preview"],
             signature_word="heat kernel",
         ),
         OperatorInfo(
@@ -196,7 +220,8 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             null_space="constants of flat components",
             null_space_rule="normal translations",
             preview=_SCALAR_SPACE,
-            preview_min_unknowns=30_000,
+            exact_growth=_GROWTH["modified_dirichlet", "exact"],
+            preview_growth=_GROWTH["modified_dirichlet", "fast preview"],
             signature_word="feature",
         ),
         OperatorInfo(
@@ -211,7 +236,8 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             null_space="rigid motions",
             null_space_rule="rigid motions",
             preview=_SHELLS_SPACE,
-            preview_min_unknowns=300_000,
+            exact_growth=_GROWTH["shells", "exact"],
+            preview_growth=_GROWTH["shells", "fast preview"],
             signature_word="vibration",
         ),
         OperatorInfo(
@@ -226,7 +252,8 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             null_space="normal rigid motions of flat components",
             null_space_rule="normal rigid motions",
             preview=_NORMAL_SHELLS_SPACE,
-            preview_min_unknowns=100_000,
+            exact_growth=_GROWTH["shells_normal", "exact"],
+            preview_growth=_GROWTH["shells_normal", "fast preview"],
         ),
     )
 }

@@ -28,7 +28,7 @@ from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
-from ..viewer.model import cost_estimate
+from ..viewer.model import predicted_seconds
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from .dialogs import file_message, offer_open_anyway
@@ -485,7 +485,7 @@ class PairWindow(QtWidgets.QWidget):
         unless scripted); returns the pending jobs."""
         key = self.pair.key()
         missing = [s for s in SIDES if self.pair.spectrum(s) is None]
-        seconds = sum(cost_estimate(key, self.pair.mesh(s).n_vertices)[0] for s in missing)
+        seconds = sum(predicted_seconds(key, self.pair.mesh(s).n_vertices) for s in missing)
         if missing and seconds > LONG_WAIT_SECONDS:
             about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
             self.status.setText(

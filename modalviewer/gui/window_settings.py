@@ -67,6 +67,7 @@ def restore(win) -> None:
         rescale=_flag(s, "compute/rescale", False),
         coarse=_flag(s, "compute/coarse", False),
         preview=_flag(s, "compute/preview", True),
+        preview_only=_flag(s, "compute/preview_only", False),
     )
     rebuild_recent(win)
 
@@ -113,6 +114,7 @@ def save(win) -> None:
     s.setValue("compute/rescale", _flag_text(c.rescale))
     s.setValue("compute/coarse", _flag_text(c.coarse))
     s.setValue("compute/preview", _flag_text(c.preview))
+    s.setValue("compute/preview_only", _flag_text(c.preview_only))
     s.sync()
 
 

@@ -256,8 +256,8 @@ class JobQueue:
 
         try:
             result = job._fn(progress, job._cancel.is_set)
-        except Cancelled:
-            outcome = (CANCELLED, None, job.error or "cancelled", "")
+        except Cancelled as exc:  # a reason given by the work itself is kept
+            outcome = (CANCELLED, None, job.error or str(exc) or "cancelled", "")
         except MemoryError:
             outcome = (
                 FAILED,

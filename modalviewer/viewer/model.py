@@ -10,7 +10,8 @@ asked to (``show=True``) and the display has not changed since the request.
 from __future__ import annotations
 
 import os
-from dataclasses import replace
+import time
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from ..core.cache import SpectrumCache
 from ..core.cost import estimate_cost
 from ..core.eigen import Cancelled
 from ..core.mesh import Mesh
-from ..core.operators import OPERATOR_INFO, operator_info
+from ..core.operators import operator_info
 from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
@@ -33,17 +34,71 @@ PROCESS_THRESHOLD = 20000
 """Problems with at least this many unknowns are computed in a separate process
 (sparse factorisations hold the GIL; a process also cancels at once)."""
 
-PREVIEW_MIN_UNKNOWNS = {name: info.preview_min_unknowns for name, info in OPERATOR_INFO.items()}
-"""With the Preview option, problems with at least this many unknowns show a preview
-spectrum while the exact one is computed
-(:attr:`~modalviewer.core.operators.OperatorInfo.preview_min_unknowns`)."""
+PREVIEW_DELAY = 0.10
+"""A preview is computed first only where it is predicted to make the exact spectrum
+arrive at most this share later than without it (:func:`preview_plan`)."""
 
 
-def preview_min_vertices(operator: str) -> int:
-    """The fewest vertices of a mesh whose ``operator`` problem gets a preview
-    (:data:`PREVIEW_MIN_UNKNOWNS` in vertices)."""
-    per_vertex = operator_info(operator).unknowns_per_vertex
-    return -(-PREVIEW_MIN_UNKNOWNS.get(operator, 0) // per_vertex)
+NOTE_FROM_SECONDS = 10.0
+"""Requests whose exact solve is predicted to take at least this long say why they get no
+preview (quicker ones would only add noise to the status line)."""
+
+
+@dataclass(frozen=True)
+class PreviewPlan:
+    """Whether a request gets a preview first, and the predictions behind it
+    (:func:`preview_plan`)."""
+
+    pays: bool
+    preview_seconds: float
+    exact_seconds: float
+    preview_mb: float
+    exact_mb: float
+
+    @property
+    def deadline(self) -> float:
+        """Seconds after which a running preview is given up: its share of the exact
+        solve's predicted time (:data:`PREVIEW_DELAY`), so a misprediction cannot delay
+        the exact spectrum by more."""
+        return PREVIEW_DELAY * self.exact_seconds
+
+    def reason(self) -> str:
+        """Why there is no preview, in words ("" where there is one)."""
+        if self.pays:
+            return ""
+        if self.preview_seconds > PREVIEW_DELAY * self.exact_seconds:
+            return (
+                f"no preview: predicted {_seconds(self.preview_seconds)} against the exact "
+                f"{_seconds(self.exact_seconds)}, it would delay the exact spectrum by more "
+                f"than {round(100 * PREVIEW_DELAY)} %"
+            )
+        return (
+            f"no preview: it would need about {_megabytes(self.preview_mb)}, more than the "
+            f"exact solve's {_megabytes(self.exact_mb)}"
+        )
+
+
+def _megabytes(value: float) -> str:
+    return f"{value:,.0f}".replace(",", "\u00a0") + "\u00a0MB"
+
+
+def _seconds(value: float) -> str:
+    return f"{value:.0f}\u00a0s" if value >= 10 else f"{value:.1f}\u00a0s"
+
+
+def preview_plan(key: SpectrumKey, n_vertices: int) -> PreviewPlan:
+    """Predict the fast preview's and the exact solve's time and memory for ``key`` on a
+    mesh of ``n_vertices``
+    (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_seconds`); a preview
+    pays when it costs at most :data:`PREVIEW_DELAY` of the exact time and needs no more
+    memory than the exact solve."""
+    info, k = operator_info(key.operator), key.k
+    preview_s = info.predicted_seconds("fast preview", n_vertices, k)
+    exact_s = info.predicted_seconds("exact", n_vertices, k)
+    preview_mb = info.predicted_peak_mb("fast preview", n_vertices)
+    exact_mb = info.predicted_peak_mb("exact", n_vertices)
+    pays = preview_s <= PREVIEW_DELAY * exact_s and preview_mb <= exact_mb
+    return PreviewPlan(pays, preview_s, exact_s, preview_mb, exact_mb)
 
 
 class ComputeRefused(ValueError):
@@ -64,6 +119,14 @@ def cost_estimate(key: SpectrumKey, n_vertices: int) -> tuple[float, float]:
     n_solved = round(COARSE_FRACTION * n_vertices) if key.coarse else n_vertices
     n = info.unknowns(n_solved)
     return estimate_cost(n, min(key.k, n), info.nonzeros(n_solved))
+
+
+def predicted_seconds(key: SpectrumKey, n_vertices: int, accuracy: str = "exact") -> float:
+    """Seconds the computation of ``key`` ("exact" or "fast preview") on ``n_vertices``
+    is predicted to take (the operator's growth laws; Coarse-to-fine solves on its
+    decimated copy)."""
+    n_solved = round(COARSE_FRACTION * n_vertices) if key.coarse else n_vertices
+    return operator_info(key.operator).predicted_seconds(accuracy, n_solved, key.k)
 
 
 MEMORY_SHARE = 0.75
@@ -89,9 +152,28 @@ COARSE_WORDS = "with Coarse-to-fine (a decimated copy)"
 """How :func:`what_fits` names Coarse-to-fine (the viewer's option)."""
 
 
-def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = COARSE_WORDS) -> str:
+PREVIEW_WORDS = "as a preview (Preview only)"
+"""How :func:`what_fits` names a preview without the exact spectrum (the viewer's option)."""
+
+
+def preview_fits(key: SpectrumKey, n_vertices: int, available: int) -> bool:
+    """Whether the fast preview of ``key`` is predicted to need at most
+    :data:`MEMORY_SHARE` of ``available`` bytes (its growth law, measured at 100 modes,
+    taken in proportion to k above that: the (N, k) arrays of the modes)."""
+    info = operator_info(key.operator)
+    needed = info.predicted_peak_mb("fast preview", n_vertices) * 2**20 * max(1.0, key.k / 100)
+    return needed <= MEMORY_SHARE * available
+
+
+def what_fits(
+    key: SpectrumKey,
+    n_vertices: int,
+    available: int,
+    coarse: str = COARSE_WORDS,
+    preview: str = PREVIEW_WORDS,
+) -> str:
     """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``),
-    or neither."""
+    a preview without the exact spectrum (named ``preview``), or none of them."""
     k = largest_k_that_fits(key, n_vertices, available)
     coarse_needs = cost_estimate(replace(key, coarse=True), n_vertices)[1]
     coarse_fits = not key.coarse and coarse_needs <= MEMORY_SHARE * available
@@ -100,24 +182,42 @@ def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = C
         options.append(f"at most {k} modes fit")
     if coarse_fits:
         options.append(f"{key.k} modes {coarse} fit")
+    if not key.coarse and preview_fits(key, n_vertices, available):
+        options.append(f"{key.k} modes {preview} fit")
     if not options:
         return "Not even one mode fits: use a coarser mesh or a machine with more memory."
     text = "; ".join(options)
     return text[0].upper() + text[1:] + "."
 
 
-def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS) -> str | None:
+def memory_refusal(
+    key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS, preview: str = PREVIEW_WORDS
+) -> str | None:
     """A message if computing ``key`` on ``n_vertices`` would need more than
     :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
     The viewer's refusals and ``modalviewer compute`` say the same."""
-    seconds, needed = cost_estimate(key, n_vertices)
+    needed = cost_estimate(key, n_vertices)[1]
+    seconds = predicted_seconds(key, n_vertices)
     available = physical_memory()
     if available and needed > MEMORY_SHARE * available:
         return (
             f"{operator_info(key.operator).label} with {key.k} modes on "
             f"{n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory "
             f"and {seconds / 60:.0f} min; this machine has {available / 2**30:.1f} GiB. "
-            + what_fits(key, n_vertices, available, coarse)
+            + what_fits(key, n_vertices, available, coarse, preview)
+        )
+    return None
+
+
+def preview_refusal(key: SpectrumKey, n_vertices: int) -> str | None:
+    """A message if even the fast preview of ``key`` is predicted to need more than
+    :data:`MEMORY_SHARE` of this machine's memory; else None."""
+    available = physical_memory()
+    if available and not preview_fits(key, n_vertices, available):
+        return (
+            f"Even a preview of {operator_info(key.operator).label} with {key.k} modes on "
+            f"{n_vertices} vertices would need more than this machine's "
+            f"{available / 2**30:.1f} GiB allow: use a coarser mesh or fewer modes."
         )
     return None
 
@@ -203,6 +303,8 @@ class ViewerModel:
                 # asked again for the spectrum on screen: the mode or map stays
                 self._show_first_mode(key.operator)
             return job
+        if state.compute_settings.preview_only and not key.coarse and not self._cached(key):
+            return self._request_preview_only(key, show, display_at_request)
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
@@ -243,6 +345,39 @@ class ViewerModel:
             job.then(self._shower(key, display_at_request))
         return job
 
+    def _request_preview_only(self, key: SpectrumKey, show: bool, before) -> SpectrumJob:
+        """Preview only (the exact spectrum not in the cache): one preview job and no
+        exact computation.  Refined where its
+        estimate calls for it if the exact solve's memory would fit (the refinement
+        factorises the operator as the exact solve does), the fast preview otherwise;
+        shown whatever its estimate (there is nothing better on its way)."""
+        state = self.state
+        spec = state.spectra.get(key)
+        if spec is not None:  # the exact spectrum or a preview of it: either answers
+            job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key, is_preview=True)
+            job.end_now((spec, None))
+            if show and state.display_operator() != key.operator:
+                self._show_first_mode(key.operator)
+            return job
+        n = state.mesh.n_vertices
+        refusal = preview_refusal(key, n)
+        if refusal:
+            raise ComputeRefused(refusal)
+        accuracy = "preview" if self.refusal(key) is None else "fast preview"
+        job = self.jobs.add(
+            SpectrumJob(
+                self._work(key, preview=True, accuracy=accuracy),
+                (state.mesh.hash, key, "preview"),
+                f"preview of {key.describe()}",
+                state.mesh.hash,
+                key,
+                is_preview=True,
+            )
+        )
+        if show:
+            job.then(self._shower(key, before))
+        return job
+
     def cancel_running(self) -> None:
         """Cancel the running job and the jobs of the same spectrum request (a preview
         and the exact computation behind it)."""
@@ -256,37 +391,33 @@ class ViewerModel:
                 self.jobs.cancel(job)
 
     def _wants_preview(self, key: SpectrumKey) -> bool:
-        """Preview first: asked for, a problem big enough for the operator
-        (:data:`PREVIEW_MIN_UNKNOWNS`), not coarse-to-fine, no preview yet, not in the
-        cache."""
+        """Preview first: asked for, predicted to pay (:func:`preview_plan`), not
+        coarse-to-fine, no preview yet, not in the cache."""
         state = self.state
-        n = operator_info(key.operator).unknowns(state.mesh.n_vertices)
         if not state.compute_settings.preview or key.coarse:
             return False
-        if n < PREVIEW_MIN_UNKNOWNS.get(key.operator, 0):
+        if not preview_plan(key, state.mesh.n_vertices).pays:
             return False
         if key in state.spectra:
             return False
-        mesh = state.compute_mesh(key)
-        return not self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
+        return not self._cached(key)
+
+    def _cached(self, key: SpectrumKey) -> bool:
+        """Whether the exact spectrum of ``key`` is in the disk cache."""
+        mesh = self.state.compute_mesh(key)
+        return self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
 
     def no_preview_note(self, key: SpectrumKey) -> str:
-        """Why a big request with "Preview first" on gets no preview ("" where it gets one,
-        or where none was asked for or the mesh is small)."""
+        """Why a request with "Preview first" on gets no preview ("" where it gets one,
+        where none was asked for, or where the exact solve is quick:
+        :data:`NOTE_FROM_SECONDS`)."""
         state = self.state
-        info = operator_info(key.operator)
         if not state.compute_settings.preview:
-            return ""
-        n = info.unknowns(state.mesh.n_vertices)
-        smallest = min(PREVIEW_MIN_UNKNOWNS.values(), default=0)
-        if n < smallest:
             return ""
         if key.coarse:
             return "no preview with Coarse-to-fine (itself an approximation)"
-        if n < PREVIEW_MIN_UNKNOWNS.get(key.operator, 0):
-            vertices = preview_min_vertices(key.operator)
-            return f"no preview below {vertices:,} vertices".replace(",", "\u00a0")
-        return ""
+        plan = preview_plan(key, state.mesh.n_vertices)
+        return plan.reason() if plan.exact_seconds >= NOTE_FROM_SECONDS else ""
 
     def _shower(self, key: SpectrumKey, before):
         """A job callback showing ``key``'s first non-zero mode if the display has not
@@ -305,18 +436,24 @@ class ViewerModel:
     def _show_first_mode(self, operator: str) -> None:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
 
-    def _work(self, key: SpectrumKey, preview: bool = False):
+    def _work(self, key: SpectrumKey, preview: bool = False, accuracy: str | None = None):
         """The function a job runs for ``key``: cache, compute, signature table (a
-        ``preview``: the reduced-space approximation, never cached)."""
+        ``preview``: the reduced-space approximation, never cached; ``accuracy`` given:
+        Preview only, that accuracy, neither stopped nor discarded)."""
         mesh = self.state.compute_mesh(key)
         cache = self.cache
         t_range = self.state.t_range
         cache_args = (mesh, key.operator, key.k, key.bending, key.membrane)
         needs_table = operator_info(key.operator).distance_kind is not None
 
+        first = preview and accuracy is None  # before an exact computation
+        deadline = preview_plan(key, mesh.n_vertices).deadline if first else None
+
         def work(progress, cancel):
             if preview:
-                spec = _compute_preview(mesh, key, progress, cancel)
+                spec = _compute_preview(
+                    mesh, key, progress, cancel, deadline, accuracy or "fast preview", first
+                )
             else:
                 spec = None if key.coarse else cache.get(*cache_args)
             if spec is None:
@@ -361,27 +498,72 @@ def _compute(mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cance
     return spec
 
 
-def _compute_preview(mesh: Mesh, key: SpectrumKey, progress, cancel) -> Spectrum:
-    """A preview spectrum, in a child process on big problems: the reduced-space work
-    holds the GIL long enough to stall the event loop (up to 5.6 s at 130k in a thread)."""
+class PreviewGivenUp(Cancelled):
+    """A preview stopped because it would have delayed the exact spectrum too much (its
+    message says why); the exact computation behind it goes on."""
+
+
+def _compute_preview(
+    mesh: Mesh,
+    key: SpectrumKey,
+    progress,
+    cancel,
+    deadline: float | None = None,
+    accuracy: str = "fast preview",
+    discard_rough: bool = True,
+) -> Spectrum:
+    """A preview (by default the fast one, never refined: a refinement costs about half
+    the exact solve), in a child process on big problems: the reduced-space work holds the
+    GIL long enough to stall the event loop (up to 5.6 s at 130k in a thread).
+
+    Given up (:class:`PreviewGivenUp`) after ``deadline`` seconds, and (``discard_rough``)
+    where its estimated error is above :data:`~modalviewer.core.preview.REFINE_ABOVE`:
+    such a preview misses modes (thin parts a smooth space cannot bend), and only the
+    refinement would find them."""
+    from ..core.preview import REFINE_ABOVE
+
     weights = (key.bending, key.membrane)
+    started = time.perf_counter()
+
+    def stop() -> bool:
+        if deadline is not None and time.perf_counter() - started > deadline:
+            raise PreviewGivenUp(
+                f"preview stopped after {_seconds(deadline)} (its share of the exact solve's "
+                f"predicted time)"
+            )
+        return cancel()
+
     if operator_info(key.operator).unknowns(mesh.n_vertices) < PROCESS_THRESHOLD:
-        return compute_spectrum(
-            mesh, key.operator, key.k, *weights, progress, cancel, accuracy="preview"
+        spec = compute_spectrum(
+            mesh, key.operator, key.k, *weights, progress, stop, accuracy=accuracy
         )
-    import tempfile
+    else:
+        import tempfile
 
-    from .process import compute_in_process
+        from .process import compute_in_process
 
-    folder = tempfile.mkdtemp(prefix="modalviewer-preview-")
-    target = Path(folder) / "preview.npz"
-    try:
-        return compute_in_process(
-            mesh, key.operator, key.k, *weights, target, progress, cancel, accuracy="preview"
+        folder = tempfile.mkdtemp(prefix="modalviewer-preview-")
+        target = Path(folder) / "preview.npz"
+        try:
+            spec = compute_in_process(
+                mesh,
+                key.operator,
+                key.k,
+                *weights,
+                target,
+                progress,
+                stop,
+                accuracy=accuracy,
+            )
+        finally:
+            target.unlink(missing_ok=True)
+            Path(folder).rmdir()
+    if discard_rough and spec.is_preview and spec.estimated_error > REFINE_ABOVE:
+        raise PreviewGivenUp(
+            f"preview not shown: its estimated error ({100 * spec.estimated_error:.0f} %) is "
+            f"above {100 * REFINE_ABOVE:.0f} %, so it may miss modes"
         )
-    finally:
-        target.unlink(missing_ok=True)
-        Path(folder).rmdir()
+    return spec
 
 
 def worst_residual(spec: Spectrum) -> float:

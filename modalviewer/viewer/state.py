@@ -92,7 +92,8 @@ class ComputeSettings:
     membrane: float = 1.0
     rescale: bool = False
     coarse: bool = False
-    preview: bool = True  # big meshes: a preview spectrum first, the exact one after
+    preview: bool = True  # a preview spectrum first where it pays, the exact one after
+    preview_only: bool = False  # a preview and no exact spectrum (huge meshes)
 
     def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
         op = operator or self.operator

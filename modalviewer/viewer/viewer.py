@@ -45,7 +45,7 @@ from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distanc
 from ..core.spectrum import Spectrum
 from ..repair import repair_for_failure, repair_unavailable
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
-from .model import ComputeRefused, ViewerModel, cost_estimate, residual_text
+from .model import ComputeRefused, ViewerModel, predicted_seconds, residual_text
 from .state import SpectrumKey
 from .wording import percent_text
 
@@ -329,7 +329,8 @@ class Viewer:
         screen meanwhile; "" otherwise (behind a preview the wait is behind a picture)."""
         if job.done or job.preview_job is not None:
             return ""
-        seconds, _ = cost_estimate(job.spectrum_key, self.state.mesh.n_vertices)
+        accuracy = "fast preview" if job.is_preview else "exact"
+        seconds = predicted_seconds(job.spectrum_key, self.state.mesh.n_vertices, accuracy)
         if seconds <= LONG_WAIT_SECONDS:
             return ""
         about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
@@ -393,6 +394,11 @@ class Viewer:
             elif preview.status == DONE:
                 error = percent_text(preview.result[0].estimated_error)
                 text = f"Preview shown (estimated error {error}); computing the exact spectrum..."
+            elif preview.status == CANCELLED and preview.error not in (None, "cancelled"):
+                # given up by the work itself (too slow, or too far off to show)
+                text = (
+                    f"{preview.error[0].upper()}{preview.error[1:]}; computing {job.description}..."
+                )
         note, self._cancel_note = self._cancel_note, ""
         return f"{note}. {text}" if note else text
 
@@ -847,7 +853,7 @@ class Viewer:
         """Seconds the spectra of ``operators`` are expected to take on this mesh."""
         settings = self.state.compute_settings
         n = self.state.mesh.n_vertices
-        return sum(cost_estimate(settings.key(op), n)[0] for op in operators)
+        return sum(predicted_seconds(settings.key(op), n) for op in operators)
 
     def prepare_comparison(self, items: list[str], wait: bool = True, then=None):
         """Request the spectra a comparison of ``items`` needs; with ``wait`` return once

@@ -104,7 +104,9 @@ def test_every_registry_entry_is_complete(name):
     assert info.null_space
     assert info.distance_kind is None or info.distance_kind in DISTANCE_KINDS
     assert (info.signature_word is None) == (info.distance_kind is None)
-    assert info.preview.samples(1) >= 1 and info.preview_min_unknowns > 0
+    assert info.preview.samples(1) >= 1
+    for law in (info.exact_growth, info.preview_growth):
+        assert law.seconds_at_100k > 0 and law.peak_mb_at_100k > 0
     module, function = info.assemble.split(":")
     assert callable(getattr(importlib.import_module(f"modalviewer.core.{module}"), function))
 

@@ -231,12 +231,11 @@ def test_clear_cache_from_the_window(window, spot_path):
     assert window.spectra["laplacian"].k == 10  # the spectrum on screen stays
 
 
-def test_a_pick_shows_the_distance_from_the_preview_first(window, spot_path, monkeypatch):
+def test_a_pick_shows_the_distance_from_the_preview_first(
+    window, spot_path, monkeypatch, previews_pay
+):
     """Found under Xvfb: the map waited for the exact spectrum although the preview had
     arrived a minute earlier."""
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
     window.open_mesh(spot_path)
     window.state.set_display(distance_kind="hks")
     window.pick_vertex(800)  # needs the Laplacian: a preview job, then the exact one
@@ -289,14 +288,11 @@ def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
 
 
 def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
-    window, spot_path, monkeypatch
+    window, spot_path, monkeypatch, previews_pay
 ):
     """Found under Xvfb: after Cancel the preview stayed (as it should) but the Modes
     panel still said the exact spectrum would replace it; after opening another mesh the
     empty plot kept the title "Spectrum (preview): ...", the signature plot its pick."""
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
     window.open_mesh(spot_path)
     window.state.set_display(distance_kind="hks")
     window.pick_vertex(800)
@@ -432,7 +428,9 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     only)."""
     from modalviewer.gui import MainWindow, window_settings
 
-    window.state.set_compute_settings(coarse=True, preview=False, operator="laplacian")
+    window.state.set_compute_settings(
+        coarse=True, preview=False, preview_only=True, operator="laplacian"
+    )
     window.state.set_colorbar(False)
     window.state.set_color_range("limits", (-0.5, 2.0))
     window.state.set_log_signature(True)
@@ -442,6 +440,7 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     qtbot.addWidget(again)
     c = again.state.compute_settings
     assert c.coarse is True and c.preview is False and c.operator == "laplacian"
+    assert c.preview_only is True
     assert again.state.style.colorbar is False
     assert again.state.style.color_range == "limits"
     assert again.state.style.color_limits == (-0.5, 2.0)
@@ -449,6 +448,10 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     assert not again.colorbar_action.isChecked()
     assert again.compute_panel.coarse_check.isChecked()
     assert not again.compute_panel.preview_check.isChecked()
+    panel = again.compute_panel
+    assert panel.preview_only_check.isChecked() and not panel.preview_check.isEnabled()
+    panel.preview_only_check.click()  # the box drives the setting
+    assert again.state.compute_settings.preview_only is False and panel.preview_check.isEnabled()
 
 
 def test_a_combo_box_names_its_whole_item_in_its_tooltip(window):

@@ -13,6 +13,7 @@ from modalviewer.core.cache import SpectrumCache
 from modalviewer.core.primitives import icosphere
 from modalviewer.viewer import ViewerModel, wording
 from modalviewer.viewer.jobs import CANCELLED, DONE, FAILED, JobQueue
+from modalviewer.viewer.state import SpectrumKey
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
@@ -246,10 +247,7 @@ def test_events_fire_once_per_change(model):
     assert seen == ["style", "display"]
 
 
-def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeypatch):
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
+def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeypatch, previews_pay):
     state = model.state
     exact_job = model.request_spectrum("laplacian", k=20, show=True)
     preview_job, running = model.jobs.jobs[0], model.jobs.jobs[1]
@@ -283,10 +281,7 @@ def test_a_preview_shows_first_and_the_exact_spectrum_replaces_it(model, monkeyp
     assert again.done and again.result[0] is exact
 
 
-def test_cancel_stops_a_preview_and_the_exact_spectrum_behind_it(model, monkeypatch):
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
+def test_cancel_stops_a_preview_and_the_exact_spectrum_behind_it(model, monkeypatch, previews_pay):
     exact = model.request_spectrum("modified_dirichlet", k=20)
     other = model.request_spectrum("laplacian", k=10)
     preview = model.jobs.running
@@ -299,12 +294,11 @@ def test_cancel_stops_a_preview_and_the_exact_spectrum_behind_it(model, monkeypa
     assert model.state.spectrum("modified_dirichlet") is None
 
 
-def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monkeypatch):
+def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(
+    model, monkeypatch, previews_pay
+):
     """While the exact job behind a preview runs the state says it follows; once it is
     cancelled, not (the Modes panel kept promising it after a Cancel)."""
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
     state = model.state
     seen = []
     state.events.spectra.connect(seen.append)
@@ -342,53 +336,196 @@ def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(model, monk
     assert state.exact_follows("laplacian") is False
 
 
-def test_the_3d_shells_get_a_preview_on_big_meshes(model, monkeypatch):
-    """Refined where the estimate calls it rough, the 3D shells preview is close on curved
-    meshes too (cow, 46k: 0.0 % after refinement), so big meshes get one."""
-    from modalviewer.viewer import model as model_module
+def test_the_3d_shells_preview_shows_where_its_estimate_is_within_2_percent(model, previews_pay):
+    """On a bumpy plate (14.6k vertices, 12 modes: estimated 1.4 %) the fast 3D shells
+    preview is shown, with its six rigid motions, until the exact spectrum replaces it;
+    on the curved spot (21 %) it is not shown (it may miss modes of thin parts)."""
+    from modalviewer.core.demo_shapes import bumpy_plate
 
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
     state = model.state
+    curved = model.request_spectrum("shells", k=12, show=True)
+    model.jobs.wait(curved)
+    assert curved.preview_job.status == "cancelled"
+    assert "estimated error (21 %)" in curved.preview_job.error, curved.preview_job.error
+    model.set_mesh(bumpy_plate(120))
     exact = model.request_spectrum("shells", k=12, show=True)
     assert exact.preview_job is not None
     model.jobs.wait(exact.preview_job)
     spec = state.spectrum("shells")
     assert spec.is_preview and spec.is_vector and int(spec.zero_mode_mask().sum()) == 6
+    assert 0.005 < spec.estimated_error < 0.02
     assert state.shows_preview() and state.derived.field().title.endswith("(preview)")
     model.jobs.wait(exact)
     assert not state.spectrum("shells").is_preview and not state.shows_preview()
 
 
-def test_no_preview_where_it_would_save_little_time(model, monkeypatch):
-    """Each operator has its own size from which a preview pays (PREVIEW_MIN_UNKNOWNS);
-    below it, and with Coarse-to-fine, the status line says why there is none."""
-    from modalviewer.viewer import model as model_module
+def _growth(monkeypatch, operator, exact, preview):
+    """Give ``operator`` the growth laws ``exact`` and ``preview`` (GrowthLaw args; mode
+    exponents 1 and 0.3 unless given)."""
+    from dataclasses import replace
 
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {"laplacian": 0, "shells": 10**6})
+    from modalviewer.core.cost import GrowthLaw
+    from modalviewer.core.operators import OPERATOR_INFO
+
+    exact = (*exact, 1.0) if len(exact) == 4 else exact
+    preview = (*preview, 0.3) if len(preview) == 4 else preview
+    info = replace(
+        OPERATOR_INFO[operator], exact_growth=GrowthLaw(*exact), preview_growth=GrowthLaw(*preview)
+    )
+    monkeypatch.setitem(OPERATOR_INFO, operator, info)
+
+
+def test_the_predictor_lets_a_preview_come_first_only_where_it_pays(monkeypatch):
+    """A preview pays when its predicted time is at most PREVIEW_DELAY of the exact
+    solve's and its memory at most the exact solve's; the time grows with k as each
+    law's mode exponent says (here 1 for the exact solve, 0.3 for the preview)."""
+    from modalviewer.viewer.model import PREVIEW_DELAY, preview_plan
+
+    assert PREVIEW_DELAY == 0.10
+    # exact: 10 s at 100k and 100 modes, growing as N^1.2; preview 0.5 s, as N^1
+    _growth(monkeypatch, "laplacian", (10.0, 1.2, 500.0, 1.0), (0.5, 1.0, 400.0, 1.0))
+    plan = preview_plan(SpectrumKey("laplacian", 100), 100_000)
+    assert plan.pays and plan.reason() == ""
+    assert plan.exact_seconds == pytest.approx(10.0) and plan.preview_seconds == pytest.approx(0.5)
+    assert plan.deadline == pytest.approx(1.0)  # 10 % of the exact solve
+    big = preview_plan(SpectrumKey("laplacian", 100), 1_000_000)
+    assert big.exact_seconds == pytest.approx(10.0 * 10**1.2)
+    assert big.preview_seconds == pytest.approx(5.0) and big.pays
+    # ten modes: the exact solve 1.0 s, the preview 0.5 * 0.1^0.3 = 0.25 s: no preview
+    few = preview_plan(SpectrumKey("laplacian", 10), 100_000)
+    assert few.exact_seconds == pytest.approx(1.0)
+    assert few.preview_seconds == pytest.approx(0.5 * 0.1**0.3)
+    assert not few.pays
+    assert few.reason() == (
+        "no preview: predicted 0.3\u00a0s against the exact 1.0\u00a0s, it would delay the "
+        "exact spectrum by more than 10 %"
+    ), few.reason()
+    # fast enough, but a preview needing more memory than the exact solve does not pay
+    _growth(monkeypatch, "laplacian", (10.0, 1.0, 500.0, 1.0), (0.5, 1.0, 600.0, 1.0))
+    heavy = preview_plan(SpectrumKey("laplacian", 100), 100_000)
+    assert not heavy.pays
+    assert (
+        heavy.reason()
+        == "no preview: it would need about 600\u00a0MB, more than the exact solve's 500\u00a0MB"
+    )
+
+
+def test_the_viewer_previews_where_the_predictor_says_and_says_why_not(model, monkeypatch):
+    """Requests get a preview job exactly where preview_plan pays; the note says why a
+    request gets none (Coarse-to-fine, or the predicted delay)."""
+    _growth(monkeypatch, "laplacian", (1e3, 1.0, 500.0, 1.0), (1.0, 1.0, 400.0, 1.0))
+    _growth(monkeypatch, "shells", (1e4, 1.0, 500.0, 1.0), (5e3, 1.0, 400.0, 1.0))
     job = model.request_spectrum("shells", k=12)
     assert model.jobs.jobs == [job] and job.preview_job is None
     note = model.no_preview_note(job.spectrum_key)
-    assert note == "no preview below 333\u00a0334 vertices", note
+    assert note.startswith("no preview: predicted") and "more than 10 %" in note, note
+    # a request whose exact solve is predicted quick says nothing about previews
+    _growth(monkeypatch, "shells", (1.0, 1.0, 500.0, 1.0), (0.5, 1.0, 400.0, 1.0))
+    assert model.no_preview_note(job.spectrum_key) == ""
     model.jobs.wait(job)
+    lap = model.request_spectrum("laplacian", k=12)
+    assert lap.preview_job is not None and model.no_preview_note(lap.spectrum_key) == ""
+    model.jobs.wait(lap)
+    assert model.state.spectrum("laplacian").is_preview is False
     model.state.set_compute_settings(coarse=True)
     seen = []  # what an observer of the first event sees (the status line's note)
     model.jobs.events.changed.connect(
         lambda j: seen.append(getattr(j, "preview_job", "unset")) if not seen else None
     )
-    coarse = model.request_spectrum("laplacian", k=12)
+    coarse = model.request_spectrum("laplacian", k=14)
     assert coarse.preview_job is None and seen == [None]
     assert "Coarse-to-fine" in model.no_preview_note(coarse.spectrum_key)
-    model.jobs.wait(coarse)
-    model.state.set_compute_settings(coarse=False)
-    lap = model.request_spectrum("laplacian", k=12)
-    assert model.no_preview_note(lap.spectrum_key) == ""
     model.jobs.cancel_all()
 
 
-def test_a_preview_is_marked_in_every_title_of_the_picture(model, monkeypatch):
+def test_a_preview_that_overruns_its_deadline_is_given_up_and_the_exact_one_follows(
+    monkeypatch, tmp_path
+):
+    """A misprediction cannot delay the exact spectrum by more than its share: the preview
+    stops at PreviewPlan.deadline, and the status line says so."""
+    import modalviewer as mv
+
+    viewer = mv.Viewer(cache=SpectrumCache(tmp_path / "cache"))
+    viewer.open_mesh(ASSETS / "spot.obj")
+    # predicted: exact 1 ms, preview 1 us: it pays, with a deadline of 0.1 ms
+    _growth(monkeypatch, "laplacian", (1e-3, 1.0, 500.0, 1.0), (1e-6, 1.0, 400.0, 1.0))
+    statuses = []
+    viewer.events.status.connect(lambda text, *_: statuses.append(text))
+    jobs = []
+    viewer.jobs.events.changed.connect(lambda j: jobs.append(j) if j not in jobs else None)
+    spec = viewer.compute("laplacian", 20)
+    assert not spec.is_preview and spec.k == 20
+    previews = [j for j in jobs if getattr(j, "is_preview", False)]
+    assert len(previews) == 1 and previews[0].status == "cancelled"
+    assert previews[0].error.startswith("preview stopped after"), previews[0].error
+    assert any(s.startswith("Preview stopped after") for s in statuses), statuses
+
+
+def test_a_preview_whose_estimate_is_above_2_percent_is_not_shown(model, monkeypatch, previews_pay):
+    """Such a preview misses modes (thin parts): the exact spectrum is the first shown."""
+    from modalviewer.core import preview as preview_module
+
+    monkeypatch.setattr(preview_module, "REFINE_ABOVE", 0.0)  # every estimate is above
+    shown = []
+    model.state.events.spectra.connect(lambda *_: shown.append(model.state.spectrum("laplacian")))
+    exact = model.request_spectrum("laplacian", k=20, show=True)
+    preview = exact.preview_job
+    model.jobs.wait(exact)
+    assert preview.status == "cancelled" and "estimated error" in preview.error, preview.error
+    assert "may miss modes" in preview.error
+    assert all(s is None or not s.is_preview for s in shown)
+    assert not model.state.spectrum("laplacian").is_preview
+
+
+def test_preview_only_computes_a_preview_and_no_exact_spectrum(model):
+    """Preview only: one job, a preview shown whatever its estimate (the curved spot's 3D
+    shells: refined, since the exact solve's memory fits); nothing follows it, and asking
+    again answers at once; turned off, the same request computes the exact spectrum."""
+    state = model.state
+    state.set_compute_settings(preview_only=True)
+    job = model.request_spectrum("shells", k=12, show=True)
+    assert model.jobs.jobs == [job] and job.is_preview
+    model.jobs.wait(job)
+    spec = state.spectrum("shells")
+    assert job.status == "done" and spec.is_preview and spec is job.result[0]
+    assert spec.parameters["preview"]["refinement"]["steps"] == 2  # the spot needs it
+    assert state.exact_follows("shells") is False and state.display.kind == "mode"
+    again = model.request_spectrum("shells", k=12)
+    assert again.done and again.result[0] is spec and not model.jobs.busy
+    state.set_compute_settings(preview_only=False)
+    exact = model.request_spectrum("shells", k=12)
+    model.jobs.wait(exact)
+    assert not state.spectrum("shells").is_preview
+
+
+def test_preview_only_takes_the_fast_preview_where_the_exact_solve_would_not_fit(
+    model, monkeypatch
+):
+    """On a machine too small for the exact solve (but not for the fast preview) the
+    refusal names Preview only, and Preview only computes the unrefined preview."""
     from modalviewer.viewer import model as model_module
 
-    monkeypatch.setattr(model_module, "PREVIEW_MIN_UNKNOWNS", {})
+    # the exact solve of 12 modes on the spot needs tens of MB; the preview (law) 8 MB
+    _growth(monkeypatch, "shells", (1.0, 1.0, 500.0, 1.0), (1.0, 1.0, 8.0 * 34, 1.0))
+    monkeypatch.setattr(model_module, "physical_memory", lambda: 12 * 2**20)
+    refusal = model.refusal(SpectrumKey("shells", 12))
+    assert refusal and "12 modes as a preview (Preview only) fit" in refusal, refusal
+    with pytest.raises(model_module.ComputeRefused):
+        model.request_spectrum("shells", k=12)
+    model.state.set_compute_settings(preview_only=True)
+    job = model.request_spectrum("shells", k=12)
+    model.jobs.wait(job)
+    spec = model.state.spectrum("shells")
+    assert spec.is_preview and spec.parameters["preview"]["refinement"]["steps"] == 0
+    assert spec.estimated_error > 0.02  # shown all the same: nothing better follows
+    # too little even for the preview: refused, saying so
+    monkeypatch.setattr(model_module, "physical_memory", lambda: 2**20)
+    model.state.set_compute_settings(k=10)
+    with pytest.raises(model_module.ComputeRefused, match="Even a preview"):
+        model.request_spectrum("shells", k=10)
+
+
+def test_a_preview_is_marked_in_every_title_of_the_picture(model, monkeypatch, previews_pay):
     state = model.state
     exact = model.request_spectrum("laplacian", k=20, show=True)
     model.jobs.wait(exact.preview_job)

@@ -1,0 +1,183 @@
+"""Time and peak memory against mesh size, 10k to 1M vertices, for every operator, exact
+and preview (refined where needed, and the fast preview the viewer shows), with the
+fitted growth exponent.
+
+    python -m benchmarks.growth [--grids 100 180 320 580 1000] [--operators ...] [-k 100]
+
+The meshes are the bumpy plate (:func:`modalviewer.core.demo_shapes.bumpy_plate`) on
+n x n grids: 10k, 32k, 102k, 336k and 1M vertices by default.  Every (size, operator,
+accuracy) runs in a fresh process with the computation processes' memory settings, so
+its peak resident memory is its own; mesh construction is not timed, assembly is.  A run
+the memory check refuses (:func:`modalviewer.viewer.model.memory_refusal`: more than
+three quarters of this machine's memory expected) is recorded as refused with the
+estimate, not started.  Growth exponents are least-squares fits of log(seconds) and
+log(peak MB) against log(vertices) over the sizes from 100k on (below that, fixed costs
+dominate).  Writes ``benchmarks/results/growth.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.run import _in_child, peak_mb, save_result  # noqa: E402
+
+FIT_FROM = 100_000
+"""Sizes from this many vertices on enter the fitted exponents."""
+
+
+def _one(grid: int, operator: str, accuracy: str, k: int) -> dict:
+    import modalviewer as mv
+    from modalviewer.core.demo_shapes import bumpy_plate
+
+    mesh = bumpy_plate(grid)
+    before = peak_mb()
+    t = time.perf_counter()
+    spec = mv.compute_spectrum(mesh, operator, k, accuracy=accuracy)
+    seconds = time.perf_counter() - t
+    preview = spec.parameters.get("preview", {})
+    return {
+        "grid": grid,
+        "vertices": mesh.n_vertices,
+        "operator": operator,
+        "accuracy": accuracy,
+        "is_preview": bool(spec.is_preview),
+        "k": int(k),
+        "seconds": round(seconds, 3),
+        "peak_mb": round(peak_mb()),
+        "mesh_mb": round(before),
+        "refinement_steps": int(preview.get("refinement", {}).get("steps", 0)),
+        "estimated_error": float(spec.estimated_error) if spec.is_preview else 0.0,
+    }
+
+
+def _refusal(grid: int, operator: str, k: int) -> str | None:
+    from modalviewer.viewer.model import memory_refusal
+    from modalviewer.viewer.state import SpectrumKey
+
+    return memory_refusal(SpectrumKey(operator, k), grid * grid)
+
+
+def fit_growth(rows: list[dict], value: str) -> tuple[float, float] | None:
+    """(value at 100k vertices, exponent): the least-squares line of log(value) against
+    log(vertices / 100k) over the rows from :data:`FIT_FROM` vertices on (None with
+    fewer than two)."""
+    use = [r for r in rows if r.get(value) and r["vertices"] >= FIT_FROM]
+    if len(use) < 2:
+        return None
+    x = np.log([r["vertices"] / 1e5 for r in use])
+    y = np.log([r[value] for r in use])
+    slope, intercept = np.polyfit(x, y, 1)
+    return float(np.exp(intercept)), float(slope)
+
+
+def main(argv=None) -> int:
+    from modalviewer.core.operators import OPERATOR_NAMES
+
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--grids", type=int, nargs="+", default=[100, 180, 320, 580, 1000])
+    p.add_argument("--operators", nargs="+", default=list(OPERATOR_NAMES))
+    p.add_argument("--accuracies", nargs="+", default=["fast preview", "preview", "exact"])
+    p.add_argument("-k", type=int, default=100)
+    p.add_argument("--name", default="growth", help="results file: benchmarks/results/NAME.json")
+    p.add_argument(
+        "--keep-others",
+        action="store_true",
+        help="keep the results file's rows of other grids or operators (re-measure some)",
+    )
+    p.add_argument(
+        "--refit", action="store_true", help="only fit again the rows in the results file"
+    )
+    args = p.parse_args(argv)
+    if args.refit:
+        data = json.loads((ROOT / "benchmarks" / "results" / f"{args.name}.json").read_text())
+        save_result(args.name, {**data, "fits": _fits(data["rows"])})
+        return 0
+    rows = []
+    order = list(OPERATOR_NAMES)
+    results = ROOT / "benchmarks" / "results" / f"{args.name}.json"
+    if args.keep_others and results.is_file():  # rows of what is not run now stay
+        rows = [
+            r
+            for r in json.loads(results.read_text())["rows"]
+            if not (r["grid"] in args.grids and r["operator"] in args.operators)
+        ]
+    for grid in args.grids:
+        for operator in args.operators:
+            for accuracy in args.accuracies:
+                # the refined preview factorises the operator as the exact solve does
+                check = accuracy != "fast preview"
+                refused = _refusal(grid, operator, args.k) if check else None
+                if refused:
+                    row = {
+                        "grid": grid,
+                        "vertices": grid * grid,
+                        "operator": operator,
+                        "accuracy": accuracy,
+                        "k": args.k,
+                        "refused": refused,
+                    }
+                else:
+                    row = _in_child(_one, grid, operator, accuracy, args.k)
+                rows.append(row)
+                print(row, flush=True)
+                rows.sort(key=lambda r: (r["grid"], order.index(r["operator"])))
+                save_result(args.name, {"k": args.k, "rows": rows, "fits": _fits(rows)})
+    return 0
+
+
+def mode_exponents(rows: list[dict], more_modes: list[dict]) -> dict[tuple[str, str], float]:
+    """(operator, accuracy) -> the exponent e of ``seconds ~ k^e``, from a run with more
+    modes (``more_modes``, e.g. growth_k300.json's rows) against the 100-mode run of the
+    same operator, accuracy and grid in ``rows``."""
+    out = {}
+    for r in more_modes:
+        if "seconds" not in r:
+            continue
+        base = next(
+            (
+                b
+                for b in rows
+                if "seconds" in b
+                and (b["operator"], b["accuracy"], b["grid"])
+                == (r["operator"], r["accuracy"], r["grid"])
+                and b["k"] != r["k"]
+            ),
+            None,
+        )
+        if base is not None:
+            e = np.log(r["seconds"] / base["seconds"]) / np.log(r["k"] / base["k"])
+            out[r["operator"], r["accuracy"]] = round(float(e), 3)
+    return out
+
+
+def _fits(rows: list[dict]) -> list[dict]:
+    fits = []
+    for operator in dict.fromkeys(r["operator"] for r in rows):
+        for accuracy in ("exact", "preview", "fast preview"):
+            sel = [r for r in rows if r["operator"] == operator and r["accuracy"] == accuracy]
+            time_fit, memory_fit = fit_growth(sel, "seconds"), fit_growth(sel, "peak_mb")
+            if time_fit and memory_fit:
+                fits.append(
+                    {
+                        "operator": operator,
+                        "accuracy": accuracy,
+                        "seconds_at_100k": round(time_fit[0], 3),
+                        "time_exponent": round(time_fit[1], 3),
+                        "peak_mb_at_100k": round(memory_fit[0], 1),
+                        "memory_exponent": round(memory_fit[1], 3),
+                    }
+                )
+    return fits
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

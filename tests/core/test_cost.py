@@ -1,0 +1,72 @@
+"""The cost predictions: growth laws from the measured runs, and their arithmetic."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from benchmarks.growth import _fits, mode_exponents
+from modalviewer.core.cost import GrowthLaw
+from modalviewer.core.operators import OPERATOR_INFO, operator_info
+
+RESULTS = Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "growth.json"
+MORE_MODES = RESULTS.with_name("growth_k300.json")
+
+
+def test_every_operators_growth_laws_are_the_fits_of_the_measured_runs():
+    """The laws in the operator registry are not typed numbers: they are what
+    benchmarks.growth fits to benchmarks/results/growth.json (rounded as it writes them)."""
+    rows = json.loads(RESULTS.read_text())["rows"]
+    fits = {(f["operator"], f["accuracy"]): f for f in _fits(rows)}
+    modes = mode_exponents(rows, json.loads(MORE_MODES.read_text())["rows"])
+    for name, info in OPERATOR_INFO.items():
+        for accuracy, law in (("exact", info.exact_growth), ("fast preview", info.preview_growth)):
+            fit = fits[name, accuracy]
+            assert law == GrowthLaw(
+                fit["seconds_at_100k"],
+                fit["time_exponent"],
+                fit["peak_mb_at_100k"],
+                fit["memory_exponent"],
+                modes[name, accuracy],
+            ), (name, accuracy)
+
+
+def test_the_laws_reproduce_the_runs_they_were_fitted_to_within_a_third():
+    """A power law through 100k..1M: every measured run from 100k on within a factor 1.35
+    of its prediction (seconds and peak memory)."""
+    rows = json.loads(RESULTS.read_text())["rows"]
+    checked = 0
+    for r in rows:
+        if "seconds" not in r or r["accuracy"] == "preview" or r["vertices"] < 100_000:
+            continue
+        info = operator_info(r["operator"])
+        t = info.predicted_seconds(r["accuracy"], r["vertices"], r["k"])
+        m = info.predicted_peak_mb(r["accuracy"], r["vertices"])
+        assert 1 / 1.35 < r["seconds"] / t < 1.35, (r, t)
+        assert 1 / 1.35 < r["peak_mb"] / m < 1.35, (r, m)
+        checked += 1
+    assert checked >= 12
+
+
+def test_predicted_time_scales_with_size_and_modes_as_the_law_says():
+    law = GrowthLaw(10.0, 1.2, 500.0, 0.8, 0.5)
+    assert law.seconds(100_000, 100) == pytest.approx(10.0)
+    assert law.seconds(200_000, 100) == pytest.approx(10.0 * 2**1.2)
+    assert law.seconds(100_000, 400) == pytest.approx(20.0)
+    assert law.peak_mb(400_000) == pytest.approx(500.0 * 4**0.8)
+    assert GrowthLaw(1.0, 1.0, 1.0, 1.0).seconds(100_000, 300) == pytest.approx(3.0)
+
+
+def test_the_300_mode_runs_are_predicted_from_the_laws_within_a_third():
+    """The mode exponents come from these runs (at one size), so the laws reproduce them
+    within the error of the size fit there (a factor 1.35, as above)."""
+    rows = json.loads(MORE_MODES.read_text())["rows"]
+    checked = 0
+    for r in rows:
+        if "seconds" not in r:
+            continue
+        info = operator_info(r["operator"])
+        t = info.predicted_seconds(r["accuracy"], r["vertices"], r["k"])
+        assert 1 / 1.35 < r["seconds"] / t < 1.35, (r, t)
+        checked += 1
+    assert checked >= 8
