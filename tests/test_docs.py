@@ -70,8 +70,12 @@ def test_performance_page_marks_tables_and_its_copy_is_current():
     `.venv/bin/python docs/_ext/benchmark_tables.py` refreshes it."""
     text = (DOCS / "performance.md").read_text()
     names = re.findall(r"<!-- table: ([\w-]+) -->", text)
-    assert sorted(names) == sorted(benchmark_tables.TABLES)
+    readme = (ROOT / "README.md").read_text()
+    in_readme = re.findall(r"<!-- table: ([\w-]+) -->", readme)
+    assert sorted(in_readme) == sorted(benchmark_tables.README_TABLES)
+    assert sorted(names + in_readme) == sorted(benchmark_tables.TABLES)
     assert benchmark_tables.fill(text) == text
+    assert benchmark_tables.fill(readme) == readme  # the README's figures too
 
 
 def test_performance_plots_are_drawn_from_the_json_and_marked_on_the_page(tmp_path):

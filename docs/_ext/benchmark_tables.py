@@ -33,6 +33,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 RESULTS = ROOT / "benchmarks" / "results"
 PAGE = ROOT / "docs" / "performance.md"
+README = ROOT / "README.md"
 PLOTS = ROOT / "docs" / "_generated" / "plots"
 
 MARKED = re.compile(r"(<!-- table: ([\w-]+) -->\n)(.*?)(<!-- end table -->)", re.S)
@@ -171,16 +172,149 @@ def curved_table(data: dict) -> str:
     """``benchmarks.curved``: preview against exact on a curved mesh with thin parts."""
     lines = [
         "| mesh | vertices | operator | exact s | preview s | / exact | exact MB | preview MB "
-        "| / exact | eig. error max (lowest 50) | refinement steps |",
-        "|" + " --- |" * 11,
+        "| / exact | eig. error max (lowest 50) | refinement steps "
+        "| fast preview s | fast preview MB | its error max / estimated |",
+        "|" + " --- |" * 14,
     ]
     for r in data["rows"]:
+        fast = (
+            f"| {r['fast_preview_seconds']:.1f} | {r['fast_preview_peak_mb']} "
+            f"| {100 * r['fast_preview_largest_error_lowest_50']:.2g} % / "
+            f"{100 * r['fast_preview_estimated_error']:.2g} % |"
+            if "fast_preview_seconds" in r
+            else "| - | - | - |"
+        )
         lines.append(
             f"| {r['mesh']} | {r['vertices']} | {r['operator']} | {r['exact_seconds']:.1f} "
             f"| {r['preview_seconds']:.1f} | {r['time_ratio']:.2f} | {r['exact_peak_mb']} "
             f"| {r['preview_peak_mb']} | {r['memory_ratio']:.2f} "
-            f"| {100 * r['largest_error_lowest_50']:.2g} % | {r['refinement_steps']} |"
+            f"| {100 * r['largest_error_lowest_50']:.2g} % | {r['refinement_steps']} " + fast
         )
+    return "\n".join(lines)
+
+
+def growth_table(data: dict) -> str:
+    """``benchmarks.growth``: seconds and peak memory against mesh size per operator and
+    accuracy, then the fitted growth exponents."""
+    rows = data["rows"]
+    sizes = sorted({r["vertices"] for r in rows})
+    head = "| operator | accuracy | " + " | ".join(f"{n:,}".replace(",", " ") for n in sizes)
+    lines = [head + " | time exponent | memory exponent |", "|" + " --- |" * (len(sizes) + 4)]
+    fits = {(f["operator"], f["accuracy"]): f for f in data["fits"]}
+    for (op, accuracy), fit in fits.items():
+        cells = []
+        for n in sizes:
+            r = next(
+                (
+                    r
+                    for r in rows
+                    if (r["operator"], r["accuracy"], r["vertices"]) == (op, accuracy, n)
+                ),
+                None,
+            )
+            if r is None:
+                cells.append("-")
+            elif "refused" in r:
+                cells.append("refused (memory)")
+            else:
+                steps = f", {r['refinement_steps']} steps" if r.get("refinement_steps") else ""
+                mb = f"{r['peak_mb']:,}".replace(",", " ")
+                cells.append(f"{r['seconds']:.1f} s, {mb} MB{steps}")
+        lines.append(
+            f"| {LABELS.get(op, op)} | {accuracy} | "
+            + " | ".join(cells)
+            + f" | {fit['time_exponent']:.2f} | {fit['memory_exponent']:.2f} |"
+        )
+    return "\n".join(lines)
+
+
+def predictor_table(data: dict) -> str:
+    """``benchmarks.growth --name growth_k300``: measured times of the exact solve and of
+    the fast preview beside the viewer's predictions (the operators' growth laws), and
+    whether a preview pays (at most 10 % of the exact time)."""
+    from modalviewer.core.operators import operator_info
+
+    rows = [r for r in data["rows"] if "seconds" in r]
+    lines = [
+        "| operator | vertices | modes | exact s (predicted) | fast preview s (predicted) "
+        "| measured / predicted ratio | pays (measured / predicted) |",
+        "|" + " --- |" * 7,
+    ]
+    for r in rows:
+        if r["accuracy"] != "exact":
+            continue
+        f = next(
+            (
+                x
+                for x in rows
+                if x["accuracy"] == "fast preview"
+                and (x["operator"], x["vertices"], x["k"]) == (r["operator"], r["vertices"], r["k"])
+            ),
+            None,
+        )
+        if f is None:
+            continue
+        info = operator_info(r["operator"])
+        pe = info.predicted_seconds("exact", r["vertices"], r["k"])
+        pf = info.predicted_seconds("fast preview", r["vertices"], r["k"])
+        ratio, predicted = f["seconds"] / r["seconds"], pf / pe
+        lines.append(
+            f"| {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} | {r['k']} "
+            f"| {r['seconds']:.1f} ({pe:.1f}) | {f['seconds']:.1f} ({pf:.1f}) "
+            f"| {ratio:.2f} / {predicted:.2f} "
+            f"| {'yes' if ratio <= 0.1 else 'no'} / {'yes' if predicted <= 0.1 else 'no'} |"
+        )
+    return "\n".join(lines)
+
+
+def million_table(data: dict) -> str:
+    """``benchmarks.million``: the viewer's window on a million vertices."""
+    n = f"{data['vertices']:,}".replace(",", " ")
+    lines = [
+        "| step | seconds | what the viewer did | longest event-loop gap "
+        "| computing process peak |",
+        "| --- | --- | --- | --- | --- |",
+        f"| open and draw {n} vertices | {data['open_and_draw_s']:.1f} | - | - | - |",
+    ]
+    for name in ("laplacian", "shells"):
+        r = data[name]
+        what = r["status"][0].rstrip(".") if r["status"] else ""
+        kind = "preview" if r["is_preview"] else "exact spectrum"
+        lines.append(
+            f"| {LABELS.get(r['operator'], r['operator'])}, {data['k']} modes"
+            f"{' (Preview only)' if r['preview_only'] else ''} | {r['on_screen_s']:.0f} "
+            f"| {what}; {kind} on screen | {r['longest_event_loop_gap_ms']:.0f} ms "
+            f"| {r['child_peak_mb_so_far'] / 1024:.1f} GB |"
+        )
+    pick = data["pick_and_distance_map_s"]
+    lines.append(f"| pick and threshold map of the heat kernel distance | {pick:.1f} | - | - | - |")
+    return "\n".join(lines)
+
+
+def scale_figures(data: dict) -> str:
+    """The README's performance figures: the largest mesh of ``benchmarks.growth`` per
+    operator, exact solve and fast preview, as a short table."""
+    rows = [r for r in data["rows"] if "seconds" in r]
+    n = max(r["vertices"] for r in rows)
+    lines = [
+        f"| {n:,} vertices, {data['k']} modes | exact | fast preview |".replace(",", " ", 2),
+        "| --- | --- | --- |",
+    ]
+    for op in dict.fromkeys(r["operator"] for r in rows):
+        cells = []
+        for accuracy in ("exact", "fast preview"):
+            r = next(
+                (
+                    r
+                    for r in rows
+                    if (r["operator"], r["accuracy"], r["vertices"]) == (op, accuracy, n)
+                ),
+                None,
+            )
+            cells.append(
+                "-" if r is None else f"{r['seconds']:.0f} s, {r['peak_mb'] / 1024:.1f} GB"
+            )
+        lines.append(f"| {LABELS.get(op, op)} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
@@ -206,7 +340,14 @@ TABLES = {
     ),
     "slivers": (["slivers"], lambda: slivers_table(load("slivers"))),
     "curved": (["curved"], lambda: curved_table(load("curved"))),
+    "growth": (["growth"], lambda: growth_table(load("growth"))),
+    "scale": (["growth"], lambda: scale_figures(load("growth"))),
+    "predictor": (["growth_k300"], lambda: predictor_table(load("growth_k300"))),
+    "million": (["million"], lambda: million_table(load("million"))),
 }
+
+README_TABLES = ("scale",)
+"""The tables marked in README.md (the others are on the performance page)."""
 
 
 def render(name: str) -> str:
@@ -227,7 +368,12 @@ def fill(text: str) -> str:
 
 
 #: The operators' names in the plots' legends.
-LABELS = {"laplacian": "Laplacian", "shells": "Discrete Shells", "modified_dirichlet": "E_D^N"}
+LABELS = {
+    "laplacian": "Laplacian",
+    "shells": "3D shells",
+    "modified_dirichlet": "E_D^N",
+    "shells_normal": "normal shells",
+}
 
 
 def _axes(ax, ylabel: str, title: str, vertices) -> None:
@@ -312,6 +458,26 @@ def preview_plot(rows: list[dict], path: Path) -> Path:
     return _save(fig, path)
 
 
+def growth_plot(data: dict, path: Path) -> Path:
+    """``benchmarks.growth``: time and peak memory against mesh size, exact (solid) and
+    fast preview (dashed), per operator."""
+    import matplotlib.pyplot as plt
+
+    rows = [r for r in data["rows"] if "seconds" in r]
+    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(8.6, 3.3), layout="constrained")
+    for i, op in enumerate(dict.fromkeys(r["operator"] for r in rows)):
+        for accuracy, style in (("exact", "o-"), ("fast preview", "^--")):
+            mine = [r for r in rows if r["operator"] == op and r["accuracy"] == accuracy]
+            label = f"{LABELS.get(op, op)}, {accuracy}"
+            _series(t_ax, mine, lambda r: r["seconds"], label, style, f"C{i}")
+            _series(m_ax, mine, lambda r: r["peak_mb"], label, style, f"C{i}")
+    vertices = [r["vertices"] for r in rows]
+    _axes(t_ax, "time (s)", f"{data['k']} modes: time", vertices)
+    _axes(m_ax, "peak memory (MB)", f"{data['k']} modes: peak memory", vertices)
+    _legend(fig, t_ax)
+    return _save(fig, path)
+
+
 def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
@@ -325,6 +491,7 @@ def _save(fig, path: Path) -> Path:
 PLOTS_MADE = {
     "spectra": (["latest"], lambda path: spectra_plot(load("latest"), path)),
     "preview": (["preview"], lambda path: preview_plot(load("preview"), path)),
+    "growth": (["growth"], lambda path: growth_plot(load("growth"), path)),
 }
 
 #: The text under each plot's image on the HTML page.
@@ -333,6 +500,8 @@ PLOT_CAPTIONS = {
     "(benchmarks/results/latest.json; dashed: plain scipy).",
     "preview": "Exact spectrum, preview and coarse-to-fine: time and peak memory against "
     "mesh size (benchmarks/results/preview.json).",
+    "growth": "Time and peak memory from 10k to 1M vertices, 100 modes, exact and fast preview "
+    "(benchmarks/results/growth.json).",
 }
 
 
@@ -383,11 +552,12 @@ def setup(app):
 
 
 def main() -> int:
-    text = PAGE.read_text()
-    new = fill(text)
-    if new != text:
-        PAGE.write_text(new)
-        print(f"wrote {PAGE.relative_to(ROOT)}")
+    for page in (PAGE, README):
+        text = page.read_text()
+        new = fill(text)
+        if new != text:
+            page.write_text(new)
+            print(f"wrote {page.relative_to(ROOT)}")
     for path in draw_plots():
         print(f"wrote {path.relative_to(ROOT)}")
     return 0
