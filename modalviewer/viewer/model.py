@@ -297,32 +297,15 @@ class ViewerModel:
         key = state.compute_settings.key(operator, k)
         display_at_request = state.display
         if state.has_spectrum(key):
-            job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
-            job.end_now((state.spectra[key], None))
-            if show and state.display_operator() != key.operator:
-                # asked again for the spectrum on screen: the mode or map stays
-                self._show_first_mode(key.operator)
-            return job
+            return self._answered(key, show)
         if state.compute_settings.preview_only and not key.coarse and not self._cached(key):
             return self._request_preview_only(key, show, display_at_request)
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
-        if self._wants_preview(key):
-            preview = self.jobs.add(
-                SpectrumJob(
-                    self._work(key, preview=True),
-                    (state.mesh.hash, key, "preview"),
-                    f"preview of {key.describe()}",
-                    state.mesh.hash,
-                    key,
-                    is_preview=True,
-                )
-            )
-            if show:
-                preview.then(self._shower(key, display_at_request))
-        else:
-            preview = None
+        preview = (
+            self._add_preview(key, show, display_at_request) if self._wants_preview(key) else None
+        )
         work = self._work(key)
         job = self.jobs.add(
             SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key, preview)
@@ -351,19 +334,33 @@ class ViewerModel:
         estimate calls for it if the exact solve's memory would fit (the refinement
         factorises the operator as the exact solve does), the fast preview otherwise;
         shown whatever its estimate (there is nothing better on its way)."""
-        state = self.state
-        spec = state.spectra.get(key)
-        if spec is not None:  # the exact spectrum or a preview of it: either answers
-            job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key, is_preview=True)
-            job.end_now((spec, None))
-            if show and state.display_operator() != key.operator:
-                self._show_first_mode(key.operator)
-            return job
-        n = state.mesh.n_vertices
-        refusal = preview_refusal(key, n)
+        if key in self.state.spectra:  # the exact spectrum or a preview of it: either answers
+            return self._answered(key, show)
+        refusal = preview_refusal(key, self.state.mesh.n_vertices)
         if refusal:
             raise ComputeRefused(refusal)
         accuracy = "preview" if self.refusal(key) is None else "fast preview"
+        return self._add_preview(key, show, before, accuracy)
+
+    def _answered(self, key: SpectrumKey, show: bool) -> SpectrumJob:
+        """An ended job holding ``key``'s spectrum already in the state; with ``show`` its
+        first mode is shown unless that operator is on screen (the mode or map stays)."""
+        state = self.state
+        spec = state.spectra[key]
+        job = SpectrumJob(
+            None, key, key.describe(), state.mesh.hash, key, is_preview=spec.is_preview
+        )
+        job.end_now((spec, None))
+        if show and state.display_operator() != key.operator:
+            self._show_first_mode(key.operator)
+        return job
+
+    def _add_preview(
+        self, key: SpectrumKey, show: bool, before, accuracy: str | None = None
+    ) -> SpectrumJob:
+        """Queue a preview job of ``key`` (``accuracy``: see :meth:`_work`), showing its
+        first mode on arrival with ``show`` if the display is still ``before``."""
+        state = self.state
         job = self.jobs.add(
             SpectrumJob(
                 self._work(key, preview=True, accuracy=accuracy),
