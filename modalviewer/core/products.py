@@ -23,6 +23,7 @@ __all__ = [
     "threaded_projection",
     "chunked_projection",
     "row_block_sums",
+    "csr_rows",
 ]
 
 
@@ -37,16 +38,20 @@ def row_blocks(N: int):
     return (slice(start, min(start + ROW_BLOCK, N)) for start in range(0, N, ROW_BLOCK))
 
 
+def csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
+    """Rows ``start:stop`` of a CSR matrix as a matrix sharing its arrays (no copy)."""
+    p = K.indptr
+    return sp.csr_matrix(
+        (K.data[p[start] : p[stop]], K.indices[p[start] : p[stop]], p[start : stop + 1] - p[start]),
+        shape=(stop - start, K.shape[1]),
+    )
+
+
 def row_halves(K: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
     """The two row halves of a CSR matrix as matrices sharing its arrays (no copy)."""
     N = K.shape[0]
     h = N // 2
-    p = K.indptr
-    top = sp.csr_matrix((K.data[: p[h]], K.indices[: p[h]], p[: h + 1]), shape=(h, K.shape[1]))
-    bottom = sp.csr_matrix(
-        (K.data[p[h] :], K.indices[p[h] :], p[h:] - p[h]), shape=(N - h, K.shape[1])
-    )
-    return [(slice(0, h), top), (slice(h, N), bottom)]
+    return [(slice(0, h), csr_rows(K, 0, h)), (slice(h, N), csr_rows(K, h, N))]
 
 
 def threaded_product(K, X, out: np.ndarray | None = None):
@@ -134,15 +139,6 @@ def threaded_projection(K, P, chunk: int = PROJECTION_ROWS) -> sp.csr_matrix:
     return (a + b).tocsr()
 
 
-def _csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
-    """Rows ``start:stop`` of K as a matrix sharing its arrays (no copy)."""
-    p = K.indptr
-    return sp.csr_matrix(
-        (K.data[p[start] : p[stop]], K.indices[p[start] : p[stop]], p[start : stop + 1] - p[start]),
-        shape=(stop - start, K.shape[1]),
-    )
-
-
 def _add(a, b):
     return tuple(x + y for x, y in zip(a, b, strict=True)) if isinstance(a, tuple) else a + b
 
@@ -164,7 +160,7 @@ def row_block_sums(K, X: np.ndarray, fn):
         total = None
         for start in range(lo, hi, ROW_BLOCK):
             stop = min(start + ROW_BLOCK, hi)
-            part = fn(slice(start, stop), np.asarray(_csr_rows(K, start, stop) @ X))
+            part = fn(slice(start, stop), np.asarray(csr_rows(K, start, stop) @ X))
             total = part if total is None else _add(total, part)
         return total
 

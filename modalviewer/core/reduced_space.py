@@ -37,7 +37,7 @@ from scipy.spatial import cKDTree
 from .laplacian import vertex_normals
 from .mesh import Mesh
 from .operators import RADIUS_FACTOR, operator_info
-from .products import row_blocks, threaded_product, threaded_transpose_product
+from .products import csr_rows, row_blocks, threaded_product, threaded_transpose_product
 
 __all__ = [
     "DEFAULT_SAMPLES",
@@ -393,9 +393,9 @@ class ReducedBasis:
         """``P[rows]^T X`` for the values X (len(rows), k) of the unknowns ``rows`` (whole
         vertices: with three components, rows start and stop at multiples of 3)."""
         c, k = self.components, X.shape[1]
-        vertices = slice(rows.start // c, rows.stop // c)
+        block = csr_rows(self.scalar, rows.start // c, rows.stop // c)
         Xs = np.ascontiguousarray(X).reshape(-1, c * k)
-        out = np.asarray(self.scalar[vertices].T @ Xs).reshape(-1, k)
+        out = np.asarray(block.T @ Xs).reshape(-1, k)
         if self.dense is not None:
             out = np.vstack([out, self.dense[rows].T @ X])
         return out
