@@ -15,23 +15,16 @@ peak memory.  Writes ``benchmarks/results/million.json`` and screenshots beside 
 from __future__ import annotations
 
 import argparse
-import os
 import resource
 import sys
-import tempfile
 import time
 from pathlib import Path
-
-os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-os.environ.setdefault("MODALVIEWER_NO_DIALOGS", "1")
-if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.run import save_result  # noqa: E402
-from modalviewer.core.cache import SpectrumCache  # noqa: E402
+from benchmarks.window import EventLoopGaps, bench_window  # noqa: E402
 
 
 def _children_peak_mb() -> float:
@@ -40,20 +33,14 @@ def _children_peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
 
 
+def _rounded(ms: float | None) -> float | None:
+    return None if ms is None else round(ms, 1)
+
+
 def run(grid: int, k: int) -> dict:
-    from qtpy import QtCore, QtWidgets
-
     from modalviewer.core.demo_shapes import bumpy_plate
-    from modalviewer.gui import MainWindow
 
-    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
-    win = MainWindow(
-        force_offscreen=True,
-        cache=SpectrumCache(Path(tempfile.mkdtemp(prefix="modalviewer-bench-"))),
-    )
-    win.resize(1280, 900)
-    win.show()
-    app.processEvents()
+    app, win = bench_window()
     mesh = bumpy_plate(grid)
     out = {"vertices": mesh.n_vertices, "triangles": int(len(mesh.faces)), "k": k}
     t = time.perf_counter()
@@ -63,23 +50,13 @@ def run(grid: int, k: int) -> dict:
     out["open_and_draw_s"] = round(time.perf_counter() - t, 2)
     statuses: list[str] = []
     win.viewer.events.status.connect(lambda text, *_: statuses.append(text))
-    gaps, last = [], [time.perf_counter()]
-
-    def tick():
-        now = time.perf_counter()
-        gaps.append(now - last[0])
-        last[0] = now
-
-    timer = QtCore.QTimer()
-    timer.timeout.connect(tick)
-    timer.start(10)
+    clock = EventLoopGaps()
 
     def compute(operator: str, preview_only: bool) -> dict:
         win.state.set_compute_settings(preview_only=preview_only)
         statuses.clear()
         stages: list[str] = []
-        gaps.clear()
-        last[0] = time.perf_counter()
+        clock.reset()
         started = time.perf_counter()
         win.compute(operator, k=k, wait=False)  # a refusal is an error on the status line
         first_on_screen = None
@@ -102,7 +79,7 @@ def run(grid: int, k: int) -> dict:
             "estimated_error": float(spec.estimated_error) if spec is not None else None,
             "status": list(dict.fromkeys(statuses)),
             "stages": list(dict.fromkeys(stages)),
-            "longest_event_loop_gap_ms": round(1e3 * max(gaps), 1) if gaps else None,
+            "longest_event_loop_gap_ms": _rounded(clock.longest_ms()),
             "child_peak_mb_so_far": round(_children_peak_mb()),
         }
         t = time.perf_counter()
@@ -124,7 +101,7 @@ def run(grid: int, k: int) -> dict:
     out["pick_and_distance_map_s"] = round(time.perf_counter() - t, 2)
     win.export_screenshot(ROOT / "benchmarks" / "results" / "million_laplacian_distance.png")
     out["shells"] = compute("shells", preview_only=True)
-    timer.stop()
+    clock.stop()
     win.close()
     return out
 

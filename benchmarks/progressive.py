@@ -15,25 +15,18 @@ benchmarks/results/ next to the JSON.
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
-os.environ.setdefault("MODALVIEWER_NO_DIALOGS", "1")
-if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-    os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.run import make_mesh, save_result  # noqa: E402
-from modalviewer.core.cache import SpectrumCache  # noqa: E402
+from benchmarks.window import EventLoopGaps, bench_window  # noqa: E402
 from modalviewer.core.operators import OPERATOR_INFO  # noqa: E402
 
 KIND = {name: info.distance_kind for name, info in OPERATOR_INFO.items() if info.distance_kind}
@@ -41,32 +34,12 @@ KIND = {name: info.distance_kind for name, info in OPERATOR_INFO.items() if info
 
 
 def run(size: str, operator: str, k: int) -> dict:
-    from qtpy import QtCore, QtWidgets
-
-    from modalviewer.gui import MainWindow
-
-    app = QtWidgets.QApplication.instance() or QtWidgets.QApplication([])
-    win = MainWindow(
-        force_offscreen=True,
-        cache=SpectrumCache(Path(tempfile.mkdtemp(prefix="modalviewer-bench-"))),
-    )
-    win.resize(1280, 900)
-    win.show()
-    app.processEvents()
+    app, win = bench_window()
     mesh = make_mesh(size)
     win.set_mesh(mesh)
     win.viewport.render_now()
     out = {"mesh": size, "vertices": mesh.n_vertices, "operator": operator, "k": k}
-    gaps, last = [], [time.perf_counter()]
-
-    def tick():
-        now = time.perf_counter()
-        gaps.append(now - last[0])
-        last[0] = now
-
-    timer = QtCore.QTimer()
-    timer.timeout.connect(tick)
-    timer.start(10)
+    clock = EventLoopGaps()
     state = win.state
     started = time.perf_counter()
     job = win.compute(operator, k=k, wait=False)  # noqa: F841 (the window keeps it)
@@ -88,14 +61,13 @@ def run(size: str, operator: str, k: int) -> dict:
     win.export_screenshot(ROOT / "benchmarks" / "results" / f"{stem}_preview.png")
     display_before = state.display
     share_before = state.derived.marked_share()
-    waiting_gaps, gaps[:] = list(gaps), []  # the gaps while nothing but waiting ran
-    last[0] = time.perf_counter()
+    waiting_gaps = clock.reset()  # the gaps while nothing but waiting ran
     while state.spectrum(operator).is_preview:
         app.processEvents()
         time.sleep(0.005)
     out["exact_on_screen_s"] = time.perf_counter() - started
     app.processEvents()
-    timer.stop()
+    clock.stop()
     exact = state.spectrum(operator)
     exact_map = state.derived.distance_map()
     # the threshold follows the map to keep its share of the surface: compared as a share
@@ -109,7 +81,7 @@ def run(size: str, operator: str, k: int) -> dict:
     )
     out["eigenvalue_error_lowest_50_max"] = float(rel.max())
     out["longest_event_loop_gap_ms_until_preview"] = 1e3 * float(max(waiting_gaps))
-    out["longest_event_loop_gap_ms_until_exact"] = 1e3 * float(max(gaps))
+    out["longest_event_loop_gap_ms_until_exact"] = 1e3 * float(max(clock.gaps))
     win.export_screenshot(ROOT / "benchmarks" / "results" / f"{stem}_exact.png")
     win.close()
     return out
