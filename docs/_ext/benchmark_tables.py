@@ -193,6 +193,11 @@ def curved_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def _find(rows: list[dict], **fields) -> dict | None:
+    """The first row whose values match ``fields``, or None."""
+    return next((r for r in rows if all(r.get(k) == v for k, v in fields.items())), None)
+
+
 def growth_table(data: dict) -> str:
     """``benchmarks.growth``: seconds and peak memory against mesh size per operator and
     accuracy, then the fitted growth exponents."""
@@ -204,14 +209,7 @@ def growth_table(data: dict) -> str:
     for (op, accuracy), fit in fits.items():
         cells = []
         for n in sizes:
-            r = next(
-                (
-                    r
-                    for r in rows
-                    if (r["operator"], r["accuracy"], r["vertices"]) == (op, accuracy, n)
-                ),
-                None,
-            )
+            r = _find(rows, operator=op, accuracy=accuracy, vertices=n)
             if r is None:
                 cells.append("-")
             elif "refused" in r:
@@ -231,8 +229,9 @@ def growth_table(data: dict) -> str:
 def predictor_table(data: dict) -> str:
     """``benchmarks.growth --name growth_k300``: measured times of the exact solve and of
     the fast preview beside the viewer's predictions (the operators' growth laws), and
-    whether a preview pays (at most 10 % of the exact time)."""
+    whether a preview pays (at most ``PREVIEW_DELAY`` of the exact time)."""
     from modalviewer.core.operators import operator_info
+    from modalviewer.viewer.model import PREVIEW_DELAY
 
     rows = [r for r in data["rows"] if "seconds" in r]
     lines = [
@@ -243,14 +242,8 @@ def predictor_table(data: dict) -> str:
     for r in rows:
         if r["accuracy"] != "exact":
             continue
-        f = next(
-            (
-                x
-                for x in rows
-                if x["accuracy"] == "fast preview"
-                and (x["operator"], x["vertices"], x["k"]) == (r["operator"], r["vertices"], r["k"])
-            ),
-            None,
+        f = _find(
+            rows, accuracy="fast preview", operator=r["operator"], vertices=r["vertices"], k=r["k"]
         )
         if f is None:
             continue
@@ -262,7 +255,8 @@ def predictor_table(data: dict) -> str:
             f"| {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} | {r['k']} "
             f"| {r['seconds']:.1f} ({pe:.1f}) | {f['seconds']:.1f} ({pf:.1f}) "
             f"| {ratio:.2f} / {predicted:.2f} "
-            f"| {'yes' if ratio <= 0.1 else 'no'} / {'yes' if predicted <= 0.1 else 'no'} |"
+            f"| {'yes' if ratio <= PREVIEW_DELAY else 'no'} "
+            f"/ {'yes' if predicted <= PREVIEW_DELAY else 'no'} |"
         )
     return "\n".join(lines)
 
@@ -303,14 +297,7 @@ def scale_figures(data: dict) -> str:
     for op in dict.fromkeys(r["operator"] for r in rows):
         cells = []
         for accuracy in ("exact", "fast preview"):
-            r = next(
-                (
-                    r
-                    for r in rows
-                    if (r["operator"], r["accuracy"], r["vertices"]) == (op, accuracy, n)
-                ),
-                None,
-            )
+            r = _find(rows, operator=op, accuracy=accuracy, vertices=n)
             cells.append(
                 "-" if r is None else f"{r['seconds']:.0f} s, {r['peak_mb'] / 1024:.1f} GB"
             )
