@@ -91,7 +91,8 @@ def main(argv=None) -> int:
     p.add_argument(
         "--keep-others",
         action="store_true",
-        help="keep the results file's rows of other grids or operators (re-measure some)",
+        help="keep the results file's rows of other grids, operators or accuracies "
+        "(re-measure some)",
     )
     p.add_argument(
         "--refit", action="store_true", help="only fit again the rows in the results file"
@@ -108,7 +109,11 @@ def main(argv=None) -> int:
         rows = [
             r
             for r in json.loads(results.read_text())["rows"]
-            if not (r["grid"] in args.grids and r["operator"] in args.operators)
+            if not (
+                r["grid"] in args.grids
+                and r["operator"] in args.operators
+                and r["accuracy"] in args.accuracies
+            )
         ]
     for grid in args.grids:
         for operator in args.operators:

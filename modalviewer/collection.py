@@ -239,17 +239,15 @@ def vertex_count_hint(path: Path) -> int:
 
 def memory_estimate(n_vertices: int, parameters: dict) -> int:
     """Bytes one mesh's task is expected to need at its peak: the largest of its spectrum
-    computations (:func:`~.core.cost.estimate_cost`) plus the kept spectra and
-    signatures."""
-    from .core.cost import estimate_cost
-
+    computations (:meth:`~.core.operators.OperatorInfo.predicted_peak_mb`) plus the
+    kept spectra and signatures."""
     k = parameters["k"]
     peak, kept = 0.0, 0.0
     for op in _operators(parameters):
         info = operator_info(op)
         n = info.unknowns(n_vertices)
         kept += 8.0 * n * min(k, n)
-        peak = max(peak, estimate_cost(n, min(k, n), info.nonzeros(n_vertices))[1])
+        peak = max(peak, info.predicted_peak_mb("exact", n_vertices, min(k, n)) * 2**20)
     kept += 8.0 * n_vertices * 100 * len(parameters["signatures"])
     return int(peak + kept + 200 * n_vertices + 50e6)
 

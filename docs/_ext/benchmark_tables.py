@@ -226,6 +226,35 @@ def growth_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def _thousands(value: float) -> str:
+    return f"{value:,.0f}".replace(",", " ")
+
+
+def memory_check_table(more_modes: dict, curved: dict) -> str:
+    """The memory check's predictions (:meth:`OperatorInfo.predicted_peak_mb`, what the
+    viewer and the command line refuse by) beside the measured peaks of exact solves it
+    was not fitted to: other mode counts (``growth_k300``) and a curved mesh
+    (``curved``)."""
+    from modalviewer.core.operators import operator_info
+
+    lines = [
+        "| mesh | operator | vertices | modes | measured peak | predicted | measured / predicted |",
+        "|" + " --- |" * 7,
+    ]
+    runs = [("plate", r, r.get("peak_mb")) for r in more_modes["rows"] if r["accuracy"] == "exact"]
+    runs += [(r["mesh"], r, r.get("exact_peak_mb")) for r in curved["rows"]]
+    for mesh, r, peak in runs:
+        if peak is None:
+            continue
+        predicted = operator_info(r["operator"]).predicted_peak_mb("exact", r["vertices"], r["k"])
+        lines.append(
+            f"| {mesh} | {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} "
+            f"| {r['k']} | {_thousands(peak)} MB | {_thousands(predicted)} MB "
+            f"| {peak / predicted:.2f} |"
+        )
+    return "\n".join(lines)
+
+
 def predictor_table(data: dict) -> str:
     """``benchmarks.growth --name growth_k300``: measured times of the exact solve and of
     the fast preview beside the viewer's predictions (the operators' growth laws), and
@@ -331,6 +360,10 @@ TABLES = {
     "scale": (["growth"], lambda: scale_figures(load("growth"))),
     "predictor": (["growth_k300"], lambda: predictor_table(load("growth_k300"))),
     "million": (["million"], lambda: million_table(load("million"))),
+    "memory": (
+        ["growth_k300", "curved"],
+        lambda: memory_check_table(load("growth_k300"), load("curved")),
+    ),
 }
 
 README_TABLES = ("scale",)

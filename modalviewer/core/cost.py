@@ -1,30 +1,42 @@
-"""Time and memory estimates of a spectrum computation, from its size alone."""
+"""Time and memory predictions of a spectrum computation, from its size alone."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = [
-    "estimate_cost",
-    "SECONDS_PER_UNKNOWN_MODE",
-    "GrowthLaw",
-]
+__all__ = ["GrowthLaw", "basis_columns", "exact_peak_mb"]
 
-SECONDS_PER_UNKNOWN_MODE = 1.5e-6
-"""Eigen-solve time per unknown and mode on the 2-core reference machine with the block
-Krylov-Schur solver and PARDISO (``make bench`` on 2026-11-23, third run, shells, 300
-modes: 35k unknowns 14.1 s, 141k 59.5 s, 391k 177.8 s)."""
+MB = 2**20
+
+GROWTH_MODES = 100
+"""The number of modes the growth laws' runs computed."""
 
 
-def estimate_cost(n_unknowns: int, k: int, nnz: int) -> tuple[float, float]:
-    """(seconds, bytes) a spectrum of ``k`` modes of an (N, N) operator with ``nnz`` entries
-    is expected to take on the reference machine: the Krylov basis with the factor while
-    iterating, then with the compact copy of the modes (the factor is freed by then)."""
-    k_work = k + max(8, k // 10)
-    basis = 8.0 * n_unknowns * (1.6 * k_work + 32)
-    modes = 8.0 * n_unknowns * k
-    factor = 8.0 * 12.0 * nnz
-    return SECONDS_PER_UNKNOWN_MODE * n_unknowns * k, basis + max(factor, modes)
+def basis_columns(k: int, n_unknowns: int) -> int:
+    """Columns of the exact solver's Krylov basis array for ``k`` modes of ``n_unknowns``
+    (:func:`.eigen.krylov_sizes`): with the modes, the arrays whose size grows with k."""
+    from .eigen import krylov_sizes  # the solver's own rule; imported late (no cycle)
+
+    n = max(int(n_unknowns), 2)
+    k = max(1, min(int(k), n))
+    _, block, max_basis, _ = krylov_sizes(k, n)
+    return max_basis + block
+
+
+def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> float:
+    """Peak memory (MB) of an exact solve of ``k`` modes: the measured law at
+    :data:`GROWTH_MODES` modes plus, for each further mode, its share of the arrays that
+    grow with k: the Krylov basis (:func:`basis_columns`) and the modes themselves, one
+    column of ``n_unknowns`` doubles each (fewer modes: less of them).  Runs it was not
+    fitted to measured 0.89 to 1.08 times it: 300 modes on the 337k plate for all four
+    operators, and 100 on Loop-subdivided spot and cheburashka (curved, thin parts; the
+    3D shells' 300 modes of cheburashka at 427k vertices: 0.99) (``benchmarks/growth.py``,
+    "Memory check" in docs/performance.md)."""
+    n = max(int(n_unknowns), 1)
+    k, k0 = min(int(k), n), min(GROWTH_MODES, n)
+    columns = basis_columns(k, n) - basis_columns(k0, n) + (k - k0)
+    arrays = 8.0 * n * (basis_columns(k, n) + k) / MB  # there whatever the law says
+    return max(law.peak_mb(n_vertices) + 8.0 * n * columns / MB, arrays)
 
 
 @dataclass(frozen=True)
@@ -48,6 +60,7 @@ class GrowthLaw:
         return self.seconds_at_100k * size**self.time_exponent * (k / 100) ** self.mode_exponent
 
     def peak_mb(self, n_vertices: int) -> float:
-        """Predicted peak resident memory (MB) of the computing process, at 100 modes."""
+        """Predicted peak resident memory (MB) of the computing process, at
+        :data:`GROWTH_MODES` modes."""
         size = max(int(n_vertices), 1) / 1e5
         return self.peak_mb_at_100k * size**self.memory_exponent

@@ -18,7 +18,6 @@ import numpy as np
 
 from ..coarsen import COARSE_FRACTION
 from ..core.cache import SpectrumCache
-from ..core.cost import estimate_cost
 from ..core.eigen import Cancelled
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
@@ -95,8 +94,8 @@ def preview_plan(key: SpectrumKey, n_vertices: int) -> PreviewPlan:
     info, k = operator_info(key.operator), key.k
     preview_s = info.predicted_seconds("fast preview", n_vertices, k)
     exact_s = info.predicted_seconds("exact", n_vertices, k)
-    preview_mb = info.predicted_peak_mb("fast preview", n_vertices)
-    exact_mb = info.predicted_peak_mb("exact", n_vertices)
+    preview_mb = info.predicted_peak_mb("fast preview", n_vertices, k)
+    exact_mb = info.predicted_peak_mb("exact", n_vertices, k)
     pays = preview_s <= PREVIEW_DELAY * exact_s and preview_mb <= exact_mb
     return PreviewPlan(pays, preview_s, exact_s, preview_mb, exact_mb)
 
@@ -113,12 +112,13 @@ def physical_memory() -> int:
         return 0
 
 
-def cost_estimate(key: SpectrumKey, n_vertices: int) -> tuple[float, float]:
-    """(seconds, bytes) the computation of ``key`` on ``n_vertices`` is expected to take."""
+def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
+    """Bytes the exact computation of ``key`` on ``n_vertices`` is predicted to need at
+    its peak (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`;
+    Coarse-to-fine solves on its decimated copy)."""
     info = operator_info(key.operator)
     n_solved = round(COARSE_FRACTION * n_vertices) if key.coarse else n_vertices
-    n = info.unknowns(n_solved)
-    return estimate_cost(n, min(key.k, n), info.nonzeros(n_solved))
+    return info.predicted_peak_mb("exact", n_solved, key.k) * 2**20
 
 
 def predicted_seconds(key: SpectrumKey, n_vertices: int, accuracy: str = "exact") -> float:
@@ -141,7 +141,7 @@ def largest_k_that_fits(key: SpectrumKey, n_vertices: int, available: int) -> in
     lo, hi = 0, max(1, key.k)
     while lo < hi:  # the memory estimate grows with k
         mid = (lo + hi + 1) // 2
-        if cost_estimate(replace(key, k=mid), n_vertices)[1] <= limit:
+        if memory_needed(replace(key, k=mid), n_vertices) <= limit:
             lo = mid
         else:
             hi = mid - 1
@@ -161,7 +161,7 @@ def preview_fits(key: SpectrumKey, n_vertices: int, available: int) -> bool:
     :data:`MEMORY_SHARE` of ``available`` bytes (its growth law, measured at 100 modes,
     taken in proportion to k above that: the (N, k) arrays of the modes)."""
     info = operator_info(key.operator)
-    needed = info.predicted_peak_mb("fast preview", n_vertices) * 2**20 * max(1.0, key.k / 100)
+    needed = info.predicted_peak_mb("fast preview", n_vertices, key.k) * 2**20
     return needed <= MEMORY_SHARE * available
 
 
@@ -175,7 +175,7 @@ def what_fits(
     """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``),
     a preview without the exact spectrum (named ``preview``), or none of them."""
     k = largest_k_that_fits(key, n_vertices, available)
-    coarse_needs = cost_estimate(replace(key, coarse=True), n_vertices)[1]
+    coarse_needs = memory_needed(replace(key, coarse=True), n_vertices)
     coarse_fits = not key.coarse and coarse_needs <= MEMORY_SHARE * available
     options = []
     if k >= 1:
@@ -196,7 +196,7 @@ def memory_refusal(
     """A message if computing ``key`` on ``n_vertices`` would need more than
     :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
     The viewer's refusals and ``modalviewer compute`` say the same."""
-    needed = cost_estimate(key, n_vertices)[1]
+    needed = memory_needed(key, n_vertices)
     seconds = predicted_seconds(key, n_vertices)
     available = physical_memory()
     if available and needed > MEMORY_SHARE * available:

@@ -70,3 +70,48 @@ def test_the_300_mode_runs_are_predicted_from_the_laws_within_a_third():
         assert 1 / 1.35 < r["seconds"] / t < 1.35, (r, t)
         checked += 1
     assert checked >= 8
+
+
+CURVED = RESULTS.with_name("curved.json")
+
+
+def test_exact_peak_memory_is_predicted_for_other_mode_counts_and_curved_meshes():
+    """The memory check's prediction (the law at 100 modes plus the arrays that grow
+    with k) against runs it was not fitted to: 300 modes on the 337k plate for every
+    operator and the exact solves on Loop-subdivided spot (curved, thin legs and ears).
+    A run may need at most 10 % more than predicted (the check keeps a quarter of the
+    memory free) and not much less (15 %), or it would refuse what fits."""
+    checked = 0
+    for r in json.loads(MORE_MODES.read_text())["rows"]:
+        if r["accuracy"] != "exact" or "peak_mb" not in r:
+            continue
+        m = operator_info(r["operator"]).predicted_peak_mb("exact", r["vertices"], r["k"])
+        assert 0.85 < r["peak_mb"] / m < 1.1, (r, m)
+        checked += 1
+    for r in json.loads(CURVED.read_text())["rows"]:
+        if r["vertices"] < 100_000:
+            continue
+        m = operator_info(r["operator"]).predicted_peak_mb("exact", r["vertices"], r["k"])
+        assert 0.85 < r["exact_peak_mb"] / m < 1.1, (r, m)
+        checked += 1
+    assert checked >= 6
+
+
+def test_more_modes_need_their_basis_and_mode_columns_and_no_more():
+    """Between two mode counts the prediction differs by exactly the Krylov basis
+    columns (the solver's own sizes) and the mode columns of N doubles each."""
+    from modalviewer.core.cost import basis_columns
+    from modalviewer.core.eigen import BASIS_EXTRA_MAX, krylov_sizes
+
+    info = operator_info("shells")
+    n_vertices = 200_000
+    n = info.unknowns(n_vertices)
+    at_100 = info.predicted_peak_mb("exact", n_vertices, 100)
+    at_300 = info.predicted_peak_mb("exact", n_vertices, 300)
+    _, block, max_basis, _ = krylov_sizes(300, n)
+    assert basis_columns(300, n) == max_basis + block
+    assert max_basis - krylov_sizes(300, n)[0] <= BASIS_EXTRA_MAX + block  # a big basis: capped
+    columns = basis_columns(300, n) - basis_columns(100, n) + 200
+    assert at_300 - at_100 == pytest.approx(8.0 * n * columns / 2**20, rel=1e-12)
+    assert at_100 == pytest.approx(info.exact_growth.peak_mb(n_vertices), rel=1e-12)
+    assert info.predicted_peak_mb("exact", n_vertices, 10) < at_100

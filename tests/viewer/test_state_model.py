@@ -413,14 +413,14 @@ def test_the_predictor_lets_a_preview_come_first_only_where_it_pays(monkeypatch)
 def test_the_viewer_previews_where_the_predictor_says_and_says_why_not(model, monkeypatch):
     """Requests get a preview job exactly where preview_plan pays; the note says why a
     request gets none (Coarse-to-fine, or the predicted delay)."""
-    _growth(monkeypatch, "laplacian", (1e3, 1.0, 500.0, 1.0), (1.0, 1.0, 400.0, 1.0))
-    _growth(monkeypatch, "shells", (1e4, 1.0, 500.0, 1.0), (5e3, 1.0, 400.0, 1.0))
+    _growth(monkeypatch, "laplacian", (1e3, 1.0, 500.0, 1.0), (1.0, 1.0, 200.0, 1.0))
+    _growth(monkeypatch, "shells", (1e4, 1.0, 500.0, 1.0), (5e3, 1.0, 200.0, 1.0))
     job = model.request_spectrum("shells", k=12)
     assert model.jobs.jobs == [job] and job.preview_job is None
     note = model.no_preview_note(job.spectrum_key)
     assert note.startswith("no preview: predicted") and "more than 10 %" in note, note
     # a request whose exact solve is predicted quick says nothing about previews
-    _growth(monkeypatch, "shells", (1.0, 1.0, 500.0, 1.0), (0.5, 1.0, 400.0, 1.0))
+    _growth(monkeypatch, "shells", (1.0, 1.0, 500.0, 1.0), (0.5, 1.0, 200.0, 1.0))
     assert model.no_preview_note(job.spectrum_key) == ""
     model.jobs.wait(job)
     lap = model.request_spectrum("laplacian", k=12)
@@ -448,7 +448,7 @@ def test_a_preview_that_overruns_its_deadline_is_given_up_and_the_exact_one_foll
     viewer = mv.Viewer(cache=SpectrumCache(tmp_path / "cache"))
     viewer.open_mesh(ASSETS / "spot.obj")
     # predicted: exact 1 ms, preview 1 us: it pays, with a deadline of 0.1 ms
-    _growth(monkeypatch, "laplacian", (1e-3, 1.0, 500.0, 1.0), (1e-6, 1.0, 400.0, 1.0))
+    _growth(monkeypatch, "laplacian", (1e-3, 1.0, 500.0, 1.0), (1e-6, 1.0, 100.0, 1.0))
     statuses = []
     viewer.events.status.connect(lambda text, *_: statuses.append(text))
     jobs = []
@@ -505,8 +505,8 @@ def test_preview_only_takes_the_fast_preview_where_the_exact_solve_would_not_fit
     refusal names Preview only, and Preview only computes the unrefined preview."""
     from modalviewer.viewer import model as model_module
 
-    # the exact solve of 12 modes on the spot needs tens of MB; the preview (law) 8 MB
-    _growth(monkeypatch, "shells", (1.0, 1.0, 500.0, 1.0), (1.0, 1.0, 8.0 * 34, 1.0))
+    # the exact solve of 12 modes on the spot needs over 100 MB; the preview (law) 8 MB
+    _growth(monkeypatch, "shells", (1.0, 1.0, 5000.0, 1.0), (1.0, 1.0, 8.0 * 34, 1.0))
     monkeypatch.setattr(model_module, "physical_memory", lambda: 12 * 2**20)
     refusal = model.refusal(SpectrumKey("shells", 12))
     assert refusal and "12 modes as a preview (Preview only) fit" in refusal, refusal
@@ -652,15 +652,15 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     from dataclasses import replace
 
     # memory for about 150 of the 300 modes asked for
-    needed = model_module.cost_estimate(replace(key, k=150), n)[1]
+    needed = model_module.memory_needed(replace(key, k=150), n)
     available = int(needed / model_module.MEMORY_SHARE)
     monkeypatch.setattr(model_module, "physical_memory", lambda: available)
     message = m.refusal(key)
     k = model_module.largest_k_that_fits(key, n, available)
     assert 1 <= k < 300 and f"at most {k} modes fit" in message.lower()
     limit = model_module.MEMORY_SHARE * available
-    assert model_module.cost_estimate(replace(key, k=k), n)[1] <= limit
-    assert model_module.cost_estimate(replace(key, k=k + 1), n)[1] > limit
+    assert model_module.memory_needed(replace(key, k=k), n) <= limit
+    assert model_module.memory_needed(replace(key, k=k + 1), n) > limit
     assert "Coarse-to-fine" in message
     monkeypatch.setattr(model_module, "physical_memory", lambda: 1024)
     assert "Not even one mode fits" in m.refusal(key)
