@@ -24,6 +24,7 @@ __all__ = [
     "chunked_projection",
     "row_block_sums",
     "csr_rows",
+    "transform_columns_in_place",
 ]
 
 
@@ -180,3 +181,20 @@ def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[s
         cols = slice(start, start + width)
         block = Y[:, cols]
         yield cols, threaded_product(K, block) if sp.issparse(K) else np.asarray(K @ block)
+
+
+def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384) -> np.ndarray:
+    """``Y A`` for a C-contiguous (N, w) Y and a (w, m) A with m <= w (an int m: Y's
+    first m columns), written over Y's own memory: returns a C-contiguous (N, m) array
+    on Y's buffer (Y itself is left meaningless).  Row chunk by chunk, so only a chunk
+    of the product is alive: row i of the result starts at i m <= i w, so a chunk's
+    writes never reach rows not read yet."""
+    n, w = Y.shape
+    m = A if isinstance(A, int) else A.shape[1]
+    if m > w or not Y.flags.c_contiguous:
+        raise ValueError("Y must be C-contiguous with at least as many columns as A")
+    out = Y.reshape(-1)[: n * m].reshape(n, m)
+    for start in range(0, n, chunk):
+        rows = slice(start, min(start + chunk, n))
+        out[rows] = Y[rows, :m].copy() if isinstance(A, int) else Y[rows] @ A
+    return out

@@ -76,3 +76,32 @@ def test_row_block_sums_add_up_the_blocks_of_k_x_and_let_each_block_write_its_ro
     np.testing.assert_allclose(
         row_block_sums(small, X[:10], lambda r, KX: KX.sum(0)), X[:10].sum(0)
     )
+
+
+@pytest.mark.parametrize("shape", [(1000, 7, 5), (1000, 7, 7), (50000, 30, 12)])
+def test_transform_columns_in_place_is_the_product_on_the_same_memory(shape):
+    """Small chunks (every chunk's writes overlap rows of the chunk being read) and
+    a float32 Y as the preview's refinement stores it."""
+    from modalviewer.core.products import transform_columns_in_place
+
+    n, w, m = shape
+    rng = np.random.default_rng(1)
+    Y = rng.standard_normal((n, w)).astype(np.float32)
+    A = rng.standard_normal((w, m))
+    expected = Y.astype(np.float64) @ A
+    base = Y.ctypes.data
+    out = transform_columns_in_place(Y, A, chunk=97)
+    assert out.shape == (n, m) and out.flags.c_contiguous and out.ctypes.data == base
+    np.testing.assert_allclose(out, expected, rtol=1e-5, atol=1e-5 * np.abs(expected).max())
+    with pytest.raises(ValueError, match="columns"):
+        transform_columns_in_place(np.ones((4, 2)), np.ones((2, 3)))
+
+
+def test_transform_columns_in_place_keeps_the_first_columns_for_an_int():
+    from modalviewer.core.products import transform_columns_in_place
+
+    Y = np.arange(600.0).reshape(100, 6)
+    expected = Y[:, :4].copy()
+    out = transform_columns_in_place(Y, 4, chunk=7)
+    assert out.flags.c_contiguous and np.shares_memory(out, Y)
+    np.testing.assert_array_equal(out, expected)
