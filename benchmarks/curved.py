@@ -1,12 +1,17 @@
-"""Preview against exact spectra on a curved mesh with thin parts (spot Loop-subdivided):
-time, peak memory and the preview's eigenvalue errors, each run in its own process.
+"""Preview against exact spectra on curved meshes: time, peak memory and the preview's
+eigenvalue errors, each run in its own process.
 
-    python -m benchmarks.curved --levels 2 3 --operators laplacian shells -k 100
+    python -m benchmarks.curved --cases spot:loop:2 hand:loop:2 -k 100
 
-Writes ``benchmarks/results/curved.json``.  Each (level, operator, accuracy) runs in a
-fresh Python process so its peak resident memory is its own; the exact run comes first
-and the preview's (and the fast preview's, never refined, what the viewer would show
-first) lowest 50 non-zero eigenvalues are compared with it.
+A case is ``asset:scheme:level``: a bundled mesh (``spot``: the cow, thin legs, ears and
+horns; ``hand``: ``demo_hand.obj``, five thin fingers; ``part``:
+``demo_machined_part.obj``, a machined part with sharp edges and holes) subdivided
+``level`` times, by Loop (``loop``, smooth) or by splitting each triangle in four in its
+plane (``flat``: the part keeps its sharp edges).  Writes
+``benchmarks/results/curved.json``.  Each (case, operator, accuracy) runs in a fresh
+Python process so its peak resident memory is its own; the exact run comes first and the
+preview's (and the fast preview's, never refined, what the viewer would show first)
+lowest 50 non-zero eigenvalues are compared with it.
 """
 
 from __future__ import annotations
@@ -26,9 +31,15 @@ CHILD = """
 import json, resource, sys, time
 import numpy as np, trimesh
 import modalviewer as mv
-level, operator, accuracy, k = int(sys.argv[1]), sys.argv[2], sys.argv[3], int(sys.argv[4])
-spot = mv.load_mesh(mv.asset_path("spot.obj"))
-v, f = trimesh.remesh.subdivide_loop(spot.vertices, spot.faces, iterations=level)
+asset, scheme, level = sys.argv[1], sys.argv[2], int(sys.argv[3])
+operator, accuracy, k = sys.argv[4], sys.argv[5], int(sys.argv[6])
+base = mv.load_mesh(mv.asset_path(asset))
+if scheme == "loop":
+    v, f = trimesh.remesh.subdivide_loop(base.vertices, base.faces, iterations=level)
+else:
+    v, f = base.vertices, base.faces
+    for _ in range(level):
+        v, f = trimesh.remesh.subdivide(v, f)
 mesh = mv.Mesh(v, f)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 t = time.perf_counter()
@@ -44,9 +55,39 @@ print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds, "peak_mb": pe
 """
 
 
-def run(level: int, operator: str, accuracy: str, k: int) -> dict:
+ASSETS = {"spot": "spot.obj", "hand": "demo_hand.obj", "part": "demo_machined_part.obj"}
+SCHEMES = {"loop": "Loop", "flat": "flat"}
+DEFAULT_CASES = ["spot:loop:2", "spot:loop:3", "hand:loop:2", "part:flat:3"]
+
+
+def parse_case(text: str) -> tuple[str, str, int]:
+    """``asset:scheme:level`` -> (asset, scheme, level), with a clear error."""
+    try:
+        asset, scheme, level = text.split(":")
+        if asset not in ASSETS or scheme not in SCHEMES or int(level) < 0:
+            raise ValueError
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: a case is asset:scheme:level with asset one of {sorted(ASSETS)}, "
+            f"scheme one of {sorted(SCHEMES)} and level >= 0, e.g. hand:loop:2"
+        ) from None
+    return asset, scheme, int(level)
+
+
+def run(case: tuple[str, str, int], operator: str, accuracy: str, k: int) -> dict:
+    asset, scheme, level = case
     out = subprocess.run(
-        [sys.executable, "-c", CHILD, str(level), operator, accuracy, str(k)],
+        [
+            sys.executable,
+            "-c",
+            CHILD,
+            ASSETS[asset],
+            scheme,
+            str(level),
+            operator,
+            accuracy,
+            str(k),
+        ],
         capture_output=True,
         text=True,
         check=True,
@@ -57,26 +98,28 @@ def run(level: int, operator: str, accuracy: str, k: int) -> dict:
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    p.add_argument("--levels", type=int, nargs="+", default=[2, 3])
+    p.add_argument(
+        "--cases", type=parse_case, nargs="+", default=[parse_case(c) for c in DEFAULT_CASES]
+    )
     p.add_argument("--operators", nargs="+", default=["laplacian", "shells"])
     p.add_argument("-k", type=int, default=100)
     args = p.parse_args(argv)
     rows = []
-    for level in args.levels:
+    for case in args.cases:
         for operator in args.operators:
-            exact = run(level, operator, "exact", args.k)
-            preview = run(level, operator, "preview", args.k)
+            exact = run(case, operator, "exact", args.k)
+            preview = run(case, operator, "preview", args.k)
             m = min(50, len(exact["eigenvalues"]), len(preview["eigenvalues"]))
             lam = exact["eigenvalues"][:m]
             errors = [abs(a - b) / b for a, b in zip(preview["eigenvalues"][:m], lam, strict=True)]
-            fast = run(level, operator, "fast preview", args.k)
+            fast = run(case, operator, "fast preview", args.k)
             m_fast = min(m, len(fast["eigenvalues"]))
             fast_errors = [
                 abs(a - b) / b
                 for a, b in zip(fast["eigenvalues"][:m_fast], lam[:m_fast], strict=True)
             ]
             row = {
-                "mesh": f"spot Loop x{level}",
+                "mesh": f"{case[0]} {SCHEMES[case[1]]} x{case[2]}",
                 "vertices": exact["vertices"],
                 "operator": operator,
                 "k": args.k,
