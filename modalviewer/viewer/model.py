@@ -510,8 +510,10 @@ def _compute_preview(
     discard_rough: bool = True,
 ) -> Spectrum:
     """A preview (by default the fast one, never refined: a refinement costs about half
-    the exact solve), in a child process on big problems: the reduced-space work holds the
-    GIL long enough to stall the event loop (up to 5.6 s at 130k in a thread).
+    the exact solve), always in a child process: the reduced-space work holds the GIL
+    long enough to stall the event loop (up to 5.6 s at 130k in a thread, and 2 to 3 s
+    in the reduced eigenproblem of the 9k-unknown spot shells, under Xvfb), and Preview
+    only computes previews of small meshes too.
 
     Given up (:class:`PreviewGivenUp`) after ``deadline`` seconds, and (``discard_rough``)
     where its estimated error is above :data:`~modalviewer.core.preview.REFINE_ABOVE`:
@@ -530,31 +532,19 @@ def _compute_preview(
             )
         return cancel()
 
-    if operator_info(key.operator).unknowns(mesh.n_vertices) < PROCESS_THRESHOLD:
-        spec = compute_spectrum(
-            mesh, key.operator, key.k, *weights, progress, stop, accuracy=accuracy
+    import tempfile
+
+    from . import process
+
+    folder = tempfile.mkdtemp(prefix="modalviewer-preview-")
+    target = Path(folder) / "preview.npz"
+    try:
+        spec = process.compute_in_process(
+            mesh, key.operator, key.k, *weights, target, progress, stop, accuracy=accuracy
         )
-    else:
-        import tempfile
-
-        from .process import compute_in_process
-
-        folder = tempfile.mkdtemp(prefix="modalviewer-preview-")
-        target = Path(folder) / "preview.npz"
-        try:
-            spec = compute_in_process(
-                mesh,
-                key.operator,
-                key.k,
-                *weights,
-                target,
-                progress,
-                stop,
-                accuracy=accuracy,
-            )
-        finally:
-            target.unlink(missing_ok=True)
-            Path(folder).rmdir()
+    finally:
+        target.unlink(missing_ok=True)
+        Path(folder).rmdir()
     if discard_rough and spec.is_preview and spec.estimated_error > REFINE_ABOVE:
         raise PreviewGivenUp(
             f"preview not shown: its estimated error ({100 * spec.estimated_error:.0f} %) is "

@@ -498,6 +498,28 @@ def test_preview_only_computes_a_preview_and_no_exact_spectrum(model):
     assert not state.spectrum("shells").is_preview
 
 
+def test_a_preview_of_a_small_mesh_is_computed_in_a_child_process(model, monkeypatch):
+    """The reduced space's dense eigenproblem holds the GIL (2 to 3 s of a frozen window
+    for the spot's 9k-unknown shells under Xvfb), so previews never run in the viewer's
+    process, however small the mesh."""
+    from modalviewer.viewer import process
+
+    calls = []
+    real = process.compute_in_process
+
+    def recording(*args, **kwargs):
+        calls.append(kwargs.get("accuracy"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(process, "compute_in_process", recording)
+    assert model.state.mesh.n_vertices < 3000  # below the exact solve's process threshold
+    model.state.set_compute_settings(preview_only=True)
+    job = model.request_spectrum("laplacian", k=12)
+    model.jobs.wait(job)
+    assert job.status == "done" and model.state.spectrum("laplacian").is_preview
+    assert calls == ["preview"]
+
+
 def test_preview_only_takes_the_fast_preview_where_the_exact_solve_would_not_fit(
     model, monkeypatch
 ):
