@@ -700,7 +700,6 @@ def preview_spectrum(
         buffer = np.empty((U.shape[0], block))
         buffer[:, :c] = U
         U = buffer
-        del buffer
         solver = _factor_below(K, mass, lam, lam_scale)
         if solver is None:  # keep the preview as it is
             refinement["failed"] = "the operator could not be factorised below its spectrum"
@@ -710,7 +709,11 @@ def preview_spectrum(
             refinement["steps"] += 1
         del solver  # the factor, before the residuals are formed
         lam = lam_b[:c]
-        U = transform_columns_in_place(U, c)
+        del U  # the buffer's first c columns, moved to its start, then the buffer shrunk
+        transform_columns_in_place(buffer, c)  # in place, so the modes own their memory
+        buffer.resize((buffer.shape[0], c))
+        U = buffer
+        del buffer
         if refinement["steps"]:
             res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
             est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)

@@ -505,3 +505,14 @@ def test_a_fast_preview_is_never_refined_and_says_how_far_off_it_may_be():
     assert np.all(fast.eigenvalues[nonzero] >= refined.eigenvalues[nonzero] * (1 - 1e-9))
     with pytest.raises(ValueError, match="'exact', 'preview', 'fast preview'"):
         mv.compute_spectrum(mesh, "shells", 12, accuracy="rough")
+
+
+def test_refined_modes_own_their_memory(ring, monkeypatch):
+    """The refinement's (N, 1.25 k) buffer is shrunk to the k modes in place: the
+    returned array holds no hidden guard columns."""
+    K, mass = operator_matrices(ring, "shells")
+    monkeypatch.setattr(pv, "REFINE_ABOVE", 0.0)  # refine whatever the estimate
+    lam, U, _, info = pv.preview_spectrum(ring, "shells", K, mass, 12)
+    assert info["refinement"]["steps"] == 2
+    assert U.shape == (K.shape[0], 12) and U.flags.owndata and U.flags.c_contiguous
+    np.testing.assert_allclose(U.T @ (mass[:, None] * U), np.eye(12), atol=1e-9)
