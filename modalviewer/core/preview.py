@@ -518,8 +518,8 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
     values, so the Ritz pairs are those of exactly that space) and (N, 8 to 32)
     temporaries (:data:`BLOCK_BYTES`).  Each solved block is Mass-normalised (a zero
     mode's column is 1/|shift| times larger than the rest) and orthogonalised against U
-    in float64 before it is stored; directions left with less than 1e-6 of their norm (converged
-    pairs: already in U) are dropped, the rest whitened in place."""
+    in float64 before it is stored; directions left with less than 1e-6 of their norm
+    (converged pairs: already in U) are dropped, the rest whitened in place."""
     import scipy.linalg as la
 
     n, b = U.shape

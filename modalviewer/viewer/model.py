@@ -30,8 +30,9 @@ from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
 PROCESS_THRESHOLD = 20000
-"""Problems with at least this many unknowns are computed in a separate process
-(sparse factorisations hold the GIL; a process also cancels at once)."""
+"""Exact spectra of at least this many unknowns are computed in a separate process
+(sparse factorisations hold the GIL; a process also cancels at once); previews always
+are (:func:`_compute_preview`)."""
 
 PREVIEW_DELAY = 0.10
 """A preview is computed first only where it is predicted to make the exact spectrum

@@ -503,6 +503,7 @@ def test_a_preview_of_a_small_mesh_is_computed_in_a_child_process(model, monkeyp
     for the spot's 9k-unknown shells under Xvfb), so previews never run in the viewer's
     process, however small the mesh."""
     from modalviewer.viewer import process
+    from modalviewer.viewer.model import PROCESS_THRESHOLD
 
     calls = []
     real = process.compute_in_process
@@ -512,7 +513,8 @@ def test_a_preview_of_a_small_mesh_is_computed_in_a_child_process(model, monkeyp
         return real(*args, **kwargs)
 
     monkeypatch.setattr(process, "compute_in_process", recording)
-    assert model.state.mesh.n_vertices < 3000  # below the exact solve's process threshold
+    # the Laplacian's unknowns are the vertices: an exact solve here stays in-process
+    assert model.state.mesh.n_vertices < PROCESS_THRESHOLD
     model.state.set_compute_settings(preview_only=True)
     job = model.request_spectrum("laplacian", k=12)
     model.jobs.wait(job)
