@@ -2,6 +2,7 @@
 eigenvalue errors, each run in its own process.
 
     python -m benchmarks.curved --cases spot:loop:2 hand:loop:2 -k 100
+    python -m benchmarks.curved --operators laplacian --keep-others   # re-measure some rows
 
 A case is ``asset:scheme:level``: a bundled mesh (``spot``: the cow, thin legs, ears and
 horns; ``hand``: ``demo_hand.obj``, five thin fingers; ``part``:
@@ -60,6 +61,14 @@ SCHEMES = {"loop": "Loop", "flat": "flat"}
 DEFAULT_CASES = ["spot:loop:2", "spot:loop:3", "hand:loop:2", "part:flat:3"]
 
 
+OPERATORS = ["laplacian", "modified_dirichlet", "shells", "shells_normal"]
+"""The order of a mesh's rows in the results file."""
+
+
+def _position(order: list[str], name: str) -> int:
+    return order.index(name) if name in order else len(order)
+
+
 def parse_case(text: str) -> tuple[str, str, int]:
     """``asset:scheme:level`` -> (asset, scheme, level), with a clear error."""
     try:
@@ -101,10 +110,24 @@ def main(argv=None) -> int:
     p.add_argument(
         "--cases", type=parse_case, nargs="+", default=[parse_case(c) for c in DEFAULT_CASES]
     )
-    p.add_argument("--operators", nargs="+", default=["laplacian", "shells"])
+    p.add_argument("--operators", nargs="+", default=["laplacian", "modified_dirichlet", "shells"])
     p.add_argument("-k", type=int, default=100)
+    p.add_argument(
+        "--keep-others",
+        action="store_true",
+        help="keep the results file's rows of other cases or operators (re-measure some)",
+    )
     args = p.parse_args(argv)
+    names = {f"{a} {SCHEMES[s]} x{level}" for a, s, level in args.cases}
     rows = []
+    results = ROOT / "benchmarks" / "results" / "curved.json"
+    if args.keep_others and results.is_file():  # rows of what is not run now stay
+        rows = [
+            r
+            for r in json.loads(results.read_text())["rows"]
+            if not (r["mesh"] in names and r["operator"] in args.operators)
+        ]
+    order = [f"{a} {SCHEMES[s]} x{level}" for a, s, level in map(parse_case, DEFAULT_CASES)]
     for case in args.cases:
         for operator in args.operators:
             exact = run(case, operator, "exact", args.k)
@@ -139,7 +162,10 @@ def main(argv=None) -> int:
             }
             rows.append(row)
             print(json.dumps(row), flush=True)
-    save_result("curved", {"rows": rows})
+            rows.sort(
+                key=lambda r: (_position(order, r["mesh"]), _position(OPERATORS, r["operator"]))
+            )
+            save_result("curved", {"rows": rows})
     return 0
 
 
