@@ -208,28 +208,36 @@ NEGATIVE_RTOL = 1e-6
 taken for rounding of a singular mass matrix (see :func:`_dense_lowest`)."""
 
 
-def _dense_lowest(A: np.ndarray, B: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
-    """Lowest k pairs of the dense symmetric pencil ``A y = lam B y``, Y B-orthonormal.
+def _dense_lowest(pencil, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest k pairs of the dense symmetric pencil ``A y = lam B y``, Y B-orthonormal;
+    ``pencil()`` makes (A, B), fresh Fortran-ordered arrays the solver may overwrite (it
+    is called again for the second way below).
 
-    LAPACK's expert driver; where B is singular (functions that vanish on the mesh, or
-    linearly dependent columns) the problem is solved on the B-orthonormal eigenbasis of
-    B's range instead.  A is positive semi-definite (an energy's Hessian), so a clearly
-    negative eigenvalue means B is singular in all but rounding (a thin torus's 192
-    samples of 3 linear functions on 1152 vertices gave -2323 where the lowest is 278)
-    and takes the second way too."""
+    LAPACK's expert driver, working in A's and B's memory; where B is singular
+    (functions that vanish on the mesh, or linearly dependent columns) the problem is
+    solved on the B-orthonormal eigenbasis of B's range instead.  A is positive
+    semi-definite (an energy's Hessian), so a clearly negative eigenvalue means B is
+    singular in all but rounding (a thin torus's 192 samples of 3 linear functions on
+    1152 vertices gave -2323 where the lowest is 278) and takes the second way too."""
     import scipy.linalg as la
 
+    A, B = pencil()
+    typical = float(np.median(np.abs(np.diag(A)) / np.maximum(np.diag(B), 1e-300)))
     try:
-        lam, Y = la.eigh(A, B, subset_by_index=[0, k - 1], driver="gvx")
-        typical = float(np.median(np.abs(np.diag(A)) / np.maximum(np.diag(B), 1e-300)))
+        lam, Y = la.eigh(
+            A, B, subset_by_index=[0, k - 1], driver="gvx", overwrite_a=True, overwrite_b=True
+        )
         if lam[0] >= -NEGATIVE_RTOL * typical:
             return lam, Y
     except np.linalg.LinAlgError:
         pass
+    A, B = pencil()
     d = 1.0 / np.sqrt(np.maximum(np.diag(B), 1e-300))
     w, E = la.eigh(B * np.outer(d, d))
+    del B
     keep = w > 1e-12 * w.max()
     T = (E[:, keep] / np.sqrt(w[keep])) * d[:, None]
+    del E
     lam, Z = la.eigh(T.T @ A @ T, subset_by_index=[0, min(k, int(keep.sum())) - 1])
     return lam, T @ Z
 
@@ -247,7 +255,7 @@ def _solve_reduced(
     """
     N = Kr.shape[0]
     if N <= max(DENSE_REDUCED, 3 * k):
-        return _dense_lowest(Kr.toarray(), Mr.toarray(), k)
+        return _dense_lowest(lambda: (Kr.toarray(order="F"), Mr.toarray(order="F")), k)
     typical = float(np.median(np.abs(Kr.diagonal()) / Mr.diagonal()))
     shift = -1e-6 * (typical or 1.0)
     for _ in range(8):
@@ -359,9 +367,13 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, precondition):
         MW = mass[rows, None] * W[rows]
         G_pw += basis.restrict_rows(MW, rows)
         G_ww += W[rows].T @ MW
-    H = np.block([[Kr.toarray(), H_pw], [H_pw.T, 0.5 * (H_ww + H_ww.T)]])
-    G = np.block([[Mr.toarray(), G_pw], [G_pw.T, 0.5 * (G_ww + G_ww.T)]])
-    new_lam, C = _dense_lowest(H, G, c)
+
+    def pencil():
+        H = np.block([[Kr.toarray(), H_pw], [H_pw.T, 0.5 * (H_ww + H_ww.T)]])
+        G = np.block([[Mr.toarray(), G_pw], [G_pw.T, 0.5 * (G_ww + G_ww.T)]])
+        return H.T, G.T  # Fortran order (symmetric), so LAPACK works in their memory
+
+    new_lam, C = _dense_lowest(pencil, c)
     dim = Kr.shape[0]
     X = basis.prolong(C[:dim], out=U)
     for rows in row_blocks(N):
@@ -528,8 +540,9 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
 
     Memory: beside U and the factor, the new directions Y (live columns, float32: they
     only span the space; the projected K and Mass matrices are formed from the stored
-    values, so the Ritz pairs are those of exactly that space) and (N, 8 to 32)
-    temporaries (:data:`BLOCK_BYTES`).  Each solved block is Mass-normalised (a zero
+    values, so the Ritz pairs are those of exactly that space) and two (N, 8 to 32)
+    float64 blocks (:data:`BLOCK_BYTES`): right-hand sides and solutions, then a block of
+    Y and its product with K, both reused throughout.  Each solved block is Mass-normalised (a zero
     mode's column is 1/|shift| times larger than the rest) and orthogonalised against U
     in float64 before it is stored; directions left with less than 1e-6 of their norm
     (converged pairs: already in U) are dropped, the rest whitened in place."""
@@ -547,8 +560,9 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
         np.multiply(mass[:, None], Uw[:, cols], out=B)
         Z = solver.solve(B)
         Z /= np.sqrt(np.einsum("ij,ij,i->j", Z, Z, mass))
-        Z -= Uw @ _weighted_product(Uw, Z, mass)
-        Y[:, cols] = Z
+        C = _weighted_product(Uw, Z, mass)
+        for rows in _rows(n):  # Z - U C and its float32 copy, a row chunk at a time
+            Y[rows, cols] = Z[rows] - Uw[rows] @ C
         del Z
     del rhs, B
     gram = _weighted_product(Y, Y, mass)
@@ -562,12 +576,17 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
     Y = transform_columns_in_place(Y, A)
     width = Y.shape[1]
     H_uy, H_yy = np.empty((u, width)), np.empty((width, width))
+    widest = min(step, width)
+    block, product = np.empty(n * widest), np.empty(n * widest)  # reused by every block
     for j in range(0, width, step):
         cols = slice(j, min(j + step, width))
-        KY = threaded_product(K, Y[:, cols].astype(np.float64))
+        w = cols.stop - j
+        Yj = block[: n * w].reshape(n, w)
+        Yj[:] = Y[:, cols]
+        KY = threaded_product(K, Yj, out=product[: n * w].reshape(n, w))
         H_uy[:, cols] = Uw.T @ KY
         H_yy[:, cols] = _weighted_product(Y, KY)
-        del KY
+    del block, product, Yj, KY
     G_uy = _weighted_product(Uw, Y, mass)
     G_yy = _weighted_product(Y, Y, mass)
     H = np.block([[np.diag(lam[:u]), H_uy], [H_uy.T, 0.5 * (H_yy + H_yy.T)]])
@@ -709,8 +728,10 @@ def preview_spectrum(
         t = time.perf_counter()
         report("preview: refining (factorising)", 0.92)
         c, lam_b = lam.shape[0], lam
-        # guard vectors: the last wanted pairs converge at the rate lam_c / lam_(c+guard)
-        block = max(c, min(c + max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)), K.shape[0] // 2))
+        # guard vectors: the last wanted pairs converge at the rate lam_c / lam_(c+guard);
+        # a single step has no next step for them to speed up
+        guard = max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)) if steps > 1 else 0
+        block = max(c, min(c + guard, K.shape[0] // 2))
         # the steps write their Ritz vectors over this buffer, made before the factor so
         # that the factor reuses the memory of the U it replaces
         buffer = np.empty((U.shape[0], block))
