@@ -12,7 +12,10 @@ plane (``flat``: the part keeps its sharp edges).  Writes
 ``benchmarks/results/curved.json``.  Each (case, operator, accuracy) runs in a fresh
 Python process so its peak resident memory is its own; the exact run comes first and the
 preview's (and the fast preview's, never refined, what the viewer would show first)
-lowest 50 non-zero eigenvalues are compared with it.
+lowest 50 non-zero eigenvalues are compared with it.  The child processes keep the C
+library's default memory settings (not
+:func:`modalviewer.processes.memory.prepare_compute_process`), so their peaks compare
+with each other, not with ``benchmarks.growth``'s.
 """
 
 from __future__ import annotations
