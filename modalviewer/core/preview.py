@@ -578,6 +578,7 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
     H_uy, H_yy = np.empty((u, width)), np.empty((width, width))
     widest = min(step, width)
     block, product = np.empty(n * widest), np.empty(n * widest)  # reused by every block
+    Yj = KY = None
     for j in range(0, width, step):
         cols = slice(j, min(j + step, width))
         w = cols.stop - j

@@ -274,6 +274,18 @@ def test_subspace_step_returns_mass_orthonormal_ritz_pairs(plate):
     assert np.all(np.diff(new) >= -1e-9 * new.max())
 
 
+def test_a_subspace_step_on_exact_eigenvectors_adds_nothing(plate):
+    """Every new direction of exact eigenpairs is already in U, so all are dropped: the
+    step returns the same values and leaves the vectors' span alone."""
+    K, mass = operator_matrices(plate, "laplacian")
+    lam, X = la.eigh(K.toarray(), np.diag(mass), subset_by_index=[0, 7])
+    solver = pv._factor_below(K, mass, lam, float(np.median(K.diagonal() / mass)))
+    buffer = np.ascontiguousarray(X)
+    new = pv._subspace_step(K, mass, solver, lam, buffer)
+    np.testing.assert_allclose(new, lam, rtol=1e-9, atol=1e-9 * lam.max())
+    np.testing.assert_allclose(np.abs(X.T @ (mass[:, None] * buffer)), np.eye(8), atol=1e-6)
+
+
 def test_subspace_step_keeps_two_blocks_beside_its_new_directions(monkeypatch):
     """Beside U and the factor (MKL's memory, not traced), a step holds the float32 new
     directions Y and two (N, step) float64 blocks: the right-hand sides and their
