@@ -64,8 +64,10 @@ SCHEMES = {"loop": "Loop", "flat": "flat"}
 DEFAULT_CASES = ["spot:loop:2", "spot:loop:3", "hand:loop:2", "part:flat:3"]
 
 
-OPERATORS = ["laplacian", "modified_dirichlet", "shells", "shells_normal"]
-"""The order of a mesh's rows in the results file."""
+def case_name(case: tuple[str, str, int]) -> str:
+    """The results file's name of a case, e.g. "hand Loop x2"."""
+    asset, scheme, level = case
+    return f"{asset} {SCHEMES[scheme]} x{level}"
 
 
 def _position(order: list[str], name: str) -> int:
@@ -109,6 +111,8 @@ def run(case: tuple[str, str, int], operator: str, accuracy: str, k: int) -> dic
 
 
 def main(argv=None) -> int:
+    from modalviewer.core.operators import OPERATOR_NAMES
+
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument(
         "--cases", type=parse_case, nargs="+", default=[parse_case(c) for c in DEFAULT_CASES]
@@ -121,7 +125,7 @@ def main(argv=None) -> int:
         help="keep the results file's rows of other cases or operators (re-measure some)",
     )
     args = p.parse_args(argv)
-    names = {f"{a} {SCHEMES[s]} x{level}" for a, s, level in args.cases}
+    names = {case_name(case) for case in args.cases}
     rows = []
     results = ROOT / "benchmarks" / "results" / "curved.json"
     if args.keep_others and results.is_file():  # rows of what is not run now stay
@@ -130,7 +134,8 @@ def main(argv=None) -> int:
             for r in json.loads(results.read_text())["rows"]
             if not (r["mesh"] in names and r["operator"] in args.operators)
         ]
-    order = [f"{a} {SCHEMES[s]} x{level}" for a, s, level in map(parse_case, DEFAULT_CASES)]
+    order = [case_name(parse_case(c)) for c in DEFAULT_CASES]
+    operators = list(OPERATOR_NAMES)  # a mesh's rows in the registry's order
     for case in args.cases:
         for operator in args.operators:
             exact = run(case, operator, "exact", args.k)
@@ -145,7 +150,7 @@ def main(argv=None) -> int:
                 for a, b in zip(fast["eigenvalues"][:m_fast], lam[:m_fast], strict=True)
             ]
             row = {
-                "mesh": f"{case[0]} {SCHEMES[case[1]]} x{case[2]}",
+                "mesh": case_name(case),
                 "vertices": exact["vertices"],
                 "operator": operator,
                 "k": args.k,
@@ -166,7 +171,7 @@ def main(argv=None) -> int:
             rows.append(row)
             print(json.dumps(row), flush=True)
             rows.sort(
-                key=lambda r: (_position(order, r["mesh"]), _position(OPERATORS, r["operator"]))
+                key=lambda r: (_position(order, r["mesh"]), _position(operators, r["operator"]))
             )
             save_result("curved", {"rows": rows})
     return 0
