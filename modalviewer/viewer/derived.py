@@ -391,7 +391,10 @@ class DerivedValues:
         cumulative = np.cumsum(areas) / areas.sum()
         i = int(np.searchsorted(cumulative, float(np.clip(share, 0.0, 1.0)) - 1e-12))
         value = float(d[order[min(i, len(order) - 1)]])
-        return float(np.clip(value / float(d.max()), 1e-4, 1.0))
+        # a few ulps up: the map compares d with fraction * max(d), whose rounding could
+        # otherwise fall just below ``value`` and leave its vertex out of the share
+        fraction = value / float(d.max()) * (1.0 + 4.0 * np.finfo(float).eps)
+        return float(np.clip(fraction, 1e-4, 1.0))
 
     # -------------------------------------------------------- pictures
     def mode_fields(self, spec: Spectrum, j: int) -> tuple[np.ndarray, np.ndarray]:

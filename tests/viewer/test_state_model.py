@@ -688,3 +688,26 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     assert "Coarse-to-fine" in message
     monkeypatch.setattr(model_module, "physical_memory", lambda: 1024)
     assert "Not even one mode fits" in m.refusal(key)
+
+
+def test_a_share_marks_its_boundary_vertex_whatever_the_rounding(model):
+    """The fraction of the largest distance that marks a share is compared with
+    ``fraction * max(d)``; for these numbers ``(v / m) * m < v`` in floating point, which
+    left the vertex at the share's boundary out (9.98 % marked for 10 % asked)."""
+    from modalviewer.core.laplacian import lumped_masses
+
+    state = model.state
+    areas = lumped_masses(state.mesh)
+    n = areas.shape[0]
+    v, m = 0.028319671145462966, 1.1242832764995638
+    assert (v / m) * m < v
+    j = n // 10
+    d = np.empty(n)
+    d[:j] = np.linspace(0.0, 0.5 * v, j)
+    d[j] = v
+    d[j + 1 :] = np.linspace(2 * v, m, n - j - 1)
+    share = float(np.cumsum(areas)[j] / areas.sum())
+    fraction = state.derived.threshold_for_share(share, d)
+    marked = float(areas[d <= fraction * d.max()].sum() / areas.sum())
+    assert marked >= share - 1e-12
+    assert marked == pytest.approx(share, abs=1e-12)  # and not the next vertex too
