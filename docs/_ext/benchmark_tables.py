@@ -246,11 +246,61 @@ def memory_check_table(more_modes: dict, curved: dict) -> str:
     for mesh, r, peak in runs:
         if peak is None:
             continue
-        predicted = operator_info(r["operator"]).predicted_peak_mb("exact", r["vertices"], r["k"])
+        info = operator_info(r["operator"])  # these runs kept their factors in core
+        predicted = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=False)
         lines.append(
             f"| {mesh} | {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} "
             f"| {r['k']} | {_thousands(peak)} MB | {_thousands(predicted)} MB "
             f"| {peak / predicted:.2f} |"
+        )
+    return "\n".join(lines)
+
+
+def big_solves_table(data: dict) -> str:
+    """``benchmarks.memory``: big exact solves with the factor in core and out of core,
+    beside the memory check's prediction for the same choice."""
+    from modalviewer.core.operators import operator_info
+
+    lines = [
+        "| mesh | operator | vertices | modes | memory limit | factor | seconds "
+        "| measured peak | predicted | largest residual | Mass-orthonormality "
+        "| eigenvalues against the first row |",
+        "|" + " --- |" * 12,
+    ]
+    for r in data["rows"]:
+        info = operator_info(r["operator"])
+        ooc = bool(r["factor_out_of_core"])
+        predicted = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=ooc)
+        limit = "half the machine" if r["limit_mb"] == "none" else f"{r['limit_mb']} MB"
+        factor = f"{_thousands(r['factor_mb'])} MB {'in a file' if ooc else 'in core'}"
+        lines.append(
+            f"| {r['mesh']} | {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} "
+            f"| {r['k']} | {limit} | {factor} | {r['seconds']:.0f} "
+            f"| {_thousands(r['peak_mb'])} MB | {_thousands(predicted)} MB "
+            f"| {r['max_residual']:.1e} | {r['mass_orthonormality']:.1e} "
+            f"| {r['largest_relative_difference']:.1e} |"
+        )
+    return "\n".join(lines)
+
+
+def factor_memory_table(data: dict) -> str:
+    """``benchmarks.factor_memory``: the factor's memory in core and out of core, the
+    plates the laws are fitted to and curved meshes beside the laws' predictions."""
+    from modalviewer.core.operators import operator_info
+
+    lines = [
+        "| mesh | operator | vertices | in core (law) | out of core (law) |",
+        "|" + " --- |" * 5,
+    ]
+    rows = [(f"plate {r['grid']} x {r['grid']}", r) for r in data["plates"]]
+    rows += [(r["mesh"], r) for r in data["curved"]]
+    for mesh, r in rows:
+        law = operator_info(r["operator"]).factor_memory
+        n = r["vertices"]
+        lines.append(
+            f"| {mesh} | {LABELS.get(r['operator'], r['operator'])} | {n} "
+            f"| {_thousands(r['in_core_mb'])} MB ({_thousands(law.in_core_mb(n))}) "
+            f"| {_thousands(r['out_of_core_mb'])} MB ({_thousands(law.out_of_core_mb(n))}) |"
         )
     return "\n".join(lines)
 
@@ -360,6 +410,8 @@ TABLES = {
     "scale": (["growth"], lambda: scale_figures(load("growth"))),
     "predictor": (["growth_k300"], lambda: predictor_table(load("growth_k300"))),
     "million": (["million"], lambda: million_table(load("million"))),
+    "big-solves": (["memory"], lambda: big_solves_table(load("memory"))),
+    "factor-memory": (["factor_memory"], lambda: factor_memory_table(load("factor_memory"))),
     "memory": (
         ["growth_k300", "curved"],
         lambda: memory_check_table(load("growth_k300"), load("curved")),

@@ -4,7 +4,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["GrowthLaw", "basis_columns", "exact_peak_mb"]
+__all__ = [
+    "FactorLaw",
+    "GrowthLaw",
+    "OUT_OF_CORE_TIME_FACTOR",
+    "basis_columns",
+    "exact_peak_mb",
+    "factor_goes_out_of_core",
+]
 
 MB = 2**20
 
@@ -64,3 +71,47 @@ class GrowthLaw:
         :data:`GROWTH_MODES` modes."""
         size = max(int(n_vertices), 1) / 1e5
         return self.peak_mb_at_100k * size**self.memory_exponent
+
+
+@dataclass(frozen=True)
+class FactorLaw:
+    """Memory (MB) of the exact solver's factorisation as powers of the mesh size: kept
+    in core, and out of core (PARDISO's symbolic data and working buffer, the factor in
+    a file), from PARDISO's analysis of the bumpy plates of 100k to 1M vertices
+    (``benchmarks/factor_memory.py``, ``benchmarks/results/factor_memory.json``)."""
+
+    in_core_mb_at_100k: float
+    in_core_exponent: float
+    out_of_core_mb_at_100k: float
+    out_of_core_exponent: float
+
+    def in_core_mb(self, n_vertices: int) -> float:
+        size = max(int(n_vertices), 1) / 1e5
+        return self.in_core_mb_at_100k * size**self.in_core_exponent
+
+    def out_of_core_mb(self, n_vertices: int) -> float:
+        size = max(int(n_vertices), 1) / 1e5
+        return self.out_of_core_mb_at_100k * size**self.out_of_core_exponent
+
+
+OUT_OF_CORE_TIME_FACTOR = 1.2
+"""An exact solve whose factor is out of core takes this times as long (its solves read
+the factor back from the file): measured on cheburashka Loop-subdivided three times
+(427k vertices, 3D shells, 300 modes, ``benchmarks/results/memory.json``)."""
+
+
+def factor_goes_out_of_core(
+    in_core_peak_mb: float, factor: FactorLaw | None, n_vertices: int, limit_mb: float | None
+) -> bool:
+    """Whether the exact solver will keep its factor in a file: where the in-core peak
+    is above the memory limit (:func:`.memory.memory_limit_mb`), out of core needs less,
+    and PARDISO (the only backend with an out-of-core mode) is there.  The solver
+    decides on the factor's real size (:func:`.eigen.factor_budget_mb`); this is the
+    same rule on the predicted sizes."""
+    if factor is None or limit_mb is None or in_core_peak_mb <= limit_mb:
+        return False
+    if factor.out_of_core_mb(n_vertices) >= factor.in_core_mb(n_vertices):
+        return False
+    from .factor import available_backends  # imported late: cost is imported by everything
+
+    return "pardiso" in available_backends()

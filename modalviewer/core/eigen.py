@@ -15,6 +15,9 @@ positive definite even when K is singular (constants, rigid motions).
 * One block step of inverse iteration on the converged vectors and a Rayleigh-Ritz step
   with K itself give exact Ritz values, Mass-orthonormal modes and residuals
   ``|K x - lambda M x| / |lambda M x|`` around 1e-10 on well-shaped meshes.
+* The solve plans to stay within a memory limit (:mod:`.memory`): where the factor
+  would not fit beside the Krylov basis, PARDISO keeps it in a file
+  (:func:`factor_budget_mb`, :mod:`.factor`); the modes are written over the basis.
 
 Every run is deterministic (fixed start block); every result carries its residuals.
 """
@@ -31,7 +34,9 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 from .factor import SPDSolver
-from .products import column_block_products
+from .memory import memory_limit_mb as default_memory_limit_mb
+from .memory import resident_mb
+from .products import column_block_products, pack_columns_in_place
 from .threads import single_blas_thread
 
 __all__ = [
@@ -136,6 +141,11 @@ class EigenResult:
     """Columns the shift-invert operator was applied to, refinement included."""
     null_dim: int = 0
     """The first ``null_dim`` pairs are the given exact null vectors (eigenvalue 0)."""
+    factor_mb: float | None = None
+    """Memory the factorisation needs in core (PARDISO's analysis), None if unknown."""
+    out_of_core: bool = False
+    """True if the factor did not fit the memory limit beside the Krylov basis and was
+    kept in a file (:mod:`.factor`)."""
 
 
 def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
@@ -190,17 +200,29 @@ def relative_residuals(
     return out
 
 
-def rounding_floors(K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray) -> np.ndarray:
+def rounding_floors(
+    K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray, columns=None
+) -> np.ndarray:
     """``eps * | |K| |x| | / (|lam| |M x|)`` per column: the relative residual that merely
     rounding x to double precision can cause (``|K dx| <= eps |K| |x|``), which no
     solver can go below.  It reaches 1e-4 for the lowest vibrations of fine meshes with a
     large spread of stiffness (cheburashka subdivided twice, 107k vertices, shells:
-    floors 0.6 to 2.2e-4, residuals 0.2 to 0.6 times them)."""
+    floors 0.6 to 2.2e-4, residuals 0.2 to 0.6 times them).
+
+    ``columns``: the columns of X to look at (``lam`` holds their eigenvalues); None:
+    all.  They are taken 32 at a time, so no copy of the chosen columns is made (300
+    shells modes of a 427k-vertex mesh: 3 GB each for the columns and their absolute
+    values)."""
     K_abs = abs(sp.csr_matrix(K))
-    out = np.empty(X.shape[1])
-    for cols, KX in column_block_products(K_abs, np.abs(X)):
-        MX = mass_diag[:, None] * X[:, cols]
-        out[cols] = np.linalg.norm(KX, axis=0) / np.linalg.norm(MX, axis=0)
+    columns = np.arange(X.shape[1]) if columns is None else np.asarray(columns, dtype=np.intp)
+    out = np.empty(columns.shape[0])
+    for start in range(0, columns.shape[0], 32):
+        chosen = columns[start : start + 32]
+        block = X[:, chosen]  # (N, 32)
+        MX = mass_diag[:, None] * block
+        np.abs(block, out=block)
+        KX = K_abs @ block
+        out[start : start + 32] = np.linalg.norm(KX, axis=0) / np.linalg.norm(MX, axis=0)
     return np.finfo(float).eps * out / np.maximum(np.abs(lam), np.finfo(float).tiny)
 
 
@@ -239,6 +261,7 @@ def solve_lowest(
     tol: float = 1e-10,
     block: int | None = None,
     null_space: sp.spmatrix | np.ndarray | None = None,
+    memory_limit_mb: float | None = None,
 ) -> EigenResult:
     """The k lowest eigenpairs of ``K x = lam diag(mass_diag) x``.
 
@@ -254,6 +277,10 @@ def solve_lowest(
         counted in k; the iteration works in their Mass-orthogonal complement (the start
         block and every solve are projected), so it cannot return them again or miss
         any.  With d >= k the first k are returned without any factorisation.
+    memory_limit_mb : the process's memory (MB) the solve plans to stay within; None:
+        :func:`.memory.memory_limit_mb`.  Where the factor would not fit beside the
+        Krylov basis and what the process already holds, PARDISO keeps it out of core
+        (slower solves, much less memory).
 
     Returns
     -------
@@ -286,6 +313,9 @@ def solve_lowest(
     columns = 0
     method, shift = "null space (no iteration)", 0.0
     lam, X = np.zeros(0), np.zeros((N, 0))
+    basis = None  # the Krylov basis array whose first columns hold the modes
+    solver_info = {"factor_mb": None, "out_of_core": False}
+    limit = default_memory_limit_mb() if memory_limit_mb is None else float(memory_limit_mb)
     if d < k:
         # the standard-form null vectors M^1/2 Z are orthonormal: project them out
         Y0 = sp.csr_matrix(sp.diags(np.sqrt(mass_diag)) @ Z)
@@ -300,10 +330,10 @@ def solve_lowest(
         if N - d > dense_limit:
             lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
             args = (K, mass_diag, inv_sqrt_m, k - d, lam_typical, report, tol, block, timer,
-                    project, N - d)  # fmt: skip
+                    project, N - d, limit, solver_info)  # fmt: skip
             try:
                 try:
-                    lam, X, shift, backend, columns = _shift_invert(
+                    lam, basis, shift, backend, columns = _shift_invert(
                         *args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL
                     )
                 except _NotConverged as failed:
@@ -315,9 +345,12 @@ def solve_lowest(
                     # undeflated shift does not, at the cost of a compressed spectrum.
                     # The columns counted include the failed attempt's.
                     report("retrying with a larger shift", 0.05)
-                    lam, X, shift, backend, columns = _shift_invert(*args, SHIFT_RTOL)
+                    lam, basis, shift, backend, columns = _shift_invert(*args, SHIFT_RTOL)
                     columns += failed.columns
                 method = f"shift-invert block Krylov-Schur ({backend})"
+                if solver_info["out_of_core"]:
+                    method += ", factor out of core"
+                X = basis[:, : lam.shape[0]]
             except _TooSmall:
                 lam = None
         if lam is None:
@@ -337,13 +370,31 @@ def solve_lowest(
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
     with timer("copy"):  # own row-major array ((n, 3, k) shells modes are then a view)
-        out = np.empty((N, k))
-        out[:, Zk.shape[1] :] = X
-        out[:, : Zk.shape[1]] = 0.0
+        d_out = Zk.shape[1]
+        if basis is not None:
+            # written over the Krylov basis, which is then shrunk to the modes: no (N, k)
+            # array beside the (N, 1.1 k + extra) basis (3.7 and 5.8 GB for 300 shells
+            # modes at 520k vertices)
+            del X
+            packed = pack_columns_in_place(basis, lam.shape[0], lead=d_out)
+            try:
+                del packed
+                basis.resize((N, k))  # refuses while another reference to it is alive
+                out = basis
+            except ValueError:
+                out = basis.reshape(-1)[: N * k].reshape(N, k).copy()
+            basis = None
+        else:
+            out = np.empty((N, k))
+            out[:, d_out:] = X
+        out[:, :d_out] = 0.0
         coo = Zk.tocoo()
         out[coo.row, coo.col] = coo.data
     res = np.concatenate([res_null, res_rest])
-    return EigenResult(all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1])
+    return EigenResult(
+        all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1],
+        solver_info["factor_mb"], solver_info["out_of_core"],
+    )  # fmt: skip
 
 
 def _null_vectors(null_space, N: int, mass_diag: np.ndarray) -> sp.csc_matrix:
@@ -396,10 +447,17 @@ def _dense_complement(K, mass_diag, Y0: sp.csr_matrix, k: int):
 
 
 def factor_below_spectrum(
-    K, mass_diag, lam_typical, report, timer, relative: float = SHIFT_RTOL
+    K,
+    mass_diag,
+    lam_typical,
+    report,
+    timer,
+    relative: float = SHIFT_RTOL,
+    memory_budget_mb: float | None = None,
 ) -> tuple[SPDSolver, float]:
     """Factor ``K - shift * M`` with ``shift = -relative * lam_typical`` just below zero
-    (K may be singular), moving further down while the factorisation fails."""
+    (K may be singular), moving further down while the factorisation fails.
+    ``memory_budget_mb``: the memory the factor may take in core (:class:`.SPDSolver`)."""
     # Far below the first non-zero mode, yet factorisable.  Scaled by the typical diagonal
     # ratio, not the largest: one sliver triangle can make the largest 1e12 times bigger.
     shift = -relative * lam_typical
@@ -407,7 +465,8 @@ def factor_below_spectrum(
         report("factorising", 0.02)
         try:
             with timer("factorisation"):
-                return SPDSolver(K - shift * sp.diags(mass_diag)), shift
+                shifted = K - shift * sp.diags(mass_diag)
+                return SPDSolver(shifted, memory_budget_mb=memory_budget_mb), shift
         except np.linalg.LinAlgError:
             shift *= 100.0  # move further below the spectrum and try again
     raise EigenError(
@@ -662,14 +721,33 @@ def krylov_sizes(k: int, n_free: int, block: int | None = None) -> tuple[int, in
     return k_work, block, max_basis, k_work + (max_basis - k_work) // 3
 
 
+def factor_budget_mb(limit_mb: float | None, n: int, basis_columns: int, block: int):
+    """The memory (MB) a factor may take so that the solve stays within ``limit_mb``:
+    what is left after this process's resident memory, the Krylov basis array and the
+    iteration's (N, block) temporaries (at most :data:`TEMPORARY_BLOCKS` of them,
+    the refinement's double blocks included); None if there is no limit."""
+    if limit_mb is None:
+        return None
+    arrays = 8.0 * n * (basis_columns + TEMPORARY_BLOCKS * block) / 2**20
+    return limit_mb - resident_mb() - arrays
+
+
+TEMPORARY_BLOCKS = 8
+"""(N, block) arrays alive beside the basis during the iteration: the operator's
+scaled right-hand sides, PARDISO's solution, the orthogonalisation's copy and its
+Cholesky-QR products; the refinement's four (N, 2 block) ones."""
+
+
 def _shift_invert(
     K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer, project, n_free,
-    shift_rtol,
+    limit_mb, solver_info, shift_rtol,
 ):  # fmt: skip
     """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2`` in the
     complement of the deflated null vectors (``project`` removes them, ``n_free`` is the
-    complement's dimension): (eigenvalues, vectors (a view into the Krylov basis),
-    shift, backend name, operator columns)."""
+    complement's dimension): (eigenvalues, the Krylov basis array (N, w) whose first k
+    columns are the Mass-orthonormal modes, shift, backend name, operator columns).
+    The factor keeps within the memory ``limit_mb`` leaves (:func:`factor_budget_mb`);
+    ``solver_info`` receives its "factor_mb" and "out_of_core"."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
     # A few more pairs than requested: the last requested pairs then converge as fast
@@ -677,7 +755,11 @@ def _shift_invert(
     k_work, block, max_basis, keep = krylov_sizes(k, n_free, block)
     if max_basis + block > n_free:
         raise _TooSmall()  # the basis would not fit: the dense solver is the right tool
-    solver, shift = factor_below_spectrum(K, mass_diag, lam_typical, report, timer, shift_rtol)
+    budget = factor_budget_mb(limit_mb, N, max_basis + block, block)
+    solver, shift = factor_below_spectrum(
+        K, mass_diag, lam_typical, report, timer, shift_rtol, budget
+    )
+    solver_info.update(factor_mb=solver.factor_mb, out_of_core=solver.out_of_core)
 
     def apply_op(V: np.ndarray) -> np.ndarray:
         # the null vectors are an invariant subspace of OP, with its largest eigenvalue
@@ -719,7 +801,8 @@ def _shift_invert(
     report("orthonormalising", 0.95)
     with timer("rayleigh_ritz"):
         lam = _rayleigh_ritz_in_place(K, inv_sqrt_m, Y)
-    return lam, Y, shift, backend, columns
+    basis = Y.base
+    return lam, basis, shift, backend, columns
 
 
 GRAM_CONDITION_LIMIT = 1e4

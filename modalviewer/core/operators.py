@@ -16,7 +16,13 @@ from __future__ import annotations
 import importlib
 from dataclasses import dataclass
 
-from .cost import GrowthLaw, exact_peak_mb
+from .cost import (
+    OUT_OF_CORE_TIME_FACTOR,
+    FactorLaw,
+    GrowthLaw,
+    exact_peak_mb,
+    factor_goes_out_of_core,
+)
 
 __all__ = [
     "OperatorInfo",
@@ -93,6 +99,9 @@ class OperatorInfo:
     exact_growth, preview_growth : measured time and memory of the exact solve and of
         the fast preview against mesh size (:class:`.cost.GrowthLaw`), which predict
         whether a preview pays.
+    factor_memory : the exact solver's factor in core and out of core against mesh
+        size (:class:`.cost.FactorLaw`), which predicts the memory of a solve whose
+        factor goes out of core.
     signature_word : the signature (and distance) its spectrum defines, in words
         ("heat kernel"), or None.
     """
@@ -109,6 +118,7 @@ class OperatorInfo:
     preview: SpaceSettings
     exact_growth: GrowthLaw
     preview_growth: GrowthLaw
+    factor_memory: FactorLaw | None = None
     signature_word: str | None = None
 
     @property
@@ -123,21 +133,56 @@ class OperatorInfo:
         """:attr:`exact_growth` ("exact") or :attr:`preview_growth` ("fast preview")."""
         return {"exact": self.exact_growth, "fast preview": self.preview_growth}[accuracy]
 
-    def predicted_seconds(self, accuracy: str, n_vertices: int, k: int) -> float:
+    def predicted_seconds(
+        self, accuracy: str, n_vertices: int, k: int, out_of_core: bool | None = None
+    ) -> float:
         """Seconds a ``compute_spectrum(mesh, name, k, accuracy=accuracy)`` ("exact" or
         "fast preview") on a mesh of ``n_vertices`` is predicted to take on the
-        reference machine (:meth:`growth`)."""
-        return self.growth(accuracy).seconds(n_vertices, k)
+        reference machine (:meth:`growth`); an exact solve whose factor goes out of
+        core (``out_of_core``; None: as :meth:`factor_out_of_core` predicts) takes
+        :data:`.cost.OUT_OF_CORE_TIME_FACTOR` times as long."""
+        seconds = self.growth(accuracy).seconds(n_vertices, k)
+        if accuracy == "exact" and self._out_of_core(n_vertices, k, out_of_core):
+            seconds *= OUT_OF_CORE_TIME_FACTOR
+        return seconds
 
-    def predicted_peak_mb(self, accuracy: str, n_vertices: int, k: int = 100) -> float:
+    def predicted_peak_mb(
+        self, accuracy: str, n_vertices: int, k: int = 100, out_of_core: bool | None = None
+    ) -> float:
         """Peak memory (MB) of that computation with ``k`` modes: the exact solve's law
-        with the arrays that grow with k (:func:`.cost.exact_peak_mb`); the fast
+        with the arrays that grow with k (:func:`.cost.exact_peak_mb`), less the factor's
+        in-core size plus its out-of-core size where the factor goes out of core
+        (``out_of_core``; None: as :meth:`factor_out_of_core` predicts); the fast
         preview's (measured at 100 modes) in proportion to k above that, for its
         (N, k) arrays of modes."""
         law = self.growth(accuracy)
-        if accuracy == "exact":
-            return exact_peak_mb(law, n_vertices, self.unknowns(n_vertices), k)
-        return law.peak_mb(n_vertices) * max(1.0, k / 100)
+        if accuracy != "exact":
+            return law.peak_mb(n_vertices) * max(1.0, k / 100)
+        peak = exact_peak_mb(law, n_vertices, self.unknowns(n_vertices), k)
+        if self._out_of_core(n_vertices, k, out_of_core):
+            factor = self.factor_memory
+            peak += factor.out_of_core_mb(n_vertices) - factor.in_core_mb(n_vertices)
+        return peak
+
+    def factor_out_of_core(
+        self, n_vertices: int, k: int = 100, limit_mb: float | None = None
+    ) -> bool:
+        """Whether the exact solve of ``k`` modes on ``n_vertices`` is predicted to keep
+        its factor in a file: its in-core peak above ``limit_mb`` (None: this machine's
+        :func:`.memory.memory_limit_mb`), as the solver decides
+        (:func:`.cost.factor_goes_out_of_core`)."""
+        if limit_mb is None:
+            from .memory import memory_limit_mb
+
+            limit_mb = memory_limit_mb()
+        law = self.growth("exact")
+        peak = exact_peak_mb(law, n_vertices, self.unknowns(n_vertices), k)
+        return factor_goes_out_of_core(peak, self.factor_memory, n_vertices, limit_mb)
+
+    def _out_of_core(self, n_vertices: int, k: int, out_of_core: bool | None) -> bool:
+        if out_of_core is None:
+            return self.factor_out_of_core(n_vertices, k)
+        return bool(out_of_core) and self.factor_memory is not None
 
     @property
     def null_space_needs_normals(self) -> bool:
@@ -204,6 +249,17 @@ _GROWTH: dict[tuple[str, str], GrowthLaw] = {
     ("shells_normal", "fast preview"): GrowthLaw(6.529, 0.936, 592.6, 0.79, 0.52),
 }
 
+# factor_memory: the fits of benchmarks/results/factor_memory.json (PARDISO's analysis of
+# the bumpy plates of 100k to 1M vertices), made by `python -m benchmarks.factor_memory`;
+# tests/core/test_cost.py checks that they are those fits.  Curved meshes fill in 1.1 to
+# 1.2 times more (spot Loop x3, hand Loop x2: the same file's curved rows).
+_FACTOR: dict[str, FactorLaw] = {
+    "laplacian": FactorLaw(60.0, 1.042, 106.8, 0.689),
+    "modified_dirichlet": FactorLaw(60.0, 1.042, 106.8, 0.689),
+    "shells": FactorLaw(855.7, 1.087, 519.8, 0.952),
+    "shells_normal": FactorLaw(110.9, 1.082, 125.8, 0.752),
+}
+
 OPERATOR_INFO: dict[str, OperatorInfo] = {
     info.name: info
     for info in (
@@ -220,6 +276,7 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             preview=_SCALAR_SPACE,
             exact_growth=_GROWTH["laplacian", "exact"],
             preview_growth=_GROWTH["laplacian", "fast preview"],
+            factor_memory=_FACTOR["laplacian"],
             signature_word="heat kernel",
         ),
         OperatorInfo(
@@ -235,6 +292,7 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             preview=_SCALAR_SPACE,
             exact_growth=_GROWTH["modified_dirichlet", "exact"],
             preview_growth=_GROWTH["modified_dirichlet", "fast preview"],
+            factor_memory=_FACTOR["modified_dirichlet"],
             signature_word="feature",
         ),
         OperatorInfo(
@@ -250,6 +308,7 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             preview=_SHELLS_SPACE,
             exact_growth=_GROWTH["shells", "exact"],
             preview_growth=_GROWTH["shells", "fast preview"],
+            factor_memory=_FACTOR["shells"],
             signature_word="vibration",
         ),
         OperatorInfo(
@@ -265,6 +324,7 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             preview=_NORMAL_SHELLS_SPACE,
             exact_growth=_GROWTH["shells_normal", "exact"],
             preview_growth=_GROWTH["shells_normal", "fast preview"],
+            factor_memory=_FACTOR["shells_normal"],
         ),
     )
 }

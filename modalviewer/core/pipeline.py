@@ -165,7 +165,7 @@ def compute_spectrum(
     # modes above the accuracy well-shaped meshes reach: how close to rounding are they?
     loose = np.flatnonzero(nonzero & (result.residuals > min(WELL_SHAPED_RESIDUAL, RESIDUAL_LIMIT)))
     floors_loose = (
-        rounding_floors(K, mass, result.eigenvalues[loose], result.vectors[:, loose])
+        rounding_floors(K, mass, result.eigenvalues[loose], result.vectors, columns=loose)
         if loose.size
         else np.zeros(0)
     )
@@ -206,6 +206,8 @@ def compute_spectrum(
             "seconds_total": time.perf_counter() - started,
             "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
             "operator_columns": result.operator_columns,
+            "factor_mb": result.factor_mb,
+            "factor_out_of_core": result.out_of_core,
             "null_space_dimension": result.null_dim,
             "modes_at_rounding_floor": at_floor,
             "worst_residual_rounding_floor": worst_floor,

@@ -16,6 +16,7 @@ from scipy.sparse import _sparsetools
 __all__ = [
     "ROW_BLOCK",
     "column_block_products",
+    "pack_columns_in_place",
     "row_blocks",
     "row_halves",
     "threaded_product",
@@ -197,4 +198,21 @@ def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384) -> np.ndarr
     for start in range(0, n, chunk):
         rows = slice(start, min(start + chunk, n))
         out[rows] = Y[rows, :m].copy() if isinstance(A, int) else Y[rows] @ A
+    return out
+
+
+def pack_columns_in_place(B: np.ndarray, m: int, lead: int = 0, chunk: int = 16384):
+    """B's first m columns moved to columns ``lead`` to ``lead + m`` of a C-contiguous
+    (N, lead + m) array on B's own memory (a C-contiguous (N, w) array with
+    ``lead + m <= w``), which is returned; its first ``lead`` columns are left
+    uninitialised and B itself meaningless.  Row chunk by chunk: row i of the result
+    ends at (i + 1)(lead + m) <= (i + 1) w, so a chunk's writes never reach rows not
+    read yet."""
+    n, w = B.shape
+    if lead + m > w or not B.flags.c_contiguous:
+        raise ValueError("B must be C-contiguous with at least lead + m columns")
+    out = B.reshape(-1)[: n * (lead + m)].reshape(n, lead + m)
+    for start in range(0, n, chunk):
+        rows = slice(start, min(start + chunk, n))
+        out[rows, lead:] = B[rows, :m].copy()
     return out

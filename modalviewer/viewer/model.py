@@ -9,7 +9,6 @@ asked to (``show=True``) and the display has not changed since the request.
 
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -19,6 +18,7 @@ import numpy as np
 from ..coarsen import COARSE_FRACTION
 from ..core.cache import SpectrumCache
 from ..core.eigen import Cancelled
+from ..core.memory import physical_memory_mb
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
 from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
@@ -106,11 +106,9 @@ class ComputeRefused(ValueError):
 
 
 def physical_memory() -> int:
-    """Bytes of physical memory, or 0 if unknown."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return 0
+    """Bytes of physical memory, or 0 if unknown (:func:`.core.memory.physical_memory_mb`)."""
+    megabytes = physical_memory_mb()
+    return 0 if megabytes is None else int(megabytes * 2**20)
 
 
 def memory_needed(key: SpectrumKey, n_vertices: int) -> float:

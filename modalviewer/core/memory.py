@@ -1,0 +1,58 @@
+"""How much memory a computation may use, and how much this process holds now.
+
+The exact solver keeps its working set within :func:`memory_limit_mb`: where the
+factorisation would not fit beside the Krylov basis, the factor goes out of core
+(:mod:`.factor`).  The limit is half this machine's memory, so a computation leaves room
+for the viewer, the rest of the desktop and the system's file cache (which then holds the
+out-of-core factor); ``MODALVIEWER_MEMORY_LIMIT_MB`` sets it explicitly.
+"""
+
+from __future__ import annotations
+
+import os
+
+__all__ = ["MEMORY_LIMIT_SHARE", "memory_limit_mb", "physical_memory_mb", "resident_mb"]
+
+MEMORY_LIMIT_SHARE = 0.5
+"""The share of this machine's memory a computation plans to stay within."""
+
+MB = 2**20
+
+
+def physical_memory_mb() -> float | None:
+    """This machine's memory in MB, or None where the system does not say."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / MB
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def memory_limit_mb() -> float | None:
+    """``MODALVIEWER_MEMORY_LIMIT_MB`` if set (a positive number), else
+    :data:`MEMORY_LIMIT_SHARE` of :func:`physical_memory_mb` (None if unknown)."""
+    text = os.environ.get("MODALVIEWER_MEMORY_LIMIT_MB", "").strip()
+    if text:
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(
+                f"MODALVIEWER_MEMORY_LIMIT_MB must be a number of megabytes, got {text!r}"
+            ) from None
+        if value <= 0:
+            raise ValueError(f"MODALVIEWER_MEMORY_LIMIT_MB must be positive, got {text!r}")
+        return value
+    physical = physical_memory_mb()
+    return None if physical is None else MEMORY_LIMIT_SHARE * physical
+
+
+def resident_mb() -> float:
+    """Memory this process holds now (resident set, MB): ``/proc/self/statm`` on Linux,
+    else the peak so far (``getrusage``), which is never less."""
+    try:
+        with open("/proc/self/statm") as f:
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / MB
+    except (OSError, ValueError, IndexError):
+        import resource  # not on Windows, where /proc is not either
+
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        return peak / 1024.0 if os.uname().sysname == "Linux" else peak / MB
