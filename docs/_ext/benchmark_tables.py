@@ -264,10 +264,14 @@ def big_solves_table(data: dict) -> str:
     lines = [
         "| mesh | operator | vertices | modes | memory limit | factor | seconds "
         "| measured peak | predicted | largest residual | Mass-orthonormality "
-        "| eigenvalues against the first row |",
+        "| eigenvalues against the mesh's first run |",
         "|" + " --- |" * 12,
     ]
+    seen = set()
     for r in data["rows"]:
+        run = (r["mesh"], r["operator"], r["k"])
+        difference = f"{r['largest_relative_difference']:.1e}" if run in seen else "(that run)"
+        seen.add(run)
         info = operator_info(r["operator"])
         ooc = bool(r["factor_out_of_core"])
         predicted = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=ooc)
@@ -277,8 +281,7 @@ def big_solves_table(data: dict) -> str:
             f"| {r['mesh']} | {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} "
             f"| {r['k']} | {limit} | {factor} | {r['seconds']:.0f} "
             f"| {_thousands(r['peak_mb'])} MB | {_thousands(predicted)} MB "
-            f"| {r['max_residual']:.1e} | {r['mass_orthonormality']:.1e} "
-            f"| {r['largest_relative_difference']:.1e} |"
+            f"| {r['max_residual']:.1e} | {r['mass_orthonormality']:.1e} | {difference} |"
         )
     return "\n".join(lines)
 
@@ -384,6 +387,21 @@ def scale_figures(data: dict) -> str:
     return "\n".join(lines)
 
 
+def big_solves_figures(data: dict) -> str:
+    """The README's memory figures: ``benchmarks.memory``'s runs, short."""
+    lines = [
+        "| mesh, 3D shells | modes | factor | time | peak memory |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for r in data["rows"]:
+        where = "out of core" if r["factor_out_of_core"] else "in core"
+        lines.append(
+            f"| {r['mesh']} ({r['vertices']:,} vertices) | {r['k']} | {where} "
+            f"| {r['seconds']:.0f} s | {r['peak_mb'] / 1024:.1f} GB |".replace(",", " ")
+        )
+    return "\n".join(lines)
+
+
 #: Every generated table: its name in the page's markers -> (JSON files, the table).
 TABLES = {
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),
@@ -411,6 +429,7 @@ TABLES = {
     "predictor": (["growth_k300"], lambda: predictor_table(load("growth_k300"))),
     "million": (["million"], lambda: million_table(load("million"))),
     "big-solves": (["memory"], lambda: big_solves_table(load("memory"))),
+    "memory-figures": (["memory"], lambda: big_solves_figures(load("memory"))),
     "factor-memory": (["factor_memory"], lambda: factor_memory_table(load("factor_memory"))),
     "memory": (
         ["growth_k300", "curved"],
@@ -418,7 +437,7 @@ TABLES = {
     ),
 }
 
-README_TABLES = ("scale",)
+README_TABLES = ("scale", "memory-figures")
 """The tables marked in README.md (the others are on the performance page)."""
 
 
