@@ -92,9 +92,11 @@ def available_backends() -> list[str]:
 
 
 OUT_OF_CORE_MARGIN = 1.1
-"""The out-of-core working buffer is this times PARDISO's stated minimum (symbolic data
-plus its smallest buffer, ``iparm[15] + iparm[62]`` KB), plus 64 MB: with exactly the
-minimum the numerical factorisation can still fail for lack of memory (error -2)."""
+OUT_OF_CORE_EXTRA_MB = 64.0
+"""The out-of-core working buffer is OUT_OF_CORE_MARGIN times PARDISO's stated minimum
+(symbolic data plus its smallest buffer, ``iparm[15] + iparm[62]`` KB) plus this: with
+exactly the minimum the numerical factorisation can fail for lack of memory (error -2;
+309k-unknown shells Hessian: 400 MB failed where the minimum was 432 MB)."""
 
 _OOC_ENVIRONMENT = threading.Lock()
 """PARDISO reads its out-of-core folder and buffer size from the environment when it
@@ -188,7 +190,8 @@ class _Pardiso:
         # smallest out-of-core buffer (KB)
         self.in_core_mb = (int(ip[15]) + int(ip[16])) / 1024.0
         self.factor_file_mb = int(ip[16]) / 1024.0
-        self.out_of_core_mb = OUT_OF_CORE_MARGIN * (int(ip[15]) + int(ip[62])) / 1024.0 + 64
+        minimum_mb = (int(ip[15]) + int(ip[62])) / 1024.0
+        self.out_of_core_mb = OUT_OF_CORE_MARGIN * minimum_mb + OUT_OF_CORE_EXTRA_MB
         if not factorise:
             return
         if memory_budget_mb is not None and self.in_core_mb > max(
@@ -213,12 +216,28 @@ class _Pardiso:
                             os.environ.pop(key, None)
                         else:
                             os.environ[key] = value
+            if error not in (0, -4):
+                # out of core failed (buffer too small: -2, file errors: -10, -11): in
+                # core it may still fit, and the caller must not read this as indefinite
+                self._factor_in_core_again()
+                error, _ = self._call(12, dummy)
         if error == -4:
             self.release()
             raise np.linalg.LinAlgError("matrix is not positive definite")
         if error != 0:
             self.release()
             raise np.linalg.LinAlgError(f"PARDISO factorisation failed (error {error})")
+
+    def _factor_in_core_again(self) -> None:
+        """Drop a failed out-of-core factorisation and its folder: a fresh handle with
+        the in-core setting (the next call must be phase 12).  The failed handle is not
+        released: PARDISO's release of it crashed the process in 1 of 5 runs (error -2,
+        64k unknowns), so its analysis's memory is left to the process's end."""
+        self._pt = np.zeros(64, dtype=np.int64)
+        self._iparm[59] = 0
+        self.out_of_core = False
+        self._remove_folder()
+        self._folder = None
 
     def _out_of_core_folder(self) -> str | None:
         """A new folder for the factor file, or None (the factor stays in core) where

@@ -222,3 +222,18 @@ def test_the_modes_are_right_when_the_basis_cannot_be_shrunk_in_place(monkeypatc
     assert held and result.vectors.flags.owndata and result.vectors.shape == (3600, 20)
     np.testing.assert_array_equal(result.vectors, reference.vectors)
     np.testing.assert_array_equal(result.eigenvalues, reference.eigenvalues)
+
+
+@needs_pardiso
+def test_a_failed_out_of_core_factorisation_falls_back_to_core(tmp_path, monkeypatch):
+    # a working buffer below PARDISO's minimum makes the out-of-core factorisation fail
+    # (error -2); the factor is then made in core instead of being reported indefinite
+    monkeypatch.setenv("MODALVIEWER_FACTOR_DIR", str(tmp_path))
+    monkeypatch.setattr(factor_module, "OUT_OF_CORE_MARGIN", 0.2)
+    monkeypatch.setattr(factor_module, "OUT_OF_CORE_EXTRA_MB", 0.0)
+    A = _laplacian_3d(40)
+    solver = SPDSolver(A, memory_budget_mb=1.0)
+    assert not solver.out_of_core
+    assert not list(tmp_path.iterdir())  # its folder is gone
+    B = np.random.default_rng(1).standard_normal((A.shape[0], 3))
+    assert np.linalg.norm(A @ solver.solve(B) - B) <= 1e-10 * np.linalg.norm(B)
