@@ -256,12 +256,12 @@ def _run(args) -> int:
                 f"upper bounds, largest relative error estimated at {spec.estimated_error:.1%} "
                 "(estimated from below, not a bound)"
             )
-        from .viewer.model import residual_text
+        from .viewer.model import memory_text, residual_text
 
         print(
             f"{Path(args.mesh).name}: {spec.k} {args.operator} modes, eigenvalues "
             f"{spec.eigenvalues[0]:.6g} .. {spec.eigenvalues[-1]:.6g}, "
-            f"{residual_text(spec)}"
+            f"{residual_text(spec)}{memory_text(spec)}"
         )
         if spec.parameters.get("null_space"):
             print(f"null space: {spec.parameters['null_space']}")

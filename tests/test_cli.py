@@ -258,3 +258,37 @@ def test_compute_refuses_what_does_not_fit_and_says_what_would(tmp_path, monkeyp
     err = capsys.readouterr().err
     assert code == 1 and "GiB of memory" in err and "modes fit" in err
     assert not (tmp_path / "s.npz").exists()
+
+
+def test_compute_says_when_the_factor_was_kept_on_disk(tmp_path):
+    # 40k vertices, 120k unknowns: the shells factor (about 300 MB in core) does not fit
+    # a 1 MB limit, so it goes out of core; the spectrum is the one computed in core
+    from modalviewer.core.demo_shapes import bumpy_plate
+    from modalviewer.core.factor import available_backends
+    from modalviewer.viewer.model import OUT_OF_CORE_WORDS
+
+    if "pardiso" not in available_backends():
+        pytest.skip("out of core is PARDISO's (the mkl wheel)")
+    plate = bumpy_plate(200)
+    path = tmp_path / "plate.obj"
+    lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in plate.vertices]
+    path.write_text("\n".join(lines + [f"f {a} {b} {c}" for a, b, c in plate.faces + 1]) + "\n")
+    runs = {}
+    for name, limit in (("tight", "1"), ("free", "1000000")):
+        env = {
+            **os.environ,
+            "MODALVIEWER_CACHE": str(tmp_path / f"cache-{name}"),
+            "MODALVIEWER_MEMORY_LIMIT_MB": limit,
+            "MODALVIEWER_FACTOR_DIR": str(tmp_path),
+        }
+        out = tmp_path / f"{name}.npz"
+        r = _run("compute", path, "--operator", "shells", "-k", 20, "-o", out, env=env)
+        assert r.returncode == 0, r.stderr
+        runs[name] = (r.stdout, mv.load_spectrum(out))
+    assert OUT_OF_CORE_WORDS in runs["tight"][0]
+    assert OUT_OF_CORE_WORDS not in runs["free"][0]
+    assert runs["tight"][1].parameters["factor_out_of_core"]
+    np.testing.assert_allclose(
+        runs["tight"][1].eigenvalues, runs["free"][1].eigenvalues, rtol=1e-12, atol=1e-9
+    )
+    assert not list(tmp_path.glob("modalviewer-factor-*"))  # the factor files are gone

@@ -556,6 +556,17 @@ def worst_residual(spec: Spectrum) -> float:
     return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
 
 
+OUT_OF_CORE_WORDS = "its factorisation was kept on disk to stay within the memory limit"
+"""What a spectrum whose solve kept its factor out of core says of it (the status line
+and ``modalviewer compute``)."""
+
+
+def memory_text(spec: Spectrum) -> str:
+    """``"; ..."`` + :data:`OUT_OF_CORE_WORDS` where the exact solve kept its factor out
+    of core (the reason it took longer), else ``""``."""
+    return f"; {OUT_OF_CORE_WORDS}" if spec.parameters.get("factor_out_of_core") else ""
+
+
 def residual_text(spec: Spectrum) -> str:
     """'largest relative residual 1.3e-05' and, where that is above what well-shaped
     meshes reach, the mode's rounding floor: the residual that rounding the mode to

@@ -45,7 +45,13 @@ from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distanc
 from ..core.spectrum import Spectrum
 from ..repair import repair_for_failure, repair_unavailable
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
-from .model import ComputeRefused, ViewerModel, predicted_seconds, residual_text
+from .model import (
+    ComputeRefused,
+    ViewerModel,
+    memory_text,
+    predicted_seconds,
+    residual_text,
+)
 from .state import SpectrumKey
 from .wording import percent_text
 
@@ -408,7 +414,7 @@ class Viewer:
             quality = (
                 f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
                 if spec.is_preview
-                else residual_text(spec)
+                else residual_text(spec) + memory_text(spec)
             )
             self._status(f"{job.description} in {job.seconds:.1f} s; {quality}.", 15000)
         elif job.status == DONE and not isinstance(job, RepairJob):
