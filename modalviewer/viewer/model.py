@@ -556,7 +556,7 @@ def worst_residual(spec: Spectrum) -> float:
     return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
 
 
-OUT_OF_CORE_WORDS = "its factorisation was kept on disk to stay within the memory limit"
+OUT_OF_CORE_WORDS = "factor kept on disk (memory limit)"
 """What a spectrum whose solve kept its factor out of core says of it (the status line
 and ``modalviewer compute``)."""
 

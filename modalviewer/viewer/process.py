@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.eigen import Cancelled
+from ..core.factor import remove_stale_factor_folders
 from ..core.mesh import Mesh
 from ..core.spectrum import load_spectrum
 
@@ -71,6 +72,9 @@ def _run_child(argv: list[str], progress, cancel, what: str) -> None:
         if child.poll() is None:
             child.kill()
         child.wait()
+        # a killed (cancelled) solve cannot remove its out-of-core factor file: it is
+        # the folder of a process that has ended now
+        remove_stale_factor_folders()
     if error is not None:
         raise RuntimeError(error)
     if child.returncode != 0:

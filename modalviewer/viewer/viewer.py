@@ -414,9 +414,13 @@ class Viewer:
             quality = (
                 f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
                 if spec.is_preview
-                else residual_text(spec) + memory_text(spec)
+                else residual_text(spec)
             )
-            self._status(f"{job.description} in {job.seconds:.1f} s; {quality}.", 15000)
+            # the disk note next to the time it explains: the status bar cuts long lines
+            self._status(
+                f"{job.description} in {job.seconds:.1f} s{memory_text(spec)}; {quality}.",
+                15000,
+            )
         elif job.status == DONE and not isinstance(job, RepairJob):
             self._status(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
         elif job.status == FAILED:

@@ -711,3 +711,34 @@ def test_a_share_marks_its_boundary_vertex_whatever_the_rounding(model):
     marked = float(areas[d <= fraction * d.max()].sum() / areas.sum())
     assert marked >= share - 1e-12
     assert marked == pytest.approx(share, abs=1e-12)  # and not the next vertex too
+
+
+def test_a_cancelled_child_leaves_no_factor_folder(tmp_path, monkeypatch):
+    """A solve killed by Cancel cannot remove its out-of-core factor file; the viewer
+    removes the folders of ended processes once its child has ended."""
+    from modalviewer.core.eigen import Cancelled
+    from modalviewer.core.factor import FOLDER_PREFIX
+    from modalviewer.viewer import process
+
+    factors = tmp_path / "factors"
+    factors.mkdir()
+    (tmp_path / "fake_solver.py").write_text(
+        "import json, os, sys, time\n"
+        f"folder = os.path.join({str(factors)!r}, '{FOLDER_PREFIX}' + str(os.getpid()) + '-x')\n"
+        "os.mkdir(folder)\n"
+        "open(os.path.join(folder, 'mkl_pardiso_lnz_0_0.bin'), 'wb').write(b'0' * 1000)\n"
+        "print(json.dumps({'stage': 'solving', 'fraction': 0.5}), flush=True)\n"
+        "time.sleep(60)\n"
+    )
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    monkeypatch.setenv("MODALVIEWER_FACTOR_DIR", str(factors))
+    stages = []
+
+    def cancel() -> bool:
+        return bool(stages)  # once the child is solving, with its factor file written
+
+    with pytest.raises(Cancelled):
+        process._run_child(["fake_solver"], lambda s, f: s != "starting" and stages.append(s),
+                           cancel, "computation")  # fmt: skip
+    assert stages == ["solving"]
+    assert not list(factors.iterdir())
