@@ -39,9 +39,11 @@ from .eigen import (
     ProgressFn,
     StageTimer,
     factor_below_spectrum,
+    factor_budget_mb,
     zero_modes,
 )
 from .factor import SPDSolver
+from .memory import memory_limit_mb
 from .mesh import Mesh
 from .nullspace import null_space
 from .operators import OPERATOR_INFO, SpaceSettings, operator_info
@@ -616,12 +618,18 @@ smooth space misses), where a shift scaled by the operator's diagonal would not.
 def _factor_below(K, mass: np.ndarray, lam: np.ndarray, lam_scale: float):
     """SPDSolver of ``K - shift M`` with ``shift = -REFINE_SHIFT * (lowest non-zero
     lam)``, moving further down while the factorisation fails
-    (:func:`.eigen.factor_below_spectrum`); None if it never succeeds."""
+    (:func:`.eigen.factor_below_spectrum`); None if it never succeeds.  The factor keeps
+    within the memory limit (:func:`.memory.memory_limit_mb`) beside what the process
+    holds (the Ritz buffer is made before it) and the subspace step's arrays: the new
+    directions in float32 (half an (N, c) float64 array) and its (N, w) blocks; where
+    it would not fit, it goes out of core (:mod:`.factor`)."""
     positive = lam[~zero_modes(lam, lam_scale)]
     lowest = float(positive.min() if positive.size else lam_scale)
+    n = K.shape[0]
+    budget = factor_budget_mb(memory_limit_mb(), n, lam.shape[0] // 2, _block_columns(n))
     try:
         return factor_below_spectrum(
-            K, mass, lowest, lambda *_: None, StageTimer(), relative=REFINE_SHIFT
+            K, mass, lowest, lambda *_: None, StageTimer(), REFINE_SHIFT, budget
         )[0]
     except EigenError:
         return None
@@ -745,6 +753,7 @@ def preview_spectrum(
             report("preview: refining", 0.94 + 0.02 * refinement["steps"])
             lam_b = _subspace_step(K, mass, solver, lam_b, U, live=lam_b.shape[0])
             refinement["steps"] += 1
+        refinement["factor_out_of_core"] = bool(solver is not None and solver.out_of_core)
         del solver  # the factor, before the residuals are formed
         lam = lam_b[:c]
         del U  # the buffer's first c columns, moved to its start, then the buffer shrunk

@@ -237,3 +237,27 @@ def test_a_failed_out_of_core_factorisation_falls_back_to_core(tmp_path, monkeyp
     assert not list(tmp_path.iterdir())  # its folder is gone
     B = np.random.default_rng(1).standard_normal((A.shape[0], 3))
     assert np.linalg.norm(A @ solver.solve(B) - B) <= 1e-10 * np.linalg.norm(B)
+
+
+@needs_pardiso
+def test_a_refined_preview_keeps_its_factor_within_the_limit(tmp_path, monkeypatch):
+    # spot Loop-subdivided twice (47k vertices, 140k unknowns): the 3D shells preview is
+    # refined with a factorisation, which a 1 MB limit sends out of core; same result
+    import trimesh
+
+    import modalviewer as mv
+
+    base = mv.load_mesh(mv.asset_path("spot.obj"))
+    mesh = mv.Mesh(*trimesh.remesh.subdivide_loop(base.vertices, base.faces, iterations=2))
+    monkeypatch.setenv("MODALVIEWER_FACTOR_DIR", str(tmp_path))
+    spectra = {}
+    for limit in ("1000000", "1"):
+        monkeypatch.setenv("MODALVIEWER_MEMORY_LIMIT_MB", limit)
+        spectra[limit] = mv.compute_spectrum(mesh, "shells", 40, accuracy="preview")
+    free, tight = spectra["1000000"], spectra["1"]
+    assert free.is_preview and tight.is_preview
+    refinement = tight.parameters["preview"]["refinement"]
+    assert refinement["steps"] >= 1 and refinement["factor_out_of_core"]
+    assert not free.parameters["preview"]["refinement"]["factor_out_of_core"]
+    np.testing.assert_allclose(tight.eigenvalues, free.eigenvalues, rtol=1e-12, atol=1e-9)
+    assert not list(tmp_path.iterdir())
