@@ -33,18 +33,12 @@ from benchmarks.run import save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
-import numpy as np, trimesh
+import numpy as np
 import modalviewer as mv
 asset, scheme, level = sys.argv[1], sys.argv[2], int(sys.argv[3])
 operator, accuracy, k = sys.argv[4], sys.argv[5], int(sys.argv[6])
-base = mv.load_mesh(mv.asset_path(asset))
-if scheme == "loop":
-    v, f = trimesh.remesh.subdivide_loop(base.vertices, base.faces, iterations=level)
-else:
-    v, f = base.vertices, base.faces
-    for _ in range(level):
-        v, f = trimesh.remesh.subdivide(v, f)
-mesh = mv.Mesh(v, f)
+from benchmarks.curved import case_mesh
+mesh = case_mesh(asset, scheme, level)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 t = time.perf_counter()
 spec = mv.compute_spectrum(mesh, operator, k, accuracy=accuracy)
@@ -62,6 +56,24 @@ print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds, "peak_mb": pe
 ASSETS = {"spot": "spot.obj", "hand": "demo_hand.obj", "part": "demo_machined_part.obj"}
 SCHEMES = {"loop": "Loop", "flat": "flat"}
 DEFAULT_CASES = ["spot:loop:2", "spot:loop:3", "hand:loop:2", "part:flat:3"]
+
+
+def case_mesh(path: str, scheme: str, level: int):
+    """The mesh of a case: ``path`` (a bundled asset's file name, or a mesh file)
+    subdivided ``level`` times by ``scheme`` ("loop", or "flat": each triangle split in
+    four in its plane)."""
+    import trimesh
+
+    import modalviewer as mv
+
+    base = mv.load_mesh(path if Path(path).is_file() else mv.asset_path(path))
+    v, f = base.vertices, base.faces
+    if scheme == "loop" and level > 0:
+        v, f = trimesh.remesh.subdivide_loop(v, f, iterations=level)
+    else:
+        for _ in range(level):
+            v, f = trimesh.remesh.subdivide(v, f)
+    return mv.Mesh(v, f)
 
 
 def case_name(case: tuple[str, str, int]) -> str:

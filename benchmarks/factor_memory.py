@@ -23,7 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.curved import ASSETS, case_name, parse_case  # noqa: E402
+from benchmarks.curved import ASSETS, case_mesh, case_name, parse_case  # noqa: E402
 from benchmarks.growth import fit_growth  # noqa: E402
 from benchmarks.run import save_result  # noqa: E402
 
@@ -67,9 +67,6 @@ def fits(rows: list[dict]) -> list[dict]:
 
 
 def main(argv=None) -> int:
-    import trimesh
-
-    import modalviewer as mv
     from modalviewer.core.demo_shapes import bumpy_plate
     from modalviewer.core.operators import OPERATOR_NAMES
 
@@ -89,14 +86,7 @@ def main(argv=None) -> int:
             print(plates[-1], flush=True)
     for case in args.curved:
         asset, scheme, level = case
-        base = mv.load_mesh(mv.asset_path(ASSETS[asset]))
-        if scheme == "loop":
-            v, f = trimesh.remesh.subdivide_loop(base.vertices, base.faces, iterations=level)
-        else:
-            v, f = base.vertices, base.faces
-            for _ in range(level):
-                v, f = trimesh.remesh.subdivide(v, f)
-        mesh = mv.Mesh(v, f)
+        mesh = case_mesh(ASSETS[asset], scheme, level)
         for operator in args.operators:
             curved.append({"mesh": case_name(case), **_sizes(mesh, operator)})
             print(curved[-1], flush=True)

@@ -37,21 +37,17 @@ RESULTS = ROOT / "benchmarks" / "results" / "memory.json"
 
 CHILD = """
 import json, resource, sys, time
-import numpy as np, trimesh
+import numpy as np
 from modalviewer.processes.memory import prepare_compute_process
 prepare_compute_process()
 import modalviewer as mv
 mesh_arg, level, operator, k = sys.argv[1], int(sys.argv[2]), sys.argv[3], int(sys.argv[4])
-assets = {"spot": "spot.obj", "hand": "demo_hand.obj", "part": "demo_machined_part.obj"}
 if mesh_arg.startswith("plate:"):
     from modalviewer.core.demo_shapes import bumpy_plate
-    base = bumpy_plate(int(mesh_arg.split(":")[1]))
+    mesh = bumpy_plate(int(mesh_arg.split(":")[1]))
 else:
-    base = mv.load_mesh(mv.asset_path(assets[mesh_arg]) if mesh_arg in assets else mesh_arg)
-v, f = base.vertices, base.faces
-if level:
-    v, f = trimesh.remesh.subdivide_loop(v, f, iterations=level)
-mesh = mv.Mesh(v, f)
+    from benchmarks.curved import ASSETS, case_mesh
+    mesh = case_mesh(ASSETS.get(mesh_arg, mesh_arg), "loop", level)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 t = time.perf_counter()
 spec = mv.compute_spectrum(mesh, operator, k)

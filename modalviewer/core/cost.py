@@ -11,6 +11,7 @@ __all__ = [
     "basis_columns",
     "exact_peak_mb",
     "factor_goes_out_of_core",
+    "power_of_size",
 ]
 
 MB = 2**20
@@ -46,6 +47,11 @@ def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> f
     return max(law.peak_mb(n_vertices) + 8.0 * n * columns / MB, arrays)
 
 
+def power_of_size(at_100k: float, exponent: float, n_vertices: int) -> float:
+    """``at_100k * (n_vertices / 100k) ** exponent``: the form of every fitted law here."""
+    return at_100k * (max(int(n_vertices), 1) / 1e5) ** exponent
+
+
 @dataclass(frozen=True)
 class GrowthLaw:
     """Seconds and peak memory of one computation as powers of the mesh size and of the
@@ -63,14 +69,13 @@ class GrowthLaw:
     def seconds(self, n_vertices: int, k: int) -> float:
         """Predicted seconds for ``k`` modes: the fit at 100 modes times
         ``(k / 100) ** mode_exponent``."""
-        size = max(int(n_vertices), 1) / 1e5
-        return self.seconds_at_100k * size**self.time_exponent * (k / 100) ** self.mode_exponent
+        at_100 = power_of_size(self.seconds_at_100k, self.time_exponent, n_vertices)
+        return at_100 * (k / 100) ** self.mode_exponent
 
     def peak_mb(self, n_vertices: int) -> float:
         """Predicted peak resident memory (MB) of the computing process, at
         :data:`GROWTH_MODES` modes."""
-        size = max(int(n_vertices), 1) / 1e5
-        return self.peak_mb_at_100k * size**self.memory_exponent
+        return power_of_size(self.peak_mb_at_100k, self.memory_exponent, n_vertices)
 
 
 @dataclass(frozen=True)
@@ -86,12 +91,10 @@ class FactorLaw:
     out_of_core_exponent: float
 
     def in_core_mb(self, n_vertices: int) -> float:
-        size = max(int(n_vertices), 1) / 1e5
-        return self.in_core_mb_at_100k * size**self.in_core_exponent
+        return power_of_size(self.in_core_mb_at_100k, self.in_core_exponent, n_vertices)
 
     def out_of_core_mb(self, n_vertices: int) -> float:
-        size = max(int(n_vertices), 1) / 1e5
-        return self.out_of_core_mb_at_100k * size**self.out_of_core_exponent
+        return power_of_size(self.out_of_core_mb_at_100k, self.out_of_core_exponent, n_vertices)
 
 
 OUT_OF_CORE_TIME_FACTOR = 1.2

@@ -36,7 +36,7 @@ import scipy.sparse as sp
 from .factor import SPDSolver
 from .memory import memory_limit_mb as default_memory_limit_mb
 from .memory import resident_mb
-from .products import column_block_products, pack_columns_in_place
+from .products import column_block_products, threaded_product, transform_columns_in_place
 from .threads import single_blas_thread
 
 __all__ = [
@@ -221,7 +221,7 @@ def rounding_floors(
         block = X[:, chosen]  # (N, 32)
         MX = mass_diag[:, None] * block
         np.abs(block, out=block)
-        KX = K_abs @ block
+        KX = threaded_product(K_abs, block)
         out[start : start + 32] = np.linalg.norm(KX, axis=0) / np.linalg.norm(MX, axis=0)
     return np.finfo(float).eps * out / np.maximum(np.abs(lam), np.finfo(float).tiny)
 
@@ -376,9 +376,8 @@ def solve_lowest(
             # array beside the (N, 1.1 k + extra) basis (3.7 and 5.8 GB for 300 shells
             # modes at 520k vertices)
             del X
-            packed = pack_columns_in_place(basis, lam.shape[0], lead=d_out)
+            transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
             try:
-                del packed
                 basis.resize((N, k))  # refuses while another reference to it is alive
                 out = basis
             except ValueError:

@@ -37,6 +37,7 @@ import sys
 import tempfile
 import threading
 import weakref
+from contextlib import contextmanager
 
 import numpy as np
 import scipy.sparse as sp
@@ -101,11 +102,28 @@ exactly the minimum the numerical factorisation can fail for lack of memory (err
 _OOC_ENVIRONMENT = threading.Lock()
 """PARDISO reads its out-of-core folder and buffer size from the environment when it
 factors: one factorisation at a time sets them."""
-_OOC_VARIABLES = (
-    "MKL_PARDISO_OOC_PATH",
-    "MKL_PARDISO_OOC_MAX_CORE_SIZE",
-    "MKL_PARDISO_OOC_KEEP_FILE",
-)
+
+
+@contextmanager
+def _out_of_core_environment(folder: str, buffer_mb: float):
+    """PARDISO's out-of-core settings in the environment while the block runs (one
+    block at a time), the previous values restored after it."""
+    settings = {
+        "MKL_PARDISO_OOC_PATH": folder,
+        "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(int(buffer_mb)),
+        "MKL_PARDISO_OOC_KEEP_FILE": "0",
+    }
+    with _OOC_ENVIRONMENT:
+        saved = {key: os.environ.get(key) for key in settings}
+        os.environ.update(settings)
+        try:
+            yield
+        finally:
+            for key, value in saved.items():
+                if value is None:
+                    os.environ.pop(key, None)
+                else:
+                    os.environ[key] = value
 
 
 FOLDER_PREFIX = "modalviewer-factor-"
@@ -203,19 +221,8 @@ class _Pardiso:
         else:
             self.out_of_core = True
             ip[59] = 2
-            with _OOC_ENVIRONMENT:
-                saved = {k: os.environ.get(k) for k in _OOC_VARIABLES}
-                os.environ["MKL_PARDISO_OOC_PATH"] = self._folder
-                os.environ["MKL_PARDISO_OOC_MAX_CORE_SIZE"] = str(int(self.out_of_core_mb))
-                os.environ["MKL_PARDISO_OOC_KEEP_FILE"] = "0"
-                try:
-                    error, _ = self._call(22, dummy)
-                finally:
-                    for key, value in saved.items():
-                        if value is None:
-                            os.environ.pop(key, None)
-                        else:
-                            os.environ[key] = value
+            with _out_of_core_environment(self._folder, self.out_of_core_mb):
+                error, _ = self._call(22, dummy)
             if error not in (0, -4):
                 # out of core failed (buffer too small: -2, file errors: -10, -11): in
                 # core it may still fit, and the caller must not read this as indefinite

@@ -16,7 +16,6 @@ from scipy.sparse import _sparsetools
 __all__ = [
     "ROW_BLOCK",
     "column_block_products",
-    "pack_columns_in_place",
     "row_blocks",
     "row_halves",
     "threaded_product",
@@ -184,35 +183,21 @@ def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[s
         yield cols, threaded_product(K, block) if sp.issparse(K) else np.asarray(K @ block)
 
 
-def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384) -> np.ndarray:
+def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384, lead: int = 0) -> np.ndarray:
     """``Y A`` for a C-contiguous (N, w) Y and a (w, m) A with m <= w (an int m: Y's
     first m columns), written over Y's own memory: returns a C-contiguous (N, m) array
-    on Y's buffer (Y itself is left meaningless).  Row chunk by chunk, so only a chunk
-    of the product is alive: row i of the result starts at i m <= i w, so a chunk's
-    writes never reach rows not read yet."""
+    on Y's buffer (Y itself is left meaningless).  ``lead`` > 0: the result is
+    (N, lead + m) with the product in its columns from ``lead`` on and the first
+    ``lead`` left for the caller (uninitialised); ``lead + m <= w``.  Row chunk by
+    chunk, so only a chunk of the product is alive: row i of the result ends at
+    (i + 1)(lead + m) <= (i + 1) w, so a chunk's writes never reach rows not read yet."""
     n, w = Y.shape
     m = A if isinstance(A, int) else A.shape[1]
-    if m > w or not Y.flags.c_contiguous:
-        raise ValueError("Y must be C-contiguous with at least as many columns as A")
-    out = Y.reshape(-1)[: n * m].reshape(n, m)
+    width = lead + m
+    if width > w or not Y.flags.c_contiguous:
+        raise ValueError("Y must be C-contiguous with at least as many columns as A (plus lead)")
+    out = Y.reshape(-1)[: n * width].reshape(n, width)
     for start in range(0, n, chunk):
         rows = slice(start, min(start + chunk, n))
-        out[rows] = Y[rows, :m].copy() if isinstance(A, int) else Y[rows] @ A
-    return out
-
-
-def pack_columns_in_place(B: np.ndarray, m: int, lead: int = 0, chunk: int = 16384):
-    """B's first m columns moved to columns ``lead`` to ``lead + m`` of a C-contiguous
-    (N, lead + m) array on B's own memory (a C-contiguous (N, w) array with
-    ``lead + m <= w``), which is returned; its first ``lead`` columns are left
-    uninitialised and B itself meaningless.  Row chunk by chunk: row i of the result
-    ends at (i + 1)(lead + m) <= (i + 1) w, so a chunk's writes never reach rows not
-    read yet."""
-    n, w = B.shape
-    if lead + m > w or not B.flags.c_contiguous:
-        raise ValueError("B must be C-contiguous with at least lead + m columns")
-    out = B.reshape(-1)[: n * (lead + m)].reshape(n, lead + m)
-    for start in range(0, n, chunk):
-        rows = slice(start, min(start + chunk, n))
-        out[rows, lead:] = B[rows, :m].copy()
+        out[rows, lead:] = Y[rows, :m].copy() if isinstance(A, int) else Y[rows] @ A
     return out
