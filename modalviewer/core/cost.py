@@ -11,6 +11,7 @@ __all__ = [
     "basis_columns",
     "exact_peak_mb",
     "factor_goes_out_of_core",
+    "float32_basis_saving_mb",
     "power_of_size",
 ]
 
@@ -29,6 +30,18 @@ def basis_columns(k: int, n_unknowns: int) -> int:
     k = max(1, min(int(k), n))
     _, block, max_basis, _ = krylov_sizes(k, n)
     return max_basis + block
+
+
+def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
+    """Memory (MB) the exact solver saves with a single-precision Krylov basis
+    (:func:`.eigen.basis_in_float32`): its double-precision basis array less the buffer
+    that holds the single-precision basis and then the modes."""
+    from .eigen import float32_basis_mb  # the solver's own rule; imported late (no cycle)
+
+    n = max(int(n_unknowns), 2)
+    k = max(1, min(int(k), n))
+    columns = basis_columns(k, n)
+    return max(0.0, 8.0 * n * columns / MB - float32_basis_mb(n, columns, k))
 
 
 def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> float:

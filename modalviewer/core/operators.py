@@ -22,6 +22,7 @@ from .cost import (
     GrowthLaw,
     exact_peak_mb,
     factor_goes_out_of_core,
+    float32_basis_saving_mb,
 )
 
 __all__ = [
@@ -147,14 +148,22 @@ class OperatorInfo:
         return seconds
 
     def predicted_peak_mb(
-        self, accuracy: str, n_vertices: int, k: int = 100, out_of_core: bool | None = None
+        self,
+        accuracy: str,
+        n_vertices: int,
+        k: int = 100,
+        out_of_core: bool | None = None,
+        basis_float32: bool | None = None,
     ) -> float:
         """Peak memory (MB) of that computation with ``k`` modes: the exact solve's law
         with the arrays that grow with k (:func:`.cost.exact_peak_mb`), less the factor's
         in-core size plus its out-of-core size where the factor goes out of core
-        (``out_of_core``; None: as :meth:`factor_out_of_core` predicts); the fast
-        preview's (measured at 100 modes) in proportion to k above that, for its
-        (N, k) arrays of modes."""
+        (``out_of_core``; None: as :meth:`factor_out_of_core` predicts), less what a
+        single-precision Krylov basis saves where it is kept so
+        (:func:`.cost.float32_basis_saving_mb`; ``basis_float32``; None: as the solver
+        decides, where the peak so far is above this machine's
+        :func:`.memory.memory_limit_mb`); the fast preview's (measured at 100 modes) in
+        proportion to k above that, for its (N, k) arrays of modes."""
         law = self.growth(accuracy)
         if accuracy != "exact":
             return law.peak_mb(n_vertices) * max(1.0, k / 100)
@@ -162,6 +171,13 @@ class OperatorInfo:
         if self._out_of_core(n_vertices, k, out_of_core):
             factor = self.factor_memory
             peak += factor.out_of_core_mb(n_vertices) - factor.in_core_mb(n_vertices)
+        if basis_float32 is None:
+            from .memory import memory_limit_mb
+
+            limit_mb = memory_limit_mb()
+            basis_float32 = limit_mb is not None and peak > limit_mb
+        if basis_float32:
+            peak -= float32_basis_saving_mb(self.unknowns(n_vertices), k)
         return peak
 
     def factor_out_of_core(

@@ -208,6 +208,7 @@ def compute_spectrum(
             "operator_columns": result.operator_columns,
             "factor_mb": result.factor_mb,
             "factor_out_of_core": result.out_of_core,
+            "basis_float32": result.basis_float32,
             "null_space_dimension": result.null_dim,
             "modes_at_rounding_floor": at_floor,
             "worst_residual_rounding_floor": worst_floor,

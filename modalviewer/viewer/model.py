@@ -556,15 +556,26 @@ def worst_residual(spec: Spectrum) -> float:
     return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
 
 
-OUT_OF_CORE_WORDS = "factor kept on disk (memory limit)"
+OUT_OF_CORE_WORDS = "factor kept on disk"
 """What a spectrum whose solve kept its factor out of core says of it (the status line
 and ``modalviewer compute``)."""
 
+FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
+"""What a spectrum whose solve kept its Krylov basis in single precision says of it."""
+
 
 def memory_text(spec: Spectrum) -> str:
-    """``"; ..."`` + :data:`OUT_OF_CORE_WORDS` where the exact solve kept its factor out
-    of core (the reason it took longer), else ``""``."""
-    return f"; {OUT_OF_CORE_WORDS}" if spec.parameters.get("factor_out_of_core") else ""
+    """``"; ... (memory limit)"`` with :data:`OUT_OF_CORE_WORDS` where the exact solve
+    kept its factor out of core (the reason it took longer) and
+    :data:`FLOAT32_BASIS_WORDS` where it kept its basis in single precision (the reason
+    its residuals are about 1e-7), else ``""``."""
+    said = [
+        words
+        for words, key in ((OUT_OF_CORE_WORDS, "factor_out_of_core"),
+                           (FLOAT32_BASIS_WORDS, "basis_float32"))
+        if spec.parameters.get(key)
+    ]  # fmt: skip
+    return f"; {' and '.join(said)} (memory limit)" if said else ""
 
 
 def residual_text(spec: Spectrum) -> str:

@@ -42,7 +42,9 @@ def test_the_laws_reproduce_the_runs_they_were_fitted_to_within_a_third():
         info = operator_info(r["operator"])
         # the runs kept their factors in core
         t = info.predicted_seconds(r["accuracy"], r["vertices"], r["k"], out_of_core=False)
-        m = info.predicted_peak_mb(r["accuracy"], r["vertices"], out_of_core=False)
+        m = info.predicted_peak_mb(
+            r["accuracy"], r["vertices"], out_of_core=False, basis_float32=False
+        )
         assert 1 / 1.35 < r["seconds"] / t < 1.35, (r, t)
         assert 1 / 1.35 < r["peak_mb"] / m < 1.35, (r, m)
         checked += 1
@@ -91,14 +93,18 @@ def test_exact_peak_memory_is_predicted_for_other_mode_counts_and_curved_meshes(
         if r["accuracy"] != "exact" or "peak_mb" not in r:
             continue
         info = operator_info(r["operator"])
-        m = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=False)
+        m = info.predicted_peak_mb(
+            "exact", r["vertices"], r["k"], out_of_core=False, basis_float32=False
+        )
         assert 0.85 < r["peak_mb"] / m < 1.1, (r, m)
         checked += 1
     for r in json.loads(CURVED.read_text())["rows"]:
         if r["vertices"] < 100_000:
             continue
         info = operator_info(r["operator"])
-        m = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=False)
+        m = info.predicted_peak_mb(
+            "exact", r["vertices"], r["k"], out_of_core=False, basis_float32=False
+        )
         part_shells = r["mesh"].startswith("part") and r["operator"] == "shells"
         low = 0.65 if part_shells else 0.85
         assert low < r["exact_peak_mb"] / m < 1.1, (r, m)
@@ -178,8 +184,10 @@ def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
     assert any(r["factor_out_of_core"] for r in rows)
     for r in rows:
         info = operator_info(r["operator"])
-        ooc = bool(r["factor_out_of_core"])
-        m = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=ooc)
+        ooc, single = bool(r["factor_out_of_core"]), bool(r.get("basis_float32"))
+        m = info.predicted_peak_mb(
+            "exact", r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
+        )
         assert 0.8 < r["peak_mb"] / m < 1.1, (r["mesh"], r["limit_mb"], r["peak_mb"], m)
         assert r["largest_relative_difference"] < 1e-10
         assert r["mass_orthonormality"] < 1e-10
@@ -188,8 +196,8 @@ def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
 def test_the_memory_check_predicts_the_factor_out_of_core_where_it_would_not_fit():
     info = operator_info("shells")
     n, k = 520_000, 300  # 1.56M unknowns
-    in_core = info.predicted_peak_mb("exact", n, k, out_of_core=False)
-    out_of_core = info.predicted_peak_mb("exact", n, k, out_of_core=True)
+    in_core = info.predicted_peak_mb("exact", n, k, out_of_core=False, basis_float32=False)
+    out_of_core = info.predicted_peak_mb("exact", n, k, out_of_core=True, basis_float32=False)
     law = info.factor_memory
     assert in_core - out_of_core == pytest.approx(law.in_core_mb(n) - law.out_of_core_mb(n))
     assert out_of_core < 0.85 * in_core

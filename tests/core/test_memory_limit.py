@@ -71,7 +71,11 @@ def test_a_factor_stays_in_core_where_the_disk_has_no_room(tmp_path, monkeypatch
 
 
 @needs_pardiso
-def test_solve_lowest_within_a_small_limit_gives_the_same_spectrum_out_of_core():
+def test_solve_lowest_within_a_small_limit_gives_the_same_spectrum_out_of_core(monkeypatch):
+    from modalviewer.core import eigen
+
+    # the basis stays in double precision here (its single-precision form has a test below)
+    monkeypatch.setattr(eigen, "basis_in_float32", lambda *args: False)
     m, k = 40, 24
     A = _laplacian_3d(m)
     mass = np.ones(A.shape[0])
@@ -261,3 +265,100 @@ def test_a_refined_preview_keeps_its_factor_within_the_limit(tmp_path, monkeypat
     assert not free.parameters["preview"]["refinement"]["factor_out_of_core"]
     np.testing.assert_allclose(tight.eigenvalues, free.eigenvalues, rtol=1e-12, atol=1e-9)
     assert not list(tmp_path.iterdir())
+
+
+def _traced_peak_mb(solve) -> tuple[float, object]:
+    """The peak of numpy's traced allocations (PARDISO's memory is not traced) during
+    ``solve()``, and its result."""
+    gc.collect()
+    tracemalloc.start()
+    try:
+        result = solve()
+        return tracemalloc.get_traced_memory()[1] / 2**20, result
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_basis_that_does_not_fit_is_kept_in_single_precision(monkeypatch):
+    from modalviewer.core import eigen
+
+    m, k = 240, 40  # 57 600 unknowns, a 2D Laplacian with known eigenvalues
+    A = _laplacian_2d(m)
+    n = A.shape[0]
+    mass = np.full(n, 0.5)
+    chosen = []
+    real_rule = eigen.basis_in_float32
+
+    def rule(*args):
+        chosen.append(real_rule(*args))
+        return chosen[-1]
+
+    monkeypatch.setattr(eigen, "basis_in_float32", rule)
+    double_mb, free = _traced_peak_mb(lambda: solve_lowest(A, mass, k, memory_limit_mb=1e9))
+    single_mb, tight = _traced_peak_mb(lambda: solve_lowest(A, mass, k, memory_limit_mb=1.0))
+    assert chosen == [False, True]
+    assert not free.basis_float32 and tight.basis_float32
+    assert "single-precision Krylov basis" in tight.method
+    assert "single-precision" not in free.method
+    one = 2.0 - 2.0 * np.cos(np.pi * np.arange(1, m + 1) / (m + 1))
+    exact = np.sort((one[:, None] + one[None, :]).ravel())[:k] / 0.5
+    np.testing.assert_allclose(free.eigenvalues, exact, rtol=1e-10)
+    # the float64 step of inverse iteration and Rayleigh-Ritz: eigenvalues to 1e-10 even
+    # though the basis was orthonormal only to about 1e-7; residuals about 1e-7
+    np.testing.assert_allclose(tight.eigenvalues, exact, rtol=1e-10)
+    assert tight.residuals.max() < 1e-6
+    X = tight.vectors
+    assert X.dtype == np.float64 and X.shape == (n, k)
+    assert X.flags.c_contiguous and X.flags.owndata
+    gram = X.T @ (mass[:, None] * X)
+    assert np.abs(gram - np.eye(k)).max() < 1e-12
+    # the basis (N, 96) in float32 is about 4.7 instead of 9.4 MB per 10k rows, and the
+    # modes are written into its memory: the whole solve's arrays need much less
+    basis_columns = eigen.krylov_sizes(k, n)[2] + eigen.krylov_sizes(k, n)[1]
+    saved_mb = 8.0 * n * basis_columns / 2**20 - eigen.float32_basis_mb(n, basis_columns, k)
+    assert saved_mb > 15
+    assert single_mb < double_mb - 0.7 * saved_mb, (single_mb, double_mb, saved_mb)
+
+
+def test_the_basis_is_single_precision_only_where_double_does_not_fit():
+    from modalviewer.core.eigen import basis_in_float32, float32_basis_mb
+
+    n, width, out, block = 3_000_000, 464, 300, 16
+    assert not basis_in_float32(None, n, width, out, block)
+    assert not basis_in_float32(1e9, n, width, out, block)
+    assert basis_in_float32(1.0, n, width, out, block)
+    # the buffer holds the float32 basis, then the float64 modes: the larger of the two
+    assert float32_basis_mb(n, width, out) == pytest.approx(8.0 * n * out / 2**20)
+    assert float32_basis_mb(n, width, 100) == pytest.approx(4.0 * n * width / 2**20)
+    # where the modes alone would be as large as the double-precision basis: no gain
+    assert not basis_in_float32(1.0, 1000, 20, 20, 4)
+
+
+@pytest.mark.parametrize("width, count, out_width", [(10, 6, 7), (40, 6, 8), (9, 9, 9)])
+def test_widening_a_single_precision_basis_in_place_keeps_its_columns(width, count, out_width):
+    from modalviewer.core.eigen import _widen_in_place
+
+    n = 10_007  # several blocks of rows, the last one short
+    buffer = np.empty(max(n * out_width, -(-n * width // 2)))
+    single = buffer.view(np.float32)[: n * width].reshape(n, width)
+    single[:] = np.random.default_rng(1).standard_normal((n, width))
+    expected = single[:, :count].astype(np.float64)
+    del single
+    _widen_in_place(buffer, n, width, count, out_width)
+    widened = buffer[: n * out_width].reshape(n, out_width)
+    np.testing.assert_array_equal(widened[:, :count], expected)
+
+
+def test_products_with_a_single_precision_basis_are_formed_in_double_precision():
+    from modalviewer.core.eigen import _basis_t_times, _subtract_basis_times
+
+    rng = np.random.default_rng(2)
+    Q = rng.standard_normal((5000, 30)).astype(np.float32)
+    W = np.asfortranarray(rng.standard_normal((5000, 4)))
+    Q64 = Q.astype(np.float64)
+    h = _basis_t_times(Q, W)
+    assert h.dtype == np.float64
+    np.testing.assert_allclose(h, Q64.T @ W, rtol=1e-13, atol=1e-12)
+    expected = W - Q64 @ h
+    _subtract_basis_times(W, Q, h)
+    np.testing.assert_allclose(W, expected, rtol=1e-13, atol=1e-12)
