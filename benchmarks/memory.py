@@ -12,9 +12,14 @@ process with the computation processes' memory settings
 (:func:`modalviewer.processes.memory.prepare_compute_process`), so its peak resident
 memory is its own.  After the peak is read the child checks the result: the largest
 relative residual and the largest deviation of ``X^T M X`` from the identity (a block of
-columns at a time, so the check adds no (N, k) array).  Rows of the same mesh, operator
-and k are compared with the first row's eigenvalues.  Rows go to
+columns at a time, so the check adds no (N, k) array).  Each row keeps its eigenvalues;
+the rows of one run are compared with its first row's, or all with a stored run of the
+same operator (``--compare-with LABEL``, any k: over the modes both have).  Rows go to
 ``benchmarks/results/memory.json`` (rows of other meshes, operators or k are kept).
+
+    python -m benchmarks.memory --mesh plate:1000 -k 300
+    python -m benchmarks.memory --mesh plate:1000 -k 100 --limits 100000 \\
+        --label "plate 1000 x 1000, in core" --compare-with "plate 1000 x 1000"
 """
 
 from __future__ import annotations
@@ -67,6 +72,7 @@ print(json.dumps({"vertices": mesh.n_vertices, "unknowns": int(X.shape[0]), "sec
                   "peak_mb": peak, "mesh_mb": before, "method": p.get("method"),
                   "factor_mb": p.get("factor_mb"),
                   "factor_out_of_core": p.get("factor_out_of_core"),
+                  "basis_float32": p.get("basis_float32"),
                   "seconds_by_stage": p.get("seconds_by_stage"),
                   "max_residual": float(spec.residuals.max()), "mass_orthonormality": worst,
                   "eigenvalues": [float(x) for x in spec.eigenvalues]}))
@@ -98,6 +104,9 @@ def main(argv=None) -> int:
     parser.add_argument("-k", type=int, default=300)
     parser.add_argument("--limits", nargs="+", default=["none"], help="'none' or MB")
     parser.add_argument("--label", default=None, help="the mesh's name in the results")
+    parser.add_argument(
+        "--compare-with", default=None, help="a stored run's label: compare with its eigenvalues"
+    )
     args = parser.parse_args(argv)
     if args.mesh.startswith("plate:"):
         grid = args.mesh.split(":")[1]
@@ -106,19 +115,33 @@ def main(argv=None) -> int:
         label = args.label or f"{Path(args.mesh).stem} Loop x{args.level}"
     old = json.loads(RESULTS.read_text())["rows"] if RESULTS.exists() else []
     rows = [r for r in old if (r["mesh"], r["operator"], r["k"]) != (label, args.operator, args.k)]
-    reference = None
+    reference, compared_with = None, None
+    if args.compare_with:
+        stored = [
+            r
+            for r in old
+            if (r["mesh"], r["operator"]) == (args.compare_with, args.operator)
+            and "eigenvalues" in r
+        ]
+        if not stored:
+            parser.error(f"no stored {args.operator} run of {args.compare_with!r} with eigenvalues")
+        reference, compared_with = np.array(stored[0]["eigenvalues"]), args.compare_with
     for limit in args.limits:
         row = run(args.mesh, args.level, args.operator, args.k, limit)
-        lam = np.array(row.pop("eigenvalues"))
+        lam = np.array(row["eigenvalues"])
         if reference is None:
             reference = lam
             row["largest_relative_difference"] = 0.0
         else:
-            scale = np.maximum(np.abs(reference), 1e-12 * np.abs(reference).max())
-            row["largest_relative_difference"] = float(np.max(np.abs(lam - reference) / scale))
+            m = min(lam.shape[0], reference.shape[0])
+            scale = np.maximum(np.abs(reference[:m]), 1e-12 * np.abs(reference[:m]).max())
+            difference = np.abs(lam[:m] - reference[:m]) / scale
+            row["largest_relative_difference"] = float(np.max(difference))
+            row["compared_with"] = compared_with or f"{label}, limit {args.limits[0]}"
         row.update(mesh=label, operator=args.operator, k=args.k, limit_mb=limit)
         print(json.dumps({key: row[key] for key in ("mesh", "limit_mb", "seconds", "peak_mb",
-                                                    "factor_out_of_core", "max_residual",
+                                                    "factor_out_of_core", "basis_float32",
+                                                    "max_residual",
                                                     "largest_relative_difference")}))  # fmt: skip
         rows.append(row)
         save_result("memory", {"rows": rows})

@@ -262,25 +262,27 @@ def big_solves_table(data: dict) -> str:
     from modalviewer.core.operators import operator_info
 
     lines = [
-        "| mesh | operator | vertices | modes | memory limit | factor | seconds "
-        "| measured peak | predicted | largest residual | Mass-orthonormality "
-        "| eigenvalues against the mesh's first run |",
-        "|" + " --- |" * 12,
+        "| mesh | operator | vertices | modes | memory limit | factor | Krylov basis "
+        "| seconds | measured peak | predicted | largest residual | Mass-orthonormality "
+        "| largest eigenvalue difference |",
+        "|" + " --- |" * 13,
     ]
-    seen = set()
     for r in data["rows"]:
-        run = (r["mesh"], r["operator"], r["k"])
-        difference = f"{r['largest_relative_difference']:.1e}" if run in seen else "(that run)"
-        seen.add(run)
+        if r.get("compared_with"):
+            difference = f"{r['largest_relative_difference']:.1e} against {r['compared_with']}"
+        else:
+            difference = "(the reference)"
         info = operator_info(r["operator"])
-        ooc = bool(r["factor_out_of_core"])
-        predicted = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=ooc)
+        ooc, single = bool(r["factor_out_of_core"]), bool(r.get("basis_float32"))
+        predicted = info.predicted_peak_mb(
+            "exact", r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
+        )
         limit = "half the machine" if r["limit_mb"] == "none" else f"{r['limit_mb']} MB"
         factor = f"{_thousands(r['factor_mb'])} MB {'in a file' if ooc else 'in core'}"
         lines.append(
             f"| {r['mesh']} | {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} "
-            f"| {r['k']} | {limit} | {factor} | {r['seconds']:.0f} "
-            f"| {_thousands(r['peak_mb'])} MB | {_thousands(predicted)} MB "
+            f"| {r['k']} | {limit} | {factor} | {'single' if single else 'double'} precision "
+            f"| {r['seconds']:.0f} | {_thousands(r['peak_mb'])} MB | {_thousands(predicted)} MB "
             f"| {r['max_residual']:.1e} | {r['mass_orthonormality']:.1e} | {difference} |"
         )
     return "\n".join(lines)
@@ -390,13 +392,14 @@ def scale_figures(data: dict) -> str:
 def big_solves_figures(data: dict) -> str:
     """The README's memory figures: ``benchmarks.memory``'s runs, short."""
     lines = [
-        "| mesh, 3D shells | modes | factor | time | peak memory |",
-        "| --- | --- | --- | --- | --- |",
+        "| mesh, 3D shells | modes | factor | Krylov basis | time | peak memory |",
+        "| --- | --- | --- | --- | --- | --- |",
     ]
     for r in data["rows"]:
         where = "out of core" if r["factor_out_of_core"] else "in core"
+        basis = "single precision" if r.get("basis_float32") else "double precision"
         lines.append(
-            f"| {r['mesh']} ({r['vertices']:,} vertices) | {r['k']} | {where} "
+            f"| {r['mesh']} ({r['vertices']:,} vertices) | {r['k']} | {where} | {basis} "
             f"| {r['seconds']:.0f} s | {r['peak_mb'] / 1024:.1f} GB |".replace(",", " ")
         )
     return "\n".join(lines)
