@@ -416,8 +416,10 @@ class ViewerModel:
         return plan.reason() if plan.exact_seconds >= NOTE_FROM_SECONDS else ""
 
     def _shower(self, key: SpectrumKey, before):
-        """A job callback showing ``key``'s first non-zero mode if the display has not
-        changed since the request (``before``)."""
+        """A job callback showing the new spectrum of ``key`` if the display has not
+        changed since the request (``before``): at the mode shown then if it was one of
+        the same operator's (a new k keeps the user's place; the last mode if there are
+        fewer now), else at its first non-zero mode."""
 
         def show_when_done(j: Job) -> None:
             if (
@@ -425,7 +427,10 @@ class ViewerModel:
                 and key in self.state.spectra
                 and self.state.display in (before, before.blank())
             ):
-                self._show_first_mode(key.operator)
+                if before.kind == "mode" and before.operator == key.operator:
+                    self.state.show_mode(before.mode, key.operator)
+                else:
+                    self._show_first_mode(key.operator)
 
         return show_when_done
 
@@ -581,12 +586,16 @@ def memory_text(spec: Spectrum) -> str:
 def residual_text(spec: Spectrum) -> str:
     """'largest relative residual 1.3e-05' and, where that is above what well-shaped
     meshes reach, the mode's rounding floor: the residual that rounding the mode to
-    double precision alone causes on this mesh (no solver goes below it)."""
+    double precision alone causes on this mesh (an estimate: no solver goes much below
+    it)."""
     worst = worst_residual(spec)
     text = f"largest relative residual {worst:.1e}"
     floor = float(spec.parameters.get("worst_residual_rounding_floor", 0.0))
     if floor > 0.0 and worst <= FLOOR_FACTOR * floor:
-        text += f" (the rounding floor of double precision for that mode here: {floor:.1e})"
+        # the floor is an estimate, not a bound: the residual may be a little below it
+        text += (
+            f" (at the rounding floor of double precision for that mode here, about {floor:.1e})"
+        )
     elif floor > 0.0:
         text += f" (rounding floor {floor:.1e})"
     return text

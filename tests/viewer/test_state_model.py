@@ -624,6 +624,20 @@ def test_a_coarse_to_fine_spectrum_is_marked_as_approximate(model):
     assert "coarse" not in wording.legend(state)
 
 
+def test_a_new_number_of_modes_keeps_the_mode_on_screen(model):
+    """Found under Xvfb: computing 20 modes while mode 7 of 12 was shown went back to
+    the first non-zero mode."""
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    model.state.show_mode(7)
+    model.jobs.wait(model.request_spectrum("laplacian", k=20, show=True))
+    assert model.state.spectrum("laplacian").k == 20
+    assert model.state.display.mode == 7
+    field = model.state.derived.field()
+    np.testing.assert_array_equal(field.values, model.state.spectrum("laplacian").mode(7))
+    model.jobs.wait(model.request_spectrum("laplacian", k=5, show=True))
+    assert model.state.display.mode == 4  # fewer modes now: the last one
+
+
 def test_asking_again_for_the_spectrum_on_screen_keeps_the_mode(model):
     """Found under Xvfb: Ctrl+R on the Laplacian at mode 5 went back to mode 3 (its
     first non-zero mode), Compute on E_D^N at mode 9 to mode 0."""
