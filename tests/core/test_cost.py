@@ -213,3 +213,30 @@ def test_the_memory_check_predicts_the_factor_out_of_core_where_it_would_not_fit
     # the scalar operators' factors are small: out of core would not save memory there
     lap = operator_info("laplacian")
     assert not lap.factor_out_of_core(100_000, 100, limit_mb=1.0)
+
+
+def test_a_single_precision_basis_is_predicted_as_its_buffer_and_chosen_over_the_limit():
+    from modalviewer.core.cost import float32_basis_saving_mb
+    from modalviewer.core.eigen import float32_basis_mb, krylov_sizes
+    from modalviewer.core.memory import memory_limit_mb
+
+    info = operator_info("shells")
+    n_vertices, k = 1_002_001, 300
+    n = info.unknowns(n_vertices)
+    _, block, max_basis, _ = krylov_sizes(k, n)
+    columns = max_basis + block
+    double = info.predicted_peak_mb("exact", n_vertices, k, out_of_core=True, basis_float32=False)
+    single = info.predicted_peak_mb("exact", n_vertices, k, out_of_core=True, basis_float32=True)
+    # the double basis and the 200 mode columns above the law's 100, against one buffer
+    beside = 8.0 * n * (columns + 200) / 2**20
+    assert float32_basis_saving_mb(n, k) == pytest.approx(beside - float32_basis_mb(n, columns, k))
+    assert double - single == pytest.approx(float32_basis_saving_mb(n, k), rel=1e-12)
+    # the memory check's default mirrors the solver: single precision where the peak with
+    # the factor out of core is still above the limit
+    limit = memory_limit_mb()
+    default = info.predicted_peak_mb("exact", n_vertices, k)
+    assert default == pytest.approx(single if double > limit else double, rel=1e-12)
+    # a mesh where the double basis fits keeps it
+    assert info.predicted_peak_mb("exact", 20_000, 100) == pytest.approx(
+        info.predicted_peak_mb("exact", 20_000, 100, out_of_core=False, basis_float32=False)
+    )
