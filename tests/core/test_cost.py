@@ -189,7 +189,11 @@ def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
             "exact", r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
         )
         assert 0.8 < r["peak_mb"] / m < 1.1, (r["mesh"], r["limit_mb"], r["peak_mb"], m)
-        assert r["largest_relative_difference"] < 1e-10
+        # a single-precision basis on either side: the same eigenvalues to 1e-8 (the 1M
+        # plate: 4.4e-9 over the lowest 100); double on both: to the last digit
+        others = [q for q in rows if r.get("compared_with", "").startswith(q["mesh"])]
+        single_either = single or any(q.get("basis_float32") for q in others)
+        assert r["largest_relative_difference"] < (1e-8 if single_either else 1e-10)
         assert r["mass_orthonormality"] < 1e-10
 
 
