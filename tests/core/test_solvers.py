@@ -216,3 +216,26 @@ def test_sign_convention_largest_entry_positive(order):
     fixed = _fix_signs(X.copy(order=order), rows=700)  # blocks of rows, the last one short
     np.testing.assert_array_equal(fixed, expected)
     assert np.all(fixed[np.abs(fixed).argmax(axis=0), np.arange(40)] > 0)
+
+
+def test_pardiso_stores_vertex_blocks_as_blocks_and_scalar_operators_plainly():
+    from modalviewer.core.factor import has_vertex_blocks
+
+    if "pardiso" not in available_backends():
+        pytest.skip("block storage is PARDISO's")
+    spot = mv.load_mesh(mv.asset_path("spot.obj"))  # curved: its 3 x 3 blocks are full
+    plate = grid_plate(41)  # 462 vertices: a Laplacian whose rows also come in threes
+    rng = np.random.default_rng(3)
+    for mesh, operator, blocks in ((spot, "shells", True), (plate, "laplacian", False)):
+        K, mass = operator_matrices(mesh, operator)
+        A = sp.csr_matrix(K + 1e-3 * float(np.median(K.diagonal() / mass)) * sp.diags(mass))
+        assert has_vertex_blocks(A) == blocks
+        solver = SPDSolver(A, backend="pardiso")
+        assert solver._impl._iparm[36] == (-80 if blocks else 0)
+        B = rng.standard_normal((A.shape[0], 4))
+        X = solver.solve(B)
+        assert np.linalg.norm(A @ X - B) <= 1e-10 * np.linalg.norm(B)
+    # rows of one group with different columns are not blocks
+    M = sp.csr_matrix(np.eye(6) + np.diag([0.1] * 5, 1) + np.diag([0.1] * 5, -1))
+    assert not has_vertex_blocks(M)
+    assert not has_vertex_blocks(sp.identity(7, format="csr"))
