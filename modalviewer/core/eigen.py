@@ -136,7 +136,7 @@ class EigenResult:
     """Where the time went: "factorisation", "solves" (the Krylov iteration's), "orthogonalisation",
     "ritz" (projected eigenproblems), "restarts" (basis rotations), "refinement" (the last
     block of solves), "rayleigh_ritz" (with K itself), "residuals", "copy" (into the
-    row-major result), "dense"."""
+    row-major result; a single-precision basis widened into the modes), "dense"."""
     operator_columns: int = 0
     """Columns the shift-invert operator was applied to, refinement included."""
     null_dim: int = 0
@@ -798,13 +798,10 @@ def basis_in_float32(
     the single-precision buffer (:func:`float32_basis_mb`) is smaller.  Double precision
     is kept wherever it fits: the Laplacian's residuals after the final step are about
     1e-11 with it, 6e-8 without (spot Loop x2, 100 modes)."""
-    if limit_mb is None:
+    left_mb = factor_budget_mb(limit_mb, n, basis_columns, block)  # now: after the factor
+    if left_mb is None or left_mb >= 0:
         return False
-    temporaries = 8.0 * n * TEMPORARY_BLOCKS * block / 2**20
-    double_mb = 8.0 * n * basis_columns / 2**20
-    if resident_mb() + double_mb + temporaries <= limit_mb:
-        return False
-    return float32_basis_mb(n, basis_columns, out_columns) < double_mb
+    return float32_basis_mb(n, basis_columns, out_columns) < 8.0 * n * basis_columns / 2**20
 
 
 def _widen_in_place(buffer: np.ndarray, n: int, width: int, count: int, out_width: int):
@@ -882,7 +879,7 @@ def _shift_invert(
         basis=Q,
     )
     if float32:
-        with timer("restarts"):
+        with timer("copy"):
             del Y, Q  # views of the buffer: it is resized below
             _widen_in_place(buffer, N, width, theta.shape[0], out_columns)
             buffer.resize((N, out_columns))
