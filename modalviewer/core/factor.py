@@ -44,6 +44,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 __all__ = [
+    "FactorTooLarge",
     "SPDSolver",
     "available_backends",
     "factor_folder",
@@ -186,26 +187,39 @@ def has_vertex_blocks(A: sp.csr_matrix, size: int = 3) -> bool:
     return agree >= 0.9 * groups.size
 
 
+class FactorTooLarge(MemoryError):
+    """A single-precision factor (which has no out-of-core mode) would need more memory
+    than its budget; raised after the analysis, before the factorisation."""
+
+
 class _Pardiso:
     """MKL PARDISO, real symmetric positive definite (mtype 2), upper triangle in CSR.
 
     Analysis (phase 11) first: it tells the memory the factor needs in core
     (``in_core_mb``); if that exceeds ``memory_budget_mb`` and out of core needs less,
-    the numerical factorisation (phase 22) writes the factor to a file."""
+    the numerical factorisation (phase 22) writes the factor to a file.  ``single``:
+    the factor and the solves in single precision (``iparm[27] = 1``), always in core
+    (:class:`FactorTooLarge` where it would exceed the budget)."""
 
     MTYPE = 2
 
     def __init__(
-        self, A: sp.csr_matrix, lib, memory_budget_mb: float | None = None, factorise=True
+        self,
+        A: sp.csr_matrix,
+        lib,
+        memory_budget_mb: float | None = None,
+        factorise=True,
+        single: bool = False,
     ):
         self._lib = lib
         U = sp.triu(A, format="csr")
         U.sum_duplicates()
         U.sort_indices()
         self.n = U.shape[0]
+        self.dtype = np.dtype(np.float32 if single else np.float64)
         self._ia = U.indptr.astype(np.int32)
         self._ja = U.indices.astype(np.int32)
-        self._a = np.ascontiguousarray(U.data, dtype=np.float64)
+        self._a = np.ascontiguousarray(U.data, dtype=self.dtype)
         self._pt = np.zeros(64, dtype=np.int64)
         ip = np.zeros(64, dtype=np.int32)
         ip[0] = 1  # no solver defaults: the values below
@@ -214,6 +228,8 @@ class _Pardiso:
         ip[23] = 1  # two-level parallel factorisation
         ip[24] = 1  # parallel forward/backward substitution
         ip[34] = 1  # zero-based indices
+        if single:
+            ip[27] = 1  # single precision: half the factor's memory and work
         if has_vertex_blocks(A):
             # variable-size block storage (VBSR) for the 3D shells' 3 x 3 vertex blocks,
             # spot Loop x3 (562k unknowns): factor 4.3 s against 5.3-6.2 s, 1846 against
@@ -224,7 +240,7 @@ class _Pardiso:
         self._alive = True
         self._folder: str | None = None
         self.out_of_core = False
-        dummy = np.zeros((self.n, 1), order="F")
+        dummy = np.zeros((self.n, 1), dtype=self.dtype, order="F")
         error, _ = self._call(11, dummy)
         if error != 0:
             self.release()
@@ -237,8 +253,16 @@ class _Pardiso:
         self.out_of_core_mb = OUT_OF_CORE_MARGIN * minimum_mb + OUT_OF_CORE_EXTRA_MB
         if not factorise:
             return
-        if memory_budget_mb is not None and self.in_core_mb > max(
-            memory_budget_mb, self.out_of_core_mb
+        if single and memory_budget_mb is not None and self.in_core_mb > memory_budget_mb:
+            self.release()
+            raise FactorTooLarge(
+                f"a single-precision factor needs {self.in_core_mb:.0f} MB, "
+                f"{memory_budget_mb:.0f} MB are left"
+            )
+        if (
+            not single
+            and memory_budget_mb is not None
+            and self.in_core_mb > max(memory_budget_mb, self.out_of_core_mb)
         ):
             self._folder = self._out_of_core_folder()
         if self._folder is None:
@@ -318,7 +342,7 @@ class _Pardiso:
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         one = b.ndim == 1
-        B = np.asfortranarray(b.reshape(self.n, -1), dtype=np.float64)
+        B = np.asfortranarray(b.reshape(self.n, -1), dtype=self.dtype)
         error, X = self._call(33, B)
         if error != 0:
             raise np.linalg.LinAlgError(f"PARDISO solve failed (error {error})")
@@ -327,7 +351,7 @@ class _Pardiso:
     def release(self) -> None:
         if self._alive:
             self._alive = False
-            dummy = np.zeros((self.n, 1), order="F")
+            dummy = np.zeros((self.n, 1), dtype=self.dtype, order="F")
             self._call(-1, dummy)
         if self._folder is not None:
             self._remove_folder()
@@ -363,9 +387,18 @@ class SPDSolver:
     backend : "auto" | "pardiso" | "cholmod" | "superlu".
     memory_budget_mb : the memory (MB) the factor may take; PARDISO writes a factor
         that needs more to a file (out of core) if that needs less.  None: in core.
+    single_precision : PARDISO factors and solves in single precision (about half the
+        factor's memory and time; float32 solutions), always in core:
+        :class:`FactorTooLarge` where it would need more than ``memory_budget_mb``.
+        A preconditioner, not a solver: on an ill-conditioned matrix the solutions
+        carry large errors (the 47k-vertex cow's shells Hessian shifted by its lowest
+        eigenvalue: 20 to 30 % relative, against 1e-9 in double precision), which a
+        preconditioned iteration tolerates (:mod:`.preview`).  The other backends solve
+        in double precision.
 
     Attributes
     ----------
+    single_precision : True if the factor is in single precision (PARDISO only).
     out_of_core : True if the factor lives in a file.
     factor_mb : memory the factor needs in core (PARDISO's analysis; None for the
         other backends).
@@ -374,10 +407,15 @@ class SPDSolver:
     """
 
     out_of_core = False
+    single_precision = False
     factor_mb: float | None = None
 
     def __init__(
-        self, A: sp.spmatrix, backend: str = "auto", memory_budget_mb: float | None = None
+        self,
+        A: sp.spmatrix,
+        backend: str = "auto",
+        memory_budget_mb: float | None = None,
+        single_precision: bool = False,
     ):
         A = sp.csr_matrix(A)
         self.n = A.shape[0]
@@ -390,7 +428,8 @@ class SPDSolver:
             raise ImportError(f"the {backend!r} backend is not available here")
         self.backend = backend
         if backend == "pardiso":
-            self._impl = _Pardiso(A, _load_mkl(), memory_budget_mb)
+            self._impl = _Pardiso(A, _load_mkl(), memory_budget_mb, single=single_precision)
+            self.single_precision = bool(single_precision)
             self.out_of_core = self._impl.out_of_core
             self.factor_mb = self._impl.in_core_mb
         elif backend == "cholmod":

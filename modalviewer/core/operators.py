@@ -61,6 +61,10 @@ class SpaceSettings:
     """Largest estimated error left unrefined; None: :data:`.preview.REFINE_ABOVE`."""
     refine_steps: int | None = None
     """Subspace-iteration steps of a refinement; None: :data:`.preview.REFINE_STEPS`."""
+    factor_step: bool = False
+    """Correct the Galerkin pairs by Rayleigh-Ritz with residuals preconditioned by a
+    single-precision factor of the fine operator (:func:`.preview._factor_steps`)
+    instead of the two-level step, where that factor fits the memory limit."""
 
     def samples(self, k: int) -> int:
         return max(self.samples_min, int(self.samples_per_mode * k))
@@ -248,7 +252,7 @@ _NORMAL_SHELLS_SPACE = SpaceSettings(200, 2.0, 2, RADIUS_FACTOR, False, True)
 # normal shells' exact spectra take about 4 s at 50k, about what a preview and its
 # refinement would (3.3 s against 3.7 s), so they are shown unrefined and the exact
 # spectrum follows.
-_SHELLS_SPACE = SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True)
+_SHELLS_SPACE = SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True, factor_step=True)
 
 # exact_growth / preview_growth: the fits of benchmarks/results/growth.json (bumpy plates
 # of 100k to 1M vertices, 100 modes) and growth_k300.json (the 337k plate, 300 modes: how

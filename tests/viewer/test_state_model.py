@@ -337,23 +337,25 @@ def test_the_state_says_whether_the_exact_spectrum_follows_a_preview(
 
 
 def test_the_3d_shells_preview_shows_where_its_estimate_is_within_2_percent(model, previews_pay):
-    """On a bumpy plate (14.6k vertices, 12 modes: estimated 1.4 %) the fast 3D shells
-    preview is shown, with its six rigid motions, until the exact spectrum replaces it;
-    on the curved spot (21 %) it is not shown (it may miss modes of thin parts)."""
-    from modalviewer.core.demo_shapes import bumpy_plate
+    """On a torus with a thin tube (640 vertices, 20 modes: estimated 3 % after the fast
+    preview's one correction step) the 3D shells preview is not shown (it may miss
+    modes); on the curved spot (estimated 0.5 %) it is shown, with its six rigid
+    motions, until the exact spectrum replaces it."""
+    from modalviewer.core.primitives import torus
 
     state = model.state
-    curved = model.request_spectrum("shells", k=12, show=True)
-    model.jobs.wait(curved)
-    assert curved.preview_job.status == "cancelled"
-    assert "estimated error (21 %)" in curved.preview_job.error, curved.preview_job.error
-    model.set_mesh(bumpy_plate(120))
+    model.set_mesh(torus(64, 10, minor=0.06))
+    thin = model.request_spectrum("shells", k=20, show=True)
+    model.jobs.wait(thin)
+    assert thin.preview_job.status == "cancelled"
+    assert "estimated error (3 %)" in thin.preview_job.error, thin.preview_job.error
+    model.open_mesh(ASSETS / "spot.obj")
     exact = model.request_spectrum("shells", k=12, show=True)
     assert exact.preview_job is not None
     model.jobs.wait(exact.preview_job)
     spec = state.spectrum("shells")
     assert spec.is_preview and spec.is_vector and int(spec.zero_mode_mask().sum()) == 6
-    assert 0.005 < spec.estimated_error < 0.02
+    assert 0.002 < spec.estimated_error < 0.02
     assert state.shows_preview() and state.derived.field().title.endswith("(preview)")
     model.jobs.wait(exact)
     assert not state.spectrum("shells").is_preview and not state.shows_preview()
@@ -478,22 +480,26 @@ def test_a_preview_whose_estimate_is_above_2_percent_is_not_shown(model, monkeyp
 
 
 def test_preview_only_computes_a_preview_and_no_exact_spectrum(model):
-    """Preview only: one job, a preview shown whatever its estimate (the curved spot's 3D
-    shells: refined, since the exact solve's memory fits); nothing follows it, and asking
-    again answers at once; turned off, the same request computes the exact spectrum."""
+    """Preview only: one job, a preview shown whatever its estimate (the 3D shells of a
+    torus with a thin tube: refined, since the exact solve's memory fits); nothing
+    follows it, and asking again answers at once; turned off, the same request computes
+    the exact spectrum."""
+    from modalviewer.core.primitives import torus
+
     state = model.state
+    model.set_mesh(torus(64, 10, minor=0.06))
     state.set_compute_settings(preview_only=True)
-    job = model.request_spectrum("shells", k=12, show=True)
+    job = model.request_spectrum("shells", k=20, show=True)
     assert model.jobs.jobs == [job] and job.is_preview
     model.jobs.wait(job)
     spec = state.spectrum("shells")
     assert job.status == "done" and spec.is_preview and spec is job.result[0]
-    assert spec.parameters["preview"]["refinement"]["steps"] == 2  # the spot needs it
+    assert spec.parameters["preview"]["refinement"]["steps"] == 1  # the thin tube needs it
     assert state.exact_follows("shells") is False and state.display.kind == "mode"
-    again = model.request_spectrum("shells", k=12)
+    again = model.request_spectrum("shells", k=20)
     assert again.done and again.result[0] is spec and not model.jobs.busy
     state.set_compute_settings(preview_only=False)
-    exact = model.request_spectrum("shells", k=12)
+    exact = model.request_spectrum("shells", k=20)
     model.jobs.wait(exact)
     assert not state.spectrum("shells").is_preview
 
@@ -526,18 +532,21 @@ def test_preview_only_takes_the_fast_preview_where_the_exact_solve_would_not_fit
     model, monkeypatch
 ):
     """On a machine too small for the exact solve (but not for the fast preview) the
-    refusal names Preview only, and Preview only computes the unrefined preview."""
+    refusal names Preview only, and Preview only computes the unrefined preview (a
+    torus with a thin tube, 640 vertices, estimated 3 %)."""
+    from modalviewer.core.primitives import torus
     from modalviewer.viewer import model as model_module
 
-    # the exact solve of 12 modes on the spot needs over 100 MB; the preview (law) 8 MB
+    model.set_mesh(torus(64, 10, minor=0.06))
+    # the exact solve of 20 modes on the torus needs 32 MB; the preview (law) 1.7 MB
     _growth(monkeypatch, "shells", (1.0, 1.0, 5000.0, 1.0), (1.0, 1.0, 8.0 * 34, 1.0))
     monkeypatch.setattr(model_module, "physical_memory", lambda: 12 * 2**20)
-    refusal = model.refusal(SpectrumKey("shells", 12))
-    assert refusal and "12 modes as a preview (Preview only) fit" in refusal, refusal
+    refusal = model.refusal(SpectrumKey("shells", 20))
+    assert refusal and "20 modes as a preview (Preview only) fit" in refusal, refusal
     with pytest.raises(model_module.ComputeRefused):
-        model.request_spectrum("shells", k=12)
+        model.request_spectrum("shells", k=20)
     model.state.set_compute_settings(preview_only=True)
-    job = model.request_spectrum("shells", k=12)
+    job = model.request_spectrum("shells", k=20)
     model.jobs.wait(job)
     spec = model.state.spectrum("shells")
     assert spec.is_preview and spec.parameters["preview"]["refinement"]["steps"] == 0
