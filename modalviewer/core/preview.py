@@ -664,40 +664,63 @@ def _single_factor(K, mass: np.ndarray, lowest: float, columns: int):
     return None
 
 
-def _preconditioned_residuals(K, mass, solver, lam, U, lam_scale, cols: slice, Z):
-    """One pass over K's row blocks and one block solve: (relative residuals of all of
-    U's columns, ``W = F^-1 R`` for the residuals R of the columns ``cols`` (float64,
-    C-ordered, Mass-orthogonal to the zero modes Z), ``r^T F^-1 r`` per column of cols),
-    with F the single-precision factor ``solver``."""
+SOLVE_BLOCK_BYTES = 1.0e9
+"""Bytes of the (N, w) arrays of one block of preconditioned residuals: the modes'
+columns (float64), their residuals and solutions (float32), 16 bytes an entry; at least
+32 columns a block.  Spot Loop x3 (562k unknowns) solves its 94 columns in one block; a
+million vertices in blocks of 32, so the peak holds no (N, k) residual arrays."""
+
+
+def _solve_block_columns(n: int) -> int:
+    """Columns per block of :func:`_preconditioned_residuals` for N = ``n`` rows."""
+    return int(max(32, SOLVE_BLOCK_BYTES // (16 * n)))
+
+
+def _preconditioned_residuals(K, mass, solver, lam, U, lam_scale, cols: slice, Z, keep: bool):
+    """(relative residuals of U's columns ``cols``, ``W = F^-1 R`` for their residuals R
+    (float64, C-ordered, Mass-orthogonal to the zero modes Z; None unless ``keep``),
+    ``r^T F^-1 r`` per column), with F the single-precision factor ``solver``.
+
+    Columns go in blocks (:data:`SOLVE_BLOCK_BYTES`): one pass over K's row blocks for the
+    block's residuals, then one block solve, so only W (where kept) spans all columns."""
     n = U.shape[0]
-    scale = np.abs(lam).copy()
-    scale[zero_modes(lam, lam_scale)] = max(float(np.abs(lam).max()), lam_scale)
     width = cols.stop - cols.start
-    R = np.empty((n, width), dtype=np.float32, order="F")
-
-    def sums(rows, KU):
-        MU = mass[rows, None] * U[rows]
-        res = KU - MU * lam[None, :]
-        R[rows] = res[:, cols]
-        return np.einsum("ij,ij->j", res, res), np.einsum("ij,ij->j", MU, MU)
-
-    res2, mu2 = row_block_sums(K, U, sums)
-    relative = np.sqrt(res2) / (scale * np.sqrt(mu2))
-    solved = solver.solve(R)
-    W = np.empty((n, width))
-    energies = np.zeros(width)
+    per_block = _solve_block_columns(n)
+    W = np.empty((n, width)) if keep else None
+    energies, res2, mu2 = np.zeros(width), np.zeros(width), np.zeros(width)
     lock = threading.Lock()
+    for start in range(0, width, per_block):
+        stop = min(start + per_block, width)
+        block = slice(cols.start + start, cols.start + stop)
+        Ub = np.ascontiguousarray(U[:, block])
+        lam_b = lam[block]
+        R = np.empty((n, stop - start), dtype=np.float32, order="F")
 
-    def widen(rows):
-        block = solved[rows].astype(np.float64)
-        part = np.einsum("ij,ij->j", R[rows].astype(np.float64), block)
-        W[rows] = block
-        with lock:
-            energies[:] += part
+        def sums(rows, KU, Ub=Ub, lam_b=lam_b, R=R):
+            MU = mass[rows, None] * Ub[rows]
+            res = KU - MU * lam_b[None, :]
+            R[rows] = res
+            return np.einsum("ij,ij->j", res, res), np.einsum("ij,ij->j", MU, MU)
 
-    _parallel_rows(n, widen)
-    R = solved = None  # the single-precision arrays, before the projection
-    if Z.shape[1]:
+        res2[start:stop], mu2[start:stop] = row_block_sums(K, Ub, sums)
+        del Ub
+        solved = solver.solve(R)
+
+        def widen(rows, R=R, solved=solved, start=start, stop=stop):
+            part = solved[rows].astype(np.float64)
+            energy = np.einsum("ij,ij->j", R[rows].astype(np.float64), part)
+            if W is not None:
+                W[rows, start:stop] = part
+            with lock:
+                energies[start:stop] += energy
+
+        _parallel_rows(n, widen)
+        del R, solved
+    scale = np.abs(lam[cols]).copy()
+    zero = zero_modes(lam, lam_scale)[cols]
+    scale[zero] = max(float(np.abs(lam).max()), lam_scale)
+    relative = np.sqrt(res2) / (scale * np.sqrt(mu2))
+    if W is not None and Z.shape[1]:
         C = _weighted_product(Z, W, mass)
 
         def project(rows):
@@ -768,17 +791,28 @@ def _factor_steps(K, mass, lam, U, lam_scale, refine_above, max_steps, report):
     if solver is None:
         return None
     seconds["single_factor"] = time.perf_counter() - t
-    Z = U[:, :first]
+    Z = np.ascontiguousarray(U[:, :first])  # the rigid motions: U's rows stay as they are
     info = {"factor_mb": solver.factor_mb, "columns_first_step": columns, "steps": 0}
     cols = slice(first, first + columns)
     while True:
         t = time.perf_counter()
         report("preview: correcting", min(0.95, 0.85 + 0.04 * info["steps"]))
-        res, W, energies = _preconditioned_residuals(K, mass, solver, lam, U, lam_scale, cols, Z)
+        # the directions are kept where a step follows (the first, or a refinement's)
+        keep = info["steps"] < 1 + max_steps
+        relative, W, energies = _preconditioned_residuals(
+            K, mass, solver, lam, U, lam_scale, cols, Z, keep
+        )
         seconds["preconditioned_residuals"] = seconds.get("preconditioned_residuals", 0.0) + (
             time.perf_counter() - t
         )
         if info["steps"]:  # every non-zero mode's residual: the estimate
+            res = np.zeros(c)
+            zero_scale = max(float(np.abs(lam).max()), lam_scale)
+            R = threaded_product(K, U[:, :first]) - (mass[:, None] * U[:, :first]) * lam[:first]
+            MZ = np.linalg.norm(mass[:, None] * U[:, :first], axis=0)
+            res[:first] = np.linalg.norm(R, axis=0) / (zero_scale * MZ)
+            del R
+            res[first:] = relative
             est = np.zeros(c)
             est[first:] = np.maximum(energies, 0.0) / np.abs(lam[first:])
             info.setdefault("estimated_error_first_step", float(est.max()))
