@@ -692,13 +692,15 @@ def _preconditioned_residuals(K, mass, solver, lam, U, lam_scale, cols: slice, Z
     for start in range(0, width, per_block):
         stop = min(start + per_block, width)
         block = slice(cols.start + start, cols.start + stop)
-        Ub = np.ascontiguousarray(U[:, block])
+        # one block: K times all of U (no copy of its columns; U is C-ordered), else
+        # times a copy of the block's columns
+        Ub, within = (U, block) if stop - start == width else (U[:, block].copy(), slice(None))
         lam_b = lam[block]
         R = np.empty((n, stop - start), dtype=np.float32, order="F")
 
-        def sums(rows, KU, Ub=Ub, lam_b=lam_b, R=R):
-            MU = mass[rows, None] * Ub[rows]
-            res = KU - MU * lam_b[None, :]
+        def sums(rows, KU, Ub=Ub, within=within, lam_b=lam_b, R=R):
+            MU = mass[rows, None] * Ub[rows, within]
+            res = KU[:, within] - MU * lam_b[None, :]
             R[rows] = res
             return np.einsum("ij,ij->j", res, res), np.einsum("ij,ij->j", MU, MU)
 

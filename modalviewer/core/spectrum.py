@@ -87,6 +87,17 @@ class Spectrum:
         (``parameters["preview"]`` holds the per-mode estimates); 0.0 for exact spectra."""
         return float(self.parameters.get("preview", {}).get("estimated_error", 0.0))
 
+    def estimated_error_of_lowest(self, share: float = 0.5) -> float:
+        """Estimated largest relative eigenvalue error of a preview's lowest ``share`` of
+        its non-zero modes (at least one; 0.0 for exact spectra): a 3D shells preview's
+        correction step preconditions its lowest modes, which are the most accurate."""
+        errors = np.asarray(self.parameters.get("preview", {}).get("estimated_errors") or [])
+        if errors.size != self.k:
+            return self.estimated_error
+        nonzero = np.flatnonzero(~self.zero_mode_mask())
+        lowest = nonzero[: max(1, int(np.ceil(share * nonzero.size)))]
+        return float(errors[lowest].max(initial=0.0))
+
     def estimated_mode_error(self, j: int) -> float:
         """Estimated relative eigenvalue error of a preview's mode ``j`` (0.0 for zero
         modes and exact spectra)."""

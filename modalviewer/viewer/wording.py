@@ -83,7 +83,8 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         zero = spec.zero_mode_mask()[j]
         value = "0 (zero mode)" if zero else f"{lam:.4g}"
         if spec.is_preview:
-            value += f" (preview; estimated error {percent_text(spec.estimated_error)})"
+            error = 0.0 if zero else spec.estimated_mode_error(j)
+            value += f" (preview; estimated error {percent_text(error)})"
         elif state.is_coarse(d.operator):
             value += " (coarse-to-fine: approximate)"
         colours = "blue +, white 0, orange -"
