@@ -31,9 +31,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.run import _in_child, peak_mb, save_result  # noqa: E402
+from modalviewer.core.cost import LAWS_FROM_VERTICES as FIT_FROM  # noqa: E402
 
-FIT_FROM = 100_000
-"""Sizes from this many vertices on enter the fitted exponents."""
+# Sizes from FIT_FROM vertices on enter the fitted exponents.
 
 
 def _one(grid: int, operator: str, accuracy: str, k: int) -> dict:

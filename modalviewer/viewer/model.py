@@ -17,6 +17,7 @@ import numpy as np
 
 from ..coarsen import COARSE_FRACTION
 from ..core.cache import SpectrumCache
+from ..core.cost import LAWS_FROM_VERTICES
 from ..core.eigen import Cancelled
 from ..core.memory import physical_memory_mb
 from ..core.mesh import Mesh
@@ -54,6 +55,7 @@ class PreviewPlan:
     exact_seconds: float
     preview_mb: float
     exact_mb: float
+    n_vertices: int = LAWS_FROM_VERTICES
 
     @property
     def deadline(self) -> float:
@@ -66,6 +68,11 @@ class PreviewPlan:
         """Why there is no preview, in words ("" where there is one)."""
         if self.pays:
             return ""
+        if self.n_vertices < LAWS_FROM_VERTICES:
+            return (
+                f"no preview below {LAWS_FROM_VERTICES:,} vertices".replace(",", "\u00a0")
+                + ": the exact solve is quick there"
+            )
         if self.preview_seconds > PREVIEW_DELAY * self.exact_seconds:
             return (
                 f"no preview: predicted {_seconds(self.preview_seconds)} against the exact "
@@ -91,14 +98,20 @@ def preview_plan(key: SpectrumKey, n_vertices: int) -> PreviewPlan:
     mesh of ``n_vertices``
     (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_seconds`); a preview
     pays when it costs at most :data:`PREVIEW_DELAY` of the exact time and needs no more
-    memory than the exact solve."""
+    memory than the exact solve, on meshes of at least
+    :data:`~modalviewer.core.cost.LAWS_FROM_VERTICES` vertices, where the laws were
+    measured (below, fixed costs make a preview take a larger share)."""
     info, k = operator_info(key.operator), key.k
     preview_s = info.predicted_seconds("fast preview", n_vertices, k)
     exact_s = info.predicted_seconds("exact", n_vertices, k)
     preview_mb = info.predicted_peak_mb("fast preview", n_vertices, k)
     exact_mb = info.predicted_peak_mb("exact", n_vertices, k)
-    pays = preview_s <= PREVIEW_DELAY * exact_s and preview_mb <= exact_mb
-    return PreviewPlan(pays, preview_s, exact_s, preview_mb, exact_mb)
+    pays = (
+        n_vertices >= LAWS_FROM_VERTICES
+        and preview_s <= PREVIEW_DELAY * exact_s
+        and preview_mb <= exact_mb
+    )
+    return PreviewPlan(pays, preview_s, exact_s, preview_mb, exact_mb, n_vertices)
 
 
 class ComputeRefused(ValueError):
@@ -158,7 +171,8 @@ PREVIEW_WORDS = "as a preview (Preview only)"
 def preview_fits(key: SpectrumKey, n_vertices: int, available: int) -> bool:
     """Whether the fast preview of ``key`` is predicted to need at most
     :data:`MEMORY_SHARE` of ``available`` bytes (its growth law, measured at 100 modes,
-    taken in proportion to k above that: the (N, k) arrays of the modes)."""
+    plus the arrays each further mode adds:
+    :meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`)."""
     info = operator_info(key.operator)
     needed = info.predicted_peak_mb("fast preview", n_vertices, key.k) * 2**20
     return needed <= MEMORY_SHARE * available

@@ -711,7 +711,8 @@ def test_refined_modes_own_their_memory(ring, monkeypatch):
 def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeypatch):
     """The correction step's residuals go through the single-precision solve in blocks
     of columns where they would take more than SOLVE_BLOCK_BYTES: the same eigenvalues
-    and estimates as in one block (thin torus, 20 modes, blocks of 5 columns forced)."""
+    and estimates as in one block (thin torus, 20 modes, blocks of 5 columns forced, and
+    of 3 in the refinement's pass that keeps its directions)."""
     mesh = torus(64, 10, minor=0.06)
     K, mass = operator_matrices(mesh, "shells")
     widths = []
@@ -723,13 +724,14 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
 
     monkeypatch.setattr(pv.SPDSolver, "solve", counting)
     whole = pv.preview_spectrum(mesh, "shells", K, mass, 20)
-    # the first step's 12 columns, then twice all 14 non-zero modes (the refinement's
-    # step and the final estimate)
-    assert widths == [12, 14, 14]
+    # the first step's 12 columns, then all 14 non-zero modes: the estimate, the same
+    # residuals again for the refinement's step (kept this time), the final estimate
+    assert widths == [12, 14, 14, 14]
     widths.clear()
     monkeypatch.setattr(pv, "_solve_block_columns", lambda n: 5)
+    monkeypatch.setattr(pv, "REFINE_BLOCK_COLUMNS", 3)  # the refinement's kept pass
     blocked = pv.preview_spectrum(mesh, "shells", K, mass, 20)
-    assert widths == [5, 5, 2, 5, 5, 4, 5, 5, 4]
+    assert widths == [5, 5, 2, 5, 5, 4, 3, 3, 3, 3, 2, 5, 5, 4]
     np.testing.assert_allclose(blocked[0], whole[0], rtol=1e-7, atol=1e-9 * whole[0].max())
     np.testing.assert_allclose(
         blocked[3]["estimated_errors"], whole[3]["estimated_errors"], rtol=1e-4, atol=1e-12

@@ -371,12 +371,14 @@ def test_a_preview_shows_where_its_lower_half_is_estimated_within_2_percent(mode
 
 def _growth(monkeypatch, operator, exact, preview):
     """Give ``operator`` the growth laws ``exact`` and ``preview`` (GrowthLaw args; mode
-    exponents 1 and 0.3 unless given)."""
+    exponents 1 and 0.3 unless given), holding at any size."""
     from dataclasses import replace
 
     from modalviewer.core.cost import GrowthLaw
     from modalviewer.core.operators import OPERATOR_INFO
+    from modalviewer.viewer import model as model_module
 
+    monkeypatch.setattr(model_module, "LAWS_FROM_VERTICES", 0)  # these laws hold at any size
     exact = (*exact, 1.0) if len(exact) == 4 else exact
     preview = (*preview, 0.3) if len(preview) == 4 else preview
     info = replace(
@@ -418,6 +420,19 @@ def test_the_predictor_lets_a_preview_come_first_only_where_it_pays(monkeypatch)
         heavy.reason()
         == "no preview: it would need about 600\u00a0MB, more than the exact solve's 500\u00a0MB"
     )
+    # below the sizes the laws were measured on no preview pays, whatever they say (the
+    # 3D shells' fast preview law at 2930 vertices says 0.09 of the exact time; the plate
+    # at 10k measured 0.28)
+    from modalviewer.viewer import model as model_module
+
+    _growth(monkeypatch, "laplacian", (10.0, 1.0, 500.0, 1.0), (0.5, 1.0, 400.0, 1.0))
+    monkeypatch.setattr(model_module, "LAWS_FROM_VERTICES", 100_000)
+    assert preview_plan(SpectrumKey("laplacian", 100), 100_000).pays
+    small = preview_plan(SpectrumKey("laplacian", 100), 99_999)
+    assert not small.pays
+    assert small.reason() == (
+        "no preview below 100\u00a0000 vertices: the exact solve is quick there"
+    ), small.reason()
 
 
 def test_the_viewer_previews_where_the_predictor_says_and_says_why_not(model, monkeypatch):
