@@ -72,7 +72,7 @@ def power_of_size(at_100k: float, exponent: float, n_vertices: int) -> float:
 LAWS_FROM_VERTICES = 100_000
 """The growth laws are fitted to the runs from this many vertices on
 (``benchmarks.growth``); below it fixed costs dominate and the laws do not hold (the 3D
-shells' fast preview: 0.28 of the exact time at 10k and 0.13 at 33k vertices, where its
+shells' fast preview: 0.30 of the exact time at 10k and 0.13 at 33k vertices, where its
 law would say 0.09)."""
 
 

@@ -277,7 +277,7 @@ _GROWTH: dict[tuple[str, str], GrowthLaw] = {
     ("modified_dirichlet", "exact"): GrowthLaw(8.991, 1.016, 452.8, 0.887, 1.08),
     ("modified_dirichlet", "fast preview"): GrowthLaw(2.831, 0.813, 407.0, 0.777, 0.39),
     ("shells", "exact"): GrowthLaw(46.357, 1.083, 1890.8, 0.994, 0.901),
-    ("shells", "fast preview"): GrowthLaw(5.832, 1.186, 1592.2, 0.947, 0.58),
+    ("shells", "fast preview"): GrowthLaw(5.776, 1.203, 1524.0, 0.954, 0.569),
     ("shells_normal", "exact"): GrowthLaw(9.686, 1.443, 477.4, 0.937, 0.672),
     ("shells_normal", "fast preview"): GrowthLaw(6.529, 0.936, 592.6, 0.79, 0.52),
 }
