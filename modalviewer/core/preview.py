@@ -775,7 +775,9 @@ def _ritz_with(K, mass, lam, U, W) -> np.ndarray:
     return mu[:c]
 
 
-def _factor_steps(K, mass, lam, U, lam_scale, refine_above, max_steps, report, factored=None):
+def _factor_steps(
+    K, mass, lam, U, lam_scale, refine_above, max_steps, report, factored=None, give_up=False
+):
     """The 3D shells' correction of the Galerkin pairs (lam, U): Rayleigh-Ritz steps
     with the residuals preconditioned by a single-precision factor of the fine operator
     (LOBPCG without its third block), U overwritten in place.
@@ -788,10 +790,15 @@ def _factor_steps(K, mass, lam, U, lam_scale, refine_above, max_steps, report, f
     further steps were taken, those preconditioned residuals (solved again, kept this
     time) make the next step.  The
     zero modes (the rigid motions, exact in the Galerkin space) are kept out of the new
-    directions.  ``factored()`` is called once the factor exists (the caller lets go of
-    what only the two-level step would need).  Returns (lam, relative residuals,
-    estimates, info), or None where the factor does not fit the memory limit (the caller
-    takes the two-level step)."""
+    directions.  With ``give_up``, where the lower half of the non-zero modes is still
+    estimated above ``refine_above`` after a step, no further step is taken and
+    ``info["unconverged"]`` is set: modes the smooth space missed altogether (the cow's
+    tail: its Galerkin values ten times too high) come in only slowly through a
+    preconditioner shifted by ``lam_1``, and subspace iteration shifted near zero finds
+    them (the caller's refinement).  ``factored()`` is called once the factor exists
+    (the caller lets go of what only the two-level step would need).  Returns (lam,
+    relative residuals, estimates, info), or None where the factor does not fit the
+    memory limit (the caller takes the two-level step)."""
     zero = zero_modes(lam, lam_scale)
     first = int(np.argmin(zero)) if not zero.all() else lam.shape[0]
     if not zero[:first].all() or zero[first:].any() or first == lam.shape[0]:
@@ -834,7 +841,9 @@ def _factor_steps(K, mass, lam, U, lam_scale, refine_above, max_steps, report, f
             est = np.zeros(c)
             est[first:] = np.maximum(energies, 0.0) / np.abs(lam[first:])
             info.setdefault("estimated_error_first_step", float(est.max()))
-            if info["steps"] >= 1 + max_steps or est.max() <= refine_above:
+            lower = est[first:][: max(1, int(np.ceil(0.5 * (c - first))))]
+            info["unconverged"] = bool(give_up and lower.max() > refine_above)
+            if info["unconverged"] or info["steps"] >= 1 + max_steps or est.max() <= refine_above:
                 break
             t = time.perf_counter()
             _, W, _ = _preconditioned_residuals(
@@ -993,8 +1002,15 @@ def preview_spectrum(
                 STEP_REFINE_STEPS if refine else 0,
                 report,
                 factored=space.clear,
+                give_up=refine,
             )
-        if corrected is not None:
+        if corrected is not None and corrected[3]["unconverged"]:
+            # modes missing: subspace iteration shifted near zero below, from these pairs
+            lam, res, est, step_info = corrected
+            seconds["correction"] = time.perf_counter() - t
+            info.update(correction="single-precision factor step", factor_step=step_info)
+            smoothing = False
+        elif corrected is not None:
             lam, res, est, step_info = corrected
             seconds["correction"] = time.perf_counter() - t
             refinement = {
@@ -1022,11 +1038,13 @@ def preview_spectrum(
         )
         seconds["smoothing"] = time.perf_counter() - t
     space.clear()  # the reduced space is done with: its memory for what follows
-    t = time.perf_counter()
-    report("preview: estimating errors", 0.9)
-    res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
-    est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
-    seconds["estimate"] = time.perf_counter() - t
+    scale = None
+    if corrected is None:
+        t = time.perf_counter()
+        report("preview: estimating errors", 0.9)
+        res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
+        est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
+        seconds["estimate"] = time.perf_counter() - t
     refinement = {"steps": 0, "estimated_error_before": float(est.max(initial=0.0))}
     if refine and est.max(initial=0.0) > refine_above:
         t = time.perf_counter()
@@ -1068,7 +1086,11 @@ def preview_spectrum(
         galerkin_eigenvalues=[float(x) for x in galerkin],
         estimated_errors=[float(e) for e in est],
         estimated_error=float(est.max()),
-        correction="two-level step" if smoothing else "none",
+        correction=(
+            "single-precision factor step"
+            if corrected is not None
+            else ("two-level step" if smoothing else "none")
+        ),
         estimate={
             "method": "block-Jacobi conjugate gradients",
             "modes": ESTIMATE_MODES,
