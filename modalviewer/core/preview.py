@@ -493,6 +493,20 @@ def estimated_errors(
     return out, c
 
 
+def _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition):
+    """(relative residuals, estimated errors, how they were estimated) of the pairs
+    (lam, U): :func:`_residual_norms` and :func:`estimated_errors`."""
+    res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
+    est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
+    method = {
+        "method": "block-Jacobi conjugate gradients",
+        "modes": ESTIMATE_MODES,
+        "steps": ESTIMATE_STEPS,
+        "scale": scale,
+    }
+    return res, est, method
+
+
 REFINE_ABOVE = 0.02
 """A preview whose largest estimated error is above this (the 2 % the previews aim at)
 is refined by subspace iteration with the fine operator (:func:`_subspace_step`)."""
@@ -1004,32 +1018,16 @@ def preview_spectrum(
                 factored=space.clear,
                 give_up=refine,
             )
-        if corrected is not None and corrected[3]["unconverged"]:
-            # modes missing: subspace iteration shifted near zero below, from these pairs
+        if corrected is not None:
             lam, res, est, step_info = corrected
             seconds["correction"] = time.perf_counter() - t
-            info.update(correction="single-precision factor step", factor_step=step_info)
+            info["factor_step"] = step_info
             smoothing = False
-        elif corrected is not None:
-            lam, res, est, step_info = corrected
-            seconds["correction"] = time.perf_counter() - t
-            refinement = {
-                "steps": step_info["steps"] - 1,
-                "estimated_error_before": step_info["estimated_error_first_step"],
-            }
-            info.update(correction="single-precision factor step", factor_step=step_info)
-            info.update(
-                refinement=refinement,
-                reduced_dimension=int(dim),
-                smoothing=False,
-                seconds_by_stage={s: round(v, 4) for s, v in seconds.items()},
-                galerkin_eigenvalues=[float(x) for x in galerkin],
-                estimated_errors=[float(e) for e in est],
-                estimated_error=float(est.max()),
-                estimate={"method": "single-precision factor"},
-            )
-            return lam, U, res, info
-    precondition = _jacobi_blocks(K, operator_info(operator).unknowns_per_vertex)
+    # the step's estimate stands unless the block-Jacobi one below replaces it
+    estimate = {"method": "single-precision factor"}
+    converged = corrected is not None and not step_info["unconverged"]
+    if not converged:
+        precondition = _jacobi_blocks(K, operator_info(operator).unknowns_per_vertex)
     if smoothing:
         t = time.perf_counter()
         report("preview: smoothing", 0.8)
@@ -1038,15 +1036,20 @@ def preview_spectrum(
         )
         seconds["smoothing"] = time.perf_counter() - t
     space.clear()  # the reduced space is done with: its memory for what follows
-    scale = None
+
     if corrected is None:
         t = time.perf_counter()
         report("preview: estimating errors", 0.9)
-        res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
-        est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
+        res, est, estimate = _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition)
         seconds["estimate"] = time.perf_counter() - t
-    refinement = {"steps": 0, "estimated_error_before": float(est.max(initial=0.0))}
-    if refine and est.max(initial=0.0) > refine_above:
+    if converged:  # its further steps are the refinement
+        refinement = {
+            "steps": step_info["steps"] - 1,
+            "estimated_error_before": step_info["estimated_error_first_step"],
+        }
+    else:  # modes missing after the step (unconverged), or no step taken
+        refinement = {"steps": 0, "estimated_error_before": float(est.max(initial=0.0))}
+    if not converged and refine and est.max(initial=0.0) > refine_above:
         t = time.perf_counter()
         report("preview: refining (factorising)", 0.92)
         c, lam_b = lam.shape[0], lam
@@ -1075,8 +1078,7 @@ def preview_spectrum(
         U = buffer
         del buffer
         if refinement["steps"]:
-            res, eta = _residual_norms(K, mass, lam, U, lam_scale, precondition)
-            est, scale = estimated_errors(K, mass, lam, U, precondition, eta, lam_scale)
+            res, est, estimate = _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition)
         seconds["refinement"] = time.perf_counter() - t
     info.update(
         refinement=refinement,
@@ -1091,12 +1093,7 @@ def preview_spectrum(
             if corrected is not None
             else ("two-level step" if smoothing else "none")
         ),
-        estimate={
-            "method": "block-Jacobi conjugate gradients",
-            "modes": ESTIMATE_MODES,
-            "steps": ESTIMATE_STEPS,
-            "scale": scale,
-        },
+        estimate=estimate,
     )
     return lam, U, res, info
 
