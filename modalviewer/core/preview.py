@@ -632,11 +632,12 @@ lowest 50 eigenvalues after one step: 1.45 % largest error at 1.0, 2.6 % at 0.1;
 
 STEP_COLUMNS = 0.6
 """Share of the modes asked for (the lowest non-zero ones) whose residuals the first
-correction step preconditions: the solve, the products with K and the Gram matrices grow with it.
-Spot Loop x3 / hand Loop x2 (187k / 206k vertices), 100 modes: 60 of 94 columns keep
-the lowest 50 eigenvalues within 1.5 / 1.4 % at 0.21 / 0.22 of the exact time (modes 51
-to 94 up to 13 % off, which the estimate reports), all 94 within 1.5 / 0.4 % at 0.24 /
-0.26 (50 columns: 2.9 % on the hand)."""
+correction step preconditions: the solve, the products with K and the Gram matrices
+grow with it.  Spot Loop x3 / hand Loop x2 (187k / 206k vertices), 100 modes: 60 of 94
+columns keep the lowest 50 eigenvalues within 1.5 / 1.4 % at 0.24 / 0.25 of the exact
+time (``benchmarks/results/curved.json``; modes 61 to 94 up to 14 / 16 % off, which
+their estimates report); all 94 columns took 0.24 / 0.26 with 1.5 / 0.4 % in a run of
+the same script beside an exact solve, and 50 columns left 2.9 % on the hand."""
 
 STEP_REFINE_STEPS = 1
 """Further correction steps (all non-zero modes preconditioned) of a refined preview
