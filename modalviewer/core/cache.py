@@ -145,8 +145,8 @@ class SpectrumCache:
 
     # ------------------------------------------------------------- use
     def get(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Spectrum | None:
-        """The cached spectrum, or None.  A hit counts as a use (for the eviction order);
-        an entry that cannot be read is deleted with a warning."""
+        """The cached spectrum (its ``from_cache`` set), or None.  A hit counts as a use
+        (for the eviction order); an entry that cannot be read is deleted with a warning."""
         path = self.path(mesh, operator, k, bending, membrane)
         if not path.is_file():
             return None
@@ -168,6 +168,7 @@ class SpectrumCache:
             return None
         self._touch(path)
         self.enforce_limit(keep=path)
+        spec.from_cache = True
         return spec
 
     def writable_path(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Path:

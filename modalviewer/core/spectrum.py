@@ -41,6 +41,7 @@ class Spectrum:
     residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
     mesh_hash : SHA-256 of the mesh geometry the spectrum belongs to.
     parameters : bending and membrane weights, solver information.
+    from_cache : read from the spectrum cache rather than computed now (not saved).
     """
 
     eigenvalues: np.ndarray
@@ -50,6 +51,7 @@ class Spectrum:
     residuals: np.ndarray
     mesh_hash: str = ""
     parameters: dict = field(default_factory=dict)
+    from_cache: bool = field(default=False, compare=False)
 
     def __repr__(self) -> str:
         """One line: operator, k, vertices, the modes' shape ((n, 3, k) for vector modes,

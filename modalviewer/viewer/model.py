@@ -586,6 +586,17 @@ FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
 """What a spectrum whose solve kept its Krylov basis in single precision says of it."""
 
 
+def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
+    """How a finished spectrum job's status line starts: "<description> in 63.2 s", or
+    for a spectrum read from the cache "<description> read from the cache in 0.3 s
+    (solved earlier in 63.2 s)", so that a cache hit does not read like a fresh solve."""
+    if not spec.from_cache:
+        return f"{job.description} in {job.seconds:.1f} s"
+    earlier = spec.parameters.get("seconds_total")
+    solved = f" (solved earlier in {earlier:.1f} s)" if isinstance(earlier, (int, float)) else ""
+    return f"{job.description} read from the cache in {job.seconds:.1f} s{solved}"
+
+
 def memory_text(spec: Spectrum) -> str:
     """``"; ... (memory limit)"`` with :data:`OUT_OF_CORE_WORDS` where the exact solve
     kept its factor out of core (the reason it took longer) and

@@ -48,6 +48,7 @@ from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, Spe
 from .model import (
     ComputeRefused,
     ViewerModel,
+    finished_text,
     memory_text,
     predicted_seconds,
     residual_text,
@@ -417,10 +418,7 @@ class Viewer:
                 else residual_text(spec)
             )
             # the disk note next to the time it explains: the status bar cuts long lines
-            self._status(
-                f"{job.description} in {job.seconds:.1f} s{memory_text(spec)}; {quality}.",
-                15000,
-            )
+            self._status(f"{finished_text(job, spec)}{memory_text(spec)}; {quality}.", 15000)
         elif job.status == DONE and not isinstance(job, RepairJob):
             self._status(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
         elif job.status == FAILED:

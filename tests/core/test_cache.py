@@ -144,3 +144,16 @@ def test_spectra_of_an_older_solver_are_not_served(tmp_path, monkeypatch):
     assert store.get(mesh, "laplacian", 5) is not None
     monkeypatch.undo()
     assert store.get(mesh, "laplacian", 5) is None
+
+
+def test_a_cache_hit_says_it_came_from_the_cache_and_the_file_does_not(tmp_path, mesh):
+    from modalviewer.core.spectrum import load_spectrum
+
+    cache = SpectrumCache(tmp_path / "c")
+    spec = _spectrum(mesh, 10, 0)
+    assert not spec.from_cache
+    path = cache.put(mesh, spec, 10)
+    hit = cache.get(mesh, "laplacian", 10)
+    assert hit.from_cache
+    np.testing.assert_array_equal(hit.eigenvalues, spec.eigenvalues)
+    assert not load_spectrum(path).from_cache

@@ -167,6 +167,22 @@ def test_messages_instead_of_dialogs(viewer, spot_path):
         viewer.show_distance(share=1.5)
 
 
+def test_a_cached_spectrum_does_not_read_like_a_fresh_solve(viewer, spot_path, tmp_path):
+    statuses = []
+    viewer.open_mesh(spot_path)
+    viewer.compute("laplacian", k=10)
+    solved = viewer.state.spectra[viewer.state.spectrum_key("laplacian")]
+    assert not solved.from_cache
+    again = Viewer(cache=mv.core.cache.SpectrumCache(tmp_path / "cache"))
+    again.events.status.connect(lambda text, _ms: statuses.append(text))
+    again.open_mesh(spot_path)
+    again.compute("laplacian", k=10)
+    assert statuses[-1].startswith("Laplacian (cotan), 10 modes read from the cache in ")
+    earlier = solved.parameters["seconds_total"]
+    assert f"(solved earlier in {earlier:.1f} s)" in statuses[-1]
+    again.close()
+
+
 def test_keep_the_largest_component(viewer, tmp_path):
     from modalviewer.core.primitives import icosphere, torus
 
