@@ -412,6 +412,14 @@ def test_the_predictor_lets_a_preview_come_first_only_where_it_pays(monkeypatch)
         "no preview: predicted 0.3\u00a0s against the exact 1.0\u00a0s, it would delay the "
         "exact spectrum by more than 10 %"
     ), few.reason()
+    # inside its share, but not by the margin curved meshes need: 1.6 * 0.7 s > 1.0 s
+    _growth(monkeypatch, "laplacian", (10.0, 1.2, 500.0, 1.0), (0.7, 1.0, 400.0, 1.0))
+    close = preview_plan(SpectrumKey("laplacian", 100), 100_000)
+    assert close.preview_seconds <= PREVIEW_DELAY * close.exact_seconds and not close.pays
+    assert close.reason() == (
+        "no preview: predicted 0.7\u00a0s against the exact 10\u00a0s, too close to its 10 % "
+        "share (previews on curved meshes take up to 1.6 times their prediction)"
+    ), close.reason()
     # fast enough, but a preview needing more memory than the exact solve does not pay
     _growth(monkeypatch, "laplacian", (10.0, 1.0, 500.0, 1.0), (0.5, 1.0, 600.0, 1.0))
     heavy = preview_plan(SpectrumKey("laplacian", 100), 100_000)
@@ -433,6 +441,29 @@ def test_the_predictor_lets_a_preview_come_first_only_where_it_pays(monkeypatch)
     assert small.reason() == (
         "no preview below 100\u00a0000 vertices: the exact solve is quick there"
     ), small.reason()
+
+
+def test_the_preview_margin_covers_the_curved_meshes_measured():
+    """PREVIEW_MARGIN is at least the largest measured / predicted fast-preview time on
+    the curved benchmark meshes the laws apply to (benchmarks/results/curved.json)."""
+    import json
+    from pathlib import Path
+
+    from modalviewer.core.cost import LAWS_FROM_VERTICES
+    from modalviewer.core.operators import operator_info
+    from modalviewer.viewer.model import PREVIEW_MARGIN
+
+    results = Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "curved.json"
+    ratios = [
+        r["fast_preview_seconds"]
+        / operator_info(r["operator"]).predicted_seconds("fast preview", r["vertices"], r["k"])
+        for r in json.loads(results.read_text())["rows"]
+        if r["vertices"] >= LAWS_FROM_VERTICES
+    ]
+    assert len(ratios) >= 9
+    assert max(ratios) > 1.0  # curved meshes are slower than the plates' laws say
+    assert PREVIEW_MARGIN >= max(ratios)
+    assert PREVIEW_MARGIN <= 1.2 * max(ratios)  # and not needlessly cautious
 
 
 def test_the_viewer_previews_where_the_predictor_says_and_says_why_not(model, monkeypatch):
