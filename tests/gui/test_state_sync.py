@@ -422,6 +422,22 @@ def test_a_closed_panel_comes_back_from_the_view_menu(window):
     assert not dock.isHidden()
 
 
+def test_a_preview_only_result_says_how_to_get_the_exact_spectrum(window, spot_path):
+    """Found under Xvfb: with Preview only ticked the Modes panel said "Compute (Ctrl+R)
+    for the exact spectrum", where Compute makes the same preview again."""
+    window.open_mesh(spot_path)
+    window.state.set_compute_settings(preview_only=True)
+    spec = window.compute("laplacian", k=30, wait=True)
+    assert spec.is_preview
+    text = window.modes_panel.eigen_label.text()
+    assert text.endswith("Untick Preview only and Compute (Ctrl+R) for the exact spectrum."), text
+    window.state.set_compute_settings(preview_only=False)
+    assert window.modes_panel.eigen_label.text().endswith(
+        " Compute (Ctrl+R) for the exact spectrum."
+    )
+    assert "Untick" not in window.modes_panel.eigen_label.text()
+
+
 def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     """Found under Xvfb: Coarse-to-fine, Preview first and the colour bar came back at
     their defaults after a restart (settings.ini held operator, weights and rescale

@@ -77,7 +77,9 @@ class ModesPanel(QtWidgets.QWidget):
             lambda _: state.set_shell_coloring(self.color_combo.currentData())
         )
         self.iso_spin.valueChanged.connect(state.set_isolines)
-        for event in (state.events.display, state.events.spectra, state.events.mesh):
+        # compute_settings: the preview's note depends on Preview only
+        events = state.events
+        for event in (events.display, events.spectra, events.mesh, events.compute_settings):
             event.connect(self.update_from_state)
         state.events.style.connect(self._update_style)
         self.update_from_state()
@@ -151,11 +153,13 @@ class ModesPanel(QtWidgets.QWidget):
         else:
             text = f"Not shown: the surface shows {_what_is_shown(state)}. M shows the mode."
         if spec.is_preview:
-            follows = (
-                "the exact spectrum replaces it when ready."
-                if state.exact_follows(op)
-                else "Compute (Ctrl+R) for the exact spectrum."
-            )
+            if state.exact_follows(op):
+                follows = "the exact spectrum replaces it when ready."
+            elif state.compute_settings.preview_only:
+                # Compute would only make the same preview again
+                follows = "untick Preview only and Compute (Ctrl+R) for the exact spectrum."
+            else:
+                follows = "Compute (Ctrl+R) for the exact spectrum."
             this_mode = (
                 f"; this mode {percent_text(spec.estimated_mode_error(state.display.mode))}"
                 if showing_mode and not zero[min(state.display.mode, spec.k - 1)]
