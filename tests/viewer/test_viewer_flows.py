@@ -183,6 +183,28 @@ def test_a_cached_spectrum_does_not_read_like_a_fresh_solve(viewer, spot_path, t
     again.close()
 
 
+def test_the_exact_solve_after_a_preview_does_not_say_there_is_no_preview(
+    viewer, spot_path, monkeypatch
+):
+    """Found under Xvfb: with a Preview only result on screen, the exact solve asked for
+    next said "no preview: predicted ..." (the note for big requests; on for every
+    request here)."""
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "NOTE_FROM_SECONDS", 0.0)
+    statuses = []
+    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    viewer.open_mesh(spot_path)
+    viewer.state.set_compute_settings(preview_only=True)
+    assert viewer.compute("laplacian", k=30).is_preview
+    viewer.state.set_compute_settings(preview_only=False)
+    assert not viewer.compute("laplacian", k=30).is_preview
+    started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 30 modes")]
+    assert started[-1] == (
+        "Computing Laplacian (cotan), 30 modes; the preview shown stays until it is ready."
+    ), started
+
+
 def test_keep_the_largest_component(viewer, tmp_path):
     from modalviewer.core.primitives import icosphere, torus
 
