@@ -244,7 +244,9 @@ def _all_zero_message(k: int, result, nulls, lam_typical: float) -> str:
             "(modalviewer.compute_spectrum_per_component)."
         )
     else:
-        advice = f" Ask for at least {k + 1} modes to see the shape's vibrations."
+        advice = (
+            f" Ask for at least {max(nulls.dimension, k) + 1} modes to see the shape's vibrations."
+        )
     return (
         head + " The mesh is made of separate pieces or is damaged, or k is not larger than "
         "the null space's dimension." + advice

@@ -322,3 +322,20 @@ def test_k_not_above_the_null_space_of_one_component_is_flagged():
     assert spec.eigenvalues.tolist() == [0.0] * 6
     with pytest.warns(ZeroModesWarning, match="the only mode is an exact zero mode"):
         mv.compute_spectrum(icosphere(2), "laplacian", k=1)
+
+
+def test_too_few_modes_for_the_null_space_advise_enough_to_pass_it():
+    """Four 3D shells modes of one closed piece are four of its six rigid motions: the
+    advice must ask for seven, not five."""
+    import warnings
+
+    import modalviewer as mv
+    from modalviewer.core.pipeline import ZeroModesWarning
+    from modalviewer.core.primitives import icosphere
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        mv.compute_spectrum(icosphere(2), "shells", 4)
+    messages = [str(w.message) for w in caught if issubclass(w.category, ZeroModesWarning)]
+    assert len(messages) == 1
+    assert "Ask for at least 7 modes" in messages[0], messages[0]
