@@ -45,9 +45,8 @@ PREVIEW_MARGIN = 1.6
 :data:`PREVIEW_DELAY` of the exact solve's: the growth laws are fitted on plates, and on
 curved meshes of 100k to 270k vertices the fast preview took up to 1.52 times their
 prediction (``benchmarks/results/curved.json``; ``tests/viewer/test_state_model.py``
-checks the margin against that file).  Without it a preview predicted just inside its
-share ran past its deadline and was thrown away, delaying the exact spectrum for
-nothing (spot Loop x3, 3D shells, 300 modes: predicted 23 s, stopped at 25 s)."""
+checks the margin against that file), and a preview that runs past its share is
+thrown away (:attr:`PreviewPlan.deadline`)."""
 
 
 NOTE_FROM_SECONDS = 10.0
@@ -83,19 +82,22 @@ class PreviewPlan:
                 f"no preview below {LAWS_FROM_VERTICES:,} vertices".replace(",", "\u00a0")
                 + ": the exact solve is quick there"
             )
-        if self.preview_seconds > PREVIEW_DELAY * self.exact_seconds:
-            return (
+        share = PREVIEW_DELAY * self.exact_seconds
+        if PREVIEW_MARGIN * self.preview_seconds > share:
+            predicted = (
                 f"no preview: predicted {_seconds(self.preview_seconds)} against the exact "
-                f"{_seconds(self.exact_seconds)}, it would delay the exact spectrum by more "
-                f"than {round(100 * PREVIEW_DELAY)} %"
+                f"{_seconds(self.exact_seconds)}, "
             )
-        if PREVIEW_MARGIN * self.preview_seconds > PREVIEW_DELAY * self.exact_seconds:
-            return (
-                f"no preview: predicted {_seconds(self.preview_seconds)} against the exact "
-                f"{_seconds(self.exact_seconds)}, too close to its "
-                f"{round(100 * PREVIEW_DELAY)} % share (previews on curved meshes take up "
-                f"to {PREVIEW_MARGIN:g} times their prediction)"
-            )
+            if self.preview_seconds > share:
+                why = (
+                    f"it would delay the exact spectrum by more than {round(100 * PREVIEW_DELAY)} %"
+                )
+            else:
+                why = (
+                    f"too close to its {round(100 * PREVIEW_DELAY)} % share (previews on curved "
+                    f"meshes take up to {PREVIEW_MARGIN:g} times their prediction)"
+                )
+            return predicted + why
         return (
             f"no preview: it would need about {_megabytes(self.preview_mb)}, more than the "
             f"exact solve's {_megabytes(self.exact_mb)}"

@@ -394,12 +394,13 @@ class Viewer:
         text = f"Computing {job.description}..."
         if isinstance(job, SpectrumJob) and not job.is_preview:
             preview = job.preview_job
-            shown = self.state.spectra.get(job.spectrum_key)
-            if preview is None and shown is not None and shown.is_preview:
-                # a preview made earlier (Preview only, or kept after a cancel)
-                text = f"Computing {job.description}; the preview shown stays until it is ready."
-            elif preview is None:
-                note = self.model.no_preview_note(job.spectrum_key)
+            if preview is None:
+                shown = self.state.spectra.get(job.spectrum_key)
+                if shown is not None and shown.is_preview:
+                    # a preview made earlier (Preview only, or kept after a cancel)
+                    note = "the preview shown stays until it is ready"
+                else:
+                    note = self.model.no_preview_note(job.spectrum_key)
                 if note:
                     text = f"Computing {job.description}; {note}."
             elif preview.status == DONE:
