@@ -15,12 +15,18 @@ from scipy.spatial import cKDTree
 
 from .core.eigen import CancelFn, ProgressFn
 from .core.laplacian import lumped_masses
-from .core.mesh import Mesh, repair_mesh
+from .core.mesh import Mesh, MeshError, repair_mesh
 from .core.operators import operator_info
 from .core.pipeline import compute_spectrum
 from .core.spectrum import Spectrum
 
-__all__ = ["COARSE_FRACTION", "decimated_copy", "transfer_spectrum", "coarse_to_fine_spectrum"]
+__all__ = [
+    "COARSE_FRACTION",
+    "decimated_copy",
+    "preview_copy",
+    "transfer_spectrum",
+    "coarse_to_fine_spectrum",
+]
 
 COARSE_FRACTION = 0.2
 """Share of the vertices the coarse-to-fine copy keeps (:func:`decimated_copy`'s
@@ -42,6 +48,80 @@ def decimated_copy(mesh: Mesh, fraction: float = COARSE_FRACTION) -> Mesh:
     )
     arrays = np.asarray(poly.points), np.asarray(poly.faces).reshape(-1, 4)[:, 1:]
     return repair_mesh(*arrays, source="coarse copy")
+
+
+PREVIEW_COPY_SHARE = 0.03
+"""Share of the vertices of the coarse copy a 3D shells preview starts from
+(:func:`preview_copy`), between :data:`PREVIEW_COPY_MIN` and :data:`PREVIEW_COPY_MAX`
+vertices and at least :data:`PREVIEW_COPY_PER_MODE` per mode."""
+
+PREVIEW_COPY_MIN = 3000
+PREVIEW_COPY_MAX = 20000
+PREVIEW_COPY_PER_MODE = 30
+
+
+def preview_copy(mesh: Mesh, k: int):
+    """The coarse copy a 3D shells preview of ``k`` modes starts from
+    (:class:`.core.transfer.CoarseCopy`), or None.
+
+    MeshLab's quadric edge collapse (through the optional ``pymeshlab``) to
+    :data:`PREVIEW_COPY_SHARE` of the vertices, with its triangle-quality, normal and
+    topology safeguards, and each vertex's nearest point on the copy from VTK's cell
+    locator.  None without ``pymeshlab``, where the mesh is too small for a copy to save
+    work (the copy would keep more than a quarter of its vertices) or where the
+    decimation leaves no usable mesh: the preview then starts from its smooth space.
+    VTK's own quadric decimation is not used: its copy of the cow subdivided twice had
+    triangles of quality 0.03 and a spectrum that missed a mode the estimate does not
+    see (4.9 % off, against 0.9 % from MeshLab's)."""
+    n = mesh.n_vertices
+    target = max(PREVIEW_COPY_MIN, PREVIEW_COPY_PER_MODE * int(k), int(PREVIEW_COPY_SHARE * n))
+    target = min(target, PREVIEW_COPY_MAX)
+    if target > n // 4:
+        return None
+    try:
+        import pymeshlab
+    except ImportError:
+        return None
+    import pyvista as pv
+
+    from .core.transfer import CoarseCopy
+
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int32)))
+    try:
+        ms.meshing_decimation_quadric_edge_collapse(
+            targetfacenum=int(2 * target),
+            qualitythr=0.5,
+            preservetopology=True,
+            preservenormal=True,
+            planarquadric=True,
+            optimalplacement=True,
+        )
+        decimated = ms.current_mesh()
+        coarse = repair_mesh(decimated.vertex_matrix(), decimated.face_matrix(), "coarse copy")
+    except (pymeshlab.PyMeshLabException, ValueError, MeshError):
+        return None
+    faces = np.hstack([np.full((coarse.n_faces, 1), 3), coarse.faces]).ravel()
+    located = pv.PolyData(np.array(coarse.vertices), faces)
+    cells, nearest = located.find_closest_cell(np.array(mesh.vertices), return_closest_point=True)
+    cells = np.asarray(cells, dtype=np.int64)
+    barycentric = _barycentric(nearest, coarse.vertices[coarse.faces[cells]])
+    return CoarseCopy(coarse, cells, barycentric)
+
+
+def _barycentric(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """(m, 3) barycentric coordinates of points lying on the triangles ``corners``
+    (m, 3, 3); degenerate triangles give their first corner."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    ab, ac, ap = b - a, c - a, points - a
+    d00, d01, d11 = (ab * ab).sum(1), (ab * ac).sum(1), (ac * ac).sum(1)
+    d20, d21 = (ap * ab).sum(1), (ap * ac).sum(1)
+    den = d00 * d11 - d01 * d01
+    ok = den > 1e-30 * np.maximum(d00 * d11, 1e-300)
+    den = np.where(ok, den, 1.0)
+    v = np.where(ok, (d11 * d20 - d01 * d21) / den, 0.0)
+    w = np.where(ok, (d00 * d21 - d01 * d20) / den, 0.0)
+    return np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, 1.0)
 
 
 def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectrum:

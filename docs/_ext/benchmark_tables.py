@@ -195,6 +195,35 @@ def curved_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def coarse_start_table(data: dict) -> str:
+    """``benchmarks.coarse_start``: the 3D shells fast preview from a coarse copy against
+    the smooth-space one, both against the exact spectrum of the same run."""
+    lines = [
+        "| mesh | vertices | exact s | smooth space: s | / exact | error / estimated "
+        "| coarse copy: vertices | s (copy) | / exact | error / estimated "
+        "| exact MB | smooth MB | coarse MB |",
+        "|" + " --- |" * 13,
+    ]
+
+    def pct(x: float) -> str:
+        return f"{100 * x:.0f}" if x >= 1 else f"{100 * x:.2g}"
+
+    for r in data["rows"]:
+        lines.append(
+            f"| {r['mesh']} | {r['vertices']} | {r['exact_seconds']:.1f} "
+            f"| {r['smooth_seconds']:.1f} | {r['smooth_time_ratio']:.2f} "
+            f"| {pct(r['smooth_largest_error_lowest_50'])} % / "
+            f"{pct(r['smooth_estimated_error_lowest_50'])} % "
+            f"| {r['coarse_vertices']} "
+            f"| {r['coarse_seconds']:.1f} ({r['coarse_copy_seconds']:.1f}) "
+            f"| {r['coarse_time_ratio']:.2f} "
+            f"| {pct(r['coarse_largest_error_lowest_50'])} % / "
+            f"{pct(r['coarse_estimated_error_lowest_50'])} % "
+            f"| {r['exact_peak_mb']} | {r['smooth_peak_mb']} | {r['coarse_peak_mb']} |"
+        )
+    return "\n".join(lines)
+
+
 def _find(rows: list[dict], **fields) -> dict | None:
     """The first row whose values match ``fields``, or None."""
     return next((r for r in rows if all(r.get(k) == v for k, v in fields.items())), None)
@@ -429,6 +458,7 @@ TABLES = {
     ),
     "slivers": (["slivers"], lambda: slivers_table(load("slivers"))),
     "curved": (["curved"], lambda: curved_table(load("curved"))),
+    "coarse-start": (["coarse_start"], lambda: coarse_start_table(load("coarse_start"))),
     "growth": (["growth"], lambda: growth_table(load("growth"))),
     "scale": (["growth"], lambda: scale_figures(load("growth"))),
     "predictor": (["growth_k300"], lambda: predictor_table(load("growth_k300"))),

@@ -22,6 +22,7 @@ from .nullspace import null_space
 from .operators import operator_info
 from .preview import compute_preview, preview_possible
 from .spectrum import Spectrum
+from .transfer import CoarseCopy
 from .validate import check_count
 
 __all__ = [
@@ -94,6 +95,7 @@ def compute_spectrum(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     accuracy: str = "exact",
+    coarse: CoarseCopy | None = None,
 ) -> Spectrum:
     """The k lowest eigenpairs of ``operator`` on ``mesh``.
 
@@ -115,6 +117,10 @@ def compute_spectrum(
         exact spectrum is computed (its estimate says how far off it may be).  A mesh too
         small for a reduced space of 3 k functions (:func:`.preview.preview_possible`)
         gets the exact spectrum instead, which is quick there (``is_preview`` False).
+    coarse : for a 3D shells preview, a coarse copy of the mesh to start from
+        (:class:`.transfer.CoarseCopy`, e.g. ``modalviewer.coarsen.preview_copy(mesh,
+        k)``): the copy's own modes, carried to the mesh and corrected by one step of
+        inverse iteration, where a smooth space misses the modes of thin parts.
 
     Returns
     -------
@@ -133,7 +139,7 @@ def compute_spectrum(
     if accuracy != "exact" and preview_possible(mesh, operator, k):
         refine = None if accuracy == "preview" else False
         return compute_preview(
-            mesh, operator, k, bending, membrane, progress, cancel, refine=refine
+            mesh, operator, k, bending, membrane, progress, cancel, refine=refine, coarse=coarse
         )
 
     def report(stage: str, fraction: float) -> None:

@@ -48,11 +48,12 @@ from .eigen import (
     StageTimer,
     factor_below_spectrum,
     factor_budget_mb,
+    solve_lowest,
     zero_modes,
 )
 from .factor import FactorTooLarge, SPDSolver
 from .memory import memory_limit_mb, resident_mb
-from .mesh import Mesh
+from .mesh import Mesh, MeshError
 from .nullspace import null_space
 from .operators import OPERATOR_INFO, SpaceSettings, operator_info
 from .products import (
@@ -71,6 +72,7 @@ from .reduced_space import (
 )
 from .spectrum import Spectrum
 from .threads import blas_limit
+from .transfer import CoarseCopy
 
 __all__ = [
     "SpaceSettings",
@@ -909,6 +911,184 @@ def _factor_below(K, mass: np.ndarray, lam: np.ndarray, lam_scale: float):
         return None
 
 
+COARSE_SHIFT = 0.5
+"""The coarse start's factor is of ``K + s M`` with s this share of the coarse copy's
+lowest non-zero eigenvalue (a coarse copy's eigenvalues lie below the mesh's: the cow
+decimated to 3 % has them about half as large).  One inverse-iteration step from the
+carried modes is insensitive to the shift (the cow subdivided twice, lowest 50 of 100:
+0.96 % off at 0.05 times the lowest non-zero eigenvalue, 1.0 % at 7 times), and a shift
+well away from zero factorises at the first try."""
+
+
+COARSE_GUARD = 0.25
+"""The coarse start carries this share more of the copy's modes than are asked for
+(at least :data:`REFINE_GUARD_MIN`): without them the top few Ritz pairs of the step
+can stand for higher modes while a wanted one is missing (a torus's 24th non-zero mode
+of 24 carried was 39 % off, its residual estimate 0.2 %)."""
+
+
+def _coarse_copy_pairs(coarse: CoarseCopy, operator: str, k: int, bending, membrane):
+    """(eigenvalues, modes (3 Nc, m)) of the coarse copy's lowest non-zero modes (at most
+    ``k``, at most half its unknowns), or None where its operator cannot be solved (a
+    decimation can leave non-manifold edges or slivers)."""
+    try:
+        Kc, mc = operator_matrices(coarse.mesh, operator, bending, membrane)
+        nulls = null_space(coarse.mesh, operator, Kc, mc)
+        kc = min(int(k), Kc.shape[0] // 2)
+        if kc <= nulls.dimension:
+            return None
+        result = solve_lowest(Kc, mc, kc, null_space=nulls.vectors)
+    except (MeshError, EigenError, np.linalg.LinAlgError, ValueError):
+        return None
+    nonzero = ~zero_modes(result.eigenvalues, float(np.median(Kc.diagonal() / mc)), nulls.dimension)
+    return result.eigenvalues[nonzero], result.vectors[:, nonzero]
+
+
+def _ritz_in_span(K, mass: np.ndarray, Y: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``count`` lowest Ritz pairs of ``K x = lam M x`` in the span of Y's columns
+    (values, coefficients C: the vectors are ``Y C``, Mass-orthonormal).  The Gram
+    matrices are formed in one pass over K's row blocks and scaled to unit diagonal;
+    numerically dependent directions (below :data:`STEP_DROP`) are dropped."""
+    import scipy.linalg as la
+
+    def sums(rows, KY):
+        return Y[rows].T @ KY, Y[rows].T @ (mass[rows, None] * Y[rows])
+
+    H, G = row_block_sums(K, Y, sums)
+    d = 1.0 / np.sqrt(np.maximum(np.diag(G), 1e-300))
+    w, V = la.eigh(0.5 * (G + G.T) * np.outer(d, d))
+    keep = w > STEP_DROP * w.max()
+    T = V[:, keep] / np.sqrt(w[keep])
+    mu, C = la.eigh(T.T @ (0.5 * (H + H.T) * np.outer(d, d)) @ T)
+    count = min(count, mu.shape[0])
+    return mu[:count], d[:, None] * (T @ C[:, :count])
+
+
+def _coarse_start(
+    mesh: Mesh, operator: str, K, mass: np.ndarray, k: int, coarse: CoarseCopy, weights, report
+):
+    """The 3D shells' preview from a coarse copy: (lam, U, solver, info) or None.
+
+    The coarse copy's own lowest modes (its Discrete Shells: a coarse discretisation
+    of the same surface, so a thin part's bending modes are there, where a smooth
+    space on the fine mesh locks them out) are carried to the mesh
+    (:func:`.transfer.displacement_prolongation`); one step of inverse iteration with a
+    factor of the fine operator shifted just below zero (``Y = (K + s M)^-1 M V``)
+    adds the mesh-scale parts every carried field lacks, and Rayleigh-Ritz in
+    ``span [Z, Y]`` (Z the exact null vectors) gives the pairs.  The factor is returned
+    for the refinement's steps.  None where the coarse copy's spectrum or the factor
+    fails (the caller takes the smooth space)."""
+    seconds = {}
+    t = time.perf_counter()
+    report("preview: coarse copy's spectrum", 0.1)
+    carried = k + max(REFINE_GUARD_MIN, int(np.ceil(COARSE_GUARD * k)))
+    pairs = _coarse_copy_pairs(coarse, operator, carried, *weights)
+    if pairs is None:
+        return None
+    lam_c, modes_c = pairs
+    seconds["coarse_spectrum"] = time.perf_counter() - t
+    t = time.perf_counter()
+    report("preview: carrying the coarse modes", 0.3)
+    nulls = null_space(mesh, operator, K, mass)
+    d = nulls.dimension
+    if k <= d:
+        return None
+    V = threaded_product(coarse.prolongation(mesh), np.ascontiguousarray(modes_c))
+    del modes_c
+    seconds["prolongation"] = time.perf_counter() - t
+    t = time.perf_counter()
+    report("preview: factorising", 0.4)
+    n = K.shape[0]
+    budget = factor_budget_mb(memory_limit_mb(), n, k, _block_columns(n))
+    try:
+        solver = factor_below_spectrum(
+            K, mass, float(lam_c[0]), lambda *_: None, StageTimer(), COARSE_SHIFT, budget
+        )[0]
+    except EigenError:
+        return None
+    seconds["factor"] = time.perf_counter() - t
+    t = time.perf_counter()
+    report("preview: inverse iteration", 0.6)
+    n, m = V.shape
+    step = _block_columns(n)
+    for j in range(0, m, step):  # V overwritten by Y = S M V, a block at a time
+        cols = slice(j, min(j + step, m))
+        V[:, cols] = solver.solve(mass[:, None] * V[:, cols])
+    Z = nulls.vectors.toarray() if d else np.zeros((n, 0))
+    if d:
+        V -= Z @ _weighted_product(Z, V, mass)
+    lam_y, C = _ritz_in_span(K, mass, V, k - d)
+    seconds["inverse_iteration"] = time.perf_counter() - t
+    count = d + lam_y.shape[0]
+    U = np.empty((n, count))
+    U[:, :d] = Z
+    for rows in _rows(n):
+        U[rows, d:] = V[rows] @ C
+    del V, Z
+    lam = np.concatenate([np.zeros(d), lam_y])
+    info = {
+        "coarse_vertices": int(coarse.mesh.n_vertices),
+        "coarse_modes": int(lam_c.shape[0]),
+        "seconds": {s: round(v, 4) for s, v in seconds.items()},
+    }
+    return lam, U, solver, info
+
+
+def _coarse_preview(mesh, operator, K, mass, k, coarse, weights, report, refine, settings):
+    """:func:`preview_spectrum` from a coarse copy (:func:`_coarse_start`), its estimate
+    and, where that is above the threshold and ``refine`` is set, subspace steps with
+    the start's factor; None where the start fails."""
+    t = time.perf_counter()
+    started = _coarse_start(mesh, operator, K, mass, k, coarse, weights, report)
+    if started is None:
+        return None
+    lam, U, solver, start_info = started
+    seconds = {"start": time.perf_counter() - t}
+    lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
+    precondition = _jacobi_blocks(K, operator_info(operator).unknowns_per_vertex)
+    t = time.perf_counter()
+    report("preview: estimating errors", 0.8)
+    res, est, estimate = _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition)
+    seconds["estimate"] = time.perf_counter() - t
+    refine_above = REFINE_ABOVE if settings.refine_above is None else settings.refine_above
+    steps = REFINE_STEPS if settings.refine_steps is None else settings.refine_steps
+    refinement = {"steps": 0, "estimated_error_before": float(est.max(initial=0.0))}
+    if refine and est.max(initial=0.0) > refine_above:
+        t = time.perf_counter()
+        c = lam.shape[0]
+        guard = max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)) if steps > 1 else 0
+        buffer = np.empty((U.shape[0], max(c, min(c + guard, K.shape[0] // 2))))
+        buffer[:, :c] = U
+        del U
+        lam_b = lam
+        while refinement["steps"] < steps:
+            report("preview: refining", 0.9 + 0.03 * refinement["steps"])
+            lam_b = _subspace_step(K, mass, solver, lam_b, buffer, live=lam_b.shape[0])
+            refinement["steps"] += 1
+        lam = lam_b[:c]
+        transform_columns_in_place(buffer, c)
+        buffer.resize((buffer.shape[0], c))
+        U = buffer
+        del buffer
+        res, est, estimate = _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition)
+        seconds["refinement"] = time.perf_counter() - t
+    del solver
+    info = {
+        "samples": 0,
+        "coarse_start": start_info,
+        "refinement": refinement,
+        "reduced_dimension": int(start_info["coarse_modes"]),
+        "smoothing": False,
+        "seconds_by_stage": {s: round(v, 4) for s, v in seconds.items()},
+        "galerkin_eigenvalues": [],
+        "estimated_errors": [float(e) for e in est],
+        "estimated_error": float(est.max(initial=0.0)),
+        "correction": "coarse copy's modes, one inverse-iteration step",
+        "estimate": estimate,
+    }
+    return lam, U, res, info
+
+
 def preview_spectrum(
     mesh: Mesh,
     operator: str,
@@ -922,8 +1102,15 @@ def preview_spectrum(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     refine: bool | None = None,
+    coarse: CoarseCopy | None = None,
+    weights: tuple[float, float] = (1.0, 1.0),
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
     """Preview eigenpairs of ``K x = lambda diag(mass) x`` for ``operator`` on ``mesh``.
+
+    For the 3D shells with a ``coarse`` copy of the mesh (``weights``: the bending and
+    membrane weights K was made with) the preview starts from the copy's own modes
+    (:func:`_coarse_start`) and is refined by subspace steps with the same factor where
+    its estimate calls for it; where that start fails, and otherwise:
 
     Galerkin projection onto :func:`reduced_basis` (``samples`` centres, polynomial
     degree ``enrich`` and ``radius_factor``; the defaults per operator are in
@@ -969,6 +1156,13 @@ def preview_spectrum(
     enrich = settings.degree if enrich is None else int(enrich)
     if radius_factor is None:
         radius_factor = settings.radius_factor
+    if coarse is not None and settings.factor_step:
+        with blas_limit():
+            done = _coarse_preview(
+                mesh, operator, K, mass, k, coarse, weights, report, refine, settings
+            )
+        if done is not None:
+            return done
     report("preview: sampling", 0.05)
     samples = max(1, min(int(samples), max_samples(mesh.n_vertices, enrich)))
     candidates = mesh.n_vertices if settings.exact_sampling else None
@@ -1118,6 +1312,7 @@ def compute_preview(
     cancel: CancelFn | None = None,
     samples: int | None = None,
     refine: bool | None = None,
+    coarse: CoarseCopy | None = None,
 ) -> Spectrum:
     """``compute_spectrum(..., accuracy="preview")``: a :class:`Spectrum` whose
     ``parameters["preview"]`` holds the reduced space, timings and estimated errors
@@ -1125,7 +1320,8 @@ def compute_preview(
 
     For meshes where :func:`preview_possible` holds; ``compute_spectrum`` computes the
     exact spectrum of the others.  ``refine``: as in :func:`preview_spectrum` (False:
-    ``accuracy="fast preview"``)."""
+    ``accuracy="fast preview"``); ``coarse``: the 3D shells' coarse copy to start from
+    (see :func:`preview_spectrum`)."""
     per_vertex = operator_info(operator).unknowns_per_vertex
     started = time.perf_counter()
     if cancel is not None and cancel():
@@ -1145,6 +1341,8 @@ def compute_preview(
         progress=progress,
         cancel=cancel,
         refine=refine,
+        coarse=coarse,
+        weights=(bending, membrane),
     )
     n = mesh.n_vertices
     modes = np.ascontiguousarray(U)
@@ -1163,7 +1361,11 @@ def compute_preview(
             "k": int(lam.shape[0]),
             "bending": float(bending),
             "membrane": float(membrane),
-            "method": "preview: Rayleigh-Ritz in a reduced space of smooth functions",
+            "method": (
+                "preview: Rayleigh-Ritz in a reduced space of smooth functions"
+                if "coarse_start" not in info
+                else "preview: a coarse copy's modes, one inverse-iteration step"
+            ),
             "zero_mode_scale": float(np.median(np.abs(K.diagonal()) / mass)),
             "seconds_assembly": assembled - started,
             "seconds_total": time.perf_counter() - started,

@@ -742,3 +742,28 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
     np.testing.assert_allclose(
         blocked[3]["estimated_errors"], whole[3]["estimated_errors"], rtol=1e-4, atol=1e-12
     )
+
+
+def test_a_coarse_copy_start_finds_the_spectrum_with_its_null_space_whole():
+    """The 3D shells preview from a coarse copy (a coarser torus of the same surface):
+    six exact zero modes, Mass-orthonormal modes, eigenvalues above the exact ones
+    (Rayleigh-Ritz) and the lowest half within 2 %."""
+    from modalviewer.core.transfer import CoarseCopy
+
+    fine, coarse = torus(96, 40, minor=0.25), torus(24, 10, minor=0.25)
+    k = 30
+    exact = mv.compute_spectrum(fine, "shells", k)
+    spec = mv.compute_spectrum(
+        fine, "shells", k, accuracy="fast preview", coarse=CoarseCopy(coarse)
+    )
+    info = spec.parameters["preview"]
+    assert info["coarse_start"]["coarse_vertices"] == coarse.n_vertices
+    assert info["correction"].startswith("coarse copy")
+    lam = spec.eigenvalues
+    assert np.all(np.abs(lam[:6]) <= 1e-9 * lam[6]) and lam[6] > 1e-3 * lam[-1]
+    Phi = spec.modes.reshape(-1, k)
+    mass = np.repeat(spec.mass, 3)
+    np.testing.assert_allclose(Phi.T @ (mass[:, None] * Phi), np.eye(k), atol=1e-9)
+    assert np.all(lam[6:] >= exact.eigenvalues[6:] * (1 - 1e-9))
+    lowest = slice(6, 6 + (k - 6) // 2)
+    assert np.max(lam[lowest] / exact.eigenvalues[lowest] - 1) < 0.02
