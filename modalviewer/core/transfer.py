@@ -176,10 +176,11 @@ def displacement_prolongation(
     blocks[:, 1] += c1
     blocks[:, 2] += c2
     N = fine.n_vertices
-    rows = np.broadcast_to(
-        (3 * np.arange(N))[:, None, None, None] + np.arange(3)[:, None], (N, 3, 3, 3)
-    )
-    cols = np.broadcast_to(3 * corners[:, :, None, None] + np.arange(3), (N, 3, 3, 3))
+    # row 3 v + r holds, for each corner i and component c, the entry of column
+    # 3 corner_i + c: the blocks in (vertex, r, corner, c) order fill the rows in turn
+    data = np.ascontiguousarray(blocks.transpose(0, 2, 1, 3)).ravel()
+    columns = np.broadcast_to(3 * corners[:, None, :, None] + np.arange(3), (N, 3, 3, 3))
+    indptr = np.arange(0, 27 * N + 1, 9, dtype=np.int64)
     return sp.csr_matrix(
-        (blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(3 * N, 3 * coarse.n_vertices)
+        (data, np.ascontiguousarray(columns).ravel(), indptr), shape=(3 * N, 3 * coarse.n_vertices)
     )

@@ -747,7 +747,7 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
 def test_a_coarse_copy_start_finds_the_spectrum_with_its_null_space_whole():
     """The 3D shells preview from a coarse copy (a coarser torus of the same surface):
     six exact zero modes, Mass-orthonormal modes, eigenvalues above the exact ones
-    (Rayleigh-Ritz) and the lowest half within 2 %."""
+    (Rayleigh-Ritz), the lowest half within 2 % and estimates that read the errors."""
     from modalviewer.core.transfer import CoarseCopy
 
     fine, coarse = torus(96, 40, minor=0.25), torus(24, 10, minor=0.25)
@@ -767,3 +767,11 @@ def test_a_coarse_copy_start_finds_the_spectrum_with_its_null_space_whole():
     assert np.all(lam[6:] >= exact.eigenvalues[6:] * (1 - 1e-9))
     lowest = slice(6, 6 + (k - 6) // 2)
     assert np.max(lam[lowest] / exact.eigenvalues[lowest] - 1) < 0.02
+    # each mode's estimate (from the start's factor) reads its true error within a
+    # factor of about two (measured 0.48 to 0.97 here)
+    error = lam[6:] / exact.eigenvalues[6:] - 1
+    estimate = np.array(info["estimated_errors"][6:])
+    sizable = error > 1e-3
+    assert sizable.sum() >= 10
+    ratio = estimate[sizable] / error[sizable]
+    assert ratio.min() > 0.4 and ratio.max() < 1.2
