@@ -1,7 +1,8 @@
 """A spectrum computation in a child process.
 
 ``python -m modalviewer.processes.job_main JOB OUT``: JOB.npz holds ``vertices``,
-``faces`` and a JSON ``params`` (operator, k, bending, membrane).  Progress goes to
+``faces`` and a JSON ``params`` (operator, k, bending, membrane, accuracy, and
+``coarse_copy``: a 3D shells preview from a coarse copy of the mesh).  Progress goes to
 stdout as JSON lines ``{"stage": ..., "fraction": ...}``, the result to OUT.npz (written
 atomically), a failure to stdout as ``{"error": ...}`` with exit code 1.  A separate
 process keeps the viewer's event loop free (sparse factorisations hold the GIL) and is
@@ -34,14 +35,20 @@ def main(argv: list[str] | None = None) -> int:
         with np.load(job_path, allow_pickle=False) as job:
             vertices, faces = job["vertices"], job["faces"]
             params = json.loads(str(job["params"]))
+        mesh = Mesh(vertices, faces)
+        accuracy = params.get("accuracy", "exact")
+        coarse = None
+        if params.get("coarse_copy") and accuracy != "exact":
+            coarse = _preview_copy(mesh, params["operator"], int(params["k"]))
         spec = compute_spectrum(
-            Mesh(vertices, faces),
+            mesh,
             params["operator"],
             int(params["k"]),
             float(params["bending"]),
             float(params["membrane"]),
             progress=_report,
-            accuracy=params.get("accuracy", "exact"),
+            accuracy=accuracy,
+            coarse=coarse,
         )
         _emit({"stage": "writing the result", "fraction": 0.97})
         save_spectrum(spec, out_path)
@@ -53,6 +60,19 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     _emit({"done": out_path})
     return 0
+
+
+def _preview_copy(mesh, operator: str, k: int):
+    """The coarse copy a 3D shells preview starts from, or None (other operators, meshes
+    too small for a copy, no ``pymeshlab``: the preview's smooth space)."""
+    from ..core.operators import operator_info
+
+    if not operator_info(operator).preview.factor_step:
+        return None
+    from ..coarsen import preview_copy
+
+    _report("preview: coarse copy", 0.02)
+    return preview_copy(mesh, k)
 
 
 def _report(stage: str, fraction: float) -> None:

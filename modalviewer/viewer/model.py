@@ -558,7 +558,11 @@ def _compute_preview(
     :data:`~modalviewer.core.preview.REFINE_ABOVE`: such a preview misses modes (thin
     parts a smooth space cannot bend), and only a refinement would find them.  The upper
     half may be further off (the 3D shells' correction step preconditions the lowest 60 %
-    of the modes): each mode's legend gives its own estimate."""
+    of the modes): each mode's legend gives its own estimate.
+    A shown preview (``discard_rough`` False: Preview only) of the 3D shells starts from
+    a coarse copy of the mesh where one can be made (``core.preview``'s coarse start): it
+    finds the modes of thin parts that the smooth space misses, at about 0.35 to 0.45 of
+    the exact time, where the smooth space's 0.25 to 0.3 would show them far off."""
     from ..core.preview import REFINE_ABOVE
 
     weights = (key.bending, key.membrane)
@@ -580,7 +584,15 @@ def _compute_preview(
     target = Path(folder) / "preview.npz"
     try:
         spec = process.compute_in_process(
-            mesh, key.operator, key.k, *weights, target, progress, stop, accuracy=accuracy
+            mesh,
+            key.operator,
+            key.k,
+            *weights,
+            target,
+            progress,
+            stop,
+            accuracy=accuracy,
+            coarse_copy=not discard_rough,
         )
     finally:
         target.unlink(missing_ok=True)

@@ -266,3 +266,25 @@ def test_a_field_of_your_own(viewer, spot_path):
         viewer.show_field("missing")
     viewer.open_mesh(spot_path)
     assert viewer.state.fields == {} and viewer.state.display.kind == "none"
+
+
+def test_a_shells_preview_only_starts_from_a_coarse_copy(viewer):
+    """Preview only of the 3D shells on a mesh big enough for a coarse copy: the preview
+    starts from the copy's modes (found whole: six rigid motions), and its eigenvalues
+    are within 2 % of the exact ones in the lower half."""
+    pytest.importorskip("pymeshlab")  # the copy's decimation (an optional dependency)
+    from modalviewer.core.primitives import torus
+
+    viewer.set_mesh(torus(160, 80, minor=0.3))  # 12 800 vertices: a 3200-vertex copy
+    viewer.state.set_compute_settings(preview_only=True)
+    spec = viewer.compute("shells", k=24)
+    assert spec.is_preview
+    start = spec.parameters["preview"]["coarse_start"]
+    assert 3000 <= start["coarse_vertices"] <= 3300
+    viewer.state.set_compute_settings(preview_only=False)
+    exact = viewer.compute("shells", k=24)
+    assert not exact.is_preview
+    assert np.sum(spec.zero_mode_mask()) == 6 == np.sum(exact.zero_mode_mask())
+    lower = slice(6, 15)
+    error = spec.eigenvalues[lower] / exact.eigenvalues[lower] - 1
+    assert np.all(error > -1e-9) and error.max() < 0.02
