@@ -977,7 +977,8 @@ def _coarse_start(
     adds the mesh-scale parts every carried field lacks, and Rayleigh-Ritz in
     ``span [Z, Y]`` (Z the exact null vectors) gives the pairs.  The factor is returned
     for the refinement's steps.  None where the coarse copy's spectrum or the factor
-    fails (the caller takes the smooth space)."""
+    fails, or the copy has fewer non-zero modes than asked for (the caller takes the
+    smooth space)."""
     seconds = {}
     t = time.perf_counter()
     report("preview: coarse copy's spectrum", 0.1)
@@ -991,7 +992,7 @@ def _coarse_start(
     report("preview: carrying the coarse modes", 0.3)
     nulls = null_space(mesh, operator, K, mass)
     d = nulls.dimension
-    if k <= d:
+    if k <= d or lam_c.shape[0] < k - d:  # the copy holds too few modes
         return None
     V = threaded_product(coarse.prolongation(mesh), np.ascontiguousarray(modes_c))
     del modes_c
@@ -1019,7 +1020,12 @@ def _coarse_start(
         V -= Z @ _weighted_product(Z, V, mass)
     lam_y, C = _ritz_in_span(K, mass, V, k - d)
     seconds["inverse_iteration"] = time.perf_counter() - t
-    U = transform_columns_in_place(V, C, lead=d)  # [Z, V C] on V's memory
+    if V.shape[1] >= d + C.shape[1]:
+        U = transform_columns_in_place(V, C, lead=d)  # [Z, V C] on V's memory
+    else:  # fewer carried modes than wanted (a small copy, many components)
+        U = np.empty((n, d + C.shape[1]))
+        for rows in _rows(n):
+            U[rows, d:] = V[rows] @ C
     del V
     U[:, :d] = Z
     del Z

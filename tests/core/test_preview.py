@@ -775,3 +775,17 @@ def test_a_coarse_copy_start_finds_the_spectrum_with_its_null_space_whole():
     assert sizable.sum() >= 10
     ratio = estimate[sizable] / error[sizable]
     assert ratio.min() > 0.4 and ratio.max() < 1.2
+
+
+def test_a_coarse_copy_with_too_few_modes_leaves_the_smooth_space():
+    """A 24-vertex copy gives at most 30 non-zero shells modes (half its 72 unknowns,
+    less the six rigid motions): for 40 modes the preview takes its smooth space, with
+    all 40 modes."""
+    from modalviewer.core.transfer import CoarseCopy
+
+    fine, coarse = torus(96, 40, minor=0.25), torus(6, 4, minor=0.25)
+    spec = mv.compute_spectrum(
+        fine, "shells", 40, accuracy="fast preview", coarse=CoarseCopy(coarse)
+    )
+    assert "coarse_start" not in spec.parameters["preview"]
+    assert spec.eigenvalues.shape == (40,) and spec.modes.shape == (fine.n_vertices, 3, 40)
