@@ -988,17 +988,14 @@ def _coarse_start(
         return None
     lam_c, modes_c = pairs
     seconds["coarse_spectrum"] = time.perf_counter() - t
-    t = time.perf_counter()
-    report("preview: carrying the coarse modes", 0.3)
     nulls = null_space(mesh, operator, K, mass)
     d = nulls.dimension
     if k <= d or lam_c.shape[0] < k - d:  # the copy holds too few modes
         return None
-    V = threaded_product(coarse.prolongation(mesh), np.ascontiguousarray(modes_c))
-    del modes_c
-    seconds["prolongation"] = time.perf_counter() - t
     t = time.perf_counter()
-    report("preview: factorising", 0.4)
+    # the factor before the carried modes: its factorisation's working memory and the
+    # (N, m) carried block are never alive at once
+    report("preview: factorising", 0.3)
     n = K.shape[0]
     budget = factor_budget_mb(memory_limit_mb(), n, k, _block_columns(n))
     try:
@@ -1009,19 +1006,28 @@ def _coarse_start(
         return None
     seconds["factor"] = time.perf_counter() - t
     t = time.perf_counter()
+    report("preview: carrying the coarse modes", 0.5)
+    V = threaded_product(coarse.prolongation(mesh), np.ascontiguousarray(modes_c))
+    del modes_c
+    seconds["prolongation"] = time.perf_counter() - t
+    t = time.perf_counter()
     report("preview: inverse iteration", 0.6)
-    n, m = V.shape
+    m = V.shape[1]
     step = _block_columns(n)
     for j in range(0, m, step):  # V overwritten by Y = S M V, a block at a time
         cols = slice(j, min(j + step, m))
         V[:, cols] = solver.solve(mass[:, None] * V[:, cols])
     Z = nulls.vectors.toarray() if d else np.zeros((n, 0))
-    if d:
-        V -= Z @ _weighted_product(Z, V, mass)
+    if d:  # Mass-orthogonal to the null vectors, a row chunk at a time (no (N, m) temporary)
+        G = _weighted_product(Z, V, mass)
+        for rows in _rows(n):
+            V[rows] -= Z[rows] @ G
     lam_y, C = _ritz_in_span(K, mass, V, k - d)
     seconds["inverse_iteration"] = time.perf_counter() - t
     if V.shape[1] >= d + C.shape[1]:
-        U = transform_columns_in_place(V, C, lead=d)  # [Z, V C] on V's memory
+        transform_columns_in_place(V, C, lead=d)  # [Z, V C] at the start of V's memory
+        V.resize((n, d + C.shape[1]), refcheck=False)  # the guard columns' memory freed
+        U = V
     else:  # fewer carried modes than wanted (a small copy, many components)
         U = np.empty((n, d + C.shape[1]))
         for rows in _rows(n):
@@ -1039,6 +1045,12 @@ def _coarse_start(
     return lam, U, solver, info
 
 
+ESTIMATE_BLOCK_COLUMNS = 16
+"""Columns per block of the coarse start's estimate: each block's residuals and
+solutions take 20 bytes an entry (float32 residuals, the double-precision solver's copy
+and solution), 180 MB at 16 columns of the cow Loop x3's 557k unknowns."""
+
+
 def _factor_estimate(K, mass, solver, lam, U, lam_scale, d):
     """(relative residuals, estimated errors, how they were estimated) of the pairs
     (lam, U) whose first d are exact null vectors: each non-zero mode's estimate is
@@ -1046,7 +1058,9 @@ def _factor_estimate(K, mass, solver, lam, U, lam_scale, d):
     spectrum), the first-order error where the residual lies in modes well above lam
     (:func:`estimated_errors`).  On the coarse start's pairs it reads 0.74 to 1.0 times
     the true errors of the lowest 50 (the cow Loop x2, median 0.92), where the
-    block-Jacobi estimate read 0.22 times."""
+    block-Jacobi estimate read 0.22 times.  Columns go through the solve in blocks of
+    :data:`ESTIMATE_BLOCK_COLUMNS`, so the estimate's arrays stay small beside the factor
+    and the modes."""
     c = lam.shape[0]
     res, est = np.zeros(c), np.zeros(c)
     if d:
@@ -1057,7 +1071,7 @@ def _factor_estimate(K, mass, solver, lam, U, lam_scale, d):
         del R
     if d < c:
         relative, _, energies = _preconditioned_residuals(
-            K, mass, solver, lam, U, lam_scale, slice(d, c), None, False
+            K, mass, solver, lam, U, lam_scale, slice(d, c), None, False, ESTIMATE_BLOCK_COLUMNS
         )
         res[d:] = relative
         est[d:] = np.maximum(energies, 0.0) / np.abs(lam[d:])
