@@ -789,3 +789,25 @@ def test_a_coarse_copy_with_too_few_modes_leaves_the_smooth_space():
     )
     assert "coarse_start" not in spec.parameters["preview"]
     assert spec.eigenvalues.shape == (40,) and spec.modes.shape == (fine.n_vertices, 3, 40)
+
+
+def test_a_coarse_start_is_refined_where_its_lower_half_is_estimated_off(monkeypatch):
+    """A refined preview (accuracy="preview") from a poor copy (72 vertices): its upper
+    modes are up to 40 % off, which does not make it refine (the lower half decides);
+    where the lower half is estimated above the threshold it is refined with the start's
+    factor, and comes within 0.1 %."""
+    from modalviewer.core.transfer import CoarseCopy
+
+    fine, copy = torus(96, 40, minor=0.25), CoarseCopy(torus(12, 6, minor=0.25))
+    k = 24
+    exact = mv.compute_spectrum(fine, "shells", k).eigenvalues
+    spec = mv.compute_spectrum(fine, "shells", k, accuracy="preview", coarse=copy)
+    info = spec.parameters["preview"]
+    assert "coarse_start" in info and info["refinement"]["steps"] == 0
+    error = spec.eigenvalues[6:] / exact[6:] - 1
+    assert error[:9].max() < 0.02 and error.max() > 0.1  # lower half close, top far
+    monkeypatch.setattr(pv, "REFINE_ABOVE", 1e-3)  # below the lower half's estimate
+    refined = mv.compute_spectrum(fine, "shells", k, accuracy="preview", coarse=copy)
+    steps = refined.parameters["preview"]["refinement"]["steps"]
+    assert steps == pv.REFINE_STEPS
+    assert np.max(refined.eigenvalues[6:] / exact[6:] - 1) < 1e-3
