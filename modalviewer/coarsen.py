@@ -24,6 +24,7 @@ __all__ = [
     "COARSE_FRACTION",
     "decimated_copy",
     "preview_copy",
+    "preview_copy_for",
     "transfer_spectrum",
     "coarse_to_fine_spectrum",
 ]
@@ -107,6 +108,15 @@ def preview_copy(mesh: Mesh, k: int):
     cells = np.asarray(cells, dtype=np.int64)
     barycentric = _barycentric(nearest, coarse.vertices[coarse.faces[cells]])
     return CoarseCopy(coarse, cells, barycentric)
+
+
+def preview_copy_for(mesh: Mesh, operator: str, k: int):
+    """:func:`preview_copy` where ``operator``'s preview starts from a coarse copy (the
+    3D shells), else None: the one place the viewer's Preview only and
+    ``modalviewer compute --preview`` decide it."""
+    if not operator_info(operator).preview.factor_step:
+        return None
+    return preview_copy(mesh, k)
 
 
 def _barycentric(points: np.ndarray, corners: np.ndarray) -> np.ndarray:

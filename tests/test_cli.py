@@ -297,3 +297,25 @@ def test_compute_says_when_the_factor_and_basis_were_kept_small(tmp_path):
         runs["tight"][1].eigenvalues, runs["free"][1].eigenvalues, rtol=1e-9, atol=1e-9
     )
     assert not list(tmp_path.glob("modalviewer-factor-*"))  # the factor files are gone
+
+
+def test_a_shells_preview_starts_from_a_coarse_copy_and_says_so(tmp_path):
+    """``compute --preview`` of the 3D shells on a 12 800-vertex torus: the preview
+    starts from a coarse copy's modes (where pymeshlab, an optional dependency that the
+    development install has, makes the copy) and the summary line says so."""
+    pytest.importorskip("pymeshlab")
+    from modalviewer.core.primitives import torus
+
+    ring = torus(160, 80, minor=0.3)
+    mesh = tmp_path / "torus.obj"
+    mesh.write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in ring.vertices)
+        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in ring.faces)
+    )
+    out = tmp_path / "s.npz"
+    r = _run("compute", mesh, "--operator", "shells", "-k", 24, "--preview", "-o", out)
+    assert r.returncode == 0, r.stderr
+    spec = mv.load_spectrum(out)
+    start = spec.parameters["preview"]["coarse_start"]
+    assert spec.is_preview and 3000 <= start["coarse_vertices"] <= 3300
+    assert f"from a {start['coarse_vertices']}-vertex coarse copy's modes" in r.stdout

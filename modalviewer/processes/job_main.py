@@ -39,7 +39,10 @@ def main(argv: list[str] | None = None) -> int:
         accuracy = params.get("accuracy", "exact")
         coarse = None
         if params.get("coarse_copy") and accuracy != "exact":
-            coarse = _preview_copy(mesh, params["operator"], int(params["k"]))
+            from ..coarsen import preview_copy_for
+
+            _report("preview: coarse copy", 0.02)
+            coarse = preview_copy_for(mesh, params["operator"], int(params["k"]))
         spec = compute_spectrum(
             mesh,
             params["operator"],
@@ -60,19 +63,6 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     _emit({"done": out_path})
     return 0
-
-
-def _preview_copy(mesh, operator: str, k: int):
-    """The coarse copy a 3D shells preview starts from, or None (other operators, meshes
-    too small for a copy, no ``pymeshlab``: the preview's smooth space)."""
-    from ..core.operators import operator_info
-
-    if not operator_info(operator).preview.factor_step:
-        return None
-    from ..coarsen import preview_copy
-
-    _report("preview: coarse copy", 0.02)
-    return preview_copy(mesh, k)
 
 
 def _report(stage: str, fraction: float) -> None:
