@@ -112,9 +112,14 @@ def preview_copy(mesh: Mesh, k: int):
 
 def preview_copy_for(mesh: Mesh, operator: str, k: int):
     """:func:`preview_copy` where ``operator``'s preview starts from a coarse copy (the
-    3D shells), else None: the one place the viewer's Preview only and
-    ``modalviewer compute --preview`` decide it."""
-    if not operator_info(operator).preview.factor_step:
+    3D shells) and the exact solve's factor is predicted to stay in memory
+    (:meth:`.core.operators.OperatorInfo.factor_out_of_core`: the start factorises the
+    operator in double precision as the exact solve does; out of core its solves would
+    cost more than the smooth space's preview, which needs no such factor), else None:
+    the one place the viewer's Preview only and ``modalviewer compute --preview``
+    decide it."""
+    info = operator_info(operator)
+    if not info.preview.factor_step or info.factor_out_of_core(mesh.n_vertices, k):
         return None
     return preview_copy(mesh, k)
 

@@ -319,3 +319,19 @@ def test_a_shells_preview_starts_from_a_coarse_copy_and_says_so(tmp_path):
     start = spec.parameters["preview"]["coarse_start"]
     assert spec.is_preview and 3000 <= start["coarse_vertices"] <= 3300
     assert f"from a {start['coarse_vertices']}-vertex coarse copy's modes" in r.stdout
+
+
+def test_no_coarse_copy_where_the_exact_factor_would_go_out_of_core(monkeypatch):
+    """The coarse start factorises in double precision as the exact solve does: where
+    that factor is predicted out of core (here: a 100 MB memory limit), the preview
+    keeps its smooth space."""
+    pytest.importorskip("pymeshlab")
+    from modalviewer.coarsen import preview_copy_for
+    from modalviewer.core import memory
+    from modalviewer.core.primitives import torus
+
+    ring = torus(160, 80, minor=0.3)
+    assert preview_copy_for(ring, "shells", 24) is not None
+    assert preview_copy_for(ring, "laplacian", 24) is None
+    monkeypatch.setattr(memory, "memory_limit_mb", lambda: 100.0)
+    assert preview_copy_for(ring, "shells", 24) is None
