@@ -88,8 +88,17 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--cases", type=parse_case, nargs="+", required=True)
     p.add_argument("-k", type=int, default=100)
+    p.add_argument(
+        "--keep-others",
+        action="store_true",
+        help="keep the results file's rows of other cases (re-measure some)",
+    )
     args = p.parse_args(argv)
     rows = []
+    results = ROOT / "benchmarks" / "results" / "coarse_start.json"
+    if args.keep_others and results.is_file():
+        names = {case_name(case) for case in args.cases}
+        rows = [r for r in json.loads(results.read_text())["rows"] if r["mesh"] not in names]
     for case in args.cases:
         exact = run(case, "exact", args.k)
         smooth = run(case, "smooth", args.k)
