@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 
-from qtpy import QtWidgets
+from qtpy import QtCore, QtWidgets
 
 
 def combo() -> QtWidgets.QComboBox:
@@ -35,11 +35,11 @@ def _refresh_tooltip(box: QtWidgets.QComboBox) -> None:
 
 
 class WrappingLabel(QtWidgets.QLabel):
-    """A word-wrapped label whose minimum height follows its text at its width.
+    """A word-wrapped label as high as its text at its width (minimum and hinted height).
 
     Layouts inside a scroll area (the docks) size a wrapped label once and do not
-    follow its height-for-width when the text grows: a plain label whose text goes from
-    two lines to six stays two lines high, cut at top and bottom."""
+    follow its height-for-width when the text changes: a plain label whose text goes
+    from two lines to six stays two lines high, cut at top and bottom."""
 
     def __init__(self, text: str = "", parent=None):
         super().__init__(text, parent)
@@ -53,10 +53,21 @@ class WrappingLabel(QtWidgets.QLabel):
         super().resizeEvent(event)
         self._fit()
 
+    def sizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt override)
+        # QLabel's own hint wraps a short text at a fraction of 80 characters, two lines
+        # high, and a form layout gives the label that height: one line centred in two
+        hint = super().sizeHint()
+        hint.setHeight(self.minimumHeight() or hint.height())
+        return hint
+
     def _fit(self) -> None:
+        # QLabel's heightForWidth is never below the minimum height, so it is measured
+        # without one: a text that shrinks (three lines back to one) gets a shorter label,
+        # not its line centred in the height of the longer text
+        kept = self.minimumHeight()
+        self.setMinimumHeight(0)
         needed = self.heightForWidth(max(self.width(), 1))
-        if needed > 0 and needed != self.minimumHeight():
-            self.setMinimumHeight(needed)
+        self.setMinimumHeight(needed if needed > 0 else kept)
 
 
 def select_data(box: QtWidgets.QComboBox, data) -> None:

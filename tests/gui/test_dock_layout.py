@@ -1,0 +1,48 @@
+"""How the docks lay their panels out: wrapped labels as high as their text."""
+
+import pytest
+
+pytestmark = pytest.mark.gui
+
+
+def _settle(qtbot, window):
+    """Let the posted layout requests of the docks run."""
+    qtbot.wait(50)
+    window.repaint()
+
+
+def test_eigenvalue_line_sits_on_top_of_the_spectrum_plot(window, spot_path, qtbot):
+    """After a three-line "Not shown" note the eigenvalue is one line again, the label
+    one line high and the plot right below it (no empty band around the line)."""
+    assert window.open_mesh(spot_path)
+    window.compute("laplacian", k=10, wait=True)
+    panel = window.modes_panel
+    label, plot = panel.eigen_label, panel.spectrum_plot
+    window.show_curvature()
+    _settle(qtbot, window)
+    assert panel.eigen_label.text().startswith("Not shown")
+    line = label.fontMetrics().lineSpacing()
+    assert label.height() >= 2 * line  # the note wraps in the dock
+    window.show_mode(3)
+    _settle(qtbot, window)
+    assert label.text().startswith("lambda_3 = ")
+    assert "\n" not in label.text()
+    assert label.height() <= line + 2, (label.height(), line)
+    spacing = panel.layout().spacing()
+    gap = plot.geometry().top() - label.geometry().bottom() - 1
+    assert 0 <= gap <= spacing + 1, (gap, spacing)
+
+
+def test_a_one_line_threshold_text_is_one_line_high(window, spot_path, qtbot):
+    """The threshold's two-line hint gives way to a one-line value: the label (a form
+    row) is one line high, not the line centred in two."""
+    assert window.open_mesh(spot_path)
+    window.compute("laplacian", k=10, wait=True)
+    label = window.distances_panel.threshold_label
+    line = label.fontMetrics().lineSpacing()
+    window.state.set_display(distance_kind="hks")
+    window.pick_vertex(300)
+    _settle(qtbot, window)
+    assert "% of surface" in label.text() and "\n" not in label.text()
+    assert label.fontMetrics().horizontalAdvance(label.text()) < label.width()
+    assert label.height() <= line + 2, (label.height(), line)
