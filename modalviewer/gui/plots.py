@@ -25,6 +25,10 @@ def nice_ticks(lo: float, hi: float, count: int = 5) -> np.ndarray:
     return np.arange(first, hi + 1e-9 * step, step) + 0.0  # + 0.0: no "-0"
 
 
+TITLE_MARGIN = 6
+"""Pixels between the title and the plot's left and right edges."""
+
+
 class LinePlot(QtWidgets.QWidget):
     """Plots y against x with an optional highlighted sample; click selects a sample."""
 
@@ -70,6 +74,22 @@ class LinePlot(QtWidgets.QWidget):
         self.highlight = index
         self.update()
 
+    def title_lines(self) -> list[str]:
+        """The title in lines no wider than the plot less its margins: broken between
+        words (inside a word only if it alone is wider), so no character is cut off."""
+        layout = QtGui.QTextLayout(self.title, self.font())
+        option = QtGui.QTextOption()
+        option.setWrapMode(QtGui.QTextOption.WrapMode.WrapAtWordBoundaryOrAnywhere)
+        layout.setTextOption(option)
+        lines = []
+        layout.beginLayout()
+        while (line := layout.createLine()).isValid():
+            line.setLineWidth(max(self.width() - 2 * TITLE_MARGIN, 1))
+            start = line.textStart()
+            lines.append(self.title[start : start + line.textLength()].strip())
+        layout.endLayout()
+        return [line for line in lines if line]
+
     def _transform(self):
         x = np.log10(self.x) if self.logx else self.x
         y = self.y
@@ -80,7 +100,9 @@ class LinePlot(QtWidgets.QWidget):
         metrics = self.fontMetrics()
         scale = max(abs(y0), abs(y1))
         left = 8 + max(metrics.horizontalAdvance(axis_label(v, scale)) for v in (y0, y1))
-        rect = self.rect().adjusted(max(46, left), 20, -10, -34)
+        # the frame starts below the title's last line
+        top = 20 + (max(len(self.title_lines()), 1) - 1) * metrics.lineSpacing()
+        rect = self.rect().adjusted(max(46, left), top, -10, -34)
         if x1 == x0:
             x1 = x0 + 1
         if y1 == y0:
@@ -125,7 +147,9 @@ class LinePlot(QtWidgets.QWidget):
         p.setRenderHint(QtGui.QPainter.RenderHint.Antialiasing)
         p.fillRect(self.rect(), QtGui.QColor("white"))
         p.setPen(QtGui.QColor("black"))
-        p.drawText(6, 14, self.title)
+        spacing = self.fontMetrics().lineSpacing()
+        for i, line in enumerate(self.title_lines()):
+            p.drawText(TITLE_MARGIN, 14 + i * spacing, line)
         if self.x.size == 0:
             p.drawText(self.rect(), QtCore.Qt.AlignmentFlag.AlignCenter, "no data")
             p.end()

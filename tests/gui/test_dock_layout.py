@@ -46,3 +46,17 @@ def test_a_one_line_threshold_text_is_one_line_high(window, spot_path, qtbot):
     assert "% of surface" in label.text() and "\n" not in label.text()
     assert label.fontMetrics().horizontalAdvance(label.text()) < label.width()
     assert label.height() <= line + 2, (label.height(), line)
+
+
+def test_a_preview_spectrum_title_is_one_whole_line(window, spot_path, qtbot):
+    """A marked spectrum's plot title names the operator briefly (as its list does), so
+    it keeps to one line of the Modes dock, its closing parenthesis included."""
+    assert window.open_mesh(spot_path)
+    window.state.set_compute_settings(preview_only=True)
+    spec = window.compute("shells", k=12, wait=True)
+    assert spec.is_preview
+    _settle(qtbot, window)
+    plot = window.modes_panel.spectrum_plot
+    assert plot.title == "Spectrum (preview): Shells 3D"
+    assert plot.title_lines() == [plot.title]
+    assert plot.fontMetrics().horizontalAdvance(plot.title) < plot.width() - 12

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from modalviewer.gui.plots import LinePlot, axis_label, nice_ticks
+from modalviewer.gui.plots import TITLE_MARGIN, LinePlot, axis_label, nice_ticks
 
 pytestmark = pytest.mark.gui
 
@@ -37,3 +37,32 @@ def test_spectrum_plot_shows_zero_and_tick_labels(qtbot):
             c = image.pixelColor(x, y)
             dark += c.red() < 100 and c.green() < 100 and c.blue() < 100
     assert dark > 30, dark
+
+
+def test_a_title_wider_than_the_plot_wraps_whole(qtbot):
+    """Seen under Xvfb: "Spectrum (preview): Discrete Shells (3D vibrations" lost its
+    ")" at the Modes dock's plot width (306 pixels at the default window size)."""
+    plot = LinePlot()
+    qtbot.addWidget(plot)
+    plot.resize(306, 140)
+    title = "Spectrum (preview): Discrete Shells (3D vibrations)"
+    plot.set_data(np.arange(10), np.arange(10.0) ** 2, title=title)
+    metrics = plot.fontMetrics()
+    assert metrics.horizontalAdvance(title) > plot.width() - 2 * TITLE_MARGIN
+    rect = plot._transform()[0]
+    image = plot.grab().toImage()
+    dark = [
+        (x, y)
+        for y in range(rect.top() - 2)
+        for x in range(plot.width())
+        if image.pixelColor(x, y).lightness() < 100
+    ]
+    # the title's ink keeps off the right edge, and a second line is drawn above the frame
+    assert max(x for x, _ in dark) <= plot.width() - TITLE_MARGIN, max(x for x, _ in dark)
+    assert any(y > 14 + 3 for _, y in dark)
+    lines = plot.title_lines()
+    assert " ".join(lines) == title and len(lines) == 2
+    assert all(metrics.horizontalAdvance(line) <= plot.width() - 2 * TITLE_MARGIN for line in lines)
+    assert rect.top() >= 20 + metrics.lineSpacing()
+    plot.resize(600, 140)  # wide enough: one line, the frame where a one-line title puts it
+    assert plot.title_lines() == [title] and plot._transform()[0].top() == 20

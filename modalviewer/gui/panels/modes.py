@@ -179,11 +179,13 @@ class ModesPanel(QtWidgets.QWidget):
             )
         self.eigen_label.setText(text)
         approximate = approximation_mark(state, op)
+        # marked: the short name (as in the spectrum list), so the title keeps to one line
+        info = OPERATOR_INFO[op]
         self.spectrum_plot.set_data(
             np.arange(spec.k),
             np.where(zero, 0.0, spec.eigenvalues),
             state.display.mode if showing_mode else None,
-            title=f"Spectrum{approximate}: {OPERATOR_INFO[op].label}",
+            title=f"Spectrum{approximate}: {info.short_label if approximate else info.label}",
         )
 
     def _update_style(self) -> None:
