@@ -25,6 +25,10 @@ def build_docks(win) -> None:
     lay = QtWidgets.QVBoxLayout(modes)
     lay.setContentsMargins(0, 0, 0, 0)
     lay.addWidget(win.modes_panel)
+    # one panel's bottom margin between the two, not two margins
+    margins = win.animation_panel.layout().contentsMargins()
+    margins.setTop(0)
+    win.animation_panel.layout().setContentsMargins(margins)
     lay.addWidget(win.animation_panel)
     add_dock(win, "Modes", modes, area.RightDockWidgetArea)
     add_dock(win, "Distances and signatures", win.distances_panel, area.RightDockWidgetArea)

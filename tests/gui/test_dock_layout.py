@@ -1,4 +1,5 @@
-"""How the docks lay their panels out: wrapped labels as high as their text."""
+"""How the docks lay their panels out: wrapped labels as high as their text, whole plot
+titles, every control of the Modes dock in view at the default window size."""
 
 import pytest
 
@@ -60,3 +61,45 @@ def test_a_preview_spectrum_title_is_one_whole_line(window, spot_path, qtbot):
     assert plot.title == "Spectrum (preview): Shells 3D"
     assert plot.title_lines() == [plot.title]
     assert plot.fontMetrics().horizontalAdvance(plot.title) < plot.width() - 12
+
+
+def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path):
+    """Seen under Xvfb: the Speed slider lay below the Modes dock's visible part at the
+    default window size. With a mode shown every control of the dock, Speed included,
+    is inside the dock's scroll area without scrolling."""
+    from qtpy import QtCore, QtWidgets
+
+    from modalviewer.gui import MainWindow
+
+    win = MainWindow()
+    qtbot.addWidget(win)
+    win.show()
+    qtbot.waitExposed(win)
+    assert (win.width(), win.height()) == (1280, 820)  # the size of a first start
+    assert win.open_mesh(spot_path)
+    win.compute("laplacian", k=10, wait=True)
+    _settle(qtbot, win)
+    modes, animation = win.modes_panel, win.animation_panel
+    scroll = animation.parentWidget()
+    while not isinstance(scroll, QtWidgets.QScrollArea):
+        scroll = scroll.parentWidget()
+    assert scroll.widget().isAncestorOf(modes)
+    viewport = scroll.viewport()
+    assert scroll.verticalScrollBar().value() == 0
+    shown = viewport.rect()
+    for widget in (
+        modes.spectrum_combo,
+        modes.mode_spin,
+        modes.eigen_label,
+        modes.spectrum_plot,
+        modes.color_combo,
+        modes.iso_spin,
+        animation.amp_slider,
+        animation.speed_slider,
+        animation.play_button,
+    ):
+        top_left = widget.mapTo(viewport, QtCore.QPoint(0, 0))
+        where = QtCore.QRect(top_left, widget.size())
+        assert shown.contains(where), (widget, where, shown)
+    assert animation.speed_slider.width() >= 100
+    win.close()

@@ -26,9 +26,14 @@ class AnimationPanel(QtWidgets.QWidget):
         )
         self.speed_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
         self.speed_slider.setRange(1, 100)
-        form.addRow(self.play_button)
+        self.speed_slider.setToolTip("Speed of the animation")
+        # Speed and Play share a row: the Modes dock shows the whole panel at the
+        # default window size, under the spectrum plot
+        speed_row = QtWidgets.QHBoxLayout()
+        speed_row.addWidget(self.speed_slider, 1)
+        speed_row.addWidget(self.play_button)
         form.addRow("Amplitude", self.amp_slider)
-        form.addRow("Speed", self.speed_slider)
+        form.addRow("Speed", speed_row)
         self.play_button.toggled.connect(lambda on: state.set_animation(playing=on))
         self.amp_slider.valueChanged.connect(lambda v: state.set_animation(amplitude=v))
         self.speed_slider.valueChanged.connect(lambda v: state.set_animation(speed=v))
