@@ -920,6 +920,11 @@ solver's shift, just above zero, left the cow Loop x3 7.4 % off where this one l
 0.74 %.  A shift well away from zero also factorises at the first try."""
 
 
+COARSE_SOLVE_COLUMNS = 16
+"""Columns per solve of the coarse start's inverse-iteration step: the right-hand sides
+and solutions of a block are its only (N, w) temporaries beside the carried modes and
+the factor (Cheburashka Loop x2, 320k unknowns: 40 MB each at 16 columns)."""
+
 COARSE_GUARD = 0.25
 """The coarse start carries this share more of the copy's modes than are asked for
 (at least :data:`REFINE_GUARD_MIN`): without them the top few Ritz pairs of the step
@@ -1013,10 +1018,14 @@ def _coarse_start(
     t = time.perf_counter()
     report("preview: inverse iteration", 0.6)
     m = V.shape[1]
-    step = _block_columns(n)
+    step = min(_block_columns(n), COARSE_SOLVE_COLUMNS)
+    rhs = np.empty((n, step), order="F")  # the solver's own layout: no copy of it is made
     for j in range(0, m, step):  # V overwritten by Y = S M V, a block at a time
         cols = slice(j, min(j + step, m))
-        V[:, cols] = solver.solve(mass[:, None] * V[:, cols])
+        B = rhs[:, : cols.stop - j]
+        np.multiply(mass[:, None], V[:, cols], out=B)
+        V[:, cols] = solver.solve(B)
+    del rhs, B
     Z = nulls.vectors.toarray() if d else np.zeros((n, 0))
     if d:  # Mass-orthogonal to the null vectors, a row chunk at a time (no (N, m) temporary)
         G = _weighted_product(Z, V, mass)
