@@ -4,8 +4,8 @@ exact spectrum, on curved meshes with thin parts; each run in its own process.
     python -m benchmarks.coarse_start --cases spot:loop:3 hand:loop:2
     python -m benchmarks.coarse_start --cases /path/cow.obj:loop:3 -k 100
 
-A case is ``mesh:scheme:level`` as in :mod:`benchmarks.curved`, where ``mesh`` is a
-bundled asset's short name or a mesh file.  For each case: the exact spectrum, the fast
+A case is ``asset:scheme:level`` as in :mod:`benchmarks.curved` (the asset a bundled
+one's short name or a mesh file).  For each case: the exact spectrum, the fast
 preview from the smooth space (``accuracy="fast preview"``) and the fast preview from a
 coarse copy (:func:`modalviewer.coarsen.preview_copy`, its decimation timed with it);
 the previews' lowest 50 non-zero eigenvalues are compared with the exact ones.  Writes
@@ -23,7 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.curved import ASSETS, SCHEMES  # noqa: E402
+from benchmarks.curved import case_name, case_path, parse_case  # noqa: E402
 from benchmarks.run import save_result  # noqa: E402
 
 CHILD = """
@@ -50,23 +50,9 @@ print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds,
 """
 
 
-def parse_case(text: str) -> tuple[str, str, int]:
-    mesh, scheme, level = text.rsplit(":", 2)
-    if scheme not in SCHEMES or not (mesh in ASSETS or Path(mesh).is_file()):
-        raise argparse.ArgumentTypeError(
-            f"{text!r}: a case is mesh:scheme:level, mesh one of {sorted(ASSETS)} or a file"
-        )
-    return mesh, scheme, int(level)
-
-
-def case_name(case) -> str:
-    mesh, scheme, level = case
-    return f"{Path(mesh).stem} {SCHEMES[scheme]} x{level}"
-
-
 def run(case, start: str, k: int) -> dict:
     mesh, scheme, level = case
-    path = ASSETS.get(mesh, str(Path(mesh).resolve()))
+    path = case_path(mesh)
     out = subprocess.run(
         [sys.executable, "-c", CHILD, path, scheme, str(level), start, str(k)],
         capture_output=True,

@@ -6,7 +6,8 @@ eigenvalue errors, each run in its own process.
 
 A case is ``asset:scheme:level``: a bundled mesh (``spot``: the cow, thin legs, ears and
 horns; ``hand``: ``demo_hand.obj``, five thin fingers; ``part``:
-``demo_machined_part.obj``, a machined part with sharp edges and holes) subdivided
+``demo_machined_part.obj``, a machined part with sharp edges and holes) or a mesh file
+(named in the results by its stem) subdivided
 ``level`` times, by Loop (``loop``, smooth) or by splitting each triangle in four in its
 plane (``flat``: the part keeps its sharp edges).  Writes
 ``benchmarks/results/curved.json``.  Each (case, operator, accuracy) runs in a fresh
@@ -77,9 +78,9 @@ def case_mesh(path: str, scheme: str, level: int):
 
 
 def case_name(case: tuple[str, str, int]) -> str:
-    """The results file's name of a case, e.g. "hand Loop x2"."""
+    """The results file's name of a case, e.g. "hand Loop x2" (a file: its stem)."""
     asset, scheme, level = case
-    return f"{asset} {SCHEMES[scheme]} x{level}"
+    return f"{Path(asset).stem} {SCHEMES[scheme]} x{level}"
 
 
 def _position(order: list[str], name: str) -> int:
@@ -87,17 +88,26 @@ def _position(order: list[str], name: str) -> int:
 
 
 def parse_case(text: str) -> tuple[str, str, int]:
-    """``asset:scheme:level`` -> (asset, scheme, level), with a clear error."""
+    """``asset:scheme:level`` -> (asset, scheme, level), with a clear error; the asset
+    is a bundled one's short name or a mesh file's path (meshes not bundled, e.g. other
+    scans)."""
     try:
-        asset, scheme, level = text.split(":")
-        if asset not in ASSETS or scheme not in SCHEMES or int(level) < 0:
+        asset, scheme, level = text.rsplit(":", 2)
+        known = asset in ASSETS or Path(asset).is_file()
+        if not known or scheme not in SCHEMES or int(level) < 0:
             raise ValueError
     except ValueError:
         raise argparse.ArgumentTypeError(
-            f"{text!r}: a case is asset:scheme:level with asset one of {sorted(ASSETS)}, "
-            f"scheme one of {sorted(SCHEMES)} and level >= 0, e.g. hand:loop:2"
+            f"{text!r}: a case is asset:scheme:level with asset one of {sorted(ASSETS)} "
+            f"or a mesh file, scheme one of {sorted(SCHEMES)} and level >= 0, "
+            "e.g. hand:loop:2"
         ) from None
     return asset, scheme, int(level)
+
+
+def case_path(asset: str) -> str:
+    """The mesh file of a case's asset: a bundled asset's file name, or the path given."""
+    return ASSETS.get(asset, str(Path(asset).resolve()))
 
 
 def run(case: tuple[str, str, int], operator: str, accuracy: str, k: int) -> dict:
@@ -107,7 +117,7 @@ def run(case: tuple[str, str, int], operator: str, accuracy: str, k: int) -> dic
             sys.executable,
             "-c",
             CHILD,
-            ASSETS[asset],
+            case_path(asset),
             scheme,
             str(level),
             operator,
