@@ -1185,8 +1185,9 @@ def preview_spectrum(
 
     The estimated errors come from the residuals of the final pairs (see
     :func:`estimated_errors`); with ``refine`` the operators without the 3D shells'
-    correction step (the scalar ones, the normal shells) factorise for the refinement
-    first and estimate with that factor (:func:`_factor_estimate`): block-Jacobi
+    correction step (the Laplacian and E_D^N: the normal shells are not refined by
+    default) factorise for the refinement first and estimate with that factor
+    (:func:`_factor_estimate`): block-Jacobi
     conjugate gradients read a localised Laplacian mode of Cheburashka Loop x2 at 2.4 %
     where it was 19 % off, the factor at 19.1 %.  Where the largest is above the
     operator's threshold (``refine_above`` of :data:`SPACE_SETTINGS`, by default
