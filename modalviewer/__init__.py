@@ -22,6 +22,7 @@ import os as _os
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
+from .coarsen import preview_copy  # noqa: E402 (numpy only; MeshLab and VTK load when run)
 from .collection import open_collection  # noqa: E402 (numpy only; Dask loads in run_batch)
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
@@ -46,6 +47,7 @@ __all__ = [  # noqa: F405
     "InteractivePicture",
     "fix_slivers",
     "SliverReport",
+    "preview_copy",
     "Viewer",
     "open_collection",
 ]

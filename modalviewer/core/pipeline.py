@@ -118,9 +118,9 @@ def compute_spectrum(
         small for a reduced space of 3 k functions (:func:`.preview.preview_possible`)
         gets the exact spectrum instead, which is quick there (``is_preview`` False).
     coarse : for a 3D shells preview, a coarse copy of the mesh to start from
-        (:class:`.transfer.CoarseCopy`, e.g. ``modalviewer.coarsen.preview_copy(mesh,
-        k)``): the copy's own modes, carried to the mesh and corrected by one step of
-        inverse iteration, where a smooth space misses the modes of thin parts.
+        (:class:`.transfer.CoarseCopy`, e.g. ``mv.preview_copy(mesh, k)``): the copy's
+        own modes, carried to the mesh and corrected by one step of inverse iteration,
+        where a smooth space misses the modes of thin parts.
 
     Returns
     -------
