@@ -126,17 +126,12 @@ def preview_copy_for(mesh: Mesh, operator: str, k: int):
 
 def _barycentric(points: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """(m, 3) barycentric coordinates of points lying on the triangles ``corners``
-    (m, 3, 3); degenerate triangles give their first corner."""
-    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
-    ab, ac, ap = b - a, c - a, points - a
-    d00, d01, d11 = (ab * ab).sum(1), (ab * ac).sum(1), (ac * ac).sum(1)
-    d20, d21 = (ap * ab).sum(1), (ap * ac).sum(1)
-    den = d00 * d11 - d01 * d01
-    ok = den > 1e-30 * np.maximum(d00 * d11, 1e-300)
-    den = np.where(ok, den, 1.0)
-    v = np.where(ok, (d11 * d20 - d01 * d21) / den, 0.0)
-    w = np.where(ok, (d00 * d21 - d01 * d20) / den, 0.0)
-    return np.clip(np.stack([1.0 - v - w, v, w], axis=1), 0.0, 1.0)
+    (m, 3, 3), clipped to the triangles (rounding); degenerate triangles give their
+    first corner."""
+    from .core.transfer import plane_coordinates
+
+    bary, _ = plane_coordinates(points, corners[:, 0], corners[:, 1], corners[:, 2])
+    return np.clip(bary, 0.0, 1.0)
 
 
 def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectrum:

@@ -49,6 +49,7 @@ from .eigen import (
     factor_below_spectrum,
     factor_budget_mb,
     solve_lowest,
+    typical_eigenvalue,
     zero_modes,
 )
 from .factor import FactorTooLarge, SPDSolver
@@ -792,6 +793,15 @@ def _ritz_with(K, mass, lam, U, W) -> np.ndarray:
     return mu[:c]
 
 
+def _zero_mode_residuals(K, mass, lam, U, first: int, lam_scale: float) -> np.ndarray:
+    """Relative residuals of the zero modes, U's first ``first`` columns: scaled by the
+    largest eigenvalue or ``lam_scale`` (a zero mode has no size of its own)."""
+    Z = U[:, :first]
+    R = threaded_product(K, Z) - (mass[:, None] * Z) * lam[:first]
+    MZ = np.linalg.norm(mass[:, None] * Z, axis=0)
+    return np.linalg.norm(R, axis=0) / (max(float(np.abs(lam).max()), lam_scale) * MZ)
+
+
 def _factor_steps(
     K, mass, lam, U, lam_scale, refine_above, max_steps, report, factored=None, give_up=False
 ):
@@ -849,11 +859,7 @@ def _factor_steps(
         )
         if info["steps"]:  # every non-zero mode's residual: the estimate
             res = np.zeros(c)
-            zero_scale = max(float(np.abs(lam).max()), lam_scale)
-            R = threaded_product(K, U[:, :first]) - (mass[:, None] * U[:, :first]) * lam[:first]
-            MZ = np.linalg.norm(mass[:, None] * U[:, :first], axis=0)
-            res[:first] = np.linalg.norm(R, axis=0) / (zero_scale * MZ)
-            del R
+            res[:first] = _zero_mode_residuals(K, mass, lam, U, first, lam_scale)
             res[first:] = relative
             est = np.zeros(c)
             est[first:] = np.maximum(energies, 0.0) / np.abs(lam[first:])
@@ -945,7 +951,7 @@ def _coarse_copy_pairs(coarse: CoarseCopy, operator: str, k: int, bending, membr
         result = solve_lowest(Kc, mc, kc, null_space=nulls.vectors)
     except (MeshError, EigenError, np.linalg.LinAlgError, ValueError):
         return None
-    nonzero = ~zero_modes(result.eigenvalues, float(np.median(Kc.diagonal() / mc)), nulls.dimension)
+    nonzero = ~zero_modes(result.eigenvalues, typical_eigenvalue(Kc, mc), nulls.dimension)
     return result.eigenvalues[nonzero], result.vectors[:, nonzero]
 
 
@@ -1073,11 +1079,7 @@ def _factor_estimate(K, mass, solver, lam, U, lam_scale, d):
     c = lam.shape[0]
     res, est = np.zeros(c), np.zeros(c)
     if d:
-        zero_scale = max(float(np.abs(lam).max()), lam_scale)
-        R = threaded_product(K, U[:, :d])
-        MZ = np.linalg.norm(mass[:, None] * U[:, :d], axis=0)
-        res[:d] = np.linalg.norm(R, axis=0) / (zero_scale * MZ)
-        del R
+        res[:d] = _zero_mode_residuals(K, mass, lam, U, d, lam_scale)
     if d < c:
         relative, _, energies = _preconditioned_residuals(
             K, mass, solver, lam, U, lam_scale, slice(d, c), None, False, ESTIMATE_BLOCK_COLUMNS
@@ -1098,7 +1100,7 @@ def _coarse_preview(mesh, operator, K, mass, k, coarse, weights, report, refine,
         return None
     lam, U, solver, start_info = started
     seconds = {"start": time.perf_counter() - t}
-    lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
+    lam_scale = typical_eigenvalue(K, mass)
     d = start_info["null_space_dimension"]
     t = time.perf_counter()
     report("preview: estimating errors", 0.8)

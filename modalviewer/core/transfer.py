@@ -28,7 +28,7 @@ from scipy.spatial import cKDTree
 
 from .mesh import Mesh
 
-__all__ = ["CoarseCopy", "nearest_triangles", "displacement_prolongation"]
+__all__ = ["CoarseCopy", "nearest_triangles", "plane_coordinates", "displacement_prolongation"]
 
 CANDIDATES = 12
 """Triangles with the nearest centroids searched for a point's nearest triangle (beside
@@ -49,9 +49,10 @@ def _vertex_triangles(mesh: Mesh) -> np.ndarray:
     return table
 
 
-def _closest_on_triangles(p, a, b, c):
-    """Nearest points of the triangles (a, b, c) to the points p (all (m, 3)) and their
-    barycentric coordinates (m, 3); degenerate triangles give their nearest corner."""
+def plane_coordinates(p, a, b, c) -> tuple[np.ndarray, np.ndarray]:
+    """(barycentric coordinates (m, 3) of the points p projected into the planes of the
+    triangles (a, b, c), all (m, 3); whether each triangle is non-degenerate (m,)).
+    Degenerate triangles get (1, 0, 0)."""
     ab, ac, ap = b - a, c - a, p - a
     d00 = np.einsum("ij,ij->i", ab, ab)
     d01 = np.einsum("ij,ij->i", ab, ac)
@@ -61,9 +62,15 @@ def _closest_on_triangles(p, a, b, c):
     den = d00 * d11 - d01 * d01
     ok = den > 1e-30 * np.maximum(d00 * d11, 1e-300)
     den = np.where(ok, den, 1.0)
-    v = (d11 * d20 - d01 * d21) / den
-    w = (d00 * d21 - d01 * d20) / den
-    bary = np.stack([1.0 - v - w, v, w], axis=1)
+    v = np.where(ok, (d11 * d20 - d01 * d21) / den, 0.0)
+    w = np.where(ok, (d00 * d21 - d01 * d20) / den, 0.0)
+    return np.stack([1.0 - v - w, v, w], axis=1), ok
+
+
+def _closest_on_triangles(p, a, b, c):
+    """Nearest points of the triangles (a, b, c) to the points p (all (m, 3)) and their
+    barycentric coordinates (m, 3); degenerate triangles give their nearest corner."""
+    bary, ok = plane_coordinates(p, a, b, c)
     inside = ok & (bary >= 0.0).all(axis=1)
     best = np.where(inside[:, None], bary, np.nan)
     point = bary[:, :1] * a + bary[:, 1:2] * b + bary[:, 2:] * c
