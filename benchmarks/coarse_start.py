@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.curved import case_name, case_path, parse_case  # noqa: E402
-from benchmarks.run import save_result  # noqa: E402
+from benchmarks.run import add_keep_others, kept_rows, save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
@@ -74,17 +74,10 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--cases", type=parse_case, nargs="+", required=True)
     p.add_argument("-k", type=int, default=100)
-    p.add_argument(
-        "--keep-others",
-        action="store_true",
-        help="keep the results file's rows of other cases (re-measure some)",
-    )
+    add_keep_others(p, "other cases")
     args = p.parse_args(argv)
-    rows = []
-    results = ROOT / "benchmarks" / "results" / "coarse_start.json"
-    if args.keep_others and results.is_file():
-        names = {case_name(case) for case in args.cases}
-        rows = [r for r in json.loads(results.read_text())["rows"] if r["mesh"] not in names]
+    names = {case_name(case) for case in args.cases}
+    rows = kept_rows("coarse_start", args.keep_others, lambda r: r["mesh"] in names)
     for case in args.cases:
         exact = run(case, "exact", args.k)
         smooth = run(case, "smooth", args.k)

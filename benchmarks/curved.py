@@ -30,7 +30,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.run import save_result  # noqa: E402
+from benchmarks.run import add_keep_others, kept_rows, save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
@@ -141,21 +141,14 @@ def main(argv=None) -> int:
     )
     p.add_argument("--operators", nargs="+", default=["laplacian", "modified_dirichlet", "shells"])
     p.add_argument("-k", type=int, default=100)
-    p.add_argument(
-        "--keep-others",
-        action="store_true",
-        help="keep the results file's rows of other cases or operators (re-measure some)",
-    )
+    add_keep_others(p, "other cases or operators")
     args = p.parse_args(argv)
     names = {case_name(case) for case in args.cases}
-    rows = []
-    results = ROOT / "benchmarks" / "results" / "curved.json"
-    if args.keep_others and results.is_file():  # rows of what is not run now stay
-        rows = [
-            r
-            for r in json.loads(results.read_text())["rows"]
-            if not (r["mesh"] in names and r["operator"] in args.operators)
-        ]
+    rows = kept_rows(  # rows of what is not run now stay
+        "curved",
+        args.keep_others,
+        lambda r: r["mesh"] in names and r["operator"] in args.operators,
+    )
     order = [case_name(parse_case(c)) for c in DEFAULT_CASES]
     operators = list(OPERATOR_NAMES)  # a mesh's rows in the registry's order
     for case in args.cases:

@@ -68,6 +68,28 @@ def save_result(name: str, data) -> None:
     (out / f"{name}.json").write_text(json.dumps(data, indent=1) + "\n")
 
 
+def add_keep_others(parser, what: str) -> None:
+    """The ``--keep-others`` option of a benchmark that re-measures some of its rows:
+    ``what`` says which rows are kept (e.g. "other cases or operators")."""
+    parser.add_argument(
+        "--keep-others",
+        action="store_true",
+        help=f"keep the results file's rows of {what} (re-measure some)",
+    )
+
+
+def kept_rows(name: str, keep: bool, measured_now) -> list[dict]:
+    """The rows of ``benchmarks/results/<name>.json`` (a list of rows, or ``{"rows":
+    [...]}``) for which ``measured_now(row)`` is False, where ``keep`` is set (the
+    ``--keep-others`` option) and the file exists; otherwise none."""
+    path = ROOT / "benchmarks" / "results" / f"{name}.json"
+    if not keep or not path.is_file():
+        return []
+    data = json.loads(path.read_text())
+    rows = data["rows"] if isinstance(data, dict) else data
+    return [row for row in rows if not measured_now(row)]
+
+
 def peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 

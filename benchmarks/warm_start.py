@@ -60,7 +60,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.run import _in_child, make_mesh, save_result  # noqa: E402
+from benchmarks.run import _in_child, add_keep_others, kept_rows, make_mesh, save_result  # noqa: E402
 
 SEED = 12345
 
@@ -219,21 +219,10 @@ def main(argv=None) -> int:
         help="operators that also get the exact-modes start (the shells' stalls: see above)",
     )
     p.add_argument("--name", default="warm_start", help="results file name")
-    p.add_argument(
-        "--keep-others",
-        action="store_true",
-        help="keep the results file's rows of other meshes and operators",
-    )
+    add_keep_others(p, "other meshes and operators")
     args = p.parse_args(argv)
-    rows = []
-    path = ROOT / "benchmarks" / "results" / f"{args.name}.json"
-    if args.keep_others and path.exists():
-        rows = [
-            row
-            for row in json.loads(path.read_text())
-            if (row["mesh"], row["operator"])
-            not in {(s, o) for s in args.sizes for o in args.operators}
-        ]
+    now = {(s, o) for s in args.sizes for o in args.operators}
+    rows = kept_rows(args.name, args.keep_others, lambda r: (r["mesh"], r["operator"]) in now)
     for size in args.sizes:
         for operator in args.operators:
             row = _in_child(_case, size, operator, args.k, args.repeats, args.ideal_operators)
