@@ -984,8 +984,9 @@ def _coarse_start(
     of the same surface, so a thin part's bending modes are there, where a smooth
     space on the fine mesh locks them out) are carried to the mesh
     (:func:`.transfer.displacement_prolongation`); one step of inverse iteration with a
-    factor of the fine operator shifted just below zero (``Y = (K + s M)^-1 M V``)
-    adds the mesh-scale parts every carried field lacks, and Rayleigh-Ritz in
+    factor of the fine operator (``Y = (K + s M)^-1 M V``, s :data:`COARSE_SHIFT` times
+    the copy's lowest non-zero eigenvalue) adds the mesh-scale parts every carried field
+    lacks, and Rayleigh-Ritz in
     ``span [Z, Y]`` (Z the exact null vectors) gives the pairs.  The factor is returned
     for the refinement's steps.  None where the coarse copy's spectrum or the factor
     fails, or the copy has fewer non-zero modes than asked for (the caller takes the
