@@ -1187,12 +1187,13 @@ def preview_spectrum(
     threshold below.  Otherwise:
 
     The estimated errors come from the residuals of the final pairs (see
-    :func:`estimated_errors`); with ``refine`` the operators without the 3D shells'
-    correction step (the Laplacian and E_D^N: the normal shells are not refined by
-    default) factorise for the refinement first and estimate with that factor
-    (:func:`_factor_estimate`): block-Jacobi
-    conjugate gradients read a localised Laplacian mode of Cheburashka Loop x2 at 2.4 %
-    where it was 19 % off, the factor at 19.1 %.  Where the largest is above the
+    :func:`estimated_errors`); the operators without the 3D shells' correction step
+    (the Laplacian, E_D^N and the normal shells) factorise the operator shifted below
+    its spectrum and estimate with that factor (:func:`_factor_estimate`), which a
+    refinement then reuses: block-Jacobi conjugate gradients read a localised Laplacian
+    mode of Cheburashka Loop x2 at 2.4 % where it was 19 % off, the factor at 19.1 %.
+    A fast preview (``refine`` False) whose factor would go out of core keeps the
+    block-Jacobi estimate.  Where the largest is above the
     operator's threshold (``refine_above`` of :data:`SPACE_SETTINGS`, by default
     :data:`REFINE_ABOVE`: curved meshes with thin parts, creases) and ``refine`` is set
     (default: per operator, see
@@ -1304,8 +1305,10 @@ def preview_spectrum(
     if corrected is None:
         t = time.perf_counter()
         report("preview: estimating errors", 0.9)
-        if refine and not settings.factor_step:  # the refinement's factor decides it
+        if not settings.factor_step:  # the refinement's factor, if one follows, decides it
             solver = _factor_below(K, mass, lam, lam_scale)
+            if solver is not None and solver.out_of_core and not refine:
+                solver = None  # solves from a file would cost more than the preview
         if solver is not None:
             d = int(np.argmin(zero_modes(lam, lam_scale))) if lam.size else 0
             res, est, estimate = _factor_estimate(K, mass, solver, lam, U, lam_scale, d)

@@ -739,8 +739,10 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
     blocked = pv.preview_spectrum(mesh, "shells", K, mass, 20)
     assert widths == [5, 5, 2, 5, 5, 4, 3, 3, 3, 3, 2, 5, 5, 4]
     np.testing.assert_allclose(blocked[0], whole[0], rtol=1e-7, atol=1e-9 * whole[0].max())
+    # single-precision solves round differently with the block's width: 2e-4 relative
+    # on one machine's processor, below 1e-4 on another's
     np.testing.assert_allclose(
-        blocked[3]["estimated_errors"], whole[3]["estimated_errors"], rtol=1e-4, atol=1e-12
+        blocked[3]["estimated_errors"], whole[3]["estimated_errors"], rtol=1e-3, atol=1e-12
     )
 
 
@@ -813,11 +815,12 @@ def test_a_coarse_start_is_refined_where_its_lower_half_is_estimated_off(monkeyp
     assert np.max(refined.eigenvalues[6:] / exact[6:] - 1) < 1e-3
 
 
-def test_a_refined_scalar_preview_estimates_with_its_factor_and_refines_where_it_must():
+def test_scalar_previews_estimate_with_a_factor_and_refine_where_they_must():
     """E_D^N on spot Loop-subdivided once, 40 modes: the fast preview's largest error is
     0.73 %, which block-Jacobi conjugate gradients read at half (0.37 %, below the 0.7 %
-    that calls for a refinement).  The refined preview estimates with the refinement's
-    factor first, reads the error within 20 %, and so refines."""
+    that calls for a refinement).  Both previews estimate with a factor of the operator
+    instead and read the error within 20 %; the refined preview so refines, with the
+    same factor."""
     import trimesh
 
     base = mv.load_mesh(mv.asset_path("spot.obj"))
@@ -827,6 +830,7 @@ def test_a_refined_scalar_preview_estimates_with_its_factor_and_refines_where_it
     fast = mv.compute_spectrum(mesh, "modified_dirichlet", k, accuracy="fast preview")
     fast_error = np.max(np.abs(fast.eigenvalues[1:] / exact[1:] - 1))
     assert fast_error > 0.007  # above the refinement threshold
+    assert 0.8 * fast_error < fast.estimated_error < 1.2 * fast_error
     refined = mv.compute_spectrum(mesh, "modified_dirichlet", k, accuracy="preview")
     info = refined.parameters["preview"]
     before = info["refinement"]["estimated_error_before"]
