@@ -22,6 +22,7 @@ from .core.spectrum import Spectrum
 
 __all__ = [
     "COARSE_FRACTION",
+    "decimate_and_locate",
     "decimated_copy",
     "preview_copy",
     "preview_copy_for",
@@ -61,34 +62,51 @@ PREVIEW_COPY_MAX = 20000
 PREVIEW_COPY_PER_MODE = 30
 
 
-def preview_copy(mesh: Mesh, k: int):
+def preview_copy(mesh: Mesh, k: int, separate_process: bool = True):
     """The coarse copy a 3D shells preview of ``k`` modes starts from
     (:class:`.core.transfer.CoarseCopy`), or None.
 
     MeshLab's quadric edge collapse (through the optional ``pymeshlab``) to
     :data:`PREVIEW_COPY_SHARE` of the vertices, with its triangle-quality, normal and
     topology safeguards, and each vertex's nearest point on the copy from VTK's cell
-    locator.  None without ``pymeshlab``, where the mesh is too small for a copy to save
-    work (the copy would keep more than a quarter of its vertices) or where the
+    locator (:func:`decimate_and_locate`).  With ``separate_process`` (the default) in
+    a child process (:mod:`.processes.copy_main`): MeshLab's and VTK's libraries and
+    working memory end with it instead of staying in the process that then computes
+    the spectrum.  None without ``pymeshlab``, where the mesh is too small for a copy to
+    save work (the copy would keep more than a quarter of its vertices) or where the
     decimation leaves no usable mesh: the preview then starts from its smooth space.
     VTK's own quadric decimation is not used: its copy of the cow subdivided twice had
     triangles of quality 0.03 and a spectrum that missed a mode the estimate does not
     see (4.9 % off, against 0.9 % from MeshLab's)."""
+    import importlib.util
+
     n = mesh.n_vertices
     target = max(PREVIEW_COPY_MIN, PREVIEW_COPY_PER_MODE * int(k), int(PREVIEW_COPY_SHARE * n))
     target = min(target, PREVIEW_COPY_MAX)
-    if target > n // 4:
+    if target > n // 4 or importlib.util.find_spec("pymeshlab") is None:
         return None
-    try:
-        import pymeshlab
-    except ImportError:
+    if separate_process:
+        made = _decimate_and_locate_in_child(mesh, target)
+    else:
+        made = decimate_and_locate(mesh.vertices, mesh.faces, target)
+    if made is None:
         return None
-    import pyvista as pv
-
     from .core.transfer import CoarseCopy
 
+    return CoarseCopy(*made)
+
+
+def decimate_and_locate(vertices: np.ndarray, faces: np.ndarray, target: int):
+    """(copy Mesh, triangles, barycentric) of :func:`preview_copy`: the mesh
+    (vertices, faces) decimated to about ``target`` vertices by MeshLab's quadric edge
+    collapse, and for each of its vertices the copy's nearest triangle and the
+    barycentric coordinates of the nearest point on it (VTK's cell locator); None where
+    the decimation leaves no usable mesh."""
+    import pymeshlab
+    import pyvista as pv
+
     ms = pymeshlab.MeshSet()
-    ms.add_mesh(pymeshlab.Mesh(np.asarray(mesh.vertices, float), np.asarray(mesh.faces, np.int32)))
+    ms.add_mesh(pymeshlab.Mesh(np.asarray(vertices, float), np.asarray(faces, np.int32)))
     try:
         ms.meshing_decimation_quadric_edge_collapse(
             targetfacenum=int(2 * target),
@@ -102,12 +120,37 @@ def preview_copy(mesh: Mesh, k: int):
         coarse = repair_mesh(decimated.vertex_matrix(), decimated.face_matrix(), "coarse copy")
     except (pymeshlab.PyMeshLabException, ValueError, MeshError):
         return None
-    faces = np.hstack([np.full((coarse.n_faces, 1), 3), coarse.faces]).ravel()
-    located = pv.PolyData(np.array(coarse.vertices), faces)
-    cells, nearest = located.find_closest_cell(np.array(mesh.vertices), return_closest_point=True)
+    del ms, decimated
+    cell_faces = np.hstack([np.full((coarse.n_faces, 1), 3), coarse.faces]).ravel()
+    located = pv.PolyData(np.array(coarse.vertices), cell_faces)
+    cells, nearest = located.find_closest_cell(np.array(vertices), return_closest_point=True)
     cells = np.asarray(cells, dtype=np.int64)
-    barycentric = _barycentric(nearest, coarse.vertices[coarse.faces[cells]])
-    return CoarseCopy(coarse, cells, barycentric)
+    return coarse, cells, _barycentric(nearest, coarse.vertices[coarse.faces[cells]])
+
+
+def _decimate_and_locate_in_child(mesh: Mesh, target: int):
+    """:func:`decimate_and_locate` in a child process (:mod:`.processes.copy_main`,
+    the arrays through its stdin and stdout); None where it makes no copy."""
+    import io
+    import subprocess
+    import sys
+
+    job = io.BytesIO()
+    np.savez(job, vertices=mesh.vertices, faces=mesh.faces, target=int(target))
+    run = subprocess.run(
+        [sys.executable, "-m", "modalviewer.processes.copy_main"],
+        input=job.getvalue(),
+        capture_output=True,
+    )
+    del job
+    if run.returncode != 0 or not run.stdout:
+        return None
+    try:
+        with np.load(io.BytesIO(run.stdout), allow_pickle=False) as made:
+            coarse = Mesh(made["vertices"], made["faces"])
+            return coarse, made["triangles"], made["barycentric"]
+    except (OSError, ValueError, KeyError, MeshError):  # not the copy's arrays
+        return None
 
 
 def preview_copy_for(mesh: Mesh, operator: str, k: int):
