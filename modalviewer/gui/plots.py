@@ -173,6 +173,7 @@ class LinePlot(QtWidgets.QWidget):
         p.drawText(
             rect.right() - metrics.horizontalAdvance(self.xlabel), rect.bottom() + 30, self.xlabel
         )
+        self._draw_ylabel(p, rect)
         p.setPen(QtGui.QPen(QtGui.QColor(40, 90, 180), 1.5))
         path = QtGui.QPainterPath(QtCore.QPointF(px[0], py[0]))
         for a, b in zip(px[1:], py[1:], strict=True):
@@ -196,6 +197,22 @@ class LinePlot(QtWidgets.QWidget):
             p.setBrush(QtGui.QColor(220, 40, 40))
             p.drawEllipse(QtCore.QPointF(px[self.highlight], py[self.highlight]), 4, 4)
         p.end()
+
+    def _draw_ylabel(self, p: QtGui.QPainter, rect: QtCore.QRect) -> None:
+        """The y axis's name, read bottom to top, in the left margin between the two
+        value labels (which sit at the frame's top and bottom), elided to fit there."""
+        if not self.ylabel:
+            return
+        metrics = self.fontMetrics()
+        room = rect.height() - 2 * metrics.height()
+        text = metrics.elidedText(self.ylabel, QtCore.Qt.TextElideMode.ElideRight, room)
+        if room <= 0 or not text:
+            return
+        p.save()
+        p.translate(2 + metrics.ascent(), rect.center().y() + metrics.horizontalAdvance(text) / 2)
+        p.rotate(-90)
+        p.drawText(0, 0, text)
+        p.restore()
 
     def mousePressEvent(self, event):  # noqa: N802
         if self.x.size == 0:

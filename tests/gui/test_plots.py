@@ -66,3 +66,34 @@ def test_a_title_wider_than_the_plot_wraps_whole(qtbot):
     assert rect.top() >= 20 + metrics.lineSpacing()
     plot.resize(600, 140)  # wide enough: one line, the frame where a one-line title puts it
     assert plot.title_lines() == [title] and plot._transform()[0].top() == 20
+
+
+def _dark_in(image, xs, ys) -> int:
+    return sum(image.pixelColor(x, y).lightness() < 100 for y in ys for x in xs)
+
+
+def test_the_y_axis_is_named_in_the_left_margin(qtbot):
+    """The plot's y label ("eigenvalue") is drawn, turned to read upwards, in the left
+    margin between the value labels at the frame's top and bottom; without one the
+    band stays white."""
+    lam = np.array([0.0, 2.0, 5.0, 9.0, 14.0, 20.0, 27.0, 35.0, 44.0])
+    plots = {}
+    for name in ("eigenvalue", ""):
+        plot = LinePlot("Spectrum", "mode index", name)
+        qtbot.addWidget(plot)
+        plot.resize(360, 220)
+        plot.set_data(np.arange(lam.size), lam)
+        plots[name] = plot
+    rect = plots[""]._transform()[0]
+    metrics = plots[""].fontMetrics()
+    xs = range(0, rect.left() - 2)
+    ys = range(rect.top() + metrics.height(), rect.bottom() - metrics.height())
+    named, unnamed = (_dark_in(plots[n].grab().toImage(), xs, ys) for n in ("eigenvalue", ""))
+    assert unnamed == 0, unnamed
+    assert named > 40, named
+    # the ink is taller than wide: the word reads upwards
+    image = plots["eigenvalue"].grab().toImage()
+    ink = [(x, y) for y in ys for x in xs if image.pixelColor(x, y).lightness() < 100]
+    width = max(x for x, _ in ink) - min(x for x, _ in ink)
+    height = max(y for _, y in ink) - min(y for _, y in ink)
+    assert height > 3 * width, (width, height)
