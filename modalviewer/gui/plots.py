@@ -199,17 +199,22 @@ class LinePlot(QtWidgets.QWidget):
         p.end()
 
     def _draw_ylabel(self, p: QtGui.QPainter, rect: QtCore.QRect) -> None:
-        """The y axis's name, read bottom to top, in the left margin between the two
-        value labels (which sit at the frame's top and bottom), elided to fit there."""
+        """The y axis's name in the left margin, between the value labels at the frame's
+        top and bottom: as it is where it fits the margin's width ("λ", "S_t"), else
+        turned to read upwards and elided to the room between the value labels."""
         if not self.ylabel:
             return
         metrics = self.fontMetrics()
+        middle = rect.center().y()
+        if metrics.horizontalAdvance(self.ylabel) <= rect.left() - 6:
+            p.drawText(2, middle + metrics.ascent() // 2, self.ylabel)
+            return
         room = rect.height() - 2 * metrics.height()
         text = metrics.elidedText(self.ylabel, QtCore.Qt.TextElideMode.ElideRight, room)
         if room <= 0 or not text:
             return
         p.save()
-        p.translate(2 + metrics.ascent(), rect.center().y() + metrics.horizontalAdvance(text) / 2)
+        p.translate(2 + metrics.ascent(), middle + metrics.horizontalAdvance(text) / 2)
         p.rotate(-90)
         p.drawText(0, 0, text)
         p.restore()

@@ -73,9 +73,9 @@ def _dark_in(image, xs, ys) -> int:
 
 
 def test_the_y_axis_is_named_in_the_left_margin(qtbot):
-    """The plot's y label ("eigenvalue") is drawn, turned to read upwards, in the left
-    margin between the value labels at the frame's top and bottom; without one the
-    band stays white."""
+    """The plot's y label is drawn in the left margin between the value labels at the
+    frame's top and bottom: turned to read upwards where it is wider than the margin
+    ("eigenvalue"), as it is where it fits ("S_t"); without one the band stays white."""
     lam = np.array([0.0, 2.0, 5.0, 9.0, 14.0, 20.0, 27.0, 35.0, 44.0])
     plots = {}
     for name in ("eigenvalue", ""):
@@ -97,3 +97,14 @@ def test_the_y_axis_is_named_in_the_left_margin(qtbot):
     width = max(x for x, _ in ink) - min(x for x, _ in ink)
     height = max(y for _, y in ink) - min(y for _, y in ink)
     assert height > 3 * width, (width, height)
+    # a name that fits the margin's width stays as it is: wider than tall
+    short = LinePlot("Spectrum", "mode index", "S_t")
+    qtbot.addWidget(short)
+    short.resize(360, 220)
+    short.set_data(np.arange(lam.size), lam)
+    image = short.grab().toImage()
+    ink = [(x, y) for y in ys for x in xs if image.pixelColor(x, y).lightness() < 100]
+    assert ink
+    width = max(x for x, _ in ink) - min(x for x, _ in ink)
+    height = max(y for _, y in ink) - min(y for _, y in ink)
+    assert width > height, (width, height)

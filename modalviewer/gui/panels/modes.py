@@ -39,7 +39,7 @@ class ModesPanel(QtWidgets.QWidget):
         lay.addLayout(row)
         self.eigen_label = WrappingLabel("No spectrum yet.")
         lay.addWidget(self.eigen_label)
-        self.spectrum_plot = LinePlot("Spectrum", "mode index", "eigenvalue")
+        self.spectrum_plot = LinePlot("Spectrum", "mode index", "\u03bb")
         lay.addWidget(self.spectrum_plot)
         form = QtWidgets.QFormLayout()
         self.color_combo = combo()
