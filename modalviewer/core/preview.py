@@ -1280,7 +1280,7 @@ def preview_spectrum(
     report("preview: prolonging", 0.65)
     U = basis.prolong(Y)
     seconds["prolongation"] = time.perf_counter() - t
-    lam_scale = float(np.median(np.abs(K.diagonal()) / mass))
+    lam_scale = typical_eigenvalue(K, mass)
     galerkin = lam
     refine_above = REFINE_ABOVE if settings.refine_above is None else settings.refine_above
     steps = REFINE_STEPS if settings.refine_steps is None else settings.refine_steps
@@ -1462,7 +1462,7 @@ def compute_preview(
                 if "coarse_start" not in info
                 else "preview: a coarse copy's modes, one inverse-iteration step"
             ),
-            "zero_mode_scale": float(np.median(np.abs(K.diagonal()) / mass)),
+            "zero_mode_scale": typical_eigenvalue(K, mass),
             "seconds_assembly": assembled - started,
             "seconds_total": time.perf_counter() - started,
             "preview": info,
