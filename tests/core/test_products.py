@@ -24,6 +24,30 @@ def test_threaded_product_equals_the_plain_product(K):
     np.testing.assert_allclose(threaded_transpose_product(S, X), S.T @ X, atol=1e-13)
 
 
+def test_row_halves_share_the_matrix_arrays_and_the_product_copies_none_of_them():
+    """scipy's constructor would copy a view under half its base array: the halves of K
+    must be views, and K @ X into ``out`` must allocate far less than K's entries."""
+    import tracemalloc
+
+    from modalviewer.core.products import csr_rows, row_halves
+
+    A = sp.random(4000, 4000, density=0.01, random_state=2, format="csr")
+    halves = row_halves(A)
+    for rows, half in halves:
+        assert np.shares_memory(half.data, A.data) and np.shares_memory(half.indices, A.indices)
+        np.testing.assert_array_equal(half.toarray(), A[rows].toarray())
+    unsorted = sp.csr_matrix((np.ones(3), np.array([2, 0, 1]), np.array([0, 3, 3])), (2, 3))
+    unsorted.has_sorted_indices = False
+    assert not csr_rows(unsorted, 0, 2).has_sorted_indices
+    X, out = np.ones((4000, 8)), np.empty((4000, 8))
+    tracemalloc.start()
+    before = tracemalloc.get_traced_memory()[0]
+    threaded_product(A, X, out=out)
+    peak = tracemalloc.get_traced_memory()[1] - before
+    tracemalloc.stop()
+    assert peak < 0.1 * (A.data.nbytes + A.indices.nbytes), peak
+
+
 def test_threaded_product_writes_into_out(K):
     X = np.random.default_rng(1).standard_normal((301, 5))
     out = np.full((301, 5), np.nan)  # old contents must not leak into the result
