@@ -85,3 +85,45 @@ def test_the_coarse_copy_is_made_in_a_child_process_that_takes_its_libraries_alo
         np.testing.assert_array_equal(child["triangles"], here.triangles)
         np.testing.assert_allclose(child["barycentric"], here.barycentric, rtol=0, atol=1e-12)
     assert 3000 <= here.mesh.n_vertices <= 3300
+
+
+RETURN_FREED = """
+import numpy as np
+from modalviewer.core.memory import resident_mb, return_freed_memory
+from modalviewer.processes.memory import prepare_compute_process
+
+prepare_compute_process()  # big arrays from the heap, freed memory kept
+big = np.ones((25_000_000,))  # 200 MB
+small = np.ones(1000)  # allocated after it: the heap cannot shrink from its top
+del big
+kept = resident_mb()
+ran = return_freed_memory()
+print(ran, kept - resident_mb())
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc_trim")
+def test_freed_memory_goes_back_to_the_system_in_a_compute_process():
+    """A compute process keeps freed heap memory (processes.memory); the pipeline's
+    return_freed_memory at each stage gives the pages of a freed 200 MB array back."""
+    out = subprocess.run(
+        [sys.executable, "-c", RETURN_FREED], capture_output=True, text=True, timeout=60
+    )
+    assert out.returncode == 0, out.stderr
+    ran, returned = out.stdout.split()
+    assert ran == "True"
+    assert float(returned) > 150.0
+
+
+def test_compute_spectrum_returns_freed_memory_once_at_each_new_stage(monkeypatch):
+    from modalviewer.core import pipeline
+    from modalviewer.core.primitives import icosphere
+
+    calls, stages = [], []
+    monkeypatch.setattr(pipeline, "return_freed_memory", lambda: calls.append(1))
+    pipeline.compute_spectrum(
+        icosphere(3), "laplacian", 10, progress=lambda stage, _: stages.append(stage)
+    )
+    changes = sum(1 for i, s in enumerate(stages) if i == 0 or s != stages[i - 1])
+    assert changes >= 3
+    assert len(calls) == changes

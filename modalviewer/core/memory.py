@@ -11,7 +11,13 @@ from __future__ import annotations
 
 import os
 
-__all__ = ["MEMORY_LIMIT_SHARE", "memory_limit_mb", "physical_memory_mb", "resident_mb"]
+__all__ = [
+    "MEMORY_LIMIT_SHARE",
+    "memory_limit_mb",
+    "physical_memory_mb",
+    "resident_mb",
+    "return_freed_memory",
+]
 
 MEMORY_LIMIT_SHARE = 0.5
 """The share of this machine's memory a computation plans to stay within."""
@@ -56,3 +62,26 @@ def resident_mb() -> float:
 
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         return peak / 1024.0 if os.uname().sysname == "Linux" else peak / MB
+
+
+def return_freed_memory() -> bool:
+    """Give the memory this process has freed back to the system (glibc's
+    ``malloc_trim(0)``: free heap pages, at its top and between the arrays still in use).
+    A computation's stages free arrays of hundreds of megabytes whose heap pages glibc
+    would otherwise keep (it serves arrays below its dynamic mmap threshold, up to 32 MB,
+    and all arrays in a compute process, from the heap) and which the next stage's
+    arrays, of other sizes, cannot always reuse; called at each new stage of
+    :func:`.pipeline.compute_spectrum`.  True where it ran (glibc), False elsewhere."""
+    import ctypes
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        trim = ctypes.CDLL("libc.so.6").malloc_trim
+    except (OSError, AttributeError):
+        return False
+    trim.argtypes = [ctypes.c_size_t]
+    trim.restype = ctypes.c_int
+    trim(0)
+    return True

@@ -17,6 +17,7 @@ from .eigen import (
     typical_eigenvalue,
     zero_modes,
 )
+from .memory import return_freed_memory
 from .mesh import Mesh
 from .nullspace import null_space
 from .operators import operator_info
@@ -136,6 +137,7 @@ def compute_spectrum(
         raise ValueError(
             f"accuracy must be one of {', '.join(map(repr, ACCURACIES))}, got {accuracy!r}"
         )
+    progress = _returning_freed_memory(progress)
     if accuracy != "exact" and preview_possible(mesh, operator, k):
         refine = None if accuracy == "preview" else False
         return compute_preview(
@@ -223,6 +225,23 @@ def compute_spectrum(
             "null_space": nulls.summary(),
         },
     )
+
+
+def _returning_freed_memory(progress: ProgressFn | None) -> ProgressFn:
+    """``progress`` that first gives freed memory back to the system at each new stage
+    (:func:`.memory.return_freed_memory`): the homer Loop x2's refined Laplacian preview
+    peaked at 601 MB without it and 520 MB with it, the exact solve at 443 to 465 and 429
+    MB, in the same time within the runs' spread."""
+    stage_now = [None]
+
+    def report(stage: str, fraction: float) -> None:
+        if stage != stage_now[0]:
+            stage_now[0] = stage
+            return_freed_memory()
+        if progress is not None:
+            progress(stage, fraction)
+
+    return report
 
 
 def _all_zero_message(k: int, result, nulls, lam_typical: float) -> str:
