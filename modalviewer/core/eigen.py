@@ -47,7 +47,9 @@ __all__ = [
     "solve_lowest",
     "relative_residuals",
     "zero_modes",
+    "lowest_share",
     "typical_eigenvalue",
+    "zero_mode_size",
     "rounding_floors",
     "ZERO_MODE_RTOL",
 ]
@@ -176,8 +178,15 @@ def typical_eigenvalue(K, mass_diag: np.ndarray) -> float:
     return float(np.median(np.abs(K.diagonal()) / np.asarray(mass_diag)))
 
 
-def _lam_max(lam: np.ndarray, lam_scale: float) -> float:
-    """The eigenvalue size zero modes are judged against: max(largest |lam|, lam_scale)."""
+def lowest_share(count: int, share: float) -> int:
+    """How many of ``count`` non-zero modes make their lowest ``share`` (at least one):
+    the part of a preview whose estimated error decides on it."""
+    return max(1, int(np.ceil(share * count)))
+
+
+def zero_mode_size(lam: np.ndarray, lam_scale: float) -> float:
+    """The eigenvalue size zero modes are judged against (a zero mode has no size of its
+    own): max(largest |lam|, lam_scale)."""
     return max(float(np.abs(lam).max(initial=0.0)), lam_scale, np.finfo(float).tiny)
 
 
@@ -195,7 +204,7 @@ def relative_residuals(
     passed on).
     """
     scale = np.abs(lam).copy()
-    scale[zero_modes(lam, lam_scale, null_dim)] = _lam_max(lam, lam_scale)
+    scale[zero_modes(lam, lam_scale, null_dim)] = zero_mode_size(lam, lam_scale)
     out = np.empty(X.shape[1])
     for cols, KX in column_block_products(K, X):  # (N, 32) temporaries, not three (N, k) ones
         MX = mass_diag[:, None] * X[:, cols]
@@ -373,7 +382,7 @@ def solve_lowest(
         X = _fix_signs(X)
         res_rest = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
         Zk = _fix_column_signs(Z[:, : min(d, k)])
-        res_null = _null_residuals(K, mass_diag, Zk, _lam_max(all_lam, median_ratio))
+        res_null = _null_residuals(K, mass_diag, Zk, zero_mode_size(all_lam, median_ratio))
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
     with timer("copy"):  # own row-major array ((n, 3, k) shells modes are then a view)

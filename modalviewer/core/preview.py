@@ -48,8 +48,10 @@ from .eigen import (
     StageTimer,
     factor_below_spectrum,
     factor_budget_mb,
+    lowest_share,
     solve_lowest,
     typical_eigenvalue,
+    zero_mode_size,
     zero_modes,
 )
 from .factor import FactorTooLarge, SPDSolver
@@ -401,7 +403,7 @@ def _residual_norms(K, mass, lam, U, lam_scale, precondition):
     blocks (D the block-Jacobi preconditioner ``precondition``; ``K U`` a block at a
     time, no (N, k) temporaries)."""
     scale = np.abs(lam).copy()
-    scale[zero_modes(lam, lam_scale)] = max(float(np.abs(lam).max()), lam_scale)
+    scale[zero_modes(lam, lam_scale)] = zero_mode_size(lam, lam_scale)
 
     def sums(rows, KU):
         MU = mass[rows, None] * U[rows]
@@ -531,12 +533,14 @@ BLOCK_BYTES = 80e6
 """Bytes of an (N, w) block of the refinement's solves and sparse products: the solver
 copies its right-hand sides and solutions (Fortran order) and ``K Y`` is formed a block
 at a time, so these temporaries stay small beside the (N, c) arrays.  The width is 8 to
-32 columns (:func:`_block_columns`): wider blocks solve faster (47k-vertex shells, two
-steps: 9.5 s with 32 columns, 11.8 s with 16)."""
+16 columns (:func:`_block_columns`): PARDISO's own work arrays for a solve grow with its
+columns, and the cow Loop x3's refined Laplacian preview peaked at 867 MB with 32
+columns and 759 MB with 16 (median of four runs each, the exact solve: 715 MB), 3 %
+slower."""
 
 
 def _block_columns(n: int) -> int:
-    return int(np.clip(BLOCK_BYTES // (8 * max(n, 1)), 8, 32))
+    return int(np.clip(BLOCK_BYTES // (8 * max(n, 1)), 8, 16))
 
 
 def _rows(n: int):
@@ -799,7 +803,7 @@ def _zero_mode_residuals(K, mass, lam, U, first: int, lam_scale: float) -> np.nd
     Z = U[:, :first]
     R = threaded_product(K, Z) - (mass[:, None] * Z) * lam[:first]
     MZ = np.linalg.norm(mass[:, None] * Z, axis=0)
-    return np.linalg.norm(R, axis=0) / (max(float(np.abs(lam).max()), lam_scale) * MZ)
+    return np.linalg.norm(R, axis=0) / (zero_mode_size(lam, lam_scale) * MZ)
 
 
 def _factor_steps(
@@ -1143,7 +1147,7 @@ def _coarse_preview(mesh, operator, K, mass, k, coarse, weights, report, refine,
     # the lower half decides: the carried modes' top pairs are the least accurate, their
     # own estimates say so, and two subspace steps for them would cost as much as the
     # exact solve (the cow Loop x3: 25 s of its 58)
-    lower = est[d:][: max(1, int(np.ceil(0.5 * (lam.shape[0] - d))))]
+    lower = est[d:][: lowest_share(lam.shape[0] - d, 0.5)]
     if refine and lower.max(initial=0.0) > refine_above:
         t = time.perf_counter()
         c = lam.shape[0]

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .eigen import zero_modes
+from .eigen import lowest_share, zero_modes
 from .files import atomic_write
 from .mesh import Mesh
 from .operators import OPERATOR_NAMES, operator_info
@@ -97,7 +97,7 @@ class Spectrum:
         if errors.size != self.k:
             return self.estimated_error
         nonzero = np.flatnonzero(~self.zero_mode_mask())
-        lowest = nonzero[: max(1, int(np.ceil(share * nonzero.size)))]
+        lowest = nonzero[: lowest_share(nonzero.size, share)]
         return float(errors[lowest].max(initial=0.0))
 
     def estimated_mode_error(self, j: int) -> float:
