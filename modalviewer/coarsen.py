@@ -68,9 +68,10 @@ def preview_copy(mesh: Mesh, k: int, separate_process: bool = True):
 
     MeshLab's quadric edge collapse (through the optional ``pymeshlab``) to
     :data:`PREVIEW_COPY_SHARE` of the vertices, with its triangle-quality, normal and
-    topology safeguards, after a fast first stage (:func:`_first_stage`), and each vertex's nearest point on the copy from VTK's cell
-    locator (:func:`decimate_and_locate`).  With ``separate_process`` (the default) in
-    a child process (:mod:`.processes.copy_main`): MeshLab's and VTK's libraries and
+    topology safeguards, after a fast first stage (:func:`_first_stage`), and each
+    vertex's nearest point on the copy from VTK's cell locator
+    (:func:`decimate_and_locate`).  With ``separate_process`` (the default) in a child
+    process (:mod:`.processes.copy_main`): MeshLab's and VTK's libraries and
     working memory end with it instead of staying in the process that then computes
     the spectrum.  None without ``pymeshlab``, where the mesh is too small for a copy to
     save work (the copy would keep more than a quarter of its vertices) or where the
