@@ -36,16 +36,21 @@ _BAR = {"open": False}  # a progress bar line is not finished: an error starts a
 
 
 def _progress_bar():
-    state = {"last": 0.0}
+    """``progress(stage, fraction)`` drawing one line on stderr, redrawn at most five
+    times a second; each stage name is padded to the longest one drawn so far, so a
+    shorter name leaves no end of the longer one behind it."""
+    state = {"last": 0.0, "width": 20}
 
     def progress(stage: str, fraction: float) -> None:
         now = time.perf_counter()
         if fraction < 1.0 and now - state["last"] < 0.2:
             return
         state["last"] = now
+        state["width"] = max(state["width"], len(stage))
         filled = int(30 * fraction)
         sys.stderr.write(
-            f"\r[{'#' * filled}{'.' * (30 - filled)}] {100 * fraction:5.1f}% {stage:<20}"
+            f"\r[{'#' * filled}{'.' * (30 - filled)}] {100 * fraction:5.1f}% "
+            f"{stage:<{state['width']}}"
         )
         _BAR["open"] = fraction < 1.0
         if fraction >= 1.0:
@@ -238,11 +243,15 @@ def _run(args) -> int:
         prepare_compute_process()  # this process exists to compute (see processes.memory)
         mesh = _load(args.mesh, args.fix_slivers)
         _refuse_if_too_large(mesh, args.operator, args.k, args.preview)
-        coarse = None
+        coarse, copy_seconds = None, 0.0
+        bar = _progress_bar()
         if args.preview:
             from .coarsen import preview_copy_for
 
+            started = time.perf_counter()
+            bar("preview: making a coarse copy", 0.0)
             coarse = preview_copy_for(mesh, args.operator, args.k)
+            copy_seconds = time.perf_counter() - started
         with _warnings_printed():
             spec = mv.compute_spectrum(
                 mesh,
@@ -250,7 +259,7 @@ def _run(args) -> int:
                 args.k,
                 args.bending,
                 args.membrane,
-                progress=_progress_bar(),
+                progress=bar,
                 accuracy="preview" if args.preview else "exact",
                 coarse=coarse,
             )
@@ -260,12 +269,14 @@ def _run(args) -> int:
             info = spec.parameters["preview"]
             start = info.get("coarse_start")
             space = (
-                f"from a {start['coarse_vertices']}-vertex coarse copy's modes"
+                f"from a {start['coarse_vertices']}-vertex coarse copy's modes, "
+                f"the copy made in {copy_seconds:.1f} s"
                 if start
                 else f"{info['samples']} samples, {info['reduced_dimension']} reduced unknowns"
             )
+            seconds = spec.parameters["seconds_total"] + copy_seconds  # all the wait
             print(
-                f"preview in {spec.parameters['seconds_total']:.1f} s ({space}): eigenvalues "
+                f"preview in {seconds:.1f} s ({space}): eigenvalues "
                 f"are upper bounds, largest relative error estimated at "
                 f"{spec.estimated_error:.1%} (estimated from below, not a bound)"
             )

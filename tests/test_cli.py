@@ -1,6 +1,7 @@
 """The headless command line: results, one-line errors, exit codes."""
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -319,6 +320,26 @@ def test_a_shells_preview_starts_from_a_coarse_copy_and_says_so(tmp_path):
     start = spec.parameters["preview"]["coarse_start"]
     assert spec.is_preview and 3000 <= start["coarse_vertices"] <= 3300
     assert f"from a {start['coarse_vertices']}-vertex coarse copy's modes" in r.stdout
+    # the wait the line states includes the copy, and the bar said it was being made
+    said = re.search(r"preview in ([\d.]+) s .*the copy made in ([\d.]+) s", r.stdout)
+    assert said, r.stdout
+    total, copy = float(said[1]), float(said[2])
+    assert 0.0 < copy < total
+    assert total >= spec.parameters["seconds_total"] + copy - 0.1
+    assert "preview: making a coarse copy" in r.stderr
+
+
+def test_the_progress_bar_leaves_no_end_of_a_longer_stage_behind(capsys, monkeypatch):
+    from modalviewer import cli
+
+    clock = iter([1.0, 2.0])
+    monkeypatch.setattr(cli.time, "perf_counter", lambda: next(clock))
+    bar = cli._progress_bar()
+    bar("preview: coarse copy's spectrum", 0.1)
+    bar("preview: factorising", 0.3)
+    last = capsys.readouterr().err.split("\r")[-1]
+    assert last.rstrip().endswith("preview: factorising")
+    assert len(last) == len("[") + 30 + len("]  30.0% ") + len("preview: coarse copy's spectrum")
 
 
 def test_no_coarse_copy_where_the_exact_factor_would_go_out_of_core(monkeypatch):
