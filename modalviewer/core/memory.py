@@ -15,6 +15,7 @@ __all__ = [
     "MEMORY_LIMIT_SHARE",
     "memory_limit_mb",
     "physical_memory_mb",
+    "glibc",
     "resident_mb",
     "return_freed_memory",
 ]
@@ -73,15 +74,28 @@ def return_freed_memory() -> bool:
     arrays, of other sizes, cannot always reuse; called at each new stage of
     :func:`.pipeline.compute_spectrum`.  True where it ran (glibc), False elsewhere."""
     import ctypes
-    import sys
 
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        trim = ctypes.CDLL("libc.so.6").malloc_trim
-    except (OSError, AttributeError):
+    libc = glibc()
+    trim = getattr(libc, "malloc_trim", None)
+    if trim is None:
         return False
     trim.argtypes = [ctypes.c_size_t]
     trim.restype = ctypes.c_int
     trim(0)
     return True
+
+
+def glibc():
+    """The C library as a ``ctypes.CDLL`` on Linux (glibc's ``libc.so.6``), else None:
+    the one place its allocator settings (:func:`return_freed_memory`,
+    :mod:`modalviewer.processes.memory`) and process settings
+    (:mod:`modalviewer.processes.copy_main`) load it from."""
+    import ctypes
+    import sys
+
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        return ctypes.CDLL("libc.so.6", use_errno=True)
+    except OSError:
+        return None

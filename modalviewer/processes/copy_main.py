@@ -12,7 +12,6 @@ this process instead of staying in the computing one
 
 from __future__ import annotations
 
-import ctypes
 import io
 import os
 import signal
@@ -24,12 +23,11 @@ import numpy as np
 def _die_with_parent() -> None:
     """Ask Linux to end this process when its parent ends (a cancelled computation is
     killed; its copy would otherwise run on)."""
-    if not sys.platform.startswith("linux"):
-        return
-    try:
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        pass
+    from ..core.memory import glibc
+
+    prctl = getattr(glibc(), "prctl", None)
+    if prctl is not None:
+        prctl(1, int(signal.SIGKILL))  # PR_SET_PDEATHSIG
 
 
 def main() -> int:

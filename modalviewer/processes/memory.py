@@ -23,7 +23,6 @@ the system when the process ends, not before.
 from __future__ import annotations
 
 import ctypes
-import sys
 
 __all__ = ["keep_freed_memory", "no_huge_page_advice", "prepare_compute_process"]
 
@@ -35,11 +34,10 @@ def keep_freed_memory() -> bool:
     """Ask glibc to serve big allocations from the heap and keep freed heap memory
     (``mallopt(M_MMAP_MAX, 0)``, ``mallopt(M_TRIM_THRESHOLD, 2 GiB)``).  True if both
     took effect; False (and nothing changed) where the C library is not glibc."""
-    if not sys.platform.startswith("linux"):
-        return False
-    try:
-        mallopt = ctypes.CDLL("libc.so.6").mallopt
-    except (OSError, AttributeError):
+    from ..core.memory import glibc
+
+    mallopt = getattr(glibc(), "mallopt", None)
+    if mallopt is None:
         return False
     mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
     mallopt.restype = ctypes.c_int
