@@ -38,7 +38,7 @@ def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
     double-precision basis array and the mode columns counted beside it above
     :data:`GROWTH_MODES`, less the one buffer that holds the single-precision basis and
     then the modes.  The 3D shells' 300 modes of the 1M-vertex plate, factor out of core:
-    16 384 MB measured, 1.06 times this prediction (``benchmarks/results/memory.json``)."""
+    14 289 MB measured, 0.92 times this prediction (``benchmarks/results/memory.json``)."""
     from .eigen import float32_basis_mb  # the solver's own rule; imported late (no cycle)
 
     n = max(int(n_unknowns), 2)
