@@ -334,6 +334,7 @@ def test_the_progress_bar_leaves_no_end_of_a_longer_stage_behind(capsys, monkeyp
 
     clock = iter([1.0, 2.0])
     monkeypatch.setattr(cli.time, "perf_counter", lambda: next(clock))
+    monkeypatch.setattr(cli, "_BAR", {"open": False})  # the open bar stays in this test
     bar = cli._progress_bar()
     bar("preview: coarse copy's spectrum", 0.1)
     bar("preview: factorising", 0.3)
