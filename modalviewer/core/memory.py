@@ -9,6 +9,7 @@ out-of-core factor); ``MODALVIEWER_MEMORY_LIMIT_MB`` sets it explicitly.
 
 from __future__ import annotations
 
+import functools
 import os
 
 __all__ = [
@@ -85,11 +86,12 @@ def return_freed_memory() -> bool:
     return True
 
 
+@functools.cache
 def glibc():
-    """The C library as a ``ctypes.CDLL`` on Linux (glibc's ``libc.so.6``), else None:
-    the one place its allocator settings (:func:`return_freed_memory`,
-    :mod:`modalviewer.processes.memory`) and process settings
-    (:mod:`modalviewer.processes.copy_main`) load it from."""
+    """The C library as a ``ctypes.CDLL`` on Linux (glibc's ``libc.so.6``), else None,
+    loaded once: the one place its allocator settings (:func:`return_freed_memory`, at
+    each stage of a computation; :mod:`modalviewer.processes.memory`) and process
+    settings (:mod:`modalviewer.processes.copy_main`) load it from."""
     import ctypes
     import sys
 

@@ -44,8 +44,8 @@ def csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
 
     The arrays are set on an empty matrix: scipy's constructor from (data, indices,
     indptr) prunes them, which copies any view smaller than half its base array, so the
-    two row halves of :func:`row_halves` were copies of all of K's entries (260 MB for
-    the cow Loop x3's 3D shells) at every product."""
+    two row halves of :func:`row_halves` would copy all of K's entries (260 MB for the
+    cow Loop x3's 3D shells) at every product."""
     p = K.indptr
     a, b = int(p[start]), int(p[stop])
     rows = sp.csr_matrix((stop - start, K.shape[1]), dtype=K.dtype)
