@@ -8,18 +8,10 @@ import warnings
 import numpy as np
 
 from .assembly import operator_matrices
-from .eigen import (
-    CancelFn,
-    EigenError,
-    ProgressFn,
-    rounding_floors,
-    solve_lowest,
-    typical_eigenvalue,
-    zero_modes,
-)
+from .eigen import CancelFn, EigenError, ProgressFn, rounding_floors
+from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
-from .nullspace import null_space
 from .operators import operator_info
 from .preview import compute_preview, preview_possible
 from .spectrum import Spectrum
@@ -154,18 +146,12 @@ def compute_spectrum(
 
     started = time.perf_counter()
     report("assembling", 0.0)
-    K, mass = operator_matrices(mesh, operator, bending, membrane)
-    assembled = time.perf_counter()
-    k = min(k, K.shape[0])
-    nulls = null_space(mesh, operator, K, mass)
     try:
-        result = solve_lowest(
-            K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors
-        )
+        pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel)
     except EigenError as exc:
         raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
-    lam_typical = typical_eigenvalue(K, mass)
-    nonzero = ~zero_modes(result.eigenvalues, lam_typical, result.null_dim)
+    K, mass, nulls, result = pairs.K, pairs.mass, pairs.nulls, pairs.result
+    k, lam_typical, nonzero = result.eigenvalues.shape[0], pairs.zero_mode_scale, pairs.nonzero
     if not nonzero.any():
         warnings.warn(
             _all_zero_message(k, result, nulls, lam_typical), ZeroModesWarning, stacklevel=2
@@ -210,7 +196,7 @@ def compute_spectrum(
             "membrane": float(membrane),
             "method": result.method,
             "shift": result.shift,
-            "seconds_assembly": assembled - started,
+            "seconds_assembly": pairs.seconds_assembly,
             "seconds_total": time.perf_counter() - started,
             "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
             "operator_columns": result.operator_columns,

@@ -49,11 +49,11 @@ from .eigen import (
     factor_below_spectrum,
     factor_budget_mb,
     lowest_share,
-    solve_lowest,
     typical_eigenvalue,
     zero_mode_size,
     zero_modes,
 )
+from .exact import exact_pairs
 from .factor import FactorTooLarge, SPDSolver
 from .memory import memory_limit_mb, resident_mb
 from .mesh import Mesh, MeshError
@@ -976,17 +976,14 @@ def _coarse_copy_pairs(coarse: CoarseCopy, operator: str, k: int, bending, membr
     """(eigenvalues, modes (3 Nc, m)) of the coarse copy's lowest non-zero modes (at most
     ``k``, at most half its unknowns), or None where its operator cannot be solved (a
     decimation can leave non-manifold edges or slivers)."""
+    unknowns = operator_info(operator).unknowns_per_vertex * coarse.mesh.n_vertices
     try:
-        Kc, mc = operator_matrices(coarse.mesh, operator, bending, membrane)
-        nulls = null_space(coarse.mesh, operator, Kc, mc)
-        kc = min(int(k), Kc.shape[0] // 2)
-        if kc <= nulls.dimension:
-            return None
-        result = solve_lowest(Kc, mc, kc, null_space=nulls.vectors)
+        pairs = exact_pairs(coarse.mesh, operator, min(int(k), unknowns // 2), bending, membrane)
     except (MeshError, EigenError, np.linalg.LinAlgError, ValueError):
         return None
-    nonzero = ~zero_modes(result.eigenvalues, typical_eigenvalue(Kc, mc), nulls.dimension)
-    return result.eigenvalues[nonzero], result.vectors[:, nonzero]
+    if not pairs.nonzero.any():
+        return None
+    return pairs.result.eigenvalues[pairs.nonzero], pairs.result.vectors[:, pairs.nonzero]
 
 
 def _ritz_in_span(K, mass: np.ndarray, Y: np.ndarray, count: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,68 @@
+"""The exact lowest eigenpairs of an operator on a mesh: the operator's matrices, its
+exactly known null space, the shift-invert solve, and which pairs are zero modes.
+
+:func:`.pipeline.compute_spectrum` checks their residuals and wraps them in a
+:class:`.spectrum.Spectrum`; the coarse-copy preview (:mod:`.preview`) solves its copy
+with them."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .assembly import operator_matrices
+from .eigen import CancelFn, EigenResult, ProgressFn, solve_lowest, typical_eigenvalue, zero_modes
+from .mesh import Mesh
+from .nullspace import NullSpace, null_space
+
+__all__ = ["ExactPairs", "exact_pairs"]
+
+
+@dataclass(frozen=True)
+class ExactPairs:
+    """What :func:`exact_pairs` computed.
+
+    Attributes
+    ----------
+    K, mass : the eigenproblem ``K phi = lambda diag(mass) phi``.
+    nulls : the operator's exact null vectors on the mesh (first in ``result``).
+    result : the k lowest pairs (k capped at the number of unknowns).
+    zero_mode_scale : the typical eigenvalue zero modes are measured against.
+    nonzero : (k,) bool, the pairs that are not zero modes (:func:`.eigen.zero_modes`).
+    seconds_assembly : wall-clock seconds of the assembly.
+    """
+
+    K: sp.csr_matrix
+    mass: np.ndarray
+    nulls: NullSpace
+    result: EigenResult
+    zero_mode_scale: float
+    nonzero: np.ndarray
+    seconds_assembly: float
+
+
+def exact_pairs(
+    mesh: Mesh,
+    operator: str,
+    k: int,
+    bending: float = 1.0,
+    membrane: float = 1.0,
+    progress: ProgressFn | None = None,
+    cancel: CancelFn | None = None,
+) -> ExactPairs:
+    """The ``min(k, unknowns)`` lowest eigenpairs of ``operator`` on ``mesh``, the exact
+    null vectors first.  Raises what the assembly, the null space and
+    :func:`.eigen.solve_lowest` raise (:class:`.mesh.MeshError`, :class:`.eigen.EigenError`,
+    :class:`.eigen.Cancelled`)."""
+    started = time.perf_counter()
+    K, mass = operator_matrices(mesh, operator, bending, membrane)
+    seconds_assembly = time.perf_counter() - started
+    k = min(int(k), K.shape[0])
+    nulls = null_space(mesh, operator, K, mass)
+    result = solve_lowest(K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors)
+    scale = typical_eigenvalue(K, mass)
+    nonzero = ~zero_modes(result.eigenvalues, scale, result.null_dim)
+    return ExactPairs(K, mass, nulls, result, scale, nonzero, seconds_assembly)
