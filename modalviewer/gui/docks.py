@@ -30,8 +30,30 @@ def build_docks(win) -> None:
     margins.setTop(0)
     win.animation_panel.layout().setContentsMargins(margins)
     lay.addWidget(win.animation_panel)
-    add_dock(win, "Modes", modes, area.RightDockWidgetArea)
-    add_dock(win, "Distances and signatures", win.distances_panel, area.RightDockWidgetArea)
+    win.modes_dock = add_dock(win, "Modes", modes, area.RightDockWidgetArea)
+    win.distances_dock = add_dock(
+        win, "Distances and signatures", win.distances_panel, area.RightDockWidgetArea
+    )
+
+
+MODES_NOTE_LINES = 3
+"""Lines the Modes dock keeps for the eigenvalue line's note (a preview's estimated
+errors and what comes next) beyond the one line it has at the start."""
+
+
+def fit_modes_dock(win) -> None:
+    """Give the Modes dock the height its controls need, the Amplitude and Speed rows
+    and a preview's note included (:data:`MODES_NOTE_LINES`), and the Distances dock
+    below it the rest (it scrolls): split evenly, the Modes dock hid its last rows at
+    the default window size.  For a first start; a remembered layout is kept."""
+    modes, distances = win.modes_dock, win.distances_dock
+    total = modes.height() + distances.height()
+    content = modes.widget().widget()
+    note = MODES_NOTE_LINES * win.modes_panel.eigen_label.fontMetrics().lineSpacing()
+    frame = modes.height() - modes.widget().viewport().height()
+    need = content.sizeHint().height() + note + frame
+    rest = max(total - need, distances.minimumSizeHint().height())
+    win.resizeDocks([modes, distances], [total - rest, rest], QtCore.Qt.Orientation.Vertical)
 
 
 def add_dock(win, title: str, widget: QtWidgets.QWidget, area) -> QtWidgets.QDockWidget:

@@ -11,6 +11,7 @@ from qtpy import QtCore, QtGui
 
 from ..core.operators import OPERATOR_INFO
 from ..viewer.state import COLOR_RANGES, RENDER_STYLES, SHELL_COLORINGS
+from .docks import fit_modes_dock
 
 
 def settings() -> QtCore.QSettings:
@@ -44,6 +45,8 @@ def restore(win) -> None:
     state = s.value("window/state") if win.remember_settings else None
     if state is not None:
         win.restoreState(state)
+    else:  # once the window is laid out
+        QtCore.QTimer.singleShot(0, win, lambda: fit_modes_dock(win))
     st = win.state
     st.set_isolines(int(s.value("view/isolines", 12)))
     coloring = str(s.value("view/shell_color", "deformed"))  # a former "auto": deformed

@@ -63,21 +63,39 @@ def test_a_preview_spectrum_title_is_one_whole_line(window, spot_path, qtbot):
     assert plot.fontMetrics().horizontalAdvance(plot.title) < plot.width() - 12
 
 
-def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path):
+@pytest.mark.parametrize("preview", [False, True], ids=["exact", "preview"])
+def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path, preview):
     """Seen under Xvfb: the Speed slider lay below the Modes dock's visible part at the
-    default window size. With a mode shown every control of the dock, Speed included,
-    is inside the dock's scroll area without scrolling."""
+    default window size, and again below a preview's note (the right docks split the
+    height evenly). With a mode shown, of an exact spectrum or of a preview, every
+    control of the dock, Speed included, is inside the dock's scroll area without
+    scrolling (the Distances dock below takes the rest and scrolls); a preview's
+    explanation is the eigenvalue line's tooltip."""
     from qtpy import QtCore, QtWidgets
 
     from modalviewer.gui import MainWindow
+    from modalviewer.gui.docks import MODES_NOTE_LINES
 
     win = MainWindow()
     qtbot.addWidget(win)
     win.show()
     qtbot.waitExposed(win)
     assert (win.width(), win.height()) == (1280, 820)  # the size of a first start
+    _settle(qtbot, win)
+    # the first start sizes the Modes dock to its controls and a preview's note, not
+    # half the height (the offscreen platform's fonts fit either way; Xvfb's did not)
+    dock = win.modes_dock
+    line = win.modes_panel.eigen_label.fontMetrics().lineSpacing()
+    frame = dock.height() - dock.widget().viewport().height()
+    need = dock.widget().widget().sizeHint().height() + MODES_NOTE_LINES * line + frame
+    assert abs(dock.height() - need) <= 8, (dock.height(), need)
     assert win.open_mesh(spot_path)
-    win.compute("laplacian", k=10, wait=True)
+    if preview:
+        win.state.set_compute_settings(preview_only=True)
+        assert win.compute("shells", k=12, wait=True).is_preview
+        win.show_mode(8)
+    else:
+        win.compute("laplacian", k=10, wait=True)
     _settle(qtbot, win)
     modes, animation = win.modes_panel, win.animation_panel
     scroll = animation.parentWidget()
@@ -86,6 +104,8 @@ def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path)
     assert scroll.widget().isAncestorOf(modes)
     viewport = scroll.viewport()
     assert scroll.verticalScrollBar().value() == 0
+    assert scroll.verticalScrollBar().maximum() == 0  # nothing of the dock out of view
+    assert win.distances_dock.height() >= win.distances_dock.minimumSizeHint().height()
     shown = viewport.rect()
     for widget in (
         modes.spectrum_combo,
@@ -102,4 +122,10 @@ def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path)
         where = QtCore.QRect(top_left, widget.size())
         assert shown.contains(where), (widget, where, shown)
     assert animation.speed_slider.width() >= 100
+    label = modes.eigen_label
+    if preview:
+        assert "this mode" in label.text() and "Preview only" in label.text()
+        assert "numbers one lower" in label.toolTip()
+    else:
+        assert label.toolTip() == ""
     win.close()

@@ -152,6 +152,7 @@ class ModesPanel(QtWidgets.QWidget):
                 text = f"lambda_{j} = {lam:.6g}   sqrt(lambda) = {np.sqrt(max(lam, 0.0)):.6g}"
         else:
             text = f"Not shown: the surface shows {_what_is_shown(state)}. M shows the mode."
+        tip = ""
         if spec.is_preview:
             if state.exact_follows(op):
                 follows = "the exact spectrum replaces it when ready."
@@ -165,12 +166,13 @@ class ModesPanel(QtWidgets.QWidget):
                 if showing_mode and not zero[min(state.display.mode, spec.k - 1)]
                 else ""
             )
+            # short, so the animation's rows below stay in view; the rest in the tooltip
             text += (
-                "\nPreview: eigenvalues above the exact ones. Estimated error (from below, "
-                f"not a bound): largest {percent_text(spec.estimated_error)}{this_mode}. "
-                "Where it misses a mode, the modes above it have numbers one lower than in "
-                f"the exact spectrum. {follows[0].upper()}{follows[1:]}"
+                f"\nPreview, estimated error (not a bound): largest "
+                f"{percent_text(spec.estimated_error)}{this_mode}. "
+                f"{follows[0].upper()}{follows[1:]}"
             )
+            tip = PREVIEW_TIP
         elif state.is_coarse(op):
             text += (
                 "\nCoarse-to-fine: computed on a copy decimated to about a fifth and carried "
@@ -178,6 +180,7 @@ class ModesPanel(QtWidgets.QWidget):
                 "Compute for the exact spectrum)."
             )
         self.eigen_label.setText(text)
+        self.eigen_label.setToolTip(tip)
         approximate = approximation_mark(state, op)
         # marked: the short name (as in the spectrum list), so the title keeps to one line
         info = OPERATOR_INFO[op]
@@ -192,6 +195,15 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.color_combo, self.iso_spin):
             select_data(self.color_combo, self.state.style.shell_coloring)
             self.iso_spin.setValue(self.state.style.isolines)
+
+
+PREVIEW_TIP = (
+    "A preview's eigenvalues lie above the exact ones. Its estimated error is an estimate "
+    "from below, not a bound. Where a preview misses a mode, the modes above it have "
+    "numbers one lower than in the exact spectrum."
+)
+"""The Modes panel's tooltip on a preview's eigenvalue line: what the line's estimate
+means, kept out of the line itself."""
 
 
 def _what_is_shown(state: ViewerState) -> str:
