@@ -38,7 +38,7 @@ def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
     double-precision basis array and the mode columns counted beside it above
     :data:`GROWTH_MODES`, less the one buffer that holds the single-precision basis and
     then the modes.  The 3D shells' 300 modes of the 1M-vertex plate, factor out of core:
-    14 289 MB measured, 0.92 times this prediction (``benchmarks/results/memory.json``)."""
+    14 289 MB measured, 1.00 times this prediction (``benchmarks/results/memory.json``)."""
     from .eigen import float32_basis_mb  # the solver's own rule; imported late (no cycle)
 
     n = max(int(n_unknowns), 2)
@@ -53,10 +53,12 @@ def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> f
     :data:`GROWTH_MODES` modes plus, for each further mode, its share of the arrays that
     grow with k: the Krylov basis (:func:`basis_columns`) and the modes themselves, one
     column of ``n_unknowns`` doubles each (fewer modes: less of them).  Runs it was not
-    fitted to measured 0.89 to 1.08 times it: 300 modes on the 337k plate for all four
-    operators, and 100 on Loop-subdivided spot and cheburashka (curved, thin parts; the
-    3D shells' 300 modes of cheburashka at 427k vertices: 0.99) (``benchmarks/growth.py``,
-    "Memory check" in docs/performance.md)."""
+    fitted to measured 0.82 to 1.08 times it: 300 modes on the 337k plate for all four
+    operators 0.82 to 0.89 (every further column is counted in full; the solve's peak
+    holds fewer at once), 100 modes on Loop-subdivided spot, the hand, the cow and
+    Cheburashka (curved, thin parts) 0.93 to 1.08, the 3D shells' 300 modes of
+    Cheburashka at 427k vertices 1.03 (``benchmarks/growth.py``, "Memory check" in
+    docs/performance.md)."""
     n = max(int(n_unknowns), 1)
     k, k0 = min(int(k), n), min(GROWTH_MODES, n)
     columns = basis_columns(k, n) - basis_columns(k0, n) + (k - k0)

@@ -272,14 +272,14 @@ _SHELLS_SPACE = SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True, factor_
 # the time grows with k), made by `python -m benchmarks.growth`; tests/core/test_cost.py
 # checks that they are those fits.
 _GROWTH: dict[tuple[str, str], GrowthLaw] = {
-    ("laplacian", "exact"): GrowthLaw(9.218, 0.993, 465.6, 0.888, 1.147),
-    ("laplacian", "fast preview"): GrowthLaw(2.969, 0.801, 388.8, 0.79, 0.224),
-    ("modified_dirichlet", "exact"): GrowthLaw(8.991, 1.016, 452.8, 0.887, 1.08),
-    ("modified_dirichlet", "fast preview"): GrowthLaw(2.831, 0.813, 407.0, 0.777, 0.39),
-    ("shells", "exact"): GrowthLaw(46.357, 1.083, 1890.8, 0.994, 0.901),
-    ("shells", "fast preview"): GrowthLaw(5.776, 1.203, 1524.0, 0.954, 0.569),
-    ("shells_normal", "exact"): GrowthLaw(9.686, 1.443, 477.4, 0.937, 0.672),
-    ("shells_normal", "fast preview"): GrowthLaw(6.529, 0.936, 592.6, 0.79, 0.52),
+    ("laplacian", "exact"): GrowthLaw(8.409, 0.949, 414.7, 0.897, 1.097),
+    ("laplacian", "fast preview"): GrowthLaw(2.774, 0.829, 439.4, 0.803, 0.502),
+    ("modified_dirichlet", "exact"): GrowthLaw(8.162, 0.98, 410.6, 0.896, 1.061),
+    ("modified_dirichlet", "fast preview"): GrowthLaw(2.972, 0.828, 441.7, 0.805, 0.387),
+    ("shells", "exact"): GrowthLaw(36.287, 1.109, 1684.4, 1.017, 0.968),
+    ("shells", "fast preview"): GrowthLaw(8.723, 1.137, 1461.0, 0.946, 0.621),
+    ("shells_normal", "exact"): GrowthLaw(7.395, 1.54, 463.5, 0.899, 0.622),
+    ("shells_normal", "fast preview"): GrowthLaw(5.431, 0.986, 443.9, 0.917, 0.518),
 }
 
 # factor_memory: the fits of benchmarks/results/factor_memory.json (PARDISO's analysis of

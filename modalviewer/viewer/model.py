@@ -40,15 +40,15 @@ PREVIEW_DELAY = 0.10
 arrive at most this share later than without it (:func:`preview_plan`)."""
 
 
-PREVIEW_MARGIN = 3.3
+PREVIEW_MARGIN = 1.75
 """A preview comes first only where this many times its predicted time fits within
 :data:`PREVIEW_DELAY` of the exact solve's predicted time: the growth laws are fitted
 on plates, and on the curved benchmark meshes of 100k to 270k vertices a fast preview's
-share of the exact time was up to 3.25 times the share the laws predict (Cheburashka
-Loop x2's 3D shells on a 2-core AMD EPYC: the preview took 0.41 of the exact time, the
-laws say 0.126; ``benchmarks/results/curved.json``, which
-``tests/viewer/test_state_model.py`` checks the margin against), and a preview that runs
-past its share is thrown away (:attr:`PreviewPlan.deadline`)."""
+share of the exact time was up to 1.69 times the share the laws predict (Cheburashka
+Loop x2's 3D shells: the preview took 0.41 of the exact time, the laws say 0.24;
+``benchmarks/results/curved.json``, which ``tests/viewer/test_state_model.py`` checks
+the margin against), and a preview that runs past its share is thrown away
+(:attr:`PreviewPlan.deadline`)."""
 
 
 NOTE_FROM_SECONDS = 10.0

@@ -81,15 +81,15 @@ CURVED = RESULTS.with_name("curved.json")
 def test_exact_peak_memory_is_predicted_for_other_mode_counts_and_curved_meshes():
     """The memory check's prediction (the law at 100 modes plus the arrays that grow
     with k) against runs it was not fitted to: 300 modes on the 337k plate for every
-    operator and the exact solves on the curved meshes (spot and the hand
-    Loop-subdivided: thin legs, ears, fingers; the machined part, flat walls and sharp
-    edges).  A run may need at most 10 % more than predicted (the check keeps a quarter
-    of the memory free) and not much less (20 %), or it would refuse what fits.  The
-    laws' plate runs (growth.json, growth_k300.json) held a copy of K in every sparse
-    product and kept freed memory, which the curved meshes' scalar runs of curved.json
-    do not: they need 0.83 to 0.93 of the prediction.  The part's 3D shells are the
-    exception measured: its factor fills in less than the plate's the law comes from,
-    so they need 0.69 of the prediction (the check errs on the side of refusing there)."""
+    operator and the exact solves on the curved meshes (spot, the hand, the cow and
+    Cheburashka Loop-subdivided: thin legs, ears, fingers; the machined part, flat walls
+    and sharp edges).  A run may need at most 10 % more than predicted (the check keeps
+    a quarter of the memory free) and not much less, or it would refuse what fits: the
+    curved meshes need 0.93 to 1.08 of the prediction; the 300-mode runs 0.82 to 0.89
+    (the prediction counts every further mode's basis and mode columns in full, more
+    than the solve's peak holds at once).  The part's 3D shells are the exception
+    measured: its factor fills in less than the plate's the law comes from, so they need
+    0.75 of the prediction (the check errs on the side of refusing there)."""
     checked = 0
     for r in json.loads(MORE_MODES.read_text())["rows"]:
         if r["accuracy"] != "exact" or "peak_mb" not in r:
@@ -98,7 +98,7 @@ def test_exact_peak_memory_is_predicted_for_other_mode_counts_and_curved_meshes(
         m = info.predicted_peak_mb(
             "exact", r["vertices"], r["k"], out_of_core=False, basis_float32=False
         )
-        assert 0.85 < r["peak_mb"] / m < 1.1, (r, m)
+        assert 0.8 < r["peak_mb"] / m < 1.1, (r, m)
         checked += 1
     for r in json.loads(CURVED.read_text())["rows"]:
         if r["vertices"] < 100_000:
@@ -108,7 +108,7 @@ def test_exact_peak_memory_is_predicted_for_other_mode_counts_and_curved_meshes(
             "exact", r["vertices"], r["k"], out_of_core=False, basis_float32=False
         )
         part_shells = r["mesh"].startswith("part") and r["operator"] == "shells"
-        low = 0.65 if part_shells else 0.8
+        low = 0.7 if part_shells else 0.85
         assert low < r["exact_peak_mb"] / m < 1.1, (r, m)
         checked += 1
     assert checked >= 10
@@ -180,10 +180,9 @@ def test_the_out_of_core_time_factor_is_the_measured_ratio():
 def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
     """Runs the laws were not fitted to (curved meshes, 300 modes), factor in core or out
     of core: at most 10 % more than predicted (the check keeps a quarter of the memory
-    free) and not much less (30 %: out of core the prediction takes the plate's factor
-    sizes, and curved meshes save more; the 520k plate's 300 modes, measured without
-    the copies of K the laws' runs held in their sparse products, need 0.75 of it), and
-    the same eigenvalues either way."""
+    free) and not much less (25 %: out of core the prediction takes the plate's factor
+    sizes, and curved meshes save more; the 520k plate's 300 modes need 0.80 of it),
+    and the same eigenvalues either way."""
     rows = json.loads(BIG_SOLVES.read_text())["rows"]
     assert any(r["factor_out_of_core"] for r in rows)
     for r in rows:
@@ -192,7 +191,7 @@ def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
         m = info.predicted_peak_mb(
             "exact", r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
         )
-        assert 0.7 < r["peak_mb"] / m < 1.1, (r["mesh"], r["limit_mb"], r["peak_mb"], m)
+        assert 0.75 < r["peak_mb"] / m < 1.1, (r["mesh"], r["limit_mb"], r["peak_mb"], m)
         # a single-precision basis on either side: the same eigenvalues to 1e-8 (the 1M
         # plate: 8.5e-9 over the lowest 100); double on both: to the last digit
         others = [q for q in rows if r.get("compared_with", "").startswith(q["mesh"])]
