@@ -22,7 +22,10 @@ import os as _os
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
-from .coarsen import preview_copy  # noqa: E402 (numpy only; MeshLab and VTK load when run)
+from .coarsen import (  # noqa: E402 (numpy only; MeshLab and VTK load when run)
+    preview_copy,
+    start_preview_copy,
+)
 from .collection import open_collection  # noqa: E402 (numpy only; Dask loads in run_batch)
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
@@ -48,6 +51,7 @@ __all__ = [  # noqa: F405
     "fix_slivers",
     "SliverReport",
     "preview_copy",
+    "start_preview_copy",
     "Viewer",
     "open_collection",
 ]

@@ -36,16 +36,17 @@ _BAR = {"open": False}  # a progress bar line is not finished: an error starts a
 
 
 def _progress_bar():
-    """``progress(stage, fraction)`` drawing one line on stderr, redrawn at most five
-    times a second; each stage name is padded to the longest one drawn so far, so a
-    shorter name leaves no end of the longer one behind it."""
-    state = {"last": 0.0, "width": 20}
+    """``progress(stage, fraction)`` drawing one line on stderr: a new stage at once
+    (it may be a long wait), the same stage's progress at most five times a second;
+    each stage name is padded to the longest one drawn so far, so a shorter name leaves
+    no end of the longer one behind it."""
+    state = {"last": 0.0, "width": 20, "stage": None}
 
     def progress(stage: str, fraction: float) -> None:
         now = time.perf_counter()
-        if fraction < 1.0 and now - state["last"] < 0.2:
+        if fraction < 1.0 and stage == state["stage"] and now - state["last"] < 0.2:
             return
-        state["last"] = now
+        state["last"], state["stage"] = now, stage
         state["width"] = max(state["width"], len(stage))
         filled = int(30 * fraction)
         sys.stderr.write(
@@ -243,15 +244,13 @@ def _run(args) -> int:
         prepare_compute_process()  # this process exists to compute (see processes.memory)
         mesh = _load(args.mesh, args.fix_slivers)
         _refuse_if_too_large(mesh, args.operator, args.k, args.preview)
-        coarse, copy_seconds = None, 0.0
+        coarse = None
         bar = _progress_bar()
-        if args.preview:
-            from .coarsen import preview_copy_for
+        started = time.perf_counter()
+        if args.preview:  # the copy is made while the operator is assembled
+            from .coarsen import start_preview_copy
 
-            started = time.perf_counter()
-            bar("preview: making a coarse copy", 0.0)
-            coarse = preview_copy_for(mesh, args.operator, args.k)
-            copy_seconds = time.perf_counter() - started
+            coarse = start_preview_copy(mesh, args.operator, args.k)
         with _warnings_printed():
             spec = mv.compute_spectrum(
                 mesh,
@@ -263,6 +262,7 @@ def _run(args) -> int:
                 accuracy="preview" if args.preview else "exact",
                 coarse=coarse,
             )
+        seconds = time.perf_counter() - started  # all the wait, the copy included
         mv.save_spectrum(spec, args.output)
         _wrote(args.output, f"spectrum, {spec.k} {args.operator} modes")
         if spec.is_preview:
@@ -270,11 +270,10 @@ def _run(args) -> int:
             start = info.get("coarse_start")
             space = (
                 f"from a {start['coarse_vertices']}-vertex coarse copy's modes, "
-                f"the copy made in {copy_seconds:.1f} s"
+                f"the copy made in {coarse.seconds:.1f} s beside the assembly"
                 if start
                 else f"{info['samples']} samples, {info['reduced_dimension']} reduced unknowns"
             )
-            seconds = spec.parameters["seconds_total"] + copy_seconds  # all the wait
             print(
                 f"preview in {seconds:.1f} s ({space}): eigenvalues "
                 f"are upper bounds, largest relative error estimated at "

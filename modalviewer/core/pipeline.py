@@ -113,7 +113,9 @@ def compute_spectrum(
     coarse : for a 3D shells preview, a coarse copy of the mesh to start from
         (:class:`.transfer.CoarseCopy`, e.g. ``mv.preview_copy(mesh, k)``): the copy's
         own modes, carried to the mesh and corrected by one step of inverse iteration,
-        where a smooth space misses the modes of thin parts.
+        where a smooth space misses the modes of thin parts.  A ``Future`` of one
+        (``mv.start_preview_copy(mesh, operator, k)``) is waited for after the
+        assembly, which so runs while the copy is made.
 
     Returns
     -------

@@ -1019,10 +1019,22 @@ def _coarse_start(
     the copy's lowest non-zero eigenvalue) adds the mesh-scale parts every carried field
     lacks, and Rayleigh-Ritz in
     ``span [Z, Y]`` (Z the exact null vectors) gives the pairs.  The factor is returned
-    for the refinement's steps.  None where the coarse copy's spectrum or the factor
-    fails, or the copy has fewer non-zero modes than asked for (the caller takes the
-    smooth space)."""
+    for the refinement's steps.  ``coarse`` may be a copy still being made (a
+    ``concurrent.futures.Future`` of one, :func:`modalviewer.coarsen.start_preview_copy`):
+    it is waited for after the assembly and the null space, which so overlap the
+    copy's process.  None where no copy came out, the coarse copy's spectrum or the
+    factor fails, or the copy has fewer non-zero modes than asked for (the caller takes
+    the smooth space)."""
     seconds = {}
+    nulls = null_space(mesh, operator, K, mass)  # while a copy still being made is made
+    d = nulls.dimension
+    if hasattr(coarse, "result"):
+        t = time.perf_counter()
+        report("preview: making a coarse copy", 0.05)
+        coarse = coarse.result()
+        seconds["waiting_for_the_copy"] = time.perf_counter() - t
+        if coarse is None:  # no usable copy came out
+            return None
     t = time.perf_counter()
     report("preview: coarse copy's spectrum", 0.1)
     carried = k + max(REFINE_GUARD_MIN, int(np.ceil(COARSE_GUARD * k)))
@@ -1031,8 +1043,6 @@ def _coarse_start(
         return None
     lam_c, modes_c = pairs
     seconds["coarse_spectrum"] = time.perf_counter() - t
-    nulls = null_space(mesh, operator, K, mass)
-    d = nulls.dimension
     if k <= d or lam_c.shape[0] < k - d:  # the copy holds too few modes
         return None
     t = time.perf_counter()

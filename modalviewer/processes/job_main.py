@@ -39,10 +39,10 @@ def main(argv: list[str] | None = None) -> int:
         accuracy = params.get("accuracy", "exact")
         coarse = None
         if params.get("coarse_copy") and accuracy != "exact":
-            from ..coarsen import preview_copy_for
+            from ..coarsen import start_preview_copy
 
-            _report("preview: coarse copy", 0.02)
-            coarse = preview_copy_for(mesh, params["operator"], int(params["k"]))
+            # made in its process while compute_spectrum assembles the operator
+            coarse = start_preview_copy(mesh, params["operator"], int(params["k"]))
         spec = compute_spectrum(
             mesh,
             params["operator"],

@@ -779,6 +779,49 @@ def test_a_coarse_copy_start_finds_the_spectrum_with_its_null_space_whole():
     assert ratio.min() > 0.4 and ratio.max() < 1.2
 
 
+def test_a_copy_still_being_made_is_waited_for_after_the_assembly(monkeypatch):
+    """``coarse`` may be a Future of the copy (mv.start_preview_copy): the operator and
+    its null space are assembled first, while the copy is made, and the preview is the
+    one from the finished copy; a Future of None (no usable copy) leaves the smooth
+    space."""
+    from concurrent.futures import Future
+
+    from modalviewer.core.transfer import CoarseCopy
+
+    fine, copy = torus(96, 40, minor=0.25), CoarseCopy(torus(24, 10, minor=0.25))
+    k = 30
+    direct = mv.compute_spectrum(fine, "shells", k, accuracy="fast preview", coarse=copy)
+    events = []
+    assemble, nulls = pv.operator_matrices, pv.null_space
+    monkeypatch.setattr(pv, "operator_matrices", lambda *a: events.append("K") or assemble(*a))
+    monkeypatch.setattr(pv, "null_space", lambda *a: events.append("null") or nulls(*a))
+
+    class Pending(Future):
+        def __init__(self, made):
+            super().__init__()
+            self.made = made
+
+        def result(self, timeout=None):
+            events.append("waited")
+            return self.made
+
+    stages = []
+    spec = mv.compute_spectrum(
+        fine,
+        "shells",
+        k,
+        accuracy="fast preview",
+        coarse=Pending(copy),
+        progress=lambda stage, _f: stages.append(stage),
+    )
+    assert events[:3] == ["K", "null", "waited"], events
+    assert "preview: making a coarse copy" in stages
+    assert spec.parameters["preview"]["coarse_start"]["coarse_vertices"] == copy.mesh.n_vertices
+    np.testing.assert_allclose(spec.eigenvalues, direct.eigenvalues, rtol=1e-10, atol=1e-12)
+    none = mv.compute_spectrum(fine, "shells", k, accuracy="fast preview", coarse=Pending(None))
+    assert "coarse_start" not in none.parameters["preview"]
+
+
 def test_a_coarse_copy_with_too_few_modes_leaves_the_smooth_space():
     """A 24-vertex copy gives at most 30 non-zero shells modes (half its 72 unknowns,
     less the six rigid motions): for 40 modes the preview takes its smooth space, with
