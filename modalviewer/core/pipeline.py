@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 import warnings
+from concurrent.futures import Future
 
 import numpy as np
 
@@ -88,7 +89,7 @@ def compute_spectrum(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     accuracy: str = "exact",
-    coarse: CoarseCopy | None = None,
+    coarse: CoarseCopy | Future | None = None,
 ) -> Spectrum:
     """The k lowest eigenpairs of ``operator`` on ``mesh``.
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 
 import numpy as np
 import scipy.sparse as sp
@@ -976,7 +976,7 @@ def _coarse_copy_pairs(coarse: CoarseCopy, operator: str, k: int, bending, membr
     """(eigenvalues, modes (3 Nc, m)) of the coarse copy's lowest non-zero modes (at most
     ``k``, at most half its unknowns), or None where its operator cannot be solved (a
     decimation can leave non-manifold edges or slivers)."""
-    unknowns = operator_info(operator).unknowns_per_vertex * coarse.mesh.n_vertices
+    unknowns = operator_info(operator).unknowns(coarse.mesh.n_vertices)
     try:
         pairs = exact_pairs(coarse.mesh, operator, min(int(k), unknowns // 2), bending, membrane)
     except (MeshError, EigenError, np.linalg.LinAlgError, ValueError):
@@ -1007,7 +1007,14 @@ def _ritz_in_span(K, mass: np.ndarray, Y: np.ndarray, count: int) -> tuple[np.nd
 
 
 def _coarse_start(
-    mesh: Mesh, operator: str, K, mass: np.ndarray, k: int, coarse: CoarseCopy, weights, report
+    mesh: Mesh,
+    operator: str,
+    K,
+    mass: np.ndarray,
+    k: int,
+    coarse: CoarseCopy | Future,
+    weights,
+    report,
 ):
     """The 3D shells' preview from a coarse copy: (lam, U, solver, info) or None.
 
@@ -1196,7 +1203,7 @@ def preview_spectrum(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     refine: bool | None = None,
-    coarse: CoarseCopy | None = None,
+    coarse: CoarseCopy | Future | None = None,
     weights: tuple[float, float] = (1.0, 1.0),
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, dict]:
     """Preview eigenpairs of ``K x = lambda diag(mass) x`` for ``operator`` on ``mesh``.
@@ -1419,7 +1426,7 @@ def compute_preview(
     cancel: CancelFn | None = None,
     samples: int | None = None,
     refine: bool | None = None,
-    coarse: CoarseCopy | None = None,
+    coarse: CoarseCopy | Future | None = None,
 ) -> Spectrum:
     """``compute_spectrum(..., accuracy="preview")``: a :class:`Spectrum` whose
     ``parameters["preview"]`` holds the reduced space, timings and estimated errors
