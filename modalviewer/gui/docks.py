@@ -44,8 +44,9 @@ errors and what comes next) beyond the one line it has at the start."""
 def fit_modes_dock(win) -> None:
     """Give the Modes dock the height its controls need, the Amplitude and Speed rows
     and a preview's note included (:data:`MODES_NOTE_LINES`), and the Distances dock
-    below it the rest (it scrolls): split evenly, the Modes dock hid its last rows at
-    the default window size.  For a first start; a remembered layout is kept."""
+    below it the rest (it scrolls): an even split leaves the Modes dock's last rows out
+    of view at the default window size.  For a first start; a remembered layout is
+    kept."""
     modes, distances = win.modes_dock, win.distances_dock
     total = modes.height() + distances.height()
     content = modes.widget().widget()
