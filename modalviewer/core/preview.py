@@ -928,13 +928,18 @@ def _leading_zero_modes(lam: np.ndarray, lam_scale: float) -> int:
 
 
 def _refinement_buffer(U: np.ndarray, steps: int, n: int) -> np.ndarray:
-    """A C-contiguous (N, c + guard) copy of the (N, c) modes U for :func:`_refine` to
-    write its Ritz vectors over (the caller drops U).  Guard vectors
-    (:data:`REFINE_GUARD`): the last wanted pairs converge at the rate
-    ``lam_c / lam_(c+guard)``; a single step has no next step for them to speed up."""
+    """A C-contiguous (N, c + guard) array holding the (N, c) modes U in its first
+    columns, for :func:`_refine` to write its Ritz vectors over (the caller drops U).
+    Guard vectors (:data:`REFINE_GUARD`): the last wanted pairs converge at the rate
+    ``lam_c / lam_(c+guard)``; a single step has no next step for them to speed up, so
+    it works in U itself (a C-contiguous float64 U is returned, not copied: a copy would
+    hold the modes twice beside the factor)."""
     c = U.shape[1]
     guard = max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)) if steps > 1 else 0
-    buffer = np.empty((U.shape[0], max(c, min(c + guard, n // 2))))
+    width = max(c, min(c + guard, n // 2))
+    if width == c and U.flags.c_contiguous and U.dtype == np.float64:
+        return U
+    buffer = np.empty((U.shape[0], width))
     buffer[:, :c] = U
     return buffer
 
@@ -1112,10 +1117,18 @@ def _coarse_start(
 ESTIMATE_BLOCK_COLUMNS = 16
 """Columns per block of the coarse start's estimate: each block's residuals and
 solutions take 20 bytes an entry (float32 residuals, the double-precision solver's copy
-and solution), 180 MB at 16 columns of the cow Loop x3's 557k unknowns."""
+and solution), 180 MB at 16 columns of the cow Loop x3's 557k unknowns; narrower blocks
+cost time there (a solve of 8 columns takes 1.5 times as long a column as one of 16)."""
+
+SCALAR_ESTIMATE_BLOCK_COLUMNS = 8
+"""Columns per block of the scalar operators' estimate (Laplacian, E_D^N, the normal
+shells).  PARDISO's work arrays for a solve grow with its columns, about 6 further
+(N,) float64 arrays a column, and beside the factor and the modes they decide the
+preview's peak: the hand Loop x2's Laplacian fast preview peaks at 815 MB with blocks of
+16 and 719 MB with blocks of 8 (the exact solve: 764 MB), 4 % slower."""
 
 
-def _factor_estimate(K, mass, solver, lam, U, lam_scale, d):
+def _factor_estimate(K, mass, solver, lam, U, lam_scale, d, block_columns=ESTIMATE_BLOCK_COLUMNS):
     """(relative residuals, estimated errors, how they were estimated) of the pairs
     (lam, U) whose first d are exact null vectors: each non-zero mode's estimate is
     ``r^T S r / lam`` with S the inverse of the factored ``K + s M`` (s below the
@@ -1123,15 +1136,16 @@ def _factor_estimate(K, mass, solver, lam, U, lam_scale, d):
     (:func:`estimated_errors`).  On the coarse start's pairs it reads 0.74 to 1.0 times
     the true errors of the lowest 50 (the cow Loop x2, median 0.92), where the
     block-Jacobi estimate read 0.22 times.  Columns go through the solve in blocks of
-    :data:`ESTIMATE_BLOCK_COLUMNS`, so the estimate's arrays stay small beside the factor
-    and the modes."""
+    ``block_columns`` (:data:`ESTIMATE_BLOCK_COLUMNS`, for the scalar operators
+    :data:`SCALAR_ESTIMATE_BLOCK_COLUMNS`), so the estimate's arrays stay small beside
+    the factor and the modes."""
     c = lam.shape[0]
     res, est = np.zeros(c), np.zeros(c)
     if d:
         res[:d] = _zero_mode_residuals(K, mass, lam, U, d, lam_scale)
     if d < c:
         relative, _, energies = _preconditioned_residuals(
-            K, mass, solver, lam, U, lam_scale, slice(d, c), None, False, ESTIMATE_BLOCK_COLUMNS
+            K, mass, solver, lam, U, lam_scale, slice(d, c), None, False, block_columns
         )
         res[d:] = relative
         est[d:] = np.maximum(energies, 0.0) / np.abs(lam[d:])
@@ -1351,7 +1365,9 @@ def preview_spectrum(
                 solver = None  # solves from a file would cost more than the preview
         if solver is not None:
             d = _leading_zero_modes(lam, lam_scale)
-            res, est, estimate = _factor_estimate(K, mass, solver, lam, U, lam_scale, d)
+            res, est, estimate = _factor_estimate(
+                K, mass, solver, lam, U, lam_scale, d, SCALAR_ESTIMATE_BLOCK_COLUMNS
+            )
         else:
             res, est, estimate = _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition)
         seconds["estimate"] = time.perf_counter() - t

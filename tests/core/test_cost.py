@@ -250,10 +250,10 @@ def test_a_single_precision_basis_is_predicted_as_its_buffer_and_chosen_over_the
 
 
 def test_fast_preview_memory_for_more_modes_covers_the_300_mode_runs():
-    """The fast preview's memory at k modes is its law at 100 modes plus
-    PREVIEW_ARRAYS_PER_MODE arrays of the unknowns' length per further mode: every
+    """The fast preview's memory at k modes is its law at 100 modes plus the operator's
+    preview_arrays_per_mode arrays of the unknowns' length per further mode: every
     300-mode fast preview on the 337k plate needs at most the prediction and at least
-    0.55 of it (the scalar previews add less than an array per mode)."""
+    0.55 of it."""
     checked = 0
     for r in json.loads(MORE_MODES.read_text())["rows"]:
         if r["accuracy"] != "fast preview" or "peak_mb" not in r:

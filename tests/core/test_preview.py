@@ -714,6 +714,24 @@ def test_refined_modes_own_their_memory(ring, monkeypatch):
     np.testing.assert_allclose(U.T @ (mass[:, None] * U), np.eye(12), atol=1e-9)
 
 
+def test_a_single_refinement_step_works_in_the_modes_own_memory():
+    """One subspace step has no guard vectors: the refinement writes over the modes U
+    themselves (a copy would hold them twice beside the factor); two steps get a new
+    (N, c + guard) buffer with U in its first columns."""
+    rng = np.random.default_rng(1)
+    U = rng.standard_normal((1000, 20))
+    assert pv._refinement_buffer(U, 1, 1000) is U
+    buffer = pv._refinement_buffer(U, 2, 1000)
+    guard = max(pv.REFINE_GUARD_MIN, int(pv.REFINE_GUARD * 20))
+    assert buffer.shape == (1000, 20 + guard) and buffer.flags.c_contiguous
+    np.testing.assert_array_equal(buffer[:, :20], U)
+    # a Fortran-ordered or single-precision U is copied into a C-contiguous float64 one
+    for other in (np.asfortranarray(U), U.astype(np.float32)):
+        copied = pv._refinement_buffer(other, 1, 1000)
+        assert copied is not other and copied.flags.c_contiguous and copied.dtype == np.float64
+        np.testing.assert_allclose(copied, other, rtol=1e-7)
+
+
 def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeypatch):
     """The correction step's residuals go through the single-precision solve in blocks
     of columns where they would take more than SOLVE_BLOCK_BYTES: the same eigenvalues
@@ -743,6 +761,33 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
     # on one machine's processor, below 1e-4 on another's
     np.testing.assert_allclose(
         blocked[3]["estimated_errors"], whole[3]["estimated_errors"], rtol=1e-3, atol=1e-12
+    )
+
+
+def test_scalar_estimate_solves_in_narrow_blocks_with_the_same_estimates(plate, monkeypatch):
+    """The scalar operators' estimate (the factor shifted below the spectrum) solves its
+    non-zero modes in blocks of SCALAR_ESTIMATE_BLOCK_COLUMNS (8): PARDISO's work arrays
+    grow with a solve's columns and set the fast preview's peak.  The estimates are
+    those of one block of all columns."""
+    K, mass = operator_matrices(plate, "laplacian")
+    widths = []
+    real = pv.SPDSolver.solve
+
+    def counting(self, b):
+        widths.append(b.shape[1])
+        return real(self, b)
+
+    monkeypatch.setattr(pv.SPDSolver, "solve", counting)
+    narrow = pv.preview_spectrum(plate, "laplacian", K, mass, 20, refine=False)
+    assert narrow[3]["estimate"]["method"] == "factor of the operator shifted below its spectrum"
+    assert widths == [8, 8, 3]  # the 19 non-zero modes (one constant)
+    widths.clear()
+    monkeypatch.setattr(pv, "SCALAR_ESTIMATE_BLOCK_COLUMNS", 19)
+    whole = pv.preview_spectrum(plate, "laplacian", K, mass, 20, refine=False)
+    assert widths == [19]
+    np.testing.assert_allclose(narrow[0], whole[0], rtol=1e-12)
+    np.testing.assert_allclose(
+        narrow[3]["estimated_errors"], whole[3]["estimated_errors"], rtol=1e-9, atol=1e-15
     )
 
 
