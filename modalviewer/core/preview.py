@@ -932,12 +932,13 @@ def _refinement_buffer(U: np.ndarray, steps: int, n: int) -> np.ndarray:
     columns, for :func:`_refine` to write its Ritz vectors over (the caller drops U).
     Guard vectors (:data:`REFINE_GUARD`): the last wanted pairs converge at the rate
     ``lam_c / lam_(c+guard)``; a single step has no next step for them to speed up, so
-    it works in U itself (a C-contiguous float64 U is returned, not copied: a copy would
-    hold the modes twice beside the factor)."""
+    it works in U itself (a C-contiguous float64 U that owns its memory is returned, not
+    copied: a copy would hold the modes twice beside the factor; a view is copied, so
+    that the memory it is a view of can go)."""
     c = U.shape[1]
     guard = max(REFINE_GUARD_MIN, int(REFINE_GUARD * c)) if steps > 1 else 0
     width = max(c, min(c + guard, n // 2))
-    if width == c and U.flags.c_contiguous and U.dtype == np.float64:
+    if width == c and U.flags.c_contiguous and U.flags.owndata and U.dtype == np.float64:
         return U
     buffer = np.empty((U.shape[0], width))
     buffer[:, :c] = U

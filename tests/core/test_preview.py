@@ -725,10 +725,14 @@ def test_a_single_refinement_step_works_in_the_modes_own_memory():
     guard = max(pv.REFINE_GUARD_MIN, int(pv.REFINE_GUARD * 20))
     assert buffer.shape == (1000, 20 + guard) and buffer.flags.c_contiguous
     np.testing.assert_array_equal(buffer[:, :20], U)
-    # a Fortran-ordered or single-precision U is copied into a C-contiguous float64 one
-    for other in (np.asfortranarray(U), U.astype(np.float32)):
+    # a Fortran-ordered or single-precision U, or a view of a wider array, is copied
+    # into a C-contiguous float64 one of its own
+    wider = rng.standard_normal((1000, 30))
+    view = wider.reshape(-1)[: 1000 * 20].reshape(1000, 20)
+    for other in (np.asfortranarray(U), U.astype(np.float32), view):
         copied = pv._refinement_buffer(other, 1, 1000)
-        assert copied is not other and copied.flags.c_contiguous and copied.dtype == np.float64
+        assert copied is not other and copied.flags.c_contiguous and copied.flags.owndata
+        assert copied.dtype == np.float64
         np.testing.assert_allclose(copied, other, rtol=1e-7)
 
 
