@@ -355,13 +355,21 @@ class ViewerModel:
                 self.state.set_computing(key, False)
 
         job.then(computing_ended)
-        behind_preview = state.spectra.get(key)
-        shown_preview = behind_preview is not None and behind_preview.is_preview
-        if show and not shown_preview:
+        if show and not self.preview_on_screen(key):
             # behind a preview already on screen the exact spectrum replaces it in place
-            # (mode, pick and map stay), as after a preview of this request
+            # (mode, pick and map stay), as after a preview of this request; a preview
+            # held but not shown (another operator on screen) is replaced where it is
+            # held, and the exact spectrum is shown as any new one
             job.then(self._shower(key, display_at_request))
         return job
+
+    def preview_on_screen(self, key: SpectrumKey) -> bool:
+        """Whether the picture is made of a preview of ``key`` (held from Preview only or
+        a cancelled exact computation, not this request's)."""
+        held = self.state.spectra.get(key)
+        return (
+            held is not None and held.is_preview and self.state.display_operator() == key.operator
+        )
 
     def _request_preview_only(self, key: SpectrumKey, show: bool, before) -> SpectrumJob:
         """Preview only (the exact spectrum not in the cache): one preview job and no

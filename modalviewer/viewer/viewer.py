@@ -395,10 +395,12 @@ class Viewer:
         if isinstance(job, SpectrumJob) and not job.is_preview:
             preview = job.preview_job
             if preview is None:
-                shown = self.state.spectra.get(job.spectrum_key)
-                if shown is not None and shown.is_preview:
+                held = self.state.spectra.get(job.spectrum_key)
+                if self.model.preview_on_screen(job.spectrum_key):
                     # a preview made earlier (Preview only, or kept after a cancel)
                     note = "the preview shown stays until it is ready"
+                elif held is not None and held.is_preview:
+                    note = "it replaces its preview when it is ready"
                 else:
                     note = self.model.no_preview_note(job.spectrum_key)
                 if note:

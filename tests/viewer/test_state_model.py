@@ -565,6 +565,38 @@ def test_preview_only_computes_a_preview_and_no_exact_spectrum(model):
     assert not state.spectrum("shells").is_preview
 
 
+def test_an_exact_spectrum_asked_for_is_shown_when_its_preview_is_held_but_not_on_screen(model):
+    """Found under Xvfb: a Laplacian preview (Preview only), then E_D^N on screen, then
+    the exact Laplacian asked for (Ctrl+R): it arrived and replaced the held preview,
+    but the picture stayed on E_D^N (the exact spectrum replaces a preview in place only
+    where that preview is on screen)."""
+    state = model.state
+    state.set_compute_settings(preview_only=True)
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    assert state.spectrum("laplacian").is_preview and state.display_operator() == "laplacian"
+    state.set_compute_settings(preview_only=False)
+    model.jobs.wait(model.request_spectrum("modified_dirichlet", k=12, show=True))
+    assert state.display_operator() == "modified_dirichlet"
+    exact = model.request_spectrum("laplacian", k=12, show=True)
+    model.jobs.wait(exact)
+    assert not state.spectrum("laplacian").is_preview
+    assert state.display.kind == "mode" and state.display_operator() == "laplacian"
+    assert state.display.mode == state.first_nonzero_mode("laplacian")
+
+
+def test_an_exact_spectrum_replaces_the_preview_on_screen_in_place(model):
+    """Behind a preview on screen the exact spectrum keeps the mode the user went to."""
+    state = model.state
+    state.set_compute_settings(preview_only=True)
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    state.show_mode(5, "laplacian")
+    state.set_compute_settings(preview_only=False)
+    assert model.preview_on_screen(state.compute_settings.key("laplacian", 12))
+    model.jobs.wait(model.request_spectrum("laplacian", k=12, show=True))
+    assert not state.spectrum("laplacian").is_preview
+    assert state.display_operator() == "laplacian" and state.display.mode == 5
+
+
 def test_a_preview_of_a_small_mesh_is_computed_in_a_child_process(model, monkeypatch):
     """The reduced space's dense eigenproblem holds the GIL (2 to 3 s of a frozen window
     for the spot's 9k-unknown shells under Xvfb), so previews never run in the viewer's

@@ -205,6 +205,31 @@ def test_the_exact_solve_after_a_preview_does_not_say_there_is_no_preview(
     ), started
 
 
+def test_the_exact_solve_behind_a_preview_not_on_screen_does_not_say_it_is_shown(
+    viewer, spot_path, monkeypatch
+):
+    """Found under Xvfb: with a Laplacian preview held and E_D^N on screen, the exact
+    Laplacian's start said "the preview shown stays until it is ready"; it is not shown.
+    The exact spectrum then comes on screen."""
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "NOTE_FROM_SECONDS", 0.0)
+    statuses = []
+    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    viewer.open_mesh(spot_path)
+    viewer.state.set_compute_settings(preview_only=True)
+    assert viewer.compute("laplacian", k=30).is_preview
+    viewer.state.set_compute_settings(preview_only=False)
+    viewer.compute("modified_dirichlet", k=30)
+    assert viewer.state.display_operator() == "modified_dirichlet"
+    assert not viewer.compute("laplacian", k=30).is_preview
+    started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 30 modes")]
+    assert started[-1] == (
+        "Computing Laplacian (cotan), 30 modes; it replaces its preview when it is ready."
+    ), started
+    assert viewer.state.display_operator() == "laplacian"
+
+
 def test_keep_the_largest_component(viewer, tmp_path):
     from modalviewer.core.primitives import icosphere, torus
 
