@@ -26,6 +26,7 @@ __all__ = [
     "decimated_copy",
     "preview_copy",
     "preview_copy_for",
+    "preview_copy_refusal",
     "start_preview_copy",
     "transfer_spectrum",
     "coarse_to_fine_spectrum",
@@ -80,13 +81,9 @@ def preview_copy(mesh: Mesh, k: int, separate_process: bool = True):
     VTK's own quadric decimation is not used: its copy of the cow subdivided twice had
     triangles of quality 0.03 and a spectrum that missed a mode the estimate does not
     see (4.9 % off, against 0.9 % from MeshLab's)."""
-    import importlib.util
-
-    n = mesh.n_vertices
-    target = max(PREVIEW_COPY_MIN, PREVIEW_COPY_PER_MODE * int(k), int(PREVIEW_COPY_SHARE * n))
-    target = min(target, PREVIEW_COPY_MAX)
-    if target > n // 4 or importlib.util.find_spec("pymeshlab") is None:
+    if _copy_refusal(mesh.n_vertices, k) is not None:
         return None
+    target = _copy_target(mesh.n_vertices, k)
     if separate_process:
         made = _decimate_and_locate_in_child(mesh, target)
     else:
@@ -189,6 +186,38 @@ def _decimate_and_locate_in_child(mesh: Mesh, target: int):
         return None
 
 
+def _copy_target(n_vertices: int, k: int) -> int:
+    """Vertices of the coarse copy for ``k`` modes of a mesh of ``n_vertices``."""
+    share = int(PREVIEW_COPY_SHARE * n_vertices)
+    return min(max(PREVIEW_COPY_MIN, PREVIEW_COPY_PER_MODE * int(k), share), PREVIEW_COPY_MAX)
+
+
+def _copy_refusal(n_vertices: int, k: int) -> str | None:
+    """Why no coarse copy is made for ``k`` modes of a mesh of ``n_vertices`` (in
+    words), or None."""
+    import importlib.util
+
+    if _copy_target(n_vertices, k) > n_vertices // 4:
+        return "the mesh is too small for a coarse copy to save work"
+    if importlib.util.find_spec("pymeshlab") is None:
+        return "no coarse copy without the optional pymeshlab"
+    return None
+
+
+def preview_copy_refusal(n_vertices: int, operator: str, k: int) -> str | None:
+    """Why a preview of ``k`` modes of ``operator`` on a mesh of ``n_vertices`` does not
+    start from a coarse copy (in words, for the status line), or None where
+    :func:`preview_copy_for` makes one (it may still fail to come out, as
+    :func:`preview_copy` says).  Operators whose preview never starts from a copy (all
+    but the 3D shells) give ``"no coarse copy for this operator"``."""
+    info = operator_info(operator)
+    if not info.preview.factor_step:
+        return "no coarse copy for this operator"
+    if info.factor_out_of_core(n_vertices, k):
+        return "the exact solve's factor would not fit in memory"
+    return _copy_refusal(n_vertices, k)
+
+
 def preview_copy_for(mesh: Mesh, operator: str, k: int):
     """:func:`preview_copy` where ``operator``'s preview starts from a coarse copy (the
     3D shells) and the exact solve's factor is predicted to stay in memory
@@ -197,8 +226,7 @@ def preview_copy_for(mesh: Mesh, operator: str, k: int):
     cost more than the smooth space's preview, which needs no such factor), else None:
     the one place the viewer's Preview only and ``modalviewer compute --preview``
     decide it."""
-    info = operator_info(operator)
-    if not info.preview.factor_step or info.factor_out_of_core(mesh.n_vertices, k):
+    if preview_copy_refusal(mesh.n_vertices, operator, k) is not None:
         return None
     return preview_copy(mesh, k)
 

@@ -32,3 +32,25 @@ def test_the_two_stage_copy_stays_on_the_surface():
     assert coarse.n_vertices - len(coarse.edges) + coarse.n_faces == 0
     nearest = np.einsum("nk,nkd->nd", barycentric, coarse.vertices[coarse.faces[triangles]])
     assert np.linalg.norm(nearest - ring.vertices, axis=1).max() < 0.01 * 0.3
+
+
+def test_the_reason_a_preview_does_not_start_from_a_coarse_copy(monkeypatch):
+    """preview_copy_refusal gives the status line's words: none for the 3D shells of a
+    mesh big enough for a copy (with pymeshlab), else why not (the operator, the mesh's
+    size, the exact factor's memory, the optional library)."""
+    import importlib.util
+
+    from modalviewer import coarsen
+    from modalviewer.core.operators import OperatorInfo
+
+    refusal = coarsen.preview_copy_refusal
+    assert refusal(200_000, "laplacian", 100) == "no coarse copy for this operator"
+    # 100 modes want a copy of 3000 vertices: more than a quarter of 10k
+    assert refusal(10_000, "shells", 100) == "the mesh is too small for a coarse copy to save work"
+    big = refusal(200_000, "shells", 100)
+    if importlib.util.find_spec("pymeshlab") is None:
+        assert big == "no coarse copy without the optional pymeshlab"
+    else:
+        assert big is None
+    monkeypatch.setattr(OperatorInfo, "factor_out_of_core", lambda self, n, k: True)
+    assert refusal(200_000, "shells", 100) == "the exact solve's factor would not fit in memory"

@@ -100,7 +100,9 @@ class SpectrumJob(Job):
     result is ``(Spectrum, SignatureTable or None)``.
 
     ``preview_job``: the preview computed first for the same request (the exact
-    spectrum follows it), or None; ``is_preview``: this job computes a preview."""
+    spectrum follows it), or None; ``is_preview``: this job computes a preview;
+    ``note``: words the status line adds to "Computing ..." when the job starts (how a
+    shown 3D shells preview starts), or ""."""
 
     def __init__(
         self,
@@ -111,11 +113,13 @@ class SpectrumJob(Job):
         spectrum_key,
         preview_job: SpectrumJob | None = None,
         is_preview: bool = False,
+        note: str = "",
     ):
         super().__init__(fn, key, description, owner)
         self.spectrum_key = spectrum_key
         self.preview_job = preview_job
         self.is_preview = is_preview
+        self.note = note
 
     @property
     def spectrum(self):

@@ -155,6 +155,22 @@ def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
     return info.predicted_peak_mb("exact", n_solved, key.k) * 2**20
 
 
+def preview_start_note(key: SpectrumKey, n_vertices: int) -> str:
+    """How a shown (Preview only) preview of ``key`` starts, for the status line: the 3D
+    shells' from a coarse copy of the mesh, or from its smooth space and why; "" for the
+    operators whose preview always starts from its smooth space."""
+    from ..coarsen import preview_copy_refusal
+
+    if not operator_info(key.operator).preview.factor_step:
+        return ""
+    refusal = preview_copy_refusal(n_vertices, key.operator, key.k)
+    return (
+        "from a coarse copy of the mesh"
+        if refusal is None
+        else f"from its smooth space ({refusal})"
+    )
+
+
 def predicted_seconds(key: SpectrumKey, n_vertices: int, accuracy: str = "exact") -> float:
     """Seconds the computation of ``key`` ("exact" or "fast preview") on ``n_vertices``
     is predicted to take (the operator's growth laws; Coarse-to-fine solves on its
@@ -412,6 +428,7 @@ class ViewerModel:
                 state.mesh.hash,
                 key,
                 is_preview=True,
+                note="" if accuracy is None else preview_start_note(key, state.mesh.n_vertices),
             )
         )
         if show:

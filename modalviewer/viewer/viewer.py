@@ -392,6 +392,8 @@ class Viewer:
         or with the reason a big request gets no preview; after a cancel that left other
         requests queued, first what it cancelled."""
         text = f"Computing {job.description}..."
+        if isinstance(job, SpectrumJob) and job.note:
+            text = f"Computing {job.description}, {job.note}..."
         if isinstance(job, SpectrumJob) and not job.is_preview:
             preview = job.preview_job
             if preview is None:

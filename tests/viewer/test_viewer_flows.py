@@ -230,6 +230,24 @@ def test_the_exact_solve_behind_a_preview_not_on_screen_does_not_say_it_is_shown
     assert viewer.state.display_operator() == "laplacian"
 
 
+def test_a_shown_shells_preview_says_how_it_starts(viewer, spot_path):
+    """Preview only of the 3D shells: the status line says whether the preview starts
+    from a coarse copy of the mesh or from its smooth space, and why (the viewer's
+    guide says it does; a newcomer under Xvfb found only "Computing preview of ...")."""
+    statuses = []
+    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    viewer.open_mesh(spot_path)
+    viewer.state.set_compute_settings(preview_only=True)
+    assert viewer.compute("shells", k=20).is_preview
+    assert viewer.compute("laplacian", k=20).is_preview
+    started = list(dict.fromkeys(s for s in statuses if s.startswith("Computing preview of")))
+    assert started == [
+        "Computing preview of Discrete Shells (3D vibrations), 20 modes, from its smooth "
+        "space (the mesh is too small for a coarse copy to save work)...",
+        "Computing preview of Laplacian (cotan), 20 modes...",
+    ], started
+
+
 def test_keep_the_largest_component(viewer, tmp_path):
     from modalviewer.core.primitives import icosphere, torus
 
