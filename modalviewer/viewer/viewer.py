@@ -314,10 +314,25 @@ class Viewer:
         except ComputeRefused as exc:
             self._error(str(exc), "Computation too large")
             return None
+        if job.status == DONE:  # answered at once: the spectrum is here already
+            self._status(self.already_here_note(job), 8000)
+            return job
         note = self.long_wait_note(job)
         if note:
             self._status(f"{job.description}: {note}.", 20000)
         return job
+
+    def already_here_note(self, job: SpectrumJob) -> str:
+        """The status line for a request the spectrum in memory answers (Ctrl+R again):
+        that nothing is computed, and for a Preview only result how to get the exact
+        spectrum."""
+        spec = job.result[0]
+        if not spec.is_preview:
+            return f"{job.description}: already computed."
+        return (
+            f"{job.description}: its preview is already here; untick Preview only and "
+            "compute again for the exact spectrum."
+        )
 
     def _finish(self, job: SpectrumJob | None, wait: bool, then=None) -> Spectrum | None:
         if job is None:

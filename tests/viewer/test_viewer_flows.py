@@ -248,6 +248,25 @@ def test_a_shown_shells_preview_says_how_it_starts(viewer, spot_path):
     ], started
 
 
+def test_asking_again_for_a_spectrum_in_memory_says_so(viewer, spot_path):
+    """Found under Xvfb: Ctrl+R with the Preview only result on screen did nothing and
+    said nothing."""
+    statuses = []
+    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    viewer.open_mesh(spot_path)
+    viewer.state.set_compute_settings(preview_only=True)
+    viewer.compute("laplacian", k=20)
+    viewer.compute("laplacian", k=20)
+    assert statuses[-1] == (
+        "Laplacian (cotan), 20 modes: its preview is already here; untick Preview only "
+        "and compute again for the exact spectrum."
+    ), statuses[-3:]
+    viewer.state.set_compute_settings(preview_only=False)
+    viewer.compute("laplacian", k=20)
+    viewer.compute("laplacian", k=20)
+    assert statuses[-1] == "Laplacian (cotan), 20 modes: already computed.", statuses[-3:]
+
+
 def test_keep_the_largest_component(viewer, tmp_path):
     from modalviewer.core.primitives import icosphere, torus
 
