@@ -151,7 +151,9 @@ class ModesPanel(QtWidgets.QWidget):
             else:
                 text = f"lambda_{j} = {lam:.6g}   sqrt(lambda) = {np.sqrt(max(lam, 0.0)):.6g}"
         else:
-            text = f"Not shown: the surface shows {_what_is_shown(state)}. M shows the mode."
+            # short (two lines), so the rows below stay in view beside a preview's note:
+            # the view's title says the rest (from which vertex, which scales)
+            text = f"Not shown (M shows it): {_what_is_shown(state)} on screen."
         tip = ""
         if spec.is_preview:
             if state.exact_follows(op):
@@ -207,14 +209,14 @@ means, kept out of the line itself."""
 
 
 def _what_is_shown(state: ViewerState) -> str:
-    """The display in a few words, for a panel that is not the one on screen."""
+    """The field on screen in a few words, for a panel that is not the one on screen
+    (the view's title names it in full: from which vertex, at which scales)."""
     d = state.display
     if d.kind == "distance":
         how = "threshold map" if d.distance_display == "threshold" else "map"
-        name = DISTANCE_KINDS[d.distance_kind].lower()
-        return f"the {name} {how} from vertex {state.picked_file_vertex}"
+        return f"{DISTANCE_KINDS[d.distance_kind].lower()} {how}"
     if d.kind == "signature":
-        return f"the {DISTANCE_KINDS[d.distance_kind].split()[0].lower()} signature"
+        return f"{DISTANCE_KINDS[d.distance_kind].split()[0].lower()} signature"
     if d.kind == "curvature":
-        return "the curvature"
+        return "curvature"
     return "no field"
