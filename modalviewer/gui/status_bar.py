@@ -15,6 +15,10 @@ class StatusBarWidgets:
     """Widest the status line gets; :data:`STATUS_LINE_WIDTH_BESIDE_MESSAGE` while a
     temporary message is shown, which needs the room more (what is computing and why)."""
     STATUS_LINE_WIDTH_BESIDE_MESSAGE = 300
+    STAGE_CHARS = 30
+    """Characters of the running stage the progress bar shows (longer ones are cut, whole
+    in its tooltip and in the Computations list); a preview's stages without their
+    "preview: " (the job is named in both)."""
 
     def __init__(self, bar: QtWidgets.QStatusBar, state, jobs):
         self.bar = bar
@@ -50,6 +54,10 @@ class StatusBarWidgets:
             self.progress.setValue(int(1000 * running.fraction))
             queued = len(self.jobs.jobs) - 1
             more = f" (+{queued} queued)" if queued else ""
-            stage = running.stage if len(running.stage) <= 20 else running.stage[:19] + "…"
+            stage = running.stage
+            if getattr(running, "is_preview", False):
+                stage = stage.removeprefix("preview: ")
+            if len(stage) > self.STAGE_CHARS:
+                stage = stage[: self.STAGE_CHARS - 1] + "…"
             self.progress.setFormat(f"{stage} %p %{more}")  # as in the Computations list
             self.progress.setToolTip(f"{running.description}: {running.stage}")

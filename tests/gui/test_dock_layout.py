@@ -146,3 +146,26 @@ def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path,
         top_left = widget.mapTo(viewport, QtCore.QPoint(0, 0))
         assert shown.contains(QtCore.QRect(top_left, widget.size())), widget
     win.close()
+
+
+def test_the_progress_bar_shows_a_previews_stage_whole(window, qtbot):
+    """Found under Xvfb: the status bar's progress read "preview: making a c… 5 %".  A
+    preview's stage shows without its "preview: " (the job is named in the tooltip and
+    the Computations list), and the longest of them fits the bar."""
+    from types import SimpleNamespace
+
+    bar = window.status_widgets
+    for stage, shown in (
+        ("preview: making a coarse copy", "making a coarse copy 5 %"),
+        ("preview: factorising (single precision)", "factorising (single precision) 5 %"),
+        ("assembling", "assembling 5 %"),
+    ):
+        job = SimpleNamespace(
+            stage=stage, fraction=0.05, description="preview of X", is_preview=True
+        )
+        bar.jobs = SimpleNamespace(running=job, jobs=[job])
+        bar._on_job_changed(job)
+        assert bar.progress.text() == shown, bar.progress.text()
+        width = bar.progress.fontMetrics().horizontalAdvance(shown)
+        assert width < bar.progress.width() - 8, (width, bar.progress.width())
+        assert bar.progress.toolTip() == f"preview of X: {stage}"
