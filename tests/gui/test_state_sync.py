@@ -610,3 +610,23 @@ def test_preferences_are_written_soon_after_they_change(window, qtbot):
     qtbot.addWidget(again)
     assert again.state.compute_settings.operator == "shells_normal"
     assert again.state.compute_settings.preview is False
+
+
+def test_the_computations_panel_keeps_how_the_last_computation_ended(window, spot_path, qtbot):
+    """Found under Xvfb: the "... in N s" message gave way to the next one within
+    seconds, and the time was lost; the Computations panel keeps the last one."""
+    from types import SimpleNamespace
+
+    from modalviewer.gui.panels.jobs import ended_text
+
+    panel = window.jobs_panel
+    assert not panel.last.isVisibleTo(window)
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=10, wait=True)
+    qtbot.waitUntil(lambda: panel.last.text() != "", timeout=60000)
+    assert panel.last.text().startswith("Last: Laplacian (cotan), 10 modes in ")
+    assert panel.last.text().endswith(" s") and panel.last.isVisibleTo(window)
+    given_up = SimpleNamespace(status="cancelled", description="preview of X", error=None)
+    assert ended_text(given_up) == "preview of X: cancelled"
+    given_up.error = "preview stopped after 3 s"
+    assert ended_text(given_up) == "preview of X: preview stopped after 3 s"

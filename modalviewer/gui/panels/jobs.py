@@ -1,10 +1,12 @@
-"""Jobs panel: the running and queued computations, each with its own Cancel."""
+"""Jobs panel: the running and queued computations, each with its own Cancel, and how the
+last one ended (the status line's message about it gives way to the next)."""
 
 from __future__ import annotations
 
 from qtpy import QtCore, QtWidgets
 
-from ...viewer.jobs import RUNNING, Job, JobQueue
+from ...viewer.jobs import CANCELLED, DONE, RUNNING, Job, JobQueue, SpectrumJob
+from ...viewer.model import finished_text
 from .common import WrappingLabel
 
 
@@ -18,6 +20,9 @@ class JobsPanel(QtWidgets.QWidget):
         self.layout_.setContentsMargins(0, 0, 0, 0)
         self.empty = QtWidgets.QLabel("No computation running.")
         self.layout_.addWidget(self.empty)
+        self.last = WrappingLabel("")
+        self.last.hide()
+        self.layout_.addWidget(self.last)
         self.rows: dict[int, tuple[QtWidgets.QWidget, QtWidgets.QLabel]] = {}
         jobs.events.changed.connect(self._on_changed)
 
@@ -27,6 +32,8 @@ class JobsPanel(QtWidgets.QWidget):
             if row is not None:
                 row[0].deleteLater()
                 del self.rows[job.id]
+                self.last.setText(f"Last: {ended_text(job)}")
+                self.last.show()
         else:
             if row is None:
                 row = self._make_row(job)
@@ -49,3 +56,16 @@ class JobsPanel(QtWidgets.QWidget):
         lay.addWidget(button, 0, QtCore.Qt.AlignmentFlag.AlignTop)
         self.layout_.addWidget(widget)
         return widget, label
+
+
+def ended_text(job: Job) -> str:
+    """How ``job`` ended, in a line: "<description> in 5.6 s" (a spectrum read from the
+    cache says so), "<description>: cancelled" (or why it was given up) or
+    "<description>: failed"."""
+    if job.status == DONE:
+        if isinstance(job, SpectrumJob) and job.result:
+            return finished_text(job, job.result[0])
+        return f"{job.description} in {job.seconds:.1f} s"
+    if job.status == CANCELLED:
+        return f"{job.description}: {job.error or 'cancelled'}"
+    return f"{job.description}: failed"
