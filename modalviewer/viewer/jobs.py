@@ -101,8 +101,8 @@ class SpectrumJob(Job):
 
     ``preview_job``: the preview computed first for the same request (the exact
     spectrum follows it), or None; ``is_preview``: this job computes a preview;
-    ``note``: words the status line adds to "Computing ..." when the job starts (how a
-    shown 3D shells preview starts), or ""."""
+    ``note``: words the status line adds to "Computing <description>" when the job
+    starts (how a shown preview starts, :func:`.model.preview_start_note`), or ""."""
 
     def __init__(
         self,

@@ -156,19 +156,21 @@ def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
 
 
 def preview_start_note(key: SpectrumKey, n_vertices: int) -> str:
-    """How a shown (Preview only) preview of ``key`` starts, for the status line: the 3D
-    shells' from a coarse copy of the mesh, or from its smooth space and why; "" for the
-    operators whose preview always starts from its smooth space."""
+    """What the status line adds to "Computing preview of ..." for a shown (Preview only)
+    preview of ``key``: how the 3D shells' starts (from a coarse copy of the mesh, or
+    from its smooth space and why), and where the exact solve is predicted to be quick
+    (below :data:`NOTE_FROM_SECONDS`) that it would take about as long; "" otherwise."""
     from ..coarsen import preview_copy_refusal
 
-    if not operator_info(key.operator).preview.factor_step:
-        return ""
-    refusal = preview_copy_refusal(n_vertices, key.operator, key.k)
-    return (
-        "from a coarse copy of the mesh"
-        if refusal is None
-        else f"from its smooth space ({refusal})"
-    )
+    note = ""
+    if operator_info(key.operator).preview.factor_step:
+        refusal = preview_copy_refusal(n_vertices, key.operator, key.k)
+        start = "a coarse copy of the mesh" if refusal is None else f"its smooth space ({refusal})"
+        note = f", from {start}"
+    exact = predicted_seconds(key, n_vertices)
+    if exact < NOTE_FROM_SECONDS:
+        note += f"; the exact spectrum would take about {max(exact, 1.0):.0f} s here"
+    return note
 
 
 def predicted_seconds(key: SpectrumKey, n_vertices: int, accuracy: str = "exact") -> float:

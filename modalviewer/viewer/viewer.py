@@ -408,7 +408,7 @@ class Viewer:
         requests queued, first what it cancelled."""
         text = f"Computing {job.description}..."
         if isinstance(job, SpectrumJob) and job.note:
-            text = f"Computing {job.description}, {job.note}..."
+            text = f"Computing {job.description}{job.note}..."
         if isinstance(job, SpectrumJob) and not job.is_preview:
             preview = job.preview_job
             if preview is None:

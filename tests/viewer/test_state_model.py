@@ -858,3 +858,27 @@ def test_a_cancelled_child_leaves_no_factor_folder(tmp_path, monkeypatch):
                            cancel, "computation")  # fmt: skip
     assert stages == ["solving"]
     assert not list(factors.iterdir())
+
+
+def test_a_shown_preview_says_when_the_exact_solve_would_be_quick():
+    """Preview only on a mesh where the exact solve is predicted under NOTE_FROM_SECONDS
+    says how long the exact spectrum would take; on a big one it says nothing of it (and
+    the 3D shells' preview says it starts from a coarse copy, where one is made)."""
+    from modalviewer.coarsen import preview_copy_refusal
+    from modalviewer.viewer.model import NOTE_FROM_SECONDS, predicted_seconds, preview_start_note
+
+    small, big = SpectrumKey("laplacian", 100), SpectrumKey("shells", 100)
+    seconds = predicted_seconds(small, 46_850)
+    assert 1.0 < seconds < NOTE_FROM_SECONDS
+    assert preview_start_note(small, 46_850) == (
+        f"; the exact spectrum would take about {seconds:.0f} s here"
+    )
+    assert preview_start_note(SpectrumKey("laplacian", 100), 400_000) == ""
+    assert predicted_seconds(big, 187_000) > NOTE_FROM_SECONDS
+    start = preview_start_note(big, 187_000)
+    refusal = preview_copy_refusal(187_000, "shells", 100)
+    assert start == (
+        ", from a coarse copy of the mesh"
+        if refusal is None
+        else f", from its smooth space ({refusal})"
+    )
