@@ -26,7 +26,7 @@ from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
-from .jobs import DONE, Job, JobQueue, RepairJob, SpectrumJob
+from .jobs import CANCELLED, DONE, Job, JobQueue, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
@@ -656,6 +656,19 @@ def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
     earlier = spec.parameters.get("seconds_total")
     solved = f" (solved earlier in {earlier:.1f} s)" if isinstance(earlier, (int, float)) else ""
     return f"{job.description} read from the cache in {job.seconds:.1f} s{solved}"
+
+
+def ended_text(job: Job) -> str:
+    """How ``job`` ended, in a line: "<description> in 5.6 s" (:func:`finished_text` for
+    a spectrum), "<description>: cancelled" (or why it was given up) or
+    "<description>: failed"."""
+    if job.status == DONE:
+        if isinstance(job, SpectrumJob) and job.result:
+            return finished_text(job, job.result[0])
+        return f"{job.description} in {job.seconds:.1f} s"
+    if job.status == CANCELLED:
+        return f"{job.description}: {job.error or 'cancelled'}"
+    return f"{job.description}: failed"
 
 
 def memory_text(spec: Spectrum) -> str:

@@ -48,6 +48,7 @@ from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, Spe
 from .model import (
     ComputeRefused,
     ViewerModel,
+    ended_text,
     finished_text,
     memory_text,
     predicted_seconds,
@@ -463,7 +464,7 @@ class Viewer:
             else:
                 self._error(f"The computation failed: {job.error}", "Computation failed")
         elif job.status == CANCELLED:
-            self._status(f"{job.description}: {job.error or 'cancelled'}.", 5000)
+            self._status(f"{ended_text(job)}.", 5000)
 
     # =============================================================== modes
     @property

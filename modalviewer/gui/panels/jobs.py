@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from qtpy import QtCore, QtWidgets
 
-from ...viewer.jobs import CANCELLED, DONE, RUNNING, Job, JobQueue, SpectrumJob
-from ...viewer.model import finished_text
+from ...viewer.jobs import RUNNING, Job, JobQueue
+from ...viewer.model import ended_text
 from .common import WrappingLabel
 
 
@@ -56,16 +56,3 @@ class JobsPanel(QtWidgets.QWidget):
         lay.addWidget(button, 0, QtCore.Qt.AlignmentFlag.AlignTop)
         self.layout_.addWidget(widget)
         return widget, label
-
-
-def ended_text(job: Job) -> str:
-    """How ``job`` ended, in a line: "<description> in 5.6 s" (a spectrum read from the
-    cache says so), "<description>: cancelled" (or why it was given up) or
-    "<description>: failed"."""
-    if job.status == DONE:
-        if isinstance(job, SpectrumJob) and job.result:
-            return finished_text(job, job.result[0])
-        return f"{job.description} in {job.seconds:.1f} s"
-    if job.status == CANCELLED:
-        return f"{job.description}: {job.error or 'cancelled'}"
-    return f"{job.description}: failed"
