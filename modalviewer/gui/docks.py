@@ -38,8 +38,8 @@ def build_docks(win) -> None:
 
 MODES_NOTE_LINES = 4
 """Lines the Modes dock keeps for the eigenvalue line's note (a preview's estimated
-errors and what comes next, after the eigenvalue or after "Not shown: the surface shows
-a distance map", two lines) beyond the one line it has at the start."""
+errors and what comes next, after the eigenvalue or after the two-line "Not shown (M
+shows it): ... on screen") beyond the one line it has at the start."""
 
 
 def fit_modes_dock(win) -> None:

@@ -404,12 +404,12 @@ class Viewer:
             self._status(self.starting_message(job))
 
     def starting_message(self, job: Job) -> str:
-        """ "Computing ...", after the preview shown before it (with its estimated error)
-        or with the reason a big request gets no preview; after a cancel that left other
+        """ "Computing ..." (a shown preview's with how it starts, :attr:`SpectrumJob.note`),
+        after the preview shown before it (with its estimated error) or with the reason a
+        big request gets no preview; after a cancel that left other
         requests queued, first what it cancelled."""
-        text = f"Computing {job.description}..."
-        if isinstance(job, SpectrumJob) and job.note:
-            text = f"Computing {job.description}{job.note}..."
+        how = job.note if isinstance(job, SpectrumJob) else ""
+        text = f"Computing {job.description}{how}..."
         if isinstance(job, SpectrumJob) and not job.is_preview:
             preview = job.preview_job
             if preview is None:

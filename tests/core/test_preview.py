@@ -736,13 +736,8 @@ def test_a_single_refinement_step_works_in_the_modes_own_memory():
         np.testing.assert_allclose(copied, other, rtol=1e-7)
 
 
-def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeypatch):
-    """The correction step's residuals go through the single-precision solve in blocks
-    of columns where they would take more than SOLVE_BLOCK_BYTES: the same eigenvalues
-    and estimates as in one block (thin torus, 20 modes, blocks of 5 columns forced, and
-    of 3 in the refinement's pass that keeps its directions)."""
-    mesh = torus(64, 10, minor=0.06)
-    K, mass = operator_matrices(mesh, "shells")
+def _solve_widths(monkeypatch) -> list[int]:
+    """The number of right-hand sides of every SPDSolver.solve from now on."""
     widths = []
     real = pv.SPDSolver.solve
 
@@ -751,6 +746,17 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
         return real(self, b)
 
     monkeypatch.setattr(pv.SPDSolver, "solve", counting)
+    return widths
+
+
+def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeypatch):
+    """The correction step's residuals go through the single-precision solve in blocks
+    of columns where they would take more than SOLVE_BLOCK_BYTES: the same eigenvalues
+    and estimates as in one block (thin torus, 20 modes, blocks of 5 columns forced, and
+    of 3 in the refinement's pass that keeps its directions)."""
+    mesh = torus(64, 10, minor=0.06)
+    K, mass = operator_matrices(mesh, "shells")
+    widths = _solve_widths(monkeypatch)
     whole = pv.preview_spectrum(mesh, "shells", K, mass, 20)
     # the first step's 12 columns, then all 14 non-zero modes: the estimate, the same
     # residuals again for the refinement's step (kept this time), the final estimate
@@ -774,14 +780,7 @@ def test_scalar_estimate_solves_in_narrow_blocks_with_the_same_estimates(plate, 
     grow with a solve's columns and set the fast preview's peak.  The estimates are
     those of one block of all columns."""
     K, mass = operator_matrices(plate, "laplacian")
-    widths = []
-    real = pv.SPDSolver.solve
-
-    def counting(self, b):
-        widths.append(b.shape[1])
-        return real(self, b)
-
-    monkeypatch.setattr(pv.SPDSolver, "solve", counting)
+    widths = _solve_widths(monkeypatch)
     narrow = pv.preview_spectrum(plate, "laplacian", K, mass, 20, refine=False)
     assert narrow[3]["estimate"]["method"] == "factor of the operator shifted below its spectrum"
     assert widths == [8, 8, 3]  # the 19 non-zero modes (one constant)

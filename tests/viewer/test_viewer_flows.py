@@ -30,6 +30,13 @@ def viewer(tmp_path):
     v.close()
 
 
+def _statuses(viewer) -> list[str]:
+    """The status-line messages ``viewer`` emits from now on, as they come."""
+    statuses = []
+    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    return statuses
+
+
 def _colours(img: np.ndarray) -> dict[str, int]:
     """Pixel counts of the paper's blue and orange (diverging ends, threshold blue)."""
     rgb = img[:, :, :3].astype(int)
@@ -168,13 +175,12 @@ def test_messages_instead_of_dialogs(viewer, spot_path):
 
 
 def test_a_cached_spectrum_does_not_read_like_a_fresh_solve(viewer, spot_path, tmp_path):
-    statuses = []
     viewer.open_mesh(spot_path)
     viewer.compute("laplacian", k=10)
     solved = viewer.state.spectra[viewer.state.spectrum_key("laplacian")]
     assert not solved.from_cache
     again = Viewer(cache=mv.core.cache.SpectrumCache(tmp_path / "cache"))
-    again.events.status.connect(lambda text, _ms: statuses.append(text))
+    statuses = _statuses(again)
     again.open_mesh(spot_path)
     again.compute("laplacian", k=10)
     assert statuses[-1].startswith("Laplacian (cotan), 10 modes read from the cache in ")
@@ -183,21 +189,28 @@ def test_a_cached_spectrum_does_not_read_like_a_fresh_solve(viewer, spot_path, t
     again.close()
 
 
+def _laplacian_preview_held(viewer, spot_path, monkeypatch) -> list[str]:
+    """A Preview only result of 30 Laplacian modes of spot on screen, Preview only
+    turned off again, every request's note on (NOTE_FROM_SECONDS 0); the status-line
+    messages from the start."""
+    from modalviewer.viewer import model as model_module
+
+    monkeypatch.setattr(model_module, "NOTE_FROM_SECONDS", 0.0)
+    statuses = _statuses(viewer)
+    viewer.open_mesh(spot_path)
+    viewer.state.set_compute_settings(preview_only=True)
+    assert viewer.compute("laplacian", k=30).is_preview
+    viewer.state.set_compute_settings(preview_only=False)
+    return statuses
+
+
 def test_the_exact_solve_after_a_preview_does_not_say_there_is_no_preview(
     viewer, spot_path, monkeypatch
 ):
     """Found under Xvfb: with a Preview only result on screen, the exact solve asked for
     next said "no preview: predicted ..." (the note for big requests; on for every
     request here)."""
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "NOTE_FROM_SECONDS", 0.0)
-    statuses = []
-    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
-    viewer.open_mesh(spot_path)
-    viewer.state.set_compute_settings(preview_only=True)
-    assert viewer.compute("laplacian", k=30).is_preview
-    viewer.state.set_compute_settings(preview_only=False)
+    statuses = _laplacian_preview_held(viewer, spot_path, monkeypatch)
     assert not viewer.compute("laplacian", k=30).is_preview
     started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 30 modes")]
     assert started[-1] == (
@@ -211,15 +224,7 @@ def test_the_exact_solve_behind_a_preview_not_on_screen_does_not_say_it_is_shown
     """Found under Xvfb: with a Laplacian preview held and E_D^N on screen, the exact
     Laplacian's start said "the preview shown stays until it is ready"; it is not shown.
     The exact spectrum then comes on screen."""
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "NOTE_FROM_SECONDS", 0.0)
-    statuses = []
-    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
-    viewer.open_mesh(spot_path)
-    viewer.state.set_compute_settings(preview_only=True)
-    assert viewer.compute("laplacian", k=30).is_preview
-    viewer.state.set_compute_settings(preview_only=False)
+    statuses = _laplacian_preview_held(viewer, spot_path, monkeypatch)
     viewer.compute("modified_dirichlet", k=30)
     assert viewer.state.display_operator() == "modified_dirichlet"
     assert not viewer.compute("laplacian", k=30).is_preview
@@ -236,8 +241,7 @@ def test_a_shown_shells_preview_says_how_it_starts(viewer, spot_path):
     guide says it does; a newcomer under Xvfb found only "Computing preview of ..."),
     and where the exact solve is quick, that it is (the newcomer's Laplacian preview of
     a 47k mesh took 6.3 s, the exact spectrum 5.6 s)."""
-    statuses = []
-    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    statuses = _statuses(viewer)
     viewer.open_mesh(spot_path)
     viewer.state.set_compute_settings(preview_only=True)
     assert viewer.compute("shells", k=20).is_preview
@@ -256,8 +260,7 @@ def test_a_shown_shells_preview_says_how_it_starts(viewer, spot_path):
 def test_asking_again_for_a_spectrum_in_memory_says_so(viewer, spot_path):
     """Found under Xvfb: Ctrl+R with the Preview only result on screen did nothing and
     said nothing."""
-    statuses = []
-    viewer.events.status.connect(lambda text, _ms: statuses.append(text))
+    statuses = _statuses(viewer)
     viewer.open_mesh(spot_path)
     viewer.state.set_compute_settings(preview_only=True)
     viewer.compute("laplacian", k=20)
