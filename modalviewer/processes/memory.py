@@ -13,9 +13,15 @@ settings make them cheaper:
   kernel compacts memory to find them, which makes the page faults of fresh arrays
   several times slower (:func:`no_huge_page_advice`).
 
+Keeping freed memory has a cost where threads allocate: glibc gives each thread that
+calls ``malloc`` an arena of its own, and what one arena keeps no other can reuse, so
+arrays freed on the solver's and the row passes' threads stay resident beside new ones
+made on the main thread.  One arena for the whole process (:func:`one_malloc_arena`)
+lets every thread reuse them.
+
 What each setting saves and costs: "Memory" in docs/how-it-works.md.
 
-:func:`prepare_compute_process` applies both.  Only for processes that exist to compute
+:func:`prepare_compute_process` applies all three.  Only for processes that exist to compute
 (the viewer's child processes, the command line, the benchmarks): memory goes back to
 the system when the process ends, not before.
 """
@@ -24,24 +30,47 @@ from __future__ import annotations
 
 import ctypes
 
-__all__ = ["keep_freed_memory", "no_huge_page_advice", "prepare_compute_process"]
+__all__ = [
+    "keep_freed_memory",
+    "no_huge_page_advice",
+    "one_malloc_arena",
+    "prepare_compute_process",
+]
 
 _M_TRIM_THRESHOLD = -1
 _M_MMAP_MAX = -4
+_M_ARENA_MAX = -8
+
+
+def _mallopt():
+    """glibc's ``mallopt`` with its argument types set, or None where the C library is
+    not glibc."""
+    from ..core.memory import glibc
+
+    mallopt = getattr(glibc(), "mallopt", None)
+    if mallopt is not None:
+        mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
+        mallopt.restype = ctypes.c_int
+    return mallopt
 
 
 def keep_freed_memory() -> bool:
     """Ask glibc to serve big allocations from the heap and keep freed heap memory
     (``mallopt(M_MMAP_MAX, 0)``, ``mallopt(M_TRIM_THRESHOLD, 2 GiB)``).  True if both
     took effect; False (and nothing changed) where the C library is not glibc."""
-    from ..core.memory import glibc
-
-    mallopt = getattr(glibc(), "mallopt", None)
+    mallopt = _mallopt()
     if mallopt is None:
         return False
-    mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
-    mallopt.restype = ctypes.c_int
     return bool(mallopt(_M_MMAP_MAX, 0)) and bool(mallopt(_M_TRIM_THRESHOLD, 2**31 - 1))
+
+
+def one_malloc_arena() -> bool:
+    """Ask glibc to serve every thread from one arena (``mallopt(M_ARENA_MAX, 1)``), so
+    memory freed on one thread is reused by the next allocation on any other.  Takes
+    effect for threads that have not yet allocated: call it when the process starts.
+    True if it took effect; False where the C library is not glibc."""
+    mallopt = _mallopt()
+    return mallopt is not None and bool(mallopt(_M_ARENA_MAX, 1))
 
 
 def no_huge_page_advice() -> bool:
@@ -58,6 +87,7 @@ def no_huge_page_advice() -> bool:
 
 
 def prepare_compute_process() -> bool:
-    """Both settings of this module; True if both took effect."""
+    """The three settings of this module; True if all took effect."""
     kept = keep_freed_memory()
-    return no_huge_page_advice() and kept
+    shared = one_malloc_arena()
+    return no_huge_page_advice() and kept and shared
