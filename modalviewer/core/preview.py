@@ -57,7 +57,7 @@ from .exact import exact_pairs
 from .factor import FactorTooLarge, SPDSolver
 from .memory import memory_limit_mb, resident_mb
 from .mesh import Mesh, MeshError
-from .nullspace import null_space
+from .nullspace import NullSpace, null_space
 from .operators import OPERATOR_INFO, SpaceSettings, operator_info
 from .products import (
     chunked_projection,
@@ -104,7 +104,9 @@ space of a connected mesh holds: the partition of unity sums to the constant, an
 3-vector spaces hold the translations and the rotation columns."""
 
 
-def _null_space_complement(mesh, operator, K, mass, basis: ReducedBasis, Mr) -> np.ndarray | None:
+def _null_space_complement(
+    mesh, operator, K, mass, basis: ReducedBasis, Mr, nulls: NullSpace | None = None
+) -> np.ndarray | None:
     """Dense columns that complete the reduced space to contain the operator's exact null
     vectors (constants and rigid motions per connected component), or None.
 
@@ -114,11 +116,12 @@ def _null_space_complement(mesh, operator, K, mass, basis: ReducedBasis, Mr) -> 
     reduced space is removed; what remains (for example the rotations of a second
     component, or its constant where basis functions straddle two components) is
     Mass-orthonormalised, and parts below 1e-8 of the vector are dropped (already
-    contained).
+    contained).  ``nulls``: the null space where it is already computed (a coarse start
+    that fell back to the smooth space).
     """
     if mesh.n_components == 1 and operator_info(operator).null_space_rule in _IN_EVERY_SPACE:
         return None
-    Z = null_space(mesh, operator, K, mass).vectors
+    Z = (null_space(mesh, operator, K, mass) if nulls is None else nulls).vectors
     if Z.shape[1] == 0 or Z.shape[1] > MAX_NULL_COLUMNS:
         return None
     Z = Z.toarray()
@@ -691,11 +694,13 @@ def _single_factor(K, mass: np.ndarray, lowest: float, columns: int):
     return None
 
 
-SOLVE_BLOCK_BYTES = 1.0e9
-"""Bytes of the (N, w) arrays of one block of preconditioned residuals: the modes'
-columns (float64), their residuals and solutions (float32), 16 bytes an entry; at least
-32 columns a block.  Spot Loop x3 (562k unknowns) solves its 94 columns in one block; a
-million vertices in blocks of 32, so the peak holds no (N, k) residual arrays."""
+STEP_BLOCK_COLUMNS = 32
+"""Columns per block of the 3D shells' preconditioned residuals (:func:`_factor_steps`):
+each block's residuals and solutions (float32) and PARDISO's work arrays for its solve
+grow with the columns and sit beside the factor and the modes.  The machined part flat
+x3 (266k vertices, 57 columns in the first step): the fast preview peaked at 2951 MB in
+two runs with blocks of 32 and at 3175 to 3428 MB in five with one block (the exact
+solve: 3376 MB), in the same time; spot Loop x3 2722 against 2838 MB, 4 % slower."""
 
 
 REFINE_BLOCK_COLUMNS = 32
@@ -705,11 +710,6 @@ near the fast one's (the machined part flat x3, 266k vertices: 1.13 times the ex
 solve's peak with one block of 94)."""
 
 
-def _solve_block_columns(n: int) -> int:
-    """Columns per block of :func:`_preconditioned_residuals` for N = ``n`` rows."""
-    return int(max(32, SOLVE_BLOCK_BYTES // (16 * n)))
-
-
 def _preconditioned_residuals(
     K, mass, solver, lam, U, lam_scale, cols: slice, Z, keep: bool, block_columns=None
 ):
@@ -717,11 +717,11 @@ def _preconditioned_residuals(
     (float64, C-ordered, Mass-orthogonal to the zero modes Z; None unless ``keep``),
     ``r^T F^-1 r`` per column), with F the single-precision factor ``solver``.
 
-    Columns go in blocks (:data:`SOLVE_BLOCK_BYTES`): one pass over K's row blocks for the
+    Columns go in blocks (:data:`STEP_BLOCK_COLUMNS`): one pass over K's row blocks for the
     block's residuals, then one block solve, so only W (where kept) spans all columns."""
     n = U.shape[0]
     width = cols.stop - cols.start
-    per_block = _solve_block_columns(n) if block_columns is None else int(block_columns)
+    per_block = STEP_BLOCK_COLUMNS if block_columns is None else int(block_columns)
     W = np.empty((n, width)) if keep else None
     energies, res2, mu2 = np.zeros(width), np.zeros(width), np.zeros(width)
     lock = threading.Lock()
@@ -1026,6 +1026,7 @@ def _coarse_start(
     coarse: CoarseCopy | Future,
     weights,
     report,
+    nulls: NullSpace,
 ):
     """The 3D shells' preview from a coarse copy: (lam, U, solver, info) or None.
 
@@ -1040,11 +1041,10 @@ def _coarse_start(
     for the refinement's steps.  ``coarse`` may be a copy still being made (a
     ``concurrent.futures.Future`` of one, :func:`modalviewer.coarsen.start_preview_copy`):
     it is waited for after the assembly and the null space, which so overlap the
-    copy's process.  None where no copy came out, the coarse copy's spectrum or the
-    factor fails, or the copy has fewer non-zero modes than asked for (the caller takes
-    the smooth space)."""
+    copy's process (the caller computes ``nulls``, the null space, before it calls).
+    None where no copy came out, the coarse copy's spectrum or the factor fails, or the
+    copy has fewer non-zero modes than asked for (the caller takes the smooth space)."""
     seconds = {}
-    nulls = null_space(mesh, operator, K, mass)  # while a copy still being made is made
     d = nulls.dimension
     if hasattr(coarse, "result"):
         t = time.perf_counter()
@@ -1065,7 +1065,10 @@ def _coarse_start(
         return None
     t = time.perf_counter()
     # the factor before the carried modes: its factorisation's working memory and the
-    # (N, m) carried block are never alive at once
+    # (N, m) carried block are never alive at once.  Double precision: the step replaces
+    # the carried modes by its solutions (the smooth space's step only adds directions),
+    # and in single precision the cow Loop x3's K + s M does not factorise at this shift
+    # nor at 10 times it; at 100 times it the step left eigenvalues 7 times too large.
     report("preview: factorising", 0.3)
     n = K.shape[0]
     budget = factor_budget_mb(memory_limit_mb(), n, k, _block_columns(n))
@@ -1158,13 +1161,13 @@ def _factor_estimate(K, mass, solver, lam, U, lam_scale, d, block_columns=ESTIMA
     return res, est, {"method": "factor of the operator shifted below its spectrum"}
 
 
-def _coarse_preview(mesh, operator, K, mass, k, coarse, weights, report, refine, settings):
+def _coarse_preview(mesh, operator, K, mass, k, coarse, weights, report, refine, settings, nulls):
     """:func:`preview_spectrum` from a coarse copy (:func:`_coarse_start`), its estimate
     and, where that of the lower half of the non-zero modes is above the threshold and
     ``refine`` is set, subspace steps with the start's factor; None where the start
     fails."""
     t = time.perf_counter()
-    started = _coarse_start(mesh, operator, K, mass, k, coarse, weights, report)
+    started = _coarse_start(mesh, operator, K, mass, k, coarse, weights, report, nulls)
     if started is None:
         return None
     lam, U, solver, start_info = started
@@ -1285,10 +1288,12 @@ def preview_spectrum(
     enrich = settings.degree if enrich is None else int(enrich)
     if radius_factor is None:
         radius_factor = settings.radius_factor
+    nulls = None
     if coarse is not None and settings.factor_step:
+        nulls = null_space(mesh, operator, K, mass)  # while a copy still being made is made
         with blas_limit():
             done = _coarse_preview(
-                mesh, operator, K, mass, k, coarse, weights, report, refine, settings
+                mesh, operator, K, mass, k, coarse, weights, report, refine, settings, nulls
             )
         if done is not None:
             return done
@@ -1302,7 +1307,7 @@ def preview_spectrum(
     report("preview: projecting", 0.2)
     Kr = _project(K, basis)
     Mr = _project_mass(mass, basis)
-    E = _null_space_complement(mesh, operator, K, mass, basis, Mr)
+    E = _null_space_complement(mesh, operator, K, mass, basis, Mr, nulls)
     if E is not None:  # exact null vectors the space lacks (components, rotations)
         Kr, Mr = _extend(Kr, K, basis, E), _extend(Mr, sp.diags(mass), basis, E)
         basis = basis.with_dense(E)
