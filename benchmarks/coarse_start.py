@@ -9,8 +9,16 @@ one's short name or a mesh file).  For each case: the exact spectrum, the fast
 preview from the smooth space (``accuracy="fast preview"``) and the fast preview from a
 coarse copy (:func:`modalviewer.coarsen.preview_copy`, its decimation timed with it);
 the previews' lowest 50 non-zero eigenvalues are compared with the exact ones, and the
-copy's own process's peak memory is recorded beside the computing process's.  Writes
-``benchmarks/results/coarse_start.json``.
+copy's own process's peak memory is recorded beside the computing process's.  Each
+process computes with the compute processes' memory settings
+(:func:`modalviewer.processes.memory.prepare_compute_process`).
+
+``factor_stages_time_ratio`` is the share of the exact time that the coarse preview's
+work with the fine operator takes: the exact run's assembly, the preview's factor, its
+inverse-iteration step (one solve per carried mode and the Rayleigh-Ritz) and its
+estimate (one solve per mode).  A preview that corrects any start with a factor of the
+fine operator and estimates each mode's error with it needs at least these, whatever
+the start costs.  Writes ``benchmarks/results/coarse_start.json``.
 """
 
 from __future__ import annotations
@@ -29,6 +37,8 @@ from benchmarks.run import add_keep_others, kept_rows, save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
+from modalviewer.processes.memory import prepare_compute_process
+prepare_compute_process()
 import modalviewer as mv
 from modalviewer.coarsen import preview_copy
 from benchmarks.curved import case_mesh
@@ -48,7 +58,10 @@ print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds,
                   "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
                   "copy_peak_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024,
                   "eigenvalues": [float(x) for x in spec.eigenvalues[~spec.zero_mode_mask()]],
-                  "estimated_errors": info.get("estimated_errors", [])[6:]}))
+                  "estimated_errors": info.get("estimated_errors", [])[6:],
+                  "assembly_seconds": spec.parameters.get("seconds_assembly", 0.0),
+                  "start_seconds": info.get("coarse_start", {}).get("seconds", {}),
+                  "stage_seconds": info.get("seconds_by_stage", {})}))
 """
 
 
@@ -99,6 +112,16 @@ def main(argv=None) -> int:
         # spectrum's solve begins: its peak is not alive beside the compute peak
         row["coarse_copy_peak_mb"] = round(coarse["copy_peak_mb"])
         row["coarse_vertices"] = coarse["coarse_vertices"]
+        start, stages = coarse["start_seconds"], coarse["stage_seconds"]
+        if "factor" in start:  # the coarse start ran (no fallback to the smooth space)
+            fine = (
+                exact["assembly_seconds"]
+                + start["factor"]
+                + start["inverse_iteration"]
+                + stages.get("estimate", 0.0)
+            )
+            row["coarse_stage_seconds"] = {**start, "estimate": stages.get("estimate", 0.0)}
+            row["factor_stages_time_ratio"] = round(fine / exact["seconds"], 3)
         rows.append(row)
         print(json.dumps(row), flush=True)
         save_result("coarse_start", {"rows": rows})

@@ -13,10 +13,10 @@ plane (``flat``: the part keeps its sharp edges).  Writes
 ``benchmarks/results/curved.json``.  Each (case, operator, accuracy) runs in a fresh
 Python process so its peak resident memory is its own; the exact run comes first and the
 preview's (and the fast preview's, never refined, what the viewer would show first)
-lowest 50 non-zero eigenvalues are compared with it.  The child processes keep the C
-library's default memory settings (not
-:func:`modalviewer.processes.memory.prepare_compute_process`), so their peaks compare
-with each other, not with ``benchmarks.growth``'s.
+lowest 50 non-zero eigenvalues are compared with it.  The child processes compute with
+the memory settings of the viewer's and the command line's compute processes
+(:func:`modalviewer.processes.memory.prepare_compute_process`), so their peaks are what
+a user's computation needs.
 """
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ from benchmarks.run import add_keep_others, kept_rows, save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
+from modalviewer.processes.memory import prepare_compute_process
+prepare_compute_process()
 import numpy as np
 import modalviewer as mv
 asset, scheme, level = sys.argv[1], sys.argv[2], int(sys.argv[3])
