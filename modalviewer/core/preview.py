@@ -551,20 +551,6 @@ def _block_columns(n: int) -> int:
     return int(np.clip(BLOCK_BYTES // (8 * max(n, 1)), 8, 16))
 
 
-SUBSPACE_BLOCK_BYTES = 35e6
-"""Bytes of an (N, w) block of the subspace steps' solves and products
-(:func:`_subspace_step`): 16 columns up to 273k unknowns, fewer above, 8 from 547k.
-The cow Loop x3's two-step refined 3D shells preview (557k unknowns) peaked at 3207 and
-3209 MB with blocks of 16 and at 3123 MB with blocks of 8 (the exact solve: 3187 MB), in
-1.07 to 1.1 times the time; the coarse start's solves keep :data:`BLOCK_BYTES`, where
-narrower blocks would cost it a quarter of its step."""
-
-
-def _subspace_step_columns(n: int) -> int:
-    """Columns per block of :func:`_subspace_step` for N = ``n`` rows."""
-    return int(np.clip(SUBSPACE_BLOCK_BYTES // (8 * max(n, 1)), 8, 16))
-
-
 def _rows(n: int):
     return (slice(i, min(i + ROW_CHUNK, n)) for i in range(0, n, ROW_CHUNK))
 
@@ -595,7 +581,7 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
     Memory: beside U and the factor, the new directions Y (live columns, float32: they
     only span the space; the projected K and Mass matrices are formed from the stored
     values, so the Ritz pairs are those of exactly that space) and two (N, 8 to 32)
-    float64 blocks (:data:`SUBSPACE_BLOCK_BYTES`): right-hand sides and solutions, then a block of
+    float64 blocks (:data:`BLOCK_BYTES`): right-hand sides and solutions, then a block of
     Y and its product with K, both reused throughout.  Each solved block is Mass-normalised (a zero
     mode's column is 1/|shift| times larger than the rest) and orthogonalised against U
     in float64 before it is stored; directions left with less than 1e-6 of their norm
@@ -606,7 +592,7 @@ def _subspace_step(K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, 
     u = b if live is None else int(live)
     Uw = U[:, :u]
     Y = np.empty((n, u), dtype=np.float32)
-    step = _subspace_step_columns(n)
+    step = _block_columns(n)
     rhs = np.empty((n, step), order="F")
     for j in range(0, u, step):
         cols = slice(j, min(j + step, u))

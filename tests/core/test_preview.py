@@ -384,7 +384,7 @@ def test_subspace_step_row_passes_stay_small_beside_its_blocks():
     buffer = np.ascontiguousarray(U)
     del U
     n, c = buffer.shape
-    step = pv._subspace_step_columns(n)
+    step = pv._block_columns(n)
     block = 8.0 * n * min(step, c)
     y_bytes = 4.0 * n * c
     tracemalloc.start()
@@ -413,7 +413,7 @@ def test_subspace_step_keeps_two_blocks_beside_its_new_directions(monkeypatch):
     buffer = np.empty((U.shape[0], 20))
     buffer[:, :16] = U
     n = U.shape[0]
-    step = pv._subspace_step_columns(n)
+    step = pv._block_columns(n)
     block = 8.0 * n * min(step, 16)
     y_bytes = 4.0 * n * 16
     tracemalloc.start()
@@ -775,26 +775,6 @@ def _solve_widths(monkeypatch) -> list[int]:
 
     monkeypatch.setattr(pv.SPDSolver, "solve", counting)
     return widths
-
-
-def test_subspace_steps_solve_8_columns_at_a_time_from_547k_unknowns(monkeypatch):
-    """The refinement's subspace steps solve 16 columns a block up to 273k unknowns and
-    8 from 547k (the cow Loop x3's 3D shells, 557k: the two-step refined preview peaked
-    at 3208 MB with 16, above the exact solve's 3187 MB, and 3123 MB with 8); a step
-    solves its live columns in blocks of that width."""
-    assert pv._subspace_step_columns(557_187) == 8
-    assert pv._subspace_step_columns(273_000) == 16
-    assert pv._subspace_step_columns(400_000) == 10
-    plate = bumpy_plate(40)
-    K, mass = operator_matrices(plate, "shells")
-    lam, U, _, _ = pv.preview_spectrum(plate, "shells", K, mass, 20, refine=False)
-    solver = pv._factor_below(K, mass, lam, float(np.median(K.diagonal() / mass)))
-    n = U.shape[0]
-    # the block width a 557k-unknown mesh gets, on this small one
-    monkeypatch.setattr(pv, "SUBSPACE_BLOCK_BYTES", 8.0 * n * 8)
-    widths = _solve_widths(monkeypatch)
-    pv._subspace_step(K, mass, solver, lam, np.ascontiguousarray(U), live=U.shape[1])
-    assert widths == [8, 8, 4], widths
 
 
 def test_the_correction_step_solves_at_most_32_columns_at_a_time(monkeypatch):
