@@ -8,6 +8,14 @@ import numpy as np
 import pytest
 
 
+def _printed_by_fresh_process(code: str) -> str:
+    """What ``code`` prints, run in a fresh Python process (the memory settings act on the
+    whole process and only before its threads allocate); fails the test if it fails."""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    return out.stdout
+
+
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
 def test_the_memory_settings_take_effect_in_a_fresh_process():
     code = (
@@ -19,9 +27,7 @@ def test_the_memory_settings_take_effect_in_a_fresh_process():
         "assert np._core.multiarray._set_madvise_hugepage(True) is False\n"
         "print(ok)\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
-    assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "True"
+    assert _printed_by_fresh_process(code).strip() == "True"
 
 
 ONE_ARENA = """
@@ -70,11 +76,8 @@ def test_a_compute_process_keeps_small_arrays_and_gives_big_ones_back():
     goes back to the system as it is freed (served from the heap, the (N, k) blocks left
     holes the next did not fit: spot Loop x3's exact 3D shells peaked at 3667 MB, with
     them given back 3401)."""
-    out = subprocess.run(
-        [sys.executable, "-c", BIG_AND_SMALL], capture_output=True, text=True, timeout=60
-    )
-    assert out.returncode == 0, out.stderr
-    kept_small, returned_big = map(float, out.stdout.split())
+    printed = _printed_by_fresh_process(BIG_AND_SMALL)
+    kept_small, returned_big = map(float, printed.split())
     assert kept_small < 2.0  # MB given back of the 20 MB array: none
     assert returned_big > 180.0  # of the 200 MB array
 
@@ -85,11 +88,8 @@ def test_memory_freed_on_a_worker_thread_is_reused_on_the_main_thread():
     array freed on a worker thread (the solver's, the row passes') is reused by the next
     array the main thread makes, where an arena per thread kept both resident (the
     refined E_D^N preview of spot Loop x2: 423 MB against the exact solve's 288)."""
-    out = subprocess.run(
-        [sys.executable, "-c", ONE_ARENA], capture_output=True, text=True, timeout=60
-    )
-    assert out.returncode == 0, out.stderr
-    assert float(out.stdout) < 5.0  # MB grown; 18.6 with an arena per thread
+    printed = _printed_by_fresh_process(ONE_ARENA)
+    assert float(printed) < 5.0  # MB grown; 18.6 with an arena per thread
 
 
 def test_the_viewer_child_process_computes_with_the_memory_settings(tmp_path):
@@ -174,11 +174,8 @@ print(ran, kept - resident_mb())
 def test_freed_memory_goes_back_to_the_system_in_a_compute_process():
     """A compute process keeps freed heap memory (processes.memory); the pipeline's
     return_freed_memory at each stage gives the pages of ten freed 20 MB arrays back."""
-    out = subprocess.run(
-        [sys.executable, "-c", RETURN_FREED], capture_output=True, text=True, timeout=60
-    )
-    assert out.returncode == 0, out.stderr
-    ran, returned = out.stdout.split()
+    printed = _printed_by_fresh_process(RETURN_FREED)
+    ran, returned = printed.split()
     assert ran == "True"
     assert float(returned) > 150.0
 
