@@ -114,13 +114,11 @@ def main(argv=None) -> int:
         row["coarse_vertices"] = coarse["coarse_vertices"]
         start, stages = coarse["start_seconds"], coarse["stage_seconds"]
         if "factor" in start:  # the coarse start ran (no fallback to the smooth space)
+            estimate = stages.get("estimate", 0.0)
             fine = (
-                exact["assembly_seconds"]
-                + start["factor"]
-                + start["inverse_iteration"]
-                + stages.get("estimate", 0.0)
+                exact["assembly_seconds"] + start["factor"] + start["inverse_iteration"] + estimate
             )
-            row["coarse_stage_seconds"] = {**start, "estimate": stages.get("estimate", 0.0)}
+            row["coarse_stage_seconds"] = {**start, "estimate": estimate}
             row["factor_stages_time_ratio"] = round(fine / exact["seconds"], 3)
         rows.append(row)
         print(json.dumps(row), flush=True)

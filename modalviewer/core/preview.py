@@ -531,10 +531,10 @@ ROW_CHUNK = 2048
 (N, c) x (c, c) products are written in place chunk by chunk, so no second (N, c) array
 is alive at once.  A pass holds three or four (rows, c) float64 temporaries (a float32
 block widened, two products, their sum): 1.6 MB each at 100 modes.  In a compute
-process (freed memory kept, :mod:`modalviewer.processes.memory`) the refined E_D^N
-preview of spot Loop x2 (47k) peaked at 280 to 282 MB with 2048 rows and 293 to 311 MB
-with 16384 (the exact solve: 287 to 288 MB); the cow Loop x3's (186k) refined Laplacian
-preview took the same time and memory with either (paired runs)."""
+process serving every array from the heap (:mod:`modalviewer.processes.memory`) the
+refined E_D^N preview of spot Loop x2 (47k) peaked at 280 to 282 MB with 2048 rows and
+293 to 311 MB with 16384 (the exact solve: 287 to 288 MB); the cow Loop x3's (186k)
+refined Laplacian preview took the same time and memory with either (paired runs)."""
 
 
 BLOCK_BYTES = 80e6

@@ -48,10 +48,11 @@ _M_ARENA_MAX = -8
 HEAP_ARRAY_MAX_BYTES = 32 * 2**20
 """Arrays up to this size come from the heap in a compute process and their memory is
 reused when freed; bigger ones are mapped and unmapped (glibc's mmap threshold, at its
-largest on 64-bit systems).  Spot Loop x3 (187k vertices), paired runs against serving
-every array from the heap: the exact 3D shells' peak 3401 against 3667 MB (glibc's
-default: 3404 MB), the fast 3D shells preview 2697 against 2752 MB at 1.04 times the
-time; cow Loop x3 Laplacian exact 713 against 730 MB at 1.02 times."""
+largest on 64-bit systems).  Against serving every array from the heap: spot Loop x3's
+(187k vertices) exact 3D shells peaked at 3401 against 3667 MB (one run each; glibc's
+defaults: 3404 MB); in paired runs its fast 3D shells preview at 2697 against 2752 MB
+in 1.04 times the time, and the cow Loop x3's Laplacian exact solve at 713 against 730
+MB in 1.02 times."""
 
 
 def _mallopt():
