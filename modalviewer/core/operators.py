@@ -271,14 +271,14 @@ _SHELLS_SPACE = SpaceSettings(100, 1.0, 2, 1.8, True, True, refine=True, factor_
 # the time grows with k), made by `python -m benchmarks.growth`; tests/core/test_cost.py
 # checks that they are those fits.
 _GROWTH: dict[tuple[str, str], GrowthLaw] = {
-    ("laplacian", "exact"): GrowthLaw(8.409, 0.949, 414.7, 0.897, 1.097),
-    ("laplacian", "fast preview"): GrowthLaw(2.659, 0.895, 399.4, 0.782, 0.548),
-    ("modified_dirichlet", "exact"): GrowthLaw(8.162, 0.98, 410.6, 0.896, 1.061),
-    ("modified_dirichlet", "fast preview"): GrowthLaw(2.846, 0.903, 402.4, 0.774, 0.466),
-    ("shells", "exact"): GrowthLaw(36.287, 1.109, 1684.4, 1.017, 0.968),
-    ("shells", "fast preview"): GrowthLaw(8.723, 1.137, 1461.0, 0.946, 0.621),
-    ("shells_normal", "exact"): GrowthLaw(7.395, 1.54, 463.5, 0.899, 0.622),
-    ("shells_normal", "fast preview"): GrowthLaw(5.849, 0.98, 443.5, 0.873, 0.604),
+    ("laplacian", "exact"): GrowthLaw(8.401, 1.109, 410.0, 0.864, 1.23),
+    ("laplacian", "fast preview"): GrowthLaw(2.888, 0.95, 324.7, 0.848, 0.496),
+    ("modified_dirichlet", "exact"): GrowthLaw(8.935, 1.051, 411.7, 0.864, 1.162),
+    ("modified_dirichlet", "fast preview"): GrowthLaw(2.967, 0.964, 320.8, 0.851, 0.534),
+    ("shells", "exact"): GrowthLaw(50.105, 1.077, 1549.9, 1.026, 0.93),
+    ("shells", "fast preview"): GrowthLaw(10.902, 1.139, 1298.5, 0.995, 0.627),
+    ("shells_normal", "exact"): GrowthLaw(9.014, 1.535, 454.2, 0.893, 0.714),
+    ("shells_normal", "fast preview"): GrowthLaw(6.455, 0.998, 419.0, 0.862, 0.555),
 }
 
 # factor_memory: the fits of benchmarks/results/factor_memory.json (PARDISO's analysis of

@@ -44,8 +44,8 @@ PREVIEW_MARGIN = 1.75
 """A preview comes first only where this many times its predicted time fits within
 :data:`PREVIEW_DELAY` of the exact solve's predicted time: the growth laws are fitted
 on plates, and on the curved benchmark meshes of 100k to 270k vertices a fast preview's
-share of the exact time was up to 1.69 times the share the laws predict (Cheburashka
-Loop x2's 3D shells: the preview took 0.41 of the exact time, the laws say 0.24;
+share of the exact time was up to 1.70 times the share the laws predict (Cheburashka
+Loop x2's 3D shells: the preview took 0.37 of the exact time, the laws say 0.22;
 ``benchmarks/results/curved.json``, which ``tests/viewer/test_state_model.py`` checks
 the margin against), and a preview that runs past its share is thrown away
 (:attr:`PreviewPlan.deadline`)."""
