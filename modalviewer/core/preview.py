@@ -348,7 +348,8 @@ TWO_LEVEL_BLOCK_COLUMNS = 16
 """Columns of the two-level step's float32 directions W widened to double at a time for
 ``K W``: one (N, 16) block beside U and W, where W in double precision would add half an
 (N, k) array (the 337k plate's normal shells, 300 modes: the fast preview's peak 2571 MB
-with W in double precision, 2220 MB so; the exact solve 2402 MB)."""
+with W in double precision, 2233 MB so, in 1.05 to 1.08 times the time; the exact
+solve 2402 MB: benchmarks/results/growth_k300.json)."""
 
 
 def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, precondition):
