@@ -79,6 +79,14 @@ print(json.dumps({"vertices": mesh.n_vertices, "unknowns": int(X.shape[0]), "sec
 """
 
 
+def relative_differences(lam: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Relative differences of the eigenvalues both arrays have (zero modes relative to
+    1e-12 of the largest reference eigenvalue)."""
+    m = min(lam.shape[0], reference.shape[0])
+    scale = np.maximum(np.abs(reference[:m]), 1e-12 * np.abs(reference[:m]).max())
+    return np.abs(lam[:m] - reference[:m]) / scale
+
+
 def run(mesh: str, level: int, operator: str, k: int, limit: str) -> dict:
     env = dict(os.environ)
     env.pop("MODALVIEWER_MEMORY_LIMIT_MB", None)
@@ -133,9 +141,7 @@ def main(argv=None) -> int:
             reference = lam
             row["largest_relative_difference"] = 0.0
         else:
-            m = min(lam.shape[0], reference.shape[0])
-            scale = np.maximum(np.abs(reference[:m]), 1e-12 * np.abs(reference[:m]).max())
-            difference = np.abs(lam[:m] - reference[:m]) / scale
+            difference = relative_differences(lam, reference)
             row["largest_relative_difference"] = float(np.max(difference))
             row["compared_with"] = compared_with or f"{label}, limit {args.limits[0]}"
         row.update(mesh=label, operator=args.operator, k=args.k, limit_mb=limit)

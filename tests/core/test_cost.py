@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from benchmarks.growth import _fits, mode_exponents
+from benchmarks.memory import relative_differences
 from modalviewer.core.cost import GrowthLaw
 from modalviewer.core.operators import OPERATOR_INFO, operator_info
 
@@ -209,20 +210,14 @@ def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
         elif single_either:
             # the stored run benchmarks.memory compared with: the first of that label
             reference = next(q for q in others if "eigenvalues" in q)
-            difference = _eigenvalue_differences(r, reference)
+            difference = relative_differences(
+                np.array(r["eigenvalues"]), np.array(reference["eigenvalues"])
+            )
             assert np.all(difference <= _residual_bounds(r, reference)), r["mesh"]
             assert r["largest_relative_difference"] == pytest.approx(difference.max())
         else:
             assert r["largest_relative_difference"] < 1e-10
         assert r["mass_orthonormality"] < 1e-10
-
-
-def _eigenvalue_differences(row: dict, reference: dict) -> np.ndarray:
-    """Relative differences of the modes both runs have, as benchmarks.memory makes them."""
-    lam, ref = np.array(row["eigenvalues"]), np.array(reference["eigenvalues"])
-    m = min(lam.shape[0], ref.shape[0])
-    scale = np.maximum(np.abs(ref[:m]), 1e-12 * np.abs(ref[:m]).max())
-    return np.abs(lam[:m] - ref[:m]) / scale
 
 
 def _residual_bounds(row: dict, reference: dict) -> np.ndarray:
