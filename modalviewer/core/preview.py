@@ -378,9 +378,9 @@ def _two_level_step(K, mass, basis: ReducedBasis, Kr, Mr, lam, U, precondition):
 
     def residuals(rows, KU):
         R = KU - (mass[rows, None] * U[rows]) * lam[None, :]
-        W[rows] = precondition(R, rows)
-        Wr = W[rows].astype(np.float64)
-        return np.einsum("ij,ij->j", Wr, mass[rows, None] * Wr)
+        D = precondition(R, rows)
+        W[rows] = D
+        return np.einsum("ij,ij->j", D, mass[rows, None] * D)
 
     norms = row_block_sums(K, U, residuals)
     # unit Mass norm; residuals of (numerically) converged pairs add nothing
