@@ -53,13 +53,13 @@ def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> f
     :data:`GROWTH_MODES` modes plus, for each further mode, its share of the arrays that
     grow with k: the Krylov basis (:func:`basis_columns`) and the modes themselves, one
     column of ``n_unknowns`` doubles each (fewer modes: less of them).  Runs it was not
-    fitted to measured 0.82 to 1.13 times it: 300 modes on the 337k plate for all four
-    operators 0.82 to 0.89 (every further column is counted in full; the solve's peak
+    fitted to measured 0.83 to 1.15 times it: 300 modes on the 337k plate for all four
+    operators 0.83 to 0.90 (every further column is counted in full; the solve's peak
     holds fewer at once), 100 modes on Loop-subdivided spot, the hand and the cow
-    (curved, thin parts, 186k to 206k vertices) 0.96 to 1.07, Cheburashka Loop x2's
-    (107k) 1.03 to 1.13, the 3D shells' 300 modes of
-    Cheburashka at 427k vertices 1.03 (``benchmarks/growth.py``, "Memory check" in
-    docs/performance.md)."""
+    (curved, thin parts, 186k to 206k vertices) 0.99 to 1.15 (the 3D shells' factors
+    fill in more than the plates'), Cheburashka Loop x2's (107k) 1.11 to 1.13, the 3D
+    shells' 300 modes of Cheburashka at 427k vertices 1.08 (``benchmarks/growth.py``,
+    "Memory check" in docs/performance.md)."""
     n = max(int(n_unknowns), 1)
     k, k0 = min(int(k), n), min(GROWTH_MODES, n)
     columns = basis_columns(k, n) - basis_columns(k0, n) + (k - k0)
