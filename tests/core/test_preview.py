@@ -179,6 +179,48 @@ def _no_single_factor(monkeypatch):
     monkeypatch.setattr(pv, "_single_factor", lambda *args: None)
 
 
+def test_first_order_errors_read_a_residual_in_the_modes_just_above():
+    """K = diag(1..60), M = I, solved through a factor of K + s I.  A Ritz vector of mode
+    i mixed with one mode j has the eigenvalue error c_j^2 (lam_j - lam_i) exactly;
+    ``r^T S r`` alone reads it short by (lam_j - theta) / (lam_j + s), half here, and
+    the estimate with ``|S r|`` reads it whole.  Mixed with two modes it stays below the
+    first-order error and above ``r^T S r`` alone; with the neighbour just above (q
+    above the cap) it is 1 / (1 - cap) times ``r^T S r``."""
+    from modalviewer.core.factor import SPDSolver
+
+    n, s = 60, 0.5
+    lam = np.arange(1.0, n + 1.0)
+    K = sp.diags(lam).tocsr()
+    mass = np.ones(n)
+    solver = pv.ShiftedFactor(SPDSolver(K + s * sp.identity(n, format="csr")), s)
+
+    def estimate(weights: dict[int, float]):
+        u = np.zeros(n)
+        for j, c in weights.items():
+            u[j] = c
+        u /= np.linalg.norm(u)
+        theta = float(u @ (lam * u))
+        est = pv._factor_estimate(K, mass, solver, np.array([theta]), u[:, None], 1.0, 0)[1]
+        r = lam * u - theta * u
+        plain = float(r @ (r / (lam + s))) / theta
+        return float(est[0]), plain, theta
+
+    i = 9  # lam_i = 10
+    # one mode above, at twice lam_i: r^T S r alone reads 10 / 20.5 of the error
+    e, plain, theta = estimate({i: 1.0, 19: 0.01})
+    true = (theta - lam[i]) / theta
+    # equal to first order: the terms of c_j^4 (c_j^2 = 1e-4) stay
+    assert e == pytest.approx(true, rel=1e-3)
+    assert plain == pytest.approx(true * (lam[19] - theta) / (lam[19] + s), rel=1e-3)
+    # two modes above: between r^T S r alone and the first-order error
+    e, plain, theta = estimate({i: 1.0, 14: 0.01, 59: 0.01})
+    true = (theta - lam[i]) / theta
+    assert plain < e <= true * (1 + 1e-9) and e > 0.9 * true
+    # the neighbour just above: q = (theta + s) / (lam_j + s) = 0.91, above the cap
+    e, plain, theta = estimate({i: 1.0, 10: 0.01})
+    assert e == pytest.approx(plain / (1 - pv.NEIGHBOUR_SHARE_CAP), rel=1e-9)
+
+
 def test_factor_step_recovers_the_modes_a_thin_tube_locks():
     """A torus with a thin tube (640 vertices, minor radius 0.06), 3D shells: the smooth
     space locks (Galerkin largest error above 50 %).  One step preconditioned by a
@@ -213,10 +255,11 @@ def test_factor_step_recovers_the_modes_a_thin_tube_locks():
         assert np.all(np.abs(values[:6]) < 1e-9 * scale)  # the rigid motions stay exact
         np.testing.assert_allclose(modes.T @ (mass[:, None] * modes), np.eye(k), atol=1e-9)
         assert modes.shape == (K.shape[0], k) and modes.flags.c_contiguous
-    # the estimate r^T F^-1 r / lam: a lower estimate, of the error's size
+    # the estimate from r^T F^-1 r and |F^-1 r|_M: of the error's size (measured: the
+    # largest 1.03 and 0.68 times the largest error)
     for errors, i in ((one, fast), (two, info)):
         estimated = np.array(i["estimated_errors"])[nonzero]
-        assert 0.3 < estimated.max() / errors.max() <= 1.0
+        assert 0.5 < estimated.max() / errors.max() <= 1.5
         assert np.all(estimated[errors > 1e-7] < 2 * errors[errors > 1e-7])
     # the reported residuals are those of the returned pairs
     R = K @ U - (mass[:, None] * U) * lam
@@ -889,14 +932,17 @@ def test_a_coarse_copy_start_finds_the_spectrum_with_its_null_space_whole():
     assert np.all(lam[6:] >= exact.eigenvalues[6:] * (1 - 1e-9))
     lowest = slice(6, 6 + (k - 6) // 2)
     assert np.max(lam[lowest] / exact.eigenvalues[lowest] - 1) < 0.02
-    # each mode's estimate (from the start's factor) reads its true error within a
-    # factor of about two (measured 0.48 to 0.97 here)
+    # each mode's estimate (from the start's factor) reads its true error closely,
+    # the top modes' too, whose errors lie in the modes just above them (measured 0.78
+    # to 1.07 times, median 1.00, the largest estimate 1.07 times the largest error;
+    # r^T S r / lam alone read 0.48 to 0.86 times and the largest at 0.49)
     error = lam[6:] / exact.eigenvalues[6:] - 1
     estimate = np.array(info["estimated_errors"][6:])
     sizable = error > 1e-3
     assert sizable.sum() >= 10
     ratio = estimate[sizable] / error[sizable]
-    assert ratio.min() > 0.4 and ratio.max() < 1.2
+    assert ratio.min() > 0.7 and ratio.max() < 1.3
+    assert 0.8 < estimate.max() / error.max() < 1.3
 
 
 def test_a_copy_still_being_made_is_waited_for_after_the_assembly(monkeypatch):
