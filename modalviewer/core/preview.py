@@ -909,7 +909,8 @@ def _factor_steps(
     time) make the next step.  The
     zero modes (the rigid motions, exact in the Galerkin space) are kept out of the new
     directions.  With ``give_up``, where the lower half of the non-zero modes is still
-    estimated above ``refine_above`` after a step, no further step is taken and
+    estimated above ``refine_above`` after the last step, or above
+    :data:`GIVE_UP_ABOVE` after an earlier one, no further step is taken and
     ``info["unconverged"]`` is set: modes the smooth space missed altogether (the cow's
     tail: its Galerkin values ten times too high) come in only slowly through a
     preconditioner shifted by ``lam_1``, and subspace iteration shifted near zero finds
@@ -955,8 +956,12 @@ def _factor_steps(
             est = np.zeros(c)
             est[first:] = _first_order_errors(lam[first:], solver.shift, energies, norms)
             info.setdefault("estimated_error_first_step", float(est.max()))
-            lower = est[first:][: max(1, int(np.ceil(0.5 * (c - first))))]
-            info["unconverged"] = bool(give_up and lower.max() > refine_above)
+            lower = est[first:][: max(1, int(np.ceil(0.5 * (c - first))))].max()
+            # before the last step only a lower half far off (modes missing) gives up; a
+            # lower half a little above the threshold takes the next step
+            last = info["steps"] >= 1 + max_steps
+            bar = refine_above if last else max(refine_above, GIVE_UP_ABOVE)
+            info["unconverged"] = bool(give_up and lower > bar)
             if info["unconverged"] or info["steps"] >= 1 + max_steps or est.max() <= refine_above:
                 break
             t = time.perf_counter()
@@ -972,6 +977,16 @@ def _factor_steps(
         cols = slice(first, c)
     info["seconds"] = {s: round(v, 4) for s, v in seconds.items()}
     return lam, res, est, info
+
+
+GIVE_UP_ABOVE = 0.05
+"""A refined 3D shells preview whose lower half of non-zero modes is estimated above
+this after the first correction step leaves the steps for the caller's subspace
+iteration (modes missing: the cow Loop x3's, Cheburashka's and homer's lower halves are
+20 to 200 % off after it); between the refinement threshold and this it takes the next
+step (the 10k benchmark mesh, spot midpoint-subdivided once, 100 modes: 2.45 % off,
+estimated 2.1 %; the second step takes it to 0.09 %, where the subspace iteration took
+4.2 s more)."""
 
 
 REFINE_GUARD = 0.25

@@ -267,6 +267,25 @@ def test_factor_step_recovers_the_modes_a_thin_tube_locks():
     np.testing.assert_allclose(res[6:], direct[6:] / lam[6:], rtol=1e-6)
 
 
+def test_a_lower_half_a_little_off_takes_a_second_step_before_giving_up(monkeypatch):
+    """The refined 3D shells preview of the thin torus (20 modes; after the first
+    correction step its lower half is estimated at about 1e-4): with the refinement
+    threshold below that, a lower half under GIVE_UP_ABOVE takes the second factor step
+    and only then, still above the threshold, leaves the rest to the subspace iteration;
+    above GIVE_UP_ABOVE (modes missing) it gives up after the first step."""
+    mesh = torus(64, 10, minor=0.06)
+    K, mass = operator_matrices(mesh, "shells")
+    monkeypatch.setattr(pv, "REFINE_ABOVE", 1e-9)  # every estimate is above it
+    monkeypatch.setattr(pv, "GIVE_UP_ABOVE", 1.0)
+    info = pv.preview_spectrum(mesh, "shells", K, mass, 20)[3]
+    assert info["factor_step"]["steps"] == 1 + pv.STEP_REFINE_STEPS
+    assert info["factor_step"]["unconverged"] and info["refinement"]["steps"] == pv.REFINE_STEPS
+    monkeypatch.setattr(pv, "GIVE_UP_ABOVE", 1e-9)
+    info = pv.preview_spectrum(mesh, "shells", K, mass, 20)[3]
+    assert info["factor_step"]["steps"] == 1
+    assert info["factor_step"]["unconverged"] and info["refinement"]["steps"] == pv.REFINE_STEPS
+
+
 def test_thin_tube_without_room_for_a_single_precision_factor(monkeypatch):
     """Where the single-precision factor does not fit (here: taken away), the 3D shells
     preview is the two-level step and, above the estimate's threshold, two steps of
@@ -320,11 +339,12 @@ def test_refinement_is_for_previews_the_estimate_calls_rough(ring, monkeypatch):
     monkeypatch.setattr(pv, "REFINE_ABOVE", 1.0)
     *_, info = pv.preview_spectrum(ring, "shells", K, mass, 20)
     assert info["refinement"]["steps"] == 0 and info["factor_step"]["steps"] == 1
-    # a threshold no step can meet: the lower half counts as unconverged (modes missing),
-    # so the subspace iteration shifted near zero refines instead of further steps
+    # a threshold no step can meet: after the last step the lower half counts as
+    # unconverged (modes missing), so the subspace iteration shifted near zero refines
     monkeypatch.setattr(pv, "REFINE_ABOVE", 0.0)
     *_, info = pv.preview_spectrum(ring, "shells", K, mass, 20)
-    assert info["factor_step"]["unconverged"] and info["factor_step"]["steps"] == 1
+    assert info["factor_step"]["unconverged"]
+    assert info["factor_step"]["steps"] == 1 + pv.STEP_REFINE_STEPS
     assert info["refinement"]["steps"] == pv.REFINE_STEPS
     assert info["correction"] == "single-precision factor step"
     monkeypatch.undo()
