@@ -80,9 +80,12 @@ class PreviewPlan:
         if self.pays:
             return ""
         if self.n_vertices < LAWS_FROM_VERTICES:
+            # only requests predicted to take NOTE_FROM_SECONDS or more are told why, so
+            # the exact solve is not "quick" here: the reason is the preview's fixed costs
             return (
                 f"no preview below {LAWS_FROM_VERTICES:,} vertices".replace(",", "\u00a0")
-                + ": the exact solve is quick there"
+                + f" (the exact solve: about {_seconds(self.exact_seconds)}): there a "
+                "preview's fixed costs take too large a share of the exact time"
             )
         share = PREVIEW_DELAY * self.exact_seconds
         if PREVIEW_MARGIN * self.preview_seconds > share:
@@ -111,7 +114,8 @@ def _megabytes(value: float) -> str:
 
 
 def _seconds(value: float) -> str:
-    return f"{value:.0f}\u00a0s" if value >= 10 else f"{value:.1f}\u00a0s"
+    """Seconds in words: a decimal below 10 s ("9.9 s"), none from there ("10 s")."""
+    return f"{value:.0f}\u00a0s" if round(value, 1) >= 10 else f"{value:.1f}\u00a0s"
 
 
 def preview_plan(key: SpectrumKey, n_vertices: int) -> PreviewPlan:
@@ -243,6 +247,16 @@ def what_fits(
     return text[0].upper() + text[1:] + "."
 
 
+def _share_words(available: int) -> str:
+    """The memory a computation may take, in words: "the 17.6 GiB a computation may take
+    (three quarters of this machine's 23.5 GiB)"."""
+    share = {0.75: "three quarters", 0.5: "half"}.get(MEMORY_SHARE, f"{MEMORY_SHARE:.0%}")
+    return (
+        f"the {MEMORY_SHARE * available / 2**30:.1f} GiB a computation may take ({share} of "
+        f"this machine's {available / 2**30:.1f} GiB)"
+    )
+
+
 def memory_refusal(
     key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS, preview: str = PREVIEW_WORDS
 ) -> str | None:
@@ -256,7 +270,7 @@ def memory_refusal(
         return (
             f"{operator_info(key.operator).label} with {key.k} modes on "
             f"{n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory "
-            f"and {seconds / 60:.0f} min; this machine has {available / 2**30:.1f} GiB. "
+            f"and {seconds / 60:.0f} min, more than {_share_words(available)}. "
             + what_fits(key, n_vertices, available, coarse, preview)
         )
     return None
@@ -269,8 +283,8 @@ def preview_refusal(key: SpectrumKey, n_vertices: int) -> str | None:
     if available and not preview_fits(key, n_vertices, available):
         return (
             f"Even a preview of {operator_info(key.operator).label} with {key.k} modes on "
-            f"{n_vertices} vertices would need more than this machine's "
-            f"{available / 2**30:.1f} GiB allow: use a coarser mesh or fewer modes."
+            f"{n_vertices} vertices would need more than {_share_words(available)}: use a "
+            "coarser mesh or fewer modes."
         )
     return None
 

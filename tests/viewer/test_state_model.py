@@ -440,8 +440,11 @@ def test_the_predictor_lets_a_preview_come_first_only_where_it_pays(monkeypatch)
     assert preview_plan(SpectrumKey("laplacian", 100), 100_000).pays
     small = preview_plan(SpectrumKey("laplacian", 100), 99_999)
     assert not small.pays
+    # the exact solve's predicted time is named, not called quick: only requests of
+    # NOTE_FROM_SECONDS or more are told why they get no preview
     assert small.reason() == (
-        "no preview below 100\u00a0000 vertices: the exact solve is quick there"
+        "no preview below 100\u00a0000 vertices (the exact solve: about 10\u00a0s): there a "
+        "preview's fixed costs take too large a share of the exact time"
     ), small.reason()
 
 
@@ -803,6 +806,12 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     assert model_module.memory_needed(replace(key, k=k), n) <= limit
     assert model_module.memory_needed(replace(key, k=k + 1), n) > limit
     assert "Coarse-to-fine" in message
+    # it names the limit it applies, not only the machine's memory (above which a
+    # refused request's need can lie)
+    assert (
+        f"more than the {limit / 2**30:.1f} GiB a computation may take (three quarters of "
+        f"this machine's {available / 2**30:.1f} GiB)" in message
+    ), message
     monkeypatch.setattr(model_module, "physical_memory", lambda: 1024)
     assert "Not even one mode fits" in m.refusal(key)
 
