@@ -27,6 +27,12 @@ SIMILAR_BLUE = np.array([0.20, 0.45, 0.85])
 # the white background of the paper style).
 GHOST_GREY = (0.55, 0.55, 0.6)
 GHOST_OPACITY = 0.18
+SURFACE_DEPTH_OFFSET = (2.0, 4.0)
+"""Polygon offset (factor, units) of the surface: it stands back in depth from its
+isolines, which lie on it."""
+GHOST_DEPTH_OFFSET = (8.0, 32.0)
+"""Polygon offset (factor, units) of the rest shape's ghost, further back than the
+surface's, so the ghost is drawn behind the surface where the two coincide."""
 
 
 def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
@@ -212,7 +218,7 @@ class MeshScene:
         # Push the surface slightly back in depth so the isolines lying on it are not
         # half hidden by depth fighting.
         self._mapper.SetResolveCoincidentTopologyToPolygonOffset()
-        self._mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 4.0)
+        self._mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(*SURFACE_DEPTH_OFFSET)
         self.isolines = pv.PolyData()
         self.zero_line = pv.PolyData()
         self.iso_actor = None
@@ -640,6 +646,12 @@ class MeshScene:
                 pickable=False,
             )
             self.ghost_actor.mapper.ScalarVisibilityOff()
+            # further back in depth than the surface (GHOST_DEPTH_OFFSET): where a mode
+            # barely moves the surface, the ghost lies behind it instead of fighting it
+            # for the pixels (pale blotches where the two meet)
+            self.ghost_actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(
+                *GHOST_DEPTH_OFFSET
+            )
         self.ghost_actor.SetVisibility(bool(visible))
 
     @property

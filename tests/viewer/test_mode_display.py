@@ -90,6 +90,27 @@ def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
         state.set_shell_coloring("deformed")
 
 
+def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
+    """At amplitude 1 (the largest displacement a four-hundredth of the diagonal) the
+    deformed surface nearly coincides with the rest shape's ghost: drawn behind it, the
+    ghost leaves the picture as it is without it.  Where the two fought for the pixels,
+    pale blotches showed on the parts a mode barely moves."""
+    state = machined.state
+    scene = machined.renderer(SIZE).scene
+    state.set_animation(amplitude=1)
+    try:
+        state.set_ghost(True)
+        with_ghost = machined.image(size=SIZE).astype(int)
+        assert scene.ghost_visible
+        state.set_ghost(False)
+        without = machined.image(size=SIZE).astype(int)
+    finally:
+        state.set_ghost(True)
+        state.set_animation(amplitude=40)
+    changed = (np.abs(with_ghost - without).max(axis=2) > 8).mean()
+    assert changed < 0.002, changed
+
+
 def test_old_settings_asking_for_automatic_get_the_deformed_shape(machined):
     state = machined.state
     state.set_shell_coloring("normal")
