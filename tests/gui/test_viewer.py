@@ -201,6 +201,65 @@ def test_loading_a_mesh_during_a_computation_drops_the_old_result(
     assert spec.n_vertices == 2930
 
 
+def _slow_reading(monkeypatch, seconds: float):
+    """load_mesh taking ``seconds`` longer, as a big file's reading does."""
+    import time
+
+    from modalviewer import io
+
+    real = io.load_mesh
+
+    def slow(path, strict=True):
+        time.sleep(seconds)
+        return real(path, strict=strict)
+
+    monkeypatch.setattr(io, "load_mesh", slow)
+
+
+def test_a_mesh_file_is_read_while_the_window_keeps_drawing(window, spot_path, monkeypatch):
+    """A mesh file is read in a worker thread: while a reading of 1.5 s goes on, the
+    window's event loop runs (a 20 ms timer ticks), the dialog naming the file shows,
+    and then the mesh opens.  Before, the window froze for the whole reading (a
+    1.5M-vertex OBJ: 15 to 20 s with the file dialog painted over it)."""
+    from qtpy import QtCore, QtWidgets
+
+    _slow_reading(monkeypatch, 1.5)
+    ticks, seen = [], []
+    timer = QtCore.QTimer()
+    timer.timeout.connect(lambda: ticks.append(1))
+    timer.start(20)
+
+    def look():
+        seen.extend(
+            d.labelText() for d in window.findChildren(QtWidgets.QProgressDialog) if d.isVisible()
+        )
+
+    QtCore.QTimer.singleShot(1200, look)
+    assert window.open_mesh(spot_path)
+    timer.stop()
+    assert len(ticks) >= 30, len(ticks)  # 1.5 s of 20 ms ticks: 75 when idle
+    assert seen and seen[0].startswith("Opening spot.obj"), seen
+    assert window.state.mesh is not None and window.state.mesh_path == spot_path
+
+
+def test_a_slow_reading_can_be_cancelled_and_keeps_the_mesh(window, spot_path, monkeypatch):
+    from qtpy import QtCore, QtWidgets
+
+    window.open_mesh(spot_path)
+    shown = window.state.mesh
+    _slow_reading(monkeypatch, 2.0)
+
+    def cancel():  # the dialog's Cancel button, as a person presses it
+        for dialog in window.findChildren(QtWidgets.QProgressDialog):
+            if dialog.isVisible():
+                dialog.findChild(QtWidgets.QPushButton).click()
+
+    QtCore.QTimer.singleShot(1200, cancel)
+    assert not window.open_mesh(spot_path.with_name("demo_hand.obj"))
+    assert window.state.mesh is shown
+    assert "cancelled" in window.statusBar().currentMessage()
+
+
 def test_bad_file_gives_a_message_and_keeps_the_mesh(window, spot_path, tmp_path):
     window.open_mesh(spot_path)
     bad = tmp_path / "broken.obj"
