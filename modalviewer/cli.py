@@ -123,6 +123,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="first remove needle and cap triangles with modalviewer.fix_slivers (needs "
         "the optional pymeshlab: pip install 'modalviewer[repair]')",
     )
+    _partial_argument(c)
     r = sub.add_parser("render", help="render a mode to PNG")
     r.add_argument("mesh")
     r.add_argument("--operator", choices=OPERATORS, default="laplacian")
@@ -146,6 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="first remove needle and cap triangles with modalviewer.fix_slivers (needs "
         "the optional pymeshlab: pip install 'modalviewer[repair]')",
     )
+    _partial_argument(r)
     d = sub.add_parser(
         "distance", help="distance from a vertex to all vertices (of a second mesh with --to)"
     )
@@ -204,6 +206,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="first remove needle and cap triangles with modalviewer.fix_slivers (needs "
         "the optional pymeshlab: pip install 'modalviewer[repair]'); with --to, both meshes",
     )
+    _partial_argument(d)
     f = sub.add_parser("figures", help="rebuild the paper's figures on the demo meshes")
     f.add_argument("-o", "--output", default="screenshots")
     from .batch_cli import add_parsers
@@ -242,7 +245,7 @@ def _run(args) -> int:
         from .processes.memory import prepare_compute_process
 
         prepare_compute_process()  # this process exists to compute (see processes.memory)
-        mesh = _load(args.mesh, args.fix_slivers)
+        mesh = _load(args.mesh, args.fix_slivers, args.partial)
         _refuse_if_too_large(mesh, args.operator, args.k, args.preview)
         coarse = None
         bar = _progress_bar()
@@ -297,7 +300,7 @@ def _run(args) -> int:
                 + f" ({spec.parameters['operator_columns']} operator columns)"
             )
         return 0
-    mesh = _load(args.mesh, args.fix_slivers)
+    mesh = _load(args.mesh, args.fix_slivers, args.partial)
     if args.command == "render":
         viewer = _viewer(mesh, args.mesh)
         viewer.state.set_isolines(args.isolines)
@@ -395,10 +398,24 @@ class _Unavailable(Exception):
     """An option needing an optional package that is not installed (exit code 2)."""
 
 
-def _load(path, fix_slivers: bool = False):
+def _partial_argument(parser) -> None:
+    parser.add_argument(
+        "--partial",
+        action="store_true",
+        help="read a damaged or truncated file's whole records and say what was dropped "
+        "(without it such a file is refused, naming the place of the damage)",
+    )
+
+
+def _load(path, fix_slivers: bool = False, partial: bool = False):
     """The mesh read from ``path``; with ``fix_slivers``, repaired by
-    :func:`modalviewer.fix_slivers`, whose report is printed."""
+    :func:`modalviewer.fix_slivers`, whose report is printed.  A damaged or truncated
+    file is refused with the place of the damage and the advice of ``--partial``, which
+    reads its whole records and prints what was dropped."""
     import modalviewer as mv
+
+    from .core.mesh import MeshError
+    from .readers import DamagedFileError
 
     if fix_slivers:  # before reading: a missing package is found out at once
         from .repair import REPAIR_PACKAGES
@@ -411,7 +428,14 @@ def _load(path, fix_slivers: bool = False):
                 f"--fix-slivers needs the optional package {module} (GPL-3.0), which is not "
                 f"installed: {command} (or pip install {module})"
             ) from None
-    mesh = mv.load_mesh(path)
+    try:
+        mesh = mv.load_mesh(path, strict=not partial)
+    except DamagedFileError as exc:
+        raise MeshError(
+            f"{exc.detail}; the file is damaged or truncated: --partial reads its whole records"
+        ) from None
+    if partial and mesh.report.messages:
+        print(f"{Path(path).name}: {' '.join(mesh.report.messages)}")
     if fix_slivers:
         mesh = mv.fix_slivers(mesh, progress=_progress_bar())
         print(f"{Path(path).name}: fix slivers: {' '.join(mesh.report.messages)}")
@@ -500,7 +524,7 @@ def _distance_to(args, mesh_a) -> int:
             "--up and --view apply to one mesh's picture; with --to each mesh is shown "
             "from its first view, turned to face the picked vertex and its best match"
         )
-    mesh_b = _load(args.to, args.fix_slivers)
+    mesh_b = _load(args.to, args.fix_slivers, args.partial)
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
     operator = KINDS[args.kind]

@@ -31,7 +31,16 @@ __all__ = ["DamagedFileError", "MeshFile", "read_mesh_file", "strips_to_triangle
 
 class DamagedFileError(MeshError):
     """A file of its format, damaged or truncated: ``load_mesh(path, strict=False)``
-    loads its complete records (the viewer offers this as "Open anyway")."""
+    loads its complete records (the viewer offers this as "Open anyway", the command
+    line as ``--partial``).  ``detail`` is the message without that advice, for callers
+    that give their own."""
+
+    def __init__(self, detail: str):
+        super().__init__(
+            detail + "; the file is damaged or truncated "
+            "(load_mesh(path, strict=False) or 'Open anyway' loads what is there)"
+        )
+        self.detail = detail
 
 
 @dataclass
@@ -52,10 +61,7 @@ class _Damage:
     def __call__(self, where: str, what: str) -> None:
         message = f"{self.name}: {where}: {what}"
         if self.strict:
-            raise DamagedFileError(
-                message + "; the file is damaged or truncated "
-                "(load_mesh(path, strict=False) or 'Open anyway' loads what is there)"
-            )
+            raise DamagedFileError(message)
         self.notes.append(f"{where}: {what}")
 
     def ends_early(self, where: str, read: int, announced: str) -> None:

@@ -384,3 +384,27 @@ def test_no_coarse_copy_where_the_exact_factor_would_go_out_of_core(monkeypatch)
     assert preview_copy_for(ring, "laplacian", 24) is None
     monkeypatch.setattr(memory, "memory_limit_mb", lambda: 100.0)
     assert preview_copy_for(ring, "shells", 24) is None
+
+
+def test_a_truncated_file_is_refused_with_the_command_lines_advice(tmp_path, capsys):
+    """A truncated OBJ: ``compute`` refuses it naming the place of the damage and the
+    advice that works on the command line (--partial, not the viewer's "Open anyway" or
+    the library's strict=False); with --partial it computes on the whole records and
+    says what was dropped."""
+    from modalviewer import cli
+
+    text = (ASSETS / "spot.obj").read_text()
+    cut = text.rfind("\nf ") + 4  # within the last face's record
+    broken = tmp_path / "cut.obj"
+    broken.write_text(text[:cut])
+    out = tmp_path / "s.npz"
+    args = ["compute", str(broken), "--operator", "laplacian", "-k", "5", "-o", str(out)]
+    assert cli.main(args) == 1
+    err = capsys.readouterr().err
+    assert "cut.obj" in err and "--partial reads its whole records" in err, err
+    assert "Open anyway" not in err and "strict=False" not in err
+    assert not out.exists()
+    assert cli.main([*args, "--partial"]) == 0
+    printed = capsys.readouterr().out
+    assert printed.startswith("cut.obj: "), printed
+    assert out.exists()
