@@ -107,7 +107,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.compute_panel = ComputePanel(self.state)
         self.compute_panel.computeRequested.connect(lambda: self.compute(wait=False))
-        self.jobs_panel = JobsPanel(self.model.jobs)
+        self.jobs_panel = JobsPanel(self.model.jobs, self.state)
         self.modes_panel = ModesPanel(self.state)
         self.animation_panel = AnimationPanel(self.state)
         self.distances_panel = DistancesPanel(self.state)

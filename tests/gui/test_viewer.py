@@ -197,8 +197,15 @@ def test_loading_a_mesh_during_a_computation_drops_the_old_result(
     qtbot.waitUntil(lambda: old_job.done, timeout=60000)
     qtbot.wait(100)
     assert window.spectra == {}
+    # the jobs panel's "Last:" does not describe the old mesh's cancelled job
+    assert window.jobs_panel.last.isHidden(), window.jobs_panel.last.text()
     spec = window.compute("laplacian", k=10, wait=True)
     assert spec.n_vertices == 2930
+    qtbot.wait(100)
+    assert "Last:" in window.jobs_panel.last.text() and not window.jobs_panel.last.isHidden()
+    # and is cleared when another mesh is opened
+    assert window.open_mesh(spot_path.with_name("demo_hand.obj"))
+    assert window.jobs_panel.last.isHidden() and window.jobs_panel.last.text() == ""
 
 
 def _slow_reading(monkeypatch, seconds: float):

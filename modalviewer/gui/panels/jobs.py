@@ -11,11 +11,17 @@ from .common import WrappingLabel
 
 
 class JobsPanel(QtWidgets.QWidget):
-    """One row per queued or running job: description, progress, Cancel."""
+    """One row per queued or running job: description, progress, Cancel; and "Last:",
+    how the last job of the mesh on screen ended.
 
-    def __init__(self, jobs: JobQueue, parent=None):
+    ``state`` (a :class:`~modalviewer.viewer.state.ViewerState`): with it, "Last:" is
+    cleared when another mesh is opened, and a job of another mesh (one the new mesh
+    cancelled) does not fill it again."""
+
+    def __init__(self, jobs: JobQueue, state=None, parent=None):
         super().__init__(parent)
         self.jobs = jobs
+        self.state = state
         self.layout_ = QtWidgets.QVBoxLayout(self)
         self.layout_.setContentsMargins(0, 0, 0, 0)
         self.empty = QtWidgets.QLabel("No computation running.")
@@ -25,6 +31,16 @@ class JobsPanel(QtWidgets.QWidget):
         self.layout_.addWidget(self.last)
         self.rows: dict[int, tuple[QtWidgets.QWidget, QtWidgets.QLabel]] = {}
         jobs.events.changed.connect(self._on_changed)
+        if state is not None:
+            state.events.mesh.connect(self._on_mesh)
+
+    def _on_mesh(self) -> None:
+        self.last.clear()
+        self.last.hide()
+
+    def _of_another_mesh(self, job: Job) -> bool:
+        mesh = None if self.state is None else self.state.mesh
+        return job.owner is not None and mesh is not None and job.owner != mesh.hash
 
     def _on_changed(self, job: Job) -> None:
         row = self.rows.get(job.id)
@@ -32,8 +48,9 @@ class JobsPanel(QtWidgets.QWidget):
             if row is not None:
                 row[0].deleteLater()
                 del self.rows[job.id]
-                self.last.setText(f"Last: {ended_text(job)}")
-                self.last.show()
+                if not self._of_another_mesh(job):
+                    self.last.setText(f"Last: {ended_text(job)}")
+                    self.last.show()
         else:
             if row is None:
                 row = self._make_row(job)
