@@ -53,8 +53,8 @@ READING_WAIT_S = 0.2
 """A mesh file read within this many seconds opens without running the event loop
 (:meth:`MainWindow._read_mesh`): the bundled meshes and most scans under 100k vertices."""
 
-READING_DIALOG_AFTER_MS = 800
-"""A reading that lasts this long shows the dialog with Cancel."""
+READING_DIALOG_S = 0.8
+"""A reading that lasts this many seconds shows the dialog with Cancel."""
 
 
 class MainWindow(QtWidgets.QMainWindow):
@@ -270,7 +270,7 @@ class MainWindow(QtWidgets.QMainWindow):
     def _read_mesh(self, path: Path, strict: bool) -> Mesh | None:
         """:func:`modalviewer.load_mesh` of ``path`` in a worker thread while the event
         loop runs, so the window keeps drawing (a 1.5M-vertex OBJ takes 15 to 20 s to
-        read).  After :data:`READING_DIALOG_AFTER_MS` a modal dialog names the file with
+        read).  After :data:`READING_DIALOG_S` a modal dialog names the file with
         a busy bar and Cancel.  Returns the mesh, None if cancelled (the thread then
         reads on and its mesh is dropped: a parser cannot be stopped midway), or raises
         what ``load_mesh`` raises."""
@@ -278,6 +278,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
         from ..io import load_mesh
 
+        started = time.monotonic()
         pool = ThreadPoolExecutor(1, thread_name_prefix="mesh-reader")
         future = pool.submit(load_mesh, path, strict=strict)
         pool.shutdown(wait=False)
@@ -292,16 +293,14 @@ class MainWindow(QtWidgets.QMainWindow):
         dialog = QtWidgets.QProgressDialog(f"Opening {path.name}{size}...", "Cancel", 0, 0, self)
         dialog.setWindowTitle("Opening mesh")
         dialog.setWindowModality(QtCore.Qt.WindowModality.WindowModal)
-        started = time.monotonic()
+        loop = QtCore.QEventLoop()
 
         def tick():  # shown by hand: QProgressDialog's own delay restarts at each value
             if future.done() or dialog.wasCanceled():
                 loop.quit()
-            elif not dialog.isVisible() and time.monotonic() - started >= wait_s:
+            elif not dialog.isVisible() and time.monotonic() - started >= READING_DIALOG_S:
                 dialog.show()
 
-        wait_s = READING_DIALOG_AFTER_MS / 1000 - READING_WAIT_S
-        loop = QtCore.QEventLoop()
         timer = QtCore.QTimer()
         timer.setInterval(50)
         timer.timeout.connect(tick)

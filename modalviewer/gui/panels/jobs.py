@@ -14,11 +14,11 @@ class JobsPanel(QtWidgets.QWidget):
     """One row per queued or running job: description, progress, Cancel; and "Last:",
     how the last job of the mesh on screen ended.
 
-    ``state`` (a :class:`~modalviewer.viewer.state.ViewerState`): with it, "Last:" is
-    cleared when another mesh is opened, and a job of another mesh (one the new mesh
-    cancelled) does not fill it again."""
+    ``state`` (the :class:`~modalviewer.viewer.state.ViewerState`): "Last:" is cleared
+    when another mesh is opened, and a job of another mesh (one the new mesh cancelled)
+    does not fill it again."""
 
-    def __init__(self, jobs: JobQueue, state=None, parent=None):
+    def __init__(self, jobs: JobQueue, state, parent=None):
         super().__init__(parent)
         self.jobs = jobs
         self.state = state
@@ -31,15 +31,14 @@ class JobsPanel(QtWidgets.QWidget):
         self.layout_.addWidget(self.last)
         self.rows: dict[int, tuple[QtWidgets.QWidget, QtWidgets.QLabel]] = {}
         jobs.events.changed.connect(self._on_changed)
-        if state is not None:
-            state.events.mesh.connect(self._on_mesh)
+        state.events.mesh.connect(self._on_mesh)
 
     def _on_mesh(self) -> None:
         self.last.clear()
         self.last.hide()
 
     def _of_another_mesh(self, job: Job) -> bool:
-        mesh = None if self.state is None else self.state.mesh
+        mesh = self.state.mesh
         return job.owner is not None and mesh is not None and job.owner != mesh.hash
 
     def _on_changed(self, job: Job) -> None:
