@@ -33,6 +33,12 @@ isolines, which lie on it."""
 GHOST_DEPTH_OFFSET = (8.0, 32.0)
 """Polygon offset (factor, units) of the rest shape's ghost, further back than the
 surface's, so the ghost is drawn behind the surface where the two coincide."""
+GHOST_FADE = (0.005, 0.02)
+"""Where a vertex moves less than the first share of the bounding-box diagonal the
+ghost is not drawn there, from the second on at :data:`GHOST_OPACITY`, linearly between:
+where the displaced surface lies within a hair of the rest shape the ghost shows nothing
+(the two coincide) and would only fight the surface for the pixels (grey patches where
+the surface moved slightly behind it, beyond any depth offset)."""
 
 
 def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
@@ -229,6 +235,7 @@ class MeshScene:
         self._zero_disp = None
         self.marker_actor = None
         self.ghost_actor = None  # the rest shape, faint, behind a displaced surface
+        self._ghost_rest = None  # its mesh
         self.picker = vtkCellPicker()
         self.picker.SetTolerance(1e-4)
         self.picker.PickFromListOn()
@@ -623,9 +630,11 @@ class MeshScene:
             if rest is not None:
                 self._move(line, rest, d, s)
 
-    def set_ghost(self, visible: bool) -> None:
-        """Show the rest shape as a faint translucent grey copy (behind a surface drawn
-        displaced, :meth:`set_displacement_scale`), or hide it; no render."""
+    def set_ghost(self, visible: bool, reach: float = 0.0) -> None:
+        """Show the rest shape as a faint translucent grey copy behind a surface drawn
+        displaced by ``reach`` times its displacement (:meth:`set_displacement_scale`),
+        or hide it; no render.  The ghost fades out where the surface moves less than
+        :data:`GHOST_FADE` of the bounding-box diagonal (:meth:`ghost_opacities`)."""
         if self.ghost_actor is None:
             if not visible:
                 return
@@ -633,26 +642,40 @@ class MeshScene:
             rest = pv.PolyData(self.rest_points.copy(), faces)
             rest.point_data["Normals"] = self.normals
             rest.GetPointData().SetNormals(rest.GetPointData().GetArray("Normals"))
+            rest.point_data["ghost_rgba"] = np.zeros((self.mesh.n_vertices, 4), np.uint8)
+            self._ghost_rest = rest  # its colours change with the mode shown
             self.ghost_actor = self.plotter.add_mesh(
                 rest,
-                color=GHOST_GREY,
-                opacity=GHOST_OPACITY,
+                scalars="ghost_rgba",
+                rgba=True,
                 interpolation="phong",
                 name="ghost",
                 render=False,
                 reset_camera=False,
                 show_scalar_bar=False,
-                scalars=None,
                 pickable=False,
             )
-            self.ghost_actor.mapper.ScalarVisibilityOff()
             # further back in depth than the surface (GHOST_DEPTH_OFFSET): where a mode
             # barely moves the surface, the ghost lies behind it instead of fighting it
             # for the pixels (pale blotches where the two meet)
             self.ghost_actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(
                 *GHOST_DEPTH_OFFSET
             )
+        if visible:
+            rgba = self._ghost_rest.point_data["ghost_rgba"]
+            rgba[:, :3] = np.round(np.asarray(GHOST_GREY) * 255).astype(np.uint8)
+            rgba[:, 3] = np.round(255 * self.ghost_opacities(reach)).astype(np.uint8)
+            self._ghost_rest.GetPointData().GetArray("ghost_rgba").Modified()
         self.ghost_actor.SetVisibility(bool(visible))
+
+    def ghost_opacities(self, reach: float) -> np.ndarray:
+        """Per-vertex opacity (n,) of the ghost behind the surface displaced by ``reach``
+        times its displacement: :data:`GHOST_OPACITY` where a vertex moves at least the
+        second share of :data:`GHOST_FADE` of the bounding-box diagonal, 0 below the
+        first, linear between."""
+        moved = np.linalg.norm(self.surface.point_data["displacement"], axis=1) * abs(reach)
+        low, high = (share * self.mesh.bounding_box_diagonal for share in GHOST_FADE)
+        return GHOST_OPACITY * np.clip((moved - low) / (high - low), 0.0, 1.0)
 
     @property
     def ghost_visible(self) -> bool:

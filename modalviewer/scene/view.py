@@ -44,7 +44,7 @@ def draw_field(scene: MeshScene, field: Field | None) -> None:
     deformation = field.deformation if field is not None else 0.0
     if deformation:
         scene.set_displacement_scale(deformation)
-    scene.set_ghost(bool(field is not None and field.ghost))
+    scene.set_ghost(bool(field is not None and field.ghost), deformation)
 
 
 class StateScene:

@@ -92,9 +92,9 @@ def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
 
 def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
     """At amplitude 1 (the largest displacement a four-hundredth of the diagonal) the
-    deformed surface nearly coincides with the rest shape's ghost: drawn behind it, the
-    ghost leaves the picture as it is without it.  Where the two fought for the pixels,
-    pale blotches showed on the parts a mode barely moves."""
+    deformed surface nearly coincides with the rest shape's ghost: drawn behind it and
+    faded out there, the ghost leaves the picture as it is without it.  Where the two
+    fought for the pixels, pale blotches showed on the parts a mode barely moves."""
     state = machined.state
     scene = machined.renderer(SIZE).scene
     state.set_animation(amplitude=1)
@@ -247,3 +247,52 @@ def test_sessions_keep_the_mode_display_and_colour_range(spot, tmp_path):
         )
     finally:
         again.close()
+
+
+def test_the_ghost_fades_where_the_surface_moved_slightly_behind_it():
+    """A plate seen face on whose left half moves a hair away from the camera (0.3 % of
+    the diagonal, beyond any depth offset) while its right half swings toward it: the
+    ghost of the left half stands just in front of the surface there and would grey it
+    over (the cow's flank in its tail mode).  It fades out where the surface moves less
+    than GHOST_FADE, so the picture is as it is without it; where the right half moved
+    out the ghost is behind the surface, hidden.  Without the fading 50 % of the plate's
+    pixels change."""
+    from modalviewer.core.laplacian import vertex_normals
+    from modalviewer.core.primitives import grid_plate
+    from modalviewer.scene.mesh_scene import GHOST_FADE, GHOST_OPACITY, MeshScene
+    from modalviewer.scene.offscreen import offscreen_plotter
+    from modalviewer.scene.view import draw_field
+    from modalviewer.viewer.derived import Field
+
+    mesh = grid_plate(40, 40)  # the unit square in the XY plane
+    x = mesh.vertices[:, 0]
+    reach = 0.1 * mesh.bounding_box_diagonal  # the default amplitude's largest motion
+    behind = 0.03  # of the largest displacement: 0.3 % of the diagonal
+    assert behind * 0.1 < GHOST_FADE[0]
+    shape = np.where(x < 0.5, -behind, -behind + (1 + behind) * np.clip(2 * x - 1, 0, 1))
+    displacement = np.zeros((mesh.n_vertices, 3))
+    displacement[:, 2] = shape  # toward the camera on +z
+    light_blue = np.full(mesh.n_vertices, 0.5)
+    field = Field(light_blue, "diverging", clim=(-1.0, 1.0), deformation=reach)
+    field.displacement = displacement
+    plotter = offscreen_plotter((400, 300))
+    try:
+        scene = MeshScene(plotter, mesh, vertex_normals(mesh))
+        scene.apply_camera_preset("+z")
+        pictures = []
+        for ghost in (True, False):
+            field.ghost = ghost
+            draw_field(scene, field)
+            assert scene.ghost_visible == ghost
+            plotter.render()
+            pictures.append(plotter.screenshot(return_img=True).astype(int))
+        plate = np.abs(pictures[1] - 255).max(axis=2) > 8
+        changed = (np.abs(pictures[0] - pictures[1]).max(axis=2) > 8)[plate].mean()
+        assert plate.mean() > 0.2, plate.mean()
+        assert changed < 0.01, changed  # 0.0 % with the fading ghost
+        # the ghost itself: full where the right half moved far, none on the left half
+        opacities = scene.ghost_opacities(reach)
+        assert opacities[x < 0.5].max() == 0.0
+        assert opacities[x > 0.75].min() == pytest.approx(GHOST_OPACITY)
+    finally:
+        plotter.close()
