@@ -17,6 +17,7 @@ import importlib
 from dataclasses import dataclass
 
 from .cost import (
+    FILL_MARGIN,
     OUT_OF_CORE_TIME_FACTOR,
     FactorLaw,
     GrowthLaw,
@@ -169,7 +170,9 @@ class OperatorInfo:
         """Peak memory (MB) of that computation with ``k`` modes: the exact solve's law
         with the arrays that grow with k (:func:`.cost.exact_peak_mb`), less the factor's
         in-core size plus its out-of-core size where the factor goes out of core
-        (``out_of_core``; None: as :meth:`factor_out_of_core` predicts), less what a
+        (``out_of_core``; None: as :meth:`factor_out_of_core` predicts), plus the factor's
+        further fill on curved meshes (:data:`.cost.FILL_MARGIN` times the factor's law
+        for the place it is kept), less what a
         single-precision Krylov basis saves where it is kept so
         (:func:`.cost.float32_basis_saving_mb`; ``basis_float32``; None: as the solver
         decides, where the peak so far is above this machine's
@@ -180,10 +183,12 @@ class OperatorInfo:
         if accuracy != "exact":
             extra = self.preview_arrays_per_mode * 8.0 * self.unknowns(n_vertices) * max(0, k - 100)
             return law.peak_mb(n_vertices) + extra / 2**20
-        peak = exact_peak_mb(law, n_vertices, self.unknowns(n_vertices), k)
+        peak = self._in_core_peak_mb(n_vertices, k)
         if self._out_of_core(n_vertices, k, out_of_core):
             factor = self.factor_memory
-            peak += factor.out_of_core_mb(n_vertices) - factor.in_core_mb(n_vertices)
+            peak += FILL_MARGIN * (
+                factor.out_of_core_mb(n_vertices) - factor.in_core_mb(n_vertices)
+            )
         if basis_float32 is None:
             from .memory import memory_limit_mb
 
@@ -204,9 +209,17 @@ class OperatorInfo:
             from .memory import memory_limit_mb
 
             limit_mb = memory_limit_mb()
-        law = self.growth("exact")
-        peak = exact_peak_mb(law, n_vertices, self.unknowns(n_vertices), k)
+        peak = self._in_core_peak_mb(n_vertices, k)
         return factor_goes_out_of_core(peak, self.factor_memory, n_vertices, limit_mb)
+
+    def _in_core_peak_mb(self, n_vertices: int, k: int) -> float:
+        """The exact solve's predicted peak with its factor in core: the law with the
+        arrays that grow with k (:func:`.cost.exact_peak_mb`) and the factor at
+        :data:`.cost.FILL_MARGIN` times its law."""
+        peak = exact_peak_mb(self.growth("exact"), n_vertices, self.unknowns(n_vertices), k)
+        if self.factor_memory is not None:
+            peak += (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
+        return peak
 
     def _out_of_core(self, n_vertices: int, k: int, out_of_core: bool | None) -> bool:
         if out_of_core is None:
