@@ -178,11 +178,12 @@ class OperatorInfo:
         decides, where the peak so far is above this machine's
         :func:`.memory.memory_limit_mb`); the fast preview's (measured at 100 modes)
         plus :attr:`preview_arrays_per_mode` float64 (N,) arrays for each mode above 100
-        (its modes, the correction's directions and their blocks)."""
+        (its modes, the correction's directions and their blocks) and the same further
+        fill of the factor as the exact solve's."""
         law = self.growth(accuracy)
         if accuracy != "exact":
             extra = self.preview_arrays_per_mode * 8.0 * self.unknowns(n_vertices) * max(0, k - 100)
-            return law.peak_mb(n_vertices) + extra / 2**20
+            return law.peak_mb(n_vertices) + extra / 2**20 + self._further_fill_mb(n_vertices)
         peak = self._in_core_peak_mb(n_vertices, k)
         if self._out_of_core(n_vertices, k, out_of_core):
             factor = self.factor_memory
@@ -217,9 +218,16 @@ class OperatorInfo:
         arrays that grow with k (:func:`.cost.exact_peak_mb`) and the factor at
         :data:`.cost.FILL_MARGIN` times its law."""
         peak = exact_peak_mb(self.growth("exact"), n_vertices, self.unknowns(n_vertices), k)
-        if self.factor_memory is not None:
-            peak += (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
-        return peak
+        return peak + self._further_fill_mb(n_vertices)
+
+    def _further_fill_mb(self, n_vertices: int) -> float:
+        """What a factor in core fills in on a curved mesh beyond the plates' law
+        (:data:`.cost.FILL_MARGIN`).  Added to the previews' predictions too: they factor
+        the same operator, and a preview is compared with the exact solve like for
+        like."""
+        if self.factor_memory is None:
+            return 0.0
+        return (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
 
     def _out_of_core(self, n_vertices: int, k: int, out_of_core: bool | None) -> bool:
         if out_of_core is None:

@@ -384,7 +384,10 @@ def _growth(monkeypatch, operator, exact, preview):
     exact = (*exact, 1.0) if len(exact) == 4 else exact
     preview = (*preview, 0.3) if len(preview) == 4 else preview
     info = replace(
-        OPERATOR_INFO[operator], exact_growth=GrowthLaw(*exact), preview_growth=GrowthLaw(*preview)
+        OPERATOR_INFO[operator],
+        exact_growth=GrowthLaw(*exact),
+        preview_growth=GrowthLaw(*preview),
+        factor_memory=None,  # the peaks are the laws' alone (no further fill of a factor)
     )
     monkeypatch.setitem(OPERATOR_INFO, operator, info)
 
