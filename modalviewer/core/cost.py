@@ -132,9 +132,9 @@ FILL_MARGIN = 1.26
 from.  PARDISO's analysis of Loop-subdivided spot (187k vertices) and the hand (206k)
 gives their 3D shells' factors 1.256 and 1.235 times the law in core, their scalar
 operators' 1.15 to 1.23 times (``benchmarks/results/factor_memory.json``, "curved").
-Without it the 3D shells of such meshes needed up to 1.15 times the predicted peak; the
-plates' own runs now need 0.82 to 0.9 of it, so there the check errs on the side of
-refusing."""
+Without it the prediction for the 3D shells of such meshes would be up to 1.15 times
+too low; with it the plates' own runs need 0.82 to 0.9 of the prediction, so there the
+check errs on the side of refusing."""
 
 OUT_OF_CORE_TIME_FACTOR = 1.2
 """An exact solve whose factor is out of core takes this times as long (its solves read
