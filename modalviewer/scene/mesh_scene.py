@@ -30,15 +30,18 @@ GHOST_OPACITY = 0.18
 SURFACE_DEPTH_OFFSET = (2.0, 4.0)
 """Polygon offset (factor, units) of the surface: it stands back in depth from its
 isolines, which lie on it."""
-GHOST_DEPTH_OFFSET = (8.0, 32.0)
-"""Polygon offset (factor, units) of the rest shape's ghost, further back than the
-surface's, so the ghost is drawn behind the surface where the two coincide."""
+GHOST_DEPTH_OFFSET = (0.0, 1e8)
+"""Polygon offset (factor, units) of the rest shape's ghost: a hundred million of the
+depth buffer's smallest steps push every ghost fragment to the back of the depth range,
+so the ghost shows only where no surface is drawn, beside the deformed shape, as
+structural-analysis tools draw the undeformed shape.  Where the deformed surface moved
+behind the rest shape the ghost stood in front of it and greyed it over in patches with
+stair-stepped edges where the two cross (the teapot's body, the cow's neck)."""
 GHOST_FADE = (0.005, 0.02)
 """Where a vertex moves less than the first share of the bounding-box diagonal the
 ghost is not drawn there, from the second on at :data:`GHOST_OPACITY`, linearly between:
 where the displaced surface lies within a hair of the rest shape the ghost shows nothing
-(the two coincide) and would only fight the surface for the pixels (grey patches where
-the surface moved slightly behind it, beyond any depth offset)."""
+but thin grey rims along the surface's outline."""
 
 
 def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
@@ -452,7 +455,8 @@ class MeshScene:
         white elsewhere.  The colour is looked up after interpolation along the surface,
         so the boundary follows the line where the interpolated distance crosses the
         threshold instead of a staircase along triangle edges (which colouring the 0/1
-        indicator gives); :meth:`set_threshold` then only changes the lookup table."""
+        indicator gives); :meth:`set_threshold` then only changes the lookup table and
+        the scalar range."""
         values = np.asarray(distances, dtype=np.float64)
         self.surface.point_data["field"] = values
         hi = float(np.max(values)) or 1.0
@@ -467,19 +471,24 @@ class MeshScene:
         self.set_threshold(threshold)
 
     def set_threshold(self, threshold: float) -> None:
-        """Move the threshold of a map made by :meth:`show_threshold`; no render."""
+        """Move the threshold of a map made by :meth:`show_threshold`; no render.
+
+        The scalar range is centred on the threshold and the table is blue below its
+        middle, white above: the step lies exactly on the threshold however small it is
+        beside the largest distance (a table spread over 0 to the largest distance put
+        every threshold below its first entry's width in that entry)."""
         n = 2048
         lo, hi = self.clim
-        cut = int(np.clip(np.floor((threshold - lo) / ((hi - lo) or 1.0) * n), 0, n - 1))
+        reach = max(threshold - lo, hi - threshold, 1e-300)
         table = np.empty((n, 4))
         table[:, :3] = WHITE
-        table[: cut + 1, :3] = SIMILAR_BLUE
+        table[: n // 2, :3] = SIMILAR_BLUE
         table[:, 3] = 1.0
         lut = pv.LookupTable()
         lut.SetNumberOfTableValues(n)
         lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
         self._mapper.lookup_table = lut
-        self._mapper.scalar_range = self.clim
+        self._mapper.scalar_range = (threshold - reach, threshold + reach)
         self.threshold = float(threshold)
         self._overlay_changed()
 
@@ -655,9 +664,8 @@ class MeshScene:
                 show_scalar_bar=False,
                 pickable=False,
             )
-            # further back in depth than the surface (GHOST_DEPTH_OFFSET): where a mode
-            # barely moves the surface, the ghost lies behind it instead of fighting it
-            # for the pixels (pale blotches where the two meet)
+            # at the back of the depth range (GHOST_DEPTH_OFFSET): the surface always
+            # covers it
             self.ghost_actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(
                 *GHOST_DEPTH_OFFSET
             )

@@ -246,6 +246,35 @@ def test_threshold_map_from_distances_moves_with_the_lookup_table_only(view, spo
     assert scene.colorbar().kind == "swatches"
 
 
+def test_a_threshold_far_below_the_largest_distance_moves_the_map(view, spot_mode):
+    """Distances with a far tail (a thin part unlike the rest: the cow's tail from its
+    flank, 1.25 against a median of 0.003): thresholds within a two-thousandth of the
+    largest distance still move the blue region, and it covers the vertices below the
+    threshold.  A table spread from 0 to the largest distance drew every such threshold
+    as its first entry, the same picture for 3.5 % to 30 % of the surface."""
+    mesh, _, _ = spot_mode
+    v = mesh.vertices
+    d = np.linalg.norm(v - v[np.argmax(v[:, 0])], axis=1)  # a vertex on the seen side
+    far = d.copy()
+    far[np.argmin(v[:, 0])] = 5000 * d.max()  # one vertex on the far side, unseen
+    scene = _scene(view, mesh)
+
+    def blue_pixels():
+        view.plotter.render()
+        img = np.asarray(view.plotter.screenshot(None, return_img=True)).astype(int)
+        return int((img[:, :, 2] > img[:, :, 0] + 60).sum())
+
+    counts, reference = [], []
+    for share in (0.2, 0.4, 0.6):
+        scene.show_threshold(far, share * d.max(), name="distance < t")
+        counts.append(blue_pixels())
+        scene.show_threshold(d, share * d.max(), name="distance < t")
+        reference.append(blue_pixels())
+    assert 500 < counts[0] < counts[1] < counts[2], counts
+    for c, r in zip(counts, reference, strict=True):
+        assert abs(c - r) <= 0.02 * r, (counts, reference)
+
+
 def test_a_long_legend_wraps_inside_the_export(view, spot_mode, tmp_path):
     """A preview's legend is longer than a narrow export is wide: it wraps at spaces
     instead of running off the right edge."""

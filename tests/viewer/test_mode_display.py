@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.ndimage import binary_erosion
 
 from modalviewer.core.laplacian import lumped_masses
 from modalviewer.scene.overlay import ColorBar, Overlay, draw_overlay
@@ -67,6 +68,12 @@ def test_the_amplitude_sets_the_largest_displacement(machined):
 
 
 def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
+    """The ghost shows where the rest shape is and the deformed shape is not (89 % of
+    those pixels change; it fades at its edges), and never over the deformed surface.
+    Where that had moved behind the rest shape the ghost greyed it over in patches
+    before it was drawn at the back of the depth range: 20 % of this part's deformed
+    surface in mode 8, 30 % of the teapot's in its mode 21 and 14 % of the cow Loop x2's
+    in its mode 10 changed with the ghost."""
     state = machined.state
     state.set_ghost(True)
     with_ghost = machined.image(size=SIZE).astype(int)
@@ -77,10 +84,18 @@ def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
     try:
         without = machined.image(size=SIZE).astype(int)
         assert not scene.ghost_visible
+        deformed = _silhouette(machined)
+        state.set_shell_coloring("normal")
+        rest = _silhouette(machined)
     finally:
+        state.set_shell_coloring("deformed")
         state.set_ghost(True)
-    changed = (np.abs(with_ghost - without).max(axis=2) > 8).mean()
-    assert changed > 0.02, changed  # 11 % of the picture
+    changed = np.abs(with_ghost - without).max(axis=2) > 8
+    beside = rest & ~deformed
+    assert beside.sum() > 1000, beside.sum()
+    assert changed[beside].mean() > 0.6, changed[beside].mean()
+    inside = binary_erosion(deformed, iterations=2)  # not the antialiased outline
+    assert changed[inside].mean() < 0.002, changed[inside].mean()
     # a mode on the rest shape has no ghost
     state.set_shell_coloring("magnitude")
     try:
