@@ -284,6 +284,12 @@ def _run(args) -> int:
             )
         from .viewer.model import memory_text, residual_text
 
+        if spec.k < args.k:
+            from .core.operators import operator_info
+
+            unknowns = operator_info(args.operator).unknowns(mesh.n_vertices)
+            whole = f": all the mesh has ({unknowns} unknowns)" if spec.k >= unknowns else ""
+            print(f"asked for {args.k} modes, {spec.k} came{whole}")
         print(
             f"{Path(args.mesh).name}: {spec.k} {args.operator} modes, eigenvalues "
             f"{spec.eigenvalues[0]:.6g} .. {spec.eigenvalues[-1]:.6g}, "

@@ -96,6 +96,21 @@ def test_compute_prints_a_spectrum_of_zero_modes_as_a_warning(tmp_path):
     assert "warnings.warn" not in r.stderr and "ZeroModesWarning" not in r.stderr
 
 
+def test_compute_says_when_fewer_modes_came_than_asked_for(tmp_path):
+    """A small mesh has as many modes as unknowns: asked for more, the summary says so
+    (it only said "wrote ... (spectrum, 126 shells modes)")."""
+    from modalviewer.core.primitives import icosphere
+
+    mesh = icosphere(1)
+    path = tmp_path / "ico42.obj"
+    lines = [f"v {x} {y} {z}" for x, y, z in mesh.vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in mesh.faces]
+    path.write_text("\n".join(lines) + "\n")
+    r = _run("compute", path, "--operator", "shells", "-k", 500, "-o", tmp_path / "s.npz")
+    assert r.returncode == 0, r.stderr
+    assert "asked for 500 modes, 126 came: all the mesh has (126 unknowns)" in r.stdout
+
+
 def test_compute_writes_a_spectrum(tmp_path):
     out = tmp_path / "s.npz"
     r = _run(

@@ -665,11 +665,24 @@ def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
     """How a finished spectrum job's status line starts: "<description> in 63.2 s", or
     for a spectrum read from the cache "<description> read from the cache in 0.3 s
     (solved earlier in 63.2 s)", so that a cache hit does not read like a fresh solve."""
+    fewer = fewer_modes_text(job, spec)
     if not spec.from_cache:
-        return f"{job.description} in {job.seconds:.1f} s"
+        return f"{job.description}{fewer} in {job.seconds:.1f} s"
     earlier = spec.parameters.get("seconds_total")
     solved = f" (solved earlier in {earlier:.1f} s)" if isinstance(earlier, (int, float)) else ""
-    return f"{job.description} read from the cache in {job.seconds:.1f} s{solved}"
+    return f"{job.description}{fewer} read from the cache in {job.seconds:.1f} s{solved}"
+
+
+def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:
+    """``" (only 126: all the mesh has)"`` where the spectrum holds fewer modes than the
+    job asked for (a mesh has as many modes as unknowns), else ``""``: the description
+    names the number asked for."""
+    asked = getattr(job.spectrum_key, "k", None)
+    if asked is None or spec.k >= asked:
+        return ""
+    unknowns = operator_info(spec.operator).unknowns(spec.n_vertices)
+    why = ": all the mesh has" if spec.k >= unknowns else ""
+    return f" (only {spec.k}{why})"
 
 
 def ended_text(job: Job) -> str:

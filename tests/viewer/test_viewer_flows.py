@@ -358,3 +358,17 @@ def test_a_shells_preview_only_starts_from_a_coarse_copy(viewer):
     lower = slice(6, 15)
     error = spec.eigenvalues[lower] / exact.eigenvalues[lower] - 1
     assert np.all(error > -1e-9) and error.max() < 0.02
+
+
+def test_a_request_for_more_modes_than_the_mesh_has_says_how_many_came(viewer):
+    """An icosphere of 42 vertices has 126 3D shells modes: asked for 500, the status
+    line says 126 came and that they are all the mesh has (it said "500 modes in 0.1 s"
+    while the plot showed 126)."""
+    from modalviewer.core.primitives import icosphere
+
+    viewer.set_mesh(icosphere(1))
+    statuses = _statuses(viewer)
+    spec = viewer.compute("shells", k=500)
+    assert spec.k == 126
+    done = [s for s in statuses if s.startswith("Discrete Shells (3D vibrations), 500 modes")]
+    assert done and " (only 126: all the mesh has) in " in done[-1], statuses
