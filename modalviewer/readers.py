@@ -487,14 +487,15 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
         if binary_count < 0:
             raise MeshError(f"{path.name}: too short for a binary STL file ({len(data)} bytes)")
         rows = (len(data) - 84) // 50
+        dtype = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+        arr = np.frombuffer(data, dtype=dtype, count=min(rows, binary_count), offset=84)
+        if len(data) != 84 + 50 * binary_count:
+            _refuse_implausible_stl(path.name, arr, binary_count, len(data))
         if rows < binary_count:
             announced = count_text(binary_count, "triangle", "triangles")
             damage.ends_early(f"triangle {rows}", rows, announced)
-        rows = min(rows, binary_count)
-        dtype = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
-        arr = np.frombuffer(data, dtype=dtype, count=rows, offset=84)
         vertices = arr["v"].reshape(-1, 3).astype(np.float64)
-        return MeshFile(vertices, np.arange(3 * rows).reshape(-1, 3), damage.notes)
+        return MeshFile(vertices, np.arange(3 * len(arr)).reshape(-1, 3), damage.notes)
     corners, triangles, current, facet_line = [], [], [], 0
     lines = data.decode("ascii", "replace").splitlines()
     ended = False
@@ -527,6 +528,29 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
         damage(f"line {len(lines)}", "the file ends before 'endsolid'")
     vertices = np.array(corners, dtype=np.float64).reshape(-1, 3)
     return MeshFile(vertices, np.array(triangles, dtype=np.int64).reshape(-1, 3), damage.notes)
+
+
+STL_COORDINATE_LIMIT = 1e30
+"""A binary STL whose size does not match its header and whose records hold coordinates
+beyond this (or not numbers) is not an STL file: real ones are in millimetres or
+metres, while random bytes read as float32 reach 3.4e38 in about one value in ten."""
+
+
+def _refuse_implausible_stl(name: str, arr: np.ndarray, announced: int, size: int) -> None:
+    """Raise MeshError where a binary STL's records are not coordinates (random or other
+    binary data with an extension .stl): opened anyway, they made a mesh of a few
+    scattered huge triangles whose computation then failed inside the solver."""
+    corners = arr["v"].reshape(-1, 9)
+    bad = ~(np.isfinite(corners) & (np.abs(corners) <= STL_COORDINATE_LIMIT)).all(axis=1)
+    if not bad.any():
+        return
+    first = int(np.flatnonzero(bad)[0])
+    raise MeshError(
+        f"{name}: not an STL file: its header announces "
+        f"{count_text(announced, 'triangle', 'triangles')} where {size} bytes hold "
+        f"{len(arr)}, and triangle {first + 1} has a coordinate that is not a number or "
+        f"beyond {STL_COORDINATE_LIMIT:.0e}; check that this is the file you meant"
+    )
 
 
 READERS = {".obj": _read_obj, ".off": _read_off, ".ply": _read_ply, ".stl": _read_stl}

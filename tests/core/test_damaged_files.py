@@ -10,6 +10,7 @@ import pytest
 import modalviewer as mv
 from modalviewer.core.primitives import grid_plate
 from modalviewer.io import read_file
+from modalviewer.readers import DamagedFileError
 
 
 def _plate():
@@ -157,6 +158,29 @@ def test_strict_false_loads_the_complete_records_of_a_cut_file(tmp_path, fmt):
     mesh = mv.load_mesh(path, strict=False)
     assert 0 < mesh.n_faces < len(f)
     assert "face" in str(mesh.report) or "triangle" in str(mesh.report)
+
+
+def test_random_bytes_named_stl_are_refused_as_no_stl_strict_or_not(tmp_path):
+    """4000 random bytes read as a binary STL: a header count of billions, records whose
+    coordinates reach 3.4e38 or are not numbers.  Refused as no STL file whether or not
+    the caller asks for a damaged file's whole records (they made a mesh of a few
+    scattered triangles whose computation failed inside the solver), while a cut real
+    STL of the same size still loads its whole records with strict=False."""
+    data = np.random.default_rng(5).integers(0, 256, 4000, dtype=np.uint8).tobytes()
+    path = tmp_path / "random.stl"
+    path.write_bytes(data)
+    announced = int(np.frombuffer(data, "<u4", 1, 80)[0])
+    for strict in (True, False):
+        with pytest.raises(mv.MeshError, match=r"^random\.stl: not an STL file: .*") as err:
+            mv.load_mesh(path, strict=strict)
+        assert not isinstance(err.value, DamagedFileError)  # no "Open anyway"
+        assert f"announces {announced} triangles where 4000 bytes hold 78" in str(err.value)
+    v, f = _plate()
+    cut = tmp_path / "cut.stl"
+    cut.write_bytes(_stl_binary(v, f)[:4000])
+    with pytest.raises(DamagedFileError):
+        mv.load_mesh(cut)
+    assert mv.load_mesh(cut, strict=False).n_faces == 78
 
 
 def test_a_face_naming_a_missing_vertex_is_named_by_line(tmp_path):
