@@ -1538,9 +1538,14 @@ def preview_spectrum(
 def preview_possible(mesh: Mesh, operator: str, k: int) -> bool:
     """Whether ``mesh`` holds a reduced space of at least 3 k functions for ``operator``
     (:func:`max_samples`); smaller meshes get the exact spectrum, quick there."""
+    return preview_possible_on(mesh.n_vertices, operator, k)
+
+
+def preview_possible_on(n_vertices: int, operator: str, k: int) -> bool:
+    """:func:`preview_possible` for a mesh of ``n_vertices``."""
     info = operator_info(operator)
     degree = info.preview.degree
-    functions = max_samples(mesh.n_vertices, degree) * scalar_functions_per_sample(degree)
+    functions = max_samples(n_vertices, degree) * scalar_functions_per_sample(degree)
     return functions * info.unknowns_per_vertex >= 3 * int(k)
 
 

@@ -23,6 +23,7 @@ from ..core.memory import physical_memory_mb
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
 from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
+from ..core.preview import preview_possible_on
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
@@ -230,16 +231,26 @@ def what_fits(
     preview: str = PREVIEW_WORDS,
 ) -> str:
     """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``),
-    a preview without the exact spectrum (named ``preview``), or none of them."""
+    a preview without the exact spectrum (named ``preview``), or none of them.  The two
+    others only where they give ``key.k`` modes: the decimated copy has as many modes as
+    unknowns, and a preview needs a reduced space of 3 k functions."""
     k = largest_k_that_fits(key, n_vertices, available)
+    info = operator_info(key.operator)
+    copy_modes = info.unknowns(round(COARSE_FRACTION * n_vertices))
     coarse_needs = memory_needed(replace(key, coarse=True), n_vertices)
-    coarse_fits = not key.coarse and coarse_needs <= MEMORY_SHARE * available
+    coarse_fits = (
+        not key.coarse and key.k <= copy_modes and coarse_needs <= MEMORY_SHARE * available
+    )
     options = []
     if k >= 1:
         options.append(f"at most {k} modes fit")
     if coarse_fits:
         options.append(f"{key.k} modes {coarse} fit")
-    if not key.coarse and preview_fits(key, n_vertices, available):
+    if (
+        not key.coarse
+        and preview_possible_on(n_vertices, key.operator, key.k)
+        and preview_fits(key, n_vertices, available)
+    ):
         options.append(f"{key.k} modes {preview} fit")
     if not options:
         return "Not even one mode fits: use a coarser mesh or a machine with more memory."

@@ -630,3 +630,18 @@ def test_the_computations_panel_keeps_how_the_last_computation_ended(window, spo
     assert ended_text(given_up) == "preview of X: cancelled"
     given_up.error = "preview stopped after 3 s"
     assert ended_text(given_up) == "preview of X: preview stopped after 3 s"
+
+
+def test_modes_k_takes_any_number_typed(window, spot_path, qtbot):
+    """Found under Xvfb: typing 5000 in Modes k left 500 (the box stopped at 2000 and
+    dropped the last digit unsaid).  A request for more modes than the mesh has gets
+    them all and says so; one that would not fit is refused by the memory check."""
+    window.open_mesh(spot_path)
+    field = window.compute_panel.k_spin
+    field.setFocus()
+    qtbot.waitUntil(field.hasFocus, timeout=2000)
+    field.selectAll()
+    qtbot.keyClicks(QtWidgets.QApplication.focusWidget(), "5000")
+    qtbot.keyClick(QtWidgets.QApplication.focusWidget(), QtCore.Qt.Key.Key_Tab)
+    assert field.value() == 5000
+    assert window.state.compute_settings.k == 5000

@@ -819,6 +819,38 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     assert "Not even one mode fits" in m.refusal(key)
 
 
+def test_a_refusal_offers_no_option_that_cannot_give_the_modes_asked_for(monkeypatch):
+    """More modes than the decimated copy has unknowns, or than a preview's reduced space
+    can hold: neither is offered (a refusal of a million shells modes on a 46k mesh
+    said "1000000 modes with Coarse-to-fine (a decimated copy) fit")."""
+    from dataclasses import replace
+
+    from modalviewer.coarsen import COARSE_FRACTION
+    from modalviewer.core.primitives import icosphere
+    from modalviewer.viewer import model as model_module
+
+    m = model_module.ViewerModel()
+    m.set_mesh(icosphere(4))  # 2562 vertices; the copy 512, 1536 shells unknowns
+    n = m.state.mesh.n_vertices
+    copy_modes = 3 * round(COARSE_FRACTION * n)
+    too_many = m.state.compute_settings.key("shells", copy_modes + 1)
+    # enough memory for the copy's solve and for 300 modes, not for the request
+    available = int(
+        max(
+            model_module.memory_needed(replace(too_many, coarse=True), n),
+            model_module.memory_needed(replace(too_many, k=300), n),
+        )
+        / model_module.MEMORY_SHARE
+    )
+    assert model_module.memory_needed(too_many, n) > model_module.MEMORY_SHARE * available
+    monkeypatch.setattr(model_module, "physical_memory", lambda: available)
+    message = m.refusal(too_many)
+    assert "Coarse-to-fine" not in message and "preview" not in message.lower(), message
+    assert "modes fit" in message
+    fewer = replace(too_many, k=copy_modes)  # as many as the copy has: offered
+    assert "Coarse-to-fine" in model_module.what_fits(fewer, n, available)
+
+
 def test_a_share_marks_its_boundary_vertex_whatever_the_rounding(model):
     """The fraction of the largest distance that marks a share is compared with
     ``fraction * max(d)``; for these numbers ``(v / m) * m < v`` in floating point, which

@@ -9,6 +9,9 @@ from ...viewer.model import PREVIEW_DELAY
 from ...viewer.state import ViewerState
 from .common import WrappingLabel, combo, quiet, select_data
 
+K_MAX = 1_000_000
+"""The Modes k box's maximum: no limit a mesh could reach before the memory check."""
+
 
 class ComputePanel(QtWidgets.QWidget):
     """Sets ``state.compute_settings``; the button asks the window to compute."""
@@ -23,8 +26,15 @@ class ComputePanel(QtWidgets.QWidget):
         for info in OPERATOR_INFO.values():
             self.operator_combo.addItem(info.label, info.name)
         self.k_spin = QtWidgets.QSpinBox()
-        self.k_spin.setRange(1, 2000)
-        self.k_spin.setToolTip("Number of modes (lowest eigenpairs) to compute")
+        # no cap of its own: a mesh has as many modes as unknowns (a request for more
+        # gets them all and says so), and the memory check refuses what would not fit,
+        # saying what would (a box that stopped at 2000 dropped typed digits unsaid)
+        self.k_spin.setRange(1, K_MAX)
+        self.k_spin.setToolTip(
+            "Number of modes (lowest eigenpairs) to compute. A mesh has as many as it has "
+            "unknowns (vertices, three per vertex for the 3D shells); a request that "
+            "would not fit in memory is refused with what would."
+        )
         self.bending_spin = QtWidgets.QDoubleSpinBox()
         self.membrane_spin = QtWidgets.QDoubleSpinBox()
         for spin in (self.bending_spin, self.membrane_spin):
