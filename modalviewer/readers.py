@@ -538,8 +538,8 @@ metres, while random bytes read as float32 reach 3.4e38 in about one value in te
 
 def _refuse_implausible_stl(name: str, arr: np.ndarray, announced: int, size: int) -> None:
     """Raise MeshError where a binary STL's records are not coordinates (random or other
-    binary data with an extension .stl): opened anyway, they made a mesh of a few
-    scattered huge triangles whose computation then failed inside the solver."""
+    binary data with an extension .stl): opened anyway, they would make a mesh of a few
+    scattered huge triangles whose computation fails inside the solver."""
     corners = arr["v"].reshape(-1, 9)
     bad = ~(np.isfinite(corners) & (np.abs(corners) <= STL_COORDINATE_LIMIT)).all(axis=1)
     if not bad.any():

@@ -34,9 +34,10 @@ GHOST_DEPTH_OFFSET = (0.0, 1e8)
 """Polygon offset (factor, units) of the rest shape's ghost: a hundred million of the
 depth buffer's smallest steps push every ghost fragment to the back of the depth range,
 so the ghost shows only where no surface is drawn, beside the deformed shape, as
-structural-analysis tools draw the undeformed shape.  Where the deformed surface moved
-behind the rest shape the ghost stood in front of it and greyed it over in patches with
-stair-stepped edges where the two cross (the teapot's body, the cow's neck)."""
+structural-analysis tools draw the undeformed shape.  At its true depth the ghost stands
+in front of the surface wherever that moved behind the rest shape, and greys it over in
+patches with stair-stepped edges where the two cross (the teapot's body, the cow's
+neck)."""
 GHOST_FADE = (0.005, 0.02)
 """Where a vertex moves less than the first share of the bounding-box diagonal the
 ghost is not drawn there, from the second on at :data:`GHOST_OPACITY`, linearly between:
@@ -475,8 +476,8 @@ class MeshScene:
 
         The scalar range is centred on the threshold and the table is blue below its
         middle, white above: the step lies exactly on the threshold however small it is
-        beside the largest distance (a table spread over 0 to the largest distance put
-        every threshold below its first entry's width in that entry)."""
+        beside the largest distance (a table spread from 0 to the largest distance would
+        draw every threshold below its first entry's width as that entry)."""
         n = 2048
         lo, hi = self.clim
         reach = max(threshold - lo, hi - threshold, 1e-300)

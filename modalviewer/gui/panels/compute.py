@@ -28,7 +28,7 @@ class ComputePanel(QtWidgets.QWidget):
         self.k_spin = QtWidgets.QSpinBox()
         # no cap of its own: a mesh has as many modes as unknowns (a request for more
         # gets them all and says so), and the memory check refuses what would not fit,
-        # saying what would (a box that stopped at 2000 dropped typed digits unsaid)
+        # saying what would (a capped box drops typed digits beyond its cap unsaid)
         self.k_spin.setRange(1, K_MAX)
         self.k_spin.setToolTip(
             "Number of modes (lowest eigenpairs) to compute. A mesh has as many as it has "
