@@ -88,12 +88,15 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         elif state.is_coarse(d.operator):
             value += " (coarse-to-fine: approximate)"
         colours = "blue +, white 0, orange -"
+        # the colours are the mode's own |Phi| (Mass-normalised), not the drawn
+        # displacement, which the Amplitude scales: the legend says which
+        magnitude = "white 0 to red: |Phi| per vertex (Mass-normalised mode)"
         if spec.is_vector and state.style.shell_coloring == "deformed":
-            colours = "deformed shape, white 0 to red: displacement magnitude"
+            colours = f"deformed shape, {magnitude}"
             if state.style.ghost:
                 colours += "; grey: rest shape"
         elif spec.is_vector and derived.vector_coloring() == "magnitude":
-            colours = "white 0 to red: displacement magnitude"
+            colours = magnitude
         elif spec.is_vector:
             colours += " (normal component, smoothed normals)"
         return f"{operator_info(d.operator).label}, mode {j}: lambda = {value}\n{colours}"

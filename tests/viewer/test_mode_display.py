@@ -58,6 +58,8 @@ def test_the_amplitude_sets_the_largest_displacement(machined):
         assert largest == pytest.approx(0.05 * diagonal, rel=1e-6)
         field = state.derived.field()
         assert field.colormap == "sequential"  # coloured by the displacement magnitude
+        # of the mode itself, not of the drawn shape, and the legend says so
+        assert "white 0 to red: |Phi| per vertex (Mass-normalised mode)" in field.legend
         np.testing.assert_allclose(
             field.values,
             np.linalg.norm(field.displacement, axis=1)

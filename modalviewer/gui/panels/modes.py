@@ -47,8 +47,9 @@ class ModesPanel(QtWidgets.QWidget):
             (
                 "Deformed shape",
                 "deformed",
-                "The surface displaced by the mode (Amplitude), coloured by the "
-                "displacement magnitude; the rest shape as a grey ghost (G)",
+                "The surface displaced by the mode (Amplitude), coloured by the mode's "
+                "|Phi| per vertex (Mass-normalised, whatever the Amplitude); the rest "
+                "shape as a grey ghost (G)",
             ),
             (
                 "Normal component on rest shape",
