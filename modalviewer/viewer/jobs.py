@@ -39,7 +39,8 @@ class Job:
 
     Attributes set on the owner's thread: ``status``, ``stage``, ``fraction``,
     ``result``, ``error`` (a message for users), ``details`` (a traceback for the log),
-    ``seconds`` (run time).
+    ``seconds`` (run time), ``said`` (what the status line said of the job, whole: the
+    Computations panel shows it where a status bar cuts long messages).
     """
 
     def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None):
@@ -54,6 +55,7 @@ class Job:
         self.error: str | None = None
         self.details = ""
         self.seconds = 0.0
+        self.said: list[str] = []
         self.callbacks: list[Callable[[Job], None]] = []
         self._fn = fn
         self._cancel = threading.Event()

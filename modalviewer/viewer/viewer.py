@@ -320,7 +320,8 @@ class Viewer:
             return job
         note = self.long_wait_note(job)
         if note:
-            self._status(f"{job.description}: {note}.", 20000)
+            job.said.append(f"{job.description}: {note}.")
+            self._status(job.said[-1], 20000)
         return job
 
     def already_here_note(self, job: SpectrumJob) -> str:
@@ -401,7 +402,10 @@ class Viewer:
     def _on_job_changed(self, job: Job) -> None:
         running = self.jobs.running
         if running is not None and job is running and job.stage == "starting":
-            self._status(self.starting_message(job))
+            message = self.starting_message(job)
+            if message not in job.said:  # "starting" may be reported more than once
+                job.said.insert(0, message)
+            self._status(message)
 
     def starting_message(self, job: Job) -> str:
         """ "Computing ..." (a shown preview's with how it starts, :attr:`SpectrumJob.note`),

@@ -645,3 +645,24 @@ def test_modes_k_takes_any_number_typed(window, spot_path, qtbot):
     qtbot.keyClick(QtWidgets.QApplication.focusWidget(), QtCore.Qt.Key.Key_Tab)
     assert field.value() == 5000
     assert window.state.compute_settings.k == 5000
+
+
+def test_the_computations_panel_shows_what_the_status_line_said_whole(window, qtbot):
+    """Found under Xvfb: the status bar cuts long messages (how a preview starts, the
+    predicted wait); a running job's row in the Computations panel shows them whole."""
+    from modalviewer.viewer.jobs import RUNNING, Job
+
+    panel = window.jobs_panel
+    job = Job(lambda *_: None, "key", "preview of Discrete Shells (3D vibrations), 40 modes")
+    job.status, job.stage, job.fraction = RUNNING, "preview: factorising", 0.3
+    long = (
+        "Computing preview of Discrete Shells (3D vibrations), 40 modes, from a coarse copy "
+        "of the mesh; the exact spectrum would take about 9 s here, the preview about 7 s."
+    )
+    job.said = [long]
+    panel._on_changed(job)
+    label = panel.rows[job.id][1]
+    assert label.text() == f"{long}\npreview: factorising 30 %"
+    job.status = "done"
+    panel._on_changed(job)
+    assert job.id not in panel.rows

@@ -372,3 +372,13 @@ def test_a_request_for_more_modes_than_the_mesh_has_says_how_many_came(viewer):
     assert spec.k == 126
     done = [s for s in statuses if s.startswith("Discrete Shells (3D vibrations), 500 modes")]
     assert done and " (only 126: all the mesh has) in " in done[-1], statuses
+
+
+def test_a_job_keeps_what_the_status_line_said_of_it(viewer, spot_path):
+    """The starting message is kept on the job, once, for the Computations panel."""
+    viewer.open_mesh(spot_path)
+    statuses = _statuses(viewer)
+    job = viewer.request_spectrum("laplacian", k=12)
+    viewer.wait_for(job)
+    started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 12 modes")]
+    assert started and job.said == started[:1], (job.said, statuses)

@@ -57,7 +57,8 @@ class JobsPanel(QtWidgets.QWidget):
             state = (
                 f"{job.stage} {int(100 * job.fraction)} %" if job.status == RUNNING else "queued"
             )
-            row[1].setText(f"{job.description}\n{state}")
+            said = "\n".join(job.said) or job.description  # whole, where the bar cuts it
+            row[1].setText(f"{said}\n{state}")
         self.empty.setVisible(not self.rows)
 
     def _make_row(self, job: Job):
