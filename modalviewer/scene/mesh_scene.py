@@ -58,6 +58,18 @@ def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
     return lut
 
 
+def _threshold_table(n: int = 2048) -> pv.LookupTable:
+    """The threshold map's table: blue (similar) below its middle, white above."""
+    table = np.empty((n, 4))
+    table[:, :3] = WHITE
+    table[: n // 2, :3] = SIMILAR_BLUE
+    table[:, 3] = 1.0
+    lut = pv.LookupTable()
+    lut.SetNumberOfTableValues(n)
+    lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
+    return lut
+
+
 # Rendering styles: the light set-up and the surface's ambient/diffuse/specular balance.
 # "paper": one headlight (the light sits at the camera, like a matcap the brightness
 # depends only on the angle between the normal and the view direction) over a high
@@ -456,14 +468,17 @@ class MeshScene:
         white elsewhere.  The colour is looked up after interpolation along the surface,
         so the boundary follows the line where the interpolated distance crosses the
         threshold instead of a staircase along triangle edges (which colouring the 0/1
-        indicator gives); :meth:`set_threshold` then only changes the lookup table and
-        the scalar range."""
+        indicator gives).  The table is blue below the middle of the scalar range and
+        white above, and :meth:`set_threshold` centres the range on the threshold: the
+        step lies exactly on it however small it is beside the largest distance (a table
+        spread from 0 to the largest distance would draw every threshold below its
+        first entry's width as that entry)."""
         values = np.asarray(distances, dtype=np.float64)
         self.surface.point_data["field"] = values
         hi = float(np.max(values)) or 1.0
         self.clim = (0.0, hi)
         self.clipped = (False, False)
-        self._mapper.scalar_range = self.clim
+        self._mapper.lookup_table = _threshold_table()
         self._mapper.SetInterpolateScalarsBeforeMapping(True)
         self._mapper.ScalarVisibilityOn()
         self.kind = "threshold"
@@ -472,23 +487,10 @@ class MeshScene:
         self.set_threshold(threshold)
 
     def set_threshold(self, threshold: float) -> None:
-        """Move the threshold of a map made by :meth:`show_threshold`; no render.
-
-        The scalar range is centred on the threshold and the table is blue below its
-        middle, white above: the step lies exactly on the threshold however small it is
-        beside the largest distance (a table spread from 0 to the largest distance would
-        draw every threshold below its first entry's width as that entry)."""
-        n = 2048
+        """Move the threshold of a map made by :meth:`show_threshold` (its scalar range,
+        centred on the threshold); no render."""
         lo, hi = self.clim
         reach = max(threshold - lo, hi - threshold, 1e-300)
-        table = np.empty((n, 4))
-        table[:, :3] = WHITE
-        table[: n // 2, :3] = SIMILAR_BLUE
-        table[:, 3] = 1.0
-        lut = pv.LookupTable()
-        lut.SetNumberOfTableValues(n)
-        lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
-        self._mapper.lookup_table = lut
         self._mapper.scalar_range = (threshold - reach, threshold + reach)
         self.threshold = float(threshold)
         self._overlay_changed()
@@ -652,8 +654,10 @@ class MeshScene:
             rest = pv.PolyData(self.rest_points.copy(), faces)
             rest.point_data["Normals"] = self.normals
             rest.GetPointData().SetNormals(rest.GetPointData().GetArray("Normals"))
-            rest.point_data["ghost_rgba"] = np.zeros((self.mesh.n_vertices, 4), np.uint8)
-            self._ghost_rest = rest  # its colours change with the mode shown
+            rgba = np.zeros((self.mesh.n_vertices, 4), np.uint8)
+            rgba[:, :3] = np.round(np.asarray(GHOST_GREY) * 255).astype(np.uint8)
+            rest.point_data["ghost_rgba"] = rgba  # the opacities follow the mode shown
+            self._ghost_rest = rest
             self.ghost_actor = self.plotter.add_mesh(
                 rest,
                 scalars="ghost_rgba",
@@ -672,7 +676,6 @@ class MeshScene:
             )
         if visible:
             rgba = self._ghost_rest.point_data["ghost_rgba"]
-            rgba[:, :3] = np.round(np.asarray(GHOST_GREY) * 255).astype(np.uint8)
             rgba[:, 3] = np.round(255 * self.ghost_opacities(reach)).astype(np.uint8)
             self._ghost_rest.GetPointData().GetArray("ghost_rgba").Modified()
         self.ghost_actor.SetVisibility(bool(visible))

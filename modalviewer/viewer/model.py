@@ -151,13 +151,23 @@ def physical_memory() -> int:
     return 0 if megabytes is None else int(megabytes * 2**20)
 
 
+def copy_vertices(n_vertices: int) -> int:
+    """Vertices of the decimated copy Coarse-to-fine solves on (:data:`COARSE_FRACTION`)."""
+    return round(COARSE_FRACTION * n_vertices)
+
+
+def solved_vertices(key: SpectrumKey, n_vertices: int) -> int:
+    """Vertices the computation of ``key`` solves on: the mesh's, or with Coarse-to-fine
+    its decimated copy's."""
+    return copy_vertices(n_vertices) if key.coarse else n_vertices
+
+
 def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
     """Bytes the exact computation of ``key`` on ``n_vertices`` is predicted to need at
     its peak (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`;
     Coarse-to-fine solves on its decimated copy)."""
     info = operator_info(key.operator)
-    n_solved = round(COARSE_FRACTION * n_vertices) if key.coarse else n_vertices
-    return info.predicted_peak_mb("exact", n_solved, key.k) * 2**20
+    return info.predicted_peak_mb("exact", solved_vertices(key, n_vertices), key.k) * 2**20
 
 
 def preview_start_note(key: SpectrumKey, n_vertices: int) -> str:
@@ -182,7 +192,7 @@ def predicted_seconds(key: SpectrumKey, n_vertices: int, accuracy: str = "exact"
     """Seconds the computation of ``key`` ("exact" or "fast preview") on ``n_vertices``
     is predicted to take (the operator's growth laws; Coarse-to-fine solves on its
     decimated copy)."""
-    n_solved = round(COARSE_FRACTION * n_vertices) if key.coarse else n_vertices
+    n_solved = solved_vertices(key, n_vertices)
     return operator_info(key.operator).predicted_seconds(accuracy, n_solved, key.k)
 
 
@@ -235,8 +245,7 @@ def what_fits(
     others only where they give ``key.k`` modes: the decimated copy has as many modes as
     unknowns, and a preview needs a reduced space of 3 k functions."""
     k = largest_k_that_fits(key, n_vertices, available)
-    info = operator_info(key.operator)
-    copy_modes = info.unknowns(round(COARSE_FRACTION * n_vertices))
+    copy_modes = operator_info(key.operator).unknowns(copy_vertices(n_vertices))
     coarse_needs = memory_needed(replace(key, coarse=True), n_vertices)
     coarse_fits = (
         not key.coarse and key.k <= copy_modes and coarse_needs <= MEMORY_SHARE * available
@@ -688,8 +697,7 @@ def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:
     """``" (only 126: all the mesh has)"`` where the spectrum holds fewer modes than the
     job asked for (a mesh has as many modes as unknowns), else ``""``: the description
     names the number asked for."""
-    asked = getattr(job.spectrum_key, "k", None)
-    if asked is None or spec.k >= asked:
+    if spec.k >= job.spectrum_key.k:
         return ""
     unknowns = operator_info(spec.operator).unknowns(spec.n_vertices)
     why = ": all the mesh has" if spec.k >= unknowns else ""
