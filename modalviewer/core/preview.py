@@ -1024,6 +1024,30 @@ def _factor_below(K, mass: np.ndarray, lam: np.ndarray, lam_scale: float):
     return ShiftedFactor(solver, -shift)
 
 
+def _with_exact_null_vectors(mesh, operator, K, mass, lam, U, res, lam_scale, nulls):
+    """(d, null space): where the smooth space's preview starts with as many zero modes
+    as the operator has exact null vectors (:mod:`.nullspace`; the reduced space holds
+    them, :func:`_null_space_complement`), those Ritz vectors are replaced in place by
+    the exact vectors (the same span to rounding: on spot Loop x1's 3D shells the other
+    modes kept 3e-10 of them, removed here), their values set to 0 and their residuals
+    measured, as the exact solver deflates them; d is their number.  d = 0
+    where the counts differ (a space without some of them: more than
+    :data:`MAX_NULL_COLUMNS`), and the modes are left as they are."""
+    if nulls is None:
+        nulls = null_space(mesh, operator, K, mass)
+    d = nulls.dimension
+    if d == 0 or _leading_zero_modes(lam, lam_scale) != d:
+        return 0, nulls
+    Z = nulls.vectors.toarray()
+    U[:, :d] = Z
+    G = _weighted_product(Z, U[:, d:], mass)  # the other modes' parts along Z: rounding
+    for rows in _rows(U.shape[0]):
+        U[rows, d:] -= Z[rows] @ G
+    lam[:d] = 0.0
+    res[:d] = _zero_mode_residuals(K, mass, lam, U, d, lam_scale)
+    return d, nulls
+
+
 def _leading_zero_modes(lam: np.ndarray, lam_scale: float) -> int:
     """How many of the ascending values lam are zero modes (:func:`.eigen.zero_modes`)."""
     zero = zero_modes(lam, lam_scale)
@@ -1300,6 +1324,8 @@ def _coarse_preview(mesh, operator, K, mass, k, coarse, weights, report, refine,
     del solver
     info = {
         "samples": 0,
+        "null_space_dimension": d,
+        "null_space": nulls.summary() if d else "",
         "coarse_start": start_info,
         "refinement": refinement,
         "reduced_dimension": int(start_info["coarse_modes"]),
@@ -1517,7 +1543,10 @@ def preview_spectrum(
             res, est, estimate = _block_jacobi_estimate(K, mass, lam, U, lam_scale, precondition)
         seconds["refinement"] = time.perf_counter() - t
     del solver
+    d, nulls = _with_exact_null_vectors(mesh, operator, K, mass, lam, U, res, lam_scale, nulls)
     info.update(
+        null_space_dimension=d,
+        null_space=nulls.summary() if d else "",
         refinement=refinement,
         reduced_dimension=int(dim),
         smoothing=bool(smoothing),
@@ -1614,6 +1643,9 @@ def compute_preview(
                 else "preview: a coarse copy's modes, one inverse-iteration step"
             ),
             "zero_mode_scale": typical_eigenvalue(K, mass),
+            "null_space_dimension": int(info["null_space_dimension"]),
+            "n_components": int(mesh.n_components),
+            **({"null_space": info["null_space"]} if info["null_space"] else {}),
             "seconds_assembly": assembled - started,
             "seconds_total": time.perf_counter() - started,
             "preview": info,
