@@ -52,6 +52,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-k", type=int, default=None, help="number of modes")
     p.add_argument("--screenshot", default=None, help="render to this PNG and exit")
     p.add_argument(
+        "--partial",
+        action="store_true",
+        help="open a damaged or truncated file's whole records at once (without it the "
+        "window asks; a run without a display refuses such a file)",
+    )
+    p.add_argument(
         "--session",
         default=None,
         help="restore a session file (File > Save Session) instead of opening a mesh",
@@ -65,6 +71,9 @@ def main(argv: list[str] | None = None) -> int:
     headless = args.screenshot is not None or not has_display()
     if headless and "QT_QPA_PLATFORM" not in os.environ:
         os.environ["QT_QPA_PLATFORM"] = "offscreen"
+    if headless:  # nobody is there to answer a question: each is answered No
+        os.environ["MODALVIEWER_NO_DIALOGS"] = "1"
+        os.environ.pop("MODALVIEWER_ASSUME_YES", None)
     from .application import ensure_application
     from .main_window import MainWindow
     from .paths import DEFAULT_MESH, SCREENSHOTS
@@ -105,7 +114,7 @@ def main(argv: list[str] | None = None) -> int:
         gc.collect()
         return 0
     path = Path(args.mesh) if args.mesh else DEFAULT_MESH
-    opened = window.open_mesh(path)
+    opened = window.open_mesh(path, strict=not args.partial)
     if not headless:
         if opened and args.operator:
             window.compute(
@@ -118,7 +127,11 @@ def main(argv: list[str] | None = None) -> int:
 
     if not opened:
         print(f"error: {window.last_error}", file=sys.stderr)
+        if str(window.last_error).endswith("the file is damaged or truncated"):
+            print("note: --partial opens the file's whole records", file=sys.stderr)
         return 1
+    if args.partial:  # what was dropped
+        print(window.mesh.report)
     operator = args.operator or "modified_dirichlet"
     out = Path(args.screenshot) if args.screenshot else SCREENSHOTS / "headless_run.png"
     if args.screenshot is None:

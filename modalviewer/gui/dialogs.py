@@ -46,7 +46,7 @@ def offer_open_anyway(window, path, error: Exception) -> bool:
     """Name the damage of a file that did not load (status bar, ``window.last_error``)
     and ask whether to load its whole records; True for "Open anyway" (the default)."""
     message = file_message(path, str(error)).split("; the file is damaged")[0]
-    window.last_error = message
+    window.last_error = f"{message}; the file is damaged or truncated"
     window.statusBar().showMessage(message, 10000)
     return ask_action(
         window,

@@ -56,3 +56,30 @@ def test_a_damaged_second_mesh_is_named_and_open_anyway_loads_it(window, monkeyp
     assert pair is not None
     assert pair.pair.mesh("b").n_faces == n_faces - 31
     pair.close()
+
+
+def test_a_run_without_a_display_refuses_a_damaged_file_instead_of_waiting(tmp_path):
+    # nobody can answer "Open anyway" off screen: the run refuses the file at once and
+    # names --partial, which opens its whole records
+    import os
+    import subprocess
+    import sys
+
+    path, n_faces = _truncated_ply(tmp_path / "cut_scan.ply")
+    out = tmp_path / "shot.png"
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", MODALVIEWER_CACHE=str(tmp_path / "c"))
+    env.pop("MODALVIEWER_NO_DIALOGS", None)
+    command = [sys.executable, "-m", "modalviewer", str(path), "--operator", "laplacian"]
+    command += ["-k", "8", "--screenshot", str(out)]
+    run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=120)
+    assert run.returncode == 1
+    assert "error: cut_scan.ply: element 'face' " in run.stderr
+    assert "the file is damaged or truncated" in run.stderr
+    assert "note: --partial opens the file's whole records" in run.stderr
+    assert not out.exists()
+    run = subprocess.run(
+        command + ["--partial"], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert f"{n_faces - 31} faces" in run.stdout  # the report of what was loaded
+    assert out.stat().st_size > 1000
