@@ -457,10 +457,21 @@ class PairWindow(QtWidgets.QWidget):
         self.request()
 
     def pick_a(self, vertex: int) -> None:
+        """Pick mesh vertex ``vertex`` of A (a mesh index, as a click gives it)."""
         self.pick("a", vertex)
 
     def pick_b(self, vertex: int) -> None:
         self.pick("b", vertex)
+
+    def pick_file_vertex(self, side: str, number: int) -> None:
+        """Pick vertex ``number`` of the file of mesh ``side`` ("a" or "b"): the number
+        the legends show); a missing spectrum is computed."""
+        try:
+            self.pair.pick_file_vertex(side, number)
+        except ValueError as exc:
+            self._on_message(str(exc))
+            return
+        self.request()
 
     def set_kind(self, kind: str) -> None:
         """ "vibration" | "feature" | "hks"; its spectra are computed in the background."""

@@ -33,7 +33,7 @@ from psygnal import Signal, SignalGroup
 from ..core.cache import SpectrumCache
 from ..core.cross import CrossTables, ScaleWarning
 from ..core.laplacian import lumped_masses
-from ..core.mesh import Mesh
+from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
 from ..core.spectrum import Spectrum
 from .jobs import CANCELLED, DONE, Job, JobQueue, SpectrumJob
@@ -246,7 +246,10 @@ class PairState:
             self.events.display.emit()
 
     def pick(self, side: str, vertex: int | None) -> None:
-        """Pick ``vertex`` of mesh ``side`` (None clears the pick)."""
+        """Pick mesh vertex ``vertex`` of mesh ``side`` (the loaded mesh's compact index,
+        as :meth:`.Viewer.pick_vertex`; None clears the pick).  The file's vertex
+        numbers, which differ where the file has vertices no face uses: see
+        :meth:`pick_file_vertex`."""
         _check_side(side)
         if vertex is not None:
             n = self.sides[side].mesh.n_vertices
@@ -259,6 +262,17 @@ class PairState:
         if new != self.picked:
             self.picked = new
             self.events.display.emit()
+
+    def pick_file_vertex(self, side: str, number: int) -> None:
+        """Pick vertex ``number`` of mesh ``side``'s file (the number the viewer shows,
+        as ``modalviewer distance --vertex`` takes it); ValueError for one no face uses
+        or the file does not have."""
+        _check_side(side)
+        try:
+            index = self.sides[side].mesh.mesh_vertex(number)
+        except MeshError as exc:
+            raise ValueError(f"{side.upper()}: {exc}") from None
+        self.pick(side, index)
 
     # ----------------------------------------------------------- spectra
     def spectrum(self, side: str, key: SpectrumKey | None = None) -> Spectrum | None:
@@ -403,7 +417,8 @@ class PairState:
         return self._distance[1]
 
     def best_match(self) -> tuple[str, int, float] | None:
-        """(side, vertex, distance): the vertex of the other mesh closest to the pick."""
+        """(side, vertex, distance): the vertex of the other mesh closest to the pick (a
+        mesh index; :meth:`best_file_match` gives the file's number)."""
         if self.picked is None:
             return None
         side = other(self.picked[0])
@@ -412,6 +427,15 @@ class PairState:
             return None
         w = int(np.argmin(d))
         return side, w, float(d[w])
+
+    def best_file_match(self) -> tuple[str, int, float] | None:
+        """:meth:`best_match` with the vertex as its file's number (the number the
+        viewer shows)."""
+        match = self.best_match()
+        if match is None:
+            return None
+        side, w, distance = match
+        return side, self.mesh(side).file_vertex(w), distance
 
     def back_match(self) -> int | None:
         """The vertex of the picked mesh closest to the best match (the pick itself when

@@ -193,3 +193,25 @@ def test_a_cancel_is_not_reported_as_a_failure_and_a_failure_is(tmp_path, spot, 
         pair.jobs.wait(job, timeout=120)
     assert len(messages) == 2 and "could not be computed: the factorisation broke" in messages[0]
     assert "failed: the factorisation broke" in pair.view("b").legend
+
+
+def test_the_pair_takes_and_gives_the_files_vertex_numbers(tmp_path, spot):
+    # spot with 7 unused vertices at the start of its file: file vertex v + 7 is mesh
+    # vertex v; pick_file_vertex and best_file_match speak in the file's numbers, as the
+    # legends and the command line do, pick and best_match in mesh indices
+    lines = ["v 9 9 9"] * 7 + [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in spot.vertices]
+    lines += [f"f {a + 8} {b + 8} {c + 8}" for a, b, c in spot.faces]
+    path = tmp_path / "padded.obj"
+    path.write_text("\n".join(lines) + "\n")
+    padded = mv.load_mesh(path)
+    pair = _pair(tmp_path, padded, _moved(spot), k=K)
+    _wait(pair)
+    pair.pick_file_vertex("a", 707)
+    assert pair.picked == ("a", 700)
+    assert pair.best_match()[:2] == ("b", 700)
+    assert pair.best_file_match()[:2] == ("b", 700)  # B's file has no unused vertices
+    assert "picked vertex 707\n" in pair.view("a").legend
+    pair.pick_file_vertex("b", 700)
+    assert pair.best_match()[:2] == ("a", 700) and pair.best_file_match()[:2] == ("a", 707)
+    with pytest.raises(ValueError, match="A: .*3"):
+        pair.pick_file_vertex("a", 3)  # no face uses it
