@@ -150,7 +150,9 @@ def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
 
 def mesh_names(paths: Sequence[Path]) -> list[str]:
     """A name per path, unique: the file's stem, or where stems repeat the path from
-    the folder the repeated files share, with ``--`` for the folder separator."""
+    the folder the repeated files share, with ``--`` for the folder separator, and the
+    file's suffix where that is still the same (``cow.obj`` and ``cow.stl`` side by
+    side)."""
     stems = [p.stem for p in paths]
     names = []
     for p, stem in zip(paths, stems, strict=True):
@@ -159,8 +161,9 @@ def mesh_names(paths: Sequence[Path]) -> list[str]:
             continue
         same = [q.resolve() for q, s in zip(paths, stems, strict=True) if s == stem]
         root = Path(os.path.commonpath([str(q.parent) for q in same]))
-        rel = p.resolve().with_suffix("").relative_to(root)
-        names.append("--".join(rel.parts))
+        rel = p.resolve().relative_to(root)
+        twins = sum(q.with_suffix("") == p.resolve().with_suffix("") for q in same)
+        names.append("--".join(rel.parts if twins > 1 else rel.with_suffix("").parts))
     return [_safe(n) for n in names]
 
 

@@ -325,3 +325,25 @@ def test_an_existing_scheduler_without_memory_resources(sources, tmp_path):
         )
     assert sorted(summary.computed) == ["plate", "sphere"]
     assert len(notes) == 1 and "without memory estimates" in notes[0]
+
+
+def test_files_of_one_name_and_two_formats_side_by_side_are_two_meshes(sources, tmp_path):
+    # sphere.obj and sphere.off in one folder: two entries, and a second run computes
+    # nothing (one name for both had kept one of them and swapped it at every run)
+    folder = tmp_path / "scans"
+    folder.mkdir()
+    (folder / "sphere.obj").write_bytes((sources / "sphere.obj").read_bytes())
+    plate = primitives.grid_plate(6, 5)
+    rows = [f"OFF\n{plate.n_vertices} {plate.n_faces} 0"]
+    rows += [f"{x!r} {y!r} {z!r}" for x, y, z in plate.vertices.tolist()]
+    rows += [f"3 {a} {b} {c}" for a, b, c in plate.faces.tolist()]
+    (folder / "sphere.off").write_text("\n".join(rows) + "\n")
+    paths = coll.find_meshes([folder])
+    assert coll.mesh_names(paths) == ["sphere.obj", "sphere.off"]
+    summary = coll.run_batch([folder], tmp_path / "store", "laplacian", K, workers=0)
+    assert sorted(summary.computed) == ["sphere.obj", "sphere.off"]
+    store = mv.open_collection(tmp_path / "store")
+    assert sorted(store.names) == ["sphere.obj", "sphere.off"]
+    assert store.spectrum("sphere.off").modes.shape[0] == plate.n_vertices
+    again = coll.run_batch([folder], tmp_path / "store", "laplacian", K, workers=0)
+    assert again.computed == [] and sorted(again.skipped) == ["sphere.obj", "sphere.off"]
