@@ -126,13 +126,46 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
     if path.suffix.lower() not in (".vtp", ".ply"):
         raise ValueError("per-vertex fields are exported as .vtp or .ply")
     _check_folder(path)
+    arrays = {array_name(name): np.asarray(values) for name, values in fields.items()}
+    if mesh.renumbered:
+        arrays["file_vertex"] = np.asarray(mesh.file_vertices)
+    if path.suffix.lower() == ".ply":
+        return atomic_write(path, lambda tmp: _write_ply(tmp, mesh, arrays))
     faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
     poly = pv.PolyData(np.array(mesh.vertices), faces)
-    for name, values in fields.items():
-        poly.point_data[array_name(name)] = np.asarray(values)
-    if mesh.renumbered:
-        poly.point_data["file_vertex"] = np.asarray(mesh.file_vertices)
+    for name, values in arrays.items():
+        poly.point_data[name] = values
     return atomic_write(path, lambda tmp: poly.save(tmp, binary=True))
+
+
+def _write_ply(path: Path, mesh: Mesh, arrays: dict[str, np.ndarray]) -> None:
+    """Binary little-endian PLY of ``mesh`` with each of ``arrays`` (n,) or (n, c) as
+    vertex properties (``name``, or ``name_0 .. name_c-1``; doubles, integers as int):
+    VTK's PLY writer keeps only colours and texture coordinates, so a field exported to
+    .ply was lost.  Any PLY reader that keeps vertex properties (trimesh, Open3D's
+    tensor API, MeshLab, plyfile) reads them back."""
+    columns = [("x", "<f8", mesh.vertices[:, 0]), ("y", "<f8", mesh.vertices[:, 1])]
+    columns.append(("z", "<f8", mesh.vertices[:, 2]))
+    for name, values in arrays.items():
+        kind = "<i4" if np.issubdtype(values.dtype, np.integer) else "<f8"
+        if values.ndim == 1:
+            columns.append((name, kind, values))
+        else:
+            columns += [(f"{name}_{j}", kind, values[:, j]) for j in range(values.shape[1])]
+    ply_type = {"<f8": "double", "<i4": "int"}
+    header = ["ply", "format binary_little_endian 1.0", f"element vertex {mesh.n_vertices}"]
+    header += [f"property {ply_type[kind]} {name}" for name, kind, _ in columns]
+    header += [f"element face {mesh.n_faces}", "property list uchar int vertex_indices"]
+    header.append("end_header")
+    vertices = np.empty(mesh.n_vertices, dtype=[(name, kind) for name, kind, _ in columns])
+    for name, _, values in columns:
+        vertices[name] = values
+    faces = np.empty(mesh.n_faces, dtype=[("n", "u1"), ("i", "<i4", 3)])
+    faces["n"], faces["i"] = 3, mesh.faces
+    with open(path, "wb") as f:
+        f.write(("\n".join(header) + "\n").encode("ascii"))
+        f.write(vertices.tobytes())
+        f.write(faces.tobytes())
 
 
 def array_name(title: str) -> str:

@@ -162,6 +162,36 @@ def test_field_export_names_the_files_vertices(files, tmp_path):
     np.testing.assert_allclose(poly.point_data["hks_distance"], d)
 
 
+def test_field_export_to_ply_keeps_the_field_and_the_files_vertices(files, tmp_path):
+    # VTK's PLY writer had dropped every point-data array: x, y, z and normals only
+    import modalviewer as mv
+    from modalviewer.scene.export import save_field_mesh
+
+    padded, _, where, _, _ = files
+    model = _model(tmp_path)
+    d = _distance(model, padded, int(where[40]))
+    mesh = model.state.mesh
+    out = save_field_mesh(tmp_path / "f.ply", mesh, {"hks distance < 0.1": d})
+    data = out.read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    assert header[1] == "format binary_little_endian 1.0"
+    props = [
+        line.split()[1:] for line in header if line.startswith("property ") and "list" not in line
+    ]
+    assert props == [["double", "x"], ["double", "y"], ["double", "z"]] + [
+        ["double", "hks_distance_0.1"],
+        ["int", "file_vertex"],
+    ]
+    kinds = {"double": "<f8", "int": "<i4"}
+    rows = np.frombuffer(data, [(n, kinds[t]) for t, n in props], mesh.n_vertices, end)
+    np.testing.assert_array_equal(rows["hks_distance_0.1"], d)
+    np.testing.assert_array_equal(rows["file_vertex"], where)
+    np.testing.assert_array_equal(np.stack([rows["x"], rows["y"], rows["z"]], 1), mesh.vertices)
+    back = mv.load_mesh(out)  # the mesh reads back, faces and all
+    np.testing.assert_array_equal(back.faces, mesh.faces)
+
+
 def test_cli_distance_to_a_second_mesh_in_file_numbers(files, tmp_path, monkeypatch, capsys):
     padded, compact, where, dup, unused = files
     monkeypatch.setenv("MODALVIEWER_CACHE", str(tmp_path / "cache"))
