@@ -24,6 +24,8 @@ def _kinds(text: str) -> list[str]:
 
 def add_parsers(sub) -> None:
     """The ``batch`` and ``similar`` subcommands of the CLI's parser."""
+    from .cli import COUNT, WEIGHT
+
     b = sub.add_parser(
         "batch",
         help="spectra and signatures of a whole dataset into one store (on Dask)",
@@ -37,9 +39,9 @@ def add_parsers(sub) -> None:
     )
     b.add_argument("-o", "--output", required=True, metavar="STORE", help="the store folder")
     b.add_argument("--operator", choices=OPERATOR_NAMES, default="laplacian")
-    b.add_argument("-k", type=int, default=50)
-    b.add_argument("--bending", type=float, default=1.0)
-    b.add_argument("--membrane", type=float, default=1.0)
+    b.add_argument("-k", type=COUNT, default=50)
+    b.add_argument("--bending", type=WEIGHT, default=1.0)
+    b.add_argument("--membrane", type=WEIGHT, default=1.0)
     b.add_argument(
         "--signatures",
         type=_kinds,

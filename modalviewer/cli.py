@@ -71,6 +71,46 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _whole(least: int):
+    """An argparse type: an integer of at least ``least`` (a one-line error naming the
+    argument, exit code 2)."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"a whole number is needed, got {text!r}") from None
+        if value < least:
+            raise argparse.ArgumentTypeError(f"must be at least {least}, got {value}")
+        return value
+
+    return parse
+
+
+def _number(low: float = 0.0, low_included: bool = True, high: float = np.inf):
+    """An argparse type: a finite number in [low, high] (low excluded unless
+    ``low_included``); a one-line error naming the argument, exit code 2."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"a number is needed, got {text!r}") from None
+        above = value >= low if low_included else value > low
+        if not (np.isfinite(value) and above and value <= high):
+            where = f"in {'[' if low_included else '('}{low:g}, {high:g}]"
+            if not np.isfinite(high):
+                where = f"a finite number {'>=' if low_included else '>'} {low:g}"
+            raise argparse.ArgumentTypeError(f"must be {where}, got {text}")
+        return value
+
+    return parse
+
+
+COUNT = _whole(1)
+WEIGHT = _number()
+
+
 def _view(text: str):
     from .viewer.camera import parse_view
 
@@ -105,9 +145,9 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("compute", help="compute a spectrum and save it as .npz")
     c.add_argument("mesh")
     c.add_argument("--operator", choices=OPERATORS, default="laplacian")
-    c.add_argument("-k", type=int, default=100)
-    c.add_argument("--bending", type=float, default=1.0)
-    c.add_argument("--membrane", type=float, default=1.0)
+    c.add_argument("-k", type=COUNT, default=100)
+    c.add_argument("--bending", type=WEIGHT, default=1.0)
+    c.add_argument("--membrane", type=WEIGHT, default=1.0)
     c.add_argument(
         "--preview",
         action="store_true",
@@ -127,9 +167,9 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("render", help="render a mode to PNG")
     r.add_argument("mesh")
     r.add_argument("--operator", choices=OPERATORS, default="laplacian")
-    r.add_argument("--mode", type=int, required=True)
-    r.add_argument("-k", type=int, default=None)
-    r.add_argument("--isolines", type=int, default=12)
+    r.add_argument("--mode", type=_whole(0), required=True)
+    r.add_argument("-k", type=COUNT, default=None)
+    r.add_argument("--isolines", type=_whole(0), default=12)
     r.add_argument(
         "--show",
         choices=SHELL_COLORINGS,
@@ -154,17 +194,17 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("mesh")
     d.add_argument(
         "--vertex",
-        type=int,
+        type=_whole(0),
         required=True,
         help="the vertex's number in the file (0-based, counting every vertex of the file, "
         "also ones no face uses), as the viewer shows it",
     )
     d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
-    d.add_argument("-k", type=int, default=100)
+    d.add_argument("-k", type=COUNT, default=100)
     marked = d.add_mutually_exclusive_group()
     marked.add_argument(
         "--share",
-        type=float,
+        type=_number(0.0, False, 1.0),
         nargs="?",
         const=DEFAULT_THRESHOLD_SHARE,
         default=None,
@@ -175,7 +215,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     marked.add_argument(
         "--threshold",
-        type=float,
+        type=_number(0.0, False),
         default=None,
         metavar="D",
         help="threshold map at this absolute distance (marks where distance <= D)",
@@ -228,9 +268,6 @@ def _viewer(mesh, path):
 def _run(args) -> int:
     import modalviewer as mv
 
-    if args.command in ("compute", "distance", "render"):
-        if args.k is not None and args.k < 1:
-            raise ValueError("-k must be at least 1")
     if args.command in ("batch", "similar"):
         from .batch_cli import run
 
@@ -314,7 +351,7 @@ def _run(args) -> int:
         with _warnings_printed():
             spec = viewer.compute(args.operator, k=args.k, wait=True)
         if not 0 <= args.mode < spec.k:
-            raise ValueError(f"--mode must be between 0 and {spec.k - 1}")
+            raise _BadArgument(f"--mode must be between 0 and {spec.k - 1}")
         viewer.show_mode(args.mode)
         viewer.set_view(args.view, up=args.up)
         written = viewer.export_screenshot(
@@ -326,10 +363,6 @@ def _run(args) -> int:
         return 0
     # distance: --vertex and every vertex number printed or written are the file's
     vertex = _mesh_vertex(mesh, args.vertex)
-    if args.share is not None and not 0 < args.share <= 1:
-        raise ValueError("--share is a share of the surface's area, in (0, 1]")
-    if args.threshold is not None and not 0 < args.threshold < np.inf:
-        raise ValueError("--threshold is a distance, above 0")
     if args.to is not None:
         return _distance_to(args, mesh)
     if args.rescale:
@@ -402,6 +435,11 @@ def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
 
 class _Unavailable(Exception):
     """An option needing an optional package that is not installed (exit code 2)."""
+
+
+class _BadArgument(ValueError):
+    """An argument out of range that only the computation's result shows (``--mode``
+    beyond the modes computed): exit code 2, as argparse's own errors."""
 
 
 def _partial_argument(parser) -> None:
@@ -600,8 +638,29 @@ def _distance_to(args, mesh_a) -> int:
     return 0
 
 
+_DASH_VALUES = ("--view", "--up")
+"""Options whose values may start with "-" (``--view -x``, ``--view -30,10``, ``--up
+-z``): argparse reads such a value as an option unless it is joined with "="."""
+
+
+def _joined_dash_values(argv: list[str]) -> list[str]:
+    """``argv`` with ``--view -x`` written ``--view=-x`` (see :data:`_DASH_VALUES`)."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        value = argv[i + 1] if i + 1 < len(argv) else ""
+        if argv[i] in _DASH_VALUES and value.startswith("-") and not value.startswith("--"):
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(argv[i])
+        i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser().parse_args(_joined_dash_values(argv))
     from .core.eigen import Cancelled
 
     try:
@@ -611,7 +670,9 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except Cancelled:
         return 130
-    except _Unavailable as exc:
+    except (_Unavailable, _BadArgument) as exc:
+        if _BAR["open"]:
+            sys.stderr.write("\n")
         sys.stderr.write(f"modalviewer: error: {exc}\n")
         return 2
     except (ValueError, OSError, RuntimeError, MemoryError) as exc:

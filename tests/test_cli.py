@@ -218,7 +218,7 @@ def test_distance_share_and_threshold_are_area_share_and_distance(tmp_path):
     r = _run(*base, "--share", 0.1, "--threshold", 0.3)
     assert r.returncode == 2 and "not allowed with argument --share" in r.stderr
     r = _run(*base, "--share", 1.5)
-    assert r.returncode == 1 and "--share is a share of the surface's area" in r.stderr
+    assert r.returncode == 2 and "argument --share: must be in (0, 1], got 1.5" in r.stderr
 
 
 def test_errors_are_one_line(tmp_path):
@@ -241,6 +241,43 @@ def test_errors_are_one_line(tmp_path):
         lines = [line for line in r.stderr.splitlines() if line.startswith("modalviewer: error")]
         assert len(lines) == 1 and fragment in lines[0], r.stderr
         assert "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (("compute", "-k", "0"), "argument -k: must be at least 1, got 0"),
+        (("compute", "-k", "2.5"), "argument -k: a whole number is needed, got '2.5'"),
+        (("compute", "--bending", "-1"), "argument --bending: must be a finite number >= 0"),
+        (("compute", "--membrane", "nan"), "argument --membrane: must be a finite number"),
+        (("render", "--mode", "-1"), "argument --mode: must be at least 0, got -1"),
+        (("render", "--mode", "1", "--isolines", "-3"), "argument --isolines: must be at least 0"),
+        (("distance", "--vertex", "-1"), "argument --vertex: must be at least 0, got -1"),
+        (("distance", "--vertex", "1", "--share", "0"), "argument --share: must be in (0, 1]"),
+        (("distance", "--vertex", "1", "--threshold", "-1"), "argument --threshold: must be a"),
+        (("batch", "-k", "0"), "argument -k: must be at least 1, got 0"),
+    ],
+)
+def test_values_out_of_range_are_argument_errors(args, fragment, capsys):
+    # exit code 2 and one line naming the argument, before any file is read (they were
+    # exit code 1 after the mesh was loaded, and --isolines -3 was taken)
+    from modalviewer import cli
+
+    command, *rest = args
+    out = ["-o", "x.png"] if command == "render" else (["-o", "s"] if command == "batch" else [])
+    out += ["-o", "x.npz"] if command == "compute" else []
+    with pytest.raises(SystemExit) as exit_:
+        cli.main([command, "missing.obj", *rest, *out])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2
+    lines = [line for line in err.splitlines() if line.startswith("modalviewer: error")]
+    assert len(lines) == 1 and fragment in lines[0], err
+
+
+def test_a_mode_beyond_those_computed_is_an_argument_error(tmp_path):
+    r = _run("render", ASSETS / "demo_plate.obj", "--mode", 9, "-k", 6, "-o", tmp_path / "x.png")
+    assert r.returncode == 2 and "modalviewer: error: --mode must be between 0 and 5" in r.stderr
+    assert not (tmp_path / "x.png").exists()
 
 
 def test_help_lists_the_subcommands():

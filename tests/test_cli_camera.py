@@ -55,6 +55,10 @@ def test_up_and_view_change_the_picture(z_up_cow, tmp_path):
     assert _differ(auto, y_up) > 0.02
     assert _differ(auto, side) > 0.02
     assert _differ(side, angled) > 0.02
+    # values starting with "-" need no "=": --view -y, --up -z (argparse read them as options)
+    below = _render(z_up_cow, tmp_path / "below.png", "--view", "-y", "--up", "-z")
+    joined = _render(z_up_cow, tmp_path / "joined.png", "--view=-y", "--up=-z")
+    assert _differ(below, joined) == 0.0 and _differ(below, side) > 0.02
 
 
 def test_distance_takes_the_view_too(tmp_path):
