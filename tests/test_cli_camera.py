@@ -98,3 +98,25 @@ def test_distance_to_a_second_mesh_refuses_up_and_view(tmp_path, capsys):
     code = cli.main(["distance", spot, "--vertex", "5", "--to", spot, "--view", "+x", "-k", "10"])
     err = capsys.readouterr().err
     assert code == 1 and "--up and --view apply to one mesh" in err
+
+
+def test_a_scene_of_a_mesh_alone_stands_a_z_up_mesh_upright(z_up_cow):
+    # the two-mesh distance figure, the pair window and notebook plots make a scene
+    # without the viewer's state: its up axis is then the one Automatic finds (it was
+    # +Y, so a Z-up scan was drawn lying on its back, seen from below)
+    from modalviewer.core.laplacian import vertex_normals
+    from modalviewer.scene.mesh_scene import MeshScene
+    from modalviewer.scene.offscreen import offscreen_plotter
+
+    upright = mv.load_mesh(ASSETS / "spot.obj")
+    lying = mv.load_mesh(z_up_cow)
+    for mesh, axis in ((upright, 1), (lying, 2)):
+        plotter = offscreen_plotter((160, 120))
+        try:
+            scene = MeshScene(plotter, mesh, vertex_normals(mesh))
+            up = np.asarray(scene.canonical_camera().up)
+            assert up[axis] > 0.9, up
+            scene.up_axis = "+x"  # a chosen axis still wins
+            assert np.asarray(scene.canonical_camera().up)[0] > 0.9
+        finally:
+            plotter.close()

@@ -277,7 +277,8 @@ class MeshScene:
         self._overlay_observer = None
         # canonical first view of this mesh; the scene keeps a reference on the plotter so
         # an export of the plotter finds the scene's legend and colour bar
-        self.up_axis: str | None = None
+        self.up_axis: str | None = None  # None or "auto": detected (:meth:`up`)
+        self._up: tuple | None = None  # (up_axis, the axis in effect) of the last call
         plotter._modalviewer_scene = self
 
     # ------------------------------------------------------------------ style
@@ -601,7 +602,18 @@ class MeshScene:
     # ----------------------------------------------------------------- camera
     def canonical_camera(self) -> cameras.Camera:
         """The canonical first view of this mesh (see ``modalviewer.viewer.camera``)."""
-        return cameras.canonical_view(self.mesh.vertices, self.mesh.faces, up=self.up_axis)
+        return cameras.canonical_view(self.mesh.vertices, self.mesh.faces, up=self.up())
+
+    def up(self) -> str:
+        """The up axis in effect: :attr:`up_axis` where set (the viewer sets its
+        state's), else the one View > Up axis > Automatic finds
+        (:func:`.viewer.camera.up_axis_of`), so that every picture made of a mesh alone
+        (the two-mesh distance figure, the pair window, notebook plots) stands a Z-up
+        scan upright as the viewer does."""
+        if self._up is None or self._up[0] != self.up_axis:
+            axis = cameras.up_axis_of(self.mesh.vertices, self.mesh.faces, self.up_axis)
+            self._up = (self.up_axis, axis)
+        return self._up[1]
 
     def set_camera(self, camera: cameras.Camera, fit: bool = True) -> None:
         """Put the camera at ``camera`` (position, focal point, up); with ``fit`` the
@@ -622,7 +634,7 @@ class MeshScene:
         if name == "canonical":
             camera = self.canonical_camera()
         else:
-            camera = cameras.preset_view(self.mesh.vertices, name, up=self.up_axis)
+            camera = cameras.preset_view(self.mesh.vertices, name, up=self.up())
         self.set_camera(camera)
         return camera
 
