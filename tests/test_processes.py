@@ -192,3 +192,23 @@ def test_compute_spectrum_returns_freed_memory_once_at_each_new_stage(monkeypatc
     changes = sum(1 for i, s in enumerate(stages) if i == 0 or s != stages[i - 1])
     assert changes >= 3
     assert len(calls) == changes
+
+
+def test_a_child_process_leaves_no_pipe_open():
+    # its output pipe was left to the garbage collector: "ResourceWarning: unclosed file
+    # <_io.TextIOWrapper name=4>", printed by modalviewer render as a warning
+    import gc
+    import warnings
+
+    from modalviewer.viewer.process import _run_child
+
+    stages = []
+    code = "import json; print(json.dumps({'stage': 'working', 'fraction': 0.5}))"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _run_child(
+            ["timeit", "-n", "1", code], lambda s, f: stages.append(s), lambda: False, "test"
+        )
+        gc.collect()
+    assert stages[-1] == "working"
+    assert not [w for w in caught if issubclass(w.category, ResourceWarning)], caught

@@ -47,7 +47,8 @@ def _run_child(argv: list[str], progress, cancel, what: str) -> None:
             lines.put(line)
         lines.put(None)
 
-    threading.Thread(target=pump, daemon=True).start()
+    reader = threading.Thread(target=pump, daemon=True)
+    reader.start()
     progress("starting", 0.0)
     error = None
     try:
@@ -72,6 +73,9 @@ def _run_child(argv: list[str], progress, cancel, what: str) -> None:
         if child.poll() is None:
             child.kill()
         child.wait()
+        reader.join(timeout=5.0)  # the pipe's end reached: it can be closed
+        if not reader.is_alive():  # else a stray grandchild holds it: left to the thread
+            child.stdout.close()
         # a killed (cancelled) solve cannot remove its out-of-core factor file: it is
         # the folder of a process that has ended now
         remove_stale_factor_folders()
