@@ -27,7 +27,7 @@ from ..core.mesh import Mesh, MeshError
 from ..core.operators import OPERATOR_INFO
 from ..core.spectrum import Spectrum
 from ..readers import DamagedFileError
-from ..viewer.jobs import Job
+from ..viewer.jobs import QUEUED, Job
 from ..viewer.state import SpectrumKey
 from ..viewer.viewer import ComputeError, Viewer
 from . import menus, window_settings
@@ -110,7 +110,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self.jobs_panel = JobsPanel(self.model.jobs, self.state)
         self.modes_panel = ModesPanel(self.state)
         self.animation_panel = AnimationPanel(self.state)
-        self.distances_panel = DistancesPanel(self.state)
+        self.distances_panel = DistancesPanel(self.state, computing=self.model.computing)
+        self.model.jobs.events.changed.connect(self._tell_distances_panel)
         self.distances_panel.showDistanceRequested.connect(lambda: self.show_distance())
         self.distances_panel.showSignatureRequested.connect(
             lambda: self.show_signature(self.state.display.signature_sample)
@@ -520,6 +521,12 @@ class MainWindow(QtWidgets.QMainWindow):
     @property
     def display(self) -> str:
         return self.state.display.kind
+
+    def _tell_distances_panel(self, job: Job) -> None:
+        """A job queued or ended: the Distances panel says whether a map waits for a
+        spectrum (progress alone changes nothing there)."""
+        if job.done or job.status == QUEUED:
+            self.distances_panel.update_from_state()
 
     @property
     def picked(self) -> int | None:

@@ -471,6 +471,17 @@ class ViewerModel:
             job.then(self._shower(key, before))
         return job
 
+    def computing(self, operator: str) -> bool:
+        """Whether a spectrum of ``operator`` for the loaded mesh is queued or being
+        computed (a map waiting for it will follow)."""
+        return any(
+            isinstance(job, SpectrumJob)
+            and not job.done
+            and not job.cancel_requested
+            and job.spectrum_key.operator == operator
+            for job in self.jobs.jobs
+        )
+
     def cancel_running(self) -> None:
         """Cancel the running job and the jobs of the same spectrum request (a preview
         and the exact computation behind it)."""

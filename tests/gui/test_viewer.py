@@ -553,3 +553,28 @@ def test_the_3d_view_keeps_a_usable_size_in_a_narrow_window(window, spot_path, q
     qtbot.wait(100)
     view = window.viewport.widget
     assert view.width() >= 320 and view.height() >= 240, (view.width(), view.height())
+
+
+def test_after_a_distance_map_fails_the_panel_says_so_and_another_kind_shows(window, qtbot):
+    # a vibration map whose shells spectrum failed left "The map follows when its
+    # spectrum is computed" with nothing computing, and another kind started nothing
+    from modalviewer.core.mesh import Mesh
+    from modalviewer.core.primitives import grid_plate
+
+    plate = grid_plate(6, 6)
+    v = np.vstack([plate.vertices, [[0.5, 0.5, 1.0]]])
+    fin = [[0, 1, plate.n_vertices]]  # the shells refuse it: not consistently oriented
+    window.set_mesh(Mesh(v, np.vstack([plate.faces, fin])))
+    window.compute("laplacian", k=12, wait=True)
+    window.pick_vertex(20)
+    window.show_distance("vibration")
+    panel = window.distances_panel
+    assert panel.threshold_label.text() == "The map follows when its spectrum is computed"
+    qtbot.waitUntil(lambda: not window.busy, timeout=60000)
+    assert "not consistently oriented" in window.last_error
+    assert panel.threshold_label.text() == "Show distance (D) computes the spectrum it needs"
+    assert window.state.display.kind == "mode"
+    panel.kind_combo.setCurrentIndex(panel.kind_combo.findData("hks"))  # as a user would
+    qtbot.waitUntil(lambda: window.state.display.kind == "distance", timeout=60000)
+    assert window.state.display.distance_kind == "hks"
+    assert panel.threshold_label.text().startswith("< ")

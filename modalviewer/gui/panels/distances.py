@@ -27,9 +27,11 @@ class DistancesPanel(QtWidgets.QWidget):
     showSignatureRequested = QtCore.Signal()
     exactCurveRequested = QtCore.Signal()
 
-    def __init__(self, state: ViewerState, parent=None):
+    def __init__(self, state: ViewerState, parent=None, computing=None):
         super().__init__(parent)
         self.state = state
+        # computing(operator): whether its spectrum is on its way (the window's jobs)
+        self.computing = computing or (lambda _operator: False)
         form = QtWidgets.QFormLayout(self)
         self.kind_combo = combo()
         for key, label in DISTANCE_KINDS.items():
@@ -112,7 +114,12 @@ class DistancesPanel(QtWidgets.QWidget):
         """Another distance kind (a threshold map keeps its share of the surface: see
         :meth:`ViewerState._match_threshold`)."""
         self.state.set_display(distance_kind=self.kind_combo.currentData())
-        if self.state.display.kind == "distance":
+        picked = self.state.picked is not None
+        if self.state.display.kind == "distance" or (
+            picked and self.state.display.kind != "signature"
+        ):
+            # with a vertex picked the new kind's map is shown (also after a map that
+            # failed, which left the mode on screen)
             self.showDistanceRequested.emit()
         elif self.state.display.kind == "signature":
             self.showSignatureRequested.emit()
@@ -190,7 +197,10 @@ class DistancesPanel(QtWidgets.QWidget):
             share = 100.0 * state.derived.surface_share(dist, thr)
             self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
         elif state.picked is not None:
-            self.threshold_label.setText("The map follows when its spectrum is computed")
+            if self.computing(operator_for_distance(d.distance_kind)):
+                self.threshold_label.setText("The map follows when its spectrum is computed")
+            else:
+                self.threshold_label.setText("Show distance (D) computes the spectrum it needs")
         elif d.keep_share:
             self.threshold_label.setText("Marks a share of the surface once a vertex is picked")
         else:
