@@ -855,8 +855,10 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     )
     if mesh.n_boundary_edges:
         summary += f", {_plural(mesh.n_boundary_edges, 'boundary edge')}"
-    else:
+    elif mesh.is_edge_manifold:
         summary += ", closed"
+    else:  # no boundary, but not a closed surface either
+        summary += ", no boundary edges"
     if not mesh.is_edge_manifold:
         summary += f", {_plural(mesh.n_nonmanifold_edges, 'non-manifold edge')}"
     report.messages.insert(0, summary + ".")

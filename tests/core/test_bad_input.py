@@ -154,3 +154,17 @@ def test_slivers_are_named_when_they_spoil_a_spectrum():
     v[row, 1] = ys[0] + 1e-9 * (ys[1] - ys[0])
     text = sliver_report(mv.Mesh(v, plate.faces))
     assert "nearly degenerate triangles" in text and "face" in text
+
+
+def test_a_surface_without_boundary_but_with_non_manifold_edges_is_not_called_closed(tmp_path):
+    # two tetrahedra sharing an edge: no boundary edge, one edge of four faces
+    tet = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)]
+    faces = tet + [(a if a < 2 else a + 2 for a in f) for f in tet]
+    v = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), (0, -1, 0), (0, 0, -1)]
+    path = tmp_path / "two_tets.obj"
+    lines = [f"v {x} {y} {z}" for x, y, z in v] + [
+        "f " + " ".join(str(i + 1) for i in f) for f in (tuple(f) for f in faces)
+    ]
+    path.write_text("\n".join(lines) + "\n")
+    report = str(mv.load_mesh(path).report)
+    assert "no boundary edges, 1 non-manifold edge" in report and "closed" not in report
