@@ -268,6 +268,14 @@ def _viewer(mesh, path):
 def _run(args) -> int:
     import modalviewer as mv
 
+    if args.command in ("render", "distance") and args.output:
+        from .scene.export import OTHER_PICTURE_SUFFIXES
+
+        if Path(args.output).suffix.lower() in OTHER_PICTURE_SUFFIXES:  # before any work
+            raise _BadArgument(
+                f"-o {args.output}: pictures are written as PNG; give a name ending in .png"
+            )
+
     if args.command in ("batch", "similar"):
         from .batch_cli import run
 
@@ -306,6 +314,8 @@ def _run(args) -> int:
         mv.save_spectrum(spec, args.output)
         _wrote(args.output, f"spectrum, {spec.k} {args.operator} modes")
         if spec.is_preview:
+            from .viewer.wording import percent_text
+
             info = spec.parameters["preview"]
             start = info.get("coarse_start")
             space = (
@@ -317,7 +327,8 @@ def _run(args) -> int:
             print(
                 f"preview in {seconds:.1f} s ({space}): eigenvalues "
                 f"are upper bounds, largest relative error estimated at "
-                f"{spec.estimated_error:.1%} (estimated from below, not a bound)"
+                f"{percent_text(spec.estimated_error).replace(chr(160), ' ')} "
+                "(estimated from below, not a bound)"
             )
         from .viewer.model import memory_text, residual_text
 

@@ -358,6 +358,7 @@ def test_a_shells_preview_starts_from_a_coarse_copy_and_says_so(tmp_path):
     development install has, makes the copy) and the summary line says so."""
     pytest.importorskip("pymeshlab")
     from modalviewer.core.primitives import torus
+    from modalviewer.viewer.wording import percent_text
 
     ring = torus(160, 80, minor=0.3)
     mesh = tmp_path / "torus.obj"
@@ -382,6 +383,11 @@ def test_a_shells_preview_starts_from_a_coarse_copy_and_says_so(tmp_path):
     assert 0.0 < copy < total
     assert total >= spec.parameters["seconds_total"] - 0.1
     assert "preview: making a coarse copy" in r.stderr
+    # the estimate in two significant digits ("0.0%" was printed for 0.04 %), and the
+    # null space's words as for an exact spectrum
+    estimate = percent_text(spec.estimated_error).replace("\u00a0", " ")
+    assert f"largest relative error estimated at {estimate} (" in r.stdout
+    assert "null space: 1 connected component: the first 6 modes" in r.stdout
 
 
 def test_the_progress_bar_leaves_no_end_of_a_longer_stage_behind(capsys, monkeypatch):
@@ -460,3 +466,20 @@ def test_a_truncated_file_is_refused_with_the_command_lines_advice(tmp_path, cap
     printed = capsys.readouterr().out
     assert printed.startswith("cut.obj: "), printed
     assert out.exists()
+
+
+def test_a_picture_named_for_another_format_is_refused_before_any_work(tmp_path, capsys):
+    # -o fig.jpg had written fig.png (PNG data, another name than asked for)
+    from modalviewer import cli
+    from modalviewer.scene.export import png_path
+
+    code = cli.main(
+        ["render", str(ASSETS / "spot.obj"), "--mode", "3", "-o", str(tmp_path / "f.jpg")]
+    )
+    err = capsys.readouterr().err
+    assert code == 2 and "-o " in err and "pictures are written as PNG" in err
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(ValueError, match="give a name ending in .png"):
+        png_path(tmp_path / "f.TIFF")
+    assert png_path(tmp_path / "fig_t0.5") == tmp_path / "fig_t0.5.png"  # a suffix kept
+    assert png_path(tmp_path / "f.PNG") == tmp_path / "f.PNG"

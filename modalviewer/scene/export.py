@@ -79,11 +79,23 @@ def side_by_side(images: list[np.ndarray], gap: int = 0, transparent: bool = Fal
     return canvas
 
 
+OTHER_PICTURE_SUFFIXES = (".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".gif", ".webp", ".pdf")
+OTHER_PICTURE_SUFFIXES += (".svg", ".eps")
+"""Suffixes of picture formats other than PNG: a name ending in one is refused, where
+PNG data under it would mislead (``-o fig.jpg`` had written ``fig.png``)."""
+
+
 def png_path(path) -> Path:
-    """``path`` with a .png suffix, its folder created and checked writable."""
+    """``path`` as the PNG to write, its folder created and checked writable: a name
+    ending in .png as it is, a name without a picture suffix with ".png" added
+    (``fig_t0.5`` -> ``fig_t0.5.png``); ValueError for another picture format's suffix
+    (:data:`OTHER_PICTURE_SUFFIXES`)."""
     path = Path(path)
-    if path.suffix.lower() != ".png":
-        path = path.with_suffix(".png")
+    suffix = path.suffix.lower()
+    if suffix in OTHER_PICTURE_SUFFIXES:
+        raise ValueError(f"{path.name}: pictures are written as PNG; give a name ending in .png")
+    if suffix != ".png":
+        path = path.with_name(path.name + ".png")
     _check_folder(path)
     return path
 
