@@ -471,10 +471,17 @@ def _unique_index_rows(rows: np.ndarray, **kwargs):
 
 # ---------------------------------------------------------------------- repair
 def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
+    """Vertices within ``tol`` of each other merged into the first of them: (vertices,
+    faces, how many merged, each file vertex's new index).  Only vertices that faces use
+    are merged: a vertex no face uses stays apart (it is removed as unreferenced later),
+    so a merged vertex is never named by the number of one no face uses."""
     if tol > 0:
         key = np.round(v / tol).astype(np.int64)
     else:
         key = v
+    in_face = np.zeros(len(v), dtype=bool)
+    in_face[f.ravel()] = True
+    key = np.column_stack([key, np.where(in_face, -1, np.arange(len(v)))])
     _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
     inverse = inverse.reshape(-1)
     order = np.argsort(first)  # keep the original order of first occurrences
@@ -837,7 +844,7 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if len(unreferenced):
         report.add(
             f"Removed {_plural(len(unreferenced), 'unreferenced vertex')} (no face uses "
-            "them; the file's "
+            f"{'it' if len(unreferenced) == 1 else 'them'}; the file's "
             + _listing([str(int(i)) for i in unreferenced[:_LISTED]], len(unreferenced))
             + "; vertex numbers shown stay the file's)."
         )

@@ -59,6 +59,20 @@ def test_maps_of_a_file_with_unused_and_duplicate_vertices():
     assert f"vertices 0, 1, {unused[2]}, {unused[3]}" in text
 
 
+def test_an_unused_vertex_at_a_used_ones_place_is_not_merged_with_it():
+    # an unused vertex 0 where vertex 5 of the file (used) lies: vertex 5 keeps its
+    # number (it was shown as vertex 0, a vertex no face uses, "merged" into it)
+    base = icosphere(1)
+    v = np.vstack([base.vertices[[4]], base.vertices])
+    m = repair_mesh(v, base.faces + 1)
+    assert m.n_vertices == base.n_vertices
+    assert m.file_vertex(m.mesh_vertex(5)) == 5 and m.file_vertex(4) == 5
+    with pytest.raises(MeshError, match="vertex 0 of the file is used by no face"):
+        m.mesh_vertex(0)
+    text = str(m.report)
+    assert "Merged" not in text and "(no face uses it; the file's vertex 0;" in text
+
+
 def test_derived_meshes_keep_the_map():
     base = icosphere(1)
     v, f, where, dup = padded(base)
