@@ -371,9 +371,9 @@ class MainWindow(QtWidgets.QMainWindow):
         except ValueError as exc:
             self.show_error(str(exc))
 
-    def pick_vertex(self, index: int) -> None:
+    def pick_vertex(self, index: int, show: bool = True) -> None:
         try:
-            self.viewer.pick_vertex(index)
+            self.viewer.pick_vertex(index, show)
         except ValueError as exc:
             self.show_error(str(exc))
 

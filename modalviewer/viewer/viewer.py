@@ -515,20 +515,25 @@ class Viewer:
     def picked(self) -> int | None:
         return self.state.picked
 
-    def pick_file_vertex(self, number: int) -> None:
+    def pick_file_vertex(self, number: int, show: bool = True) -> None:
         """Pick vertex ``number`` of the mesh file (the number the viewer shows, as
-        ``modalviewer distance --vertex`` takes it); ValueError for one no face uses."""
+        ``modalviewer distance --vertex`` takes it); ValueError for one no face uses.
+        ``show``: as for :meth:`pick_vertex`."""
         if self.state.mesh is None:
             return
-        self.pick_vertex(self.state.mesh.mesh_vertex(number))
+        self.pick_vertex(self.state.mesh.mesh_vertex(number), show)
 
-    def pick_vertex(self, index: int) -> None:
+    def pick_vertex(self, index: int, show: bool = True) -> None:
         """Pick mesh vertex ``index`` (the loaded mesh's compact index, as a click on it
-        does): marker and distance map (see :meth:`pick_file_vertex`)."""
+        does): marker and, with ``show``, the distance map of the display's kind, whose
+        spectrum is computed if missing (see :meth:`pick_file_vertex`).  A script that
+        shows another kind next picks with ``show=False``, so that no spectrum it does
+        not need is computed (the 3D shells for the default vibration distance)."""
         if self.state.mesh is None:
             return
         self.state.set_pick(index)
-        self.show_distance()
+        if show:
+            self.show_distance()
 
     def show_distance(
         self,

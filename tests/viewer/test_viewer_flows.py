@@ -382,3 +382,19 @@ def test_a_job_keeps_what_the_status_line_said_of_it(viewer, spot_path):
     viewer.wait_for(job)
     started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 12 modes")]
     assert started and job.said == started[:1], (job.said, statuses)
+
+
+def test_a_script_picks_without_computing_the_default_kinds_spectrum(viewer, spot_path):
+    # pick_file_vertex then show_distance("hks") had started the 3D shells for the
+    # default vibration distance as well
+    viewer.open_mesh(spot_path)
+    viewer.state.set_compute_settings(k=12)
+    viewer.pick_file_vertex(123, show=False)
+    assert viewer.picked == 123 and viewer.model.jobs.jobs == []
+    viewer.show_distance("hks")
+    operators = [job.spectrum_key.operator for job in viewer.model.jobs.jobs]
+    assert operators == ["laplacian"]
+    for job in list(viewer.model.jobs.jobs):
+        viewer.wait_for(job)
+    d = viewer.show_distance("hks")
+    assert d.shape == (viewer.mesh.n_vertices,) and d[123] == 0.0
