@@ -24,9 +24,16 @@ from collections.abc import Callable, Hashable
 
 from psygnal import Signal, SignalGroup
 
-from ..core.eigen import Cancelled
+from ..core.eigen import Cancelled, EigenError
+from ..core.mesh import MeshError
+from .process import ChildError
 
 _ids = itertools.count(1)
+
+EXPECTED_FAILURES: tuple[type[Exception], ...] = (MeshError, EigenError, ChildError)
+"""Failures whose message is for the user (a mesh the operator cannot run on, a solve
+that did not converge, a child process's reported error): their jobs keep no traceback,
+so the log says what failed without one."""
 
 PROGRESS_INTERVAL = 0.05
 """Seconds between two progress reports of the same stage (each crosses threads)."""
@@ -272,6 +279,8 @@ class JobQueue:
                 "Coarse-to-fine.",
                 traceback.format_exc(),
             )
+        except EXPECTED_FAILURES as exc:  # the message says it all: no traceback
+            outcome = (FAILED, None, str(exc) or type(exc).__name__, "")
         except Exception as exc:  # reported to the user, never raised into the event loop
             outcome = (FAILED, None, str(exc) or type(exc).__name__, traceback.format_exc())
         else:

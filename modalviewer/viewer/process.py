@@ -31,6 +31,11 @@ from ..core.mesh import Mesh
 from ..core.spectrum import load_spectrum
 
 
+class ChildError(RuntimeError):
+    """A failure a child process reported in words (its own traceback, if any, stayed in
+    the child): a message for the user, not a fault of this process."""
+
+
 def _run_child(argv: list[str], progress, cancel, what: str) -> None:
     """Run ``python -m ...argv``; relay its progress; kill it on cancel; raise its error."""
     child = subprocess.Popen(
@@ -80,7 +85,7 @@ def _run_child(argv: list[str], progress, cancel, what: str) -> None:
         # the folder of a process that has ended now
         remove_stale_factor_folders()
     if error is not None:
-        raise RuntimeError(error)
+        raise ChildError(error)
     if child.returncode != 0:
         raise RuntimeError(
             f"the {what} process stopped unexpectedly (exit code {child.returncode}); "

@@ -451,7 +451,10 @@ class Viewer:
         elif job.status == DONE and not isinstance(job, RepairJob):
             self._status(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
         elif job.status == FAILED:
-            log.error("computation failed: %s\n%s", job.error, job.details)
+            if job.details:  # an unexpected fault: its traceback for the log
+                log.error("computation failed: %s\n%s", job.error, job.details)
+            else:
+                log.warning("computation failed: %s", job.error)
             mesh = self.state.mesh
             if isinstance(job, RepairJob):
                 return  # reported by its own callback (_on_repaired)

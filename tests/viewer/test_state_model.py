@@ -77,6 +77,45 @@ def test_a_failing_job_reports_its_own_error_and_the_queue_goes_on():
     assert good.status == DONE and good.result == 42
 
 
+def test_an_expected_failure_keeps_no_traceback_and_a_fault_keeps_one(caplog):
+    # a refusal whose message says it all (a non-manifold mesh for the shells) was
+    # logged with a full traceback, which reads as a crash on a terminal
+    import logging
+
+    from modalviewer.core.mesh import MeshError
+    from modalviewer.viewer import Viewer
+    from modalviewer.viewer.process import ChildError
+
+    queue = JobQueue()
+    jobs = []
+    for error in (MeshError("312 non-manifold edges"), ChildError("not converged"), KeyError(3)):
+
+        def fail(progress, cancel, error=error):
+            raise error
+
+        jobs.append(queue.submit(fail, repr(error), "failing"))
+    for job in jobs:
+        queue.wait(job, timeout=10)
+    refused, reported, fault = jobs
+    assert refused.status == reported.status == fault.status == FAILED
+    assert refused.details == "" and reported.details == ""
+    assert "Traceback" in fault.details and "KeyError" in fault.details
+    viewer = Viewer()
+    try:
+        with caplog.at_level(logging.WARNING, logger="modalviewer"):
+            viewer._on_job_finished(refused)
+            viewer._on_job_finished(fault)
+        texts = [
+            (r.levelname, r.getMessage())
+            for r in caplog.records
+            if r.getMessage().startswith("computation failed")
+        ]
+        assert texts[0] == ("WARNING", "computation failed: 312 non-manifold edges")
+        assert texts[1][0] == "ERROR" and "Traceback" in texts[1][1]
+    finally:
+        viewer.close()
+
+
 def test_an_observer_that_raises_stops_neither_the_job_callbacks_nor_the_queue():
     """An observer of ``finished`` that raises (the window's handler did, for repair
     jobs) must not keep the job's own callbacks from running (a scripted wait on it
