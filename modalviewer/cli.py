@@ -623,6 +623,7 @@ def _distance_to(args, mesh_a) -> int:
                 display=display,
                 threshold=1.0 if marked is None else min(1.0, marked[0] / float(d.max())),
                 face_marker=True,
+                colorbar=f"{label} distance",
             ),
         ]
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))

@@ -36,6 +36,7 @@ class Panel:
     azimuth: float = 0.0  # degrees about the up axis, from the viewer's first view
     elevation: float = 0.0
     face_marker: bool = False  # turned about the up axis so the marker faces the camera
+    colorbar: str | None = None  # the colour bar's title (a two-swatch legend on a threshold map)
 
 
 def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
@@ -58,8 +59,14 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
             if panel.display == "threshold":
                 thr = panel.threshold * float(d.max())
                 scene.show_threshold(d, thr, name="threshold")
+                if panel.colorbar:
+                    scene.set_colorbar(
+                        panel.colorbar, labels=[f"{panel.colorbar} <= {thr:.3g}", "the rest"]
+                    )
             else:
                 scene.show_field(d, "sequential", isolines=0, name="distance")
+                if panel.colorbar:
+                    scene.set_colorbar(panel.colorbar)
         scene.show_marker(panel.marker)
         # the viewer's first view of the mesh, turned about its up axis by ``azimuth``
         # (or until the marker faces the camera) and tilted by ``elevation``

@@ -483,3 +483,26 @@ def test_a_picture_named_for_another_format_is_refused_before_any_work(tmp_path,
         png_path(tmp_path / "f.TIFF")
     assert png_path(tmp_path / "fig_t0.5") == tmp_path / "fig_t0.5.png"  # a suffix kept
     assert png_path(tmp_path / "f.PNG") == tmp_path / "f.PNG"
+
+
+def test_the_two_mesh_distance_figure_has_a_colour_bar(tmp_path):
+    # the distance panel of `distance A --to B` drew no colour bar: its colours had no
+    # values; now a bar (continuous) or a two-swatch legend (threshold) as in the viewer
+    from PIL import Image
+
+    spot = ASSETS / "spot.obj"
+    base = ("distance", spot, "--vertex", 5, "--to", spot, "--kind", "hks", "-k", 12)
+    pictures = {}
+    for name, extra in (("continuous", ()), ("threshold", ("--share", 0.1))):
+        out = tmp_path / f"{name}.png"
+        r = _run(*base, *extra, "--size", "800x600", "-o", out)
+        assert r.returncode == 0, r.stderr
+        pictures[name] = np.asarray(Image.open(out).convert("RGB")).astype(int)
+    img = pictures["continuous"]
+    bottom = img[int(0.85 * img.shape[0]) :, img.shape[1] // 2 :]  # under panel B
+    r, g, b = bottom[..., 0], bottom[..., 1], bottom[..., 2]
+    assert ((r > 150) & (g < 80) & (b < 80)).sum() > 50  # the bar's red end
+    img = pictures["threshold"]
+    bottom = img[int(0.85 * img.shape[0]) :, img.shape[1] // 2 :]
+    r, g, b = bottom[..., 0], bottom[..., 1], bottom[..., 2]
+    assert ((b > r + 60) & (b > g + 20)).sum() > 20  # the blue swatch
