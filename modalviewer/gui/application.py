@@ -21,7 +21,26 @@ def ensure_application():
     if not has_display():
         os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
     prepare_offscreen()
+    _quiet_offscreen_notices()
     app = QtWidgets.QApplication(sys.argv[:1])
     app.setApplicationName("modalviewer")
     app.setOrganizationName("modalviewer")
     return app
+
+
+OFFSCREEN_NOTICES = ("This plugin does not support propagateSizeHints()",)
+"""Messages Qt's off-screen platform prints for every window it shows: they say nothing
+about the picture, and a ``--screenshot`` run printed them among its own lines."""
+
+
+def _quiet_offscreen_notices() -> None:
+    """Drop :data:`OFFSCREEN_NOTICES` from Qt's messages; every other message goes to
+    stderr as Qt prints it."""
+    from qtpy import QtCore
+
+    def handler(kind, context, message: str) -> None:
+        if message in OFFSCREEN_NOTICES:
+            return
+        sys.stderr.write(message + "\n")
+
+    QtCore.qInstallMessageHandler(handler)
