@@ -24,7 +24,7 @@ def _kinds(text: str) -> list[str]:
 
 def add_parsers(sub) -> None:
     """The ``batch`` and ``similar`` subcommands of the CLI's parser."""
-    from .cli import COUNT, WEIGHT
+    from .cli import COUNT, WEIGHT, _number, _whole
 
     b = sub.add_parser(
         "batch",
@@ -53,7 +53,7 @@ def add_parsers(sub) -> None:
     where = b.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
-        type=int,
+        type=_whole(0),
         default=None,
         metavar="N",
         help="a local Dask cluster of N worker processes (default: one per core); 0: one "
@@ -68,7 +68,7 @@ def add_parsers(sub) -> None:
     )
     b.add_argument(
         "--memory-limit",
-        type=float,
+        type=_number(0.0, False),
         default=None,
         metavar="GB",
         help="each local worker's memory limit (default: the machine's memory over the "
@@ -80,7 +80,7 @@ def add_parsers(sub) -> None:
     )
     s.add_argument("store")
     s.add_argument("mesh", help="a mesh file, or the name of a mesh in the store")
-    s.add_argument("-n", type=int, default=10, help="how many to list (default 10)")
+    s.add_argument("-n", type=COUNT, default=10, help="how many to list (default 10)")
 
 
 def run(args) -> int:
@@ -150,8 +150,6 @@ def _similar(args) -> int:
 
     from .collection import open_collection
 
-    if args.n < 1:
-        raise ValueError("-n must be at least 1")
     collection = open_collection(args.store)
     if not collection.names:
         raise ValueError(f"{args.store} holds no meshes")

@@ -506,3 +506,19 @@ def test_the_two_mesh_distance_figure_has_a_colour_bar(tmp_path):
     bottom = img[int(0.85 * img.shape[0]) :, img.shape[1] // 2 :]
     r, g, b = bottom[..., 0], bottom[..., 1], bottom[..., 2]
     assert ((b > r + 60) & (b > g + 20)).sum() > 20  # the blue swatch
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["batch", "x", "-o", "s", "--workers", "-1"], "argument --workers: must be at least 0"),
+        (["batch", "x", "-o", "s", "--memory-limit", "-3"], "argument --memory-limit: must be a"),
+        (["similar", "store", "mesh.obj", "-n", "0"], "argument -n: must be at least 1, got 0"),
+    ],
+)
+def test_collection_commands_refuse_values_out_of_range_as_argument_errors(argv, fragment, capsys):
+    from modalviewer import cli
+
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(argv)
+    assert exit_.value.code == 2 and fragment in capsys.readouterr().err

@@ -1,5 +1,6 @@
 """Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
 
+from .cache import SpectrumCache
 from .components import (
     ComponentSpectrum,
     compute_spectrum_per_component,
@@ -51,6 +52,7 @@ __all__ = [
     "SignatureTable",
     "Spectrum",
     "SpectrumFileError",
+    "SpectrumCache",
     "compute_spectrum",
     "ZeroModesWarning",
     "default_times",
