@@ -29,7 +29,7 @@ def build_figures(out_dir, progress=print) -> list[Path]:
     def save(name: str, comparison=None) -> None:
         path = out / f"{name}.png"
         if comparison is None:
-            viewer.export_screenshot(path)
+            viewer.export_screenshot(path, size=FIGURE_SIZE)
         else:
             viewer.export_comparison(comparison, path)
         made.append(path)

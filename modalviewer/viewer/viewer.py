@@ -746,7 +746,8 @@ class Viewer:
         colorbar : bool, optional
             With the colour bar and legend (None: as the state says).
         size : (int, int), optional
-            (width, height) of the off-screen picture, default 1024 x 768.
+            (width, height) of the off-screen picture, default 1024 x 768 (a size given
+            to one call does not carry over to the next).
 
         Returns
         -------
@@ -765,7 +766,11 @@ class Viewer:
                 transparent=transparent,
                 scene=self._picture.scene,
             )
-        return self.renderer(size).screenshot(path, scale=scale, transparent=transparent)
+        from ..scene.offscreen import DEFAULT_SIZE
+
+        return self.renderer(size or DEFAULT_SIZE).screenshot(
+            path, scale=scale, transparent=transparent
+        )
 
     def image(self, scale: int = 1, transparent: bool = False, size=None) -> np.ndarray:
         """The picture as an (h, w, 3 or 4) uint8 array (for notebooks)."""
@@ -773,7 +778,9 @@ class Viewer:
             from ..scene.export import grab
 
             return grab(self._picture.plotter, self._picture.scene, scale, transparent)
-        return self.renderer(size).image(scale, transparent)
+        from ..scene.offscreen import DEFAULT_SIZE
+
+        return self.renderer(size or DEFAULT_SIZE).image(scale, transparent)
 
     def animation_frame(self, phase: float, size=None) -> float:
         """Move the picture's surface to ``phase`` (radians) of the vibration shown (a

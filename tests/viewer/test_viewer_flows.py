@@ -398,3 +398,15 @@ def test_a_script_picks_without_computing_the_default_kinds_spectrum(viewer, spo
         viewer.wait_for(job)
     d = viewer.show_distance("hks")
     assert d.shape == (viewer.mesh.n_vertices,) and d[123] == 0.0
+
+
+def test_a_size_given_to_one_picture_does_not_carry_over(viewer, spot_path, tmp_path):
+    # after export_screenshot(size=(400, 300)), pictures without a size stayed 400 x 300
+    from PIL import Image
+
+    viewer.open_mesh(spot_path)
+    small = viewer.export_screenshot(tmp_path / "small.png", size=(400, 300))
+    assert Image.open(small).size == (400, 300)
+    assert Image.open(viewer.export_screenshot(tmp_path / "default.png")).size == (1024, 768)
+    assert viewer.image(size=(320, 200)).shape[:2] == (200, 320)
+    assert viewer.image().shape[:2] == (768, 1024)
