@@ -119,6 +119,11 @@ def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
     from .core.operators import operator_for_distance
     from .viewer import Viewer
 
+    if mode is not None and spectrum is None:  # it drew the plain mesh without a word
+        raise ValueError(
+            f"mode={mode} is a mode of a spectrum: pass one, e.g. "
+            f"plot(mesh, mv.compute_spectrum(mesh, 'laplacian', k), mode={mode})"
+        )
     viewer = Viewer()
     viewer.set_mesh(mesh)
     if spectrum is not None:
