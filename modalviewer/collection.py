@@ -405,6 +405,9 @@ def _write_error(store: Path, name: str, source: Path, parameters: dict, error: 
             "error": error,
         },
     )
+    # a result of the file as it was before: the store holds one record per mesh, and
+    # an out-of-date result would be listed and ranked beside this failure
+    (store / "meshes" / f"{name}.npz").unlink(missing_ok=True)
 
 
 def _read_entry(path: Path) -> dict | None:

@@ -347,3 +347,19 @@ def test_files_of_one_name_and_two_formats_side_by_side_are_two_meshes(sources, 
     assert store.spectrum("sphere.off").modes.shape[0] == plate.n_vertices
     again = coll.run_batch([folder], tmp_path / "store", "laplacian", K, workers=0)
     assert again.computed == [] and sorted(again.skipped) == ["sphere.obj", "sphere.off"]
+
+
+def test_a_file_that_fails_after_it_was_computed_leaves_no_old_result(sources, tmp_path):
+    # its old result had stayed beside the new failure: listed in names and in errors,
+    # and ranked by `similar`
+    folder = tmp_path / "scans"
+    folder.mkdir()
+    scan = folder / "scan.obj"
+    scan.write_bytes((sources / "sphere.obj").read_bytes())
+    store = tmp_path / "store"
+    assert coll.run_batch([folder], store, "laplacian", K, workers=0).computed == ["scan"]
+    scan.write_text("v 0 0 0\nv 1 0\nf 1 2 3\n")  # damaged since
+    coll.run_batch([folder], store, "laplacian", K, workers=0)
+    c = mv.open_collection(store)
+    assert c.names == [] and list(c.errors) == ["scan"]
+    assert not (store / "meshes" / "scan.npz").exists()
