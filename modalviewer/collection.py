@@ -101,11 +101,13 @@ class CollectionError(ValueError):
 
 # ------------------------------------------------------------------ sources and names
 def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
-    """The mesh files of ``sources``: folders (searched recursively for the readable
-    suffixes), glob patterns, mesh files, and list files (any other file: one path per
-    line, relative to the list's folder; blank lines and ``#`` comments skipped).
+    """The mesh files of ``sources``: folders (searched recursively for the extensions
+    :func:`.io.load_mesh` reads, meshio's too where it is installed, less those other
+    files use: :data:`.io.AMBIGUOUS_EXTENSIONS`), glob patterns, mesh files, and list
+    files (any other file: one path per line, relative to the list's folder; blank
+    lines and ``#`` comments skipped).
     Each file once, in the order found; ValueError for a source that matches nothing."""
-    from .io import SUPPORTED_EXTENSIONS
+    from .io import is_mesh_file
 
     found: list[Path] = []
 
@@ -116,16 +118,12 @@ def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
         text = str(source)
         path = Path(text)
         if path.is_dir():
-            files = [
-                p
-                for p in sorted(path.rglob("*"))
-                if p.suffix.lower() in SUPPORTED_EXTENSIONS and p.is_file()
-            ]
+            files = [p for p in sorted(path.rglob("*")) if is_mesh_file(p, True) and p.is_file()]
             if not files:
                 raise ValueError(f"{text}: no mesh files in this folder")
             for p in files:
                 add(p)
-        elif path.is_file() and path.suffix.lower() in SUPPORTED_EXTENSIONS:
+        elif path.is_file() and is_mesh_file(path):
             add(path)
         elif path.is_file():
             for line in path.read_text(encoding="utf-8").splitlines():

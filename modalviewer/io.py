@@ -77,6 +77,22 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
     return vertices, faces, notes
 
 
+AMBIGUOUS_EXTENSIONS = (".dat", ".xml", ".svg", ".node", ".ele", ".wkt", ".txt")
+"""Extensions meshio reads that other files use too: a folder searched for meshes
+(``batch``) leaves them out; a file named as a source is read as a mesh."""
+
+
+def is_mesh_file(path, in_folder: bool = False) -> bool:
+    """Whether ``path``'s name ends in an extension :func:`load_mesh` reads (its own
+    readers', and meshio's where meshio is installed); ``in_folder``: for a folder's
+    search, without :data:`AMBIGUOUS_EXTENSIONS`."""
+    name = Path(path).name.lower()
+    extensions = SUPPORTED_EXTENSIONS + _meshio_extensions()
+    if in_folder:
+        extensions = tuple(e for e in extensions if e not in AMBIGUOUS_EXTENSIONS)
+    return any(name.endswith(e) for e in extensions)
+
+
 def _meshio_extensions() -> tuple[str, ...]:
     """The extensions meshio reads, () without meshio."""
     try:

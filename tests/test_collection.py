@@ -363,3 +363,22 @@ def test_a_file_that_fails_after_it_was_computed_leaves_no_old_result(sources, t
     c = mv.open_collection(store)
     assert c.names == [] and list(c.errors) == ["scan"]
     assert not (store / "meshes" / "scan.npz").exists()
+
+
+def test_formats_meshio_reads_are_meshes_in_folders_and_as_sources(sources, tmp_path):
+    # a .vtu named as a source was read as a list file (21 failures named after its XML
+    # lines) and a folder's search skipped it; an .xml beside it is not taken for a mesh
+    meshio = pytest.importorskip("meshio")
+    folder = tmp_path / "scans"
+    folder.mkdir()
+    sphere = mv.load_mesh(sources / "sphere.obj")
+    meshio.write_points_cells(folder / "ball.vtu", sphere.vertices, [("triangle", sphere.faces)])
+    (folder / "notes.xml").write_text("<notes>not a mesh</notes>\n")
+    (folder / "plate.obj").write_bytes((sources / "plate.obj").read_bytes())
+    assert [p.name for p in coll.find_meshes([folder])] == ["ball.vtu", "plate.obj"]
+    assert coll.find_meshes([folder / "ball.vtu"]) == [folder / "ball.vtu"]
+    summary = coll.run_batch([folder / "ball.vtu"], tmp_path / "store", "laplacian", K, workers=0)
+    assert summary.computed == ["ball"]
+    assert (
+        mv.open_collection(tmp_path / "store").spectrum("ball").modes.shape[0] == sphere.n_vertices
+    )
