@@ -56,7 +56,9 @@ class OffscreenViewport(QtWidgets.QWidget):
         super().__init__(parent)
         self.setMinimumSize(200, 150)
         self.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
-        self.plotter = pv.Plotter(off_screen=True, window_size=(640, 480))
+        # notebook=False: in a Jupyter kernel pyvista would show through its notebook
+        # backend (trame, or an ImportError without it) instead of rendering here
+        self.plotter = pv.Plotter(off_screen=True, notebook=False, window_size=(640, 480))
         self.plotter.set_background("white")
         fit_smaller_side(self.plotter.renderer)
         # pyvista skips render() until the first show; show once (off-screen: no window)

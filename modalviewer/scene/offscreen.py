@@ -27,7 +27,7 @@ def offscreen_plotter(size=DEFAULT_SIZE):
 
     from .mesh_scene import fit_smaller_side
 
-    plotter = pv.Plotter(off_screen=True, window_size=[int(size[0]), int(size[1])])
+    plotter = pv.Plotter(off_screen=True, notebook=False, window_size=[int(size[0]), int(size[1])])
     plotter.set_background("white")
     fit_smaller_side(plotter.renderer)
     return plotter
