@@ -30,7 +30,10 @@ def _read_vtk(path: Path):
 
     data = pv.read(str(path))
     if not isinstance(data, pv.PolyData):
-        data = data.extract_surface()
+        try:  # the algorithm named: pyvista 0.47+ warns that its default will change
+            data = data.extract_surface(algorithm="dataset_surface")
+        except TypeError:  # an older pyvista, which has only this one
+            data = data.extract_surface()
     data = data.triangulate()
     faces = np.asarray(data.faces).reshape(-1, 4)[:, 1:] if data.n_cells else np.zeros((0, 3))
     return np.asarray(data.points, dtype=np.float64), np.asarray(faces, dtype=np.int64)

@@ -29,7 +29,8 @@ print(f"best match on B: vertex {match}, heat kernel distance {distance:.3g}")
 panels = [
     Panel(pair.mesh("a"), "A: the picked fingertip", marker=pick, azimuth=150, elevation=30),
     Panel(pair.mesh("b"), "B: heat kernel distance and best match", marker=match,
-          distances=pair.distance_on("b"), azimuth=150, elevation=30),
+          distances=pair.distance_on("b"), azimuth=150, elevation=30,
+          colorbar="heat kernel distance"),
 ]  # fmt: skip
 render_panels(panels, "two_hands_best_match.png", size=(560, 480))
 viewer.close()

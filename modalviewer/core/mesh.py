@@ -94,7 +94,8 @@ def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
         face = int(np.flatnonzero(out.any(axis=1))[0])
         raise MeshError(
             f"face {face} refers to vertex {int(f[face][out[face]][0])}, which does not exist "
-            f"(the mesh has {_plural(n, 'vertex')}); the file is corrupt or truncated"
+            f"(the mesh has {_plural(n, 'vertex')}); faces and vertices do not belong "
+            "together (a file cut short or damaged, or arrays of two meshes)"
         )
 
 

@@ -98,7 +98,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.session:
         notes = window.open_session(args.session, wait=headless)
         if window.state.mesh is None:
-            print(f"error: {window.last_error}", file=sys.stderr)
+            print(f"modalviewer: error: {window.last_error}", file=sys.stderr)
             if headless:
                 return 1
         if not headless:
@@ -126,9 +126,9 @@ def main(argv: list[str] | None = None) -> int:
         return app.exec()
 
     if not opened:
-        print(f"error: {window.last_error}", file=sys.stderr)
+        print(f"modalviewer: error: {window.last_error}", file=sys.stderr)
         if str(window.last_error).endswith("the file is damaged or truncated"):
-            print("note: --partial opens the file's whole records", file=sys.stderr)
+            print("modalviewer: note: --partial opens the file's whole records", file=sys.stderr)
         return 1
     if args.partial:  # what was dropped
         print(window.mesh.report)
@@ -142,7 +142,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         spec = window.compute(operator, k=args.k, wait=True)
     except Exception as exc:  # ComputeError carries the user message
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"modalviewer: error: {exc}", file=sys.stderr)
         return 1
     if args.mode is not None:
         window.show_mode(args.mode)

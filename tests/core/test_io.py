@@ -37,6 +37,24 @@ def test_formats_round_trip(tmp_path, ext):
     assert loaded.total_area == pytest.approx(mesh.total_area, rel=1e-6)
 
 
+def test_an_unstructured_grid_file_reads_without_a_warning(tmp_path):
+    # pyvista's extract_surface warned (FutureWarning) for every .vtk grid read, also in
+    # batch output
+    import warnings
+
+    import pyvista as pv
+
+    mesh = icosphere(2)
+    cells = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
+    grid = pv.UnstructuredGrid(cells, np.full(mesh.n_faces, pv.CellType.TRIANGLE), mesh.vertices)
+    path = tmp_path / "grid.vtk"
+    grid.save(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        loaded = mv.load_mesh(path)
+    assert loaded.n_faces == mesh.n_faces
+
+
 def test_repairs_are_made_and_reported(tmp_path):
     plate = grid_plate(4, 4)
     n = plate.n_vertices

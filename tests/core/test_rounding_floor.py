@@ -41,6 +41,11 @@ def test_a_residual_above_1e8_on_a_hand_is_at_its_rounding_floor():
     assert f"{spec.residuals[worst]:.1e}" in text and "rounding floor" in text
     said = f"at the rounding floor of double precision for that mode here, about {floor:.1e}"
     assert said in text
+    # three times the floor is not "at" it (it was said so up to ten times)
+    spec.parameters["worst_residual_rounding_floor"] = spec.residuals[worst] / 3.0
+    text = residual_text(spec)
+    assert "(3 times the rounding floor of double precision for that mode here" in text
+    assert "at the rounding floor" not in text
 
 
 def test_a_well_shaped_mesh_reports_no_floor():

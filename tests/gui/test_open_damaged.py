@@ -73,7 +73,7 @@ def test_a_run_without_a_display_refuses_a_damaged_file_instead_of_waiting(tmp_p
     command += ["-k", "8", "--screenshot", str(out)]
     run = subprocess.run(command, capture_output=True, text=True, env=env, timeout=120)
     assert run.returncode == 1
-    assert "error: cut_scan.ply: element 'face' " in run.stderr
+    assert "modalviewer: error: cut_scan.ply: element 'face' " in run.stderr
     assert "the file is damaged or truncated" in run.stderr
     assert "note: --partial opens the file's whole records" in run.stderr
     assert not out.exists()
