@@ -453,8 +453,7 @@ class Viewer:
         elif job.status == FAILED:
             if job.details:  # an unexpected fault: its traceback for the log
                 log.error("computation failed: %s\n%s", job.error, job.details)
-            else:
-                log.warning("computation failed: %s", job.error)
+            # every failure's message is logged once below, as the user is told it
             mesh = self.state.mesh
             if isinstance(job, RepairJob):
                 return  # reported by its own callback (_on_repaired)
