@@ -2,9 +2,10 @@
 =================================================
 
 The vibration distance compares how two points move in the low vibration modes, over
-all time scales.  Picking a vertex on spot's flank and marking the tenth of the
-surface's area closest to it (``share=0.1``) finds the matching point on the other flank
-and the regions that vibrate in the same way.  100 modes; the first call computes the
+all time scales.  Picking vertex 2000 on spot's far flank (out of view, with its
+marker) and marking the tenth of the surface's area closest to it (``share=0.1``) finds
+the matching region on the near flank, shown here, and the regions that vibrate in the
+same way.  100 modes; the first call computes the
 spectrum, the map is drawn once it is in.
 """
 
