@@ -96,15 +96,9 @@ def _batch(args) -> int:
     from .cli import _Unavailable
     from .collection import progress_bar, run_batch
 
-    if args.k < 1:
-        raise ValueError("-k must be at least 1")
-    workers = args.workers
+    workers = args.workers  # -k, --workers and --memory-limit checked by the parser
     if workers is None:
         workers = os.cpu_count() or 1
-    if workers < 0:
-        raise ValueError("--workers must be 0 or more")
-    if args.memory_limit is not None and args.memory_limit <= 0:
-        raise ValueError("--memory-limit must be above 0")
     if workers > 0 or args.scheduler:
         try:
             import distributed  # noqa: F401
@@ -134,11 +128,11 @@ def _batch(args) -> int:
     )
     if summary.interrupted:
         sys.stderr.write("\n")  # the progress line stopped short
+    print(f"{args.output}: {summary.text()}")  # the summary first, then its details
     for name, error in summary.failed.items():
         print(f"failed: {name}: {error}")
-    print(f"{args.output}: {summary.text()}")
     if summary.failed_before:
-        print("(--retry-failed retries them: " + ", ".join(summary.failed_before) + ")")
+        print("recorded failures not tried again: " + ", ".join(summary.failed_before))
     if summary.interrupted:
         sys.stderr.write("modalviewer: interrupted (the store holds every finished mesh)\n")
         return 130

@@ -497,14 +497,15 @@ class BatchSummary:
 
     def text(self) -> str:
         rate = len(self.computed) / self.seconds * 60.0 if self.seconds > 0 else 0.0
-        words = (
-            f"{len(self.computed)} computed, {len(self.skipped)} already done, "
-            f"{len(self.failed)} failed, in {self.seconds:.1f} s"
-        )
+        words = f"{len(self.computed)} computed, {len(self.skipped)} already done"
+        if self.failed_before:  # skipped as done, but they are failures
+            words += (
+                f" ({len(self.failed_before)} of them recorded failures, not tried again: "
+                "--retry-failed)"
+            )
+        words += f", {len(self.failed)} failed, in {self.seconds:.1f} s"
         if self.computed:
             words += f" ({rate:.1f} meshes per minute)"
-        if self.failed_before:
-            words += f"; {len(self.failed_before)} of those done had failed before"
         return ("interrupted: " if self.interrupted else "") + words
 
 

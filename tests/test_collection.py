@@ -159,6 +159,11 @@ def test_resume_recomputes_nothing(store, sources, client, monkeypatch):
     summary = coll.run_batch([sources], store, **params)
     assert calls == [] and summary.computed == [] and len(summary.skipped) == 7
     assert summary.failed_before == ["broken"]
+    # a recorded failure is not counted as if it were done without saying so
+    assert summary.text().startswith(
+        "0 computed, 7 already done (1 of them recorded failures, not tried again: "
+        "--retry-failed), 0 failed, in "
+    )
     # a touched file is read again, but its geometry hash says it is done
     os.utime(sources / "sphere.obj", ns=(time.time_ns(), time.time_ns()))
     summary = coll.run_batch([sources], store, **params)
@@ -382,3 +387,18 @@ def test_formats_meshio_reads_are_meshes_in_folders_and_as_sources(sources, tmp_
     assert (
         mv.open_collection(tmp_path / "store").spectrum("ball").modes.shape[0] == sphere.n_vertices
     )
+
+
+def test_batch_prints_its_summary_first_and_names_recorded_failures(sources, tmp_path, capsys):
+    from modalviewer.cli import main
+
+    files = [str(sources / "sphere.obj"), str(sources / "broken.obj")]
+    argv = ["batch", *files, "-o", str(tmp_path / "s"), "-k", "6", "--workers", "0"]
+    assert main(argv) == 1
+    lines = capsys.readouterr().out.splitlines()
+    assert "1 computed, 0 already done, 1 failed" in lines[0]
+    assert lines[1].startswith("failed: broken: ")
+    assert main(argv) == 0  # the failure is recorded, not tried again
+    lines = capsys.readouterr().out.splitlines()
+    assert "0 computed, 2 already done (1 of them recorded failures, not tried again" in lines[0]
+    assert lines[1] == "recorded failures not tried again: broken"
