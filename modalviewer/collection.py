@@ -159,8 +159,9 @@ def mesh_names(paths: Sequence[Path]) -> list[str]:
             continue
         same = [q.resolve() for q, s in zip(paths, stems, strict=True) if s == stem]
         root = Path(os.path.commonpath([str(q.parent) for q in same]))
-        rel = p.resolve().relative_to(root)
-        twins = sum(q.with_suffix("") == p.resolve().with_suffix("") for q in same)
+        here = p.resolve()
+        rel = here.relative_to(root)
+        twins = sum(q.with_suffix("") == here.with_suffix("") for q in same)
         names.append("--".join(rel.parts if twins > 1 else rel.with_suffix("").parts))
     return [_safe(n) for n in names]
 

@@ -586,6 +586,23 @@ def _weighted_product(A: np.ndarray, B: np.ndarray, weights: np.ndarray | None =
     return out
 
 
+def _remove_parts_along(Z: np.ndarray, X: np.ndarray, mass: np.ndarray, run=None) -> None:
+    """``X -= Z (Z^T M X)`` in place, a row block at a time (no (N, m) temporary): X
+    made Mass-orthogonal to the Mass-orthonormal columns of Z (the exact null vectors).
+    ``run(n, fn)`` calls ``fn(rows)`` for the row blocks (:func:`_parallel_rows`);
+    by default one after another."""
+    C = _weighted_product(Z, X, mass)
+
+    def project(rows):
+        X[rows] -= Z[rows] @ C
+
+    if run is None:
+        for rows in _rows(X.shape[0]):
+            project(rows)
+    else:
+        run(X.shape[0], project)
+
+
 def _subspace_step(
     K, mass: np.ndarray, solver, lam: np.ndarray, U: np.ndarray, live=None, solved=None
 ):
@@ -845,12 +862,7 @@ def _preconditioned_residuals(
     scale[zero] = max(float(np.abs(lam).max()), lam_scale)
     relative = np.sqrt(res2) / (scale * np.sqrt(mu2))
     if W is not None and Z.shape[1]:
-        C = _weighted_product(Z, W, mass)
-
-        def project(rows):
-            W[rows] -= Z[rows] @ C
-
-        _parallel_rows(n, project)
+        _remove_parts_along(Z, W, mass, _parallel_rows)
     return relative, W, energies, solution_norms
 
 
@@ -1044,9 +1056,7 @@ def _with_exact_null_vectors(mesh, operator, K, mass, lam, U, res, lam_scale, nu
         return 0, nulls
     Z = nulls.vectors.toarray()
     U[:, :d] = Z
-    G = _weighted_product(Z, U[:, d:], mass)  # the other modes' parts along Z: rounding
-    for rows in _rows(U.shape[0]):
-        U[rows, d:] -= Z[rows] @ G
+    _remove_parts_along(Z, U[:, d:], mass)  # the other modes' parts along Z: rounding
     lam[:d] = 0.0
     res[:d] = _zero_mode_residuals(K, mass, lam, U, d, lam_scale)
     return d, nulls
@@ -1230,10 +1240,8 @@ def _coarse_start(
         V[:, cols] = solver.solve(B)
     del rhs, B
     Z = nulls.vectors.toarray() if d else np.zeros((n, 0))
-    if d:  # Mass-orthogonal to the null vectors, a row chunk at a time (no (N, m) temporary)
-        G = _weighted_product(Z, V, mass)
-        for rows in _rows(n):
-            V[rows] -= Z[rows] @ G
+    if d:  # Mass-orthogonal to the null vectors
+        _remove_parts_along(Z, V, mass)
     lam_y, C = _ritz_in_span(K, mass, V, k - d)
     seconds["inverse_iteration"] = time.perf_counter() - t
     if V.shape[1] >= d + C.shape[1]:

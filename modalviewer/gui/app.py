@@ -75,6 +75,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ["MODALVIEWER_NO_DIALOGS"] = "1"
         os.environ.pop("MODALVIEWER_ASSUME_YES", None)
     from .application import ensure_application
+    from .dialogs import DAMAGED_WORDS
     from .main_window import MainWindow
     from .paths import DEFAULT_MESH, SCREENSHOTS
 
@@ -127,7 +128,7 @@ def main(argv: list[str] | None = None) -> int:
 
     if not opened:
         print(f"modalviewer: error: {window.last_error}", file=sys.stderr)
-        if str(window.last_error).endswith("the file is damaged or truncated"):
+        if str(window.last_error).endswith(DAMAGED_WORDS):
             print("modalviewer: note: --partial opens the file's whole records", file=sys.stderr)
         return 1
     if args.partial:  # what was dropped

@@ -449,12 +449,7 @@ class PairWindow(QtWidgets.QWidget):
 
     def pick(self, side: str, vertex: int) -> None:
         """Pick ``vertex`` of ``side`` (as a click does); a missing spectrum is computed."""
-        try:
-            self.pair.pick(side, vertex)
-        except ValueError as exc:
-            self._on_message(str(exc))
-            return
-        self.request()
+        self._pick_then_request(lambda: self.pair.pick(side, vertex))
 
     def pick_a(self, vertex: int) -> None:
         """Pick mesh vertex ``vertex`` of A (a mesh index, as a click gives it)."""
@@ -464,10 +459,14 @@ class PairWindow(QtWidgets.QWidget):
         self.pick("b", vertex)
 
     def pick_file_vertex(self, side: str, number: int) -> None:
-        """Pick vertex ``number`` of the file of mesh ``side`` ("a" or "b"): the number
+        """Pick vertex ``number`` of the file of mesh ``side`` ("a" or "b"; the number
         the legends show); a missing spectrum is computed."""
+        self._pick_then_request(lambda: self.pair.pick_file_vertex(side, number))
+
+    def _pick_then_request(self, pick) -> None:
+        """``pick()``, then the spectra it needs; a refused pick (ValueError) is said."""
         try:
-            self.pair.pick_file_vertex(side, number)
+            pick()
         except ValueError as exc:
             self._on_message(str(exc))
             return

@@ -765,11 +765,7 @@ class Viewer:
                 transparent=transparent,
                 scene=self._picture.scene,
             )
-        from ..scene.offscreen import DEFAULT_SIZE
-
-        return self.renderer(size or DEFAULT_SIZE).screenshot(
-            path, scale=scale, transparent=transparent
-        )
+        return self._renderer_sized(size).screenshot(path, scale=scale, transparent=transparent)
 
     def image(self, scale: int = 1, transparent: bool = False, size=None) -> np.ndarray:
         """The picture as an (h, w, 3 or 4) uint8 array (for notebooks)."""
@@ -777,9 +773,14 @@ class Viewer:
             from ..scene.export import grab
 
             return grab(self._picture.plotter, self._picture.scene, scale, transparent)
+        return self._renderer_sized(size).image(scale, transparent)
+
+    def _renderer_sized(self, size):
+        """:meth:`renderer` at ``size``, or the default size where None: a picture's
+        size does not carry over from an earlier call, as :meth:`renderer`'s does."""
         from ..scene.offscreen import DEFAULT_SIZE
 
-        return self.renderer(size or DEFAULT_SIZE).image(scale, transparent)
+        return self.renderer(size or DEFAULT_SIZE)
 
     def animation_frame(self, phase: float, size=None) -> float:
         """Move the picture's surface to ``phase`` (radians) of the vibration shown (a
