@@ -108,6 +108,7 @@ def _number(low: float = 0.0, low_included: bool = True, high: float = np.inf):
 
 
 COUNT = _whole(1)
+MODE_INDEX = _whole(0)
 WEIGHT = _number()
 
 
@@ -167,7 +168,7 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("render", help="render a mode to PNG")
     r.add_argument("mesh")
     r.add_argument("--operator", choices=OPERATORS, default="laplacian")
-    r.add_argument("--mode", type=_whole(0), required=True)
+    r.add_argument("--mode", type=MODE_INDEX, required=True)
     r.add_argument("-k", type=COUNT, default=None)
     r.add_argument("--isolines", type=_whole(0), default=12)
     r.add_argument(

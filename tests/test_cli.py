@@ -522,3 +522,46 @@ def test_collection_commands_refuse_values_out_of_range_as_argument_errors(argv,
     with pytest.raises(SystemExit) as exit_:
         cli.main(argv)
     assert exit_.value.code == 2 and fragment in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "args, fragment",
+    [
+        (("-k", "0"), "argument -k: must be at least 1, got 0"),
+        (("-k", "2.5"), "argument -k: a whole number is needed, got '2.5'"),
+        (("--mode", "-3"), "argument --mode: must be at least 0, got -3"),
+    ],
+)
+def test_the_viewers_own_values_out_of_range_are_argument_errors(args, fragment, capsys):
+    # as the headless commands': exit code 2 before any window or file (the viewer took
+    # --mode -3 and showed a mode counted from the end, and -k 0 failed after loading)
+    from modalviewer.gui import app
+
+    with pytest.raises(SystemExit) as exit_:
+        app.main(["missing.obj", *args])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2
+    lines = [line for line in err.splitlines() if line.startswith("modalviewer: error")]
+    assert len(lines) == 1 and fragment in lines[0], err
+
+
+def test_the_viewers_mode_beyond_those_computed_is_an_argument_error(tmp_path):
+    out = tmp_path / "x.png"
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", MODALVIEWER_CACHE=str(tmp_path / "c"))
+    args = (ASSETS / "demo_plate.obj", "--operator", "laplacian", "-k", 6, "--mode", 9)
+    r = _run(*args, "--screenshot", out, env=env)
+    assert r.returncode == 2 and "modalviewer: error: --mode must be between 0 and 5" in r.stderr
+    assert not out.exists()
+
+
+def test_the_window_says_when_its_mode_is_beyond_those_computed():
+    from types import SimpleNamespace
+
+    from modalviewer.gui.app import _show_mode
+
+    said, shown = [], []
+    window = SimpleNamespace(show_error=said.append, show_mode=shown.append)
+    _show_mode(window, SimpleNamespace(k=6), 9)
+    assert said == ["--mode 9: the spectrum has modes 0 to 5"] and shown == [5]
+    _show_mode(window, SimpleNamespace(k=6), 2)
+    assert len(said) == 1 and shown == [5, 2]

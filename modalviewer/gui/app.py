@@ -17,6 +17,7 @@ import traceback
 import weakref
 from pathlib import Path
 
+from ..cli import COUNT, MODE_INDEX
 from ..core.operators import OPERATOR_NAMES
 from ..scene.platform import has_display
 
@@ -48,8 +49,8 @@ def build_parser() -> argparse.ArgumentParser:
         choices=list(OPERATOR_NAMES),
         help="spectrum to compute at start (headless default: modified_dirichlet)",
     )
-    p.add_argument("--mode", type=int, default=None, help="mode to show")
-    p.add_argument("-k", type=int, default=None, help="number of modes")
+    p.add_argument("--mode", type=MODE_INDEX, default=None, help="mode to show (from 0)")
+    p.add_argument("-k", type=COUNT, default=None, help="number of modes")
     p.add_argument("--screenshot", default=None, help="render to this PNG and exit")
     p.add_argument(
         "--partial",
@@ -63,6 +64,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="restore a session file (File > Save Session) instead of opening a mesh",
     )
     return p
+
+
+def _show_mode(window, spec, mode: int | None) -> None:
+    """Show ``--mode`` once the window's spectrum is computed; one beyond its modes is
+    said in the window, and the last mode is shown."""
+    if mode is None or spec is None:
+        return
+    if mode >= spec.k:
+        window.show_error(f"--mode {mode}: the spectrum has modes 0 to {spec.k - 1}")
+    window.show_mode(min(mode, spec.k - 1))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -119,10 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     if not headless:
         if opened and args.operator:
             window.compute(
-                args.operator,
-                k=args.k,
-                wait=False,
-                then=lambda _s: args.mode is not None and window.show_mode(args.mode),
+                args.operator, k=args.k, wait=False, then=lambda s: _show_mode(window, s, args.mode)
             )
         return app.exec()
 
@@ -145,6 +153,9 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:  # ComputeError carries the user message
         print(f"modalviewer: error: {exc}", file=sys.stderr)
         return 1
+    if args.mode is not None and args.mode >= spec.k:  # as argparse's own errors
+        print(f"modalviewer: error: --mode must be between 0 and {spec.k - 1}", file=sys.stderr)
+        return 2
     if args.mode is not None:
         window.show_mode(args.mode)
     app.processEvents()
