@@ -59,7 +59,10 @@ def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
 
 
 def _threshold_table(n: int = 2048) -> pv.LookupTable:
-    """The threshold map's table: blue (similar) below its middle, white above."""
+    """The threshold maps' table: blue (similar) below its middle, white above.  Fine
+    (2048 entries), so the step of :meth:`MeshScene.show_threshold`, which looks colours up
+    after interpolation along the surface, falls within 1/2048 of the range from the
+    threshold."""
     table = np.empty((n, 4))
     table[:, :3] = WHITE
     table[: n // 2, :3] = SIMILAR_BLUE
@@ -103,7 +106,7 @@ COLORMAPS = {  # colours from the low to the high end of each colour map
 }
 DIVERGING = lookup_table([ORANGE, WHITE, BLUE])  # negative -> zero -> positive
 SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
-THRESHOLD = lookup_table([SIMILAR_BLUE, WHITE], n=2)  # closer than threshold -> blue
+THRESHOLD = _threshold_table()  # closer than threshold -> blue
 
 
 def isoline_segments(
@@ -479,7 +482,7 @@ class MeshScene:
         hi = float(np.max(values)) or 1.0
         self.clim = (0.0, hi)
         self.clipped = (False, False)
-        self._mapper.lookup_table = _threshold_table()
+        self._mapper.lookup_table = THRESHOLD
         self._mapper.SetInterpolateScalarsBeforeMapping(True)
         self._mapper.ScalarVisibilityOn()
         self.kind = "threshold"
