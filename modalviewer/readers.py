@@ -149,15 +149,20 @@ def _read_obj_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
     three coordinates, every ``f`` line three positive indices); None for any other
     file, which the line-by-line reader then reads and checks."""
     lines = text.splitlines()
+    if any(line.rstrip() in ("v", "f") for line in lines):  # a bare record: cut there
+        return None
     v_lines = [line[2:] for line in lines if line[:2] == "v "]
-    face_text = "\n".join(line[2:] for line in lines if line[:2] == "f ")
+    face_records = [line[2:] for line in lines if line[:2] == "f "]
+    face_text = "\n".join(face_records)
     widths = {len(line.split()) for line in v_lines}  # x y z, maybe w or r g b after
     if len(widths) != 1 or min(widths) < 3:
         return None
     width = widths.pop()
     if "/" in face_text:
         face_text = re.sub(r"/\S*", "", face_text)
-    f_lines = face_text.splitlines()
+    # split on "\n", not splitlines(): a last record with nothing after "f " (a file cut
+    # there) must stay a line of its own, which splitlines() drops
+    f_lines = face_text.split("\n") if face_records else []
     if any(len(line.split()) != 3 for line in f_lines):
         return None
     try:
@@ -185,7 +190,8 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
     polygons: list = []
     face_lines: list = []
     for number, line in enumerate(text.splitlines(), start=1):
-        if line[:2] == "v " or line[:2] == "v\t":
+        record = line.rstrip()  # "v" or "f" alone: a record cut after its letter
+        if line[:2] == "v " or line[:2] == "v\t" or record == "v":
             words = line.split()
             try:
                 xyz = [float(w) for w in words[1:4]]
@@ -196,7 +202,7 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
                 unplaced.append(len(vertices))
                 xyz = [np.nan] * 3
             vertices.append(xyz)
-        elif line[:2] == "f " or line[:2] == "f\t":
+        elif line[:2] == "f " or line[:2] == "f\t" or record == "f":
             words = line.split()[1:]
             try:
                 corners = [int(w.split("/")[0]) for w in words]

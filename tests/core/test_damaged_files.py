@@ -205,6 +205,21 @@ def test_an_obj_record_cut_mid_line_is_named(tmp_path):
         mv.load_mesh(path)
 
 
+@pytest.mark.parametrize("ending", ["f ", "f", "f \n", "f 3 "])
+def test_an_obj_cut_just_after_a_face_records_f_is_refused(tmp_path, ending):
+    # a file cut after "f " loaded as the faces before it, without a word (the fast
+    # reader's splitlines() dropped the empty last record)
+    v, f = _plate()
+    text = _obj(v, f[:100]).decode() + ending
+    path = tmp_path / "cut.obj"
+    path.write_text(text)
+    line = len(v) + 101
+    with pytest.raises(mv.MeshError, match=rf"^cut\.obj: line {line}: the face record"):
+        mv.load_mesh(path)
+    mesh = mv.load_mesh(path, strict=False)
+    assert mesh.n_faces == 100 and f"line {line}: the face record" in str(mesh.report).lower()
+
+
 @pytest.mark.parametrize("fmt", ["obj", "off", "ply-ascii", "ply-binary"])
 @pytest.mark.parametrize("where", ["before", "between", "after"])
 def test_unused_vertices_keep_the_files_numbering(tmp_path, fmt, where):
