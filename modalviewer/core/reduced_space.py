@@ -369,11 +369,15 @@ class ReducedBasis:
 
     def prolong(self, Y: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """``P Y`` for reduced coefficients Y (dimension, k): (c n, k) values, written
-        into ``out`` if given (C-contiguous)."""
+        into ``out`` if given (C-contiguous).  A new array owns its memory (not a view of
+        the (n, c k) product), so the preview's refinement can work in it and shrink it
+        in place instead of copying it."""
         c, k = self.components, Y.shape[1]
         Ys = np.ascontiguousarray(Y[: self.n_sparse]).reshape(-1, c * k)
-        flat = None if out is None else out.reshape(-1, c * k)
-        U = threaded_product(self.scalar, Ys, out=flat).reshape(-1, k)
+        if out is None:
+            out = np.empty((self.scalar.shape[0] * c, k))
+        threaded_product(self.scalar, Ys, out=out.reshape(-1, c * k))
+        U = out
         if self.dense is not None:
             Yd = Y[self.n_sparse :]
             for rows in row_blocks(U.shape[0]):  # no (c n, k) temporary

@@ -161,16 +161,26 @@ def test_estimated_errors_follow_the_measured_errors(request, mesh_name, operato
     k = 20
     exact = _exact(mesh, operator, k)
     K, mass = operator_matrices(mesh, operator)
-    lam, _, _, info = pv.preview_spectrum(mesh, operator, K, mass, k, refine=False)
-    nonzero = exact > 1e-8 * exact.max()
-    measured = (lam[nonzero] - exact[nonzero]) / exact[nonzero]
-    estimated = np.array(info["estimated_errors"])
-    assert np.all(estimated[~nonzero] == 0.0)
-    estimated = estimated[nonzero]
-    # measured here: largest estimate 0.85 to 0.99 times the largest error, per mode
-    # 0.85 to 0.99 in the median
-    assert 0.6 < estimated.max() / measured.max() < 1.3
-    assert 0.6 < np.median(estimated / measured) < 1.3
+    for refine in (False, True):
+        lam, _, _, info = pv.preview_spectrum(mesh, operator, K, mass, k, refine=refine)
+        nonzero = exact > 1e-8 * exact.max()
+        measured = (lam[nonzero] - exact[nonzero]) / exact[nonzero]
+        estimated = np.array(info["estimated_errors"])
+        assert np.all(estimated[~nonzero] == 0.0)
+        estimated = estimated[nonzero]
+        # measured here: the fast previews' largest estimate 0.57 to 1.25 times the
+        # largest error (the shells' of the plate the 0.57, at 2.1 %), per mode 0.96 to
+        # 1.19 in the median; after subspace steps (the scalar operators' refinement)
+        # the estimate reads the errors as lying above the refined space: 1.7 to 3.0
+        # times, each mode's at least its error (0.25 to 0.27 times without the guard
+        # modes and that reading); the shells' refined smooth-space preview 0.83
+        refined = info["refinement"]["steps"] > 0 and operator != "shells"
+        high = 4.0 if refined else 1.3
+        assert 0.5 < estimated.max() / measured.max() < high, (refine, estimated.max())
+        assert 0.6 < np.median(estimated / measured) < high
+        if refined:
+            big = measured > 1e-3 * measured.max()
+            assert np.all(estimated[big] >= 0.9 * measured[big])
 
 
 def _no_single_factor(monkeypatch):
@@ -310,8 +320,11 @@ def test_thin_tube_without_room_for_a_single_precision_factor(monkeypatch):
     assert np.all(np.abs(lam[:6]) < 1e-9 * scale)
     np.testing.assert_allclose(U.T @ (mass[:, None] * U), np.eye(k), atol=1e-8)
     estimated = np.array(info["estimated_errors"])[nonzero]
-    assert 0.1 < estimated.max() / after.max() < 1.0
-    assert np.all(estimated[after > 1e-7] < 2 * after[after > 1e-7])
+    # after subspace steps the estimate reads the errors as lying above the refined
+    # space (its guard modes' top value): measured 1.5 times the largest error, each
+    # mode's at least its error (block-Jacobi read the largest at 0.1 to 1 times)
+    assert 1.0 <= estimated.max() / after.max() < 4.0
+    assert np.all(estimated[after > 1e-7] >= 0.9 * after[after > 1e-7])
 
 
 def test_a_memory_limit_leaves_no_room_for_the_single_precision_factor(monkeypatch):
@@ -876,12 +889,13 @@ def test_the_correction_step_solves_at_most_32_columns_at_a_time(monkeypatch):
     time whatever the mesh's size (one block of 57 on the 266k-vertex part set the fast
     preview's peak above the exact solve's in two of five runs): 80 modes of a torus,
     60 % of the modes asked for (48 columns) in blocks of 32 and 16, then the estimate
-    of its 74 non-zero modes in blocks of 32, 32 and 10."""
+    of its 94 non-zero modes (74 asked for, 20 guard modes) in blocks of 32, 32 and
+    30."""
     mesh = torus(64, 16, minor=0.2)
     K, mass = operator_matrices(mesh, "shells")
     widths = _solve_widths(monkeypatch)
     pv.preview_spectrum(mesh, "shells", K, mass, 80, refine=False)
-    assert widths == [32, 16, 32, 32, 10], widths
+    assert widths == [32, 16, 32, 32, 30], widths
 
 
 def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeypatch):
@@ -893,14 +907,15 @@ def test_preconditioned_residuals_in_column_blocks_give_the_same_preview(monkeyp
     K, mass = operator_matrices(mesh, "shells")
     widths = _solve_widths(monkeypatch)
     whole = pv.preview_spectrum(mesh, "shells", K, mass, 20)
-    # the first step's 12 columns, then all 14 non-zero modes: the estimate, the same
-    # residuals again for the refinement's step (kept this time), the final estimate
-    assert widths == [12, 14, 14, 14]
+    # the first step's 12 columns (60 % of the 20 asked for), then all 19 non-zero
+    # modes (the 14 asked for and 5 guard modes): the estimate, the same residuals again
+    # for the refinement's step (kept this time), the final estimate
+    assert widths == [12, 19, 19, 19]
     widths.clear()
     monkeypatch.setattr(pv, "STEP_BLOCK_COLUMNS", 5)
     monkeypatch.setattr(pv, "REFINE_BLOCK_COLUMNS", 3)  # the refinement's kept pass
     blocked = pv.preview_spectrum(mesh, "shells", K, mass, 20)
-    assert widths == [5, 5, 2, 5, 5, 4, 3, 3, 3, 3, 2, 5, 5, 4]
+    assert widths == [5, 5, 2, 5, 5, 5, 4, 3, 3, 3, 3, 3, 3, 1, 5, 5, 5, 4]
     np.testing.assert_allclose(blocked[0], whole[0], rtol=1e-7, atol=1e-9 * whole[0].max())
     # single-precision solves round differently with the block's width: 2e-4 relative
     # on one machine's processor, below 1e-4 on another's

@@ -380,7 +380,7 @@ def test_a_preview_shows_where_its_lower_half_is_estimated_within_2_percent(mode
     (such a preview may miss modes).  The 3D shells of a torus
     with a thin tube (640 vertices, 20 modes) are: the correction step preconditions
     the lowest 60 % of the modes, whose estimates are below 0.1 %, while the two highest
-    are estimated at 2.7 and 3.4 % (2.6 and 3.3 % off); each mode's legend gives its own
+    are estimated at 2.7 and 3.3 % (2.6 and 3.3 % off); each mode's legend gives its own
     estimate.  The exact
     spectrum then replaces the preview."""
     from modalviewer.core.primitives import torus
@@ -403,7 +403,7 @@ def test_a_preview_shows_where_its_lower_half_is_estimated_within_2_percent(mode
     assert "(preview; estimated error < 0.01 %)" in text, text
     state.show_mode(19)
     text = wording.legend(state).replace("\u00a0", " ")
-    assert "(preview; estimated error 3.4 %)" in text, text
+    assert "(preview; estimated error 3.3 %)" in text, text
     model.jobs.wait(exact)
     assert not state.spectrum("shells").is_preview and not state.shows_preview()
 
