@@ -819,20 +819,23 @@ def _single_factor(K, mass: np.ndarray, lowest: float, columns: int):
     return None
 
 
-STEP_BLOCK_COLUMNS = 32
+STEP_BLOCK_COLUMNS = 16
 """Columns per block of the 3D shells' preconditioned residuals (:func:`_factor_steps`):
 each block's residuals and solutions (float32) and PARDISO's work arrays for its solve
 grow with the columns and sit beside the factor and the modes.  The machined part flat
 x3 (266k vertices, 57 columns in the first step): the fast preview peaked at 2951 MB in
 two runs with blocks of 32 and at 3175 to 3428 MB in five with one block (the exact
-solve: 3376 MB), in the same time; spot Loop x3 2722 against 2838 MB, 4 % slower."""
+solve: 3376 MB), in the same time; spot Loop x3 2722 against 2838 MB, 4 % slower.  With
+the guard modes (:data:`SMOOTH_GUARD`) in the space the refined preview peaked at 3356 MB
+with blocks of 32 and 2990 MB with blocks of 16 (the exact solve: 3276 MB), its
+correction 8 % slower."""
 
 
-REFINE_BLOCK_COLUMNS = 32
-"""Columns per block where a refinement's step keeps all non-zero modes' preconditioned
+REFINE_BLOCK_COLUMNS = 16
+"""Columns per block where a refinement's step keeps all wanted modes' preconditioned
 residuals: narrow blocks beside those (N, k) directions keep the refined preview's peak
 near the fast one's (the machined part flat x3, 266k vertices: 1.13 times the exact
-solve's peak with one block of 94)."""
+solve's peak with one block of 94; see :data:`STEP_BLOCK_COLUMNS`)."""
 
 
 def _preconditioned_residuals(
@@ -1003,14 +1006,14 @@ def _factor_steps(
         seconds["preconditioned_residuals"] = seconds.get("preconditioned_residuals", 0.0) + (
             time.perf_counter() - t
         )
-        if info["steps"]:  # every non-zero mode's residual: the estimate
+        if info["steps"]:  # every wanted non-zero mode's residual: the estimate
             res = np.zeros(c)
             res[:first] = _zero_mode_residuals(K, mass, lam, U, first, lam_scale)
-            res[first:] = relative
+            res[cols] = relative
             est = np.zeros(c)
-            est[first:] = _first_order_errors(lam[first:], solver.shift, energies, norms)
+            est[cols] = _first_order_errors(lam[cols], solver.shift, energies, norms)
             info.setdefault("estimated_error_first_step", float(est.max()))
-            lower = est[first:][: max(1, int(np.ceil(0.5 * (c - first))))].max()
+            lower = est[first:][: max(1, int(np.ceil(0.5 * (asked - first))))].max()
             # before the last step only a lower half far off (modes missing) gives up; a
             # lower half a little above the threshold takes the next step
             last = info["steps"] >= 1 + max_steps
@@ -1028,7 +1031,7 @@ def _factor_steps(
         del W
         info["steps"] += 1
         seconds["rayleigh_ritz"] = seconds.get("rayleigh_ritz", 0.0) + time.perf_counter() - t
-        cols = slice(first, c)
+        cols = slice(first, min(c, max(first + 1, asked)))  # guard modes stay unsolved
     info["seconds"] = {s: round(v, 4) for s, v in seconds.items()}
     return lam, res, est, info
 
@@ -1686,12 +1689,13 @@ least :data:`REFINE_GUARD_MIN`), keeps them through its correction and refinemen
 returns the lowest k.  Without them the top modes' errors lie in the modes just above
 them, outside the space, where the residual estimate reads them short: spot Loop x2's
 3D shells refined preview, 100 modes, estimated its largest error at 0.66 % where mode
-99 was 6.2 % off (with them: 1.37 % off, estimated 1.41 %); spot Loop x1's refined
+99 was 6.2 % off (with them: 3.6 % off, estimated 4.3 %); spot Loop x1's refined
 Laplacian and E_D^N read 0.13 and 0.17 times their largest errors (with them and the
 estimate's reading above the refined space, :func:`_first_order_errors`: 2.1 and 2.5
-times, each mode's at least its error, and the errors themselves halved).  The 3D
-shells' correction preconditions all of them after its first step, which costs about a
-quarter more time; the scalar operators estimate the wanted modes only."""
+times, each mode's at least its error, and the errors themselves halved).  The guard
+modes stay in the spaces unsolved: only the wanted modes' residuals are preconditioned
+and estimated (solving the 3D shells' guard modes too took them to 1.37 %, estimated
+1.41 %, for a quarter more time and 0.5 GB more at the part flat x3's peak)."""
 
 
 def _guard_modes(k: int) -> int:
