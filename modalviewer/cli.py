@@ -7,6 +7,7 @@ Bad arguments and bad files give a one-line error and exit code 2 (usage) or 1
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -277,6 +278,9 @@ def _run(args) -> int:
                 f"-o {args.output}: pictures are written as PNG; give a name ending in .png"
             )
 
+    for option, path in _outputs(args):  # before any work: a folder that cannot be made
+        _make_folder(option, Path(path))
+
     if args.command in ("batch", "similar"):
         from .batch_cli import run
 
@@ -445,6 +449,30 @@ def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
         raise ValueError(refusal)
 
 
+def _outputs(args) -> list[tuple[str, str]]:
+    """(option, path) of the files a headless command writes (not batch's store)."""
+    if args.command not in ("compute", "render", "distance"):
+        return []
+    found = [("-o", args.output)] if getattr(args, "output", None) else []
+    if getattr(args, "csv", None):
+        found.append(("--csv", args.csv))
+    return found
+
+
+def _make_folder(option: str, path: Path) -> None:
+    """Create ``path``'s folder (and its parents) as pictures' exports do, before any
+    work; an argument error (exit code 2) where it cannot be made or written in."""
+    folder = path.parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _BadArgument(
+            f"{option} {path}: the folder {folder} cannot be made ({exc.strerror})"
+        ) from None
+    if not os.access(folder, os.W_OK):
+        raise _BadArgument(f"{option} {path}: the folder {folder} is not writable")
+
+
 class _Unavailable(Exception):
     """An option needing an optional package that is not installed (exit code 2)."""
 
@@ -467,7 +495,8 @@ def _load(path, fix_slivers: bool = False, partial: bool = False):
     """The mesh read from ``path``; with ``fix_slivers``, repaired by
     :func:`modalviewer.fix_slivers`, whose report is printed.  A damaged or truncated
     file is refused with the place of the damage and the advice of ``--partial``, which
-    reads its whole records and prints what was dropped."""
+    reads its whole records and prints what was dropped.  The load's report is printed
+    where it says more than the mesh's shape."""
     import modalviewer as mv
 
     from .core.mesh import MeshError
@@ -490,7 +519,9 @@ def _load(path, fix_slivers: bool = False, partial: bool = False):
         raise MeshError(
             f"{exc.detail}; the file is damaged or truncated: --partial reads its whole records"
         ) from None
-    if partial and mesh.report.messages:
+    # what loading found and repaired (merged vertices, flipped faces, unused vertices,
+    # dropped records): the summary alone is not printed
+    if len(mesh.report.messages) > 1 or (partial and mesh.report.messages):
         print(f"{Path(path).name}: {' '.join(mesh.report.messages)}")
     if fix_slivers:
         mesh = mv.fix_slivers(mesh, progress=_progress_bar())
@@ -537,7 +568,7 @@ def _mesh_vertex(mesh, number: int) -> int:
     try:
         return mesh.mesh_vertex(number)
     except MeshError as exc:
-        raise ValueError(f"--vertex {number}: {exc}") from None
+        raise _BadArgument(f"--vertex {number}: {exc}") from None
 
 
 def _write_csv(path, mesh, d: np.ndarray, what: str) -> None:
@@ -588,7 +619,15 @@ def _distance_to(args, mesh_a) -> int:
     spec_b = _cached_spectrum(mesh_b, operator, args.k)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", mv.ScaleWarning)
-        tables = mv.CrossTables(spec_a, spec_b)
+        try:
+            tables = mv.CrossTables(spec_a, spec_b)
+        except ValueError as exc:  # the library's advice, in this command's options
+            if args.rescale or "do not overlap" not in str(exc):
+                raise
+            raise ValueError(
+                str(exc).replace(" (rescale both to the same area) or pass t_range", "")
+                + "; --rescale rescales both to the same area"
+            ) from None
     for warning in caught:
         sys.stderr.write(f"modalviewer: warning: {warning.message} (or pass --rescale)\n")
     vertex = _mesh_vertex(mesh_a, args.vertex)  # the file's numbers in, and out below

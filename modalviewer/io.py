@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.mesh import Mesh, MeshError, MeshReport, repair_mesh
+from .core.mesh import Mesh, MeshError, MeshReport, repair_mesh, shape_summary
 from .readers import count_text, read_mesh_file, strips_to_triangles
 
 __all__ = ["load_mesh", "read_arrays", "read_file", "strips_to_triangles", "SUPPORTED_EXTENSIONS"]
@@ -189,8 +189,13 @@ def mesh_from_arrays(vertices, faces, source: str, repair: bool = True, notes=()
     try:
         if repair:
             mesh = repair_mesh(vertices, faces, source=source)
-        else:
+        else:  # the report says what was not looked at, never "no problems found"
             mesh = Mesh(vertices, faces, report=MeshReport(source=source))
+            mesh.report.add(shape_summary(mesh))
+            mesh.report.add(
+                "Not repaired (repair=False): duplicate vertices, face orientation and "
+                "unused vertices are as in the file."
+            )
     except MeshError as exc:
         if str(exc).startswith(source + ":"):
             raise

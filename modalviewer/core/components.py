@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .eigen import CancelFn, ProgressFn
-from .mesh import Mesh, MeshReport
+from .mesh import Mesh, MeshReport, shape_summary
 from .pipeline import compute_spectrum
 from .spectrum import Spectrum
 from .validate import check_count
@@ -96,9 +96,12 @@ def largest_component(mesh: Mesh) -> Mesh:
         messages come first).  A mesh with one component is returned as a copy, with the
         report saying so.
     """
-    report = MeshReport(source=mesh.report.source, messages=list(mesh.report.messages))
     parts = split_components(mesh)
     kept, vertices = parts[0]
+    # the input's first sentence describes the input: the result's own comes first
+    before = shape_summary(mesh)
+    messages = [shape_summary(kept)] + [m for m in mesh.report.messages if m != before]
+    report = MeshReport(source=mesh.report.source, messages=messages)
     if len(parts) == 1:
         report.add("The mesh has one connected component; nothing was removed.")
     else:

@@ -34,8 +34,11 @@ def new_file_mode() -> int:
 
 
 def temp_beside(path: Path, suffix: str | None = None) -> Path:
-    """An empty temporary file in ``path``'s folder, with the umask's permissions."""
+    """An empty temporary file in ``path``'s folder, with the umask's permissions.  A
+    missing folder is a FileNotFoundError naming it (not the temporary file)."""
     path = Path(path)
+    if not path.parent.is_dir():
+        raise FileNotFoundError(f"the folder {path.parent} does not exist")
     fd, tmp = tempfile.mkstemp(
         prefix=f".{path.name}.", suffix=path.suffix if suffix is None else suffix, dir=path.parent
     )

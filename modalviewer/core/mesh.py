@@ -92,10 +92,13 @@ def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
     out = (f < 0) | (f >= n)
     if out.any():
         face = int(np.flatnonzero(out.any(axis=1))[0])
+        cause = "a file cut short or damaged, or arrays of two meshes"
+        if f.min() >= 1 and f.max() == n:  # every index one too large at most
+            cause = "faces numbered from 1 as in OBJ files, where 0 is the first vertex: subtract 1"
         raise MeshError(
             f"face {face} refers to vertex {int(f[face][out[face]][0])}, which does not exist "
             f"(the mesh has {_plural(n, 'vertex')}); faces and vertices do not belong "
-            "together (a file cut short or damaged, or arrays of two meshes)"
+            f"together ({cause})"
         )
 
 
@@ -163,7 +166,8 @@ class Mesh:
         if degenerate.any():
             raise MeshError(
                 f"{_plural(int(degenerate.sum()), 'face')} have zero area (first: face "
-                f"{int(np.flatnonzero(degenerate)[0])}); repair_mesh (or load_mesh) collapses them"
+                f"{int(np.flatnonzero(degenerate)[0])}); loading with repair (load_mesh or "
+                "as_mesh with repair=True, the default) collapses them"
             )
         self.report = report if report is not None else MeshReport()
         self._file_map = None
@@ -766,8 +770,12 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
         f = np.asarray(faces)
     except (TypeError, ValueError) as exc:
         raise MeshError(f"could not read vertex or face data ({exc})") from None
-    if v.ndim != 2 or v.shape[1] != 3 or len(v) == 0:
+    if v.size == 0:
         raise MeshError("the file contains no vertices")
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise MeshError(
+            f"vertices must be an (n, 3) array of x, y, z coordinates; got shape {v.shape}"
+        )
     if f.size == 0:
         raise MeshError(
             f"the file contains {_plural(len(v), 'vertex')} but no faces: a point cloud is "
@@ -857,6 +865,17 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
         report.add("The surface is not orientable, so some faces disagree in orientation.")
 
     mesh = Mesh(v, f, report=report, file_map=file_map)
+    report.messages.insert(0, shape_summary(mesh))
+    problem = mesh.shell_problem()
+    if problem:
+        report.add("Shells and E_D^N cannot run: " + problem)
+    return mesh
+
+
+def shape_summary(mesh: Mesh) -> str:
+    """The report's first sentence: vertices, faces, components, boundary, non-manifold
+    edges, and parts joined to the rest only at vertices (each can turn about its
+    vertex: three zero modes more for the 3D shells than its component's six)."""
     summary = (
         f"{_plural(mesh.n_vertices, 'vertex')}, {_plural(mesh.n_faces, 'face')}, "
         f"{_plural(mesh.n_components, 'component')}"
@@ -869,8 +888,10 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
         summary += ", no boundary edges"
     if not mesh.is_edge_manifold:
         summary += f", {_plural(mesh.n_nonmanifold_edges, 'non-manifold edge')}"
-    report.messages.insert(0, summary + ".")
-    problem = mesh.shell_problem()
-    if problem:
-        report.add("Shells and E_D^N cannot run: " + problem)
-    return mesh
+    hinged = mesh.n_face_components - mesh.n_components
+    if hinged > 0:
+        summary += (
+            f", {_plural(hinged, 'part')} joined to the rest only at a vertex (free to "
+            "turn about it: 3 more zero modes each for the 3D shells)"
+        )
+    return summary + "."

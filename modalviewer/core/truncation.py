@@ -94,7 +94,10 @@ def truncation_error(spec: Spectrum, times: float | Sequence[float] | np.ndarray
     k = lam.size
     z = np.exp(-np.outer(lam, times)).sum(axis=0)
     tail = SAFETY_FACTOR * _tail(float(lam[-1]), k, p, k, total, times)
-    return tail / (z + tail)
+    # at large scales both sums underflow to 0; the tail, which decays like exp(-lam_k t)
+    # against the lowest mode's exp(-lam_1 t), is then nothing beside them
+    whole = z + tail
+    return np.divide(tail, whole, out=np.zeros_like(whole), where=whole > 0)
 
 
 def k_for_truncation(spec: Spectrum, t: float, level: float = TRUNCATION_LEVEL) -> int:

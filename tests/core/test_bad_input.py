@@ -168,3 +168,16 @@ def test_a_surface_without_boundary_but_with_non_manifold_edges_is_not_called_cl
     path.write_text("\n".join(lines) + "\n")
     report = str(mv.load_mesh(path).report)
     assert "no boundary edges, 1 non-manifold edge" in report and "closed" not in report
+
+
+def test_arrays_of_the_wrong_shape_or_numbered_from_one_say_so():
+    # (n, 2) vertices were "the file contains no vertices"; faces numbered from 1 were
+    # "a file cut short or damaged"
+    spot = mv.load_mesh(mv.asset_path("spot.obj"))
+    v, f = spot.vertices, spot.faces
+    with pytest.raises(mv.MeshError, match=r"vertices must be an \(n, 3\) array .* \(2930, 2\)"):
+        mv.as_mesh((v[:, :2], f))
+    with pytest.raises(mv.MeshError, match="faces numbered from 1 as in OBJ files.*subtract 1"):
+        mv.as_mesh((v, f + 1))
+    with pytest.raises(mv.MeshError, match="cut short or damaged"):
+        mv.as_mesh((v[:100], f))

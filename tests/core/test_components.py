@@ -71,3 +71,28 @@ def test_per_component_progress_and_small_parts_left_out(parts):
     assert seen[-1] == pytest.approx(1.0) and all(0.0 <= f <= 1.0 for f in seen)
     with pytest.raises(ValueError, match="no component"):
         mv.compute_spectrum_per_component(parts, "laplacian", min_vertices=10**6)
+
+
+def test_the_largest_components_report_begins_with_its_own_shape(parts):
+    # it began with the input's "... 3 components ..." sentence
+    loaded = mv.as_mesh((parts.vertices, parts.faces))
+    assert str(loaded.report).startswith("arrays: 524 vertices, 1040 faces, 3 components")
+    kept = mv.largest_component(loaded)
+    text = str(kept.report)
+    assert text.startswith("arrays: 200 vertices, 400 faces, 1 component, closed."), text
+    assert "3 components" not in text and "Kept the largest of 3 connected components" in text
+
+
+def test_a_part_joined_at_a_single_vertex_is_reported_with_its_zero_modes():
+    # two spheres sharing one vertex: one component, but the second can turn about the
+    # shared vertex (3 more zero modes of the 3D shells), which the report did not say
+    s = icosphere(1)
+    v, f = np.array(s.vertices), np.array(s.faces)
+    top, bottom = int(v[:, 2].argmax()), int(v[:, 2].argmin())
+    second = f + len(v)
+    second[second == bottom + len(v)] = top
+    mesh = mv.as_mesh((np.vstack([v, v - v[bottom] + v[top]]), np.vstack([f, second])))
+    assert mesh.n_components == 1 and mesh.n_face_components == 2
+    assert "1 part joined to the rest only at a vertex" in str(mesh.report)
+    spec = mv.compute_spectrum(mesh, "shells", 12)
+    assert int(spec.zero_mode_mask().sum()) == 6 + 3

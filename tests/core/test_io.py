@@ -169,3 +169,17 @@ def test_an_obj_without_vertices_names_the_file_and_the_format(tmp_path, text):
     path.write_text(text)
     with pytest.raises(mv.MeshError, match=r"^broken\.obj: no vertices found in this OBJ file"):
         mv.load_mesh(path)
+
+
+def test_a_mesh_loaded_without_repair_says_what_was_not_checked(tmp_path):
+    # its report said "no problems found" for a triangle soup of 5856 components
+    import modalviewer as mv
+
+    spot = mv.load_mesh(mv.asset_path("spot.obj"))
+    soup_v = spot.vertices[spot.faces[:50]].reshape(-1, 3)
+    soup_f = np.arange(150).reshape(-1, 3)
+    mesh = mv.as_mesh((soup_v, soup_f), repair=False)
+    text = str(mesh.report)
+    assert "no problems found" not in text
+    assert "150 vertices, 50 faces, 50 components" in text
+    assert "Not repaired (repair=False)" in text

@@ -69,3 +69,15 @@ def test_the_suggested_k_brings_the_true_error_below_the_level(operator):
     assert k - zeros <= 2 * needed
     # a spectrum already below the level keeps its k
     assert k_for_truncation(spec, default_times(spec)[0], 0.05) == spec.k
+
+
+def test_the_estimate_is_zero_not_nan_at_very_large_scales():
+    # at 100 times the largest default scale every exp(-lambda t) underflows: the estimate
+    # was 0 / 0 (nan, with a RuntimeWarning); the tail is nothing there
+    spec = mv.compute_spectrum(torus(16, 8), "shells", 30)
+    t = default_times(spec)
+    times = np.array([t[-1], 100 * t[-1], 1e6 * t[-1]])
+    with np.errstate(invalid="raise", divide="raise"):
+        estimate = truncation_error(spec, times)
+    assert np.all(np.isfinite(estimate)) and np.all(estimate[1:] == 0.0)
+    assert 0.0 <= estimate[0] < 1e-3

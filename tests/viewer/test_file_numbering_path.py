@@ -113,7 +113,7 @@ def test_cli_vertex_and_csv_rows_are_the_files(files, tmp_path, monkeypatch, cap
     np.testing.assert_allclose(values[where], ref, rtol=1e-9, atol=1e-12)
     assert values[dup] == values[where[7]] and values[pick] == 0.0
 
-    assert main(["distance", str(padded), "--vertex", str(unused[0]), *args]) == 1
+    assert main(["distance", str(padded), "--vertex", str(unused[0]), *args]) == 2
     err = capsys.readouterr().err
     assert f"--vertex {unused[0]}: vertex {unused[0]} of the file is used by no face" in err
 
