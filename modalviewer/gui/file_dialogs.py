@@ -8,6 +8,7 @@ from pathlib import Path
 
 from qtpy import QtWidgets
 
+from ..core.operators import operator_info
 from ..core.spectrum import save_spectrum
 from ..io import SUPPORTED_EXTENSIONS
 from .dialogs import ScreenshotDialog, ask
@@ -96,13 +97,31 @@ def field_dialog(win) -> None:
             win.show_error(f"Could not export the field: {exc}")
 
 
+def spectrum_to_export(state):
+    """The spectrum File > Export spectrum writes: the one the picture on screen is made
+    of (a mode's operator, a distance's), else the one shown last."""
+    shown = state.display_operator()
+    spec = state.spectrum(shown) if shown is not None else None
+    if spec is None:
+        d = state.display
+        spec = state.spectrum(d.operator) if d.operator is not None else None
+    if spec is None:
+        computed = state.operators_computed()
+        spec = state.spectrum(computed[0]) if computed else None
+    return spec
+
+
 def spectrum_dialog(win) -> None:
-    spec = win.state.spectrum(win.current_operator)
+    spec = spectrum_to_export(win.state)
     if spec is None:
         win.show_error("Compute a spectrum first.")
         return
+    folder = Path(win.state.mesh_path).parent if win.state.mesh_path else Path.cwd()
     path, _ = QtWidgets.QFileDialog.getSaveFileName(
-        win, "Export spectrum", f"{spec.operator}.npz", "NumPy (*.npz)"
+        win,
+        f"Export spectrum: {operator_info(spec.operator).label}",
+        str(folder / f"{spec.operator}.npz"),
+        "NumPy (*.npz)",
     )
     if path:
         try:

@@ -499,6 +499,8 @@ class MainWindow(QtWidgets.QMainWindow):
             return [str(exc)]
         if self.state.mesh_path is not None and self.remember_settings:
             window_settings.remember_file(self, Path(self.state.mesh_path).resolve())
+        if notes:  # in a box of their own: the status bar's line is soon another's
+            self.show_info("\n".join(notes), "Session restored with changes")
         return notes
 
     # ==================================================== read-only views

@@ -698,7 +698,10 @@ class Viewer:
         field = self.state.derived.field()
         if field is None or field.colormap == "plain":
             return "field", np.zeros(self.state.mesh.n_vertices)
-        return (field.title or "field"), np.asarray(field.values, dtype=np.float64)
+        title = field.title or "field"
+        if field.colormap == "threshold":  # the values are the distances: their name only,
+            title = title.split(" <")[0]  # not the threshold, which the slider moves
+        return title, np.asarray(field.values, dtype=np.float64)
 
     def export_field(self, path) -> Path:
         """Write the mesh with the field shown as point data (.vtp or .ply)."""

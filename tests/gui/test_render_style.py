@@ -179,7 +179,7 @@ def test_zero_line_absent_where_the_mode_is_dead(view):
     zero = np.asarray(scene._zero_rest).reshape(-1, 3)
     assert len(zero) > 20  # the real nodal line
     h = 0.07  # about one edge length of the level-4 sphere
-    assert np.all(zero[:, 2] > 0.15), zero[:, 2].min()  # measured 0.27
+    assert np.all(zero[:, 2] > 0.1), zero[:, 2].min()  # measured 0.13 (0.27 at 1 %)
     assert np.all(np.abs(zero[:, 0]) < h), np.abs(zero[:, 0]).max()
     # the thin isolines are unchanged by the filter: none in the dead half either way
     iso = np.asarray(scene._iso_rest).reshape(-1, 3)
@@ -331,3 +331,21 @@ def test_a_narrow_picture_keeps_the_swatch_labels_inside():
     wide = draw_overlay(np.full((h, 600, 3), 255, np.uint8), Overlay(None, bar))
     rows_wide = np.flatnonzero((wide < 128).all(axis=2).any(axis=1))
     assert rows_wide.max() - rows_wide.min() < rows.max() - rows.min()
+
+
+def test_zero_line_of_a_mode_dwarfed_by_a_far_peak_is_kept(view):
+    """A mode whose peak lies far from its zero line (the cow Loop x2's first Laplacian
+    mode: its tail peak, the body's line 0.35 to 0.92 % of it at the crossed triangles'
+    corners) keeps its line: a bump of height 1 at the north pole over 0.05 x, which
+    changes sign along x = 0 on the southern half (0.35 % at an edge's length from it).
+    At 1 % the line was dropped."""
+    mesh = icosphere(4)
+    v = mesh.vertices
+    bump = np.exp(-30.0 * np.sum((v - [0.0, 0.0, 1.0]) ** 2, axis=1))
+    field = bump + 0.05 * v[:, 0]
+    scene = _scene(view, mesh)
+    scene.show_field(field, "diverging", isolines=6)
+    zero = np.asarray(scene._zero_rest).reshape(-1, 3)
+    south = zero[zero[:, 2] < -0.3]
+    assert len(south) > 20, len(south)
+    assert np.all(np.abs(south[:, 0]) < 0.07)  # along x = 0, within an edge

@@ -666,3 +666,65 @@ def test_the_computations_panel_shows_what_the_status_line_said_whole(window, qt
     job.status = "done"
     panel._on_changed(job)
     assert job.id not in panel.rows
+
+
+def test_a_typed_t1_alone_takes_the_default_t2_and_a_reversed_range_is_said(
+    window, spot_path, qtbot
+):
+    # t1 typed with t2 left at its default was ignored, and t1 > t2 too, without a word
+    window.open_mesh(spot_path)
+    window.compute("laplacian", k=30, wait=True)
+    window.pick_vertex(700)
+    window.show_distance("hks")
+    qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
+    panel = window.distances_panel
+    from modalviewer.core.signatures import default_times
+
+    default = default_times(window.state.spectrum("laplacian"))
+    t1 = 0.1 * float(default[-1])
+    panel.t1_edit.setText(f"{t1:.6g}")
+    panel.t1_edit.editingFinished.emit()
+    assert window.state.t_range == pytest.approx((t1, float(default[-1])), 1e-5)
+    assert panel.range_label.text() == ""
+    panel.t1_edit.setText(f"{10 * default[-1]:g}")
+    panel.t1_edit.editingFinished.emit()
+    assert window.state.t_range == pytest.approx((t1, float(default[-1])), 1e-5)  # kept
+    assert panel.range_label.text().startswith("t1 must be above 0 and below t2")
+    panel.t2_edit.setText(f"{0.5 * default[-1]:g}")
+    panel.t2_edit.editingFinished.emit()  # t1 still above t2: said again, nothing taken
+    assert window.state.t_range == pytest.approx((t1, float(default[-1])), 1e-5)
+    panel.t1_edit.clear()  # t1 back to its default, t2 typed
+    panel.t1_edit.editingFinished.emit()
+    assert window.state.t_range == pytest.approx((float(default[0]), 0.5 * default[-1]), 1e-5)
+    panel.t2_edit.clear()  # both empty: the default range
+    panel.t2_edit.editingFinished.emit()
+    assert window.state.t_range is None and panel.range_label.text() == ""
+
+
+def test_a_session_restored_with_changes_says_so_in_a_box(
+    window, spot_path, tmp_path, monkeypatch, qtbot
+):
+    # the note (mesh changed, pick dropped) was shown in the status bar, where the
+    # computation's status replaced it within half a second
+    import shutil
+
+    from modalviewer.core.primitives import icosphere
+
+    mesh_path = tmp_path / "m.obj"
+    shutil.copy(spot_path, mesh_path)
+    window.open_mesh(mesh_path)
+    window.compute("laplacian", k=12, wait=True)
+    window.pick_vertex(704)
+    session = window.save_session(tmp_path / "s.json")
+    sphere = icosphere(2)  # 162 vertices: vertex 704 is gone
+    lines = [f"v {x} {y} {z}" for x, y, z in sphere.vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in sphere.faces]
+    mesh_path.write_text("\n".join(lines) + "\n")
+    monkeypatch.delenv("MODALVIEWER_NO_DIALOGS")
+    notes = window.open_session(session, wait=True)
+    assert any("704" in note for note in notes), notes
+    box = window.message_box
+    qtbot.waitUntil(lambda: box.isVisible(), timeout=5000)
+    assert box.windowTitle() == "Session restored with changes"
+    assert "704" in box.text()
+    box.close()

@@ -369,6 +369,8 @@ def test_export_field_as_vtp(window, spot_path, tmp_path):
     name = back.point_data.keys()[0]
     assert "<" not in name and name.startswith("Heat_kernel_distance")
     np.testing.assert_allclose(back.point_data[name], d)
+    # the name is the distance's, not the threshold's (it changed with the slider)
+    assert name == "Heat_kernel_distance"
 
 
 def test_corrupted_cache_entry_is_recomputed(window, spot_path):

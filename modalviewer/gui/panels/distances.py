@@ -5,7 +5,7 @@ from __future__ import annotations
 from qtpy import QtCore, QtGui, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
-from ...core.signatures import signature
+from ...core.signatures import default_times, signature
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, quiet, select_data
@@ -66,6 +66,8 @@ class DistancesPanel(QtWidgets.QWidget):
         form.addRow(self.by_share_check)
         form.addRow("t1", self.t1_edit)
         form.addRow("t2", self.t2_edit)
+        self.range_label = WrappingLabel("")  # what was wrong with a typed scale range
+        form.addRow(self.range_label)
         form.addRow(self.pick_label)
         form.addRow(self.distance_button)
         self.scale_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
@@ -135,15 +137,45 @@ class DistancesPanel(QtWidgets.QWidget):
             fraction = position
         self.state.set_display(threshold=fraction)
 
+    def _default_range(self) -> tuple[float, float] | None:
+        """The range an empty field stands for: the default scales of the distance's
+        spectrum (None before it is computed)."""
+        spec = self.state.spectrum(operator_for_distance(self.state.display.distance_kind))
+        if spec is None:
+            return None
+        times = default_times(spec)
+        return float(times[0]), float(times[-1])
+
     def _on_range(self) -> None:
-        try:
-            t1, t2 = float(self.t1_edit.text()), float(self.t2_edit.text())
-        except ValueError:
-            if not self.t1_edit.text() and not self.t2_edit.text():
-                self.state.set_scale_range(None)
+        """A typed t1 or t2: an empty field keeps its default (or the value in use); a
+        range that is not 0 < t1 < t2 is said below the fields and not taken."""
+        texts = [self.t1_edit.text().strip(), self.t2_edit.text().strip()]
+        if not any(texts):
+            self.range_label.setText("")
+            self.state.set_scale_range(None)
             return
-        if 0 < t1 < t2:
-            self.state.set_scale_range((t1, t2))
+        try:
+            typed = [float(t) if t else None for t in texts]
+        except ValueError:  # the validator lets through what it cannot finish
+            self.range_label.setText("t1 and t2 are scales (positive numbers).")
+            return
+        defaults = self._default_range()
+        if None in typed and defaults is None:
+            self.range_label.setText(
+                "Type both t1 and t2, or compute the distance's spectrum first (an empty "
+                "field then takes its default)."
+            )
+            return
+        t1 = typed[0] if typed[0] is not None else defaults[0]
+        t2 = typed[1] if typed[1] is not None else defaults[1]
+        if not 0 < t1 < t2:
+            self.range_label.setText(
+                f"t1 must be above 0 and below t2 (t1 = {t1:.4g}, t2 = {t2:.4g}); the "
+                "range in use is kept."
+            )
+            return
+        self.range_label.setText("")
+        self.state.set_scale_range((t1, t2))
 
     def _on_scale(self, value: int) -> None:
         self.state.set_display(signature_sample=value)
