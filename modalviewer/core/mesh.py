@@ -382,12 +382,17 @@ class Mesh:
     def face_component_labels(self) -> np.ndarray:
         """(m,) label of each face's part, faces connected through shared edges (see
         :attr:`n_face_components`)."""
-        F, E = self.n_faces, len(self.edges)
-        faces = np.repeat(np.arange(F), 3)
-        graph = sp.coo_matrix(
-            (np.ones(3 * F), (faces, F + self.face_edges.ravel())), shape=(F + E, F + E)
-        )
-        return connected_components(graph, directed=False)[1][:F]
+        # faces joined through each edge's consecutive faces (int32 throughout: the
+        # graph's arrays are the load's largest temporaries)
+        F = self.n_faces
+        fe = self.face_edges.ravel()
+        order = np.argsort(fe, kind="stable").astype(np.int32)
+        shared = fe[order[1:]] == fe[order[:-1]]
+        a, b = order[:-1][shared] // 3, order[1:][shared] // 3
+        del order, shared
+        graph = sp.csr_matrix((np.ones(len(a), dtype=np.float32), (a, b)), shape=(F, F))
+        del a, b
+        return connected_components(graph, directed=False)[1]
 
     @cached_property
     def component_labels(self) -> np.ndarray:
