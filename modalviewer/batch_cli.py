@@ -39,7 +39,7 @@ def add_parsers(sub) -> None:
     )
     b.add_argument("-o", "--output", required=True, metavar="STORE", help="the store folder")
     b.add_argument("--operator", choices=OPERATOR_NAMES, default="laplacian")
-    b.add_argument("-k", type=COUNT, default=50)
+    b.add_argument("-k", type=COUNT, default=50, help="number of modes (default: 50)")
     b.add_argument("--bending", type=WEIGHT, default=1.0)
     b.add_argument("--membrane", type=WEIGHT, default=1.0)
     b.add_argument(

@@ -147,7 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("compute", help="compute a spectrum and save it as .npz")
     c.add_argument("mesh")
     c.add_argument("--operator", choices=OPERATORS, default="laplacian")
-    c.add_argument("-k", type=COUNT, default=100)
+    c.add_argument("-k", type=COUNT, default=100, help="number of modes (default: 100)")
     c.add_argument("--bending", type=WEIGHT, default=1.0)
     c.add_argument("--membrane", type=WEIGHT, default=1.0)
     c.add_argument(
@@ -170,7 +170,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("mesh")
     r.add_argument("--operator", choices=OPERATORS, default="laplacian")
     r.add_argument("--mode", type=MODE_INDEX, required=True)
-    r.add_argument("-k", type=COUNT, default=None)
+    r.add_argument(
+        "-k", type=COUNT, default=None, help="number of modes (default: the viewer's, 100)"
+    )
     r.add_argument("--isolines", type=_whole(0), default=12)
     r.add_argument(
         "--show",
@@ -202,7 +204,7 @@ def build_parser() -> argparse.ArgumentParser:
         "also ones no face uses), as the viewer shows it",
     )
     d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
-    d.add_argument("-k", type=COUNT, default=100)
+    d.add_argument("-k", type=COUNT, default=100, help="number of modes (default: 100)")
     marked = d.add_mutually_exclusive_group()
     marked.add_argument(
         "--share",

@@ -567,3 +567,19 @@ def test_the_window_says_when_its_mode_is_beyond_those_computed():
     assert said == ["--mode 9: the spectrum has modes 0 to 5"] and shown == [5]
     _show_mode(window, SimpleNamespace(k=6), 2)
     assert len(said) == 1 and shown == [5, 2]
+
+
+def test_every_commands_k_says_its_default():
+    # "-k K" was listed without its default (compute and distance 100, batch 50)
+    import argparse
+
+    from modalviewer.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    seen = 0
+    for name, parser in sub.choices.items():
+        for action in parser._actions:
+            if "-k" in action.option_strings:
+                assert action.help and "default" in action.help, (name, action.help)
+                seen += 1
+    assert seen >= 4
