@@ -7,7 +7,6 @@ Bad arguments and bad files give a one-line error and exit code 2 (usage) or 1
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -462,17 +461,15 @@ def _outputs(args) -> list[tuple[str, str]]:
 
 
 def _make_folder(option: str, path: Path) -> None:
-    """Create ``path``'s folder (and its parents) as pictures' exports do, before any
-    work; an argument error (exit code 2) where it cannot be made or written in."""
-    folder = path.parent
+    """Create ``path``'s folder (and its parents) as pictures' exports do
+    (:func:`.core.files.make_folder_for`), before any work; an argument error (exit code
+    2) where it cannot be made or written in."""
+    from .core.files import make_folder_for
+
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        make_folder_for(path)
     except OSError as exc:
-        raise _BadArgument(
-            f"{option} {path}: the folder {folder} cannot be made ({exc.strerror})"
-        ) from None
-    if not os.access(folder, os.W_OK):
-        raise _BadArgument(f"{option} {path}: the folder {folder} is not writable")
+        raise _BadArgument(f"{option} {path}: {exc}") from None
 
 
 class _Unavailable(Exception):

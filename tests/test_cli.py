@@ -26,6 +26,17 @@ def _run(*args, cwd=None, env=None):
     )
 
 
+def _assert_one_argument_error(main, argv, fragment, capsys):
+    """``main(argv)`` exits with code 2 and one "modalviewer: error" line holding
+    ``fragment``."""
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2
+    lines = [line for line in err.splitlines() if line.startswith("modalviewer: error")]
+    assert len(lines) == 1 and fragment in lines[0], err
+
+
 def _error_lines(stderr):
     return [line for line in stderr.splitlines() if line.startswith("modalviewer: error")]
 
@@ -268,12 +279,7 @@ def test_values_out_of_range_are_argument_errors(args, fragment, capsys):
     command, *rest = args
     out = ["-o", "x.png"] if command == "render" else (["-o", "s"] if command == "batch" else [])
     out += ["-o", "x.npz"] if command == "compute" else []
-    with pytest.raises(SystemExit) as exit_:
-        cli.main([command, "missing.obj", *rest, *out])
-    err = capsys.readouterr().err
-    assert exit_.value.code == 2
-    lines = [line for line in err.splitlines() if line.startswith("modalviewer: error")]
-    assert len(lines) == 1 and fragment in lines[0], err
+    _assert_one_argument_error(cli.main, [command, "missing.obj", *rest, *out], fragment, capsys)
 
 
 def test_a_mode_beyond_those_computed_is_an_argument_error(tmp_path):
@@ -539,12 +545,7 @@ def test_the_viewers_own_values_out_of_range_are_argument_errors(args, fragment,
     # --mode -3 and showed a mode counted from the end, and -k 0 failed after loading)
     from modalviewer.gui import app
 
-    with pytest.raises(SystemExit) as exit_:
-        app.main(["missing.obj", *args])
-    err = capsys.readouterr().err
-    assert exit_.value.code == 2
-    lines = [line for line in err.splitlines() if line.startswith("modalviewer: error")]
-    assert len(lines) == 1 and fragment in lines[0], err
+    _assert_one_argument_error(app.main, ["missing.obj", *args], fragment, capsys)
 
 
 def test_the_viewers_mode_beyond_those_computed_is_an_argument_error(tmp_path):

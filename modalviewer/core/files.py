@@ -33,6 +33,19 @@ def new_file_mode() -> int:
     return 0o666 & ~current_umask()
 
 
+def make_folder_for(path: Path) -> Path:
+    """Make ``path``'s folder (and its parents) and check that it can be written in;
+    returns the folder.  An OSError saying which folder and why otherwise."""
+    folder = Path(path).parent
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OSError(f"the folder {folder} cannot be made ({exc.strerror})") from None
+    if not os.access(folder, os.W_OK):
+        raise OSError(f"the folder {folder} is not writable; choose another one")
+    return folder
+
+
 def temp_beside(path: Path, suffix: str | None = None) -> Path:
     """An empty temporary file in ``path``'s folder, with the umask's permissions.  A
     missing folder is a FileNotFoundError naming it (not the temporary file)."""

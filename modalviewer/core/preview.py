@@ -1153,16 +1153,14 @@ def _refine(
     for i in range(steps):
         report("preview: refining", at + 0.02 * i)
         last = i == steps - 1
-        solved = c  # the wanted pairs' (the guard vectors stay in the space unsolved)
-        live = lam.shape[0]
-        values = _subspace_step(
+        values = _subspace_step(  # the wanted pairs solved for, the guard vectors not
             K,
             mass,
             solver,
             lam,
             buffer,
-            live=live,
-            solved=solved,
+            live=lam.shape[0],
+            solved=c,
             beyond=beyond if last else 0,
             columns=columns,
         )
@@ -1623,7 +1621,7 @@ def preview_spectrum(
     if not converged and refine and est[:wanted].max(initial=0.0) > refine_above:
         t = time.perf_counter()
         report("preview: refining (factorising)", 0.92)
-        c = wanted  # the guards stay in the refinement's space, unsolved at its last step
+        c = wanted  # the guard modes stay in the refinement's space, never solved for
         # the buffer before a factor made here, so that the factor reuses the memory of
         # the U it replaces
         buffer = _refinement_buffer(U, steps, K.shape[0], wanted)
@@ -1645,17 +1643,11 @@ def preview_spectrum(
         if taken:
             report("preview: estimating errors", 0.98)
             d = _leading_zero_modes(lam, lam_scale)
-            columns = ESTIMATE_BLOCK_COLUMNS if settings.factor_step else None
+            columns = (
+                ESTIMATE_BLOCK_COLUMNS if settings.factor_step else SCALAR_ESTIMATE_BLOCK_COLUMNS
+            )
             res, est, estimate = _factor_estimate(
-                K,
-                mass,
-                solver,
-                lam,
-                U,
-                lam_scale,
-                d,
-                columns or SCALAR_ESTIMATE_BLOCK_COLUMNS,
-                above=above,
+                K, mass, solver, lam, U, lam_scale, d, columns, above=above
             )
         solver = None
         seconds["refinement"] = time.perf_counter() - t

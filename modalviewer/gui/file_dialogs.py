@@ -99,16 +99,12 @@ def field_dialog(win) -> None:
 
 def spectrum_to_export(state):
     """The spectrum File > Export spectrum writes: the one the picture on screen is made
-    of (a mode's operator, a distance's), else the one shown last."""
-    shown = state.display_operator()
-    spec = state.spectrum(shown) if shown is not None else None
-    if spec is None:
-        d = state.display
-        spec = state.spectrum(d.operator) if d.operator is not None else None
-    if spec is None:
-        computed = state.operators_computed()
-        spec = state.spectrum(computed[0]) if computed else None
-    return spec
+    of (a mode's operator, a distance's), else the viewer's current one."""
+    for operator in (state.display_operator(), state.current_operator()):
+        spec = state.spectrum(operator) if operator is not None else None
+        if spec is not None:
+            return spec
+    return None
 
 
 def spectrum_dialog(win) -> None:

@@ -3,22 +3,13 @@ with the permissions of the user's umask."""
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
 import numpy as np
 
-from ..core.files import atomic_write
+from ..core.files import atomic_write, make_folder_for
 from ..core.mesh import Mesh
-
-
-def _check_folder(path: Path) -> None:
-    folder = path.parent
-    if not folder.exists():
-        folder.mkdir(parents=True, exist_ok=True)
-    if not os.access(folder, os.W_OK):
-        raise OSError(f"the folder {folder} is not writable; choose another one")
 
 
 def grab(
@@ -96,7 +87,7 @@ def png_path(path) -> Path:
         raise ValueError(f"{path.name}: pictures are written as PNG; give a name ending in .png")
     if suffix != ".png":
         path = path.with_name(path.name + ".png")
-    _check_folder(path)
+    make_folder_for(path)
     return path
 
 
@@ -137,7 +128,7 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
     path = Path(path)
     if path.suffix.lower() not in (".vtp", ".ply"):
         raise ValueError("per-vertex fields are exported as .vtp or .ply")
-    _check_folder(path)
+    make_folder_for(path)
     arrays = {array_name(name): np.asarray(values) for name, values in fields.items()}
     if mesh.renumbered:
         arrays["file_vertex"] = np.asarray(mesh.file_vertices)

@@ -556,6 +556,13 @@ class ViewerState:
         nonzero = ~spec.zero_mode_mask()
         return int(np.argmax(nonzero)) if nonzero.any() else 0
 
+    def current_operator(self) -> str | None:
+        """The operator of the mode shown or last shown, else the first one computed."""
+        d = self.display
+        if d.operator is not None and self.spectrum(d.operator) is not None:
+            return d.operator
+        return self._first_computed()
+
     def _first_computed(self) -> str | None:
         ops = self.operators_computed()
         return ops[0] if ops else None

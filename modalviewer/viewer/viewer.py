@@ -476,11 +476,7 @@ class Viewer:
     @property
     def current_operator(self) -> str | None:
         """The operator of the mode shown or last shown, else the first one computed."""
-        d = self.state.display
-        if d.operator is not None and self.state.spectrum(d.operator) is not None:
-            return d.operator
-        computed = self.state.operators_computed()
-        return computed[0] if computed else None
+        return self.state.current_operator()
 
     def show_mode(self, index: int, operator: str | None = None) -> None:
         """Colour the surface by mode ``index`` of ``operator`` (default: the spectrum
