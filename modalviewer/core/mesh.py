@@ -79,6 +79,78 @@ def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return 2.0 * np.sqrt(3.0) * double_area / np.maximum(sq, np.finfo(float).tiny)
 
 
+def checked_arrays(vertices, faces, polygons: bool = False):
+    """``(vertices (n, 3) float64, faces (m, 3) int64, note)`` of raw arrays, checked
+    before anything is done with them; never reshaped.
+
+    Faces must be an (m, 3) array of integers, or of floats that are whole numbers;
+    a (3, m) array is refused (its transpose is meant: ``faces.T``).  With ``polygons``
+    an (m, p) array of quads or polygons (p > 3) is split into triangles fanned from each
+    first vertex and ``note`` says so ("" otherwise); without it, it is refused.
+    Vertices must be (n, 3) and finite, and face indices in 0..n-1.
+
+    Raises
+    ------
+    MeshError
+        Naming what is wrong and how to fix it.
+    """
+    try:
+        v = np.array(vertices, dtype=np.float64)
+        f = np.asarray(faces)
+    except (TypeError, ValueError) as exc:
+        raise MeshError(f"vertices and faces must be numeric arrays ({exc})") from None
+    if v.size == 0:
+        raise MeshError("the mesh has no vertices")
+    if v.ndim != 2 or v.shape[1] != 3:
+        hint = "; pass vertices.T" if v.ndim == 2 and v.shape[0] == 3 else ""
+        raise MeshError(
+            f"vertices must be an (n, 3) array of x, y, z coordinates; got shape {v.shape}{hint}"
+        )
+    if f.size == 0:
+        raise MeshError(
+            f"the mesh has {_plural(len(v), 'vertex')} but no faces: a point cloud is not "
+            "a surface (reconstruct a surface from it first)"
+        )
+    if f.ndim != 2:
+        raise MeshError(f"faces must be an (m, 3) array of vertex indices; got shape {f.shape}")
+    if f.dtype == bool or not (
+        np.issubdtype(f.dtype, np.integer) or np.issubdtype(f.dtype, np.floating)
+    ):
+        raise MeshError(f"face indices must be integers; got an array of {f.dtype}")
+    if np.issubdtype(f.dtype, np.floating):
+        whole = np.isfinite(f) & (f == np.round(f))
+        if not whole.all():
+            face = int(np.flatnonzero(~whole.all(axis=1))[0])
+            raise MeshError(
+                f"face indices must be whole numbers; face {face} is {f[face].tolist()}"
+            )
+    if f.shape[1] != 3:
+        if f.shape[0] == 3 and f.shape[1] > 3:
+            raise MeshError(
+                f"faces have shape {f.shape}: three rows of {f.shape[1]} indices, one "
+                "column per face; faces are one row per face, (m, 3): pass faces.T"
+            )
+        if f.shape[1] < 3:
+            raise MeshError(f"faces must be an (m, 3) array of vertex indices; got {f.shape}")
+        if not polygons:
+            raise MeshError(
+                f"faces have shape {f.shape}: polygons of {f.shape[1]} vertices; a Mesh "
+                "holds triangles (as_mesh and repair_mesh split polygons into triangles)"
+            )
+    f = f.astype(np.int64)
+    _check_finite_and_indices(v, f)
+    note = ""
+    if f.shape[1] > 3:
+        p = f.shape[1]
+        kind = "quad" if p == 4 else f"polygon of {p} vertices"
+        note = (
+            f"Split {_plural(len(f), kind)} into {_plural(len(f) * (p - 2), 'triangle')} "
+            "(fanned from each one's first vertex)."
+        )
+        f = np.stack([f[:, [0, i, i + 1]] for i in range(1, p - 1)], axis=1).reshape(-1, 3)
+    return v, f, note
+
+
 def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
     """Raise MeshError for NaN/Inf coordinates or face indices outside 0..n-1."""
     bad = ~np.isfinite(v).all(axis=1)
@@ -129,27 +201,7 @@ class Mesh:
     def __init__(
         self, vertices, faces, report: MeshReport | None = None, file_map: np.ndarray | None = None
     ):
-        try:
-            v = np.array(vertices, dtype=np.float64, copy=True)
-            f_raw = np.asarray(faces)
-        except (TypeError, ValueError) as exc:
-            raise MeshError(f"vertices and faces must be numeric arrays ({exc})") from None
-        if v.ndim != 2 or v.shape[1] != 3:
-            raise MeshError(f"vertices must have shape (n, 3), got {v.shape}")
-        if v.shape[0] == 0:
-            raise MeshError("the mesh has no vertices")
-        if f_raw.size == 0:
-            raise MeshError(
-                "the mesh has no faces (a point cloud is not a surface); "
-                "triangulate it first, for example by surface reconstruction"
-            )
-        if f_raw.ndim != 2 or f_raw.shape[1] != 3:
-            raise MeshError(f"faces must have shape (m, 3) (triangles), got {f_raw.shape}")
-        if not np.issubdtype(f_raw.dtype, np.integer):
-            if not np.all(np.isfinite(f_raw)) or np.any(f_raw != np.round(f_raw)):
-                raise MeshError("face indices must be whole numbers")
-        f = f_raw.astype(np.int64, copy=True)
-        _check_finite_and_indices(v, f)
+        v, f, _ = checked_arrays(vertices, faces)
         repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
         if repeated.any():
             raise MeshError(
@@ -770,24 +822,9 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
         With ``mesh.report`` describing every change.
     """
     report = MeshReport(source=source)
-    try:
-        v = np.array(vertices, dtype=np.float64)
-        f = np.asarray(faces)
-    except (TypeError, ValueError) as exc:
-        raise MeshError(f"could not read vertex or face data ({exc})") from None
-    if v.size == 0:
-        raise MeshError("the file contains no vertices")
-    if v.ndim != 2 or v.shape[1] != 3:
-        raise MeshError(
-            f"vertices must be an (n, 3) array of x, y, z coordinates; got shape {v.shape}"
-        )
-    if f.size == 0:
-        raise MeshError(
-            f"the file contains {_plural(len(v), 'vertex')} but no faces: a point cloud is "
-            "not a surface. Reconstruct a surface from it first."
-        )
-    f = f.reshape(-1, 3).astype(np.int64)
-    _check_finite_and_indices(v, f)
+    v, f, split = checked_arrays(vertices, faces, polygons=True)
+    if split:
+        report.add(split)
     diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     if diag == 0:
         raise MeshError("all vertices coincide: the mesh has no extent")
