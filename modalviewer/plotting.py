@@ -129,6 +129,7 @@ def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
     if spectrum is not None:
         viewer.add_spectrum(spectrum)
     if vertex is not None:
+        kind = distance_kind_of(spectrum, kind)
         needed = operator_for_distance(kind)
         if viewer.state.spectrum(needed) is None:
             viewer.compute(needed, k=k, wait=True)
@@ -143,12 +144,31 @@ def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
     return viewer
 
 
+def distance_kind_of(spectrum: Spectrum | None, kind: str | None) -> str:
+    """``kind``, or where it is None the distance ``spectrum`` defines (heat kernel for
+    the Laplacian, feature for E_D^N, vibration for the 3D shells), or "vibration"
+    without a spectrum."""
+    if kind is not None:
+        return kind
+    if spectrum is None:
+        return "vibration"
+    from .core.operators import DISTANCE_KINDS, operator_info
+
+    own = operator_info(spectrum.operator).distance_kind
+    if own is None:
+        raise ValueError(
+            f"a {spectrum.operator} spectrum defines no distance; pass kind= (one of "
+            f"{', '.join(DISTANCE_KINDS)})"
+        )
+    return own
+
+
 def plot(
     mesh,
     spectrum: Spectrum | None = None,
     mode: int | None = None,
     field=None,
-    kind: str = "vibration",
+    kind: str | None = None,
     vertex: int | None = None,
     screenshot=None,
     size=DEFAULT_PLOT_SIZE,
@@ -170,7 +190,9 @@ def plot(
         ``(name, values)`` pair or a dict (its first item); signed values in the modes'
         diverging colours, others white to red.
     vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
-        ``vertex`` (the input's vertex number); a spectrum of the kind's operator is used
+        ``vertex`` (the input's vertex number); by default the distance of ``spectrum``
+        (heat kernel for a Laplacian spectrum, feature for E_D^N, vibration for the 3D
+        shells), or "vibration" without one.  A spectrum of the kind's operator is used
         if given, otherwise ``k`` modes are computed (cached on disk as in the viewer).
     screenshot : also write the PNG there (the page, .html, for an interactive one).
     size : (width, height) in pixels.

@@ -254,3 +254,37 @@ def test_an_interactive_plot_without_the_extra_is_an_image_with_a_warning(spot, 
     with pytest.warns(UserWarning, match=r"modalviewer\[notebook\]"):
         picture = mv.plot(spot, field=spot.vertices[:, 1], interactive=True, size=(200, 150))
     assert isinstance(picture, mv.Picture) and picture.shape[:2] == (150, 200)
+
+
+@pytest.mark.parametrize(
+    "operator, word", [("laplacian", "Heat kernel"), ("modified_dirichlet", "Feature")]
+)
+def test_plot_draws_the_distance_of_the_spectrum_it_is_given(spot, operator, word, monkeypatch):
+    pytest.importorskip("pyvista")
+    from modalviewer.plotting import _prepared_viewer, distance_kind_of
+    from modalviewer.viewer import Viewer
+
+    spec = mv.compute_spectrum(spot, operator, k=8)
+
+    def no_compute(*args, **kwargs):
+        raise AssertionError("plot computed a spectrum it was not asked for")
+
+    with monkeypatch.context() as m:
+        m.setattr(Viewer, "compute", no_compute)
+        picture = mv.plot(spot, spec, vertex=7, size=(160, 120))
+    assert picture.shape == (120, 160, 3)
+    viewer = _prepared_viewer(spot, spec, None, 7, distance_kind_of(spec, None), 8)
+    try:
+        legend = viewer.state.derived.field().legend
+        assert legend.startswith(f"{word} distance from vertex 7"), legend
+        assert viewer.state.spectrum("shells") is None  # no 3D shells computed
+        np.testing.assert_allclose(
+            viewer.state.derived.field().values, mv.multiscale_distance(spec, 7), atol=1e-12
+        )
+    finally:
+        viewer.close()
+    shells_normal = mv.compute_spectrum(spot, "shells_normal", k=8)
+    with pytest.raises(ValueError, match="defines no distance; pass kind="):
+        distance_kind_of(shells_normal, None)
+    assert distance_kind_of(None, None) == "vibration"
+    assert distance_kind_of(spec, "vibration") == "vibration"
