@@ -92,6 +92,8 @@ meshes: "Known null spaces" in docs/how-it-works.md)."""
 
 ProgressFn = Callable[[str, float], None]
 CancelFn = Callable[[], bool]
+ConvergedFn = Callable[[np.ndarray, np.ndarray], None]
+"""``on_converged(values, vectors)``: newly converged pairs, handed over in order."""
 
 
 class Cancelled(Exception):
@@ -275,6 +277,7 @@ def solve_lowest(
     block: int | None = None,
     null_space: sp.spmatrix | np.ndarray | None = None,
     memory_limit_mb: float | None = None,
+    on_modes: ConvergedFn | None = None,
 ) -> EigenResult:
     """The k lowest eigenpairs of ``K x = lam diag(mass_diag) x``.
 
@@ -295,6 +298,13 @@ def solve_lowest(
         Krylov basis and what the process already holds, PARDISO keeps it out of core
         (slower solves, much less memory); where even then the basis would not fit, it
         is stored in single precision (:func:`basis_in_float32`).
+    on_modes : called as ``on_modes(eigenvalues, vectors)`` with pairs as they
+        converge, lowest first and in order, before the solve ends: (m,) eigenvalues and a
+        new (N, m) array of Mass-orthonormal vectors (signs as in the result), the null
+        vectors first.  They equal the result's pairs to the solver's tolerance (a
+        cluster of equal eigenvalues as a subspace); the result itself, from a last step
+        of inverse iteration and Rayleigh-Ritz, is not handed over.  Not called by the
+        dense solver (small problems) nor where the null vectors fill all k.
 
     Returns
     -------
@@ -330,6 +340,7 @@ def solve_lowest(
     basis = None  # the Krylov basis array whose first columns hold the modes
     solver_info = {"factor_mb": None, "out_of_core": False, "basis_float32": False}
     limit = default_memory_limit_mb() if memory_limit_mb is None else float(memory_limit_mb)
+    handover = _Handover(on_modes, Z, k)
     if d < k:
         # the standard-form null vectors M^1/2 Z are orthonormal: project them out
         Y0 = sp.csr_matrix(sp.diags(np.sqrt(mass_diag)) @ Z)
@@ -348,7 +359,7 @@ def solve_lowest(
             try:
                 try:
                     lam, basis, shift, backend, columns = _shift_invert(
-                        *args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL
+                        *args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL, handover.attempt()
                     )
                 except _NotConverged as failed:
                     if not d:
@@ -359,7 +370,9 @@ def solve_lowest(
                     # undeflated shift does not, at the cost of a compressed spectrum.
                     # The columns counted include the failed attempt's.
                     report("retrying with a larger shift", 0.05)
-                    lam, basis, shift, backend, columns = _shift_invert(*args, SHIFT_RTOL)
+                    lam, basis, shift, backend, columns = _shift_invert(
+                        *args, SHIFT_RTOL, handover.attempt()
+                    )
                     columns += failed.columns
                 method = f"shift-invert block Krylov-Schur ({backend})"
                 if solver_info["out_of_core"]:
@@ -391,13 +404,18 @@ def solve_lowest(
             # written over the Krylov basis, which is then shrunk to the modes: no (N, k)
             # array beside the (N, 1.1 k + extra) basis (3.7 and 5.8 GB for 300 shells
             # modes at 520k vertices)
-            del X
-            transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
-            try:
-                basis.resize((N, k))  # refuses while another reference to it is alive
-                out = basis
-            except ValueError:
-                out = basis.reshape(-1)[: N * k].reshape(N, k).copy()
+            if basis.shape[1] >= k:
+                del X
+                transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
+                try:
+                    basis.resize((N, k))  # refuses while another reference to it is alive
+                    out = basis
+                except ValueError:
+                    out = basis.reshape(-1)[: N * k].reshape(N, k).copy()
+            else:  # more null vectors than the basis has columns: it cannot hold them
+                out = np.empty((N, k))
+                out[:, d_out:] = X
+                del X
             basis = None
         else:
             out = np.empty((N, k))
@@ -410,6 +428,38 @@ def solve_lowest(
         all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1],
         solver_info["factor_mb"], solver_info["out_of_core"], solver_info["basis_float32"],
     )  # fmt: skip
+
+
+class _Handover:
+    """Relays converged pairs to ``solve_lowest``'s ``on_modes``: the null vectors
+    first, then the iteration's pairs, each once (a retried iteration hands over its
+    first pairs again: those already relayed are skipped), signs fixed as in the
+    result."""
+
+    def __init__(self, on_modes: ConvergedFn | None, Z: sp.csc_matrix, k: int) -> None:
+        self.on_modes = on_modes
+        self.Z = Z[:, : min(Z.shape[1], k)]
+        self.relayed = 0  # iteration pairs relayed
+        self.seen = 0  # pairs the current attempt has handed over
+
+    def attempt(self) -> ConvergedFn | None:
+        """The callback for one attempt of the iteration (None without ``on_modes``)."""
+        self.seen = 0
+        return None if self.on_modes is None else self._relay
+
+    def _relay(self, lam: np.ndarray, X: np.ndarray) -> None:
+        skip = max(0, self.relayed - self.seen)
+        self.seen += lam.shape[0]
+        lam, X = lam[skip:], _fix_signs(X[:, skip:])
+        if lam.shape[0] == 0:
+            return
+        first = self.relayed == 0
+        self.relayed += lam.shape[0]
+        if first and self.Z.shape[1]:
+            Zk = _fix_column_signs(self.Z).toarray()
+            lam = np.concatenate([np.zeros(Zk.shape[1]), lam])
+            X = np.hstack([Zk, X])
+        self.on_modes(lam, X)
 
 
 def _null_vectors(null_space, N: int, mass_diag: np.ndarray) -> sp.csc_matrix:
@@ -632,6 +682,44 @@ def _rotate_in_place(Q: np.ndarray, j: int, S: np.ndarray, rows: int = 32768) ->
         block[:, :p] = block[:, :j] @ S
 
 
+CLUSTER_RTOL = 1e-3
+"""Converged Ritz pairs are handed over early (``on_converged``) only up to a gap: a
+pair whose Ritz value lies within this relative distance of the next one's waits for
+it, so that a cluster of (nearly) equal eigenvalues is handed over whole and the modes
+handed over span the same space as the final ones."""
+
+
+def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> int:
+    """The number of leading pairs that may be handed over: ``done`` converged ones,
+    less those in a cluster that reaches past them (see :data:`CLUSTER_RTOL`).  A
+    trailing cluster of ``block`` or more equal values waits too: a block Krylov method
+    sees at most ``block`` copies of an eigenvalue before rounding brings in the others,
+    so such a cluster may have more members to come."""
+
+    def same(i: int) -> bool:  # pairs i - 1 and i belong to one cluster
+        return theta[i] >= theta[i - 1] * (1.0 - CLUSTER_RTOL)
+
+    ready = min(done, theta.shape[0] - 1)  # the next Ritz value must be there to compare
+    while ready > handed and same(ready):
+        ready -= 1
+    first = ready - 1  # the trailing cluster's first pair
+    while first > 0 and same(first):
+        first -= 1
+    if ready - first >= block:
+        ready = max(handed, first)
+    return ready
+
+
+def _basis_times(Q: np.ndarray, j: int, S: np.ndarray) -> np.ndarray:
+    """``Q[:, :j] @ S`` as a new float64 array, a block of rows at a time (a
+    single-precision basis is widened one block at a time)."""
+    out = np.empty((Q.shape[0], S.shape[1]))
+    for start in range(0, Q.shape[0], _SWEEP_ROWS):
+        rows = slice(start, start + _SWEEP_ROWS)
+        out[rows] = Q[rows, :j].astype(np.float64, copy=False) @ S
+    return out
+
+
 def block_krylov_schur(
     apply_op: Callable[[np.ndarray], np.ndarray],
     N: int,
@@ -647,6 +735,7 @@ def block_krylov_schur(
     timer: StageTimer | None = None,
     project: Callable[[np.ndarray], np.ndarray] | None = None,
     basis: np.ndarray | None = None,
+    on_converged: ConvergedFn | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """The k largest eigenpairs of a symmetric positive definite operator.
 
@@ -670,6 +759,12 @@ def block_krylov_schur(
         a new float64 one).  In single precision every product with it is still formed
         in double precision (:func:`_basis_t_times`); its columns are then orthonormal
         only to about 1e-7, so ``tol`` should not be below :data:`FLOAT32_BASIS_TOL`.
+    on_converged : called as ``on_converged(theta, Y)`` with the pairs that have newly
+        converged at a check, largest first, in order: the Ritz values (m,) and a new
+        (N, m) array of their Ritz vectors.  The pairs handed over so far are always
+        the leading ones, and a pair is held back while the next Ritz value lies within
+        :data:`CLUSTER_RTOL` of it (a cluster is handed over whole).  With a callback the
+        Ritz pairs are also checked while the basis has fewer than k columns.
 
     Returns
     -------
@@ -693,6 +788,7 @@ def block_krylov_schur(
     applied = 0
     restarts = 0
     done = 0
+    handed = 0  # leading pairs given to on_converged
     check_every = max(1, 64 // b)
     blocks_since_check = 0
     while True:
@@ -714,18 +810,27 @@ def block_krylov_schur(
         # Ritz pairs are checked every ``check_every`` blocks (an eigh of the projected
         # matrix costs about as much as orthogonalising 64 vectors).
         blocks_since_check = (blocks_since_check + 1) % check_every
-        if (j < k or blocks_since_check) and not full:
+        too_few = j < k and on_converged is None
+        if (too_few or blocks_since_check) and not full:
             report("solving", 0.05 + 0.85 * done / k)
             continue
+        wanted = min(k, j)
         with timer("ritz"):
             theta, S = np.linalg.eigh(0.5 * (T[:j, :j] + T[:j, :j].T))
             theta, S = theta[::-1], S[:, ::-1]
-            estimates = np.linalg.norm(R @ S[:, :keep], axis=0)
+            estimates = np.linalg.norm(R @ S[:, : min(keep, j)], axis=0)
         # rounding floor: zero modes make theta[0] up to 1e6 times theta[k]
         floor = 16 * np.finfo(float).eps * abs(theta[0])
-        converged = estimates[:k] <= np.maximum(tol * np.abs(theta[:k]), floor)
-        done = int(np.argmin(converged)) if not converged.all() else k
+        converged = estimates[:wanted] <= np.maximum(tol * np.abs(theta[:wanted]), floor)
+        done = int(np.argmin(converged)) if not converged.all() else wanted
         report("solving", 0.05 + 0.85 * done / k)
+        if on_converged is not None and done < k:
+            ready = _whole_clusters(theta, done, handed, b)
+            if ready > handed:
+                with timer("handover"):
+                    Y_new = _basis_times(Q, j, S[:, handed:ready])
+                on_converged(theta[handed:ready].copy(), Y_new)
+                handed = ready
         if done == k:
             with timer("restarts"):
                 _rotate_in_place(Q, j, S[:, :k])
@@ -752,10 +857,16 @@ def block_krylov_schur(
         sequence_start = p
 
 
+MIN_WORKING_PAIRS = 24
+"""The iteration works with at least this many pairs (where the space allows): with a
+basis of 20 columns for a few wanted pairs, clustered spectra (a mesh of many similar
+parts) did not converge in 60 restarts."""
+
+
 def krylov_sizes(k: int, n_free: int, block: int | None = None) -> tuple[int, int, int, int]:
     """(working pairs, block size, basis size, pairs kept at a restart) for k pairs in a
     space of dimension ``n_free``; the basis array has ``basis size + block`` columns."""
-    k_work = max(k, min(n_free // 2, k + max(8, k // 10)))
+    k_work = max(k, min(n_free // 2, max(k + max(8, k // 10), MIN_WORKING_PAIRS)))
     if block is None:
         block = int(np.clip(k_work // 16, 4, 16))
     extra = int(BASIS_EXTRA * k_work)
@@ -831,7 +942,7 @@ def _widen_in_place(buffer: np.ndarray, n: int, width: int, count: int, out_widt
 
 def _shift_invert(
     K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer, project, n_free,
-    limit_mb, solver_info, out_columns, shift_rtol,
+    limit_mb, solver_info, out_columns, shift_rtol, on_converged=None,
 ):  # fmt: skip
     """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2`` in the
     complement of the deflated null vectors (``project`` removes them, ``n_free`` is the
@@ -841,7 +952,9 @@ def _shift_invert(
     (:func:`factor_budget_mb`); where even then a double-precision basis would not fit,
     the basis is single precision (:func:`basis_in_float32`), and the returned array is
     then exactly (N, ``out_columns``).  ``solver_info`` receives "factor_mb",
-    "out_of_core" and "basis_float32"."""
+    "out_of_core" and "basis_float32".  ``on_converged(eigenvalues, vectors)`` receives
+    the pairs as they converge (:func:`block_krylov_schur`), as eigenvalues of K and
+    Mass-orthonormal vectors."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
     # A few more pairs than requested: the last requested pairs then converge as fast
@@ -886,6 +999,9 @@ def _shift_invert(
         timer=timer,
         project=project,
         basis=Q,
+        on_converged=None
+        if on_converged is None
+        else lambda theta, Y: on_converged(shift + 1.0 / theta, inv_sqrt_m[:, None] * Y),
     )
     if float32:
         with timer("copy"):

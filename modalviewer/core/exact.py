@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import scipy.sparse as sp
@@ -18,7 +19,17 @@ from .eigen import CancelFn, EigenResult, ProgressFn, solve_lowest, typical_eige
 from .mesh import Mesh
 from .nullspace import NullSpace, null_space
 
-__all__ = ["ExactPairs", "exact_pairs"]
+__all__ = ["ExactPairs", "ModeSink", "exact_pairs"]
+
+
+class ModeSink(Protocol):
+    """Receives the pairs of :func:`exact_pairs` as they converge."""
+
+    def start(self, K, mass: np.ndarray, nulls: NullSpace, scale: float, k: int) -> None:
+        """The problem: matrices, null space, typical eigenvalue, pairs to come."""
+
+    def __call__(self, eigenvalues: np.ndarray, vectors: np.ndarray) -> None:
+        """The next converged pairs, in order (see :func:`.eigen.solve_lowest`)."""
 
 
 @dataclass(frozen=True)
@@ -52,17 +63,24 @@ def exact_pairs(
     membrane: float = 1.0,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
+    on_modes: ModeSink | None = None,
 ) -> ExactPairs:
     """The ``min(k, unknowns)`` lowest eigenpairs of ``operator`` on ``mesh``, the exact
     null vectors first.  Raises what the assembly, the null space and
     :func:`.eigen.solve_lowest` raise (:class:`.mesh.MeshError`, :class:`.eigen.EigenError`,
-    :class:`.eigen.Cancelled`)."""
+    :class:`.eigen.Cancelled`).  ``on_modes``: told the problem first
+    (:meth:`ModeSink.start`), then given the pairs as they converge
+    (:func:`.eigen.solve_lowest`'s ``on_modes``)."""
     started = time.perf_counter()
     K, mass = operator_matrices(mesh, operator, bending, membrane)
     seconds_assembly = time.perf_counter() - started
     k = min(int(k), K.shape[0])
     nulls = null_space(mesh, operator, K, mass)
-    result = solve_lowest(K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors)
     scale = typical_eigenvalue(K, mass)
+    if on_modes is not None:
+        on_modes.start(K, mass, nulls, scale, k)
+    result = solve_lowest(
+        K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors, on_modes=on_modes
+    )
     nonzero = ~zero_modes(result.eigenvalues, scale, result.null_dim)
     return ExactPairs(K, mass, nulls, result, scale, nonzero, seconds_assembly)

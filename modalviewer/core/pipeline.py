@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import time
 import warnings
+from collections.abc import Callable
 from concurrent.futures import Future
 
 import numpy as np
 
 from .assembly import operator_matrices
-from .eigen import CancelFn, EigenError, ProgressFn, rounding_floors
+from .eigen import CancelFn, EigenError, ProgressFn, relative_residuals, rounding_floors
 from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
@@ -90,6 +91,7 @@ def compute_spectrum(
     cancel: CancelFn | None = None,
     accuracy: str = "exact",
     coarse: CoarseCopy | Future | None = None,
+    on_modes: Callable[[Spectrum], None] | None = None,
 ) -> Spectrum:
     """The k lowest eigenpairs of ``operator`` on ``mesh``.
 
@@ -117,6 +119,18 @@ def compute_spectrum(
         where a smooth space misses the modes of thin parts.  A ``Future`` of one
         (``mv.start_preview_copy(mesh, operator, k)``) is waited for after the
         assembly, which so runs while the copy is made.
+
+    on_modes : called as ``on_modes(spectrum_so_far)`` while the solve runs, with a
+        :class:`.spectrum.Spectrum` of the first j modes whenever j grows (the exact null
+        vectors first), lowest first: the eigensolver's pairs as they converge, whose
+        eigenvalues and modes equal the finished spectrum's to the solver's tolerance (a
+        cluster of equal eigenvalues is handed over whole, as a subspace).  Its
+        ``is_complete`` is False and ``modes_requested`` says how many are to come; its
+        residuals are those of the converged Ritz pairs, before the final refinement.
+        The last call has the finished spectrum, the one returned.  Small problems
+        (solved densely) get that last call only.  The callback runs in the computing
+        thread; whatever it keeps stays valid (each call's arrays are new views of
+        columns that are not written again).
 
     Returns
     -------
@@ -150,7 +164,10 @@ def compute_spectrum(
     started = time.perf_counter()
     report("assembling", 0.0)
     try:
-        pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel)
+        sink = (
+            None if on_modes is None else _ModesSoFar(mesh, operator, bending, membrane, on_modes)
+        )
+        pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel, sink)
     except EigenError as exc:
         raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
     K, mass, nulls, result = pairs.K, pairs.mass, pairs.nulls, pairs.result
@@ -186,7 +203,7 @@ def compute_spectrum(
         modes = modes.reshape(n, per_vertex, k)
     if progress is not None:
         progress("done", 1.0)
-    return Spectrum(
+    spectrum = Spectrum(
         eigenvalues=result.eigenvalues,
         modes=modes,
         operator=operator,
@@ -214,6 +231,61 @@ def compute_spectrum(
             "null_space": nulls.summary(),
         },
     )
+    if on_modes is not None:
+        on_modes(spectrum)
+    return spectrum
+
+
+class _ModesSoFar:
+    """Collects the pairs handed over during a solve (:class:`.exact.ModeSink`) into
+    one (N, k) array, and gives ``on_modes`` a Spectrum of the first j at each step."""
+
+    def __init__(self, mesh: Mesh, operator: str, bending: float, membrane: float, on_modes):
+        self.mesh, self.operator, self.on_modes = mesh, operator, on_modes
+        self.weights = {"bending": float(bending), "membrane": float(membrane)}
+        self.count = 0
+
+    def start(self, K, mass: np.ndarray, nulls, scale: float, k: int) -> None:
+        self.K, self.mass, self.nulls, self.scale, self.k = K, mass, nulls, scale, k
+        self.eigenvalues = np.zeros(k)
+        self.residuals = np.zeros(k)
+        self.vectors = None  # (N, k), made at the first hand-over
+
+    def __call__(self, eigenvalues: np.ndarray, vectors: np.ndarray) -> None:
+        j0, j1 = self.count, self.count + eigenvalues.shape[0]
+        if self.vectors is None:
+            self.vectors = np.empty((vectors.shape[0], self.k))
+        self.eigenvalues[j0:j1] = eigenvalues
+        self.vectors[:, j0:j1] = vectors
+        null_here = max(0, min(self.nulls.dimension, j1) - j0)
+        self.residuals[j0:j1] = relative_residuals(
+            self.K, self.mass, eigenvalues, vectors, self.scale, null_here
+        )
+        self.count = j1
+        per_vertex = operator_info(self.operator).unknowns_per_vertex
+        modes = self.vectors[:, :j1]
+        if per_vertex > 1:
+            modes = modes.reshape(self.mesh.n_vertices, per_vertex, j1)
+        self.on_modes(
+            Spectrum(
+                eigenvalues=self.eigenvalues[:j1].copy(),
+                modes=modes,
+                operator=self.operator,
+                mass=self.mass[::per_vertex],
+                residuals=self.residuals[:j1].copy(),
+                mesh_hash=self.mesh.hash,
+                parameters={
+                    "k": self.k,
+                    "modes_requested": self.k,
+                    **self.weights,
+                    "method": "shift-invert block Krylov-Schur, converged Ritz pairs",
+                    "null_space_dimension": min(self.nulls.dimension, j1),
+                    "zero_mode_scale": self.scale,
+                    "n_components": self.nulls.n_components,
+                    "null_space": self.nulls.summary(),
+                },
+            )
+        )
 
 
 def _returning_freed_memory(progress: ProgressFn | None) -> ProgressFn:

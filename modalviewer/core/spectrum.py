@@ -107,6 +107,18 @@ class Spectrum:
         return float(errors[j]) if 0 <= j < len(errors) else 0.0
 
     @property
+    def modes_requested(self) -> int:
+        """How many modes the computation gives: more than :attr:`k` while the modes are
+        handed over as they converge (``compute_spectrum(..., on_modes=...)``)."""
+        return int(self.parameters.get("modes_requested", self.k))
+
+    @property
+    def is_complete(self) -> bool:
+        """False for the first modes of a computation still running (see
+        :attr:`modes_requested`)."""
+        return self.k >= self.modes_requested
+
+    @property
     def null_space_dimension(self) -> int:
         """How many of the first modes are deflated exact null vectors (constants per
         component, rigid motions per component, ...; :mod:`.nullspace`)."""
