@@ -682,11 +682,21 @@ def _rotate_in_place(Q: np.ndarray, j: int, S: np.ndarray, rows: int = 32768) ->
         block[:, :p] = block[:, :j] @ S
 
 
+HANDOVER_COLUMNS = 32
+"""Converged pairs are handed over (``on_converged``) at most this many at a time, so
+that the new arrays they come in stay small beside the basis."""
+
 CLUSTER_RTOL = 1e-3
 """Converged Ritz pairs are handed over early (``on_converged``) only up to a gap: a
 pair whose Ritz value lies within this relative distance of the next one's waits for
 it, so that a cluster of (nearly) equal eigenvalues is handed over whole and the modes
 handed over span the same space as the final ones."""
+
+
+def _scale_rows(Y: np.ndarray, factors: np.ndarray) -> np.ndarray:
+    """``Y`` with row i multiplied by ``factors[i]``, in place; returns Y."""
+    Y *= factors[:, None]
+    return Y
 
 
 def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> int:
@@ -763,8 +773,10 @@ def block_krylov_schur(
         converged at a check, largest first, in order: the Ritz values (m,) and a new
         (N, m) array of their Ritz vectors.  The pairs handed over so far are always
         the leading ones, and a pair is held back while the next Ritz value lies within
-        :data:`CLUSTER_RTOL` of it (a cluster is handed over whole).  With a callback the
-        Ritz pairs are also checked while the basis has fewer than k columns.
+        :data:`CLUSTER_RTOL` of it (a cluster is handed over whole, in one call; the
+        pairs of one check come in calls of about :data:`HANDOVER_COLUMNS`).  With a
+        callback the Ritz pairs are also checked while the basis has fewer than k
+        columns.
 
     Returns
     -------
@@ -808,7 +820,11 @@ def block_krylov_schur(
         R[:, j - b :] = Rn
         full = j + b > max_basis
         # Ritz pairs are checked every ``check_every`` blocks (an eigh of the projected
-        # matrix costs about as much as orthogonalising 64 vectors).
+        # matrix costs about as much as orthogonalising 64 vectors); where pairs are
+        # handed over as they converge, as often as an eigh costs at most an eighth of
+        # the orthogonalisation since the last check (j^3 against 4 N j b per block).
+        if on_converged is not None:
+            check_every = max(1, int(np.ceil(2.0 * j * j / (N * b))))
         blocks_since_check = (blocks_since_check + 1) % check_every
         too_few = j < k and on_converged is None
         if (too_few or blocks_since_check) and not full:
@@ -826,11 +842,16 @@ def block_krylov_schur(
         report("solving", 0.05 + 0.85 * done / k)
         if on_converged is not None and done < k:
             ready = _whole_clusters(theta, done, handed, b)
-            if ready > handed:
+            # a few columns at a time (each piece is a new (N, m) array), clusters whole
+            while handed < ready:
+                stop = min(handed + HANDOVER_COLUMNS, ready)
+                while stop < ready and theta[stop] >= theta[stop - 1] * (1.0 - CLUSTER_RTOL):
+                    stop += 1
                 with timer("handover"):
-                    Y_new = _basis_times(Q, j, S[:, handed:ready])
-                on_converged(theta[handed:ready].copy(), Y_new)
-                handed = ready
+                    Y_new = _basis_times(Q, j, S[:, handed:stop])
+                on_converged(theta[handed:stop].copy(), Y_new)
+                del Y_new
+                handed = stop
         if done == k:
             with timer("restarts"):
                 _rotate_in_place(Q, j, S[:, :k])
@@ -1001,7 +1022,7 @@ def _shift_invert(
         basis=Q,
         on_converged=None
         if on_converged is None
-        else lambda theta, Y: on_converged(shift + 1.0 / theta, inv_sqrt_m[:, None] * Y),
+        else lambda theta, Y: on_converged(shift + 1.0 / theta, _scale_rows(Y, inv_sqrt_m)),
     )
     if float32:
         with timer("copy"):
