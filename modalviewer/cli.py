@@ -378,7 +378,9 @@ def _run(args) -> int:
         print(f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}")
         _wrote(written, f"{_png(written)}, mode {args.mode}")
         return 0
-    # distance: --vertex and every vertex number printed or written are the file's
+    # distance: computed on the vertices faces use (mesh.solver_mesh, whose map gives the
+    # input's numbers); --vertex and every vertex number printed or written are the file's
+    mesh = mesh.solver_mesh
     vertex = _mesh_vertex(mesh, args.vertex)
     if args.to is not None:
         return _distance_to(args, mesh)
@@ -393,7 +395,7 @@ def _run(args) -> int:
         viewer = _viewer(mesh, args.mesh)
         viewer.add_spectrum(spec)
         viewer.state.set_display(distance_kind=args.kind)
-        viewer.pick_vertex(vertex)
+        viewer.pick_vertex(args.vertex)
         if marked is None:
             viewer.show_distance(args.kind, display="continuous")
         else:
@@ -611,6 +613,7 @@ def _distance_to(args, mesh_a) -> int:
             "from its first view, turned to face the picked vertex and its best match"
         )
     mesh_b = _load(args.to, args.fix_slivers, args.partial)
+    mesh_b = mesh_b.solver_mesh  # as mesh_a: the vertices faces use, with the file's numbers
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
     operator = KINDS[args.kind]

@@ -2,8 +2,8 @@
 
 * :func:`as_mesh`: ``(V, F)`` arrays, a ``trimesh.Trimesh``, a ``pyvista.PolyData`` (or
   any pyvista data set: its surface) or a ``meshio.Mesh`` as a :class:`~.core.mesh.Mesh`,
-  through the same repair and report as :func:`~modalviewer.io.load_mesh`.  The vertex
-  numbering of the object is the file numbering of the mesh (``mesh.file_vertices``).
+  through the same repair and report as :func:`~modalviewer.io.load_mesh`.  Vertex i of
+  the object is vertex i of the mesh.
 * :func:`operator_matrices`: the sparse ``(K, M)`` of an operator's eigenproblem.
 * :func:`to_pyvista`: the mesh with modes and fields as point arrays.
 
@@ -96,9 +96,10 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     surface; polygons are triangulated, which ``mesh.report`` says) or a ``meshio.Mesh``
     (its triangle cells; quads and polygons are triangulated, volume cells skipped).
     ``repair`` as in :func:`~modalviewer.io.load_mesh`; ``name`` names the mesh in the
-    report (default: the object's type).  Vertex i of the object is file vertex i of the
-    mesh: :meth:`Mesh.mesh_vertex` and :meth:`Mesh.to_file_field` convert, and without a
-    repair that drops or merges vertices the numbering is the same.
+    report (default: the object's type).  Vertex i of the object is vertex i of the mesh,
+    always: a repair changes only the faces (vertices no face uses are ``mesh.unused``
+    and have no value; a merged duplicate takes the values of the vertex it was merged
+    into).
 
     Parameters
     ----------
@@ -166,7 +167,7 @@ def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = Non
     ``spectrum``: each mode as ``"mode_<j>"`` ((n,), or (n, 3) for vector modes) and the
     vertex masses as ``"mass"``; the eigenvalues go to ``field_data["eigenvalues"]``.
     ``fields``: a dict name -> (n,) or (n, c) per-vertex array.  Points are the mesh's
-    vertices in the mesh's numbering (``mesh.file_vertices`` maps to the input's).
+    vertices, one per input vertex in the input's order (NaN values at ``mesh.unused``).
 
     Parameters
     ----------

@@ -134,7 +134,7 @@ def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
         if viewer.state.spectrum(needed) is None:
             viewer.compute(needed, k=k, wait=True)
         viewer.state.set_display(distance_kind=kind)
-        viewer.state.set_pick(mesh.mesh_vertex(int(vertex)))
+        viewer.state.set_pick_file_vertex(int(vertex))
         viewer.show_distance(kind, display="continuous")
     elif spectrum is not None:
         j = viewer.state.first_nonzero_mode(spectrum.operator) if mode is None else int(mode)
@@ -185,8 +185,8 @@ def plot(
     ----------
     mesh : anything :func:`~modalviewer.as_mesh` takes (a file path too).
     spectrum, mode : show mode ``mode`` of ``spectrum`` (default its first non-zero one).
-    field : per-vertex values to colour by instead: an (n,) array in the mesh's vertex
-        order (``mesh.n_vertices``; :meth:`Mesh.file_vertices` maps to the input's), a
+    field : per-vertex values to colour by instead: an (n,) array, one value per vertex
+        of ``mesh`` (``mesh.n_vertices``, NaN allowed at ``mesh.unused`` vertices), a
         ``(name, values)`` pair or a dict (its first item); signed values in the modes'
         diverging colours, others white to red.
     vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
@@ -310,7 +310,8 @@ def add_to_plotter(
     values_or_spectrum : per-vertex values ((n,); signed: the modes' diverging colours,
         otherwise white to red) or a :class:`Spectrum`: its mode ``mode`` (default the
         first non-zero one; vector modes by their normal component, as the viewer), or
-        with ``vertex`` the multiscale distance from that vertex (the input's number).
+        with ``vertex`` the multiscale distance from that vertex.  Vertex numbers and
+        values are in ``mesh``'s numbering; the surface drawn is its vertices faces use.
 
     Parameters
     ----------
@@ -330,15 +331,17 @@ def add_to_plotter(
     """
     from .core.laplacian import vertex_normals
     from .core.signatures import multiscale_distance
+    from .core.spectrum import on_solver_mesh
     from .scene.mesh_scene import MeshScene
 
     mesh = as_mesh(mesh)
-    normals = vertex_normals(mesh)
-    scene = MeshScene(plotter, mesh, normals)
+    solver = mesh.solver_mesh  # the vertices faces use: what is drawn
+    normals = vertex_normals(solver)
+    scene = MeshScene(plotter, solver, normals)
     if isinstance(values_or_spectrum, Spectrum):
-        spec = values_or_spectrum
+        spec = on_solver_mesh(values_or_spectrum, solver)
         if vertex is not None:
-            values = multiscale_distance(spec, mesh.mesh_vertex(int(vertex)))
+            values = multiscale_distance(spec, solver.mesh_vertex(int(vertex)))
             scene.show_field(values, "sequential", isolines=isolines, name=name or "distance")
             return scene
         from .viewer.mode_scalar import mode_scalar, smoothed_normals
@@ -346,12 +349,16 @@ def add_to_plotter(
         if mode is None:
             nonzero = np.flatnonzero(~spec.zero_mode_mask())
             mode = int(nonzero[0]) if nonzero.size else 0
-        values = mode_scalar(spec, int(mode), smoothed_normals(mesh) if spec.is_vector else normals)
+        values = mode_scalar(
+            spec, int(mode), smoothed_normals(solver) if spec.is_vector else normals
+        )
         scene.show_field(values, "diverging", isolines=isolines, name=name or f"mode {mode}")
         return scene
     values = np.asarray(values_or_spectrum, dtype=np.float64)
     if values.shape != (mesh.n_vertices,):
         raise ValueError(f"one value per mesh vertex, ({mesh.n_vertices},); got {values.shape}")
+    if solver is not mesh:
+        values = values[solver.file_vertices]
     signed = float(values.min()) < 0.0 < float(values.max())
     scene.show_field(values, "diverging" if signed else "sequential", isolines=isolines, name=name)
     return scene

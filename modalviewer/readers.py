@@ -500,8 +500,8 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
         if rows < binary_count:
             announced = count_text(binary_count, "triangle", "triangles")
             damage.ends_early(f"triangle {rows}", rows, announced)
-        vertices = arr["v"].reshape(-1, 3).astype(np.float64)
-        return MeshFile(vertices, np.arange(3 * len(arr)).reshape(-1, 3), damage.notes)
+        corners = arr["v"].reshape(-1, 3).astype(np.float64)
+        return MeshFile(*_stl_vertices(corners), damage.notes)
     corners, triangles, current, facet_line = [], [], [], 0
     lines = data.decode("ascii", "replace").splitlines()
     ended = False
@@ -532,8 +532,22 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
             ended = True
     if not ended:
         damage(f"line {len(lines)}", "the file ends before 'endsolid'")
-    vertices = np.array(corners, dtype=np.float64).reshape(-1, 3)
-    return MeshFile(vertices, np.array(triangles, dtype=np.int64).reshape(-1, 3), damage.notes)
+    return MeshFile(
+        *_stl_vertices(np.array(corners, dtype=np.float64).reshape(-1, 3)), damage.notes
+    )
+
+
+def _stl_vertices(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, triangles) of an STL file's triangle corners (3 m, 3): STL names a
+    vertex by its position only, so its vertices are the distinct corner positions in
+    the order they first appear (vertex i is the i-th distinct one)."""
+    if len(corners) == 0:
+        return corners, np.zeros((0, 3), dtype=np.int64)
+    _, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return corners[first[order]], rank[inverse.reshape(-1)].reshape(-1, 3)
 
 
 STL_COORDINATE_LIMIT = 1e30
@@ -577,15 +591,21 @@ def read_mesh_file(path, strict: bool = True) -> MeshFile:
     used = np.zeros(len(result.vertices), dtype=bool)
     used[result.faces.ravel()] = True
     unused = int((~used).sum())
-    if unused and len(result.faces):
+    if unused and len(result.faces) and path.suffix.lower() == ".obj" and _ends_in_face(path):
         result.notes.append(
-            f"{count_text(unused, 'vertex', 'vertices')} of the file "
-            f"{'is' if unused == 1 else 'are'} used by no face"
-            + (
-                " (the file may be truncated: a file cut between two face records "
-                "leaves such vertices)"
-                if path.suffix.lower() == ".obj"
-                else ""
-            )
+            f"the file ends with a face record and {count_text(unused, 'vertex', 'vertices')} "
+            f"of it {'is' if unused == 1 else 'are'} used by no face: it may be truncated (a "
+            "file cut between two face records leaves such vertices)"
         )
     return result
+
+
+def _ends_in_face(path: Path) -> bool:
+    """Whether the last record of an OBJ file is a face ("f ..."): a file cut between two
+    face records ends so, one that ends in a comment (``# End of File``) or another
+    record does not."""
+    with open(path, "rb") as fh:
+        fh.seek(max(0, path.stat().st_size - 4096))
+        lines = [line.strip() for line in fh.read().splitlines()]
+    last = next((line for line in reversed(lines) if line), b"")
+    return last.startswith((b"f ", b"f\t"))

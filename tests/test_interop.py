@@ -50,8 +50,8 @@ def test_arrays_round_trip_keeps_the_numbering(plate):
 def test_arrays_are_repaired_and_reported(plate):
     v = np.vstack([plate.vertices, [[9.0, 9.0, 9.0]]])  # a vertex no face uses
     mesh = mv.as_mesh((v, plate.faces), name="mine")
-    assert mesh.n_vertices == plate.n_vertices
-    assert mesh.file_to_mesh[-1] == -1
+    assert mesh.n_vertices == len(v)  # vertex i of the arrays is vertex i of the mesh
+    np.testing.assert_array_equal(mesh.unused, [plate.n_vertices])
     assert str(mesh.report).startswith("mine:")
     with pytest.raises(mv.MeshError, match="no faces"):
         mv.as_mesh((v, np.zeros((0, 3), int)))

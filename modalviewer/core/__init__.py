@@ -22,7 +22,7 @@ from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
 from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
 from .local_signature import local_signature
-from .mesh import Mesh, MeshError, MeshReport, repair_mesh
+from .mesh import Mesh, MeshError, MeshReport, remove_unused, repair_mesh
 from .pipeline import ZeroModesWarning, compute_spectrum
 from .shells import normal_shells_hessian, shells_hessian
 from .signatures import SignatureTable, default_times, multiscale_distance, signature
@@ -62,6 +62,7 @@ __all__ = [
     "modified_dirichlet_matrix",
     "multiscale_distance",
     "normal_shells_hessian",
+    "remove_unused",
     "repair_mesh",
     "save_spectrum",
     "shells_hessian",

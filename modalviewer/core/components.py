@@ -45,9 +45,8 @@ def _plural(count: int, word: str) -> str:
 def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
     """The connected components, largest area first.
 
-    Each component keeps the map to the file's vertex numbers
-    (:attr:`~modalviewer.core.mesh.Mesh.file_to_mesh`): the file's vertices of other
-    components map to -1 in it.
+    Each component is a mesh of its own, its vertices those of ``mesh`` that its faces
+    use (``vertices`` maps back).
 
     Parameters
     ----------
@@ -61,6 +60,12 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
         component's arrays belongs to vertex ``vertices[i]`` of ``mesh`` (ascending, so
         the component keeps the original vertex order).
     """
+    solver = mesh.solver_mesh
+    if solver is not mesh:  # unused or merged vertices: the parts of the vertices in faces
+        return [
+            (Mesh(part.vertices, part.faces), solver.file_vertices[vertices])
+            for part, vertices in split_components(solver)
+        ]
     labels = mesh.component_labels
     face_label = labels[mesh.faces[:, 0]]
     areas = np.bincount(face_label, weights=mesh.face_areas, minlength=mesh.n_components)
@@ -81,8 +86,8 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
 def largest_component(mesh: Mesh) -> Mesh:
     """A new mesh of the component with the largest area.
 
-    Vertex numbers stay the file's (the removed components' vertices are, for the
-    result, used by no face).
+    Vertex numbers stay the input's: the removed components' vertices are, in the
+    result, used by no face (:attr:`~modalviewer.core.mesh.Mesh.unused`).
 
     Parameters
     ----------
@@ -96,25 +101,45 @@ def largest_component(mesh: Mesh) -> Mesh:
         messages come first).  A mesh with one component is returned as a copy, with the
         report saying so.
     """
+    if not mesh.renumbered:  # the input's numbering: the other components' faces go
+        solver = mesh.solver_mesh
+        labels = solver.component_labels[solver.faces[:, 0]]
+        if solver.n_components == 1:
+            keep = np.ones(mesh.n_faces, dtype=bool)
+        else:
+            area = np.bincount(labels, weights=solver.face_areas, minlength=solver.n_components)
+            size = np.bincount(solver.component_labels, minlength=solver.n_components)
+            largest = min(range(solver.n_components), key=lambda c: (-area[c], -size[c], c))
+            keep = labels == largest
+        kept = Mesh(mesh.vertices, mesh.faces[keep], merged_into=mesh.merged_into)
+        report = _largest_report(mesh, kept, solver.n_components)
+        return Mesh(kept.vertices, kept.faces, report=report, merged_into=kept.merged_into)
     parts = split_components(mesh)
-    kept, vertices = parts[0]
+    kept = parts[0][0]
+    kept.report = _largest_report(mesh, kept, len(parts))
+    return kept
+
+
+def _largest_report(mesh: Mesh, kept: Mesh, n_parts: int) -> MeshReport:
+    """The report of :func:`largest_component` (``kept`` of ``mesh``'s ``n_parts``
+    components); vertex counts are of the vertices faces use."""
     # the input's first sentence describes the input: the result's own comes first
-    before = shape_summary(mesh)
-    messages = [shape_summary(kept)] + [m for m in mesh.report.messages if m != before]
+    first = shape_summary(mesh)
+    messages = [shape_summary(kept)] + [m for m in mesh.report.messages if m != first]
     report = MeshReport(source=mesh.report.source, messages=messages)
-    if len(parts) == 1:
+    if n_parts == 1:
         report.add("The mesh has one connected component; nothing was removed.")
     else:
-        dropped_v = mesh.n_vertices - kept.n_vertices
+        dropped_v = mesh.solver_mesh.n_vertices - kept.solver_mesh.n_vertices
         dropped_f = mesh.n_faces - kept.n_faces
         share = 100.0 * kept.total_area / mesh.total_area
         report.add(
-            f"Kept the largest of {mesh.n_components} connected components "
-            f"({_plural(kept.n_vertices, 'vertex')}, {share:.1f} % of the area); removed "
-            f"{_plural(len(parts) - 1, 'component')} with {_plural(dropped_v, 'vertex')} "
-            f"and {_plural(dropped_f, 'face')}."
+            f"Kept the largest of {n_parts} connected components "
+            f"({_plural(kept.solver_mesh.n_vertices, 'vertex')}, {share:.1f} % of the area); "
+            f"removed {_plural(n_parts - 1, 'component')} with "
+            f"{_plural(dropped_v, 'vertex')} and {_plural(dropped_f, 'face')}."
         )
-    return Mesh(kept.vertices, kept.faces, report=report, file_map=kept.file_map)
+    return report
 
 
 @dataclass

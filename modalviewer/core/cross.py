@@ -103,7 +103,24 @@ def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
     if not (np.isfinite(area) and area > 0):
         raise ValueError(f"the target area must be a positive number, got {area}")
     factor = np.sqrt(area / mesh.total_area)
-    return Mesh(mesh.vertices * factor, mesh.faces, report=mesh.report, file_map=mesh.file_map)
+    return Mesh(
+        mesh.vertices * factor,
+        mesh.faces,
+        report=mesh.report,
+        file_map=mesh.file_map,
+        merged_into=mesh.merged_into,
+    )
+
+
+def _source_row(table: SignatureTable, vertex: int) -> np.ndarray:
+    """The normalised signature of ``vertex``; a ValueError naming it if no face uses
+    it."""
+    row = table.table[check_vertex(vertex, table.table.shape[0])]
+    if np.isnan(row).any():
+        from .mesh import _unused_words
+
+        raise ValueError(_unused_words(int(vertex)))
+    return row
 
 
 def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
@@ -197,13 +214,11 @@ class CrossTables:
 
     def a_to_b(self, vertex: int) -> np.ndarray:
         """(n_b,) distance from vertex ``vertex`` of A to every vertex of B."""
-        v = check_vertex(vertex, self.a.table.shape[0])
-        return self.b.distance_to(self.a.table[v])
+        return self.b.distance_to(_source_row(self.a, vertex))
 
     def b_to_a(self, vertex: int) -> np.ndarray:
         """(n_a,) distance from vertex ``vertex`` of B to every vertex of A."""
-        w = check_vertex(vertex, self.b.table.shape[0])
-        return self.a.distance_to(self.b.table[w])
+        return self.a.distance_to(_source_row(self.b, vertex))
 
     def mutual_best_matches(
         self, vertices_a: Vertices, vertices_b: Vertices | None = None
@@ -220,11 +235,13 @@ class CrossTables:
         back = np.empty(len(va), np.int64)
         for i, v in enumerate(va):
             d = self.a_to_b(v)
-            w = int(np.argmin(d)) if vb is None else int(vb[np.argmin(d[vb])])
+            w = int(np.nanargmin(d)) if vb is None else int(vb[np.nanargmin(d[vb])])
             matches_b[i], distances[i] = w, d[w]
             d_back = self.b_to_a(w)
             back[i] = (
-                int(np.argmin(d_back)) if vertices_b is None else int(va[np.argmin(d_back[va])])
+                int(np.nanargmin(d_back))
+                if vertices_b is None
+                else int(va[np.nanargmin(d_back[va])])
             )
         return Matches(va, matches_b, distances, back, back == va)
 
@@ -280,7 +297,7 @@ def cross_distance(
     Returns
     -------
     ndarray, shape (n_b,)
-        The distance to each vertex of B.
+        The distance to each vertex of B (NaN at the vertices no face uses).
 
     Raises
     ------
@@ -288,7 +305,7 @@ def cross_distance(
         If the spectra are of different operators (or shells spectra of different
         weights), or their default scale ranges do not overlap.
     """
-    v = check_vertex(vertex, spec_a.n_vertices)
+    v = spec_a.check_source(check_vertex(vertex, spec_a.n_vertices))
     _check_pair(spec_a, spec_b)
     times = common_times(spec_a, spec_b, t_range, samples)
     table_b = SignatureTable(spec_b, (times[0], times[-1]), len(times), include_zero)
@@ -323,7 +340,7 @@ def best_match(
         Its distance.
     """
     d = cross_distance(spec_a, vertex, spec_b, t_range, samples, include_zero)
-    w = int(np.argmin(d))
+    w = int(np.nanargmin(d))  # vertices no face uses have no distance (NaN)
     return w, float(d[w])
 
 

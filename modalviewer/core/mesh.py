@@ -5,16 +5,20 @@ immutable after construction.  Construction validates; it never repairs.  Repair
 (merging duplicates, collapsing zero-area faces, re-orienting) happen only in
 :func:`repair_mesh`, which returns a new mesh and a report in plain words.
 
-Vertex numbers of the file.  The mesh the operators use is compact: a vertex no face
-uses is dropped (it would have no area, so the mass matrix would be singular) and
-duplicates are merged, so vertex i of the mesh need not be vertex i of the file.  The
-mesh carries the map back: :attr:`Mesh.file_vertices` (for each mesh vertex its file
-index; for merged vertices the first), :attr:`Mesh.n_file_vertices` and
-:attr:`Mesh.file_to_mesh` (for each file vertex its mesh vertex, -1 where no face uses
-it).  Every vertex number a user sees or types (picks, ``--vertex``, CSV rows, sessions,
-exports) is the file's: convert with :meth:`Mesh.mesh_vertex`, :meth:`Mesh.file_vertex`
-and :meth:`Mesh.to_file_field`.  Without a map (nothing dropped) the maps are the
-identity.
+One vertex numbering, the user's own.  Vertex i of a mesh is row i of the arrays, or
+the i-th vertex record of the file, it was made from: :func:`repair_mesh` keeps every
+input vertex in its place and changes only the faces.  A vertex no face uses (see
+:attr:`Mesh.unused`) has no value: NaN in every per-vertex result, an empty row of the
+stiffness and a zero of the mass, as libigl's matrices have.  A duplicate merged into
+another vertex (:attr:`Mesh.merged_into`) is used by no face either and takes that
+vertex's values.
+
+The solvers work on :attr:`Mesh.solver_mesh`, the used vertices only (for a mesh without
+unused vertices the mesh itself); it is a mesh of another numbering, which it carries
+the map back from (:attr:`Mesh.file_to_mesh`, :meth:`Mesh.to_file_field`, ...).
+Results come back in the input's numbering (:func:`~.pipeline.compute_spectrum`
+expands them); nobody outside the library sees the solver's numbering.
+:func:`remove_unused` gives a compact mesh with its map, for those who want one.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-__all__ = ["Mesh", "MeshError", "MeshReport", "repair_mesh", "triangle_quality"]
+__all__ = ["Mesh", "MeshError", "MeshReport", "remove_unused", "repair_mesh", "triangle_quality"]
 
 
 class MeshError(ValueError):
@@ -61,6 +65,13 @@ def _plural(count: int, word: str) -> str:
     if word.endswith("vertex"):
         return f"{count} {word[:-6]}vertices"
     return f"{count} {word}s"
+
+
+def _unused_words(index: int) -> str:
+    return (
+        f"vertex {index} (counting from 0) is used by no face: it has no value, so no "
+        "distances, signatures or modes there (mesh.unused lists such vertices)"
+    )
 
 
 def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -187,9 +198,12 @@ class Mesh:
     report : MeshReport, optional
         What loading found and repaired.
     file_map : array_like, shape (n_file,), optional
-        For each vertex of the file the mesh was read from, its vertex in this mesh, or
-        -1 where the file's vertex is used by no face (see :attr:`file_to_mesh`).  Every
-        mesh vertex must appear.  None: the mesh's numbering is the file's.
+        Only for a solver mesh (:attr:`solver_mesh`): for each vertex of the input its
+        vertex in this mesh, or -1 where the input's vertex is used by no face (see
+        :attr:`file_to_mesh`).  None: the mesh's numbering is the input's.
+    merged_into : array_like, shape (n,), optional
+        For each vertex the vertex it was merged into (itself where none): a merged
+        vertex is used by no face and takes the values of the one it was merged into.
 
     Raises
     ------
@@ -199,7 +213,12 @@ class Mesh:
     """
 
     def __init__(
-        self, vertices, faces, report: MeshReport | None = None, file_map: np.ndarray | None = None
+        self,
+        vertices,
+        faces,
+        report: MeshReport | None = None,
+        file_map: np.ndarray | None = None,
+        merged_into: np.ndarray | None = None,
     ):
         v, f, _ = checked_arrays(vertices, faces)
         repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
@@ -235,6 +254,18 @@ class Mesh:
             if not (len(fm) == n and np.array_equal(fm, np.arange(n))):
                 fm.setflags(write=False)
                 self._file_map = fm
+        self._merged = None
+        if merged_into is not None:
+            mi = np.array(merged_into, dtype=np.int64).reshape(-1)
+            n = len(v)
+            if mi.shape != (n,) or (n and (mi.min() < 0 or mi.max() >= n)):
+                raise MeshError(f"merged_into must hold one vertex index per vertex ({n})")
+            if np.any(mi[mi] != mi):
+                raise MeshError("merged_into must name vertices that are not merged themselves")
+            if not np.array_equal(mi, np.arange(n)):
+                mi.setflags(write=False)
+                self._merged = mi
+        self._input: Mesh | None = None
 
     # ------------------------------------------------------------------ basics
     @property
@@ -257,6 +288,62 @@ class Mesh:
 
     def __repr__(self) -> str:
         return f"Mesh(n_vertices={self.n_vertices}, n_faces={self.n_faces})"
+
+    # ------------------------------------------------------- the input numbering
+    @property
+    def merged_into(self) -> np.ndarray:
+        """(n,) int64: for each vertex the vertex it was merged into (a duplicate, or
+        the end of a collapsed zero-area face), itself where none; a merged vertex takes
+        that vertex's values."""
+        return np.arange(self.n_vertices) if self._merged is None else self._merged
+
+    @cached_property
+    def _in_face(self) -> np.ndarray:
+        used = np.zeros(self.n_vertices, dtype=bool)
+        used[self._faces.ravel()] = True
+        used.setflags(write=False)
+        return used
+
+    @cached_property
+    def unused(self) -> np.ndarray:
+        """(u,) int64, ascending: the vertices without a value, which no face uses and
+        which are not merged into one that a face uses.  Their per-vertex results are
+        NaN; asking for distances from one is an error naming it."""
+        out = np.flatnonzero(~self._in_face[self.merged_into])
+        out.setflags(write=False)
+        return out
+
+    @cached_property
+    def solver_mesh(self) -> Mesh:
+        """The mesh the solvers work on: this one's vertices that faces use, in their
+        order; the mesh itself where every vertex is used by a face (and none merged).
+
+        Its :attr:`file_to_mesh` maps this mesh's vertices to it (a merged vertex to
+        the vertex it was merged into, -1 for :attr:`unused` ones), its
+        :attr:`file_vertices` back, and :meth:`to_file_field` expands its per-vertex
+        results to this mesh's numbering (NaN at unused vertices).
+        """
+        if self._file_map is not None or (self._merged is None and self._in_face.all()):
+            return self
+        rep = np.flatnonzero(self._in_face)
+        compact = np.full(self.n_vertices, -1, dtype=np.int64)
+        compact[rep] = np.arange(len(rep))
+        solver = Mesh(
+            self._vertices[rep],
+            compact[self._faces],
+            report=self.report,
+            file_map=compact[self.merged_into],
+        )
+        rep.setflags(write=False)
+        solver.__dict__["_first_file_vertex"] = rep  # the input's vertex of each
+        solver._input = self
+        return solver
+
+    @property
+    def input_mesh(self) -> Mesh:
+        """For a :attr:`solver_mesh`, the mesh in the input's numbering it was made from;
+        for any other mesh the mesh itself."""
+        return self._input if self._input is not None else self
 
     # --------------------------------------------------- the file's numbering
     @property
@@ -301,7 +388,8 @@ class Mesh:
         return self._first_file_vertex
 
     def file_vertex(self, index: int) -> int:
-        """The file's number of mesh vertex ``index`` (the first of merged duplicates)."""
+        """The input's number of vertex ``index`` of a solver mesh (the vertex a face
+        uses, of merged duplicates); ``index`` itself for any other mesh."""
         index = int(index)
         if not 0 <= index < self.n_vertices:
             raise MeshError(
@@ -327,12 +415,13 @@ class Mesh:
                 f"numbered 0 to {n - 1})"
             )
         if self._file_map is None:
+            if self._merged is not None or not self._in_face.all():
+                if not self._in_face[self.merged_into[file_index]]:
+                    raise MeshError(_unused_words(file_index))
             return file_index
         mesh_index = int(self._file_map[file_index])
         if mesh_index < 0:
-            raise MeshError(
-                f"vertex {file_index} of the file is used by no face; its distances are undefined"
-            )
+            raise MeshError(_unused_words(file_index))
         return mesh_index
 
     def to_file_field(self, values) -> np.ndarray:
@@ -385,7 +474,10 @@ class Mesh:
 
     @cached_property
     def bounding_box_diagonal(self) -> float:
+        """The diagonal of the bounding box of the vertices that faces use."""
         v = self._vertices
+        if not self._in_face.all():
+            v = v[self._in_face]
         return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
 
     @property
@@ -448,12 +540,22 @@ class Mesh:
 
     @cached_property
     def component_labels(self) -> np.ndarray:
-        """(n,) connected-component label of each vertex."""
+        """(n,) connected-component label of each vertex, 0 to :attr:`n_components` - 1
+        in the order of their first vertices; -1 for :attr:`unused` vertices (a merged
+        vertex has the label of the one it was merged into)."""
         e = self.edges
         n = self.n_vertices
         adj = sp.coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
         _, labels = connected_components(adj, directed=False)
-        return labels
+        if self._merged is None and self._in_face.all():
+            return labels
+        used = self._in_face
+        _, first, inverse = np.unique(labels[used], return_index=True, return_inverse=True)
+        rank = np.empty(len(first), dtype=np.int64)
+        rank[np.argsort(first, kind="stable")] = np.arange(len(first))
+        out = np.full(n, -1, dtype=np.int64)
+        out[used] = rank[inverse.reshape(-1)]
+        return np.where(used[self.merged_into], out[self.merged_into], -1)
 
     @property
     def n_boundary_edges(self) -> int:
@@ -534,9 +636,10 @@ def _unique_index_rows(rows: np.ndarray, **kwargs):
 # ---------------------------------------------------------------------- repair
 def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
     """Vertices within ``tol`` of each other merged into the first of them: (vertices,
-    faces, how many merged, each file vertex's new index).  Only vertices that faces use
-    are merged: a vertex no face uses stays apart (it is removed as unreferenced later),
-    so a merged vertex is never named by the number of one no face uses."""
+    faces, how many merged, each file vertex's new index, each new vertex's file
+    index).  Only vertices that faces use are merged: a vertex no face uses stays apart
+    (it is left without a value later), so a merged vertex is never named by the number
+    of one no face uses."""
     if tol > 0:
         key = np.round(v / tol).astype(np.int64)
     else:
@@ -549,8 +652,8 @@ def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
     order = np.argsort(first)  # keep the original order of first occurrences
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
-    new_v = v[first[order]]
-    return new_v, rank[inverse][f], len(v) - len(new_v), rank[inverse]
+    kept = first[order]
+    return v[kept], rank[inverse][f], len(v) - len(kept), rank[inverse], kept
 
 
 def _double_areas(v: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -810,11 +913,11 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     drop unreferenced vertices, make the orientation consistent per component where
     possible.
 
-    The result is compact (no vertex without a face, so the mass matrix is positive
-    definite) and carries the map to the file's numbering (``vertices`` is the file's):
-    :attr:`Mesh.file_vertices`, :attr:`Mesh.file_to_mesh`; merged duplicates and
-    vertices merged by a collapse map to the vertex they were merged into, unreferenced
-    ones to -1.  The report names vertices by the file's numbers.
+    The result keeps the input's numbering: vertex i is row i of ``vertices``; only the
+    faces change.  Merged duplicates and vertices merged by a collapse are used by no
+    face and take the values of the vertex they were merged into
+    (:attr:`Mesh.merged_into`); vertices no face uses are :attr:`Mesh.unused`.  The
+    report names vertices by their numbers counting from 0.
 
     Returns
     -------
@@ -830,16 +933,17 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
         raise MeshError("all vertices coincide: the mesh has no extent")
 
     n_file = len(v)
-    v, f, merged, file_map = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
+    v_input = v
+    v, f, merged, file_map, rep = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
     if merged:
         first = np.full(len(v), n_file, dtype=np.int64)
         np.minimum.at(first, file_map, np.arange(n_file))
         dup = np.flatnonzero(first[file_map] != np.arange(n_file))
         pairs = [f"{int(i)} into {int(first[file_map[i]])}" for i in dup[:_LISTED]]
         report.add(
-            f"Merged {_plural(merged, 'duplicate vertex')} (the file's "
+            f"Merged {_plural(merged, 'duplicate vertex')} ("
             + _listing(pairs, len(dup))
-            + ")."
+            + ", counting from 0; each takes the values of the vertex it was merged into)."
         )
 
     repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
@@ -890,14 +994,15 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if not used.all():
         remap = np.where(used, np.cumsum(used) - 1, -1)
         file_map = remap[file_map]
-        v, f = v[used], remap[f]
+        v, f, rep = v[used], remap[f], rep[used]
     unreferenced = np.flatnonzero(file_map < 0)  # merged ones are said above
     if len(unreferenced):
+        them = "it has" if len(unreferenced) == 1 else "they have"
         report.add(
-            f"Removed {_plural(len(unreferenced), 'unreferenced vertex')} (no face uses "
-            f"{'it' if len(unreferenced) == 1 else 'them'}; the file's "
+            f"{_plural(len(unreferenced), 'vertex').capitalize()} used by no face ("
             + _listing([str(int(i)) for i in unreferenced[:_LISTED]], len(unreferenced))
-            + "; vertex numbers shown stay the file's)."
+            + f", counting from 0): {them} no value (NaN) in the results; vertex numbers "
+            "stay the input's (mesh.unused lists them)."
         )
 
     f, flipped, orientable = _orient_faces(f)
@@ -906,7 +1011,10 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if not orientable:
         report.add("The surface is not orientable, so some faces disagree in orientation.")
 
-    mesh = Mesh(v, f, report=report, file_map=file_map)
+    # the input's numbering: every input vertex in its place, the faces on the vertex
+    # of each merged group that has the group's coordinates
+    merged_into = np.where(file_map >= 0, rep[np.maximum(file_map, 0)], np.arange(n_file))
+    mesh = Mesh(v_input, rep[f], report=report, merged_into=merged_into)
     report.messages.insert(0, shape_summary(mesh))
     problem = mesh.shell_problem()
     if problem:
@@ -918,9 +1026,11 @@ def shape_summary(mesh: Mesh) -> str:
     """The report's first sentence: vertices, faces, components, boundary, non-manifold
     edges, and parts joined to the rest only at vertices (each can turn about its
     vertex: three zero modes more for the 3D shells than its component's six)."""
+    unused = len(mesh.unused)
     summary = (
-        f"{_plural(mesh.n_vertices, 'vertex')}, {_plural(mesh.n_faces, 'face')}, "
-        f"{_plural(mesh.n_components, 'component')}"
+        f"{_plural(mesh.n_vertices, 'vertex')}"
+        + (f" ({unused} used by no face)" if unused else "")
+        + f", {_plural(mesh.n_faces, 'face')}, {_plural(mesh.n_components, 'component')}"
     )
     if mesh.n_boundary_edges:
         summary += f", {_plural(mesh.n_boundary_edges, 'boundary edge')}"
@@ -937,3 +1047,21 @@ def shape_summary(mesh: Mesh) -> str:
             "turn about it: 3 more zero modes each for the 3D shells)"
         )
     return summary + "."
+
+
+def remove_unused(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
+    """A compact copy of ``mesh``: its vertices that faces use, in their order, and the
+    map back.
+
+    Returns
+    -------
+    compact : Mesh
+        No unused or merged vertices; vertex i of it is vertex ``kept[i]`` of ``mesh``.
+    kept : ndarray of int64, shape (n_compact,)
+        For each vertex of ``compact`` its index in ``mesh`` (ascending).  Values of
+        ``mesh``'s numbering are ``values[kept]`` in ``compact``'s.
+    """
+    solver = mesh.solver_mesh
+    kept = np.array(solver.file_vertices if solver is not mesh else np.arange(mesh.n_vertices))
+    compact = Mesh(solver.vertices, solver.faces, report=mesh.report)
+    return compact, kept

@@ -16,7 +16,7 @@ from .memory import return_freed_memory
 from .mesh import Mesh
 from .operators import operator_info
 from .preview import compute_preview, preview_possible
-from .spectrum import Spectrum
+from .spectrum import Spectrum, in_input_numbering
 from .transfer import CoarseCopy
 from .validate import check_count
 
@@ -134,7 +134,10 @@ def compute_spectrum(
 
     Returns
     -------
-    Spectrum with ascending eigenvalues and Mass-orthonormal modes, (n, k) or (n, 3, k).
+    Spectrum with ascending eigenvalues and Mass-orthonormal modes, (n, k) or (n, 3, k),
+    one row per vertex of ``mesh``: the solver works on the vertices faces use
+    (``mesh.solver_mesh``); rows of ``mesh.unused`` vertices are NaN, a merged
+    duplicate's row is that of the vertex it was merged into.
     The exactly known null vectors of the operator (:mod:`.nullspace`: a constant per
     component for the Laplacian, six rigid motions per component for the shells, ...)
     come first, as eigenvalue 0, counted in k; ``spec.null_space_dimension`` says how
@@ -146,6 +149,11 @@ def compute_spectrum(
         raise ValueError(
             f"accuracy must be one of {', '.join(map(repr, ACCURACIES))}, got {accuracy!r}"
         )
+    if mesh.solver_mesh is not mesh:  # unused or merged vertices: solve on the others
+        solved = compute_spectrum(
+            mesh.solver_mesh, operator, k, bending, membrane, progress, cancel, accuracy, coarse
+        )
+        return in_input_numbering(solved, mesh)
     progress = _returning_freed_memory(progress)
     if accuracy != "exact" and preview_possible(mesh, operator, k):
         refine = None if accuracy == "preview" else False

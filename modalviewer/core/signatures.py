@@ -75,7 +75,8 @@ def signature(
     include_zero : bool
         Whether the sum includes the zero modes.
     vertices : int or array_like of int, optional
-        Vertex indices in ``0..n-1`` (default: every vertex).
+        Vertex indices in ``0..n-1`` (default: every vertex); the rows of vertices no
+        face uses are NaN.
 
     Returns
     -------
@@ -156,7 +157,12 @@ class SignatureTable:
         (distance below 1e-3 of the signature norms) the entries are recomputed directly,
         so near-zero distances keep full relative accuracy and d(v, v) = 0 exactly.
         """
-        return self.distance_to(self.table[check_vertex(vertex, self.table.shape[0])])
+        row = self.table[check_vertex(vertex, self.table.shape[0])]
+        if np.isnan(row).any():
+            from .mesh import _unused_words
+
+            raise ValueError(_unused_words(vertex))
+        return self.distance_to(row)
 
     def distance_to(self, row: np.ndarray) -> np.ndarray:
         """(n,) distance from a normalised signature ``row`` (T,) to every vertex.
@@ -203,12 +209,13 @@ def multiscale_distance(
     Returns
     -------
     ndarray, shape (n,)
-        The distance from ``vertex`` to each vertex (0 at ``vertex`` itself).
+        The distance from ``vertex`` to each vertex (0 at ``vertex`` itself; NaN at the
+        vertices no face uses).
 
     Raises
     ------
     ValueError
-        If the spectrum has no non-zero modes.
+        If the spectrum has no non-zero modes, or no face uses ``vertex``.
     """
-    vertex = check_vertex(vertex, spec.n_vertices)
+    vertex = spec.check_source(check_vertex(vertex, spec.n_vertices))
     return SignatureTable(spec, t_range, samples, include_zero).distance_from(vertex)

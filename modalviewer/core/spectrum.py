@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -31,13 +31,16 @@ class Spectrum:
     Attributes
     ----------
     eigenvalues : (k,) ascending, units 1/time^2 for vibrations (frequency = sqrt).
-    modes : (n, k), or (n, 3, k) for ``"shells"``; M-orthonormal: with the columns
-        ``Phi = modes.reshape(-1, k)`` and ``M`` the lumped mass (``mass``, repeated for
-        each component of a vector mode), ``Phi.T @ M @ Phi`` is the identity, so a mode's
-        values scale with 1 / sqrt(area).  :meth:`euclidean_modes` gives unit-length
-        columns instead.
+    modes : (n, k), or (n, 3, k) for ``"shells"``, one row per vertex of the mesh (its
+        input numbering); NaN at the vertices no face uses (``mesh.unused``), a merged
+        duplicate's row that of the vertex it was merged into.  M-orthonormal: with the
+        rows of the vertices faces use, ``Phi = modes.reshape(-1, k)`` and ``M`` the lumped
+        mass (``mass``, repeated for each component of a vector mode), ``Phi.T @ M @ Phi``
+        is the identity, so a mode's values scale with 1 / sqrt(area).
+        :meth:`euclidean_modes` gives unit-length columns instead.
     operator : one of ``OPERATORS``.
-    mass : (n,) lumped vertex masses used for orthonormality.
+    mass : (n,) lumped vertex masses used for orthonormality (0 at vertices no face
+        uses, as the mass matrix has).
     residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
     mesh_hash : SHA-256 of the mesh geometry the spectrum belongs to.
     parameters : bending and membrane weights, solver information.
@@ -144,8 +147,22 @@ class Spectrum:
         has norm 1), same shape as ``modes``; a new array.  They are orthogonal in the
         mass inner product, not in the Euclidean one."""
         flat = self.modes.reshape(-1, self.k)
-        norms = np.linalg.norm(flat, axis=0)
+        faced = np.repeat(self.mass > 0, flat.shape[0] // max(self.mass.shape[0], 1))
+        norms = np.linalg.norm(flat[faced], axis=0)
         return (flat / np.where(norms > 0, norms, 1.0)).reshape(self.modes.shape)
+
+    def check_source(self, vertex: int) -> int:
+        """``vertex`` if it has values (a face uses it, or it was merged into a vertex a
+        face uses); a ValueError naming it otherwise."""
+        if np.isnan(self.modes[vertex]).any():
+            from .mesh import _unused_words
+
+            raise ValueError(_unused_words(vertex))
+        return vertex
+
+    def has_unused(self) -> bool:
+        """Whether some vertices have no value (NaN rows: used by no face)."""
+        return bool(np.isnan(self.modes[:, ..., 0]).any()) if self.k else False
 
     def squared_modes(self, vertices=None) -> np.ndarray:
         """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes); only the rows of
@@ -270,8 +287,44 @@ def load_spectrum(
     expected = (n, 3, k) if per_vertex == 3 else (n, k)
     if spec.modes.shape != expected or spec.residuals.shape != (k,):
         raise SpectrumFileError(f"{path} has inconsistent array shapes")
-    if not (np.all(np.isfinite(spec.eigenvalues)) and np.all(np.isfinite(spec.modes))):
+    valued = spec.mass > 0  # vertices no face uses have mass 0 and NaN modes
+    if not (
+        np.all(np.isfinite(spec.eigenvalues))
+        and np.all(np.isfinite(spec.modes[valued]))
+        and np.all(np.isfinite(spec.mass))
+    ):
         raise SpectrumFileError(f"{path} contains NaN or infinite values")
     if mesh_hash is not None and spec.mesh_hash != mesh_hash:
         raise SpectrumFileError(f"{path} belongs to another mesh")
     return spec
+
+
+def in_input_numbering(spec: Spectrum, mesh: Mesh) -> Spectrum:
+    """``spec``, computed on ``mesh.solver_mesh``, in ``mesh``'s numbering: a row per
+    vertex of ``mesh``, NaN modes and zero mass at its unused vertices, a merged
+    vertex's modes those of the vertex it was merged into (and mass 0: no face uses it).
+    ``spec`` itself where the solver mesh is ``mesh``."""
+    solver = mesh.solver_mesh
+    if solver is mesh:
+        return spec
+    mass = np.zeros(mesh.n_vertices)
+    mass[solver.file_vertices] = spec.mass
+    return replace(
+        spec,
+        modes=solver.to_file_field(spec.modes),
+        mass=mass,
+        mesh_hash=mesh.hash,
+        parameters={**spec.parameters, "unused_vertices": int(mesh.unused.size)},
+    )
+
+
+def on_solver_mesh(spec: Spectrum, mesh: Mesh) -> Spectrum:
+    """``spec`` of ``mesh.input_mesh`` (one row per input vertex) on ``mesh``, a solver
+    mesh (:attr:`.mesh.Mesh.solver_mesh`); ``spec`` itself where it is in that numbering
+    already."""
+    if mesh.input_mesh is mesh or spec.n_vertices == mesh.n_vertices:
+        return spec
+    if spec.mesh_hash and spec.mesh_hash != mesh.input_mesh.hash:
+        return spec  # another mesh's: the caller's check says so
+    rows = mesh.file_vertices
+    return replace(spec, modes=spec.modes[rows], mass=spec.mass[rows], mesh_hash=mesh.hash)

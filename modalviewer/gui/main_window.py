@@ -395,8 +395,8 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_view_clicked(self, x: float, y: float) -> None:
         scene = self.scene
         vertex = scene.vertex_at_display(x, y) if scene is not None else None
-        if vertex is not None:
-            self.pick_vertex(vertex)
+        if vertex is not None:  # a vertex of the drawn (solver's) mesh: the input's number
+            self.pick_vertex(self.viewer.state.mesh.file_vertex(vertex))
 
     # ========================================================= shape pair
     def open_second_mesh(self, path, wait: bool = True, k: int | None = None) -> PairWindow:
@@ -532,7 +532,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     @property
     def picked(self) -> int | None:
-        return self.state.picked
+        return self.viewer.picked  # the input's number
 
     @property
     def last_distance(self):

@@ -1,6 +1,6 @@
 """A mesh repair in a child process: ``python -m modalviewer.processes.repair_main IN OUT``.
 
-IN is a pickle of (repair name, vertices, faces, report, file_map) written by
+IN is a pickle of (repair name, vertices, faces, report, file_map, merged_into) written by
 :func:`modalviewer.viewer.process.repair_in_process`; OUT receives the repaired Mesh
 (pickled).  Progress and errors go to stdout as JSON lines.
 """
@@ -24,8 +24,8 @@ def main(argv: list[str] | None = None) -> int:
 
     try:
         with open(job_path, "rb") as fh:
-            name, vertices, faces, report, *file_map = pickle.load(fh)
-        mesh = Mesh(vertices, faces, report=report, file_map=(file_map or [None])[0])
+            name, vertices, faces, report, file_map, merged_into = pickle.load(fh)
+        mesh = Mesh(vertices, faces, report=report, file_map=file_map, merged_into=merged_into)
         repaired = apply_repair(
             name, mesh, progress=lambda stage, f: _emit({"stage": stage, "fraction": f})
         )

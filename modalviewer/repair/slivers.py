@@ -180,10 +180,9 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         Hausdorff distance between the two surfaces, at their vertices (both relative
         to the bounding-box diagonal).
 
-        Where nothing was changed the result keeps the input's map to the file's vertex
-        numbers (:attr:`~modalviewer.core.mesh.Mesh.file_to_mesh`); a repaired mesh has
-        new vertex numbers (MeshLab renumbers, removes and adds vertices), so it has no
-        map (its numbering is its own) and its report says so.
+        Where nothing was changed the result keeps the input's vertices and numbering; a
+        repaired mesh has new vertex numbers (MeshLab renumbers, removes and adds
+        vertices: its numbering is its own) and its report says so.
 
     Raises
     ------
@@ -205,7 +204,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         worst_quality_before=float(q0.min()),
     )
     if report.below_min_quality_before == 0:
-        out = Mesh(v0, f0, report=report, file_map=mesh.file_map)
+        out = Mesh(v0, f0, report=report, file_map=mesh.file_map, merged_into=mesh.merged_into)
         report.triangles_after = mesh.n_faces
         report.below_min_quality_after = 0
         report.worst_quality_after = report.worst_quality_before

@@ -120,9 +120,10 @@ def save_screenshot(
 def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Path:
     """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply.
 
-    The points are the mesh's: the file's vertices in the file's order, less those no
-    face uses (merged duplicates once).  Where that numbering differs from the file's,
-    a point-data array ``file_vertex`` gives each point's vertex number in the file."""
+    The points are the mesh's vertices, one per input vertex in the input's order (the
+    fields' values NaN at vertices no face uses); a solver's mesh of another numbering
+    (:attr:`~modalviewer.core.mesh.Mesh.solver_mesh`) gets a point-data array
+    ``file_vertex``: each point's vertex number in the input."""
     import pyvista as pv
 
     path = Path(path)

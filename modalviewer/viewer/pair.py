@@ -94,7 +94,7 @@ class PairEvents(SignalGroup):
 
 class _Side:
     def __init__(self, mesh: Mesh, path) -> None:
-        self.mesh = mesh
+        self.mesh = mesh.solver_mesh  # the vertices faces use; its map gives the input's numbers
         self.path = Path(path) if path is not None else None
         self.masses = lumped_masses(mesh)
         self.unit_mesh: Mesh | None = None

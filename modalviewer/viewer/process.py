@@ -139,9 +139,10 @@ def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
     child Python; returns the repaired Mesh with its report."""
     job_path, out_path = _temp_path(".pickle"), _temp_path(".pickle")
     try:
+        source = mesh.input_mesh  # repaired in the input's numbering
         with open(job_path, "wb") as fh:
-            job = (name, np.asarray(mesh.vertices), np.asarray(mesh.faces), mesh.report)
-            pickle.dump((*job, mesh.file_map), fh)  # the map to the file's vertex numbers
+            job = (name, np.asarray(source.vertices), np.asarray(source.faces), source.report)
+            pickle.dump((*job, source.file_map, np.asarray(source.merged_into)), fh)
         _run_child(
             ["modalviewer.processes.repair_main", job_path, out_path], progress, cancel, "repair"
         )

@@ -148,7 +148,7 @@ def restore_session(model, path) -> Restored:
         for name in repairs:
             mesh = repair_in_process(name, mesh, lambda *_: None, lambda: False)
         model.set_mesh(mesh, mesh_path, repairs)
-    if mesh.hash != mesh_info.get("hash"):
+    if state.mesh.hash != mesh_info.get("hash"):  # the hash saved is the state's mesh's
         out.notes.append(
             f"{mesh_path.name} changed on disk since the session was saved: spectra are "
             "recomputed and the pick may point elsewhere"

@@ -50,7 +50,7 @@ from psygnal import Signal, SignalGroup
 
 from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance, operator_info
-from ..core.spectrum import Spectrum
+from ..core.spectrum import Spectrum, on_solver_mesh
 from .derived import DerivedValues
 
 DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature", "field")
@@ -271,8 +271,10 @@ class ViewerState:
         self, mesh: Mesh | None, path: Path | str | None = None, repairs: list[str] | None = None
     ) -> None:
         """Load ``mesh`` (read from ``path``, then given ``repairs``): spectra, pick and
-        display of the previous mesh are dropped."""
-        self.mesh = mesh
+        display of the previous mesh are dropped.  The state holds ``mesh.solver_mesh``
+        (the vertices faces use); its map gives the input's numbers, which is what is
+        shown and saved."""
+        self.mesh = mesh.solver_mesh if mesh is not None else None
         self.mesh_repairs = list(repairs or [])
         self.mesh_path = Path(path) if path is not None else None
         self.spectra.clear()
@@ -310,6 +312,8 @@ class ViewerState:
         It becomes the spectrum shown for its operator; the operator's spectra of other
         keys (another k, other weights) are dropped: nothing shows them any more, and at
         130k vertices each holds 100 to 300 MB (exact ones come back from the cache)."""
+        if self.mesh is not None:
+            spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
             raise ValueError("the spectrum does not belong to the loaded mesh")
         if spec.is_preview and self.has_spectrum(key):
@@ -534,10 +538,12 @@ class ViewerState:
         if not name:
             raise ValueError("a field needs a name")
         values = np.array(values, dtype=np.float64)
+        if self.mesh.renumbered and values.shape == (self.mesh.n_file_vertices,):
+            values = values[self.mesh.file_vertices]  # the input's numbering
         if values.shape != (self.mesh.n_vertices,):
             raise ValueError(
                 f"field {name!r} has shape {values.shape}; the mesh has "
-                f"{self.mesh.n_vertices} vertices: give one value per vertex"
+                f"{self.mesh.n_file_vertices} vertices: give one value per vertex"
             )
         if not np.all(np.isfinite(values)):
             raise ValueError(f"field {name!r} has values that are not finite")

@@ -42,7 +42,7 @@ from psygnal import Signal, SignalGroup
 from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
-from ..core.spectrum import Spectrum
+from ..core.spectrum import Spectrum, in_input_numbering
 from ..repair import repair_for_failure, repair_unavailable
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
 from .model import (
@@ -148,7 +148,15 @@ class Viewer:
     # ============================================================== meshes
     @property
     def mesh(self) -> Mesh | None:
-        return self.state.mesh
+        """The loaded mesh, in its input's numbering (as loaded or given)."""
+        return self.state.mesh.input_mesh if self.state.mesh is not None else None
+
+    def _public(self, spec: Spectrum | None) -> Spectrum | None:
+        """``spec`` of the loaded mesh in the input's numbering (one row per vertex of
+        :attr:`mesh`)."""
+        if spec is None or self.state.mesh is None:
+            return spec
+        return in_input_numbering(spec, self.state.mesh.input_mesh)
 
     def open_mesh(self, path, strict: bool = True) -> Mesh:
         """Load a mesh file and show it.
@@ -249,7 +257,7 @@ class Viewer:
     @property
     def spectra(self) -> dict[str, Spectrum]:
         """The latest spectrum of each computed operator."""
-        return {op: self.state.spectrum(op) for op in self.state.operators_computed()}
+        return {op: self._public(self.state.spectrum(op)) for op in self.state.operators_computed()}
 
     def add_spectrum(self, spectrum: Spectrum) -> None:
         """Put a spectrum computed elsewhere (``modalviewer.compute_spectrum``, a file)
@@ -340,13 +348,13 @@ class Viewer:
         if job is None:
             return None
         if then is not None:
-            job.then(lambda j: then(j.result[0]) if j.status == DONE else None)
+            job.then(lambda j: then(self._public(j.result[0])) if j.status == DONE else None)
         if not wait:
             return None
         self.wait_for(job)
         if job.status != DONE:
             raise ComputeError(job.error or job.status)
-        return job.result[0]
+        return self._public(job.result[0])
 
     def long_wait_note(self, job: SpectrumJob) -> str:
         """ "this will take about ..." for a request expected to take long with nothing on
@@ -511,25 +519,24 @@ class Viewer:
     # ======================================================== picks, maps
     @property
     def picked(self) -> int | None:
-        return self.state.picked
+        """The picked vertex (the input's number, as :attr:`mesh` numbers it), or None."""
+        return self.state.picked_file_vertex
 
     def pick_file_vertex(self, number: int, show: bool = True) -> None:
-        """Pick vertex ``number`` of the mesh file (the number the viewer shows, as
-        ``modalviewer distance --vertex`` takes it); ValueError for one no face uses.
-        ``show``: as for :meth:`pick_vertex`."""
-        if self.state.mesh is None:
-            return
-        self.pick_vertex(self.state.mesh.mesh_vertex(number), show)
+        """The same as :meth:`pick_vertex`: the viewer has one numbering, the input's."""
+        self.pick_vertex(number, show)
 
     def pick_vertex(self, index: int, show: bool = True) -> None:
-        """Pick mesh vertex ``index`` (the loaded mesh's compact index, as a click on it
-        does): marker and, with ``show``, the distance map of the display's kind, whose
-        spectrum is computed if missing (see :meth:`pick_file_vertex`).  A script that
-        shows another kind next picks with ``show=False``, so that no spectrum it does
-        not need is computed (the 3D shells for the default vibration distance)."""
+        """Pick vertex ``index`` of :attr:`mesh` (the input's numbering: row ``index`` of
+        the arrays, the ``index``-th vertex record of the file, as ``modalviewer distance
+        --vertex`` takes it; a ValueError for one no face uses): marker and, with
+        ``show``, the distance map of the display's kind, whose spectrum is computed if
+        missing.  A script that shows another kind next picks with ``show=False``, so
+        that no spectrum it does not need is computed (the 3D shells for the default
+        vibration distance)."""
         if self.state.mesh is None:
             return
-        self.state.set_pick(index)
+        self.state.set_pick_file_vertex(index)
         if show:
             self.show_distance()
 
@@ -626,12 +633,21 @@ class Viewer:
         return self.state.derived.distance_map()
 
     def distance_map(self, kind: str) -> np.ndarray | None:
-        """Distance of ``kind`` from the picked vertex, or None if its spectrum is missing."""
-        return self.state.derived.distance_map(kind)
+        """Distance of ``kind`` from the picked vertex (one value per vertex of
+        :attr:`mesh`, NaN where no face uses one), or None if its spectrum is missing."""
+        return self._input_field(self.state.derived.distance_map(kind))
 
     @property
     def last_distance(self) -> np.ndarray | None:
-        return self.state.derived.distance_map() if self.state.display.kind == "distance" else None
+        if self.state.display.kind != "distance":
+            return None
+        return self._input_field(self.state.derived.distance_map())
+
+    def _input_field(self, values: np.ndarray | None) -> np.ndarray | None:
+        """Per-vertex ``values`` of the solver's mesh in the input's numbering."""
+        if values is None or self.state.mesh is None:
+            return values
+        return self.state.mesh.to_file_field(values)
 
     def set_threshold(self, fraction: float) -> float:
         """Move the threshold (a fraction of the largest distance); returns the time the
@@ -693,11 +709,11 @@ class Viewer:
             return None
         field = self.state.derived.field()
         if field is None or field.colormap == "plain":
-            return "field", np.zeros(self.state.mesh.n_vertices)
+            return "field", self._input_field(np.zeros(self.state.mesh.n_vertices))
         title = field.title or "field"
         if field.colormap == "threshold":  # the values are the distances: their name only,
             title = title.split(" <")[0]  # not the threshold, which the slider moves
-        return title, np.asarray(field.values, dtype=np.float64)
+        return title, self._input_field(np.asarray(field.values, dtype=np.float64))
 
     def export_field(self, path) -> Path:
         """Write the mesh with the field shown as point data (.vtp or .ply)."""
@@ -707,7 +723,7 @@ class Viewer:
         if field is None:
             raise ValueError("nothing to export: open a mesh first")
         name, values = field
-        return save_field_mesh(Path(path), self.state.mesh, {name: values})
+        return save_field_mesh(Path(path), self.mesh, {name: values})
 
     def renderer(self, size=None):
         """The off-screen renderer drawing this viewer (made on first use; ``size``

@@ -23,13 +23,16 @@ def parts():
 
 def test_largest_component_by_area_with_a_report(parts):
     kept = mv.largest_component(parts)
-    assert (kept.n_vertices, kept.n_faces, kept.n_components) == (200, 400, 1)
-    np.testing.assert_array_equal(kept.vertices, parts.vertices[162:362])
+    assert (kept.n_vertices, kept.n_faces, kept.n_components) == (524, 400, 1)
+    # the input's numbering: the other components' vertices are used by no face
+    np.testing.assert_array_equal(kept.vertices, parts.vertices)
+    np.testing.assert_array_equal(kept.unused, np.r_[0:162, 362:524])
+    np.testing.assert_array_equal(kept.solver_mesh.vertices, parts.vertices[162:362])
     text = str(kept.report)
     assert "Kept the largest of 3 connected components (200 vertices" in text
     assert "removed 2 components with 324 vertices and 640 faces" in text
     one = mv.largest_component(kept)
-    assert one.n_vertices == 200 and "one connected component" in str(one.report)
+    assert one.solver_mesh.n_vertices == 200 and "one connected component" in str(one.report)
 
 
 def test_split_components_keeps_vertex_order(parts):
@@ -79,7 +82,9 @@ def test_the_largest_components_report_begins_with_its_own_shape(parts):
     assert str(loaded.report).startswith("arrays: 524 vertices, 1040 faces, 3 components")
     kept = mv.largest_component(loaded)
     text = str(kept.report)
-    assert text.startswith("arrays: 200 vertices, 400 faces, 1 component, closed."), text
+    assert text.startswith(
+        "arrays: 524 vertices (324 used by no face), 400 faces, 1 component, closed."
+    ), text
     assert "3 components" not in text and "Kept the largest of 3 connected components" in text
 
 

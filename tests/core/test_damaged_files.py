@@ -234,9 +234,22 @@ def test_unused_vertices_keep_the_files_numbering(tmp_path, fmt, where):
     vertices, faces, notes = read_file(path)
     assert len(vertices) == len(v_file) and np.array_equal(faces, f_file)
     assert np.array_equal(vertices[at : at + 3], extra)
-    assert any("3 vertices of the file are used by no face" in n for n in notes), notes
     mesh = mv.load_mesh(path)
-    assert "3 vertices of the file are used by no face" in str(mesh.report)
+    assert "3 vertices used by no face" in str(mesh.report)
+    np.testing.assert_array_equal(mesh.unused, np.arange(at, at + 3))
+    np.testing.assert_array_equal(mesh.vertices, v_file)
+
+
+def test_an_obj_ending_in_a_face_record_with_unused_vertices_may_be_truncated(tmp_path):
+    v, f = _plate()
+    body = [f"v {x} {y} {z}" for x, y, z in np.vstack([v, [[7.0, 7.0, 7.0]]])]
+    body += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f]
+    cut = tmp_path / "cut.obj"
+    cut.write_text("\n".join(body) + "\n")
+    complete = tmp_path / "complete.obj"
+    complete.write_text("\n".join(body) + "\n# End of File\n")
+    assert "it may be truncated" in str(mv.load_mesh(cut).report)
+    assert "truncated" not in str(mv.load_mesh(complete).report)
 
 
 @pytest.mark.parametrize("fmt", ["obj", "off", "ply-ascii"])
@@ -263,7 +276,9 @@ def test_strict_false_keeps_the_numbers_after_an_incomplete_vertex_record(tmp_pa
     assert np.array_equal(faces, f[~using])
     mesh = mv.load_mesh(path, strict=False)
     assert mesh.n_faces == len(f) - using.sum()
-    assert mesh.n_vertices == len(np.unique(f[~using]))
+    assert mesh.n_vertices == len(v)  # the input's numbering: vertex 20 has no value
+    assert mesh.solver_mesh.n_vertices == len(np.unique(f[~using]))
+    assert broken in mesh.unused
     assert f"{using.sum()} faces using a vertex whose record was incomplete dropped" in str(
         mesh.report
     )

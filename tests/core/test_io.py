@@ -65,11 +65,12 @@ def test_repairs_are_made_and_reported(tmp_path):
     mesh = mv.repair_mesh(v, np.vstack([f, extra]), source="messy")
     text = str(mesh.report)
     assert "Merged 3 duplicate vertices" in text
-    assert "Removed 1 unreferenced vertex" in text
+    assert "1 vertex used by no face" in text
     assert "degenerate" in text and "Flipped 1 face" in text
-    assert mesh.n_faces == plate.n_faces and mesh.n_vertices == plate.n_vertices
+    assert mesh.n_faces == plate.n_faces and mesh.solver_mesh.n_vertices == plate.n_vertices
+    assert mesh.n_vertices == len(v)  # the input's numbering
     assert mesh.is_consistently_oriented
-    np.testing.assert_array_equal(mesh.vertices, plate.vertices)
+    np.testing.assert_array_equal(mesh.solver_mesh.vertices, plate.vertices)
 
 
 def test_duplicate_vertices_merged(tmp_path):
@@ -77,7 +78,9 @@ def test_duplicate_vertices_merged(tmp_path):
     v = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
     path = _write_obj(tmp_path / "split.obj", v, [[0, 1, 2], [3, 4, 5]])
     mesh = mv.load_mesh(path)
-    assert mesh.n_vertices == 4 and "Merged 2 duplicate vertices" in str(mesh.report)
+    assert mesh.n_vertices == 6 and mesh.solver_mesh.n_vertices == 4
+    assert "Merged 2 duplicate vertices" in str(mesh.report)
+    assert list(mesh.merged_into) == [0, 1, 2, 1, 4, 2]
     raw = mv.load_mesh(path, repair=False)
     assert raw.n_vertices == 6
 

@@ -21,10 +21,14 @@ def test_the_window_picks_and_exports_in_file_numbers(window, tmp_path):
     window.open_mesh(path)
     window.compute("laplacian", k=20, wait=True)
     window.pick_file_vertex(41)
-    assert window.picked == 40 and window.state.picked_file_vertex == 41
+    assert window.picked == 41 and window.state.picked_file_vertex == 41
     assert window.distances_panel.pick_label.text().startswith("Picked vertex 41 at")
     window.pick_file_vertex(n + 1)  # used by no face: a message, the pick stays
-    assert window.picked == 40
+    assert window.picked == 41
     window.show_distance("hks")
     out = window.export_field(tmp_path / "f.vtp")
-    np.testing.assert_array_equal(pv.read(out).point_data["file_vertex"], np.arange(1, n + 1))
+    exported = pv.read(out)  # one point per vertex of the file, in the file's order
+    assert exported.n_points == len(v) and "file_vertex" not in exported.point_data
+    values = np.asarray(exported.point_data[exported.point_data.keys()[0]])
+    assert np.isnan(values[[0, n + 1]]).all() and np.isfinite(values[1 : n + 1]).all()
+    assert values[41] == 0.0

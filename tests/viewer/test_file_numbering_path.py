@@ -88,7 +88,9 @@ def test_load_pick_distance_in_file_numbers(files, tmp_path):
     # picking the duplicate picks the vertex it was merged into
     model.state.set_pick_file_vertex(dup)
     assert model.state.picked == 7 and model.state.picked_file_vertex == where[7]
-    with pytest.raises(ValueError, match=f"vertex {unused[2]} of the file is used by no face"):
+    with pytest.raises(
+        ValueError, match=rf"vertex {unused[2]} \(counting from 0\) is used by no face"
+    ):
         model.state.set_pick_file_vertex(unused[2])
 
 
@@ -115,7 +117,7 @@ def test_cli_vertex_and_csv_rows_are_the_files(files, tmp_path, monkeypatch, cap
 
     assert main(["distance", str(padded), "--vertex", str(unused[0]), *args]) == 2
     err = capsys.readouterr().err
-    assert f"--vertex {unused[0]}: vertex {unused[0]} of the file is used by no face" in err
+    assert f"--vertex {unused[0]}: vertex {unused[0]} (counting from 0) is used by no face" in err
 
 
 def test_sessions_store_file_numbers_and_read_old_ones(files, tmp_path):

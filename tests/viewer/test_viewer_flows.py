@@ -285,7 +285,9 @@ def test_keep_the_largest_component(viewer, tmp_path):
     viewer.set_mesh(mv.Mesh(vertices, faces))
     assert viewer.mesh.n_components == 2
     repaired = viewer.repair_mesh("largest_component")
-    assert viewer.mesh is repaired and repaired.n_vertices == big.n_vertices
+    assert viewer.mesh is repaired and repaired.n_vertices == len(vertices)  # the same numbers
+    np.testing.assert_array_equal(repaired.unused, np.arange(big.n_vertices, len(vertices)))
+    assert viewer.state.mesh.n_vertices == big.n_vertices  # solved on the torus alone
 
 
 def test_a_shape_pair_without_a_window(viewer, tmp_path):
