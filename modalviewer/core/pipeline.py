@@ -151,7 +151,16 @@ def compute_spectrum(
         )
     if mesh.solver_mesh is not mesh:  # unused or merged vertices: solve on the others
         solved = compute_spectrum(
-            mesh.solver_mesh, operator, k, bending, membrane, progress, cancel, accuracy, coarse
+            mesh.solver_mesh,
+            operator,
+            k,
+            bending,
+            membrane,
+            progress,
+            cancel,
+            accuracy,
+            coarse,
+            None if on_modes is None else lambda so_far: on_modes(in_input_numbering(so_far, mesh)),
         )
         return in_input_numbering(solved, mesh)
     progress = _returning_freed_memory(progress)

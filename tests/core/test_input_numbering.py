@@ -170,3 +170,12 @@ def test_without_repair_an_unused_vertex_is_named_not_a_degenerate_face(base):
     np.testing.assert_array_equal(m.unused, [base.n_vertices])
     spec = mv.compute_spectrum(m, "laplacian", k=5)
     assert np.all(np.isnan(spec.modes[-1])) and np.all(np.isfinite(spec.modes[:-1]))
+
+
+def test_modes_handed_over_as_they_converge_are_in_the_input_numbering(case):
+    v, f, where, dup, unused, m = case
+    calls = []
+    final = mv.compute_spectrum(m, "laplacian", k=8, on_modes=calls.append)
+    assert calls and all(s.n_vertices == len(v) for s in calls)
+    assert all(np.all(np.isnan(s.modes[unused])) for s in calls)
+    np.testing.assert_array_equal(calls[-1].modes[where], final.modes[where])
