@@ -19,6 +19,7 @@ import scipy.sparse as sp
 from .core.assembly import operator_matrices as _operator_matrices
 from .core.mesh import Mesh
 from .core.spectrum import Spectrum
+from .extras import extra_needed
 
 __all__ = ["as_mesh", "operator_matrices", "to_pyvista", "arrays_of"]
 
@@ -73,11 +74,12 @@ def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
     if module == "trimesh":
         return np.asarray(obj.vertices, np.float64), np.asarray(obj.faces, np.int64), []
     if module == "pyvista" or module == "vtkmodules":
-        if module == "vtkmodules":
-            import pyvista as pv
+        with extra_needed("as_mesh of a VTK object"):
+            if module == "vtkmodules":
+                import pyvista as pv
 
-            obj = pv.wrap(obj)
-        return _from_pyvista(obj)
+                obj = pv.wrap(obj)
+            return _from_pyvista(obj)
     if module == "meshio":
         return _from_meshio(obj)
     if isinstance(obj, (tuple, list)) and len(obj) == 2:
@@ -161,6 +163,7 @@ def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float
     return sp.csr_matrix(K), sp.diags_array(np.asarray(mass, dtype=np.float64), format="dia")
 
 
+@extra_needed("mv.to_pyvista")
 def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = None):
     """A ``pyvista.PolyData`` of ``mesh`` with point arrays.
 

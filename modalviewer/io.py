@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.mesh import Mesh, MeshError, MeshReport, repair_mesh, shape_summary
+from .extras import MissingExtraError, extra_needed
 from .readers import count_text, read_mesh_file, strips_to_triangles
 
 __all__ = ["load_mesh", "read_arrays", "read_file", "strips_to_triangles", "SUPPORTED_EXTENSIONS"]
@@ -26,7 +27,8 @@ SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 
 
 def _read_vtk(path: Path):
-    import pyvista as pv
+    with extra_needed(f"reading {path.suffix.lower()} files"):
+        import pyvista as pv
 
     data = pv.read(str(path))
     if not isinstance(data, pv.PolyData):
@@ -65,7 +67,7 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
         else:
             found = read_mesh_file(path, strict=strict)
             vertices, faces, notes = found.vertices, found.faces, found.notes
-    except MeshError:
+    except (MeshError, MissingExtraError):
         raise
     except Exception:  # a parser may raise anything on a file of another type
         raise MeshError(

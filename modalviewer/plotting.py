@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.spectrum import Spectrum
+from .extras import extra_needed
 from .interop import as_mesh
 
 __all__ = ["Picture", "InteractivePicture", "plot", "view", "add_to_plotter"]
@@ -163,6 +164,7 @@ def distance_kind_of(spectrum: Spectrum | None, kind: str | None) -> str:
     return own
 
 
+@extra_needed("mv.plot")
 def plot(
     mesh,
     spectrum: Spectrum | None = None,
@@ -244,6 +246,7 @@ def _interactive(viewer, size) -> InteractivePicture:
     return InteractivePicture(html, legend, size)
 
 
+@extra_needed("mv.view (the desktop viewer)")
 def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: bool = True):
     """Open the desktop viewer on in-memory data; returns the window (``.viewer`` its
     :class:`~modalviewer.viewer.Viewer`).
@@ -294,6 +297,7 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     return window
 
 
+@extra_needed("mv.add_to_plotter")
 def add_to_plotter(
     plotter,
     mesh,

@@ -288,3 +288,44 @@ def test_plot_draws_the_distance_of_the_spectrum_it_is_given(spot, operator, wor
         distance_kind_of(shells_normal, None)
     assert distance_kind_of(None, None) == "vibration"
     assert distance_kind_of(spec, "vibration") == "vibration"
+
+
+def test_a_missing_extra_is_named_in_one_line(tmp_path):
+    (tmp_path / "x.vtp").write_bytes(b"<VTKFile></VTKFile>")
+    code = f"""
+import sys
+for name in ("PySide6", "pyvista", "vtk", "vtkmodules", "qtpy", "pyvistaqt"):
+    sys.modules[name] = None
+import numpy as np
+import modalviewer as mv
+mesh = mv.load_mesh(mv.asset_path("demo_plate.obj"))
+spec = mv.compute_spectrum(mesh, "laplacian", k=5)
+calls = {{
+    "plot": lambda: mv.plot(mesh, spec),
+    "to_pyvista": lambda: mv.to_pyvista(mesh),
+    "add_to_plotter": lambda: mv.add_to_plotter(None, mesh, spec),
+    "view": lambda: mv.view(mesh, block=False),
+    "image": lambda: mv.Viewer().image(),
+    "screenshot": lambda: mv.Viewer().export_screenshot({str(tmp_path / "s.png")!r}),
+    "vtp": lambda: mv.load_mesh({str(tmp_path / "x.vtp")!r}),
+}}
+for name, call in calls.items():
+    try:
+        call()
+    except Exception as exc:
+        print(name, type(exc).__name__, isinstance(exc, ModuleNotFoundError), str(exc))
+    else:
+        print(name, "no error")
+"""
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300
+    )
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.strip().splitlines()
+    assert len(lines) == 7, out.stdout
+    for line in lines:
+        name, kind, is_missing, message = line.split(" ", 3)
+        assert kind == "MissingExtraError" and is_missing == "True", line
+        assert message.endswith('which is not installed: pip install "modalviewer[viewer]"'), line
+        assert "damaged" not in message, line
+    assert lines[-1].startswith("vtp MissingExtraError True reading .vtp files needs pyvista")

@@ -43,6 +43,7 @@ from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ..core.spectrum import Spectrum, in_input_numbering
+from ..extras import extra_needed
 from ..repair import repair_for_failure, repair_unavailable
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
 from .model import (
@@ -715,6 +716,7 @@ class Viewer:
             title = title.split(" <")[0]  # not the threshold, which the slider moves
         return title, self._input_field(np.asarray(field.values, dtype=np.float64))
 
+    @extra_needed("Viewer.export_field")
     def export_field(self, path) -> Path:
         """Write the mesh with the field shown as point data (.vtp or .ply)."""
         from ..scene.export import save_field_mesh
@@ -725,6 +727,7 @@ class Viewer:
         name, values = field
         return save_field_mesh(Path(path), self.mesh, {name: values})
 
+    @extra_needed("the viewer's pictures")
     def renderer(self, size=None):
         """The off-screen renderer drawing this viewer (made on first use; ``size``
         (width, height) in pixels, default 1024x768)."""
@@ -736,6 +739,7 @@ class Viewer:
             self._renderer.resize(size)
         return self._renderer
 
+    @extra_needed("Viewer.export_screenshot")
     def export_screenshot(
         self,
         path,
@@ -782,6 +786,7 @@ class Viewer:
             )
         return self._renderer_sized(size).screenshot(path, scale=scale, transparent=transparent)
 
+    @extra_needed("Viewer.image")
     def image(self, scale: int = 1, transparent: bool = False, size=None) -> np.ndarray:
         """The picture as an (h, w, 3 or 4) uint8 array (for notebooks)."""
         if self._picture is not None:
@@ -964,6 +969,7 @@ class Viewer:
         self.prepare_comparison(items, wait=wait)
         return comparison
 
+    @extra_needed("Viewer.export_comparison")
     def export_comparison(self, comparison, path, size=None, scale: int = 1) -> Path:
         """Write the views of ``comparison`` side by side to a PNG, seen from the camera of
         this viewer's picture.

@@ -1,0 +1,60 @@
+"""Optional dependencies: the extra that installs each, and one-line errors naming it.
+
+``import modalviewer`` needs numpy and scipy only.  Pictures, the window, some file
+formats, sliver repair, batch runs and interactive notebook pictures need optional
+packages, installed by the extras of ``pyproject.toml``.  Where one is missing, the
+call that needs it raises :class:`MissingExtraError` (a ``ModuleNotFoundError``) with
+one line saying what needs which package and the ``pip install`` that brings it.
+"""
+
+from __future__ import annotations
+
+from contextlib import contextmanager
+
+__all__ = ["EXTRA_OF", "MissingExtraError", "extra_needed", "install_command"]
+
+EXTRA_OF = {
+    "pyvista": "viewer",
+    "vtk": "viewer",
+    "vtkmodules": "viewer",
+    "qtpy": "viewer",
+    "PySide6": "viewer",
+    "pyvistaqt": "viewer",
+    "matplotlib": "viewer",
+    "PIL": "viewer",
+    "meshio": "meshio",
+    "pymeshlab": "repair",
+    "fast_simplification": "repair",
+    "dask": "batch",
+    "distributed": "batch",
+    "trame_pyvista": "notebook",
+    "trame_vtk": "notebook",
+}
+"""The top-level module of each optional package and the extra that installs it."""
+
+
+class MissingExtraError(ModuleNotFoundError):
+    """An optional package is missing; the message names the extra that installs it."""
+
+
+def install_command(module: str) -> str:
+    """``pip install "modalviewer[<extra>]"`` for an optional ``module``."""
+    return f'pip install "modalviewer[{EXTRA_OF[module.split(".")[0]]}]"'
+
+
+@contextmanager
+def extra_needed(what: str):
+    """Run the block; an optional package it fails to import becomes a
+    :class:`MissingExtraError` saying that ``what`` needs it and how to install it.
+    A missing module that is no optional package's is raised as it is."""
+    try:
+        yield
+    except MissingExtraError:
+        raise
+    except ModuleNotFoundError as exc:
+        top = (exc.name or "").split(".")[0]
+        if top not in EXTRA_OF:
+            raise
+        raise MissingExtraError(
+            f"{what} needs {top}, which is not installed: {install_command(top)}", name=top
+        ) from None
