@@ -160,7 +160,7 @@ def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float
         The lumped mass; N is n, or 3 n for vector modes.
     """
     K, mass = _operator_matrices(as_mesh(mesh), operator, bending, membrane)
-    return sp.csr_matrix(K), sp.diags_array(np.asarray(mass, dtype=np.float64), format="dia")
+    return sp.csr_matrix(K), sp.diags(np.asarray(mass, dtype=np.float64), format="dia")
 
 
 @extra_needed("mv.to_pyvista")

@@ -329,3 +329,24 @@ for name, call in calls.items():
         assert message.endswith('which is not installed: pip install "modalviewer[viewer]"'), line
         assert "damaged" not in message, line
     assert lines[-1].startswith("vtp MissingExtraError True reading .vtp files needs pyvista")
+
+
+def test_every_sparse_result_is_one_kind_and_products_agree(plate):
+    n = plate.n_vertices
+    results = {
+        "stiffness_matrix": mv.stiffness_matrix(plate),
+        "mass_matrix": mv.mass_matrix(plate),
+        "modified_dirichlet_matrix": mv.modified_dirichlet_matrix(plate),
+        "shells_hessian": mv.shells_hessian(plate),
+        "normal_shells_hessian": mv.normal_shells_hessian(plate),
+    }
+    for operator in ("laplacian", "shells"):
+        K, M = mv.operator_matrices(plate, operator)
+        results[f"{operator} K"], results[f"{operator} M"] = K, M
+    for name, A in results.items():
+        assert isinstance(A, sp.spmatrix), (name, type(A))
+        x = np.ones(A.shape[1])
+        assert (A @ x).shape == (A * x).shape == (A.shape[0],), name
+    K, M = mv.operator_matrices(plate, "laplacian")
+    x = np.arange(n, dtype=float)
+    np.testing.assert_allclose(M * x, M.diagonal() * x, rtol=1e-15)
