@@ -821,10 +821,12 @@ def block_krylov_schur(
         full = j + b > max_basis
         # Ritz pairs are checked every ``check_every`` blocks (an eigh of the projected
         # matrix costs about as much as orthogonalising 64 vectors); where pairs are
-        # handed over as they converge, as often as an eigh costs at most an eighth of
-        # the orthogonalisation since the last check (j^3 against 4 N j b per block).
+        # handed over as they converge, as often as an eigh costs at most a sixteenth of
+        # the orthogonalisation since the last check: it runs at about a sixth of the
+        # matrix products' rate, so it costs as much as 6 j^3 flops of them, against
+        # 4 N j b per block of orthogonalisation.
         if on_converged is not None:
-            check_every = max(1, int(np.ceil(2.0 * j * j / (N * b))))
+            check_every = max(1, int(np.ceil(24.0 * j * j / (N * b))))
         blocks_since_check = (blocks_since_check + 1) % check_every
         too_few = j < k and on_converged is None
         if (too_few or blocks_since_check) and not full:
