@@ -72,3 +72,27 @@ def test_the_installed_package_computes_and_answers_help(installed):
     assert str(work / "env") in lines[0] and lines[1] == "6 True"
     out = _run(python, "-m", "modalviewer", "--help", cwd=work)
     assert "usage: modalviewer" in out.stdout and "default: the bundled mesh" in out.stdout
+
+
+GALLERY = sorted((ROOT / "examples" / "gallery").glob("[0-9]*.py"))
+
+
+@pytest.mark.parametrize("script", GALLERY, ids=[p.stem for p in GALLERY])
+def test_each_gallery_script_runs_from_the_installed_wheel(installed, script, tmp_path):
+    """A copy of the script, run in a folder outside the checkout by the fresh
+    environment's Python: its meshes must come from the wheel (``mv.asset_path``), not
+    from a path next to the package's source."""
+    _, python, work = installed
+    import os
+
+    run_in = tmp_path / "run"
+    run_in.mkdir()
+    shutil.copy(script, run_in / script.name)
+    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", MODALVIEWER_CACHE=str(work / "cache"))
+    env.pop("PYTHONPATH", None)
+    out = subprocess.run(
+        [python, script.name], cwd=run_in, env=env, capture_output=True, text=True, timeout=600
+    )
+    assert out.returncode == 0, out.stderr[-3000:]
+    pngs = list(run_in.glob("*.png"))
+    assert pngs and all(p.stat().st_size > 1000 for p in pngs), script.name

@@ -8,14 +8,10 @@ measures how the surface bends, and its modes follow the fold.  Each spectrum ha
 dozen modes (1225 vertices); the two views are drawn side by side with ten isolines.
 """
 
-from pathlib import Path
-
 import modalviewer as mv
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "demo_folded_plate.obj")
+viewer.open_mesh(mv.asset_path("demo_folded_plate.obj"))
 viewer.state.set_isolines(10)
 viewer.compute("laplacian", k=12)
 viewer.compute("modified_dirichlet", k=12)

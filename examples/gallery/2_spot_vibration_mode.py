@@ -7,14 +7,10 @@ is drawn as the viewer draws 3D modes: the surface displaced by the mode, colour
 the length of the displacement, over a faint ghost of the rest shape.
 """
 
-from pathlib import Path
-
 import modalviewer as mv
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "spot.obj")
+viewer.open_mesh(mv.asset_path("spot.obj"))
 viewer.compute("shells", k=20)
 viewer.show_mode(8)  # 3D modes are shown deformed, over the rest shape's ghost
 viewer.export_screenshot("spot_vibration_mode.png", size=(800, 600))

@@ -9,14 +9,10 @@ same way.  100 modes; the first call computes the
 spectrum, the map is drawn once it is in.
 """
 
-from pathlib import Path
-
 import modalviewer as mv
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "spot.obj")
+viewer.open_mesh(mv.asset_path("spot.obj"))
 viewer.compute("shells", k=100)
 viewer.pick_vertex(2000)
 distances = viewer.show_distance("vibration", display="threshold", share=0.1)

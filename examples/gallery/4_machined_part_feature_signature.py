@@ -9,14 +9,10 @@ machined part (4150 vertices, 100 modes) at a small scale, beside its total curv
 which marks the same edges, but also every fillet and rounded corner.
 """
 
-from pathlib import Path
-
 import modalviewer as mv
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "demo_machined_part.obj")
+viewer.open_mesh(mv.asset_path("demo_machined_part.obj"))
 viewer.compute("modified_dirichlet", k=100)
 viewer.state.set_display(distance_kind="feature")
 viewer.show_signature(10)

@@ -10,15 +10,13 @@ mark the 5 % of the area closest to the pick; 50 modes each.
 """
 
 import json
-from pathlib import Path
 
 import modalviewer as mv
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-landmarks = json.loads((ASSETS / "demo_landmarks.json").read_text())["demo_hand_bent"]
+landmarks = json.loads(mv.asset_path("demo_landmarks.json").read_text())["demo_hand_bent"]
 
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "demo_hand_bent.obj")
+viewer.open_mesh(mv.asset_path("demo_hand_bent.obj"))
 viewer.compute("shells", k=50)
 viewer.compute("laplacian", k=50)
 viewer.pick_vertex(landmarks["finger2"])

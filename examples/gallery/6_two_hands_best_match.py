@@ -10,18 +10,16 @@ drawn by ``modalviewer.cross_figure`` with the viewer's scene and colours.
 """
 
 import json
-from pathlib import Path
 
 import modalviewer as mv
 from modalviewer.cross_figure import Panel, render_panels
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-landmarks = json.loads((ASSETS / "demo_landmarks.json").read_text())
+landmarks = json.loads(mv.asset_path("demo_landmarks.json").read_text())
 
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "demo_hand.obj")
+viewer.open_mesh(mv.asset_path("demo_hand.obj"))
 viewer.state.set_display(distance_kind="hks")
-pair = viewer.pair(ASSETS / "demo_hand_bent.obj", k=50)
+pair = viewer.pair(mv.asset_path("demo_hand_bent.obj"), k=50)
 pick = landmarks["demo_hand"]["finger1"]
 pair.pick("a", pick)
 side, match, distance = pair.best_match()
