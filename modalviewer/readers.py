@@ -180,7 +180,13 @@ def _read_obj_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
 
 def _read_obj(path: Path, strict: bool) -> MeshFile:
     damage = _Damage(path.name, strict)
-    text = path.read_bytes().decode("utf-8", "replace")
+    data = path.read_bytes()
+    if b"\0" in data[:4096]:  # an OBJ file is text, which has no NUL bytes
+        raise MeshError(
+            f"{path.name}: not an OBJ file: it holds binary data (a file of another type, "
+            "such as an image, with the name of a mesh file?)"
+        )
+    text = data.decode("utf-8", "replace")
     fast = _read_obj_fast(text)
     if fast is not None:
         _check_last_line(text, damage, ("v", "f"))

@@ -282,3 +282,15 @@ def test_strict_false_keeps_the_numbers_after_an_incomplete_vertex_record(tmp_pa
     assert f"{using.sum()} faces using a vertex whose record was incomplete dropped" in str(
         mesh.report
     )
+
+
+@pytest.mark.parametrize("strict", [True, False])
+def test_an_image_renamed_obj_is_called_not_an_obj_file(tmp_path, strict):
+    from PIL import Image
+
+    png = tmp_path / "picture.png"
+    Image.fromarray(np.random.default_rng(0).integers(0, 255, (64, 64, 3), np.uint8)).save(png)
+    path = tmp_path / "picture.obj"
+    path.write_bytes(png.read_bytes())
+    with pytest.raises(mv.MeshError, match=r"^picture\.obj: not an OBJ file: it holds binary"):
+        mv.load_mesh(path, strict=strict)
