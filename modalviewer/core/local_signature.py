@@ -164,6 +164,22 @@ def local_signature(
         If a scale has not settled to ``rtol`` within ``max_steps`` Lanczos steps.
     """
     vertices = check_vertices(vertices, mesh.n_vertices)
+    solver = mesh.solver_mesh
+    if solver is not mesh:  # unused or merged vertices: on the vertices faces use
+        from .spectrum import on_solver_mesh
+
+        return local_signature(
+            solver,
+            operator,
+            [solver.mesh_vertex(v) for v in vertices],  # an unused vertex: its name
+            times,
+            include_zero=include_zero,
+            spectrum=None if spectrum is None else on_solver_mesh(spectrum, solver),
+            bending=bending,
+            membrane=membrane,
+            rtol=rtol,
+            max_steps=max_steps,
+        )
     times = check_times(times)
     K, mass = operator_matrices(mesh, operator, bending, membrane)
     per_vertex = operator_info(operator).unknowns_per_vertex

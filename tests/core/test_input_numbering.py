@@ -179,3 +179,16 @@ def test_modes_handed_over_as_they_converge_are_in_the_input_numbering(case):
     assert calls and all(s.n_vertices == len(v) for s in calls)
     assert all(np.all(np.isnan(s.modes[unused])) for s in calls)
     np.testing.assert_array_equal(calls[-1].modes[where], final.modes[where])
+
+
+def test_the_local_signature_takes_input_vertices(base, case):
+    v, f, where, dup, unused, m = case
+    times = np.array([0.05, 0.5])
+    got = mv.local_signature(m, "laplacian", [where[5], dup], times)
+    want = mv.local_signature(base, "laplacian", [5, 3], times)
+    np.testing.assert_allclose(got, want, rtol=1e-10)
+    spec = mv.compute_spectrum(m, "laplacian", k=10)
+    with_spec = mv.local_signature(m, "laplacian", [where[5]], times, spectrum=spec)
+    np.testing.assert_allclose(with_spec, want[:1], rtol=1e-8)
+    with pytest.raises(MeshError, match=f"vertex {unused[1]} .*used by no face"):
+        mv.local_signature(m, "laplacian", [unused[1]], times)
