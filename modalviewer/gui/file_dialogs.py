@@ -9,7 +9,7 @@ from pathlib import Path
 from qtpy import QtWidgets
 
 from ..core.operators import operator_info
-from ..core.spectrum import save_spectrum
+from ..core.spectrum import in_input_numbering, save_spectrum
 from ..io import SUPPORTED_EXTENSIONS
 from .dialogs import ScreenshotDialog, ask
 from .paths import ASSETS, SCREENSHOTS
@@ -99,11 +99,12 @@ def field_dialog(win) -> None:
 
 def spectrum_to_export(state):
     """The spectrum File > Export spectrum writes: the one the picture on screen is made
-    of (a mode's operator, a distance's), else the viewer's current one."""
+    of (a mode's operator, a distance's), else the viewer's current one; in the input
+    mesh's numbering (one row per vertex of the file)."""
     for operator in (state.display_operator(), state.current_operator()):
         spec = state.spectrum(operator) if operator is not None else None
         if spec is not None:
-            return spec
+            return in_input_numbering(spec, state.mesh.input_mesh)
     return None
 
 

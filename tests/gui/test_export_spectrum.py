@@ -25,3 +25,25 @@ def test_the_exported_spectrum_is_the_one_on_screen(tmp_path):
     assert spectrum_to_export(state).operator == "laplacian"
     state.show_mode(3, "laplacian")
     assert spectrum_to_export(state).operator == "laplacian"
+
+
+def test_the_exported_spectrum_has_a_row_per_vertex_of_the_file(tmp_path):
+    import numpy as np
+
+    import modalviewer as mv
+
+    plate = mv.load_mesh(ASSETS / "demo_plate.obj")
+    v = np.vstack([[[9.0, 9.0, 9.0]], plate.vertices])  # vertex 0 used by no face
+    path = tmp_path / "padded.obj"
+    rows = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in v]
+    path.write_text("\n".join(rows + [f"f {a + 2} {b + 2} {c + 2}" for a, b, c in plate.faces]))
+    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    mesh = model.open_mesh(path)
+    model.jobs.wait(model.request_spectrum("laplacian", k=8, show=True))
+    spec = spectrum_to_export(model.state)
+    mv.save_spectrum(spec, tmp_path / "s.npz")
+    back = mv.load_spectrum(tmp_path / "s.npz", mesh=mesh)  # the file's mesh, as loaded
+    assert back.n_vertices == len(v) and np.isnan(back.modes[0]).all()
+    np.testing.assert_allclose(
+        back.modes[1:], mv.compute_spectrum(plate, "laplacian", k=8).modes, atol=1e-10
+    )
