@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -722,11 +723,18 @@ def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> in
 
 def _basis_times(Q: np.ndarray, j: int, S: np.ndarray) -> np.ndarray:
     """``Q[:, :j] @ S`` as a new float64 array, a block of rows at a time (a
-    single-precision basis is widened one block at a time)."""
+    single-precision basis is widened one block at a time), the two halves of the rows
+    on two threads (the solver's BLAS runs on one)."""
     out = np.empty((Q.shape[0], S.shape[1]))
-    for start in range(0, Q.shape[0], _SWEEP_ROWS):
-        rows = slice(start, start + _SWEEP_ROWS)
-        out[rows] = Q[rows, :j].astype(np.float64, copy=False) @ S
+
+    def half(bounds: tuple[int, int]) -> None:
+        for start in range(bounds[0], bounds[1], _SWEEP_ROWS):
+            rows = slice(start, min(start + _SWEEP_ROWS, bounds[1]))
+            out[rows] = Q[rows, :j].astype(np.float64, copy=False) @ S
+
+    middle = Q.shape[0] // 2
+    with ThreadPoolExecutor(2) as pool:
+        list(pool.map(half, [(0, middle), (middle, Q.shape[0])]))
     return out
 
 
