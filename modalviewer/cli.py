@@ -180,8 +180,34 @@ def build_parser() -> argparse.ArgumentParser:
         help="3D vibration modes (shells): the deformed shape over the rest shape's ghost "
         "(default), or the normal component or the magnitude on the rest shape",
     )
-    r.add_argument("--size", type=_size, default=(1024, 768))
+    r.add_argument(
+        "--size",
+        type=_size,
+        default=None,
+        help="WIDTHxHEIGHT in pixels (default 1024x768; 640x480 with --animate)",
+    )
     r.add_argument("--transparent", action="store_true")
+    r.add_argument(
+        "--animate",
+        action="store_true",
+        help="write one period of the mode vibrating as the window shows it: -o NAME.gif "
+        "(or NAME.mp4 where imageio-ffmpeg is installed: pip install 'modalviewer[video]')",
+    )
+    r.add_argument(
+        "--frames",
+        type=_whole(2),
+        default=None,
+        help="with --animate: frames in the period (default: one period at the window's "
+        "speed, 52 at 25 fps)",
+    )
+    r.add_argument(
+        "--fps", type=_whole(1), default=25, help="with --animate: frames per second (default 25)"
+    )
+    r.add_argument(
+        "--marker",
+        action="store_true",
+        help="draw the picked vertex's marker (mode pictures leave it out)",
+    )
     _camera_arguments(r)
     r.add_argument("-o", "--output", required=True)
     r.add_argument(
@@ -271,7 +297,17 @@ def _viewer(mesh, path):
 def _run(args) -> int:
     import modalviewer as mv
 
-    if args.command in ("render", "distance") and args.output:
+    if args.command == "render" and args.animate:  # before any work
+        from .scene.animation import animation_path, check_size
+
+        try:
+            check_size(args.output, args.size or (2, 2))
+            animation_path(args.output)
+        except ValueError as exc:
+            raise _BadArgument(f"-o {args.output}: {exc}") from None
+    elif args.command == "render" and args.frames is not None:
+        raise _BadArgument("--frames applies to an animation (--animate)")
+    elif args.command in ("render", "distance") and args.output:
         from .scene.export import OTHER_PICTURE_SUFFIXES
 
         if Path(args.output).suffix.lower() in OTHER_PICTURE_SUFFIXES:  # before any work
@@ -371,12 +407,17 @@ def _run(args) -> int:
             raise _BadArgument(f"--mode must be between 0 and {spec.k - 1}")
         viewer.show_mode(args.mode)
         viewer.set_view(args.view, up=args.up)
-        written = viewer.export_screenshot(
-            args.output, transparent=args.transparent, size=args.size
-        )
+        if args.animate:
+            written = viewer.export_animation(
+                args.output, frames=args.frames, fps=args.fps, size=args.size, marker=args.marker
+            )
+        else:
+            written = viewer.export_screenshot(
+                args.output, transparent=args.transparent, size=args.size, marker=args.marker
+            )
         viewer.close()
         print(f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}")
-        _wrote(written, f"{_png(written)}, mode {args.mode}")
+        _wrote(written, f"{_picture(written)}, mode {args.mode}")
         return 0
     # distance: computed on the vertices faces use (mesh.solver_mesh, whose map gives the
     # input's numbers); --vertex and every vertex number printed or written are the file's
@@ -536,6 +577,18 @@ def _png(path) -> str:
 
     with Image.open(path) as image:
         return f"PNG {image.width}x{image.height}"
+
+
+def _picture(path) -> str:
+    """The picture or animation written: "PNG WxH", "GIF WxH, N frames" or "MP4"."""
+    if Path(path).suffix.lower() == ".mp4":
+        return "MP4"
+    if Path(path).suffix.lower() == ".gif":
+        from PIL import Image
+
+        with Image.open(path) as image:
+            return f"GIF {image.width}x{image.height}, {image.n_frames} frames"
+    return _png(path)
 
 
 def _wrote(path, what: str) -> None:

@@ -29,6 +29,8 @@ EXTRA_OF = {
     "distributed": "batch",
     "trame_pyvista": "notebook",
     "trame_vtk": "notebook",
+    "imageio": "video",
+    "imageio_ffmpeg": "video",
 }
 """The top-level module of each optional package and the extra that installs it."""
 

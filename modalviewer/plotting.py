@@ -177,11 +177,15 @@ def plot(
     k: int = 50,
     transparent: bool = False,
     interactive: bool = False,
-) -> Picture | InteractivePicture:
+    animate: bool = False,
+    frames: int | None = None,
+    fps: float = 25,
+):
     """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`; with
     ``interactive``, the same scene as an :class:`InteractivePicture` to turn in the
     notebook (it needs the ``notebook`` extra; without it a :class:`Picture`, with a
-    warning saying how to install it).
+    warning saying how to install it); with ``animate``, the mode vibrating as an
+    :class:`~modalviewer.scene.animation.Animation` (a looping GIF shown inline).
 
     Parameters
     ----------
@@ -199,6 +203,9 @@ def plot(
     screenshot : also write the PNG there (the page, .html, for an interactive one).
     size : (width, height) in pixels.
     interactive : a page with the 3D scene instead of an image.
+    animate, frames, fps : one period of the mode vibrating, ``frames`` frames (default:
+        one period at the window's speed) played at ``fps``; ``screenshot`` then names a
+        .gif (or .mp4 where imageio-ffmpeg is installed).
     """
     if isinstance(mesh, (str, Path)):
         from .io import load_mesh
@@ -219,7 +226,11 @@ def plot(
                 stacklevel=2,
             )
             interactive = False
-        if interactive:
+        if animate:
+            from .scene.animation import Animation
+
+            picture = Animation(viewer.animation_images(frames, fps, size), fps)
+        elif interactive:
             picture = _interactive(viewer, size)
         else:
             picture = Picture(viewer.image(transparent=transparent, size=size))

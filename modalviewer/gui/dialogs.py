@@ -62,10 +62,31 @@ def offer_open_anyway(window, path, error: Exception) -> bool:
     )
 
 
-class ScreenshotDialog(QtWidgets.QDialog):
-    """File, size multiplier, transparent background, colour bar and legend."""
+def _size_boxes(form, size) -> tuple:
+    """Width and height spin boxes (pixels) on one row of ``form``, set to ``size``."""
+    boxes = []
+    row = QtWidgets.QHBoxLayout()
+    for value in size:
+        box = QtWidgets.QSpinBox()
+        box.setRange(16, 8192)
+        box.setValue(int(value))
+        box.setSuffix(" px")
+        boxes.append(box)
+    row.addWidget(boxes[0])
+    row.addWidget(QtWidgets.QLabel("x"))
+    row.addWidget(boxes[1])
+    row.addStretch(1)
+    form.addRow("Width x height", row)
+    return tuple(boxes)
 
-    def __init__(self, parent, start_dir: str, colorbar: bool = False):
+
+class ScreenshotDialog(QtWidgets.QDialog):
+    """File, width and height in pixels, size multiplier, transparent background,
+    colour bar and legend, pick marker."""
+
+    def __init__(
+        self, parent, start_dir: str, colorbar: bool = False, size=(1024, 768), marker=False
+    ):
         super().__init__(parent)
         self.setWindowTitle("Export screenshot")
         form = QtWidgets.QFormLayout(self)
@@ -77,14 +98,19 @@ class ScreenshotDialog(QtWidgets.QDialog):
         row.addWidget(self.path_edit)
         row.addWidget(browse)
         form.addRow("File", row)
+        self.width_box, self.height_box = _size_boxes(form, size)
         self.scale = QtWidgets.QSpinBox()
         self.scale.setRange(1, 8)
         self.transparent = QtWidgets.QCheckBox("Transparent background")
         self.colorbar = QtWidgets.QCheckBox("Colour bar and legend")
         self.colorbar.setChecked(colorbar)
+        self.marker = QtWidgets.QCheckBox("Pick marker")
+        self.marker.setChecked(bool(marker))
+        self.marker.setToolTip("The picked vertex's marker (shown on distance maps by default)")
         form.addRow("Size multiplier", self.scale)
         form.addRow(self.transparent)
         form.addRow(self.colorbar)
+        form.addRow(self.marker)
         buttons = QtWidgets.QDialogButtonBox(
             QtWidgets.QDialogButtonBox.StandardButton.Save
             | QtWidgets.QDialogButtonBox.StandardButton.Cancel
@@ -100,10 +126,73 @@ class ScreenshotDialog(QtWidgets.QDialog):
         if path:
             self.path_edit.setText(path)
 
+    def size(self) -> tuple[int, int]:
+        return self.width_box.value(), self.height_box.value()
+
     def values(self):
+        """(path, scale, transparent, colour bar, (width, height), marker)."""
         return (
             self.path_edit.text(),
             self.scale.value(),
             self.transparent.isChecked(),
             self.colorbar.isChecked(),
+            self.size(),
+            self.marker.isChecked(),
+        )
+
+
+class AnimationDialog(QtWidgets.QDialog):
+    """File (.gif, or .mp4 where its writer is installed), width and height, frames in
+    one period and frames per second."""
+
+    def __init__(self, parent, start_dir: str, size=(640, 480), frames: int = 52, fps: int = 25):
+        from ..scene.animation import mp4_available
+
+        super().__init__(parent)
+        self.setWindowTitle("Export animation")
+        form = QtWidgets.QFormLayout(self)
+        self.path_edit = QtWidgets.QLineEdit(str(Path(start_dir) / "mode.gif"))
+        self.path_edit.setMinimumWidth(420)
+        browse = QtWidgets.QPushButton("...")
+        browse.clicked.connect(self._browse)
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(self.path_edit)
+        row.addWidget(browse)
+        form.addRow("File", row)
+        self.width_box, self.height_box = _size_boxes(form, size)
+        self.frames = QtWidgets.QSpinBox()
+        self.frames.setRange(2, 1000)
+        self.frames.setValue(int(frames))
+        self.fps = QtWidgets.QSpinBox()
+        self.fps.setRange(1, 100)
+        self.fps.setValue(int(fps))
+        form.addRow("Frames in one period", self.frames)
+        form.addRow("Frames per second", self.fps)
+        self.filters = "GIF (*.gif)" + (";;MP4 (*.mp4)" if mp4_available() else "")
+        if not mp4_available():
+            note = QtWidgets.QLabel("MP4 needs imageio-ffmpeg: pip install 'modalviewer[video]'")
+            note.setWordWrap(True)
+            form.addRow(note)
+        buttons = QtWidgets.QDialogButtonBox(
+            QtWidgets.QDialogButtonBox.StandardButton.Save
+            | QtWidgets.QDialogButtonBox.StandardButton.Cancel
+        )
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+
+    def _browse(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, "Animation", self.path_edit.text(), self.filters
+        )
+        if path:
+            self.path_edit.setText(path)
+
+    def values(self):
+        """(path, (width, height), frames, fps)."""
+        return (
+            self.path_edit.text(),
+            (self.width_box.value(), self.height_box.value()),
+            self.frames.value(),
+            self.fps.value(),
         )

@@ -11,7 +11,7 @@ from qtpy import QtWidgets
 from ..core.operators import operator_info
 from ..core.spectrum import in_input_numbering, save_spectrum
 from ..io import SUPPORTED_EXTENSIONS
-from .dialogs import ScreenshotDialog, ask
+from .dialogs import AnimationDialog, ScreenshotDialog, ask
 from .paths import ASSETS, SCREENSHOTS
 
 
@@ -43,19 +43,59 @@ def open_mesh_dialog(win) -> None:
         win.open_mesh(path)
 
 
+def _saved_size(win, key: str, default) -> tuple[int, int]:
+    """The picture size last asked for under ``key`` in the settings, else ``default``."""
+    try:
+        w, h = (int(x) for x in str(win.settings.value(key, "")).split("x"))
+        return (w, h)
+    except ValueError:
+        return tuple(int(x) for x in default)
+
+
 def screenshot_dialog(win) -> None:
     start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
-    dialog = ScreenshotDialog(win, start, win.state.style.colorbar)
+    size = _saved_size(win, "files/screenshot_size", (1024, 768))
+    marker = win.viewer.marker_shown()
+    dialog = ScreenshotDialog(win, start, win.state.style.colorbar, size, marker)
     if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
         return
-    path, scale, transparent, colorbar = dialog.values()
+    path, scale, transparent, colorbar, size, marker = dialog.values()
     try:
-        out = win.export_screenshot(path, scale, transparent, colorbar)
+        out = win.export_screenshot(path, scale, transparent, colorbar, size=size, marker=marker)
     except (OSError, ValueError) as exc:
         win.show_error(f"Could not save the screenshot: {exc}")
         return
     if win.remember_settings:
         win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
+        win.settings.setValue("files/screenshot_size", f"{size[0]}x{size[1]}")
+    win.statusBar().showMessage(f"Saved {out}", 8000)
+
+
+def animation_dialog(win) -> None:
+    """File > Export animation: one period of the mode shown (a mode must be shown)."""
+    from ..scene.animation import ANIMATION_SIZE, DEFAULT_FPS, period_frames
+
+    d = win.state.display
+    if d.kind != "mode" or win.state.spectrum(d.operator) is None:
+        win.show_error("Show a vibration mode first: an animation shows a mode vibrating.")
+        return
+    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    size = _saved_size(win, "files/animation_size", ANIMATION_SIZE)
+    frames = period_frames(win.state.animation.speed, DEFAULT_FPS)
+    dialog = AnimationDialog(win, start, size, frames, DEFAULT_FPS)
+    if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
+        return
+    path, size, frames, fps = dialog.values()
+    win.statusBar().showMessage(f"Writing {Path(path).name} ({frames} frames)...")
+    QtWidgets.QApplication.processEvents()
+    try:
+        out = win.viewer.export_animation(path, frames=frames, fps=fps, size=size)
+    except (OSError, ValueError) as exc:
+        win.show_error(f"Could not save the animation: {exc}")
+        return
+    if win.remember_settings:
+        win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
+        win.settings.setValue("files/animation_size", f"{size[0]}x{size[1]}")
     win.statusBar().showMessage(f"Saved {out}", 8000)
 
 
@@ -70,7 +110,7 @@ def pair_screenshot_dialog(pair_window) -> None:
     dialog.colorbar.hide()  # the pair's legends are part of its picture
     if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
         return
-    path, scale, transparent, _ = dialog.values()
+    path, scale, transparent, _, _, _ = dialog.values()
     try:
         out = pair_window.export_screenshot(path, scale, transparent)
     except (OSError, ValueError) as exc:

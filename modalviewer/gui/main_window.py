@@ -444,10 +444,12 @@ class MainWindow(QtWidgets.QMainWindow):
         return self.compare
 
     # ===================================================== export, repairs
-    def export_screenshot(self, path, scale: int = 1, transparent: bool = False, colorbar=None):
+    def export_screenshot(
+        self, path, scale: int = 1, transparent: bool = False, colorbar=None, size=None, marker=None
+    ):
         """:meth:`Viewer.export_screenshot <modalviewer.viewer.Viewer.export_screenshot>`
-        of this window's view."""
-        return self.viewer.export_screenshot(path, scale, transparent, colorbar)
+        of this window's view (at ``size``: drawn at that size from the view's camera)."""
+        return self.viewer.export_screenshot(path, scale, transparent, colorbar, size, marker)
 
     def current_field(self):
         return self.viewer.current_field()

@@ -81,6 +81,13 @@ def build_menus(win) -> None:
     _action(
         win,
         m,
+        "Export &animation (GIF/MP4)...",
+        lambda: file_dialogs.animation_dialog(win),
+        tip="One period of the mode shown, vibrating as on screen",
+    )
+    _action(
+        win,
+        m,
         "Export per-vertex &field (PLY/VTP)...",
         lambda: file_dialogs.field_dialog(win),
         "Ctrl+Shift+E",

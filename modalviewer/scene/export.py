@@ -19,13 +19,15 @@ def grab(
     transparent: bool = False,
     legend: bool = True,
     colorbar: bool | None = None,
+    marker: bool = True,
 ) -> np.ndarray:
     """The plotter's view rendered at ``scale`` times its size, (h, w, 3 or 4) uint8.
 
     The scene's legend (if ``legend`` and the scene has one) and colour bar (as shown on
     screen when ``colorbar`` is None, else forced on or off; a two-swatch legend for
     threshold maps) are drawn onto the image at the same scale, also on a transparent
-    background.  ``scene`` defaults to the scene drawn on the plotter."""
+    background.  ``scene`` defaults to the scene drawn on the plotter; without
+    ``marker`` its pick marker is left out."""
     from .overlay import draw_overlay
 
     scale = int(max(1, scale))
@@ -34,6 +36,8 @@ def grab(
     overlay = scene.overlay(legend=legend, colorbar=colorbar) if scene is not None else None
     # the scene's own 2D actors are replaced by the overlay drawn at the export's scale
     hidden = [a for a in scene.overlay_actors() if a.GetVisibility()] if scene else []
+    if scene is not None and not marker and scene.marker_actor is not None:
+        hidden += [scene.marker_actor] if scene.marker_actor.GetVisibility() else []
     for actor in hidden:
         actor.SetVisibility(False)
     try:
@@ -108,12 +112,14 @@ def save_screenshot(
     legend: bool = True,
     colorbar: bool | None = None,
     scene=None,
+    marker: bool = True,
 ) -> Path:
     """Render the viewport's (or plotter's) view to a PNG at ``scale`` times its size,
-    with legend and colour bar as :func:`grab` draws them; written atomically."""
+    with legend, colour bar and pick marker as :func:`grab` draws them; written
+    atomically."""
     plotter = getattr(viewport, "plotter", viewport)
     path = png_path(path)
-    img = grab(plotter, scene, scale, transparent, legend, colorbar)
+    img = grab(plotter, scene, scale, transparent, legend, colorbar, marker)
     return save_png(path, img)
 
 

@@ -264,6 +264,7 @@ class MeshScene:
         self.picker.PickFromListOn()
         self.picker.AddPickList(self.surface_actor)
         self.field_name = ""
+        self._values: np.ndarray | None = None  # the field of show_field, unscaled
         self.clim = (0.0, 1.0)
         self.clipped = (False, False)  # values beyond the low / high end of clim
         self.kind = "plain"
@@ -326,8 +327,9 @@ class MeshScene:
         isolines: number of isolines (the zero level drawn bold for diverging fields).
         displacement: (n, 3) shape of the animation, carried along by the isolines.
         """
-        values = np.asarray(values, dtype=np.float64)
-        self.surface.point_data["field"] = values
+        values = np.array(values, dtype=np.float64)  # the animation rewrites the copy drawn
+        self._values = values
+        self.surface.point_data["field"] = values.copy()
         if displacement is not None:
             self.surface.point_data["displacement"] = displacement
         if kind == "diverging":
@@ -660,6 +662,29 @@ class MeshScene:
         ):
             if rest is not None:
                 self._move(line, rest, d, s)
+
+    def set_color_factor(self, factor: float) -> None:
+        """Colour a diverging field as ``factor`` times its values (1: as shown): a signed
+        mode's colours change sign as it vibrates.  Other fields keep their colours; no
+        render."""
+        if self.kind != "diverging" or self._values is None:
+            return
+        field = self.surface.point_data["field"]  # a view of the VTK array
+        np.multiply(self._values, factor, out=field)
+        self.surface.GetPointData().GetArray("field").Modified()
+
+    def motion_points(self, reach: float, both: bool = True, most: int = 20000) -> np.ndarray:
+        """(m, 3) the rest shape and the surface displaced by ``reach`` times its
+        displacement (and by minus that with ``both``): the points a picture of the
+        deformed shape or of a whole vibration must hold.  At most ``most`` vertices of
+        each (every k-th)."""
+        step = max(1, -(-self.mesh.n_vertices // most))
+        rest = self.rest_points[::step]
+        disp = np.asarray(self.surface.point_data["displacement"])[::step]
+        if reach == 0.0 or not np.any(disp):
+            return rest
+        moved = [rest + reach * disp] + ([rest - reach * disp] if both else [])
+        return np.concatenate([rest, *moved])
 
     def set_ghost(self, visible: bool, reach: float = 0.0) -> None:
         """Show the rest shape as a faint translucent grey copy behind a surface drawn

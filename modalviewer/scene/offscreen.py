@@ -59,21 +59,76 @@ class OffscreenRenderer:
             self.plotter.window_size = list(size)
             self.drawing.reset_camera()
 
-    def image(self, scale: int = 1, transparent: bool = False, colorbar: bool | None = None):
-        """The picture as an (h, w, 3 or 4) uint8 array, legend and colour bar drawn on."""
+    def set_camera(self, camera: dict | None) -> None:
+        """Look from ``camera`` (position, focal point, view up as plain data, e.g. a
+        window's); None keeps the camera."""
+        if camera is None or self.scene is None:
+            return
+        from ..viewer.camera import Camera
+
+        self.scene.set_camera(
+            Camera(
+                tuple(camera["position"]), tuple(camera["focal_point"]), tuple(camera["view_up"])
+            ),
+            fit=False,
+        )
+
+    def frame(
+        self, reach: float | None = None, both: bool = False, colorbar: bool | None = None
+    ) -> None:
+        """Fit the camera, keeping its direction, so that the shape fills the picture
+        clear of the legend and colour bar (:func:`.framing.fit_points`): the rest shape
+        and the surface displaced by ``reach`` times its displacement (default: as the
+        field draws it), and by minus that too with ``both`` (a whole vibration)."""
+        from .framing import fit_clear_of_overlay
+
+        scene = self.scene
+        if scene is None:
+            return
+        if reach is None:
+            field = self.drawing.field
+            reach = field.deformation if field is not None else 0.0
+        fit_clear_of_overlay(
+            self.plotter.renderer,
+            scene.motion_points(reach, both),
+            self.size,
+            scene.overlay(colorbar=colorbar),
+            scene.overlay_scale,
+        )
+
+    def image(
+        self,
+        scale: int = 1,
+        transparent: bool = False,
+        colorbar: bool | None = None,
+        marker: bool = True,
+    ):
+        """The picture as an (h, w, 3 or 4) uint8 array, legend and colour bar drawn on
+        (and the pick marker if ``marker``)."""
         from .export import grab
 
         return grab(
-            self.plotter, self.scene, scale=scale, transparent=transparent, colorbar=colorbar
+            self.plotter,
+            self.scene,
+            scale=scale,
+            transparent=transparent,
+            colorbar=colorbar,
+            marker=marker,
         )
 
     def screenshot(
-        self, path, scale: int = 1, transparent: bool = False, colorbar: bool | None = None
+        self,
+        path,
+        scale: int = 1,
+        transparent: bool = False,
+        colorbar: bool | None = None,
+        marker: bool = True,
     ) -> Path:
         """Write the picture to a PNG (atomically); returns its path."""
         from .export import save_png
 
-        return save_png(path, np.ascontiguousarray(self.image(scale, transparent, colorbar)))
+        img = self.image(scale, transparent, colorbar, marker)
+        return save_png(path, np.ascontiguousarray(img))
 
     def close(self) -> None:
         self.drawing.close()

@@ -283,16 +283,19 @@ class StateScene:
             if self.field is not None:
                 self.field.deformation = deformation
             self.scene.set_displacement_scale(deformation)
+            self.scene.set_color_factor(1.0)
             self.scene.show_marker(self.state.picked)
             self.request_render()
         if self.on_animation is not None:
             self.on_animation(playing)
 
     def animation_frame(self, phase: float) -> float:
-        """Move the surface to ``phase`` (radians) of the vibration; returns the time
-        this took in s."""
+        """Move the surface to ``phase`` (radians) of the vibration, ``sin(phase)`` of the
+        amplitude, a signed mode's colours scaled by the same factor (they change sign
+        with the motion); returns the time this took in s."""
         started = time.perf_counter()
         amplitude = self.state.derived.amplitude_length()
         self.scene.set_displacement_scale(amplitude * np.sin(phase))
+        self.scene.set_color_factor(float(np.sin(phase)))
         self.request_render()
         return time.perf_counter() - started

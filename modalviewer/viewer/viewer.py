@@ -747,11 +747,15 @@ class Viewer:
         transparent: bool = False,
         colorbar: bool | None = None,
         size=None,
+        marker: bool | None = None,
+        fit: bool = True,
     ) -> Path:
         """Save the picture as PNG (atomically).
 
-        With a window attached, its view as on screen; otherwise the same scene drawn off
-        screen.
+        With a window attached and no ``size``, its view as on screen.  Otherwise the
+        same scene drawn off screen at ``size``, seen from the picture's direction with
+        the camera fitted so that the whole shape (deformed as drawn) lies inside the
+        frame, clear of the legend and the colour bar.
 
         Parameters
         ----------
@@ -764,36 +768,75 @@ class Viewer:
         colorbar : bool, optional
             With the colour bar and legend (None: as the state says).
         size : (int, int), optional
-            (width, height) of the off-screen picture, default 1024 x 768 (a size given
-            to one call does not carry over to the next).
+            (width, height) in pixels (before ``scale``); without a window the default
+            is 1024 x 768 (a size given to one call does not carry over to the next).
+        marker : bool, optional
+            With the pick marker (None: on distance maps, not on other pictures).
+        fit : bool
+            Fit the camera to the shape (off screen); False keeps the camera as it is
+            (pictures of several displays from one camera).
 
         Returns
         -------
         pathlib.Path
             The file written.
         """
-        from ..scene.export import save_screenshot
+        from ..scene.export import png_path, save_png
 
+        path = png_path(path)  # a wrong name is refused before any drawing
         if colorbar is not None:
             self.state.set_colorbar(colorbar)
-        if self._picture is not None:
-            return save_screenshot(
-                self._picture.plotter,
-                Path(path),
-                scale=scale,
-                transparent=transparent,
-                scene=self._picture.scene,
-            )
-        return self._renderer_sized(size).screenshot(path, scale=scale, transparent=transparent)
+        return save_png(path, self.image(scale, transparent, size, marker, fit))
 
     @extra_needed("Viewer.image")
-    def image(self, scale: int = 1, transparent: bool = False, size=None) -> np.ndarray:
-        """The picture as an (h, w, 3 or 4) uint8 array (for notebooks)."""
-        if self._picture is not None:
+    def image(
+        self,
+        scale: int = 1,
+        transparent: bool = False,
+        size=None,
+        marker: bool | None = None,
+        fit: bool = True,
+    ) -> np.ndarray:
+        """The picture as an (h, w, 3 or 4) uint8 array (for notebooks); ``size``,
+        ``marker`` and ``fit`` as in :meth:`export_screenshot`."""
+        marker = self.marker_shown(marker)
+        if self._picture is not None and size is None:
             from ..scene.export import grab
 
-            return grab(self._picture.plotter, self._picture.scene, scale, transparent)
-        return self._renderer_sized(size).image(scale, transparent)
+            return grab(
+                self._picture.plotter, self._picture.scene, scale, transparent, marker=marker
+            )
+        renderer, temporary = self._offscreen_at(size)
+        try:
+            if fit:
+                renderer.frame()
+            return renderer.image(scale, transparent, marker=marker)
+        finally:
+            if temporary:
+                renderer.close()
+
+    def marker_shown(self, marker: bool | None = None) -> bool:
+        """Whether a picture shows the pick marker: ``marker`` where given, else on
+        distance maps only (a mode's picture is the same whatever vertex was picked)."""
+        if marker is not None:
+            return bool(marker)
+        return self.state.display.kind == "distance"
+
+    def _offscreen_at(self, size):
+        """(an off-screen renderer of the state at ``size``, whether it is a temporary
+        one to close): this viewer's own without a window; with a window a new one,
+        looking from the window's camera."""
+        if self._picture is None:
+            return self._renderer_sized(size), False
+        from ..scene.offscreen import OffscreenRenderer
+
+        renderer = OffscreenRenderer(self.state, size or self._picture_size())
+        renderer.set_camera(self.current_camera())
+        return renderer, True
+
+    def _picture_size(self) -> tuple[int, int]:
+        w, h = self._picture.plotter.window_size
+        return int(w), int(h)
 
     def _renderer_sized(self, size):
         """:meth:`renderer` at ``size``, or the default size where None: a picture's
@@ -801,6 +844,71 @@ class Viewer:
         from ..scene.offscreen import DEFAULT_SIZE
 
         return self.renderer(size or DEFAULT_SIZE)
+
+    @extra_needed("Viewer.animation_images")
+    def animation_images(
+        self, frames: int | None = None, fps: float | None = None, size=None, marker=None
+    ) -> list[np.ndarray]:
+        """The frames of one period of the mode shown vibrating, as the window animates
+        it (RGB uint8 arrays, ``size`` (width, height), default 640 x 480): ``frames``
+        frames (default: as many as play one period at ``fps`` at the window's speed),
+        the camera from the picture's direction fitted to the whole motion, legend and
+        colour bar drawn on; the pick marker only if ``marker``.  ValueError when no
+        mode is shown."""
+        from ..scene.animation import ANIMATION_SIZE, DEFAULT_FPS, frame_phases, period_frames
+        from ..scene.offscreen import OffscreenRenderer
+
+        state = self.state
+        d = state.display
+        if state.mesh is None or d.kind != "mode" or state.spectrum(d.operator) is None:
+            raise ValueError("an animation shows a vibration mode: show a mode first")
+        fps = DEFAULT_FPS if fps is None else float(fps)
+        if fps <= 0:
+            raise ValueError(f"fps must be positive, got {fps:g}")
+        n = period_frames(state.animation.speed, fps) if frames is None else int(frames)
+        if n < 2:
+            raise ValueError(f"an animation needs at least 2 frames, got {n}")
+        size = tuple(int(x) for x in (size or ANIMATION_SIZE))
+        camera = self.current_camera()
+        renderer = OffscreenRenderer(state, size)
+        try:
+            renderer.set_camera(camera)
+            reach = state.derived.amplitude_length()
+            renderer.frame(reach=reach, both=True)
+            marker = bool(marker)
+            images = []
+            for phase in frame_phases(n):
+                renderer.drawing.animation_frame(phase)
+                images.append(renderer.image(marker=marker)[..., :3])
+        finally:
+            renderer.close()
+        return images
+
+    @extra_needed("Viewer.export_animation")
+    def export_animation(
+        self,
+        path,
+        frames: int | None = None,
+        fps: float | None = None,
+        size=None,
+        marker: bool | None = None,
+    ) -> Path:
+        """Write one period of the mode shown, vibrating as the window shows it, to a GIF
+        or (where imageio and imageio-ffmpeg are installed) an MP4, atomically; it loops
+        without a jump.  ``frames``, ``fps``, ``size`` and ``marker`` as in
+        :meth:`animation_images` (``fps`` default 25).  Returns the path written."""
+        from ..scene.animation import (
+            ANIMATION_SIZE,
+            DEFAULT_FPS,
+            animation_path,
+            check_size,
+            write_animation,
+        )
+
+        path = animation_path(path)  # a wrong name is refused before any drawing
+        check_size(path, size or ANIMATION_SIZE)
+        images = self.animation_images(frames, fps, size, marker)
+        return write_animation(path, images, DEFAULT_FPS if fps is None else fps)
 
     def animation_frame(self, phase: float, size=None) -> float:
         """Move the picture's surface to ``phase`` (radians) of the vibration shown (a

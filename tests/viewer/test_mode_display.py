@@ -27,7 +27,9 @@ def machined():
 
 
 def _silhouette(viewer) -> np.ndarray:
-    return viewer.image(transparent=True, size=SIZE)[..., 3] > 0
+    """The shape's pixels, seen from the camera of the picture before (not fitted
+    again: the deformed and the rest shape are compared in one frame)."""
+    return viewer.image(transparent=True, size=SIZE, fit=False)[..., 3] > 0
 
 
 def test_a_deformed_mode_export_differs_from_the_rest_shape(machined):
@@ -84,7 +86,7 @@ def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
     assert "grey: rest shape" in state.derived.field().legend
     state.set_ghost(False)
     try:
-        without = machined.image(size=SIZE).astype(int)
+        without = machined.image(size=SIZE, fit=False).astype(int)
         assert not scene.ghost_visible
         deformed = _silhouette(machined)
         state.set_shell_coloring("normal")
@@ -120,7 +122,7 @@ def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
         with_ghost = machined.image(size=SIZE).astype(int)
         assert scene.ghost_visible
         state.set_ghost(False)
-        without = machined.image(size=SIZE).astype(int)
+        without = machined.image(size=SIZE, fit=False).astype(int)
     finally:
         state.set_ghost(True)
         state.set_animation(amplitude=40)
