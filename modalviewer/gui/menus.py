@@ -191,9 +191,10 @@ def build_menus(win) -> None:
 
 
 COLOR_RANGE_ITEMS = (
-    ("auto", "&Automatic (robust for distances, signatures, curvature)"),
+    ("auto", "&Automatic (spread or robust for distances, signatures, curvature)"),
     ("symmetric", "&Symmetric: the largest value"),
     ("robust", "&Robust: 99th percentile by area, beyond it clipped"),
+    ("spread", "Spread by &area: each tenth of the colours a tenth of the surface"),
     ("limits", "Typed &limits..."),
 )
 

@@ -265,6 +265,7 @@ class MeshScene:
         self.picker.AddPickList(self.surface_actor)
         self.field_name = ""
         self._values: np.ndarray | None = None  # the field of show_field, unscaled
+        self.scale: tuple | None = None  # a spread colour scale's knots (show_field)
         self.clim = (0.0, 1.0)
         self.clipped = (False, False)  # values beyond the low / high end of clim
         self.kind = "plain"
@@ -317,6 +318,7 @@ class MeshScene:
         displacement: np.ndarray | None = None,
         name: str = "",
         clipped: tuple[bool, bool] = (False, False),
+        scale: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
         """Colour the surface by ``values`` (n,).
 
@@ -326,8 +328,17 @@ class MeshScene:
         (low, high) says which ends values lie beyond (the colour bar marks them).
         isolines: number of isolines (the zero level drawn bold for diverging fields).
         displacement: (n, 3) shape of the animation, carried along by the isolines.
+        scale: (knot values, knot positions) of a spread colour scale (a sequential field
+        coloured by ``np.interp(values, *scale)`` over 0..1; the colour bar keeps the
+        values, its ticks placed by the scale; the isolines divide the colours evenly).
         """
         values = np.array(values, dtype=np.float64)  # the animation rewrites the copy drawn
+        self.scale = None
+        if scale is not None and kind == "sequential":
+            self.scale = (np.asarray(scale[0], float), np.asarray(scale[1], float))
+            true_range = (float(self.scale[0][0]), float(self.scale[0][-1]))
+            values = np.interp(values, *self.scale)
+            clim = (0.0, 1.0)
         self._values = values
         self.surface.point_data["field"] = values.copy()
         if displacement is not None:
@@ -354,6 +365,8 @@ class MeshScene:
         self.field_name = name
         self._overlay_changed()
         self.set_isolines(values, isolines if kind != "threshold" else 0, kind == "diverging")
+        if self.scale is not None:
+            self.clim = true_range  # what the colour bar says
 
     def set_isolines(self, values: np.ndarray, count: int, emphasise_zero: bool) -> None:
         """Contour the rest shape (so the lines can follow the animation) at ``count``
@@ -485,6 +498,7 @@ class MeshScene:
         first entry's width as that entry)."""
         values = np.asarray(distances, dtype=np.float64)
         self.surface.point_data["field"] = values
+        self.scale = None
         hi = float(np.max(values)) or 1.0
         self.clim = (0.0, hi)
         self.clipped = (False, False)
@@ -508,6 +522,7 @@ class MeshScene:
     def show_plain(self) -> None:
         """The plain light-grey surface, no field and no isolines (a fresh mesh)."""
         self.surface.point_data["field"] = np.zeros(self.mesh.n_vertices)
+        self.scale = None
         self._mapper.ScalarVisibilityOff()
         self.field_name = ""
         self.kind = "plain"
@@ -539,7 +554,8 @@ class MeshScene:
         self.colorbar_labels = list(labels) if labels is not None else None
         if clim is not None:
             self.clim = (float(clim[0]), float(clim[1]))
-            self._mapper.scalar_range = self.clim
+            if self.scale is None:  # a spread scale's colours span 0..1 of its knots
+                self._mapper.scalar_range = self.clim
         self._overlay_changed()
 
     def colorbar(self) -> ColorBar | None:
@@ -550,7 +566,14 @@ class MeshScene:
         if self.kind == "threshold":
             labels = self.colorbar_labels or [self.colorbar_title, "the rest"]
             return ColorBar("", colors, (0.0, 1.0), "swatches", labels[:2])
-        return ColorBar(self.colorbar_title, colors, tuple(self.clim), clipped=self.clipped)
+        ticks = []
+        if self.scale is not None and self.kind == "sequential":
+            from ..viewer.color_scale import tick_values
+
+            ticks = tick_values(self.scale)
+        return ColorBar(
+            self.colorbar_title, colors, tuple(self.clim), clipped=self.clipped, ticks=ticks
+        )
 
     def overlay(self, legend: bool = True, colorbar: bool | None = None) -> Overlay:
         """Legend and colour bar for an export: the legend if ``legend`` and set; the

@@ -28,6 +28,7 @@ class ColorBar:
     kind: str = "continuous"
     labels: list = field(default_factory=list)
     clipped: tuple[bool, bool] = (False, False)
+    ticks: list = field(default_factory=list)  # (value, position 0..1): a spread scale's
 
 
 @dataclass
@@ -158,6 +159,11 @@ def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.nd
             ticks = [(lo, 0.0), (hi, 1.0)]
             if lo < 0 < hi:
                 ticks.append((0.0, (0.0 - lo) / (hi - lo)))
+            if bar.ticks:  # a spread scale: its values where they lie on the bar
+                ticks = [(float(v), float(p)) for v, p in bar.ticks]
+                for _, pos in ticks:
+                    x = x0 + pos * width
+                    draw.line([(x, y1), (x, y1 + 0.3 * FONT_PX * s)], fill=black, width=1)
             for value, pos in ticks:
                 text = colorbar_label(value)
                 if pos in (0.0, 1.0) and bar.clipped[int(pos)]:

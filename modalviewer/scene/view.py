@@ -40,6 +40,7 @@ def draw_field(scene: MeshScene, field: Field | None) -> None:
             displacement=field.displacement,
             name=field.title,
             clipped=field.clipped,
+            scale=field.scale,
         )
     deformation = field.deformation if field is not None else 0.0
     if deformation:

@@ -144,7 +144,7 @@ class Comparison:
                 field = Field(d, "threshold", title=item_label(item), threshold=thr)
                 title = f"{item_label(item)} from vertex {shown}: blue < {thr:.3g} ({marked:.1f} %)"
             else:
-                field = Field(d, "sequential", title=item_label(item))
+                field = derived.scaled(Field(d, "sequential", title=item_label(item)))
                 title = f"{item_label(item)} from vertex {shown}"
             views.append(ComparisonView(item, title + mark, field, vertex))
         return views

@@ -58,6 +58,9 @@ class Field:
     ghost : draw the rest shape faint behind the displaced surface.
     clim : the colour range; ``clipped`` (low, high): values lie beyond that end (drawn
         in the end's colour, marked on the colour bar); ``color_range`` the range's rule.
+    scale : None (colours linear in the value) or (knot values, knot positions), the
+        piecewise-linear map of a "spread" range from value to colour position (0..1,
+        :mod:`.color_scale`).
     """
 
     values: np.ndarray
@@ -73,6 +76,7 @@ class Field:
     ghost: bool = False
     clipped: tuple[bool, bool] = (False, False)
     color_range: str = ""
+    scale: tuple[np.ndarray, np.ndarray] | None = None
 
 
 def robust_limit(values: np.ndarray, weights: np.ndarray, percent: float = ROBUST_PERCENTILE):
@@ -175,11 +179,20 @@ class DerivedValues:
     def color_range(self, values: np.ndarray, colormap: str) -> tuple[tuple, tuple, str]:
         """(clim, clipped (low, high), rule) of ``values`` drawn with ``colormap``
         ("diverging": symmetric about 0; else from 0) under ``style.color_range``; the
-        rule is the one applied ("auto" resolved: robust except for modes)."""
+        rule is the one applied ("auto" resolved: symmetric for modes; robust for other
+        fields, or "spread" for a one-signed field of which a tenth of the robust linear
+        scale would cover more than :data:`.color_scale.SPREAD_SHARE` of the surface)."""
+        from .color_scale import SPREAD_SHARE, crowded_share
+
         style, values = self.state.style, np.asarray(values, dtype=np.float64)
         rule = style.color_range
-        if rule == "auto":
+        automatic = rule == "auto"
+        if automatic:
             rule = "symmetric" if self.state.display.kind == "mode" else "robust"
+        if rule == "spread":
+            if colormap == "sequential" and values.size:
+                return (float(values.min()), float(values.max())), (False, False), rule
+            rule = "robust"
         if rule == "limits" and style.color_limits is not None:
             lo, hi = style.color_limits
         else:
@@ -190,6 +203,13 @@ class DerivedValues:
                 a = float(np.max(np.abs(values))) if values.size else 0.0
             a = a or 1.0
             lo, hi = (-a, a) if colormap == "diverging" else (0.0, a)
+        if (
+            automatic
+            and colormap == "sequential"
+            and values.size
+            and crowded_share(values, self.vertex_areas(), (lo, hi)) > SPREAD_SHARE
+        ):
+            return (float(values.min()), float(values.max())), (False, False), "spread"
         tol = 1e-12 * max(abs(lo), abs(hi))
         clipped = (
             bool(values.size and values.min() < lo - tol),
@@ -197,11 +217,21 @@ class DerivedValues:
         )
         return (float(lo), float(hi)), clipped, rule
 
-    def _ranged(self, field: Field) -> Field:
-        """``field`` with its colour range, and the range named in its legend."""
+    def scaled(self, field: Field) -> Field:
+        """``field`` with its colour range (:meth:`color_range`) and, on a spread range,
+        its scale's knots; the compare windows' fields too."""
+        from .color_scale import spread_knots
+
         field.clim, field.clipped, field.color_range = self.color_range(
             field.values, field.colormap
         )
+        if field.color_range == "spread":
+            field.scale = spread_knots(field.values, self.vertex_areas())
+        return field
+
+    def _ranged(self, field: Field) -> Field:
+        """``field`` with its colour range, and the range named in its legend."""
+        self.scaled(field)
         note = wording.range_note(field.color_range, field.clim, field.clipped)
         field.legend = f"{field.legend}\n{note}" if field.legend else note
         return field

@@ -69,11 +69,14 @@ SHELL_COLORINGS = ("deformed", "normal", "magnitude")
 amplitude, coloured by the displacement magnitude), "normal" (its normal component
 against smoothed normals on the rest shape) or "magnitude" (its magnitude on the rest
 shape).  Sessions and settings holding the former "auto" get "deformed"."""
-COLOR_RANGES = ("auto", "symmetric", "robust", "limits")
+COLOR_RANGES = ("auto", "symmetric", "robust", "spread", "limits")
 """Colour ranges: "symmetric" about the largest |value| (sequential fields: 0 to the
 largest value), "robust" (the 99th area-weighted percentile of |value|, beyond it
-clipped), "limits" (:attr:`_Style.color_limits`), "auto" (robust for distances,
-signatures and curvature, where one extreme dominates; symmetric for modes)."""
+clipped), "spread" (one-signed fields: colours by the share of the area below each value,
+the colour bar labelled with the values; see :mod:`.color_scale`), "limits"
+(:attr:`_Style.color_limits`), "auto" (for distances, signatures and curvature, where
+one extreme dominates: spread where a tenth of the robust range would cover more than a
+quarter of the surface, else robust; symmetric for modes)."""
 RENDER_STYLES = ("paper", "shaded")
 
 

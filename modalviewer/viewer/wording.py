@@ -141,6 +141,8 @@ def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool])
     from .derived import ROBUST_PERCENTILE
 
     lo, hi = clim
+    if rule == "spread":
+        return "colours spread by area: each tenth of the bar covers a tenth of the surface"
     if rule == "robust":
         text = f"robust range: {ROBUST_PERCENTILE:g}th percentile of |value| by area"
     elif rule == "limits":

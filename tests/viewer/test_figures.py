@@ -188,3 +188,47 @@ def test_the_pick_marker_shows_on_distance_maps_and_not_on_modes(spot, tmp_path)
     spot.show_distance("hks", display="continuous")
     assert magenta(spot.image(size=(800, 600))) > 20
     assert magenta(spot.image(size=(800, 600), marker=False)) == 0
+
+
+def _scale_positions(img: np.ndarray) -> np.ndarray:
+    """The position (0 white .. 1 red) on the white-to-red scale of each surface pixel
+    of a transparent picture, undoing the shading (which scales all three channels):
+    colour = (1 - t) white + t (0.78, 0.08, 0.08), so green / red = (1 - 0.92 t) /
+    (1 - 0.22 t)."""
+    surface = img[..., 3] > 0
+    r = np.maximum(img[..., 0][surface].astype(float), 1.0)
+    q = np.clip(img[..., 1][surface] / r, 0.0, 1.0)
+    return np.clip((1.0 - q) / (0.92 - 0.22 * q), 0.0, 1.0)
+
+
+def _largest_tenth(viewer) -> float:
+    img = viewer.image(size=(640, 480), transparent=True, marker=False)
+    t = _scale_positions(img)
+    return float(np.bincount(np.minimum((t * 10).astype(int), 9), minlength=10).max() / t.size)
+
+
+def test_a_continuous_distance_map_spreads_its_colours_over_the_visible_surface(spot):
+    """spot's vibration distance from a vertex on its flank: the robust linear range
+    leaves most of the visible surface in its lowest tenth; the automatic range spreads
+    the colours by area, so no tenth of the scale covers more than a quarter of the
+    surface's pixels, and the colour bar's ticks are the true distances."""
+    spot.state.set_colorbar(False)  # the bar's own colours are not the surface's
+    spot.pick_vertex(1500, show=False)
+    spot.show_distance("vibration", display="continuous")
+    try:
+        field = spot.state.derived.field()
+        assert field.color_range == "spread"
+        spread = _largest_tenth(spot)
+        spot.state.set_color_range("robust")
+        linear = _largest_tenth(spot)
+    finally:
+        spot.state.set_color_range("auto")
+        spot.state.set_colorbar(True)
+    assert spread < 0.25 < linear, (spread, linear)
+    bar = spot.renderer().scene.colorbar()
+    d = spot.state.derived.distance_map()
+    ticks = dict((p, v) for v, p in bar.ticks)
+    assert ticks[0.0] == pytest.approx(d.min()) and ticks[1.0] == pytest.approx(d.max())
+    areas = spot.state.derived.vertex_areas()
+    # the middle tick is the distance below which half the surface's area lies
+    assert areas[d <= ticks[0.5]].sum() / areas.sum() == pytest.approx(0.5, abs=0.03)
