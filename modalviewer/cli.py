@@ -71,6 +71,35 @@ def _size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def _mode_list(text: str) -> list[int]:
+    """An argparse type: mode numbers as "1-8", "2,5,9" or both ("0,3-5")."""
+    modes = []
+    try:
+        for part in text.split(","):
+            if "-" in part.strip()[1:]:
+                lo, hi = (int(x) for x in part.split("-"))
+                if hi < lo:
+                    raise ValueError
+                modes += range(lo, hi + 1)
+            else:
+                modes.append(int(part))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"modes look like 1-8 or 2,5,9, got {text!r}") from None
+    if not modes or min(modes) < 0 or len(modes) > 64:
+        raise argparse.ArgumentTypeError("modes are 1 to 64 numbers of at least 0")
+    return modes
+
+
+def _grid(text: str) -> tuple[int, int]:
+    try:
+        columns, rows = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"a grid looks like 4x2, got {text!r}") from None
+    if columns < 1 or rows < 1:
+        raise argparse.ArgumentTypeError("a grid has at least one column and one row")
+    return columns, rows
+
+
 def _whole(least: int):
     """An argparse type: an integer of at least ``least`` (a one-line error naming the
     argument, exit code 2)."""
@@ -168,7 +197,20 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("render", help="render a mode to PNG")
     r.add_argument("mesh")
     r.add_argument("--operator", choices=OPERATORS, default="laplacian")
-    r.add_argument("--mode", type=MODE_INDEX, required=True)
+    which = r.add_mutually_exclusive_group(required=True)
+    which.add_argument("--mode", type=MODE_INDEX)
+    which.add_argument(
+        "--modes",
+        type=_mode_list,
+        help="several modes side by side in one picture, e.g. 1-8 or 2,5,9 (one camera, "
+        "one colour bar)",
+    )
+    r.add_argument(
+        "--grid",
+        type=_grid,
+        default=None,
+        help="with --modes: COLUMNSxROWS of the panels (default: rows of up to 4)",
+    )
     r.add_argument(
         "-k", type=COUNT, default=None, help="number of modes (default: the viewer's, 100)"
     )
@@ -297,6 +339,16 @@ def _viewer(mesh, path):
 def _run(args) -> int:
     import modalviewer as mv
 
+    if args.command == "render" and args.modes is not None and args.animate:
+        raise _BadArgument("--animate shows one mode: give --mode")
+    if args.command == "render" and args.grid is not None:
+        if args.modes is None:
+            raise _BadArgument("--grid applies to several modes (--modes)")
+        if args.grid[0] * args.grid[1] < len(args.modes):
+            raise _BadArgument(
+                f"--grid {args.grid[0]}x{args.grid[1]} has fewer cells than the "
+                f"{len(args.modes)} modes"
+            )
     if args.command == "render" and args.animate:  # before any work
         from .scene.animation import animation_path, check_size
 
@@ -398,15 +450,31 @@ def _run(args) -> int:
         return 0
     mesh = _load(args.mesh, args.fix_slivers, args.partial)
     if args.command == "render":
+        from .scene.grid import grid_shape
+
         viewer = _viewer(mesh, args.mesh)
         viewer.state.set_isolines(args.isolines)
         viewer.state.set_shell_coloring(args.show)
         with _warnings_printed():
             spec = viewer.compute(args.operator, k=args.k, wait=True)
-        if not 0 <= args.mode < spec.k:
-            raise _BadArgument(f"--mode must be between 0 and {spec.k - 1}")
-        viewer.show_mode(args.mode)
+        asked = [args.mode] if args.modes is None else args.modes
+        if not all(0 <= j < spec.k for j in asked):
+            option = "--mode" if args.modes is None else "--modes"
+            raise _BadArgument(f"{option} must be between 0 and {spec.k - 1}")
+        viewer.show_mode(asked[0])
         viewer.set_view(args.view, up=args.up)
+        if args.modes is not None:
+            size = args.size or (1024, 768)
+            columns, rows = args.grid or grid_shape(len(args.modes))
+            panel = (max(16, size[0] // columns), max(16, size[1] // rows))
+            written = viewer.export_mode_grid(
+                args.output, args.modes, grid=(columns, rows), size=panel
+            )
+            viewer.close()
+            shown = ", ".join(f"{j}: {spec.eigenvalues[j]:.6g}" for j in args.modes)
+            print(f"modes of {args.operator}: lambda {shown}")
+            _wrote(written, f"{_png(written)}, {len(args.modes)} modes")
+            return 0
         if args.animate:
             written = viewer.export_animation(
                 args.output, frames=args.frames, fps=args.fps, size=args.size, marker=args.marker

@@ -180,6 +180,8 @@ def plot(
     animate: bool = False,
     frames: int | None = None,
     fps: float = 25,
+    modes=None,
+    grid=None,
 ):
     """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`; with
     ``interactive``, the same scene as an :class:`InteractivePicture` to turn in the
@@ -203,6 +205,9 @@ def plot(
     screenshot : also write the PNG there (the page, .html, for an interactive one).
     size : (width, height) in pixels.
     interactive : a page with the 3D scene instead of an image.
+    modes, grid : several modes of ``spectrum`` side by side in one picture, one
+        camera and one colour bar (``grid`` (columns, rows), default rows of up to 4;
+        ``size`` is then each panel's).
     animate, frames, fps : one period of the mode vibrating, ``frames`` frames (default:
         one period at the window's speed) played at ``fps``; ``screenshot`` then names a
         .gif (or .mp4 where imageio-ffmpeg is installed).
@@ -226,7 +231,11 @@ def plot(
                 stacklevel=2,
             )
             interactive = False
-        if animate:
+        if modes is not None:
+            if spectrum is None:
+                raise ValueError("modes= are modes of a spectrum: pass one")
+            picture = Picture(viewer.mode_grid(modes, spectrum.operator, grid, size))
+        elif animate:
             from .scene.animation import Animation
 
             picture = Animation(viewer.animation_images(frames, fps, size), fps)

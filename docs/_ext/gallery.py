@@ -78,6 +78,11 @@ def digest(source: str) -> str:
     return hashlib.sha256(source.encode()).hexdigest()
 
 
+def pictures(folder: Path) -> list[Path]:
+    """The pictures a script wrote in ``folder``: PNGs and GIF animations."""
+    return sorted([*folder.glob("*.png"), *folder.glob("*.gif")])
+
+
 def run(script: Path, out_root: Path = OUT, force: bool = False) -> Example:
     """Run ``script`` in a temporary folder unless its output for the same text is in
     ``out_root``; returns the example with its images (copied to ``out_root/<name>``)."""
@@ -87,7 +92,7 @@ def run(script: Path, out_root: Path = OUT, force: bool = False) -> Example:
     out = out_root / script.stem
     stamp = out / "hash"
     if not force and stamp.is_file() and stamp.read_text().strip() == digest(source):
-        example.images = sorted(out.glob("*.png"))
+        example.images = pictures(out)
         log = out / "output.txt"
         example.output = log.read_text() if log.is_file() else ""
         return example
@@ -112,7 +117,7 @@ def run(script: Path, out_root: Path = OUT, force: bool = False) -> Example:
         if result.returncode != 0:
             example.error = f"exit status {result.returncode}:\n{result.stderr[-2000:]}"
             return example
-        images = sorted(Path(tmp).glob("*.png"))
+        images = pictures(Path(tmp))
         if not images:
             example.error = "wrote no PNG"
             return example

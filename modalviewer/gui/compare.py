@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 from qtpy import QtWidgets
 
-from ..scene.export import save_png, side_by_side
+from ..scene.comparison import caption
+from ..scene.export import png_path, save_png, side_by_side
 from ..scene.mesh_scene import MeshScene
-from ..scene.view import draw_field
+from ..scene.view import draw_field, label_field
 from ..viewer.comparison import Comparison, item_label
 from .viewport import make_viewport
 from .window_keys import dispatch_key, install_keys
@@ -69,6 +70,7 @@ class CompareWindow(QtWidgets.QWidget):
                 ("Ctrl+W", self.close),
                 ("Right", lambda: self.comparison.step(+1)),
                 ("Left", lambda: self.comparison.step(-1)),
+                ("Ctrl+E", self.export_dialog),
             ],
         )
         self.resize(420 * len(items), 480)
@@ -106,14 +108,36 @@ class CompareWindow(QtWidgets.QWidget):
                 scene.show_marker(view.marker)
             if view.field is not None or self.distances:
                 draw_field(scene, view.field)
+                label_field(scene, view.field)
         self.render_all()
 
-    def grab_images(self) -> list[np.ndarray]:
-        return [viewport.render_now() for viewport in self.viewports]
+    def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
+        """Each view as on screen at ``scale``, its colour bar drawn on and its title
+        written above it."""
+        from ..scene.export import grab
 
-    def export_screenshot(self, path) -> Path:
-        """The views side by side in one PNG (written atomically)."""
-        return save_png(path, side_by_side(self.grab_images()))
+        images = []
+        for viewport, scene, title in zip(self.viewports, self.scenes, self.titles, strict=True):
+            if hasattr(viewport, "render_now"):
+                viewport.render_now()  # an off-screen view sizes its plotter here
+            image = grab(viewport.plotter, scene, scale, transparent)
+            images.append(caption(image, title.text()))
+        self.render_all()
+        return images
+
+    def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
+        """The views side by side, each with its title and colour bar (or a threshold
+        map's legend), in one PNG (written atomically)."""
+        path = png_path(path)  # checked before rendering
+        scale = int(max(1, scale))
+        images = self.grab_images(scale, transparent)
+        return save_png(path, side_by_side(images, gap=4 * scale, transparent=transparent))
+
+    def export_dialog(self) -> None:
+        """Ctrl+E: the export dialog (file, size multiplier, transparent background)."""
+        from .file_dialogs import window_screenshot_dialog
+
+        window_screenshot_dialog(self, "compare.png", "Export the comparison")
 
     def closeEvent(self, event):  # noqa: N802
         for event_ in (self.state.events.pick, self.state.events.display, self.state.events.style):

@@ -81,8 +81,9 @@ def _size_boxes(form, size) -> tuple:
 
 
 class ScreenshotDialog(QtWidgets.QDialog):
-    """File, width and height in pixels, size multiplier, transparent background,
-    colour bar and legend, pick marker."""
+    """File, width and height in pixels (not asked with ``size`` None), size
+    multiplier, transparent background, colour bar and legend, pick marker (not asked
+    with ``marker`` None)."""
 
     def __init__(
         self, parent, start_dir: str, colorbar: bool = False, size=(1024, 768), marker=False
@@ -98,7 +99,9 @@ class ScreenshotDialog(QtWidgets.QDialog):
         row.addWidget(self.path_edit)
         row.addWidget(browse)
         form.addRow("File", row)
-        self.width_box, self.height_box = _size_boxes(form, size)
+        self.width_box = self.height_box = None
+        if size is not None:
+            self.width_box, self.height_box = _size_boxes(form, size)
         self.scale = QtWidgets.QSpinBox()
         self.scale.setRange(1, 8)
         self.transparent = QtWidgets.QCheckBox("Transparent background")
@@ -110,7 +113,8 @@ class ScreenshotDialog(QtWidgets.QDialog):
         form.addRow("Size multiplier", self.scale)
         form.addRow(self.transparent)
         form.addRow(self.colorbar)
-        form.addRow(self.marker)
+        if marker is not None:
+            form.addRow(self.marker)
         buttons = QtWidgets.QDialogButtonBox(
             QtWidgets.QDialogButtonBox.StandardButton.Save
             | QtWidgets.QDialogButtonBox.StandardButton.Cancel
@@ -126,7 +130,9 @@ class ScreenshotDialog(QtWidgets.QDialog):
         if path:
             self.path_edit.setText(path)
 
-    def size(self) -> tuple[int, int]:
+    def size(self) -> tuple[int, int] | None:
+        if self.width_box is None:
+            return None
         return self.width_box.value(), self.height_box.value()
 
     def values(self):

@@ -99,26 +99,42 @@ def animation_dialog(win) -> None:
     win.statusBar().showMessage(f"Saved {out}", 8000)
 
 
-def pair_screenshot_dialog(pair_window) -> None:
-    """Export a shape pair window: the main window's dialog (folder, size multiplier,
-    transparent background), starting where the main window's screenshots go."""
-    win = pair_window.main
+def window_screenshot_dialog(window, name: str, title: str) -> None:
+    """Export a window of several views (shape pair, comparison) as one picture: the
+    main window's dialog (file, size multiplier, transparent background; the views keep
+    their on-screen size, their legends and colour bars are part of the picture),
+    starting where the main window's screenshots go.  The result is said in the
+    window's status line, or the main window's status bar."""
+    win = window.main
     start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
-    dialog = ScreenshotDialog(pair_window, start)
-    dialog.setWindowTitle("Export the pair")
-    dialog.path_edit.setText(str(Path(start) / "pair.png"))
-    dialog.colorbar.hide()  # the pair's legends are part of its picture
+    dialog = ScreenshotDialog(window, start, size=None, marker=None)
+    dialog.setWindowTitle(title)
+    dialog.path_edit.setText(str(Path(start) / name))
+    dialog.colorbar.hide()  # the views' legends and colour bars are part of the picture
     if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
         return
     path, scale, transparent, _, _, _ = dialog.values()
+    status = getattr(window, "status", None)
+
+    def say(text: str) -> None:
+        if status is not None:
+            status.setText(text)
+        else:
+            win.statusBar().showMessage(text, 8000)
+
     try:
-        out = pair_window.export_screenshot(path, scale, transparent)
+        out = window.export_screenshot(path, scale, transparent)
     except (OSError, ValueError) as exc:
-        pair_window.status.setText(f"Could not save the screenshot: {exc}")
+        say(f"Could not save the screenshot: {exc}")
         return
     if win.remember_settings:
         win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
-    pair_window.status.setText(f"Saved {out}")
+    say(f"Saved {out}")
+
+
+def pair_screenshot_dialog(pair_window) -> None:
+    """Export a shape pair window (:func:`window_screenshot_dialog`)."""
+    window_screenshot_dialog(pair_window, "pair.png", "Export the pair")
 
 
 def field_dialog(win) -> None:
@@ -209,3 +225,44 @@ def open_session_dialog(win) -> None:
     )
     if path:
         win.open_session(path, wait=False)
+
+
+def mode_grid_dialog(win) -> None:
+    """File > Export mode grid: modes of the spectrum shown side by side in one PNG
+    (asked as "1-8" or "2,5,9"; one camera, the view's direction; one colour bar)."""
+    import argparse
+
+    from ..cli import _mode_list
+
+    operator = win.viewer.current_operator
+    spec = win.state.spectrum(operator) if operator is not None else None
+    if spec is None:
+        win.show_error("Compute a spectrum first: a mode grid shows its modes.")
+        return
+    first = win.state.display.mode if win.state.display.kind == "mode" else 1
+    last = min(spec.k - 1, first + 7)
+    text, ok = QtWidgets.QInputDialog.getText(
+        win,
+        "Export mode grid",
+        f"Modes of {operator_info(operator).label} (e.g. 1-8 or 2,5,9; 0 .. {spec.k - 1}):",
+        text=f"{first}-{last}",
+    )
+    if not ok:
+        return
+    try:
+        modes = _mode_list(text)
+    except argparse.ArgumentTypeError as exc:
+        win.show_error(str(exc))
+        return
+    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    path, _ = QtWidgets.QFileDialog.getSaveFileName(
+        win, "Export mode grid", str(Path(start) / "modes.png"), "PNG (*.png)"
+    )
+    if not path:
+        return
+    try:
+        out = win.viewer.export_mode_grid(path, modes, operator)
+    except (OSError, ValueError) as exc:
+        win.show_error(f"Could not save the mode grid: {exc}")
+        return
+    win.statusBar().showMessage(f"Saved {out}", 8000)

@@ -88,6 +88,13 @@ def build_menus(win) -> None:
     _action(
         win,
         m,
+        "Export mode &grid...",
+        lambda: file_dialogs.mode_grid_dialog(win),
+        tip="Several modes side by side in one picture, one camera, one colour bar",
+    )
+    _action(
+        win,
+        m,
         "Export per-vertex &field (PLY/VTP)...",
         lambda: file_dialogs.field_dialog(win),
         "Ctrl+Shift+E",

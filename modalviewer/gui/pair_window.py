@@ -177,7 +177,13 @@ class PairWindow(QtWidgets.QWidget):
         self.back_markers: dict[str, object] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
         self._keys = install_keys(
-            self, [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]
+            self,
+            [
+                ("Escape", self._escape),
+                ("Ctrl+W", self.close),
+                ("R", self.reset_cameras),
+                ("Ctrl+E", self._export_dialog),
+            ],
         )
         self._sync_controls()
 
@@ -282,7 +288,13 @@ class PairWindow(QtWidgets.QWidget):
         elif view.colormap == "threshold":
             scene.show_threshold(view.values, view.threshold, name=view.colorbar_title)
         else:
-            scene.show_field(view.values, "sequential", isolines=0, name=view.colorbar_title)
+            from ..core.laplacian import lumped_masses
+            from ..viewer.color_scale import auto_spread
+
+            scale = auto_spread(view.values, lumped_masses(scene.mesh))
+            scene.show_field(
+                view.values, "sequential", isolines=0, name=view.colorbar_title, scale=scale
+            )
         scene.set_legend(view.legend)
         if view.values is None:
             scene.set_colorbar(None)

@@ -11,7 +11,7 @@ import numpy as np
 from .export import grab, save_png, side_by_side
 from .mesh_scene import MeshScene
 from .offscreen import offscreen_plotter
-from .view import draw_field
+from .view import draw_field, label_field
 
 VIEW_SIZE = (480, 480)
 """Pixels of each view unless a size is given."""
@@ -46,6 +46,7 @@ def comparison_images(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -
         try:
             scene = MeshScene(plotter, state.mesh, state.derived.normals, style=state.style.render)
             draw_field(scene, view.field)
+            label_field(scene, view.field)
             scene.show_marker(view.marker)
             scene.set_camera(camera or scene.canonical_camera())
             images.append(caption(grab(plotter, scene, scale=scale), view.title))

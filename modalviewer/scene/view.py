@@ -48,6 +48,22 @@ def draw_field(scene: MeshScene, field: Field | None) -> None:
     scene.set_ghost(bool(field is not None and field.ghost), deformation)
 
 
+def label_field(scene: MeshScene, field: Field | None) -> None:
+    """The colour bar of a picture drawn by :func:`draw_field` without a legend (the
+    compare views): a continuous field's bar titled and ranged as the field; a threshold
+    map's two swatches ("<title> < threshold", "the rest"); none for the plain surface.
+    No render."""
+    if field is None or field.colormap == "plain":
+        scene.set_colorbar(None)
+    elif field.colormap == "threshold":
+        similar = f"{field.title} < {field.threshold:.3g}"
+        if field.share_similar is not None:
+            similar += f" ({100 * field.share_similar:.1f} %)"
+        scene.set_colorbar(field.title, labels=[similar, "the rest"])
+    else:
+        scene.set_colorbar(field.title, clim=field.clim)
+
+
 class StateScene:
     """Keeps a :class:`MeshScene` on ``plotter`` in step with ``state``.
 

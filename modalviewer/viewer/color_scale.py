@@ -62,3 +62,15 @@ def tick_values(knots) -> list[tuple[float, float]]:
     """(value, position) of the colour bar's ticks on the spread scale ``knots``."""
     values, positions = knots
     return [(float(np.interp(p, positions, values)), float(p)) for p in TICKS]
+
+
+def auto_spread(values: np.ndarray, weights: np.ndarray):
+    """The spread scale's knots for a one-signed ``values`` of which a tenth of the
+    linear range 0 .. largest would cover more than :data:`SPREAD_SHARE` of the weight,
+    else None (linear colours read well)."""
+    values = np.asarray(values, dtype=np.float64)
+    if values.size == 0 or values.min() < 0:
+        return None
+    if crowded_share(values, weights, (0.0, float(values.max()))) <= SPREAD_SHARE:
+        return None
+    return spread_knots(values, weights)

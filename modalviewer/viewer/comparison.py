@@ -142,6 +142,7 @@ class Comparison:
                     thr = derived.threshold_for_share(share, d) * float(d.max())
                 marked = 100.0 * derived.surface_share(d, thr)
                 field = Field(d, "threshold", title=item_label(item), threshold=thr)
+                field.share_similar = marked / 100.0
                 title = f"{item_label(item)} from vertex {shown}: blue < {thr:.3g} ({marked:.1f} %)"
             else:
                 field = derived.scaled(Field(d, "sequential", title=item_label(item)))

@@ -910,6 +910,25 @@ class Viewer:
         images = self.animation_images(frames, fps, size, marker)
         return write_animation(path, images, DEFAULT_FPS if fps is None else fps)
 
+    def mode_grid(self, modes, operator: str | None = None, grid=None, size=None) -> np.ndarray:
+        """Modes ``modes`` of ``operator`` (default: the one shown) side by side in one
+        picture (RGB uint8): panels of ``size`` (width, height) pixels (default 400 x
+        340) in a ``grid`` (columns, rows; default rows of up to 4), one camera fitted to
+        all, each captioned with its mode number and eigenvalue, one colour bar for the
+        range they share (see :func:`modalviewer.scene.grid.mode_grid`)."""
+        from ..scene.grid import GRID_PANEL, mode_grid
+
+        return mode_grid(self, modes, operator, grid, size or GRID_PANEL)
+
+    def export_mode_grid(
+        self, path, modes, operator: str | None = None, grid=None, size=None
+    ) -> Path:
+        """Write :meth:`mode_grid` to a PNG (atomically); returns the path."""
+        from ..scene.export import png_path, save_png
+
+        path = png_path(path)
+        return save_png(path, self.mode_grid(modes, operator, grid, size))
+
     def animation_frame(self, phase: float, size=None) -> float:
         """Move the picture's surface to ``phase`` (radians) of the vibration shown (a
         still of the animation, kept until the display changes); returns the time this

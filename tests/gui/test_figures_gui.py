@@ -106,3 +106,97 @@ def test_file_export_animation_writes_a_gif(window, spot_path, qtbot, tmp_path):
     with Image.open(out) as image:
         assert (image.n_frames, image.size) == (6, (240, 180))
     assert f"Saved {out}" in window.statusBar().currentMessage()
+
+
+def _bar_colours(panel: np.ndarray, colors) -> float:
+    """The largest deviation (0..255) of the middle row of a continuous colour bar, as
+    :func:`modalviewer.scene.overlay.draw_overlay` places it at the bottom of a view
+    (``panel``: the view's pixels below its caption), from the gradient through
+    ``colors``."""
+    from modalviewer.scene.overlay import FONT_PX, MARGIN_PX
+
+    h, w = panel.shape[:2]
+    width = min(0.5 * w, 320)
+    x0 = 0.5 * (w - width)
+    y1 = h - MARGIN_PX - FONT_PX - 0.4 * FONT_PX
+    row = int(round(y1 - 0.45 * FONT_PX))
+    xs = np.arange(int(x0) + 3, int(x0 + width) - 3)
+    t = (xs + 0.5 - x0) / width
+    anchors = np.linspace(0, 1, len(colors))
+    want = np.column_stack([np.interp(t, anchors, [c[i] for c in colors]) for i in range(3)])
+    return float(np.abs(panel[row, xs, :3].astype(float) - 255 * want).max())
+
+
+def test_a_compare_windows_export_has_a_colour_bar_per_continuous_view(
+    window, spot_path, qtbot, tmp_path
+):
+    from modalviewer.scene.mesh_scene import COLORMAPS
+
+    assert window.open_mesh(spot_path)
+    for op in ("laplacian", "shells"):
+        window.compute(op, k=12, wait=True)
+    window.viewer.pick_vertex(1500)
+    window.viewer.show_distance("vibration", display="continuous")
+    compare = window.open_comparison(["vibration", "hks"])
+    qtbot.wait(50)
+    out = tmp_path / "compare.png"
+    QtCore.QTimer.singleShot(
+        200,
+        lambda: (
+            QtWidgets.QApplication.activeModalWidget().path_edit.setText(str(out)),
+            QtWidgets.QApplication.activeModalWidget().accept(),
+        ),
+    )
+    qtbot.keyClick(compare, QtCore.Qt.Key.Key_E, QtCore.Qt.KeyboardModifier.ControlModifier)
+    img = np.asarray(Image.open(out))
+    heights = [vp.plotter.window_size[1] for vp in compare.viewports]
+    widths = [vp.plotter.window_size[0] for vp in compare.viewports]
+    assert img.shape[1] == sum(widths) + 4
+    x = 0
+    for w, h in zip(widths, heights, strict=True):
+        panel = img[img.shape[0] - h :, x : x + w]  # below the caption
+        assert _bar_colours(panel, COLORMAPS["sequential"]) < 12
+        x += w + 4
+    # a threshold map: each view's two-swatch legend (the blue swatch) instead
+    window.viewer.show_distance("vibration", display="threshold", share=0.2)
+    images = compare.grab_images()
+    for image in images:
+        bottom = image[-80:].astype(int)
+        blue = (bottom[..., 2] - bottom[..., 0] > 80).sum()
+        assert blue > 100, blue
+
+
+def test_a_session_restores_the_modes_panel_as_it_was(window, spot_path, qtbot, tmp_path):
+    """Saved on E_D^N mode 5 with a distance map on screen, the reopened window's Modes
+    panel shows E_D^N and mode 5 (it showed the first spectrum computed and mode 0),
+    and the distance map, pick, share and display come back."""
+    from modalviewer.gui import MainWindow
+
+    assert window.open_mesh(spot_path)
+    window.compute("laplacian", k=12, wait=True)
+    window.compute("modified_dirichlet", k=12, wait=True)
+    window.compute("shells", k=12, wait=True)
+    window.show_mode(5, "modified_dirichlet")
+    window.viewer.pick_vertex(1500, show=False)
+    window.viewer.show_distance("vibration", display="threshold", share=0.15)
+    session = window.save_session(tmp_path / "s.json")
+    second = MainWindow()
+    qtbot.addWidget(second)
+    second.show()
+    qtbot.waitExposed(second)
+    try:
+        assert second.open_session(session, wait=True) == []
+        panel = second.modes_panel
+        assert panel.spectrum_combo.currentData() == "modified_dirichlet"
+        assert panel.mode_spin.value() == 5 and panel.mode_slider.value() == 5
+        d = second.state.display
+        assert (d.kind, d.distance_kind, d.distance_display) == (
+            "distance",
+            "vibration",
+            "threshold",
+        )
+        assert second.state.picked == 1500
+        assert second.state.derived.marked_share() == pytest.approx(0.15, abs=0.01)
+        assert second.distances_panel.kind_combo.currentData() == "vibration"
+    finally:
+        second.close()

@@ -336,7 +336,8 @@ def test_linked_comparison_of_three_operators(window, spot_path, tmp_path, qtbot
     assert np.mean(np.any(before != after, axis=2)) > 0.01
     assert window.picked is None  # a drag is not a click
     out = compare.export_screenshot(tmp_path / "compare.png")
-    assert Image.open(out).size[0] == sum(img.shape[1] for img in images)
+    gaps = 4 * (len(images) - 1)
+    assert Image.open(out).size[0] == sum(img.shape[1] for img in images) + gaps
 
 
 def test_comparison_of_distances(window, spot_path):
@@ -345,9 +346,14 @@ def test_comparison_of_distances(window, spot_path):
     window.compute("shells", k=20, wait=True)
     window.pick_vertex(500)
     compare = window.open_comparison(["vibration", "hks"])
-    vib, hks = (np.array(s.surface.point_data["field"]) for s in compare.scenes)
-    np.testing.assert_allclose(vib, window.distance_map("vibration"))
-    np.testing.assert_allclose(hks, window.distance_map("hks"))
+    drawn = []
+    for scene, kind in zip(compare.scenes, ("vibration", "hks"), strict=True):
+        d = window.distance_map(kind)
+        # coloured by the distance, or by its spread scale (the share of area below it)
+        expected = d if scene.scale is None else np.interp(d, *scene.scale)
+        np.testing.assert_allclose(scene.surface.point_data["field"], expected)
+        drawn.append(d)
+    vib, hks = drawn
     assert not np.allclose(vib / vib.max(), hks / hks.max())
 
 

@@ -232,3 +232,50 @@ def test_a_continuous_distance_map_spreads_its_colours_over_the_visible_surface(
     areas = spot.state.derived.vertex_areas()
     # the middle tick is the distance below which half the surface's area lies
     assert areas[d <= ticks[0.5]].sum() / areas.sum() == pytest.approx(0.5, abs=0.03)
+
+
+def test_render_modes_writes_a_grid_with_one_camera_and_one_colour_bar(tmp_path, capsys):
+    out = tmp_path / "row.png"
+    args = ["render", str(ASSETS / "spot.obj"), "--operator", "laplacian", "-k", "12"]
+    args += ["--modes", "1-8", "--grid", "4x2", "--size", "1200x700", "-o", str(out)]
+    assert main(args) == 0
+    printed = capsys.readouterr().out
+    assert "8 modes" in printed and "lambda 1: " in printed
+    img = np.asarray(Image.open(out))
+    # 4 panels of 300 wide and 3 gaps of 4; two rows of panels (350 high and a caption
+    # each) and the colour bar's strip below
+    assert img.shape[1] == 4 * 300 + 3 * 4
+    # one colour bar: the orange-white-blue gradient, 320 pixels wide in the middle of
+    # a row of the strip below the panels; no panel has its own
+    from modalviewer.scene.mesh_scene import COLORMAPS
+
+    def deviation(row_pixels, x0, width=320):
+        xs = np.arange(int(x0) + 3, int(x0 + width) - 3)
+        t = (xs + 0.5 - x0) / width
+        colors = COLORMAPS["diverging"]
+        anchors = np.linspace(0, 1, len(colors))
+        want = np.column_stack([np.interp(t, anchors, [c[i] for c in colors]) for i in range(3)])
+        return np.abs(row_pixels[xs, :3].astype(float) - 255 * want).max()
+
+    w = img.shape[1]
+    best = {y: deviation(img[y], 0.5 * (w - 320)) for y in range(img.shape[0])}
+    bar_rows = [y for y, dev in best.items() if dev < 12]
+    assert bar_rows and min(bar_rows) > img.shape[0] - 60, bar_rows
+    assert max(bar_rows) - min(bar_rows) < 14  # one bar, about 13 pixels high
+
+
+def test_a_mode_grid_shares_its_camera_and_restores_the_display(spot):
+    spot.show_mode(3, "laplacian")
+    before = spot.state.display
+    img = spot.mode_grid([1, 2, 3], "laplacian", size=(200, 180))
+    assert spot.state.display == before
+    assert spot.state.style.color_range == "auto"
+    assert img.shape[1] == 3 * 200 + 2 * 4
+    with pytest.raises(ValueError, match="between 0 and 11"):
+        spot.mode_grid([3, 40], "laplacian")
+
+
+def test_plot_modes_draws_a_grid(spot):
+    spec = spot.state.spectrum("laplacian")
+    picture = mv.plot(spot.mesh, spec, modes=[1, 2], size=(200, 160))
+    assert picture.shape[1] == 2 * 200 + 4
