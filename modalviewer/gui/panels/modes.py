@@ -87,10 +87,12 @@ class ModesPanel(QtWidgets.QWidget):
         self._update_style()
 
     def _operator(self) -> str | None:
+        """The spectrum the panel shows: the mode's on screen, or the one last shown
+        (a distance map on screen, a restored session), else the first computed."""
         d = self.state.display
         if d.kind == "mode":
             return d.operator
-        return self.spectrum_combo.currentData()
+        return self.state.current_operator()
 
     def _on_spectrum_chosen(self, _index: int) -> None:
         """Show the chosen spectrum's modes: the mode last shown of it, or its first
