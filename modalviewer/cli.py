@@ -18,6 +18,7 @@ from .core.operators import (
     OPERATOR_NAMES,
     distance_word,
     operator_for_distance,
+    signature_kind,
 )
 from .viewer.state import DEFAULT_THRESHOLD_SHARE, SHELL_COLORINGS
 
@@ -270,7 +271,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="the vertex's number in the file (0-based, counting every vertex of the file, "
         "also ones no face uses), as the viewer shows it",
     )
-    d.add_argument("--kind", choices=tuple(KINDS), default="vibration")
+    d.add_argument(
+        "--kind",
+        choices=tuple(KINDS),
+        default="vibration",
+        help="vibration (3D shells), feature (E_D^N), hks (heat kernel of the Laplacian) or "
+        "wks (wave kernel signature of the Laplacian, over energies)",
+    )
     d.add_argument("-k", type=COUNT, default=100, help="number of modes (default: 100)")
     marked = d.add_mutually_exclusive_group()
     marked.add_argument(
@@ -496,7 +503,7 @@ def _run(args) -> int:
     if args.rescale:
         raise ValueError("--rescale applies to two meshes (with --to)")
     spec = _cached_spectrum(mesh, KINDS[args.kind], args.k)
-    d = mv.multiscale_distance(spec, vertex)
+    d = mv.multiscale_distance(spec, vertex, kind=signature_kind(args.kind))
     marked = _threshold(args, mesh, d)
     if args.csv:
         _write_csv(args.csv, mesh, d, f"{args.kind} distance from vertex {args.vertex}")
@@ -737,6 +744,11 @@ def _distance_to(args, mesh_a) -> int:
     mesh_b = mesh_b.solver_mesh  # as mesh_a: the vertices faces use, with the file's numbers
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
+    if signature_kind(args.kind) == "wks":
+        raise ValueError(
+            "--to compares heat-type signatures (--kind vibration, feature or hks); the "
+            "wave kernel distance is of one mesh"
+        )
     operator = KINDS[args.kind]
     spec_a = _cached_spectrum(mesh_a, operator, args.k)
     spec_b = _cached_spectrum(mesh_b, operator, args.k)

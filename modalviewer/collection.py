@@ -37,8 +37,9 @@ reads it too, plus:
     the non-zero eigenvalues times the surface area (Shape-DNA: scale invariant for the
     scalar operators).
 ``sig.KIND.times``, ``sig.KIND.values``
-    the signature of distance kind KIND (vibration, feature, hks) at every vertex and at
-    the standard scales (:func:`~.core.signatures.default_times`), (T,) and (n, T).
+    the signature of distance kind KIND (vibration, feature, hks, wks) at every vertex
+    and at the standard scales (:func:`~.core.signatures.default_times`; for wks the
+    energies of :func:`~.core.signatures.default_energies`), (T,) and (n, T).
 ``hist.KIND``
     (S, B) the signature histogram: at S of those scales, the area-weighted histogram of
     ``log10(A S_t(v) / Z(t))`` over ``B`` bins :data:`HISTOGRAM_EDGES` (``A S_t / Z`` has
@@ -69,7 +70,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.files import atomic_write
-from .core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
+from .core.operators import DISTANCE_KINDS, operator_for_distance, operator_info, signature_kind
 from .core.spectrum import FORMAT_VERSION as SPECTRUM_FORMAT_VERSION
 from .core.spectrum import Spectrum
 
@@ -263,16 +264,23 @@ def _operators(parameters: dict) -> list[str]:
     return ops
 
 
-def _histogram(spec: Spectrum, area: float) -> np.ndarray:
-    """(HISTOGRAM_SCALES, bins) area-weighted histograms of log10(A S_t(v) / Z(t))."""
-    from .core.signatures import _used, default_times
+def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
+    """(HISTOGRAM_SCALES, bins) area-weighted histograms of log10(A S_t(v) / Z(t)), or
+    for ``kind="wks"`` of log10(A W_E(v)) at energies of the default band."""
+    from .core.signatures import _used, default_energies, default_times, signature, wks_sigma
 
-    mask = _used(spec, False)
-    times = default_times(spec)
-    picked = times[np.linspace(0, len(times) - 1, HISTOGRAM_SCALES).round().astype(int)]
-    weights = np.exp(-np.outer(spec.eigenvalues[mask], picked))  # (k, S)
-    s = spec.squared_modes()[:, mask] @ weights  # (n, S)
-    h = area * s / weights.sum(axis=0)
+    if kind == "wks":
+        energies = default_energies(spec)
+        picked = energies[np.linspace(0, len(energies) - 1, HISTOGRAM_SCALES).round().astype(int)]
+        _, w = signature(spec, kind="wks", energies=picked, sigma=wks_sigma(energies))
+        h = area * w
+    else:
+        mask = _used(spec, False)
+        times = default_times(spec)
+        picked = times[np.linspace(0, len(times) - 1, HISTOGRAM_SCALES).round().astype(int)]
+        weights = np.exp(-np.outer(spec.eigenvalues[mask], picked))  # (k, S)
+        s = spec.squared_modes()[:, mask] @ weights  # (n, S)
+        h = area * s / weights.sum(axis=0)
     logs = np.log10(np.clip(h, 10.0 ** HISTOGRAM_EDGES[0], 10.0 ** HISTOGRAM_EDGES[-1]))
     share = spec.mass / spec.mass.sum()
     return np.stack(
@@ -330,10 +338,10 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
             arrays["shape_dna"] = shape_dna(main, area)
             for kind in parameters["signatures"]:
                 spec = spectra[operator_for_distance(kind)]
-                times, values = signature(spec)
+                times, values = signature(spec, kind=signature_kind(kind))
                 arrays[f"sig.{kind}.times"] = times
                 arrays[f"sig.{kind}.values"] = values
-                arrays[f"hist.{kind}"] = _histogram(spec, area)
+                arrays[f"hist.{kind}"] = _histogram(spec, area, signature_kind(kind))
         arrays["meta"] = np.array(
             json.dumps(
                 {

@@ -197,7 +197,7 @@ def plot(
         of ``mesh`` (``mesh.n_vertices``, NaN allowed at ``mesh.unused`` vertices), a
         ``(name, values)`` pair or a dict (its first item); signed values in the modes'
         diverging colours, others white to red.
-    vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks") from
+    vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks", "wks") from
         ``vertex`` (the input's vertex number); by default the distance of ``spectrum``
         (heat kernel for a Laplacian spectrum, feature for E_D^N, vibration for the 3D
         shells), or "vibration" without one.  A spectrum of the kind's operator is used

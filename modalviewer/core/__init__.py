@@ -25,7 +25,13 @@ from .local_signature import local_signature
 from .mesh import Mesh, MeshError, MeshReport, remove_unused, repair_mesh
 from .pipeline import ZeroModesWarning, compute_spectrum
 from .shells import normal_shells_hessian, shells_hessian
-from .signatures import SignatureTable, default_times, multiscale_distance, signature
+from .signatures import (
+    SignatureTable,
+    default_energies,
+    default_times,
+    multiscale_distance,
+    signature,
+)
 from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, save_spectrum
 from .truncation import k_for_truncation, truncation_error
 
@@ -55,6 +61,7 @@ __all__ = [
     "SpectrumCache",
     "compute_spectrum",
     "ZeroModesWarning",
+    "default_energies",
     "default_times",
     "load_spectrum",
     "local_signature",

@@ -36,6 +36,7 @@ __all__ = [
     "distance_word",
     "operator_info",
     "operator_for_distance",
+    "signature_kind",
 ]
 
 
@@ -110,6 +111,10 @@ class OperatorInfo:
         factor goes out of core.
     signature_word : the signature (and distance) its spectrum defines, in words
         ("heat kernel"), or None.
+    wave_distance_kind : the distance of the wave kernel signature of its spectrum
+        offered by the viewer and the CLI (``"wks"`` for the Laplacian), or None; the
+        library computes that signature for any spectrum
+        (:func:`.signatures.signature`).
     preview_arrays_per_mode : float64 arrays of the unknowns' length a fast preview
         holds at its peak for each mode beyond the 100 its growth law was measured with
         (:meth:`predicted_peak_mb`).  The 300-mode runs on the 337k plate
@@ -133,6 +138,7 @@ class OperatorInfo:
     factor_memory: FactorLaw | None = None
     signature_word: str | None = None
     preview_arrays_per_mode: float = 3.0
+    wave_distance_kind: str | None = None
 
     @property
     def vector(self) -> bool:
@@ -332,6 +338,7 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             factor_memory=_FACTOR["laplacian"],
             signature_word="heat kernel",
             preview_arrays_per_mode=1.25,
+            wave_distance_kind="wks",
         ),
         OperatorInfo(
             "modified_dirichlet",
@@ -389,8 +396,9 @@ DISTANCE_KINDS: dict[str, str] = {
     "vibration": "Vibration distance",
     "feature": "Feature distance",
     "hks": "Heat kernel distance",
+    "wks": "Wave kernel distance",
 }
-"""Distance kinds (paper Section 6) and their names in words."""
+"""Distance kinds (paper Section 6, and the wave kernel's) and their names in words."""
 
 
 def operator_info(name: str) -> OperatorInfo:
@@ -406,12 +414,22 @@ def operator_info(name: str) -> OperatorInfo:
 def operator_for_distance(kind: str) -> str:
     """The operator whose spectrum defines distance ``kind`` (vibration -> shells, ...)."""
     for info in OPERATOR_INFO.values():
-        if info.distance_kind == kind:
+        if kind in (info.distance_kind, info.wave_distance_kind):
             return info.name
     raise ValueError(f"unknown distance kind {kind!r}; choose one of {', '.join(DISTANCE_KINDS)}")
 
 
+def signature_kind(kind: str) -> str:
+    """The signature (:data:`.signatures.SIGNATURE_KINDS`) distance ``kind`` is made of:
+    "wks" for a wave kernel distance, "heat" for the others."""
+    info = operator_info(operator_for_distance(kind))
+    return "wks" if kind == info.wave_distance_kind else "heat"
+
+
 def distance_word(kind: str) -> str:
-    """Distance ``kind`` in lower-case words ("heat kernel" for ``"hks"``)."""
+    """Distance ``kind`` in lower-case words ("heat kernel" for ``"hks"``, "wave
+    kernel" for ``"wks"``)."""
+    if signature_kind(kind) == "wks":
+        return "wave kernel"
     word = operator_info(operator_for_distance(kind)).signature_word
     return word if word is not None else kind

@@ -1,8 +1,16 @@
 """Multi-scale signatures and the distance of eq. (31) (paper Section 6).
 
 The heat kernel signature (Laplacian modes), the feature signature (E_D^N modes) and
-the vibration signature (3-vector shells modes) share one formula,
+the vibration signature (3-vector shells modes) share one formula, ``kind="heat"``:
 ``S_t(v) = sum_j exp(-lambda_j t) |phi_j(v)|^2``; zero modes are left out by default.
+
+``kind="wks"`` is the wave kernel signature of Aubry, Schlickewei and Cremers (2011), a
+band-pass filter in log-eigenvalue instead of the heat kernel's low-pass one, for any
+operator's spectrum: at energy ``E`` (``e = log E``)
+``W_E(v) = sum_j exp(-(e - log lambda_j)^2 / (2 sigma^2)) |phi_j(v)|^2 / C_E`` with
+``C_E = sum_j exp(-(e - log lambda_j)^2 / (2 sigma^2))``, over the non-zero modes.  Its
+distance is eq. (31) with the energies in place of the scales: the Euclidean distance of
+the rows ``W_E(v) sqrt(d log E)`` (docs/conventions.md).
 """
 
 from __future__ import annotations
@@ -14,7 +22,31 @@ import numpy as np
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_times, check_vertex, check_vertices
 
-__all__ = ["default_times", "signature", "multiscale_distance", "SignatureTable"]
+__all__ = [
+    "default_times",
+    "default_energies",
+    "wks_sigma",
+    "signature",
+    "multiscale_distance",
+    "SignatureTable",
+    "SIGNATURE_KINDS",
+    "WKS_VARIANCE",
+]
+
+SIGNATURE_KINDS: dict[str, str] = {
+    "heat": "sum_j exp(-lambda_j t) |phi_j(v)|^2 over scales t",
+    "wks": "the wave kernel signature over energies E (Aubry et al. 2011)",
+}
+"""The signature kinds of :func:`signature` and :class:`SignatureTable`."""
+
+WKS_VARIANCE = 7.0
+"""The wave kernel's sigma in units of the log-energy spacing (Aubry et al.'s choice)."""
+
+
+def _check_kind(kind: str) -> str:
+    if kind not in SIGNATURE_KINDS:
+        raise ValueError(f"unknown signature kind {kind!r}; choose one of 'heat', 'wks'")
+    return kind
 
 
 def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
@@ -56,11 +88,68 @@ def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False
     return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
 
 
+def default_energies(spec: Spectrum, samples: int = 100) -> np.ndarray:
+    """Energies of the wave kernel signature: ``samples`` values log-spaced from the
+    smallest to the largest non-zero eigenvalue (Aubry et al.'s band).
+
+    Raises
+    ------
+    ValueError
+        If the spectrum has fewer than two distinct non-zero eigenvalues.
+    """
+    samples = check_count(samples, "samples", 2)
+    lam = _positive_eigenvalues(spec)
+    return np.exp(np.linspace(np.log(lam.min()), np.log(lam.max()), samples))
+
+
+def wks_sigma(energies: Sequence[float] | np.ndarray) -> float:
+    """The wave kernel's width in log-energy: :data:`WKS_VARIANCE` times the spacing of
+    ``log(energies)`` (their range over ``len - 1``; for one energy, ``WKS_VARIANCE``
+    times 0.05)."""
+    e = np.log(check_times(energies, "energies"))
+    if e.size < 2 or e.max() == e.min():
+        return WKS_VARIANCE * 0.05
+    return WKS_VARIANCE * float(e.max() - e.min()) / (e.size - 1)
+
+
+def _positive_eigenvalues(spec: Spectrum) -> np.ndarray:
+    lam = spec.eigenvalues[~spec.zero_mode_mask()]
+    if lam.size == 0:
+        raise ValueError("the spectrum has no non-zero modes; compute more modes")
+    if lam.min() <= 0:
+        raise ValueError(
+            f"the wave kernel signature needs positive eigenvalues; this spectrum has "
+            f"{lam.min():.3g}"
+        )
+    if lam.max() == lam.min():
+        raise ValueError("the wave kernel signature needs two distinct non-zero eigenvalues")
+    return lam
+
+
+def _wks_weights(spec: Spectrum, energies: np.ndarray, sigma: float) -> np.ndarray:
+    """(k', T) ``exp(-(log E - log lambda_j)^2 / (2 sigma^2))`` over the non-zero modes."""
+    lam = _positive_eigenvalues(spec)
+    gap = np.log(energies)[None, :] - np.log(lam)[:, None]
+    return np.exp(-(gap**2) / (2.0 * sigma**2))
+
+
+def _check_sigma(sigma, energies) -> float:
+    if sigma is None:
+        return wks_sigma(energies)
+    sigma = float(sigma)
+    if not (np.isfinite(sigma) and sigma > 0):
+        raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
+    return sigma
+
+
 def signature(
     spec: Spectrum,
     times: float | Sequence[float] | np.ndarray | None = None,
     include_zero: bool = False,
     vertices: int | Sequence[int] | np.ndarray | None = None,
+    kind: str = "heat",
+    energies: float | Sequence[float] | np.ndarray | None = None,
+    sigma: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The signature ``sum_j exp(-lambda_j t) |phi_j(v)|^2`` at every vertex (or at
     ``vertices``) and scale: the heat kernel signature for the Laplacian, the feature
@@ -73,15 +162,23 @@ def signature(
     times : float or array_like of float, optional
         Positive, finite scales (default: :func:`default_times`).
     include_zero : bool
-        Whether the sum includes the zero modes.
+        Whether the sum includes the zero modes (``kind="heat"`` only).
     vertices : int or array_like of int, optional
         Vertex indices in ``0..n-1`` (default: every vertex); the rows of vertices no
         face uses are NaN.
+    kind : {"heat", "wks"}
+        ``"wks"``: the wave kernel signature ``W_E(v)`` (module docstring) at
+        ``energies`` instead of the heat form at ``times``.
+    energies : float or array_like of float, optional
+        ``kind="wks"``: positive energies E (default: :func:`default_energies`).
+    sigma : float, optional
+        ``kind="wks"``: the kernel's width in log-energy (default: :func:`wks_sigma` of
+        the energies).
 
     Returns
     -------
     times : ndarray, shape (T,)
-        The scales.
+        The scales (the energies for ``kind="wks"``).
     values : ndarray, shape (n, T) or (len(vertices), T)
         The signature of each vertex at each scale.
 
@@ -91,6 +188,21 @@ def signature(
         For scales that are not positive and finite, or vertices that are not integer
         indices of the mesh.
     """
+    if _check_kind(kind) == "wks":
+        if times is not None or include_zero:
+            raise ValueError(
+                "the wave kernel signature takes energies=, over the non-zero modes "
+                "(no times or include_zero)"
+            )
+        energies = default_energies(spec) if energies is None else check_times(energies, "energies")
+        sigma = _check_sigma(sigma, energies)
+        if vertices is not None:
+            vertices = check_vertices(vertices, spec.n_vertices, allow_empty=True)
+        weights = _wks_weights(spec, energies, sigma)
+        squared = spec.squared_modes(vertices)[:, ~spec.zero_mode_mask()]
+        return energies, (squared @ weights) / weights.sum(axis=0)
+    if energies is not None or sigma is not None:
+        raise ValueError('energies= and sigma= belong to kind="wks"')
     mask = _used(spec, include_zero)
     times = default_times(spec, include_zero=include_zero) if times is None else times
     times = check_times(times)
@@ -102,12 +214,18 @@ def signature(
     return times, values
 
 
-def normalised_signatures(spec: Spectrum, times, include_zero: bool = False, vertices=None):
+def normalised_signatures(
+    spec: Spectrum, times, include_zero: bool = False, vertices=None, kind: str = "heat"
+):
     """(n, T), or (len(vertices), T): ``S_t(v) / Z(t) * sqrt(dlogt)`` at the log-spaced
-    ``times``, the rows whose Euclidean distances are eq. (31)'s Riemann sum."""
-    mask = _used(spec, include_zero)
+    ``times``, the rows whose Euclidean distances are eq. (31)'s Riemann sum; for
+    ``kind="wks"`` ``W_E(v) * sqrt(dlogE)`` at the log-spaced energies ``times``."""
     times = np.asarray(times, dtype=np.float64)
     dlogt = (np.log(times[-1]) - np.log(times[0])) / (len(times) - 1)
+    if _check_kind(kind) == "wks":
+        _, values = signature(spec, kind="wks", energies=times, vertices=vertices)
+        return values * np.sqrt(dlogt)
+    mask = _used(spec, include_zero)
     weights = np.exp(-np.outer(spec.eigenvalues[mask], times))  # (k, T)
     z = weights.sum(axis=0)  # (T,)
     return (spec.squared_modes(vertices)[:, mask] @ (weights / z)) * np.sqrt(dlogt)
@@ -117,8 +235,10 @@ class SignatureTable:
     """Normalised signatures of all vertices, ready for fast distance queries.
 
     Holds ``F = S_t(v) / Z(t) * sqrt(dlogt)`` as (n, T) so that
-    ``delta(v, w) = |F[v] - F[w]|``.  Building costs one (n, k) x (k, T) product;
-    each query then costs O(n T).
+    ``delta(v, w) = |F[v] - F[w]|``; with ``kind="wks"`` ``F = W_E(v) sqrt(dlogE)`` over
+    energies, ``t_range`` then being the energy range (default
+    :func:`default_energies`).  Building costs one (n, k) x (k, T) product; each query
+    then costs O(n T).
     """
 
     def __init__(
@@ -127,17 +247,26 @@ class SignatureTable:
         t_range: Sequence[float] | np.ndarray | None = None,
         samples: int = 100,
         include_zero: bool = False,
+        kind: str = "heat",
     ):
         samples = check_count(samples, "samples", 2)
+        self.kind = _check_kind(kind)
+        """The signature kind, "heat" or "wks"."""
+        if kind == "wks" and include_zero:
+            raise ValueError("the wave kernel signature leaves the zero modes out")
         self.t_range = None if t_range is None else check_t_range(t_range)
         """The scale range asked for (None: the default range, see :attr:`times`)."""
         if self.t_range is None:
-            times = default_times(spec, samples, include_zero)
+            if kind == "wks":
+                times = default_energies(spec, samples)
+            else:
+                times = default_times(spec, samples, include_zero)
         else:
             t1, t2 = self.t_range
             times = np.exp(np.linspace(np.log(t1), np.log(t2), samples))
         self.times = times
-        self.table = normalised_signatures(spec, times, include_zero)
+        """The scales (the energies for ``kind="wks"``), ascending."""
+        self.table = normalised_signatures(spec, times, include_zero, kind=kind)
 
     @property
     def table(self) -> np.ndarray:
@@ -187,6 +316,7 @@ def multiscale_distance(
     t_range: Sequence[float] | np.ndarray | None = None,
     samples: int = 100,
     include_zero: bool = False,
+    kind: str = "heat",
 ) -> np.ndarray:
     """The multi-scale distance ``delta_[t1,t2](vertex, w)`` of eq. (31) to every vertex w.
 
@@ -205,6 +335,9 @@ def multiscale_distance(
         The number of scales of the sum.
     include_zero : bool
         Whether the signatures include the zero modes.
+    kind : {"heat", "wks"}
+        ``"wks"``: the distance of the wave kernel signatures over the energy range
+        ``t_range`` (default: :func:`default_energies`' range).
 
     Returns
     -------
@@ -218,4 +351,5 @@ def multiscale_distance(
         If the spectrum has no non-zero modes, or no face uses ``vertex``.
     """
     vertex = spec.check_source(check_vertex(vertex, spec.n_vertices))
-    return SignatureTable(spec, t_range, samples, include_zero).distance_from(vertex)
+    table = SignatureTable(spec, t_range, samples, include_zero, kind=kind)
+    return table.distance_from(vertex)

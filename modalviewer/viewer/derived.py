@@ -28,8 +28,13 @@ import numpy as np
 
 from ..core.curvature import total_curvature
 from ..core.laplacian import lumped_masses, vertex_normals
-from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
-from ..core.signatures import SignatureTable, signature
+from ..core.operators import (
+    DISTANCE_KINDS,
+    operator_for_distance,
+    operator_info,
+    signature_kind,
+)
+from ..core.signatures import SignatureTable, signature, wks_sigma
 from ..core.spectrum import Spectrum
 from . import wording
 from .mode_scalar import smoothed_normals, vector_mode_scalar
@@ -96,8 +101,8 @@ class DerivedValues:
         self.state = state
         self._mesh = None  # the mesh the per-mesh values below belong to
         self._per_mesh: dict[str, object] = {}
-        # operator -> (spectrum, t_range, table)
-        self._tables: dict[str, tuple[Spectrum, tuple | None, SignatureTable]] = {}
+        # (operator, signature kind) -> (spectrum, t_range, table)
+        self._tables: dict[tuple[str, str], tuple[Spectrum, tuple | None, SignatureTable]] = {}
         # ((kind, vertex, t_range), spectrum, distances) of the last distance map
         self._distance: tuple | None = None
         self._truncation: dict = {}  # (spectrum id, t) -> (spectrum, (error, k))
@@ -116,9 +121,9 @@ class DerivedValues:
         self._exact_curve = None
 
     def _drop_stale_spectra(self, operator: str = "") -> None:
-        for op, (spec, _, _) in list(self._tables.items()):
-            if spec is not self.state.spectrum(op):
-                del self._tables[op]
+        for key, (spec, _, _) in list(self._tables.items()):
+            if spec is not self.state.spectrum(key[0]):
+                del self._tables[key]
         if self._distance is not None and not any(
             self._distance[1] is spec for spec in self.state.spectra.values()
         ):
@@ -138,7 +143,7 @@ class DerivedValues:
 
     def keep_table(self, spec: Spectrum, table: SignatureTable) -> None:
         """Keep ``table``, built with ``spec`` (over ``table.t_range``), for reuse."""
-        self._tables[spec.operator] = (spec, table.t_range, table)
+        self._tables[spec.operator, table.kind] = (spec, table.t_range, table)
 
     # ------------------------------------------------------- per mesh
     @property
@@ -252,18 +257,29 @@ class DerivedValues:
         spec = self.state.spectrum(operator)
         return spec is not None and not spec.zero_mode_mask().all()
 
-    def table(self, operator: str) -> SignatureTable:
-        """The signature table of ``operator``'s spectrum over the current scale range."""
+    def table(self, operator: str, kind: str = "heat") -> SignatureTable:
+        """The signature table of ``operator``'s spectrum over the current scale range,
+        of signature ``kind`` ("heat", or "wks": the range is then of energies)."""
         spec = self.state.spectrum(operator)
         if spec is None:
             raise ValueError(f"no spectrum of {operator!r} has been computed")
         t_range = self.state.t_range
-        kept = self._tables.get(operator)
+        kept = self._tables.get((operator, kind))
         if kept is not None and kept[0] is spec and kept[1] == t_range:
             return kept[2]
-        table = SignatureTable(spec, t_range=t_range)
-        self._tables[operator] = (spec, t_range, table)
+        table = SignatureTable(spec, t_range=t_range, kind=kind)
+        self._tables[operator, kind] = (spec, t_range, table)
         return table
+
+    def kind_table(self, kind: str | None = None) -> SignatureTable:
+        """The signature table distance ``kind`` (the display's by default) uses."""
+        kind = kind or self.state.display.distance_kind
+        return self.table(operator_for_distance(kind), signature_kind(kind))
+
+    def wave(self) -> bool:
+        """Whether the display's distance kind is a wave kernel's (its scales are
+        energies)."""
+        return signature_kind(self.state.display.distance_kind) == "wks"
 
     def signature_time(self) -> float:
         """The scale t the signature display is shown at: the typed one
@@ -271,19 +287,25 @@ class DerivedValues:
         display = self.state.display
         if display.signature_time is not None:
             return float(display.signature_time)
-        table = self.table(operator_for_distance(display.distance_kind))
+        table = self.kind_table()
         return float(table.times[int(np.clip(display.signature_sample, 0, len(table.times) - 1))])
 
     def nearest_sample(self, t: float) -> int:
         """The index of the table's scale nearest to ``t`` (in log scale): where the
         slider stands for a typed scale."""
-        table = self.table(operator_for_distance(self.state.display.distance_kind))
+        table = self.kind_table()
         return int(np.argmin(np.abs(np.log(table.times) - np.log(float(t)))))
 
-    def signature_values(self, operator: str, t: float) -> np.ndarray:
-        """(n,) the signature of ``operator`` at scale ``t``, or with
+    def signature_values(self, operator: str, t: float, kind: str = "heat") -> np.ndarray:
+        """(n,) the signature of ``operator`` at scale ``t`` (of ``kind`` "wks": at
+        energy ``t``, the width that of the table's energies), or with
         ``style.log_signature`` its log10 over its smallest value (0 at the smallest)."""
-        _, values = signature(self.state.spectrum(operator), [t])
+        spec = self.state.spectrum(operator)
+        if kind == "wks":
+            sigma = wks_sigma(self.table(operator, kind).times)
+            _, values = signature(spec, kind="wks", energies=[t], sigma=sigma)
+        else:
+            _, values = signature(spec, [t])
         values = values[:, 0]
         if self.state.style.log_signature:
             positive = values[values > 0]
@@ -295,10 +317,14 @@ class DerivedValues:
         """(estimated truncation error (0..1), k suggested for below
         :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`) of the signature of
         ``operator`` (the display's) at scale ``t`` (the one shown); see
-        :mod:`modalviewer.core.truncation`.  None without signatures."""
+        :mod:`modalviewer.core.truncation`.  None without signatures, and for the wave
+        kernel's (the estimate is the heat kernel's)."""
         from ..core.truncation import TRUNCATION_LEVEL, k_for_truncation, truncation_error
 
-        operator = operator or operator_for_distance(self.state.display.distance_kind)
+        if operator is None:
+            if self.wave():
+                return None
+            operator = operator_for_distance(self.state.display.distance_kind)
         if not self.has_signatures(operator):
             return None
         spec = self.state.spectrum(operator)
@@ -316,10 +342,11 @@ class DerivedValues:
     # ------------------------------------------- the picked vertex's curve
     def curve_key(self) -> tuple | None:
         """What the picked vertex's signature curve is made of (operator, spectrum id,
-        vertex, scale range), or None without one."""
+        vertex, scale range), or None without one (also for the wave kernel's signature,
+        whose curve is not summed over all modes)."""
         state = self.state
         operator = operator_for_distance(state.display.distance_kind)
-        if state.picked is None or not self.has_signatures(operator):
+        if state.picked is None or not self.has_signatures(operator) or self.wave():
             return None
         return (operator, id(state.spectrum(operator)), state.picked, state.t_range)
 
@@ -358,7 +385,7 @@ class DerivedValues:
 
     def scale_limits(self) -> tuple[float, float]:
         """(t1, t2) the distances and signatures use: the chosen range or the default."""
-        table = self.table(operator_for_distance(self.state.display.distance_kind))
+        table = self.kind_table()
         return float(table.times[0]), float(table.times[-1])
 
     # ------------------------------------------------------ distances
@@ -373,7 +400,7 @@ class DerivedValues:
         key = (kind, state.picked, state.t_range)
         if self._distance is not None and self._distance[0] == key and self._distance[1] is spec:
             return self._distance[2]
-        d = self.table(operator_for_distance(kind)).distance_from(state.picked)
+        d = self.kind_table(kind).distance_from(state.picked)
         self._distance = (key, spec, d)
         return d
 
@@ -503,13 +530,13 @@ class DerivedValues:
             if not self.has_signatures(operator):
                 return plain
             t = self.signature_time()
-            values = self.signature_values(operator, t)[:, None]
+            values = self.signature_values(operator, t, signature_kind(d.distance_kind))[:, None]
             return self._ranged(
                 Field(
                     values[:, 0],
                     "sequential",
                     isolines=state.style.isolines,
-                    title=f"signature t = {t:.3g}{mark}",
+                    title=f"signature {'E' if self.wave() else 't'} = {t:.3g}{mark}",
                     legend=wording.legend(state, self),
                 )
             )

@@ -49,7 +49,13 @@ import numpy as np
 from psygnal import Signal, SignalGroup
 
 from ..core.mesh import Mesh
-from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance, operator_info
+from ..core.operators import (
+    DISTANCE_KINDS,
+    OPERATOR_INFO,
+    operator_for_distance,
+    operator_info,
+    signature_kind,
+)
 from ..core.spectrum import Spectrum, on_solver_mesh
 from .derived import DerivedValues
 
@@ -142,7 +148,8 @@ class Display:
     kind : "none" | "mode" | "distance" | "signature" | "curvature".
     operator : the spectrum a mode belongs to.
     mode : index of the mode shown.
-    distance_kind : "vibration" | "feature" | "hks" (also picks the signature's spectrum).
+    distance_kind : "vibration" | "feature" | "hks" | "wks" (also picks the signature's
+        spectrum and kind).
     distance_display : "continuous" | "threshold".
     threshold : threshold as a fraction of the largest distance (0..1].
     threshold_share : the share (0..1) of the surface's area the threshold map marks;
@@ -521,7 +528,14 @@ class ViewerState:
         )
         if new == self.display:
             return
+        wave_changed = signature_kind(new.distance_kind) != signature_kind(
+            self.display.distance_kind
+        )
         self.display = new
+        if wave_changed and self.t_range is not None:
+            # a scale range is of times t, a wave kernel's of energies E: neither carries over
+            self.t_range = None
+            self.events.scale_range.emit()
         self._match_threshold(
             fraction_set="threshold" in changes,
             share_set="threshold_share" in changes,

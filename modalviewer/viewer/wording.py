@@ -12,7 +12,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..core.mesh import _plural
-from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
+from ..core.operators import (
+    DISTANCE_KINDS,
+    distance_word,
+    operator_for_distance,
+    operator_info,
+)
 
 if TYPE_CHECKING:
     from .derived import DerivedValues
@@ -112,15 +117,17 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
             share = 100.0 * derived.surface_share(dist, thr)
             return f"blue: {name.lower()} < {thr:.3g}, {share:.1f} % of the surface\n{source}"
         t1, t2 = derived.scale_limits()
+        scales = "energies E" if derived.wave() else "scales t"
         return (
             f"{name} {source}: white 0 to red {float(dist.max()):.3g}\n"
-            f"scales t = {t1:.3g} .. {t2:.3g}"
+            f"{scales} = {t1:.3g} .. {t2:.3g}"
         )
     if d.kind == "signature":
         if not derived.has_signatures(operator_for_distance(d.distance_kind)):
             return ""
-        word = {"vibration": "Vibration", "feature": "Feature", "hks": "Heat kernel"}
-        text = f"{word[d.distance_kind]} signature at t = {derived.signature_time():.3g}"
+        word = distance_word(d.distance_kind).capitalize()
+        at = "E" if derived.wave() else "t"
+        text = f"{word} signature at {at} = {derived.signature_time():.3g}"
         if state.style.log_signature:
             text += ", log10(S / smallest S)"
         note = truncation_note(state, derived)

@@ -112,9 +112,22 @@ def test_every_registry_entry_is_complete(name):
 
 
 def test_each_distance_kind_belongs_to_one_operator():
-    kinds = [i.distance_kind for i in OPERATOR_INFO.values() if i.distance_kind]
+    kinds = [
+        kind
+        for i in OPERATOR_INFO.values()
+        for kind in (i.distance_kind, i.wave_distance_kind)
+        if kind
+    ]
     assert sorted(kinds) == sorted(DISTANCE_KINDS)
     assert operators.distance_word("hks") == "heat kernel"
+    assert operators.distance_word("wks") == "wave kernel"
+    assert operators.operator_for_distance("wks") == "laplacian"
+    assert [operators.signature_kind(k) for k in ("hks", "feature", "vibration", "wks")] == [
+        "heat",
+        "heat",
+        "heat",
+        "wks",
+    ]
 
 
 def test_the_default_support_radius_is_one_constant():

@@ -91,3 +91,23 @@ def test_typed_scale_log_colours_and_the_exact_curve(window, qtbot):
     )[0]
     np.testing.assert_allclose(panel.signature_plot.second, exact, rtol=1e-6)
     assert np.all(panel.signature_plot.second >= panel.signature_plot.y - 1e-12)
+
+
+def test_the_distances_panel_offers_the_wave_kernel_distance_over_energies(window):
+    state, panel = window.state, window.distances_panel
+    window.set_mesh(torus(16, 8))
+    spec = window.compute("laplacian", k=20, wait=True)
+    window.viewer.pick_vertex(3)
+    form = panel.layout()
+    assert form.labelForField(panel.t1_edit).text() == "t1"
+    panel.kind_combo.setCurrentIndex(panel.kind_combo.findData("wks"))
+    assert state.display.distance_kind == "wks"
+    assert form.labelForField(panel.t1_edit).text() == "E1"
+    assert form.labelForField(panel.scale_row).text() == "E"
+    energies = mv.default_energies(spec)
+    assert panel.t1_edit.placeholderText() == f"default {energies[0]:.4g}"
+    assert panel.signature_plot.xlabel == "E (log)"
+    _, w = mv.signature(spec, kind="wks", energies=energies, vertices=[3])
+    np.testing.assert_allclose(panel.signature_plot.y, w[0], rtol=1e-12)
+    panel.kind_combo.setCurrentIndex(panel.kind_combo.findData("hks"))
+    assert form.labelForField(panel.t1_edit).text() == "t1"

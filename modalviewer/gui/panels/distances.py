@@ -4,8 +4,13 @@ from __future__ import annotations
 
 from qtpy import QtCore, QtGui, QtWidgets
 
-from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
-from ...core.signatures import default_times, signature
+from ...core.operators import (
+    DISTANCE_KINDS,
+    OPERATOR_INFO,
+    operator_for_distance,
+    signature_kind,
+)
+from ...core.signatures import default_energies, default_times, signature
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, quiet, select_data
@@ -85,6 +90,7 @@ class DistancesPanel(QtWidgets.QWidget):
         scale_row = QtWidgets.QHBoxLayout()
         scale_row.addWidget(self.scale_edit, 1)
         scale_row.addWidget(self.log_check)
+        self.scale_row = scale_row
         form.addRow("t", scale_row)
         self.signature_plot = LinePlot("Signature of the picked vertex", "t (log)", "S_t")
         form.addRow(self.signature_plot)
@@ -143,7 +149,7 @@ class DistancesPanel(QtWidgets.QWidget):
         spec = self.state.spectrum(operator_for_distance(self.state.display.distance_kind))
         if spec is None:
             return None
-        times = default_times(spec)
+        times = default_energies(spec) if self.state.derived.wave() else default_times(spec)
         return float(times[0]), float(times[-1])
 
     def _on_range(self) -> None:
@@ -244,9 +250,21 @@ class DistancesPanel(QtWidgets.QWidget):
             self.pick_label.setText(
                 f"Picked vertex {state.picked_file_vertex} at ({x:.4g}, {y:.4g}, {z:.4g})"
             )
+        self._update_scale_words()
         self._update_range_placeholders()
         self._update_scale_edit()
         self._update_signature_plot()
+
+    def _update_scale_words(self) -> None:
+        """A wave kernel's scales are energies E, the others' times t."""
+        wave = signature_kind(self.state.display.distance_kind) == "wks"
+        form = self.layout()
+        for edit, word in ((self.t1_edit, "1"), (self.t2_edit, "2"), (self.scale_row, "")):
+            label = form.labelForField(edit)
+            if label is not None:
+                label.setText(("E" if wave else "t") + word)
+        plot = self.signature_plot
+        plot.xlabel, plot.ylabel = ("E (log)", "W_E") if wave else ("t (log)", "S_t")
 
     def _update_scale_edit(self) -> None:
         """The box shows the scale t the signature is (or would be) shown at."""
@@ -265,7 +283,7 @@ class DistancesPanel(QtWidgets.QWidget):
             self.t1_edit.setPlaceholderText("default")
             self.t2_edit.setPlaceholderText("default")
             return
-        table = self.state.derived.table(operator)
+        table = self.state.derived.kind_table()
         self.t1_edit.setPlaceholderText(f"default {table.times[0]:.4g}")
         self.t2_edit.setPlaceholderText(f"default {table.times[-1]:.4g}")
         if self.state.t_range is None:
@@ -280,8 +298,13 @@ class DistancesPanel(QtWidgets.QWidget):
         if not state.derived.has_signatures(operator) or state.picked is None:
             self.signature_plot.set_data([], [], title="Signature of the picked vertex")
             return
-        table = state.derived.table(operator)
-        times, values = signature(spec, table.times, vertices=[state.picked])
+        table = state.derived.kind_table()
+        if table.kind == "wks":
+            times, values = signature(
+                spec, kind="wks", energies=table.times, vertices=[state.picked]
+            )
+        else:
+            times, values = signature(spec, table.times, vertices=[state.picked])
         self.signature_plot.set_data(
             times,
             values[0],
