@@ -457,7 +457,7 @@ def _run(args) -> int:
         return 0
     mesh = _load(args.mesh, args.fix_slivers, args.partial)
     if args.command == "render":
-        from .scene.grid import grid_shape
+        from .scene.grid import grid_shape, padded, panel_size
 
         viewer = _viewer(mesh, args.mesh)
         viewer.state.set_isolines(args.isolines)
@@ -471,12 +471,16 @@ def _run(args) -> int:
         viewer.show_mode(asked[0])
         viewer.set_view(args.view, up=args.up)
         if args.modes is not None:
+            from .scene.export import png_path, save_png
+
             size = args.size or (1024, 768)
-            columns, rows = args.grid or grid_shape(len(args.modes))
-            panel = (max(16, size[0] // columns), max(16, size[1] // rows))
-            written = viewer.export_mode_grid(
-                args.output, args.modes, grid=(columns, rows), size=panel
-            )
+            grid = args.grid or grid_shape(len(args.modes))
+            try:
+                panel = panel_size(size, len(args.modes), grid)
+            except ValueError as exc:
+                raise _BadArgument(f"--size {size[0]}x{size[1]}: {exc}") from None
+            img = viewer.mode_grid(args.modes, grid=grid, size=panel)
+            written = save_png(png_path(args.output), padded(img, size))
             viewer.close()
             shown = ", ".join(f"{j}: {spec.eigenvalues[j]:.6g}" for j in args.modes)
             print(f"modes of {args.operator}: lambda {shown}")

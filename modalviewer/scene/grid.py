@@ -52,6 +52,36 @@ def bar_strip(width: int, colorbar, scale: float = 1.0) -> np.ndarray:
     return np.ascontiguousarray(strip)
 
 
+CAPTION_PX = 31
+"""Rows of a one-line caption above a panel (:func:`.comparison.caption` at scale 1)."""
+
+BAR_PX = 66
+"""Rows of the colour bar's strip below the panels, at most."""
+
+
+def panel_size(total, count: int, grid=None, gap: int = 4) -> tuple[int, int]:
+    """The panel size that makes a grid of ``count`` panels, with one-line captions and
+    the colour bar's strip, at most ``total`` (width, height) pixels."""
+    columns, rows = grid_shape(count, grid)
+    w = (int(total[0]) - gap * (columns - 1)) // columns
+    h = (int(total[1]) - BAR_PX - rows * CAPTION_PX - gap * (rows - 1)) // rows
+    if w < 16 or h < 16:
+        raise ValueError(f"{total[0]}x{total[1]} is too small for {columns}x{rows} panels")
+    return w, h
+
+
+def padded(img: np.ndarray, total) -> np.ndarray:
+    """``img`` on a white canvas of ``total`` (width, height) pixels, at its top left
+    (a grid's rounding leaves a few rows or columns); larger images are returned as
+    they are."""
+    w, h = int(total[0]), int(total[1])
+    if img.shape[1] > w or img.shape[0] > h:
+        return img
+    canvas = np.full((h, w, 3), 255, np.uint8)
+    canvas[: img.shape[0], : img.shape[1]] = img[..., :3]
+    return canvas
+
+
 def mode_grid(viewer, modes, operator: str | None = None, grid=None, size=GRID_PANEL):
     """The picture (RGB uint8) of ``modes`` of ``operator`` (default: the one shown)
     of ``viewer``'s mesh: panels of ``size`` pixels in a ``grid`` (columns, rows),
