@@ -29,6 +29,7 @@ EXTRA_OF = {
     "distributed": "batch",
     "trame_pyvista": "notebook",
     "trame_vtk": "notebook",
+    "robust_laplacian": "robust",
     "imageio": "video",
     "imageio_ffmpeg": "video",
 }

@@ -24,6 +24,7 @@ from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
 from .local_signature import local_signature
 from .mesh import Mesh, MeshError, MeshReport, remove_unused, repair_mesh
 from .pipeline import ZeroModesWarning, compute_spectrum
+from .robust import negative_cotan_weights, robust_laplacian_matrices
 from .shells import normal_shells_hessian, shells_hessian
 from .signatures import (
     SignatureTable,
@@ -62,6 +63,8 @@ __all__ = [
     "compute_spectrum",
     "ZeroModesWarning",
     "default_energies",
+    "negative_cotan_weights",
+    "robust_laplacian_matrices",
     "default_times",
     "load_spectrum",
     "local_signature",

@@ -1,15 +1,15 @@
 """``operator_matrices``: the (K, mass) of an operator's eigenproblem on a mesh.
 
 The assembly function of each operator comes from the registry
-(:attr:`.operators.OperatorInfo.assemble`); the mass is the lumped vertex area, repeated
-for each unknown of a vertex.
+(:attr:`.operators.OperatorInfo.assemble`); the mass is the lumped vertex area (or the
+operator's own, :attr:`.operators.OperatorInfo.assembles_mass`), repeated for each
+unknown of a vertex.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .laplacian import lumped_masses
 from .mesh import Mesh
 from .operators import operator_info
 
@@ -19,8 +19,7 @@ __all__ = ["operator_matrices"]
 def operator_matrices(mesh: Mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):
     """(K, mass_diag) of the eigenproblem ``K phi = lambda diag(mass) phi``."""
     info = operator_info(operator)  # a ValueError naming the known operators
-    m = lumped_masses(mesh)
-    K = info.stiffness(mesh, bending, membrane)
+    K, m = info.matrices(mesh, bending, membrane)
     if info.unknowns_per_vertex > 1:
         m = np.repeat(m, info.unknowns_per_vertex)
     return K, m

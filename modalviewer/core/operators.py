@@ -99,7 +99,7 @@ class OperatorInfo:
     has_weights : whether the bending and membrane weights apply.
     assemble : ``"module:function"`` in :mod:`modalviewer.core` that assembles K:
         ``function(mesh)``, or ``function(mesh, bending, membrane)`` with weights
-        (:meth:`stiffness`).
+        (:meth:`stiffness`); with ``assembles_mass`` it returns (K, mass).
     null_space : the exactly known null vectors in words.
     null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
     preview : the preview's reduced space (:class:`SpaceSettings`).
@@ -111,6 +111,13 @@ class OperatorInfo:
         factor goes out of core.
     signature_word : the signature (and distance) its spectrum defines, in words
         ("heat kernel"), or None.
+    assembles_mass : whether :attr:`assemble` returns the (n,) masses with K (an
+        operator with a mass of its own); otherwise the mass is the lumped vertex area.
+    measured_as : the operator whose measured laws (:attr:`exact_growth`,
+        :attr:`preview_growth`, :attr:`factor_memory`) this one borrows, or None: its own
+        runs in ``benchmarks/results/growth.json``.
+    nonnegative_weights : whether its weights stay non-negative on any mesh, so that the
+        viewer suggests it where the cotan weights go negative.
     wave_distance_kind : the distance of the wave kernel signature of its spectrum
         offered by the viewer and the CLI (``"wks"`` for the Laplacian), or None; the
         library computes that signature for any spectrum
@@ -139,6 +146,9 @@ class OperatorInfo:
     signature_word: str | None = None
     preview_arrays_per_mode: float = 3.0
     wave_distance_kind: str | None = None
+    assembles_mass: bool = False
+    measured_as: str | None = None
+    nonnegative_weights: bool = False
 
     @property
     def vector(self) -> bool:
@@ -246,11 +256,19 @@ class OperatorInfo:
 
     def stiffness(self, mesh, bending: float = 1.0, membrane: float = 1.0):
         """The operator's sparse matrix K on ``mesh`` (the function :attr:`assemble`)."""
+        return self.matrices(mesh, bending, membrane)[0]
+
+    def matrices(self, mesh, bending: float = 1.0, membrane: float = 1.0):
+        """(K, mass (n,) per vertex) on ``mesh``: the function :attr:`assemble`, and the
+        lumped vertex areas unless it returns a mass of its own (:attr:`assembles_mass`)."""
         module, function = self.assemble.split(":")
         assemble = getattr(importlib.import_module(f"modalviewer.core.{module}"), function)
-        if self.has_weights:
-            return assemble(mesh, bending, membrane)
-        return assemble(mesh)
+        result = assemble(mesh, bending, membrane) if self.has_weights else assemble(mesh)
+        if self.assembles_mass:
+            return result
+        from .laplacian import lumped_masses
+
+        return result, lumped_masses(mesh)
 
 
 # Preview spaces.  Without smoothing the space itself must be fine (10k spot, Galerkin
@@ -372,6 +390,27 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             preview_growth=_GROWTH["shells", "fast preview"],
             factor_memory=_FACTOR["shells"],
             signature_word="vibration",
+        ),
+        OperatorInfo(
+            "laplacian_robust",
+            "Laplacian (robust, intrinsic Delaunay)",
+            "Robust Laplacian",
+            unknowns_per_vertex=1,
+            distance_kind=None,
+            has_weights=False,
+            assemble="robust:robust_laplacian_matrices",
+            null_space="constants",
+            null_space_rule="constants",
+            preview=_SCALAR_SPACE,
+            # the cotan Laplacian's laws: as many unknowns, a matrix of about the same
+            # sparsity (the intrinsic flips replace edges, keeping their number)
+            exact_growth=_GROWTH["laplacian", "exact"],
+            preview_growth=_GROWTH["laplacian", "fast preview"],
+            factor_memory=_FACTOR["laplacian"],
+            preview_arrays_per_mode=1.25,
+            assembles_mass=True,
+            measured_as="laplacian",
+            nonnegative_weights=True,
         ),
         OperatorInfo(
             "shells_normal",

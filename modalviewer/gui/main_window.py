@@ -277,11 +277,18 @@ class MainWindow(QtWidgets.QMainWindow):
         what ``load_mesh`` raises."""
         from concurrent.futures import ThreadPoolExecutor
 
+        from ..core.robust import negative_cotan_weights
         from ..io import load_mesh
 
         started = time.monotonic()
         pool = ThreadPoolExecutor(1, thread_name_prefix="mesh-reader")
-        future = pool.submit(load_mesh, path, strict=strict)
+
+        def read():
+            mesh = load_mesh(path, strict=strict)
+            negative_cotan_weights(mesh)  # counted here, for the Compute panel's note
+            return mesh
+
+        future = pool.submit(read)
         pool.shutdown(wait=False)
         try:
             return future.result(timeout=READING_WAIT_S)  # small files: no dialog at all

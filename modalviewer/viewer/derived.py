@@ -245,6 +245,13 @@ class DerivedValues:
         """(n,) total curvature sqrt(k1^2 + k2^2) of the mesh."""
         return self._mesh_value("curvature", total_curvature)
 
+    def negative_cotan_weights(self) -> int:
+        """The number of edges of the mesh whose cotan weight is negative
+        (:func:`~modalviewer.core.robust.negative_cotan_weights`)."""
+        from ..core.robust import negative_cotan_weights
+
+        return negative_cotan_weights(self.state.mesh)
+
     def vertex_areas(self) -> np.ndarray:
         """(n,) lumped vertex areas: shares "of the surface" are shares of its area, not
         of its vertices, which differ on a mesh of uneven density."""

@@ -14,6 +14,7 @@ import numpy as np
 from ..core.mesh import _plural
 from ..core.operators import (
     DISTANCE_KINDS,
+    OPERATOR_INFO,
     distance_word,
     operator_for_distance,
     operator_info,
@@ -160,6 +161,22 @@ def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool])
     if ends:
         text += f" ({' and '.join(ends)} clipped)"
     return text
+
+
+def negative_weights_note(state: ViewerState) -> str:
+    """ "This mesh has 46 negative cotan weights: try the Laplacian (robust, intrinsic
+    Delaunay)." where the mesh has edges whose cotan weight is negative and the registry
+    has an operator whose weights never are; else ""."""
+    robust = next((info for info in OPERATOR_INFO.values() if info.nonnegative_weights), None)
+    if state.mesh is None or robust is None:
+        return ""
+    count = state.derived.negative_cotan_weights()
+    if count == 0:
+        return ""
+    return (
+        f"This mesh has {_plural(count, 'negative cotan weight')}: try the {robust.label}, "
+        "whose weights are never negative."
+    )
 
 
 def truncation_note(state: ViewerState, derived: DerivedValues | None = None) -> str:

@@ -111,3 +111,18 @@ def test_the_distances_panel_offers_the_wave_kernel_distance_over_energies(windo
     np.testing.assert_allclose(panel.signature_plot.y, w[0], rtol=1e-12)
     panel.kind_combo.setCurrentIndex(panel.kind_combo.findData("hks"))
     assert form.labelForField(panel.t1_edit).text() == "t1"
+
+
+def test_the_compute_panel_suggests_the_robust_laplacian_on_slivers(window):
+    from modalviewer.core.primitives import add_slivers, icosphere
+
+    pytest.importorskip("robust_laplacian")
+    panel = window.compute_panel
+    window.set_mesh(icosphere(3))
+    assert "negative cotan" not in panel.mesh_info.text()
+    v, f = add_slivers(icosphere(3), needles=20, caps=20, eps=1e-8, seed=2)
+    window.set_mesh(mv.Mesh(v, f))
+    assert "This mesh has 46 negative cotan weights: try the Laplacian (robust" in (
+        panel.mesh_info.text()
+    )
+    assert panel.operator_combo.findData("laplacian_robust") >= 0

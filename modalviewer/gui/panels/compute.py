@@ -5,6 +5,7 @@ from __future__ import annotations
 from qtpy import QtCore, QtWidgets
 
 from ...core.operators import OPERATOR_INFO
+from ...viewer import wording
 from ...viewer.model import PREVIEW_DELAY
 from ...viewer.state import ViewerState
 from .common import WrappingLabel, combo, quiet, select_data
@@ -139,4 +140,7 @@ class ComputePanel(QtWidgets.QWidget):
                 "a part held at a single vertex can rotate about it (three more zero modes "
                 "for the shells)."
             )
+        note = wording.negative_weights_note(self.state)
+        if note:
+            text += "\n" + note
         self.mesh_info.setText(text)
