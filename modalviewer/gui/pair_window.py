@@ -363,10 +363,24 @@ class PairWindow(QtWidgets.QWidget):
         if running is not None:
             self.progress.setValue(int(1000 * running.fraction))
             more = f" (+{len(pending) - 1} queued)" if len(pending) > 1 else ""
-            self.progress.setFormat(f"{running.description}: {running.stage} %p %{more}")
+            self.progress.setFormat(
+                self._fitted(running.description, f": {running.stage} %p %{more}")
+            )
         elif pending:
             self.progress.setValue(0)
-            self.progress.setFormat(f"waiting: {pending[0].description}")
+            self.progress.setFormat(self._fitted(f"waiting: {pending[0].description}", ""))
+        if pending:  # the whole text where the bar shows it shortened
+            self.progress.setToolTip(pending[0].description)
+
+    def _fitted(self, head: str, tail: str) -> str:
+        """``head`` + ``tail`` as the progress bar's format, ``head`` (the computation's
+        name) shortened with an ellipsis so that the text fits inside the bar: the
+        stage and percentage in ``tail`` always show ("%p" is the bar's percentage)."""
+        metrics = self.progress.fontMetrics()
+        room = self.progress.width() - 2 * metrics.horizontalAdvance("M")  # frame, margins
+        tail_width = metrics.horizontalAdvance(tail.replace("%p", "100"))
+        elide = QtCore.Qt.TextElideMode.ElideRight
+        return metrics.elidedText(head, elide, max(0, room - tail_width)) + tail
 
     # ========================================================== cameras
     def set_linked(self, on: bool) -> None:

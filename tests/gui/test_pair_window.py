@@ -198,3 +198,26 @@ def test_pair_export_dialog_offers_size_and_transparency(
     big, small = Image.open(out), Image.open(one)
     assert big.mode == "RGBA" and small.mode == "RGB"
     assert abs(big.width - 2 * small.width) <= 8 and big.height == 2 * small.height
+
+
+def test_the_pairs_progress_text_fits_its_bar(window, spot_path, moved_spot, qtbot):
+    """A newcomer found the pair's progress text cut off inside its bar (the
+    computation's long name, stage and percentage); the name is shortened with an
+    ellipsis and the stage and percentage always show."""
+    window.open_mesh(spot_path)
+    window.state.set_display(distance_kind="vibration")
+    pair = window.open_second_mesh(moved_spot, wait=False, k=20)
+    seen = []
+
+    def text_fits():
+        bar = pair.progress
+        if bar.isVisible() and "%" in bar.text():
+            seen.append((bar.text(), bar.fontMetrics().horizontalAdvance(bar.text()), bar.width()))
+        return bool(seen)
+
+    qtbot.waitUntil(text_fits, timeout=20000)
+    pair.pair.cancel()
+    text, width, room = seen[0]
+    assert width <= room - 8, seen[0]
+    assert text.rstrip(")").split(" (+")[0].endswith(" %"), text  # the percentage shows
+    qtbot.waitUntil(lambda: not pair.pair.pending(), timeout=20000)
