@@ -30,6 +30,7 @@ from .collection import open_collection  # noqa: E402 (numpy only; Dask loads in
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
 from .data import asset_path  # noqa: E402
+from .extras import MissingExtraError  # noqa: E402
 from .interop import as_mesh, operator_matrices, to_pyvista  # noqa: E402
 from .io import load_mesh  # noqa: E402
 from .plotting import InteractivePicture, Picture, add_to_plotter, plot, view  # noqa: E402
@@ -41,6 +42,7 @@ __all__ = [  # noqa: F405
     "load_mesh",
     "as_mesh",
     "asset_path",
+    "MissingExtraError",
     "operator_matrices",
     "to_pyvista",
     "plot",
