@@ -155,12 +155,23 @@ def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float
     Returns
     -------
     K : scipy.sparse.csr_matrix of shape (N, N)
-        Symmetric positive semi-definite.
+        Symmetric positive semi-definite; empty rows and columns at the vertices no face
+        uses (``mesh.unused``) and at merged duplicates.
     M : scipy.sparse.dia_matrix of shape (N, N)
-        The lumped mass; N is n, or 3 n for vector modes.
+        The lumped mass (zero where K's rows are empty); N is n, or 3 n for vector modes.
     """
-    K, mass = _operator_matrices(as_mesh(mesh), operator, bending, membrane)
-    return sp.csr_matrix(K), sp.diags(np.asarray(mass, dtype=np.float64), format="dia")
+    mesh = as_mesh(mesh)
+    solver = mesh.solver_mesh
+    K, mass = _operator_matrices(solver, operator, bending, membrane)
+    K, mass = sp.csr_matrix(K), np.asarray(mass, dtype=np.float64)
+    if solver is not mesh:  # the input's numbering: empty rows and zero mass where unused
+        per = K.shape[0] // solver.n_vertices
+        rows = (per * np.asarray(solver.file_vertices)[:, None] + np.arange(per)).ravel()
+        n = per * mesh.n_vertices
+        P = sp.csr_matrix((np.ones(len(rows)), (rows, np.arange(len(rows)))), shape=(n, len(rows)))
+        K = sp.csr_matrix(P @ K @ P.T)
+        mass = P @ mass
+    return K, sp.diags(mass, format="dia")
 
 
 @extra_needed("mv.to_pyvista")

@@ -192,3 +192,18 @@ def test_the_local_signature_takes_input_vertices(base, case):
     np.testing.assert_allclose(with_spec, want[:1], rtol=1e-8)
     with pytest.raises(MeshError, match=f"vertex {unused[1]} .*used by no face"):
         mv.local_signature(m, "laplacian", [unused[1]], times)
+
+
+@pytest.mark.parametrize("operator", ["laplacian", "laplacian_robust", "shells"])
+def test_every_operators_matrices_are_empty_at_unused_vertices(base, case, operator):
+    if operator == "laplacian_robust":
+        pytest.importorskip("robust_laplacian")
+    v, f, where, dup, unused, m = case
+    K, M = mv.operator_matrices(m, operator)
+    Kc, Mc = mv.operator_matrices(base, operator)
+    per = K.shape[0] // len(v)
+    rows = (per * where[:, None] + np.arange(per)).ravel()
+    empty = (per * np.r_[unused, dup][:, None] + np.arange(per)).ravel()
+    assert abs(K[empty]).sum() == 0 and np.all(M.diagonal()[empty] == 0)
+    np.testing.assert_allclose(K[rows][:, rows].toarray(), Kc.toarray(), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(M.diagonal()[rows], Mc.diagonal(), rtol=1e-15)
