@@ -444,6 +444,24 @@ def big_solves_figures(data: dict) -> str:
 
 
 #: Every generated table: its name in the page's markers -> (JSON files, the table).
+def correspondence_table(data: dict) -> str:
+    """Functional maps on three bases (``benchmarks.correspondence``): the mean and median
+    geodesic error of each basis, descriptor and refinement."""
+    lines = [
+        "| basis | descriptors | modes | mean error | median error | map s |",
+        "|" + " --- |" * 6,
+    ]
+    for r in data["rows"]:
+        modes = str(r["k"])
+        if r["zoomout"] is not None:
+            modes += f" -> {r['zoomout']} (ZoomOut, {r['zoomout_step']} a step)"
+        lines.append(
+            f"| {LABELS.get(r['basis'], r['basis'])} | {r['descriptors'].upper()} | {modes} "
+            f"| {r['mean_error']:.3f} | {r['median_error']:.3f} | {r['map_seconds']:.1f} |"
+        )
+    return "\n".join(lines)
+
+
 TABLES = {
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),
     "paper": (["latest"], lambda: paper_table(load("latest"))),
@@ -473,6 +491,7 @@ TABLES = {
     "big-solves": (["memory"], lambda: big_solves_table(load("memory"))),
     "memory-figures": (["memory"], lambda: big_solves_figures(load("memory"))),
     "factor-memory": (["factor_memory"], lambda: factor_memory_table(load("factor_memory"))),
+    "correspondence": (["correspondence"], lambda: correspondence_table(load("correspondence"))),
     "memory": (
         ["growth_k300", "curved"],
         lambda: memory_check_table(load("growth_k300"), load("curved")),

@@ -20,6 +20,7 @@ from .cross import (
 )
 from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
+from .fmaps import FunctionalMap, correspondence_errors, functional_map
 from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
 from .local_signature import local_signature
 from .mesh import Mesh, MeshError, MeshReport, remove_unused, repair_mesh
@@ -63,6 +64,9 @@ __all__ = [
     "compute_spectrum",
     "ZeroModesWarning",
     "default_energies",
+    "FunctionalMap",
+    "functional_map",
+    "correspondence_errors",
     "negative_cotan_weights",
     "robust_laplacian_matrices",
     "default_times",

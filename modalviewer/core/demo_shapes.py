@@ -12,7 +12,7 @@ from .mesh import Mesh, repair_mesh
 from .primitives import grid_plate
 
 __all__ = ["plate", "folded_plate", "bumpy_plate", "voxel_surface", "double_torus",
-           "machined_part"]  # fmt: skip
+           "machined_part", "bent_pose"]  # fmt: skip
 
 PLATE_N = (48, 24)  # grid cells of the Fig. 1 plate, 2 x 1
 FOLD_X = 1.0  # the fold runs along the grid line x = 1
@@ -33,6 +33,31 @@ def folded_plate(angle_degrees: float = 90.0) -> Mesh:
     v[right, 0] = FOLD_X + d * np.cos(a)
     v[right, 2] = d * np.sin(a)
     return Mesh(v, base.faces)
+
+
+def bent_pose(
+    mesh: Mesh, angle_degrees: float = 40.0, at: float = 0.5, width: float = 0.4
+) -> Mesh:
+    """A second pose of ``mesh``, vertex for vertex (the ground truth of a correspondence
+    is the identity): the part beyond ``at`` of the bounding box's longest extent turned
+    by ``angle_degrees`` about an axis across it, the turn growing smoothly (a smoothstep)
+    over ``width`` of that extent, so only that band is strained, the more the farther
+    from the axis.  The axis runs along the box's middle extent, through the band's middle
+    and the box's centre, so a flat shape bends as a sheet does (nearly isometrically)."""
+    v = np.array(mesh.vertices)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    extent = hi - lo
+    along, third = int(np.argmax(extent)), int(np.argmin(extent))
+    s = (v[:, along] - lo[along]) / extent[along]
+    x = np.clip((s - at) / width + 0.5, 0.0, 1.0)
+    phi = np.radians(angle_degrees) * x * x * (3.0 - 2.0 * x)
+    pivot = 0.5 * (lo + hi)
+    pivot[along] = lo[along] + at * extent[along]
+    a, b = v[:, along] - pivot[along], v[:, third] - pivot[third]
+    out = v.copy()
+    out[:, along] = pivot[along] + np.cos(phi) * a - np.sin(phi) * b
+    out[:, third] = pivot[third] + np.sin(phi) * a + np.cos(phi) * b
+    return Mesh(out, mesh.faces)
 
 
 def fold_vertices(mesh: Mesh) -> np.ndarray:
