@@ -748,18 +748,13 @@ def _distance_to(args, mesh_a) -> int:
     mesh_b = mesh_b.solver_mesh  # as mesh_a: the vertices faces use, with the file's numbers
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
-    if signature_kind(args.kind) == "wks":
-        raise ValueError(
-            "--to compares heat-type signatures (--kind vibration, feature or hks); the "
-            "wave kernel distance is of one mesh"
-        )
     operator = KINDS[args.kind]
     spec_a = _cached_spectrum(mesh_a, operator, args.k)
     spec_b = _cached_spectrum(mesh_b, operator, args.k)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", mv.ScaleWarning)
         try:
-            tables = mv.CrossTables(spec_a, spec_b)
+            tables = mv.CrossTables(spec_a, spec_b, kind=signature_kind(args.kind))
         except ValueError as exc:  # the library's advice, in this command's options
             if args.rescale or "do not overlap" not in str(exc):
                 raise

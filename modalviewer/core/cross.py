@@ -50,7 +50,7 @@ import numpy as np
 
 from .mesh import Mesh
 from .operators import operator_info
-from .signatures import SignatureTable, default_times, normalised_signatures
+from .signatures import SignatureTable, default_energies, default_times, normalised_signatures
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_vertex, check_vertices
 
@@ -145,10 +145,15 @@ def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
 
 
 def common_times(
-    spec_a: Spectrum, spec_b: Spectrum, t_range: TRange = None, samples: int = 100
+    spec_a: Spectrum,
+    spec_b: Spectrum,
+    t_range: TRange = None,
+    samples: int = 100,
+    kind: str = "heat",
 ) -> np.ndarray:
     """Log-spaced scales shared by both spectra: ``t_range`` if given, else the
-    intersection of the two default ranges (see the module docstring).
+    intersection of the two default ranges (see the module docstring); for
+    ``kind="wks"`` energies, the intersection of the default energy bands.
 
     Parameters
     ----------
@@ -172,7 +177,8 @@ def common_times(
     """
     samples = check_count(samples, "samples", 2)
     if t_range is None:
-        ta, tb = default_times(spec_a, 2), default_times(spec_b, 2)
+        ends = default_energies if kind == "wks" else default_times
+        ta, tb = ends(spec_a, 2), ends(spec_b, 2)
         t1, t2 = max(ta[0], tb[0]), min(ta[-1], tb[-1])
         if not t1 < t2:
             raise ValueError(
@@ -193,7 +199,8 @@ class CrossTables:
 
     Attributes
     ----------
-    times : (T,) the common scales (:func:`common_times`).
+    times : (T,) the common scales (:func:`common_times`; with ``kind="wks"`` the common
+        energies of the wave kernel signatures, whose width is then the same on both).
     a, b : :class:`SignatureTable` of each mesh at ``times``.
     """
 
@@ -204,13 +211,14 @@ class CrossTables:
         t_range: TRange = None,
         samples: int = 100,
         include_zero: bool = False,
+        kind: str = "heat",
     ):
         _check_pair(spec_a, spec_b)
-        times = common_times(spec_a, spec_b, t_range, samples)
+        times = common_times(spec_a, spec_b, t_range, samples, kind)
         t = (times[0], times[-1])
         self.times = times
-        self.a = SignatureTable(spec_a, t, len(times), include_zero)
-        self.b = SignatureTable(spec_b, t, len(times), include_zero)
+        self.a = SignatureTable(spec_a, t, len(times), include_zero, kind=kind)
+        self.b = SignatureTable(spec_b, t, len(times), include_zero, kind=kind)
 
     def a_to_b(self, vertex: int) -> np.ndarray:
         """(n_b,) distance from vertex ``vertex`` of A to every vertex of B."""

@@ -35,9 +35,7 @@ def folded_plate(angle_degrees: float = 90.0) -> Mesh:
     return Mesh(v, base.faces)
 
 
-def bent_pose(
-    mesh: Mesh, angle_degrees: float = 40.0, at: float = 0.5, width: float = 0.4
-) -> Mesh:
+def bent_pose(mesh: Mesh, angle_degrees: float = 40.0, at: float = 0.5, width: float = 0.4) -> Mesh:
     """A second pose of ``mesh``, vertex for vertex (the ground truth of a correspondence
     is the identity): the part beyond ``at`` of the bounding box's longest extent turned
     by ``angle_degrees`` about an axis across it, the turn growing smoothly (a smoothstep)

@@ -85,8 +85,8 @@ class PairWindow(QtWidgets.QWidget):
         for kind, label in DISTANCE_KINDS.items():
             self.kind_combo.addItem(label, kind)
         self.kind_combo.setToolTip(
-            "The signature compared: vibration (Discrete Shells), feature (E_D^N) or "
-            "heat kernel (Laplacian)"
+            "The signature compared: vibration (Discrete Shells), feature (E_D^N), heat "
+            "kernel or wave kernel (Laplacian)"
         )
         self.kind_combo.currentIndexChanged.connect(
             lambda: self.set_kind(self.kind_combo.currentData())

@@ -34,7 +34,12 @@ from ..core.cache import SpectrumCache
 from ..core.cross import CrossTables, ScaleWarning
 from ..core.laplacian import lumped_masses
 from ..core.mesh import Mesh, MeshError
-from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info
+from ..core.operators import (
+    DISTANCE_KINDS,
+    operator_for_distance,
+    operator_info,
+    signature_kind,
+)
 from ..core.spectrum import Spectrum
 from .jobs import CANCELLED, DONE, Job, JobQueue, SpectrumJob
 from .state import (
@@ -161,7 +166,7 @@ class PairState:
         self._spectra: dict[tuple[str, str, SpectrumKey], Spectrum] = {}
         self._pending: dict[tuple[str, str, SpectrumKey], Job] = {}
         self._failed: dict[tuple[str, str, SpectrumKey], str] = {}
-        self._tables: tuple | None = None  # (ids of both spectra, CrossTables or error)
+        self._tables: tuple | None = None  # (ids of both spectra, kind; CrossTables or error)
         self._distance: tuple | None = None  # (tables id, pick, distances)
         self._back: tuple | None = None  # (tables id, side, best match, back match)
 
@@ -380,13 +385,13 @@ class PairState:
         sa, sb = self.spectrum("a"), self.spectrum("b")
         if sa is None or sb is None:
             return None
-        ids = (id(sa), id(sb))
+        ids = (id(sa), id(sb), self.kind)  # the heat and wave kernels share a spectrum
         if self._tables is None or self._tables[0] != ids:
             self.note = ""
             try:
                 with warnings.catch_warnings(record=True) as caught:
                     warnings.simplefilter("always", ScaleWarning)
-                    tables = CrossTables(sa, sb)
+                    tables = CrossTables(sa, sb, kind=signature_kind(self.kind))
                 if any(issubclass(w.category, ScaleWarning) for w in caught):
                     area_a, area_b = (float(s.mass.sum()) for s in (sa, sb))
                     self.note = (

@@ -215,3 +215,22 @@ def test_the_pair_takes_and_gives_the_files_vertex_numbers(tmp_path, spot):
     assert pair.best_match()[:2] == ("a", 700) and pair.best_file_match()[:2] == ("a", 707)
     with pytest.raises(ValueError, match="A: .*3"):
         pair.pick_file_vertex("a", 3)  # no face uses it
+
+
+def test_the_wave_kernel_distance_between_shapes_is_its_own(tmp_path, spot):
+    """The heat and wave kernel kinds share the Laplacian's spectrum; switching between
+    them gives each its own tables (a cache keyed by the spectra alone served the heat
+    kernel's for both)."""
+    moved = _moved(spot)
+    pair = _pair(tmp_path, spot, moved, k=K, kind="hks")
+    _wait(pair)
+    pair.pick("a", 700)
+    heat = pair.distance_on("b").copy()
+    pair.set_kind("wks")
+    _wait(pair)
+    wave = pair.distance_on("b")
+    spec_a, spec_b = pair.spectrum("a"), pair.spectrum("b")
+    expected = mv.CrossTables(spec_a, spec_b, kind="wks").a_to_b(700)
+    np.testing.assert_allclose(wave, expected, rtol=1e-10, atol=1e-12 * expected.max())
+    assert not np.allclose(wave / wave.max(), heat / heat.max())
+    assert wave[700] <= 1e-8 * wave.max()

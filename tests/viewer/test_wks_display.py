@@ -70,10 +70,12 @@ def test_cli_distance_kind_wks_writes_the_library_distance(tmp_path, monkeypatch
     expected = mv.multiscale_distance(spec, 3, kind="wks")
     np.testing.assert_allclose(rows[:, 1], expected, rtol=1e-6, atol=1e-9 * expected.max())
     assert "wks distance from vertex 3" in capsys.readouterr().out
-    # two meshes compare heat-type signatures only: a one-line error
+    # a mesh against itself: the wave kernel distance to B is the one on A
+    csv_to = tmp_path / "to.csv"
     args = ["distance", str(path), "--vertex", "3", "--kind", "wks", "--to", str(path)]
-    assert cli.main(args) == 1
-    assert "wave kernel distance is of one mesh" in capsys.readouterr().err
+    assert cli.main([*args, "-k", "20", "--csv", str(csv_to)]) == 0
+    rows = np.loadtxt(csv_to, delimiter=",", skiprows=1)
+    np.testing.assert_allclose(rows[:, 1], expected, rtol=1e-6, atol=1e-6 * expected.max())
 
 
 def test_a_batch_store_keeps_the_wks_signature(tmp_path):
