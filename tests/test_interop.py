@@ -155,6 +155,8 @@ def test_plot_returns_the_viewers_picture(spot, tmp_path):
     assert red > 200  # white to red
     dist = mv.plot(spot, spec, vertex=0, size=(320, 240), k=8)
     assert not np.array_equal(dist.array, field.array)
+    wave = mv.plot(spot, spec, vertex=0, kind="wks", size=(320, 240), k=8)
+    assert not np.array_equal(wave.array, dist.array)  # the wave kernel's own map
     # a mode without a spectrum is refused (it drew the plain grey mesh without a word)
     with pytest.raises(ValueError, match="mode=8 is a mode of a spectrum: pass one"):
         mv.plot(spot, mode=8)
