@@ -30,7 +30,6 @@ format: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m benchmarks.run --sizes 10k 50k 130k --baseline-max-unknowns 200000 --few 12 50
-	$(PY) -m benchmarks.preview --sizes 10k 50k 130k
 	$(PY) -m benchmarks.growth
 
 $(DOCS_STAMP): $(STAMP)

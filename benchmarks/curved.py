@@ -1,5 +1,4 @@
-"""Preview against exact spectra on curved meshes: time, peak memory and the preview's
-eigenvalue errors, each run in its own process.
+"""Exact spectra on curved meshes: time and peak memory, each run in its own process.
 
     python -m benchmarks.curved --cases spot:loop:2 hand:loop:2 -k 100
     python -m benchmarks.curved --operators laplacian --keep-others   # re-measure some rows
@@ -10,10 +9,8 @@ horns; ``hand``: ``demo_hand.obj``, five thin fingers; ``part``:
 (named in the results by its stem) subdivided
 ``level`` times, by Loop (``loop``, smooth) or by splitting each triangle in four in its
 plane (``flat``: the part keeps its sharp edges).  Writes
-``benchmarks/results/curved.json``.  Each (case, operator, accuracy) runs in a fresh
-Python process so its peak resident memory is its own; the exact run comes first and the
-preview's (and the fast preview's, never refined, what the viewer would show first)
-lowest 50 non-zero eigenvalues are compared with it.  The child processes compute with
+``benchmarks/results/curved.json``.  Each (case, operator) runs in a fresh Python
+process so its peak resident memory is its own.  The child processes compute with
 the memory settings of the viewer's and the command line's compute processes
 (:func:`modalviewer.processes.memory.prepare_compute_process`), so their peaks are what
 a user's computation needs.
@@ -39,20 +36,17 @@ prepare_compute_process()
 import numpy as np
 import modalviewer as mv
 asset, scheme, level = sys.argv[1], sys.argv[2], int(sys.argv[3])
-operator, accuracy, k = sys.argv[4], sys.argv[5], int(sys.argv[6])
+operator, k = sys.argv[4], int(sys.argv[5])
 from benchmarks.curved import case_mesh
 mesh = case_mesh(asset, scheme, level)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 t = time.perf_counter()
-spec = mv.compute_spectrum(mesh, operator, k, accuracy=accuracy)
+spec = mv.compute_spectrum(mesh, operator, k)
 seconds = time.perf_counter() - t
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 nonzero = spec.eigenvalues[~spec.zero_mode_mask()]
 print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds, "peak_mb": peak,
-                  "mesh_mb": before, "eigenvalues": [float(x) for x in nonzero],
-                  "estimated_error": float(spec.estimated_error) if spec.is_preview else 0.0,
-                  "refinement_steps": int(spec.parameters.get("preview", {})
-                                          .get("refinement", {}).get("steps", 0))}))
+                  "mesh_mb": before, "eigenvalues": [float(x) for x in nonzero]}))
 """
 
 
@@ -112,7 +106,7 @@ def case_path(asset: str) -> str:
     return ASSETS.get(asset, str(Path(asset).resolve()))
 
 
-def run(case: tuple[str, str, int], operator: str, accuracy: str, k: int) -> dict:
+def run(case: tuple[str, str, int], operator: str, k: int) -> dict:
     asset, scheme, level = case
     out = subprocess.run(
         [
@@ -123,7 +117,6 @@ def run(case: tuple[str, str, int], operator: str, accuracy: str, k: int) -> dic
             scheme,
             str(level),
             operator,
-            accuracy,
             str(k),
         ],
         capture_output=True,
@@ -155,35 +148,14 @@ def main(argv=None) -> int:
     operators = list(OPERATOR_NAMES)  # a mesh's rows in the registry's order
     for case in args.cases:
         for operator in args.operators:
-            exact = run(case, operator, "exact", args.k)
-            preview = run(case, operator, "preview", args.k)
-            m = min(50, len(exact["eigenvalues"]), len(preview["eigenvalues"]))
-            lam = exact["eigenvalues"][:m]
-            errors = [abs(a - b) / b for a, b in zip(preview["eigenvalues"][:m], lam, strict=True)]
-            fast = run(case, operator, "fast preview", args.k)
-            m_fast = min(m, len(fast["eigenvalues"]))
-            fast_errors = [
-                abs(a - b) / b
-                for a, b in zip(fast["eigenvalues"][:m_fast], lam[:m_fast], strict=True)
-            ]
+            exact = run(case, operator, args.k)
             row = {
                 "mesh": case_name(case),
                 "vertices": exact["vertices"],
                 "operator": operator,
                 "k": args.k,
                 "exact_seconds": round(exact["seconds"], 2),
-                "preview_seconds": round(preview["seconds"], 2),
-                "time_ratio": round(preview["seconds"] / exact["seconds"], 3),
                 "exact_peak_mb": round(exact["peak_mb"]),
-                "preview_peak_mb": round(preview["peak_mb"]),
-                "memory_ratio": round(preview["peak_mb"] / exact["peak_mb"], 3),
-                "largest_error_lowest_50": round(max(errors), 5),
-                "estimated_error": round(preview["estimated_error"], 5),
-                "refinement_steps": preview["refinement_steps"],
-                "fast_preview_seconds": round(fast["seconds"], 2),
-                "fast_preview_peak_mb": round(fast["peak_mb"]),
-                "fast_preview_largest_error_lowest_50": round(max(fast_errors), 5),
-                "fast_preview_estimated_error": round(fast["estimated_error"], 5),
             }
             rows.append(row)
             print(json.dumps(row), flush=True)

@@ -1,12 +1,11 @@
-"""Time and peak memory against mesh size, 10k to 1M vertices, for every operator, exact
-and preview (refined where needed, and the fast preview the viewer shows), with the
-fitted growth exponent.
+"""Time and peak memory of the exact solve against mesh size, 10k to 1M vertices, for
+every operator, with the fitted growth exponents (the memory check's laws).
 
     python -m benchmarks.growth [--grids 100 180 320 580 1000] [--operators ...] [-k 100]
 
 The meshes are the bumpy plate (:func:`modalviewer.core.demo_shapes.bumpy_plate`) on
-n x n grids: 10k, 32k, 102k, 336k and 1M vertices by default.  Every (size, operator,
-accuracy) runs in a fresh process with the computation processes' memory settings, so
+n x n grids: 10k, 32k, 102k, 336k and 1M vertices by default.  Every (size, operator)
+runs in a fresh process with the computation processes' memory settings, so
 its peak resident memory is its own; mesh construction is not timed, assembly is.  A run
 the memory check refuses (:func:`modalviewer.viewer.model.memory_refusal`: more than
 three quarters of this machine's memory expected) is recorded as refused with the
@@ -36,28 +35,23 @@ from modalviewer.core.cost import LAWS_FROM_VERTICES as FIT_FROM  # noqa: E402
 # Sizes from FIT_FROM vertices on enter the fitted exponents.
 
 
-def _one(grid: int, operator: str, accuracy: str, k: int) -> dict:
+def _one(grid: int, operator: str, k: int) -> dict:
     import modalviewer as mv
     from modalviewer.core.demo_shapes import bumpy_plate
 
     mesh = bumpy_plate(grid)
     before = peak_mb()
     t = time.perf_counter()
-    spec = mv.compute_spectrum(mesh, operator, k, accuracy=accuracy)
+    mv.compute_spectrum(mesh, operator, k)
     seconds = time.perf_counter() - t
-    preview = spec.parameters.get("preview", {})
     return {
         "grid": grid,
         "vertices": mesh.n_vertices,
         "operator": operator,
-        "accuracy": accuracy,
-        "is_preview": bool(spec.is_preview),
         "k": int(k),
         "seconds": round(seconds, 3),
         "peak_mb": round(peak_mb()),
         "mesh_mb": round(before),
-        "refinement_steps": int(preview.get("refinement", {}).get("steps", 0)),
-        "estimated_error": float(spec.estimated_error) if spec.is_preview else 0.0,
     }
 
 
@@ -94,14 +88,12 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--grids", type=int, nargs="+", default=[100, 180, 320, 580, 1000])
     p.add_argument("--operators", nargs="+", default=list(OPERATOR_NAMES))
-    p.add_argument("--accuracies", nargs="+", default=["fast preview", "preview", "exact"])
     p.add_argument("-k", type=int, default=100)
     p.add_argument("--name", default="growth", help="results file: benchmarks/results/NAME.json")
     p.add_argument(
         "--keep-others",
         action="store_true",
-        help="keep the results file's rows of other grids, operators or accuracies "
-        "(re-measure some)",
+        help="keep the results file's rows of other grids or operators (re-measure some)",
     )
     p.add_argument(
         "--refit", action="store_true", help="only fit again the rows in the results file"
@@ -118,78 +110,43 @@ def main(argv=None) -> int:
         rows = [
             r
             for r in json.loads(results.read_text())["rows"]
-            if not (
-                r["grid"] in args.grids
-                and r["operator"] in args.operators
-                and r["accuracy"] in args.accuracies
-            )
+            if not (r["grid"] in args.grids and r["operator"] in args.operators)
         ]
     for grid in args.grids:
         for operator in args.operators:
-            for accuracy in args.accuracies:
-                # the refined preview factorises the operator as the exact solve does
-                check = accuracy != "fast preview"
-                refused = _refusal(grid, operator, args.k) if check else None
-                if refused:
-                    row = {
-                        "grid": grid,
-                        "vertices": grid * grid,
-                        "operator": operator,
-                        "accuracy": accuracy,
-                        "k": args.k,
-                        "refused": refused,
-                    }
-                else:
-                    row = _in_child(_one, grid, operator, accuracy, args.k)
-                rows.append(row)
-                print(row, flush=True)
-                rows.sort(key=lambda r: (r["grid"], order.index(r["operator"])))
-                save_result(args.name, {"k": args.k, "rows": rows, "fits": _fits(rows)})
+            refused = _refusal(grid, operator, args.k)
+            if refused:
+                row = {
+                    "grid": grid,
+                    "vertices": grid * grid,
+                    "operator": operator,
+                    "k": args.k,
+                    "refused": refused,
+                }
+            else:
+                row = _in_child(_one, grid, operator, args.k)
+            rows.append(row)
+            print(row, flush=True)
+            rows.sort(key=lambda r: (r["grid"], order.index(r["operator"])))
+            save_result(args.name, {"k": args.k, "rows": rows, "fits": _fits(rows)})
     return 0
-
-
-def mode_exponents(rows: list[dict], more_modes: list[dict]) -> dict[tuple[str, str], float]:
-    """(operator, accuracy) -> the exponent e of ``seconds ~ k^e``, from a run with more
-    modes (``more_modes``, e.g. growth_k300.json's rows) against the 100-mode run of the
-    same operator, accuracy and grid in ``rows``."""
-    out = {}
-    for r in more_modes:
-        if "seconds" not in r:
-            continue
-        base = next(
-            (
-                b
-                for b in rows
-                if "seconds" in b
-                and (b["operator"], b["accuracy"], b["grid"])
-                == (r["operator"], r["accuracy"], r["grid"])
-                and b["k"] != r["k"]
-            ),
-            None,
-        )
-        if base is not None:
-            e = np.log(r["seconds"] / base["seconds"]) / np.log(r["k"] / base["k"])
-            out[r["operator"], r["accuracy"]] = round(float(e), 3)
-    return out
 
 
 def _fits(rows: list[dict]) -> list[dict]:
     fits = []
     for operator in dict.fromkeys(r["operator"] for r in rows):
-        for accuracy in ("exact", "preview", "fast preview"):
-            sel = [r for r in rows if r["operator"] == operator and r["accuracy"] == accuracy]
-            time_fit, memory_fit = fit_growth(sel, "seconds"), fit_growth(sel, "peak_mb")
-            if time_fit and memory_fit:
-                fits.append(
-                    {
-                        "operator": operator,
-                        "accuracy": accuracy,
-                        "seconds_at_100k": round(time_fit[0], 3),
-                        "time_exponent": round(time_fit[1], 3),
-                        "peak_mb_at_100k": round(memory_fit[0], 1),
-                        "memory_exponent": round(memory_fit[1], 3),
-                    }
-                )
+        sel = [r for r in rows if r["operator"] == operator]
+        time_fit, memory_fit = fit_growth(sel, "seconds"), fit_growth(sel, "peak_mb")
+        if time_fit and memory_fit:
+            fits.append(
+                {
+                    "operator": operator,
+                    "seconds_at_100k": round(time_fit[0], 3),
+                    "time_exponent": round(time_fit[1], 3),
+                    "peak_mb_at_100k": round(memory_fit[0], 1),
+                    "memory_exponent": round(memory_fit[1], 3),
+                }
+            )
     return fits
 
 

@@ -55,7 +55,6 @@ def run(size: str, operator: str, k: int, desktop: bool = False) -> dict:
     win.show()
     app.processEvents()
     mesh = make_mesh(size)
-    win.state.set_compute_settings(preview=False)  # the exact computation (see progressive.py)
     win.set_mesh(mesh)
     win.viewport.render_now()  # the first draw of a new mesh is slow in software
     app.processEvents()

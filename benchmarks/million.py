@@ -4,10 +4,9 @@
 
 The real main window, off-screen (software OpenGL), empty cache, on the bumpy plate of a
 1000 x 1000 grid (1 000 000 vertices).  Measured: seconds to set the mesh and draw it;
-for the Laplacian (exact, with "Preview first where it pays"), then a pick and its heat
-kernel distance map, then the 3D shells (Preview only): what the viewer did
-(preview or not, and why, from its status line), seconds until the spectrum was on
-screen, the progress stages seen, the longest gap of the event loop while computing (a
+for the Laplacian's exact spectrum, then a pick and its heat kernel distance map: what
+the viewer said (its status line), seconds until the spectrum was on screen, the
+progress stages seen, the longest gap of the event loop while computing (a
 10 ms timer: the window stays responsive when it is short) and the computing process's
 peak memory.  Writes ``benchmarks/results/million.json`` and screenshots beside it.
 """
@@ -52,8 +51,7 @@ def run(grid: int, k: int) -> dict:
     win.viewer.events.status.connect(lambda text, *_: statuses.append(text))
     clock = EventLoopGaps()
 
-    def compute(operator: str, preview_only: bool) -> dict:
-        win.state.set_compute_settings(preview_only=preview_only)
+    def compute(operator: str) -> dict:
         statuses.clear()
         stages: list[str] = []
         clock.reset()
@@ -68,15 +66,11 @@ def run(grid: int, k: int) -> dict:
                 first_on_screen = time.perf_counter() - started
             app.processEvents()
             time.sleep(0.005)
-        spec = win.state.spectrum(operator)
         row = {
             "operator": operator,
-            "preview_only": preview_only,
             "on_screen_s": round(time.perf_counter() - started, 1),
             "first_on_screen_s": None if first_on_screen is None else round(first_on_screen, 1),
             "error": win.viewer.last_error,
-            "is_preview": bool(spec is not None and spec.is_preview),
-            "estimated_error": float(spec.estimated_error) if spec is not None else None,
             "status": list(dict.fromkeys(statuses)),
             "stages": list(dict.fromkeys(stages)),
             "longest_event_loop_gap_ms": _rounded(clock.longest_ms()),
@@ -90,7 +84,7 @@ def run(grid: int, k: int) -> dict:
         win.export_screenshot(ROOT / "benchmarks" / "results" / f"million_{operator}.png")
         return row
 
-    out["laplacian"] = compute("laplacian", preview_only=False)
+    out["laplacian"] = compute("laplacian")
     # a pick shows the heat kernel distance from the vertex (the Laplacian's spectrum)
     win.state.set_display(distance_kind="hks")
     t = time.perf_counter()
@@ -100,7 +94,6 @@ def run(grid: int, k: int) -> dict:
     app.processEvents()
     out["pick_and_distance_map_s"] = round(time.perf_counter() - t, 2)
     win.export_screenshot(ROOT / "benchmarks" / "results" / "million_laplacian_distance.png")
-    out["shells"] = compute("shells", preview_only=True)
     clock.stop()
     win.close()
     return out

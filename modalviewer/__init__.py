@@ -14,18 +14,13 @@ import os as _os
 # MKL PARDISO (Intel OpenMP threads) and numpy's OpenBLAS take turns on the same cores.
 # By default both keep their threads spinning after each call (KMP_BLOCKTIME 200 ms,
 # OpenBLAS about 0.1 s), so each slows the other down; the eigensolver alternates
-# between them hundreds of times.  Measured on the 10k shells benchmark (35k unknowns,
-# 300 modes, 2 cores): 23.0 s with the defaults, 16.4 s with these.  Set before numpy
+# between them hundreds of times (benchmarks/import_order.py measures it).  Set before numpy
 # loads OpenBLAS; an explicit setting in the environment wins.  When numpy was imported
 # first, the OpenBLAS timeout comes too late: the eigensolver then runs OpenBLAS on one
 # thread at run time (core/threads.py), whatever the import order.
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
-from .coarsen import (  # noqa: E402 (numpy only; MeshLab and VTK load when run)
-    preview_copy,
-    start_preview_copy,
-)
 from .collection import open_collection  # noqa: E402 (numpy only; Dask loads in run_batch)
 from .core import *  # noqa: E402, F403
 from .core import __all__ as _core_all  # noqa: E402
@@ -52,8 +47,6 @@ __all__ = [  # noqa: F405
     "InteractivePicture",
     "fix_slivers",
     "SliverReport",
-    "preview_copy",
-    "start_preview_copy",
     "Viewer",
     "open_collection",
 ]

@@ -27,8 +27,20 @@ OPERATORS = OPERATOR_NAMES
 KINDS = {kind: operator_for_distance(kind) for kind in DISTANCE_KINDS}
 
 
+PREVIEW_REMOVED = (
+    "--preview was removed: every spectrum is exact. For the lowest modes sooner ask for "
+    "fewer modes (-k); from Python, compute_spectrum(..., on_modes=callback) hands over "
+    "the lowest exact modes as they converge"
+)
+"""What any command says to ``--preview`` (an argument error, exit code 2)."""
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit code 2
+        if message.startswith("unrecognized arguments:"):
+            given = message.split(":", 1)[1].split()
+            if any(a == "--preview" or a.startswith("--preview=") for a in given):
+                message = PREVIEW_REMOVED
         sys.stderr.write(f"modalviewer: error: {message}\n")
         raise SystemExit(2)
 
@@ -179,14 +191,6 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("-k", type=COUNT, default=100, help="number of modes (default: 100)")
     c.add_argument("--bending", type=WEIGHT, default=1.0)
     c.add_argument("--membrane", type=WEIGHT, default=1.0)
-    c.add_argument(
-        "--preview",
-        action="store_true",
-        help="a preview in seconds (Rayleigh-Ritz in a reduced space of smooth functions; "
-        "for the 3D shells of meshes of 12k vertices or more, from a coarse copy's modes "
-        "where pymeshlab is installed): eigenvalues are upper bounds, with their estimated "
-        "error",
-    )
     c.add_argument("-o", "--output", required=True)
     c.add_argument(
         "--fix-slivers",
@@ -392,14 +396,8 @@ def _run(args) -> int:
 
         prepare_compute_process()  # this process exists to compute (see processes.memory)
         mesh = _load(args.mesh, args.fix_slivers, args.partial)
-        _refuse_if_too_large(mesh, args.operator, args.k, args.preview)
-        coarse = None
+        _refuse_if_too_large(mesh, args.operator, args.k)
         bar = _progress_bar()
-        started = time.perf_counter()
-        if args.preview:  # the copy is made while the operator is assembled
-            from .coarsen import start_preview_copy
-
-            coarse = start_preview_copy(mesh, args.operator, args.k)
         with _warnings_printed():
             spec = mv.compute_spectrum(
                 mesh,
@@ -408,29 +406,9 @@ def _run(args) -> int:
                 args.bending,
                 args.membrane,
                 progress=bar,
-                accuracy="preview" if args.preview else "exact",
-                coarse=coarse,
             )
-        seconds = time.perf_counter() - started  # all the wait, the copy included
         mv.save_spectrum(spec, args.output)
         _wrote(args.output, f"spectrum, {spec.k} {args.operator} modes")
-        if spec.is_preview:
-            from .viewer.wording import percent_text
-
-            info = spec.parameters["preview"]
-            start = info.get("coarse_start")
-            space = (
-                f"from a {start['coarse_vertices']}-vertex coarse copy's modes, "
-                f"the copy made in {coarse.seconds:.1f} s beside the assembly"
-                if start
-                else f"{info['samples']} samples, {info['reduced_dimension']} reduced unknowns"
-            )
-            print(
-                f"preview in {seconds:.1f} s ({space}): eigenvalues "
-                f"are upper bounds, largest relative error estimated at "
-                f"{percent_text(spec.estimated_error).replace(chr(160), ' ')} "
-                "(estimated from below, not a bound)"
-            )
         from .viewer.model import memory_text, residual_text
 
         if spec.k < args.k:
@@ -554,11 +532,9 @@ def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
     return value, state.derived.surface_share(d, value)
 
 
-def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
+def _refuse_if_too_large(mesh, operator: str, k: int) -> None:
     """The viewer's memory check before an exact computation starts: a ValueError saying
     what would fit where it would need more than its share of this machine's memory."""
-    if preview:
-        return
     from .viewer.model import memory_refusal
     from .viewer.state import ComputeSettings
 
@@ -566,7 +542,6 @@ def _refuse_if_too_large(mesh, operator: str, k: int, preview: bool) -> None:
         ComputeSettings().key(operator, k),
         mesh.n_vertices,
         coarse="on a decimated copy",
-        preview="as a preview (--preview)",
     )
     if refusal:
         raise ValueError(refusal)

@@ -250,7 +250,7 @@ def memory_estimate(n_vertices: int, parameters: dict) -> int:
         info = operator_info(op)
         n = info.unknowns(n_vertices)
         kept += 8.0 * n * min(k, n)
-        peak = max(peak, info.predicted_peak_mb("exact", n_vertices, min(k, n)) * 2**20)
+        peak = max(peak, info.predicted_peak_mb(n_vertices, min(k, n)) * 2**20)
     kept += 8.0 * n_vertices * 100 * len(parameters["signatures"])
     return int(peak + kept + 200 * n_vertices + 50e6)
 
@@ -964,9 +964,9 @@ class Collection:
         return shape_dna(spectrum, mesh.total_area), mesh.hash
 
     def spectrum_fits(self, spectrum: Spectrum | None) -> bool:
-        """Whether ``spectrum`` can stand for the store's: its operator and weights, exact
-        (not a preview), at least its k modes."""
-        if spectrum is None or spectrum.operator != self.operator or spectrum.is_preview:
+        """Whether ``spectrum`` can stand for the store's: its operator and weights, at
+        least its k modes."""
+        if spectrum is None or spectrum.operator != self.operator:
             return False
         if spectrum.k < min(
             self.k, spectrum.n_vertices * operator_info(self.operator).unknowns_per_vertex

@@ -1,7 +1,6 @@
 """The headless command line: results, one-line errors, exit codes."""
 
 import os
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -360,44 +359,6 @@ def test_compute_says_when_the_factor_and_basis_were_kept_small(tmp_path):
     assert not list(tmp_path.glob("modalviewer-factor-*"))  # the factor files are gone
 
 
-def test_a_shells_preview_starts_from_a_coarse_copy_and_says_so(tmp_path):
-    """``compute --preview`` of the 3D shells on a 12 800-vertex torus: the preview
-    starts from a coarse copy's modes (where pymeshlab, an optional dependency that the
-    development install has, makes the copy) and the summary line says so."""
-    pytest.importorskip("pymeshlab")
-    from modalviewer.core.primitives import torus
-    from modalviewer.viewer.wording import percent_text
-
-    ring = torus(160, 80, minor=0.3)
-    mesh = tmp_path / "torus.obj"
-    mesh.write_text(
-        "".join(f"v {x} {y} {z}\n" for x, y, z in ring.vertices)
-        + "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in ring.faces)
-    )
-    out = tmp_path / "s.npz"
-    r = _run("compute", mesh, "--operator", "shells", "-k", 24, "--preview", "-o", out)
-    assert r.returncode == 0, r.stderr
-    spec = mv.load_spectrum(out)
-    start = spec.parameters["preview"]["coarse_start"]
-    assert spec.is_preview and 3000 <= start["coarse_vertices"] <= 3300
-    assert f"from a {start['coarse_vertices']}-vertex coarse copy's modes" in r.stdout
-    # the wait the line states includes the copy (made beside the assembly), and the
-    # bar said when the preview waited for it
-    said = re.search(
-        r"preview in ([\d.]+) s .*the copy made in ([\d.]+) s beside the assembly", r.stdout
-    )
-    assert said, r.stdout
-    total, copy = float(said[1]), float(said[2])
-    assert 0.0 < copy < total
-    assert total >= spec.parameters["seconds_total"] - 0.1
-    assert "preview: making a coarse copy" in r.stderr
-    # the estimate in two significant digits ("0.0%" was printed for 0.04 %), and the
-    # null space's words as for an exact spectrum
-    estimate = percent_text(spec.estimated_error).replace("\u00a0", " ")
-    assert f"largest relative error estimated at {estimate} (" in r.stdout
-    assert "null space: 1 connected component: the first 6 modes" in r.stdout
-
-
 def test_the_progress_bar_leaves_no_end_of_a_longer_stage_behind(capsys, monkeypatch):
     from modalviewer import cli
 
@@ -405,18 +366,17 @@ def test_the_progress_bar_leaves_no_end_of_a_longer_stage_behind(capsys, monkeyp
     monkeypatch.setattr(cli.time, "perf_counter", lambda: next(clock))
     monkeypatch.setattr(cli, "_BAR", {"open": False})  # the open bar stays in this test
     bar = cli._progress_bar()
-    bar("preview: coarse copy's spectrum", 0.1)
-    bar("preview: factorising", 0.3)
+    bar("computing the null space", 0.1)
+    bar("factorising", 0.3)
     last = capsys.readouterr().err.split("\r")[-1]
-    assert last.rstrip().endswith("preview: factorising")
-    assert len(last) == len("[") + 30 + len("]  30.0% ") + len("preview: coarse copy's spectrum")
+    assert last.rstrip().endswith("factorising")
+    assert len(last) == len("[") + 30 + len("]  30.0% ") + len("computing the null space")
 
 
 def test_the_progress_bar_draws_a_new_stage_at_once(capsys, monkeypatch):
-    """Found with the copy made beside the assembly: "making a coarse copy" came 0.1 s
-    after "assembling" and was not drawn, though the wait it names then lasted seconds.
-    A new stage is drawn at once; the same stage's progress at most five times a
-    second."""
+    """A stage that came 0.1 s after "assembling" was not drawn, though the wait it
+    names then lasted seconds.  A new stage is drawn at once; the same stage's progress
+    at most five times a second."""
     from modalviewer import cli
 
     clock = iter([1.0, 1.1, 1.15, 1.5])
@@ -424,32 +384,16 @@ def test_the_progress_bar_draws_a_new_stage_at_once(capsys, monkeypatch):
     monkeypatch.setattr(cli, "_BAR", {"open": False})
     bar = cli._progress_bar()
     bar("assembling", 0.0)
-    bar("preview: making a coarse copy", 0.05)  # 0.1 s later: a new stage
-    bar("preview: making a coarse copy", 0.06)  # 0.05 s later, same stage: not drawn
-    bar("preview: making a coarse copy", 0.07)  # 0.4 s after the last drawing
+    bar("factorising", 0.05)  # 0.1 s later: a new stage
+    bar("factorising", 0.06)  # 0.05 s later, same stage: not drawn
+    bar("factorising", 0.07)  # 0.4 s after the last drawing
     drawn = capsys.readouterr().err.split("\r")[1:]
     assert [d.split("% ")[1].rstrip() for d in drawn] == [
         "assembling",
-        "preview: making a coarse copy",
-        "preview: making a coarse copy",
+        "factorising",
+        "factorising",
     ]
     assert "7.0%" in drawn[-1]
-
-
-def test_no_coarse_copy_where_the_exact_factor_would_go_out_of_core(monkeypatch):
-    """The coarse start factorises in double precision as the exact solve does: where
-    that factor is predicted out of core (here: a 100 MB memory limit), the preview
-    keeps its smooth space."""
-    pytest.importorskip("pymeshlab")
-    from modalviewer.coarsen import preview_copy_for
-    from modalviewer.core import memory
-    from modalviewer.core.primitives import torus
-
-    ring = torus(160, 80, minor=0.3)
-    assert preview_copy_for(ring, "shells", 24) is not None
-    assert preview_copy_for(ring, "laplacian", 24) is None
-    monkeypatch.setattr(memory, "memory_limit_mb", lambda: 100.0)
-    assert preview_copy_for(ring, "shells", 24) is None
 
 
 def test_a_truncated_file_is_refused_with_the_command_lines_advice(tmp_path, capsys):
@@ -584,3 +528,23 @@ def test_every_commands_k_says_its_default():
                 assert action.help and "default" in action.help, (name, action.help)
                 seen += 1
     assert seen >= 4
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["compute", "mesh.obj", "--preview", "-o", "s.npz"],
+        ["distance", "mesh.obj", "--vertex", "0", "--preview"],
+        ["batch", "folder", "-o", "store", "--preview=yes"],
+    ],
+    ids=["compute", "distance", "batch"],
+)
+def test_the_removed_preview_option_is_an_argument_error_saying_what_to_use(argv, capsys):
+    """--preview is gone (every spectrum is exact): any command given it exits with code
+    2 and one line naming fewer modes and the callback for early modes, before any file
+    is read."""
+    from modalviewer.cli import main
+
+    _assert_one_argument_error(main, argv, "--preview was removed", capsys)
+    _assert_one_argument_error(main, argv, "fewer modes (-k)", capsys)
+    _assert_one_argument_error(main, argv, "on_modes=callback", capsys)

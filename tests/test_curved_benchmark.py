@@ -20,7 +20,7 @@ def test_a_flat_subdivision_of_the_part_keeps_its_shape_and_runs():
     """One split in four: a vertex per edge more; the child returns the five non-zero
     eigenvalues of six exact Laplacian modes (one zero mode: one component), sorted."""
     part = mv.load_mesh(mv.asset_path("demo_machined_part.obj"))
-    row = curved.run(("part", "flat", 1), "laplacian", "exact", 6)
+    row = curved.run(("part", "flat", 1), "laplacian", 6)
     assert row["vertices"] == part.n_vertices + part.edges.shape[0]
     assert len(row["eigenvalues"]) == 5 and np.all(np.diff(row["eigenvalues"]) >= 0)
-    assert row["seconds"] > 0 and row["estimated_error"] == 0.0
+    assert row["seconds"] > 0

@@ -8,9 +8,8 @@
 
 At build time (Sphinx's ``source-read`` event) every marked block is replaced by the table
 made from the JSON results now in ``benchmarks/results``, so the HTML pages always show
-the measured numbers.  The tables of ``make bench`` and of the preview benchmark are made
-by the benchmark scripts' own functions (``benchmarks.run.table``,
-``benchmarks.run.stage_table``, ``benchmarks.preview.table``), the others here.
+the measured numbers.  The tables of ``make bench`` are made by the benchmark script's own
+functions (``benchmarks.run.table``, ``benchmarks.run.stage_table``), the others here.
 
 The plots of time and peak memory against mesh size are drawn with matplotlib from the
 same files into ``docs/_generated/plots/`` when a build starts; the page marks each with
@@ -48,24 +47,19 @@ def load(name: str):
 def _benchmarks():
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
-    from benchmarks import preview, run
+    from benchmarks import run
 
-    return run, preview
+    return run
 
 
 def spectra_table(rows: list[dict]) -> str:
     """``make bench``'s spectra table (``benchmarks.run.table``)."""
-    return _benchmarks()[0].table(rows)
+    return _benchmarks().table(rows)
 
 
 def stage_table(rows: list[dict]) -> str:
     """``make bench``'s table of the solver's stages (``benchmarks.run.stage_table``)."""
-    return _benchmarks()[0].stage_table(rows)
-
-
-def preview_table(rows: list[dict]) -> str:
-    """The preview benchmark's table (``benchmarks.preview.table``)."""
-    return _benchmarks()[1].table(rows)
+    return _benchmarks().stage_table(rows)
 
 
 #: The paper's Table 1 (Chinese dragon, 2.66 GHz MacBook Pro, MUMPS, vibration modes, 300
@@ -169,64 +163,15 @@ def slivers_table(data: dict) -> str:
 
 
 def curved_table(data: dict) -> str:
-    """``benchmarks.curved``: preview against exact on a curved mesh with thin parts."""
+    """``benchmarks.curved``: exact spectra of curved meshes with thin parts."""
     lines = [
-        "| mesh | vertices | operator | exact s | preview s | / exact | exact MB | preview MB "
-        "| / exact | eig. error max (lowest 50) | refinement steps "
-        "| fast preview s | / exact | fast preview MB | its error max / estimated |",
-        "|" + " --- |" * 15,
+        "| mesh | vertices | operator | modes | exact s | exact MB |",
+        "|" + " --- |" * 6,
     ]
     for r in data["rows"]:
-        fast = (
-            f"| {r['fast_preview_seconds']:.1f} "
-            f"| {r['fast_preview_seconds'] / r['exact_seconds']:.2f} "
-            f"| {r['fast_preview_peak_mb']} "
-            f"| {100 * r['fast_preview_largest_error_lowest_50']:.2g} % / "
-            f"{100 * r['fast_preview_estimated_error']:.2g} % |"
-            if "fast_preview_seconds" in r
-            else "| - | - | - | - |"
-        )
         lines.append(
-            f"| {r['mesh']} | {r['vertices']} | {r['operator']} | {r['exact_seconds']:.1f} "
-            f"| {r['preview_seconds']:.1f} | {r['time_ratio']:.2f} | {r['exact_peak_mb']} "
-            f"| {r['preview_peak_mb']} | {r['memory_ratio']:.2f} "
-            f"| {100 * r['largest_error_lowest_50']:.2g} % | {r['refinement_steps']} " + fast
-        )
-    return "\n".join(lines)
-
-
-def coarse_start_table(data: dict) -> str:
-    """``benchmarks.coarse_start``: the 3D shells fast preview from a coarse copy against
-    the smooth-space one, both against the exact spectrum of the same run; the share of
-    the exact time the preview's work with the fine operator takes (assembly, factor,
-    step, estimate) and the copy's own process's peak ("-" in rows measured before
-    either was recorded)."""
-    lines = [
-        "| mesh | vertices | exact s | smooth space: s | / exact | error / estimated "
-        "| coarse copy: vertices | s (copy) | / exact | error / estimated "
-        "| fine-operator stages / exact | exact MB | smooth MB | coarse MB "
-        "| copy's process MB |",
-        "|" + " --- |" * 15,
-    ]
-
-    def pct(x: float) -> str:
-        return f"{100 * x:.0f}" if x >= 1 else f"{100 * x:.2g}"
-
-    for r in data["rows"]:
-        fine = r.get("factor_stages_time_ratio")
-        lines.append(
-            f"| {r['mesh']} | {r['vertices']} | {r['exact_seconds']:.1f} "
-            f"| {r['smooth_seconds']:.1f} | {r['smooth_time_ratio']:.2f} "
-            f"| {pct(r['smooth_largest_error_lowest_50'])} % / "
-            f"{pct(r['smooth_estimated_error_lowest_50'])} % "
-            f"| {r['coarse_vertices']} "
-            f"| {r['coarse_seconds']:.1f} ({r['coarse_copy_seconds']:.1f}) "
-            f"| {r['coarse_time_ratio']:.2f} "
-            f"| {pct(r['coarse_largest_error_lowest_50'])} % / "
-            f"{pct(r['coarse_estimated_error_lowest_50'])} % "
-            f"| {'-' if fine is None else f'{fine:.2f}'} "
-            f"| {r['exact_peak_mb']} | {r['smooth_peak_mb']} | {r['coarse_peak_mb']} "
-            f"| {r.get('coarse_copy_peak_mb', '-')} |"
+            f"| {r['mesh']} | {r['vertices']} | {r['operator']} | {r['k']} "
+            f"| {r['exact_seconds']:.1f} | {r['exact_peak_mb']} |"
         )
     return "\n".join(lines)
 
@@ -237,27 +182,26 @@ def _find(rows: list[dict], **fields) -> dict | None:
 
 
 def growth_table(data: dict) -> str:
-    """``benchmarks.growth``: seconds and peak memory against mesh size per operator and
-    accuracy, then the fitted growth exponents."""
+    """``benchmarks.growth``: seconds and peak memory of the exact solve against mesh
+    size per operator, then the fitted growth exponents."""
     rows = data["rows"]
     sizes = sorted({r["vertices"] for r in rows})
-    head = "| operator | accuracy | " + " | ".join(f"{n:,}".replace(",", " ") for n in sizes)
-    lines = [head + " | time exponent | memory exponent |", "|" + " --- |" * (len(sizes) + 4)]
-    fits = {(f["operator"], f["accuracy"]): f for f in data["fits"]}
-    for (op, accuracy), fit in fits.items():
+    head = "| operator | " + " | ".join(f"{n:,}".replace(",", " ") for n in sizes)
+    lines = [head + " | time exponent | memory exponent |", "|" + " --- |" * (len(sizes) + 3)]
+    for fit in data["fits"]:
+        op = fit["operator"]
         cells = []
         for n in sizes:
-            r = _find(rows, operator=op, accuracy=accuracy, vertices=n)
+            r = _find(rows, operator=op, vertices=n)
             if r is None:
                 cells.append("-")
             elif "refused" in r:
                 cells.append("refused (memory)")
             else:
-                steps = f", {r['refinement_steps']} steps" if r.get("refinement_steps") else ""
                 mb = f"{r['peak_mb']:,}".replace(",", " ")
-                cells.append(f"{r['seconds']:.1f} s, {mb} MB{steps}")
+                cells.append(f"{r['seconds']:.1f} s, {mb} MB")
         lines.append(
-            f"| {LABELS.get(op, op)} | {accuracy} | "
+            f"| {LABELS.get(op, op)} | "
             + " | ".join(cells)
             + f" | {fit['time_exponent']:.2f} | {fit['memory_exponent']:.2f} |"
         )
@@ -279,13 +223,13 @@ def memory_check_table(more_modes: dict, curved: dict) -> str:
         "| mesh | operator | vertices | modes | measured peak | predicted | measured / predicted |",
         "|" + " --- |" * 7,
     ]
-    runs = [("plate", r, r.get("peak_mb")) for r in more_modes["rows"] if r["accuracy"] == "exact"]
+    runs = [("plate", r, r.get("peak_mb")) for r in more_modes["rows"]]
     runs += [(r["mesh"], r, r.get("exact_peak_mb")) for r in curved["rows"]]
     for mesh, r, peak in runs:
         if peak is None:
             continue
         info = operator_info(r["operator"])  # these runs kept their factors in core
-        predicted = info.predicted_peak_mb("exact", r["vertices"], r["k"], out_of_core=False)
+        predicted = info.predicted_peak_mb(r["vertices"], r["k"], out_of_core=False)
         lines.append(
             f"| {mesh} | {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} "
             f"| {r['k']} | {_thousands(peak)} MB | {_thousands(predicted)} MB "
@@ -313,7 +257,7 @@ def big_solves_table(data: dict) -> str:
         info = operator_info(r["operator"])
         ooc, single = bool(r["factor_out_of_core"]), bool(r.get("basis_float32"))
         predicted = info.predicted_peak_mb(
-            "exact", r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
+            r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
         )
         limit = "half the machine" if r["limit_mb"] == "none" else f"{r['limit_mb']} MB"
         factor = f"{_thousands(r['factor_mb'])} MB {'in a file' if ooc else 'in core'}"
@@ -348,41 +292,6 @@ def factor_memory_table(data: dict) -> str:
     return "\n".join(lines)
 
 
-def predictor_table(data: dict) -> str:
-    """``benchmarks.growth --name growth_k300``: measured times of the exact solve and of
-    the fast preview beside the viewer's predictions (the operators' growth laws), and
-    whether a preview pays (at most ``PREVIEW_DELAY`` of the exact time)."""
-    from modalviewer.core.operators import operator_info
-    from modalviewer.viewer.model import PREVIEW_DELAY
-
-    rows = [r for r in data["rows"] if "seconds" in r]
-    lines = [
-        "| operator | vertices | modes | exact s (predicted) | fast preview s (predicted) "
-        "| measured / predicted ratio | pays (measured / predicted) |",
-        "|" + " --- |" * 7,
-    ]
-    for r in rows:
-        if r["accuracy"] != "exact":
-            continue
-        f = _find(
-            rows, accuracy="fast preview", operator=r["operator"], vertices=r["vertices"], k=r["k"]
-        )
-        if f is None:
-            continue
-        info = operator_info(r["operator"])
-        pe = info.predicted_seconds("exact", r["vertices"], r["k"])
-        pf = info.predicted_seconds("fast preview", r["vertices"], r["k"])
-        ratio, predicted = f["seconds"] / r["seconds"], pf / pe
-        lines.append(
-            f"| {LABELS.get(r['operator'], r['operator'])} | {r['vertices']} | {r['k']} "
-            f"| {r['seconds']:.1f} ({pe:.1f}) | {f['seconds']:.1f} ({pf:.1f}) "
-            f"| {ratio:.2f} / {predicted:.2f} "
-            f"| {'yes' if ratio <= PREVIEW_DELAY else 'no'} "
-            f"/ {'yes' if predicted <= PREVIEW_DELAY else 'no'} |"
-        )
-    return "\n".join(lines)
-
-
 def million_table(data: dict) -> str:
     """``benchmarks.million``: the viewer's window on a million vertices."""
     n = f"{data['vertices']:,}".replace(",", " ")
@@ -392,16 +301,13 @@ def million_table(data: dict) -> str:
         "| --- | --- | --- | --- | --- |",
         f"| open and draw {n} vertices | {data['open_and_draw_s']:.1f} | - | - | - |",
     ]
-    for name in ("laplacian", "shells"):
-        r = data[name]
-        what = r["status"][0].rstrip(".") if r["status"] else ""
-        kind = "preview" if r["is_preview"] else "exact spectrum"
-        lines.append(
-            f"| {LABELS.get(r['operator'], r['operator'])}, {data['k']} modes"
-            f"{' (Preview only)' if r['preview_only'] else ''} | {r['on_screen_s']:.0f} "
-            f"| {what}; {kind} on screen | {r['longest_event_loop_gap_ms']:.0f} ms "
-            f"| {r['child_peak_mb_so_far'] / 1024:.1f} GB |"
-        )
+    r = data["laplacian"]
+    what = r["status"][-1].rstrip(".") if r["status"] else ""
+    lines.append(
+        f"| {LABELS.get(r['operator'], r['operator'])}, {data['k']} modes "
+        f"| {r['on_screen_s']:.0f} | {what} | {r['longest_event_loop_gap_ms']:.0f} ms "
+        f"| {r['child_peak_mb_so_far'] / 1024:.1f} GB |"
+    )
     pick = data["pick_and_distance_map_s"]
     lines.append(f"| pick and threshold map of the heat kernel distance | {pick:.1f} | - | - | - |")
     return "\n".join(lines)
@@ -409,21 +315,17 @@ def million_table(data: dict) -> str:
 
 def scale_figures(data: dict) -> str:
     """The README's performance figures: the largest mesh of ``benchmarks.growth`` per
-    operator, exact solve and fast preview, as a short table."""
+    operator, the exact solve, as a short table."""
     rows = [r for r in data["rows"] if "seconds" in r]
     n = max(r["vertices"] for r in rows)
     lines = [
-        f"| {n:,} vertices, {data['k']} modes | exact | fast preview |".replace(",", " ", 2),
-        "| --- | --- | --- |",
+        f"| {n:,} vertices, {data['k']} modes | exact |".replace(",", " ", 2),
+        "| --- | --- |",
     ]
     for op in dict.fromkeys(r["operator"] for r in rows):
-        cells = []
-        for accuracy in ("exact", "fast preview"):
-            r = _find(rows, operator=op, accuracy=accuracy, vertices=n)
-            cells.append(
-                "-" if r is None else f"{r['seconds']:.0f} s, {r['peak_mb'] / 1024:.1f} GB"
-            )
-        lines.append(f"| {LABELS.get(op, op)} | " + " | ".join(cells) + " |")
+        r = _find(rows, operator=op, vertices=n)
+        cell = "-" if r is None else f"{r['seconds']:.0f} s, {r['peak_mb'] / 1024:.1f} GB"
+        lines.append(f"| {LABELS.get(op, op)} | {cell} |")
     return "\n".join(lines)
 
 
@@ -466,7 +368,6 @@ TABLES = {
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),
     "paper": (["latest"], lambda: paper_table(load("latest"))),
     "stages": (["latest"], lambda: stage_table(load("latest"))),
-    "preview": (["preview"], lambda: preview_table(load("preview"))),
     "viewer": (
         [
             "interactive_130k_shells",
@@ -483,10 +384,8 @@ TABLES = {
     ),
     "slivers": (["slivers"], lambda: slivers_table(load("slivers"))),
     "curved": (["curved"], lambda: curved_table(load("curved"))),
-    "coarse-start": (["coarse_start"], lambda: coarse_start_table(load("coarse_start"))),
     "growth": (["growth"], lambda: growth_table(load("growth"))),
     "scale": (["growth"], lambda: scale_figures(load("growth"))),
-    "predictor": (["growth_k300"], lambda: predictor_table(load("growth_k300"))),
     "million": (["million"], lambda: million_table(load("million"))),
     "big-solves": (["memory"], lambda: big_solves_table(load("memory"))),
     "memory-figures": (["memory"], lambda: big_solves_figures(load("memory"))),
@@ -580,49 +479,18 @@ def spectra_plot(rows: list[dict], path: Path) -> Path:
     return _save(fig, path)
 
 
-def preview_plot(rows: list[dict], path: Path) -> Path:
-    """The preview benchmark: wall time and peak memory of the exact spectrum, the
-    preview and coarse-to-fine against the number of vertices, per operator."""
-    import matplotlib.pyplot as plt
-
-    fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(8.6, 3.3), layout="constrained")
-    methods = [
-        ("exact", "o-", lambda r: r["exact_s"], lambda r: r["exact_peak_mb"]),
-        ("preview", "^--", lambda r: r["preview"]["seconds"], lambda r: r["preview"]["peak_mb"]),
-        (
-            "coarse-to-fine",
-            "v:",
-            lambda r: r["coarse-to-fine"]["seconds"],
-            lambda r: r["coarse-to-fine"]["peak_mb"],
-        ),
-    ]
-    for i, op in enumerate(sorted({r["operator"] for r in rows})):
-        mine = [r for r in rows if r["operator"] == op]
-        for method, style, seconds, memory in methods:
-            label = f"{LABELS.get(op, op)}, {method}"
-            _series(t_ax, mine, seconds, label, style, f"C{i}")
-            _series(m_ax, mine, memory, label, style, f"C{i}")
-    k = sorted({r["k"] for r in rows})
-    vertices = [r["vertices"] for r in rows]
-    _axes(t_ax, "time (s)", f"{', '.join(map(str, k))} modes: time", vertices)
-    _axes(m_ax, "peak memory (MB)", f"{', '.join(map(str, k))} modes: peak memory", vertices)
-    _legend(fig, t_ax)
-    return _save(fig, path)
-
-
 def growth_plot(data: dict, path: Path) -> Path:
-    """``benchmarks.growth``: time and peak memory against mesh size, exact (solid) and
-    fast preview (dashed), per operator."""
+    """``benchmarks.growth``: time and peak memory of the exact solve against mesh size,
+    per operator."""
     import matplotlib.pyplot as plt
 
     rows = [r for r in data["rows"] if "seconds" in r]
     fig, (t_ax, m_ax) = plt.subplots(1, 2, figsize=(8.6, 3.3), layout="constrained")
     for i, op in enumerate(dict.fromkeys(r["operator"] for r in rows)):
-        for accuracy, style in (("exact", "o-"), ("fast preview", "^--")):
-            mine = [r for r in rows if r["operator"] == op and r["accuracy"] == accuracy]
-            label = f"{LABELS.get(op, op)}, {accuracy}"
-            _series(t_ax, mine, lambda r: r["seconds"], label, style, f"C{i}")
-            _series(m_ax, mine, lambda r: r["peak_mb"], label, style, f"C{i}")
+        mine = [r for r in rows if r["operator"] == op]
+        label = LABELS.get(op, op)
+        _series(t_ax, mine, lambda r: r["seconds"], label, "o-", f"C{i}")
+        _series(m_ax, mine, lambda r: r["peak_mb"], label, "o-", f"C{i}")
     vertices = [r["vertices"] for r in rows]
     _axes(t_ax, "time (s)", f"{data['k']} modes: time", vertices)
     _axes(m_ax, "peak memory (MB)", f"{data['k']} modes: peak memory", vertices)
@@ -642,7 +510,6 @@ def _save(fig, path: Path) -> Path:
 #: Every generated plot: its name in the page's markers -> (JSON files, draw to a path).
 PLOTS_MADE = {
     "spectra": (["latest"], lambda path: spectra_plot(load("latest"), path)),
-    "preview": (["preview"], lambda path: preview_plot(load("preview"), path)),
     "growth": (["growth"], lambda path: growth_plot(load("growth"), path)),
 }
 
@@ -650,9 +517,7 @@ PLOTS_MADE = {
 PLOT_CAPTIONS = {
     "spectra": "Eigenproblem time and peak memory against mesh size, 300 modes "
     "(benchmarks/results/latest.json; dashed: plain scipy).",
-    "preview": "Exact spectrum, preview and coarse-to-fine: time and peak memory against "
-    "mesh size (benchmarks/results/preview.json).",
-    "growth": "Time and peak memory from 10k to 1M vertices, 100 modes, exact and fast preview "
+    "growth": "Exact solve: time and peak memory from 10k to 1M vertices, 100 modes "
     "(benchmarks/results/growth.json).",
 }
 

@@ -23,7 +23,13 @@ from .mesh import Mesh
 from .operators import operator_info
 from .spectrum import Spectrum, load_spectrum, save_spectrum
 
-__all__ = ["CacheEntry", "SpectrumCache", "default_cache_dir", "default_cache_limit"]
+__all__ = [
+    "CacheEntry",
+    "SolveRecord",
+    "SpectrumCache",
+    "default_cache_dir",
+    "default_cache_limit",
+]
 
 log = logging.getLogger("modalviewer.cache")
 
@@ -72,6 +78,19 @@ class CacheEntry:
     path: Path
     size: int
     last_used: float
+
+
+@dataclass(frozen=True)
+class SolveRecord:
+    """What a cached spectrum says of the solve that made it: its operator, the mesh
+    (hash and vertex count), the number of modes and the solve's seconds
+    (``parameters["seconds_total"]``)."""
+
+    operator: str
+    mesh_hash: str
+    n_vertices: int
+    k: int
+    seconds: float
 
 
 SOLVER_VERSION = 2
@@ -142,6 +161,18 @@ class SpectrumCache:
                 pass
         self._remove_stale_parts(max_age=_STALE_PART_SECONDS)
         return freed
+
+    def solves(self) -> list[SolveRecord]:
+        """The solves this machine recorded in the cache, most recently used first: each
+        entry's operator, mesh, modes and ``seconds_total``, read from the file's
+        metadata and the header of its mass array (not its modes).  Entries that cannot
+        be read, or carry no time (coarse-to-fine, foreign files), are left out."""
+        records = []
+        for entry in self.entries():
+            record = _solve_record(entry.path)
+            if record is not None:
+                records.append(record)
+        return records
 
     # ------------------------------------------------------------- use
     def get(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Spectrum | None:
@@ -252,3 +283,33 @@ class SpectrumCache:
                     p.unlink()
             except OSError:
                 pass
+
+
+def _solve_record(path: Path) -> SolveRecord | None:
+    """The :class:`SolveRecord` of one cache file, or None."""
+    import zipfile
+
+    import numpy as np
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            with archive.open("meta.npy") as fh:
+                meta = json.loads(str(np.lib.format.read_array(fh, allow_pickle=False)))
+            with archive.open("mass.npy") as fh:
+                version = np.lib.format.read_magic(fh)
+                read = (
+                    np.lib.format.read_array_header_1_0
+                    if version == (1, 0)
+                    else np.lib.format.read_array_header_2_0
+                )
+                shape = read(fh)[0]
+        params = meta.get("parameters", {})
+        seconds = params.get("seconds_total")
+        if not isinstance(seconds, (int, float)) or seconds <= 0 or "transferred_from" in params:
+            return None
+        return SolveRecord(
+            str(meta["operator"]), str(meta.get("mesh_hash", "")), int(shape[0]),
+            int(params["k"]), float(seconds),
+        )  # fmt: skip
+    except Exception:  # damaged or foreign: no record (get() deals with the file)
+        return None

@@ -48,7 +48,6 @@ __all__ = [
     "solve_lowest",
     "relative_residuals",
     "zero_modes",
-    "lowest_share",
     "typical_eigenvalue",
     "zero_mode_size",
     "rounding_floors",
@@ -179,12 +178,6 @@ def typical_eigenvalue(K, mass_diag: np.ndarray) -> float:
     """median(diag(K) / mass): the eigenvalue size zero modes are judged against when a
     spectrum holds nothing larger (``lam_scale`` of :func:`zero_modes`)."""
     return float(np.median(np.abs(K.diagonal()) / np.asarray(mass_diag)))
-
-
-def lowest_share(count: int, share: float) -> int:
-    """How many of ``count`` non-zero modes make their lowest ``share`` (at least one):
-    the part of a preview whose estimated error decides on it."""
-    return max(1, int(np.ceil(share * count)))
 
 
 def zero_mode_size(lam: np.ndarray, lam_scale: float) -> float:

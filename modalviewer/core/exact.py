@@ -2,8 +2,7 @@
 exactly known null space, the shift-invert solve, and which pairs are zero modes.
 
 :func:`.pipeline.compute_spectrum` checks their residuals and wraps them in a
-:class:`.spectrum.Spectrum`; the coarse-copy preview (:mod:`.preview`) solves its copy
-with them."""
+:class:`.spectrum.Spectrum`."""
 
 from __future__ import annotations
 

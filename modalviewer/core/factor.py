@@ -5,9 +5,8 @@ Backends, tried in this order by ``backend="auto"``:
 ``"pardiso"``
     Intel MKL PARDISO (the ``mkl`` wheel, x86_64), called through ``ctypes``: supernodal
     Cholesky with a parallel nested-dissection (METIS) ordering and parallel blocked
-    triangular solves.  On the 140 550-unknown Discrete Shells Hessian of the 50k
-    benchmark mesh it factors in about 2 s and solves a block of 64 right-hand sides in
-    about 12 ms per column (CHOLMOD from ``cholespy``: 21 s and 41 ms).
+    triangular solves; the fastest of the three on the benchmark meshes ("Spectra" in
+    docs/performance.md).
 ``"cholmod"``
     CHOLMOD through ``cholespy`` (wheels for every platform).
 ``"superlu"``
@@ -17,11 +16,9 @@ Out of core: given ``memory_budget_mb``, PARDISO keeps its factor in memory only
 analysis says it fits that budget; otherwise it writes the factor to a file in a
 temporary folder (PARDISO's out-of-core mode, ``iparm[59] = 2``) and keeps only its
 symbolic data and a working buffer in memory.  Each solve then reads the factor back
-(from the page cache while the system has memory to spare, else from disk): on the
-309k-unknown shells Hessian of the 320 x 320 plate the factor takes 370 MB of the
-process's memory instead of 940 MB and a block of 16 solves 0.6 s instead of 0.34 s
-("Memory" in docs/performance.md).  The folder is removed with the factor.  CHOLMOD and
-SuperLU have no such mode and ignore the budget.
+(from the page cache while the system has memory to spare, else from disk): less
+memory, slower solves ("Memory of big exact solves" in docs/performance.md).  The folder
+is removed with the factor.  CHOLMOD and SuperLU have no such mode and ignore the budget.
 
 Every backend raises :class:`numpy.linalg.LinAlgError` if the matrix is not positive
 definite.
@@ -44,7 +41,6 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 __all__ = [
-    "FactorTooLarge",
     "SPDSolver",
     "available_backends",
     "factor_folder",
@@ -97,8 +93,8 @@ OUT_OF_CORE_MARGIN = 1.1
 OUT_OF_CORE_EXTRA_MB = 64.0
 """The out-of-core working buffer is OUT_OF_CORE_MARGIN times PARDISO's stated minimum
 (symbolic data plus its smallest buffer, ``iparm[15] + iparm[62]`` KB) plus this: with
-exactly the minimum the numerical factorisation can fail for lack of memory (error -2;
-309k-unknown shells Hessian: 400 MB failed where the minimum was 432 MB)."""
+exactly the minimum the numerical factorisation can fail for lack of memory (error
+-2)."""
 
 _OOC_ENVIRONMENT = threading.Lock()
 """PARDISO reads its out-of-core folder and buffer size from the environment when it
@@ -187,19 +183,12 @@ def has_vertex_blocks(A: sp.csr_matrix, size: int = 3) -> bool:
     return agree >= 0.9 * groups.size
 
 
-class FactorTooLarge(MemoryError):
-    """A single-precision factor (which has no out-of-core mode) would need more memory
-    than its budget; raised after the analysis, before the factorisation."""
-
-
 class _Pardiso:
     """MKL PARDISO, real symmetric positive definite (mtype 2), upper triangle in CSR.
 
     Analysis (phase 11) first: it tells the memory the factor needs in core
     (``in_core_mb``); if that exceeds ``memory_budget_mb`` and out of core needs less,
-    the numerical factorisation (phase 22) writes the factor to a file.  ``single``:
-    the factor and the solves in single precision (``iparm[27] = 1``), always in core
-    (:class:`FactorTooLarge` where it would exceed the budget)."""
+    the numerical factorisation (phase 22) writes the factor to a file."""
 
     MTYPE = 2
 
@@ -209,14 +198,13 @@ class _Pardiso:
         lib,
         memory_budget_mb: float | None = None,
         factorise=True,
-        single: bool = False,
     ):
         self._lib = lib
         U = sp.triu(A, format="csr")
         U.sum_duplicates()
         U.sort_indices()
         self.n = U.shape[0]
-        self.dtype = np.dtype(np.float32 if single else np.float64)
+        self.dtype = np.dtype(np.float64)
         self._ia = U.indptr.astype(np.int32)
         self._ja = U.indices.astype(np.int32)
         self._a = np.ascontiguousarray(U.data, dtype=self.dtype)
@@ -228,13 +216,10 @@ class _Pardiso:
         ip[23] = 1  # two-level parallel factorisation
         ip[24] = 1  # parallel forward/backward substitution
         ip[34] = 1  # zero-based indices
-        if single:
-            ip[27] = 1  # single precision: half the factor's memory and work
         if has_vertex_blocks(A):
-            # variable-size block storage (VBSR) for the 3D shells' 3 x 3 vertex blocks,
-            # spot Loop x3 (562k unknowns): factor 4.3 s against 5.3-6.2 s, 1846 against
-            # 2128 MB, the same residuals; a scalar Laplacian's factor grows with it (159
-            # against 135 MB), so scalar operators keep the plain storage
+            # variable-size block storage (VBSR) for the 3D shells' 3 x 3 vertex blocks:
+            # a smaller factor made faster with the same residuals; a scalar operator's
+            # factor grows with it, so scalar operators keep the plain storage
             ip[36] = -80
         self._iparm = ip
         self._alive = True
@@ -253,16 +238,8 @@ class _Pardiso:
         self.out_of_core_mb = OUT_OF_CORE_MARGIN * minimum_mb + OUT_OF_CORE_EXTRA_MB
         if not factorise:
             return
-        if single and memory_budget_mb is not None and self.in_core_mb > memory_budget_mb:
-            self.release()
-            raise FactorTooLarge(
-                f"a single-precision factor needs {self.in_core_mb:.0f} MB, "
-                f"{memory_budget_mb:.0f} MB are left"
-            )
-        if (
-            not single
-            and memory_budget_mb is not None
-            and self.in_core_mb > max(memory_budget_mb, self.out_of_core_mb)
+        if memory_budget_mb is not None and self.in_core_mb > max(
+            memory_budget_mb, self.out_of_core_mb
         ):
             self._folder = self._out_of_core_folder()
         if self._folder is None:
@@ -387,18 +364,9 @@ class SPDSolver:
     backend : "auto" | "pardiso" | "cholmod" | "superlu".
     memory_budget_mb : the memory (MB) the factor may take; PARDISO writes a factor
         that needs more to a file (out of core) if that needs less.  None: in core.
-    single_precision : PARDISO factors and solves in single precision (about half the
-        factor's memory and time; float32 solutions), always in core:
-        :class:`FactorTooLarge` where it would need more than ``memory_budget_mb``.
-        A preconditioner, not a solver: on an ill-conditioned matrix the solutions
-        carry large errors (the 47k-vertex cow's shells Hessian shifted by its lowest
-        eigenvalue: 20 to 30 % relative, against 1e-9 in double precision), which a
-        preconditioned iteration tolerates (:mod:`.preview`).  The other backends solve
-        in double precision.
 
     Attributes
     ----------
-    single_precision : True if the factor is in single precision (PARDISO only).
     out_of_core : True if the factor lives in a file.
     factor_mb : memory the factor needs in core (PARDISO's analysis; None for the
         other backends).
@@ -407,7 +375,6 @@ class SPDSolver:
     """
 
     out_of_core = False
-    single_precision = False
     factor_mb: float | None = None
 
     def __init__(
@@ -415,7 +382,6 @@ class SPDSolver:
         A: sp.spmatrix,
         backend: str = "auto",
         memory_budget_mb: float | None = None,
-        single_precision: bool = False,
     ):
         A = sp.csr_matrix(A)
         self.n = A.shape[0]
@@ -428,8 +394,7 @@ class SPDSolver:
             raise ImportError(f"the {backend!r} backend is not available here")
         self.backend = backend
         if backend == "pardiso":
-            self._impl = _Pardiso(A, _load_mkl(), memory_budget_mb, single=single_precision)
-            self.single_precision = bool(single_precision)
+            self._impl = _Pardiso(A, _load_mkl(), memory_budget_mb)
             self.out_of_core = self._impl.out_of_core
             self.factor_mb = self._impl.in_core_mb
         elif backend == "cholmod":

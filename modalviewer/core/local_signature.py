@@ -190,8 +190,6 @@ def local_signature(
     if spectrum is not None:
         if spectrum.operator != operator or spectrum.mesh_hash != mesh.hash:
             raise ValueError("spectrum must be of this mesh and operator")
-        if spectrum.is_preview:
-            raise ValueError("spectrum must be exact, not a preview")
         modes = spectrum.modes.reshape(K.shape[0], spectrum.k)
         used = np.ones(spectrum.k, dtype=bool) if include_zero else ~spectrum.zero_mode_mask()
         rows = (vertices[:, None] * per_vertex + np.arange(per_vertex)).ravel()

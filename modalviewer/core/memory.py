@@ -90,8 +90,7 @@ def return_freed_memory() -> bool:
 def glibc():
     """The C library as a ``ctypes.CDLL`` on Linux (glibc's ``libc.so.6``), else None,
     loaded once: the one place its allocator settings (:func:`return_freed_memory`, at
-    each stage of a computation; :mod:`modalviewer.processes.memory`) and process
-    settings (:mod:`modalviewer.processes.copy_main`) load it from."""
+    each stage of a computation; :mod:`modalviewer.processes.memory`) load it from."""
     import ctypes
     import sys
 

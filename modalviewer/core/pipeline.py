@@ -5,7 +5,6 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Callable
-from concurrent.futures import Future
 
 import numpy as np
 
@@ -15,9 +14,7 @@ from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
 from .operators import operator_info
-from .preview import compute_preview, preview_possible
 from .spectrum import Spectrum, in_input_numbering
-from .transfer import CoarseCopy
 from .validate import check_count
 
 __all__ = [
@@ -77,8 +74,20 @@ def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
     )
 
 
-ACCURACIES = ("exact", "preview", "fast preview")
+ACCURACIES = ("exact",)
 """The ``accuracy`` values of :func:`compute_spectrum`."""
+
+REMOVED_ACCURACIES = ("preview", "fast preview")
+"""``accuracy`` values :func:`compute_spectrum` refuses with advice: the approximate
+preview spectra are no longer computed."""
+
+PREVIEW_REMOVED = (
+    "the preview spectrum was removed: every spectrum is exact. For modes to look at "
+    "early, pass on_modes= (a callback that receives the lowest exact modes as they "
+    "converge) or ask for fewer modes k"
+)
+"""Why ``accuracy="preview"`` fails, and what to use instead (the library's ValueError;
+the command line's ``--preview`` says the same)."""
 
 
 def compute_spectrum(
@@ -90,7 +99,6 @@ def compute_spectrum(
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
     accuracy: str = "exact",
-    coarse: CoarseCopy | Future | None = None,
     on_modes: Callable[[Spectrum], None] | None = None,
 ) -> Spectrum:
     """The k lowest eigenpairs of ``operator`` on ``mesh``.
@@ -103,23 +111,9 @@ def compute_spectrum(
     bending, membrane : Discrete Shells weights (ignored by the scalar energies).
     progress : ``progress(stage, fraction)`` with fraction in [0, 1].
     cancel : polled; returning True raises :class:`Cancelled`.
-    accuracy : "exact" (default), "preview" or "fast preview".  "preview": a
-        Rayleigh-Ritz approximation in a reduced space of smooth functions on the same mesh
-        (:mod:`.preview`), seconds instead of minutes on big meshes; ``spec.is_preview``
-        is then True and ``spec.estimated_error`` holds its estimated relative eigenvalue
-        error.  Where that estimate is above 2 % (curved meshes with thin parts) the
-        preview is refined with a factorisation of the operator, which costs about half
-        the exact solve.  "fast preview" never refines: what the viewer shows while the
-        exact spectrum is computed (its estimate says how far off it may be).  A mesh too
-        small for a reduced space of 3 k functions (:func:`.preview.preview_possible`)
-        gets the exact spectrum instead, which is quick there (``is_preview`` False).
-    coarse : for a 3D shells preview, a coarse copy of the mesh to start from
-        (:class:`.transfer.CoarseCopy`, e.g. ``mv.preview_copy(mesh, k)``): the copy's
-        own modes, carried to the mesh and corrected by one step of inverse iteration,
-        where a smooth space misses the modes of thin parts.  A ``Future`` of one
-        (``mv.start_preview_copy(mesh, operator, k)``) is waited for after the
-        assembly, which so runs while the copy is made.
-
+    accuracy : "exact", the only value: every spectrum is exact.  The approximate
+        "preview" and "fast preview" raise a ValueError that says what to use instead
+        (:data:`PREVIEW_REMOVED`).
     on_modes : called as ``on_modes(spectrum_so_far)`` while the solve runs, with a
         :class:`.spectrum.Spectrum` of the first j modes whenever j grows (the exact null
         vectors first), lowest first: the eigensolver's pairs as they converge, whose
@@ -145,10 +139,10 @@ def compute_spectrum(
     """
     operator_info(operator)  # a ValueError naming the known operators
     k = check_count(k, "k")
+    if accuracy in REMOVED_ACCURACIES:
+        raise ValueError(f"accuracy={accuracy!r}: {PREVIEW_REMOVED}")
     if accuracy not in ACCURACIES:
-        raise ValueError(
-            f"accuracy must be one of {', '.join(map(repr, ACCURACIES))}, got {accuracy!r}"
-        )
+        raise ValueError(f"accuracy must be 'exact', got {accuracy!r}")
     if mesh.solver_mesh is not mesh:  # unused or merged vertices: solve on the others
         solved = compute_spectrum(
             mesh.solver_mesh,
@@ -159,16 +153,10 @@ def compute_spectrum(
             progress,
             cancel,
             accuracy,
-            coarse,
             None if on_modes is None else lambda so_far: on_modes(in_input_numbering(so_far, mesh)),
         )
         return in_input_numbering(solved, mesh)
     progress = _returning_freed_memory(progress)
-    if accuracy != "exact" and preview_possible(mesh, operator, k):
-        refine = None if accuracy == "preview" else False
-        return compute_preview(
-            mesh, operator, k, bending, membrane, progress, cancel, refine=refine, coarse=coarse
-        )
 
     def report(stage: str, fraction: float) -> None:
         if cancel is not None and cancel():
@@ -307,9 +295,8 @@ class _ModesSoFar:
 
 def _returning_freed_memory(progress: ProgressFn | None) -> ProgressFn:
     """``progress`` that first gives freed memory back to the system at each new stage
-    (:func:`.memory.return_freed_memory`): the homer Loop x2's refined Laplacian preview
-    peaked at 601 MB without it and 520 MB with it, the exact solve at 443 to 465 and 429
-    MB, in the same time within the runs' spread."""
+    (:func:`.memory.return_freed_memory`), which lowers a solve's peak memory at no
+    measurable cost in time."""
     stage_now = [None]
 
     def report(stage: str, fraction: float) -> None:

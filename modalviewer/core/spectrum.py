@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .eigen import lowest_share, zero_modes
+from .eigen import zero_modes
 from .files import atomic_write
 from .mesh import Mesh
 from .operators import OPERATOR_NAMES, operator_info
@@ -58,13 +58,13 @@ class Spectrum:
 
     def __repr__(self) -> str:
         """One line: operator, k, vertices, the modes' shape ((n, 3, k) for vector modes,
-        (n, k) for scalar ones), the eigenvalue range, preview or exact (not the arrays)."""
+        (n, k) for scalar ones) and the eigenvalue range (not the arrays)."""
         lam = self.eigenvalues
         span = f"{lam.min():.3g} .. {lam.max():.3g}" if lam.size else "none"
         return (
             f"Spectrum(operator={self.operator!r}, k={self.k}, n_vertices={self.n_vertices}, "
             f"modes={tuple(self.modes.shape)}, "
-            f"eigenvalues={span}, {'preview' if self.is_preview else 'exact'})"
+            f"eigenvalues={span})"
         )
 
     @property
@@ -80,35 +80,6 @@ class Spectrum:
         return self.modes.ndim == 3
 
     @property
-    def is_preview(self) -> bool:
-        """True for a preview (``compute_spectrum(..., accuracy="preview")``): eigenvalues
-        are upper bounds of the exact ones, with an estimated relative error
-        ``estimated_error`` (estimated from below)."""
-        return bool(self.parameters.get("preview"))
-
-    @property
-    def estimated_error(self) -> float:
-        """Estimated largest relative eigenvalue error of a preview's non-zero modes
-        (``parameters["preview"]`` holds the per-mode estimates); 0.0 for exact spectra."""
-        return float(self.parameters.get("preview", {}).get("estimated_error", 0.0))
-
-    def estimated_error_of_lowest(self, share: float = 0.5) -> float:
-        """Estimated largest relative eigenvalue error of a preview's lowest ``share`` of
-        its non-zero modes (at least one; 0.0 for exact spectra): a 3D shells preview's
-        correction step preconditions its lowest modes, which are the most accurate."""
-        errors = np.asarray(self.parameters.get("preview", {}).get("estimated_errors") or [])
-        if errors.size != self.k:
-            return self.estimated_error
-        nonzero = np.flatnonzero(~self.zero_mode_mask())
-        lowest = nonzero[: lowest_share(nonzero.size, share)]
-        return float(errors[lowest].max(initial=0.0))
-
-    def estimated_mode_error(self, j: int) -> float:
-        """Estimated relative eigenvalue error of a preview's mode ``j`` (0.0 for zero
-        modes and exact spectra)."""
-        errors = self.parameters.get("preview", {}).get("estimated_errors") or []
-        return float(errors[j]) if 0 <= j < len(errors) else 0.0
-
     @property
     def modes_requested(self) -> int:
         """How many modes the computation gives: more than :attr:`k` while the modes are

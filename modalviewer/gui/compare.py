@@ -60,7 +60,7 @@ class CompareWindow(QtWidgets.QWidget):
             self.titles.append(title)
         for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
             event.connect(self.refresh)
-        # a spectrum replaced (the exact one after its preview) redraws the views
+        # a spectrum replaced (another k, other weights) redraws the views
         self.state.events.spectra.connect(self._on_spectra)
         self.comparison.changed.connect(self.refresh)
         self._keys = install_keys(

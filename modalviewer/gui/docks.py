@@ -37,14 +37,14 @@ def build_docks(win) -> None:
 
 
 MODES_NOTE_LINES = 4
-"""Lines the Modes dock keeps for the eigenvalue line's note (a preview's estimated
-errors and what comes next, after the eigenvalue or after the two-line "Not shown (M
-shows it): ... on screen") beyond the one line it has at the start."""
+"""Lines the Modes dock keeps for the eigenvalue line's note (a coarse-to-fine
+spectrum's, after the eigenvalue or after the two-line "Not shown (M shows it): ... on
+screen") beyond the one line it has at the start."""
 
 
 def fit_modes_dock(win) -> None:
     """Give the Modes dock the height its controls need, the Amplitude and Speed rows
-    and a preview's note included (:data:`MODES_NOTE_LINES`), and the Distances dock
+    and the eigenvalue line's note included (:data:`MODES_NOTE_LINES`), and the Distances dock
     below it the rest (it scrolls): an even split leaves the Modes dock's last rows out
     of view at the default window size.  For a first start; a remembered layout is
     kept."""

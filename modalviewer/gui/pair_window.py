@@ -28,7 +28,7 @@ from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
-from ..viewer.model import predicted_seconds
+from ..viewer.model import estimated_seconds, seconds_text
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from .dialogs import file_message, offer_open_anyway
@@ -521,9 +521,9 @@ class PairWindow(QtWidgets.QWidget):
         unless scripted); returns the pending jobs."""
         key = self.pair.key()
         missing = [s for s in SIDES if self.pair.spectrum(s) is None]
-        seconds = sum(predicted_seconds(key, self.pair.mesh(s).n_vertices) for s in missing)
-        if missing and seconds > LONG_WAIT_SECONDS:
-            about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+        seconds = self._estimated_seconds(key, missing)
+        if missing and seconds is not None and seconds > LONG_WAIT_SECONDS:
+            about = seconds_text(seconds)
             self.status.setText(
                 f"Computing the {operator_info(key.operator).label} spectra of both meshes "
                 f"takes about {about} (Cancel stops it)."
@@ -531,6 +531,25 @@ class PairWindow(QtWidgets.QWidget):
         jobs = self.pair.request()
         self._on_jobs()
         return jobs
+
+    def _estimated_seconds(self, key, sides) -> float | None:
+        """Seconds the spectra of ``key`` on ``sides`` are expected to take, from this
+        machine's recorded solves (:func:`.viewer.model.estimated_seconds`); None where
+        one of them has no estimate or is in the cache, and for Coarse-to-fine."""
+        if key.coarse:
+            return None
+        records = self.pair.cache.solves()
+        total = 0.0
+        for side in sides:
+            mesh = self.pair.sides[side].compute_mesh(key.rescale)
+            args = (mesh, key.operator, key.k, key.bending, key.membrane)
+            if self.pair.cache.path(*args).is_file():
+                return None
+            seconds = estimated_seconds(records, key.operator, mesh.n_vertices, key.k, mesh.hash)
+            if seconds is None:
+                return None
+            total += seconds
+        return total
 
     def wait(self, timeout: float | None = None) -> None:
         """Run the event loop until this window's spectra for the current kind are in;

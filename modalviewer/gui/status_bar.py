@@ -17,8 +17,7 @@ class StatusBarWidgets:
     STATUS_LINE_WIDTH_BESIDE_MESSAGE = 300
     STAGE_CHARS = 30
     """Characters of the running stage the progress bar shows (longer ones are cut, whole
-    in its tooltip and in the Computations list); a preview's stages without their
-    "preview: " (the job is named in both)."""
+    in its tooltip and in the Computations list)."""
 
     def __init__(self, bar: QtWidgets.QStatusBar, state, jobs):
         self.bar = bar
@@ -55,8 +54,6 @@ class StatusBarWidgets:
             queued = len(self.jobs.jobs) - 1
             more = f" (+{queued} queued)" if queued else ""
             stage = running.stage
-            if getattr(running, "is_preview", False):
-                stage = stage.removeprefix("preview: ")
             if len(stage) > self.STAGE_CHARS:
                 stage = stage[: self.STAGE_CHARS - 1] + "…"
             self.progress.setFormat(f"{stage} %p %{more}")  # as in the Computations list

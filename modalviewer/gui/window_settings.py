@@ -69,8 +69,6 @@ def restore(win) -> None:
         membrane=float(s.value("compute/membrane", 1.0)),
         rescale=_flag(s, "compute/rescale", False),
         coarse=_flag(s, "compute/coarse", False),
-        preview=_flag(s, "compute/preview", True),
-        preview_only=_flag(s, "compute/preview_only", False),
     )
     rebuild_recent(win)
 
@@ -116,8 +114,8 @@ def save(win) -> None:
     s.setValue("compute/membrane", c.membrane)
     s.setValue("compute/rescale", _flag_text(c.rescale))
     s.setValue("compute/coarse", _flag_text(c.coarse))
-    s.setValue("compute/preview", _flag_text(c.preview))
-    s.setValue("compute/preview_only", _flag_text(c.preview_only))
+    for removed in ("compute/preview", "compute/preview_only"):  # options no longer offered
+        s.remove(removed)
     s.sync()
 
 

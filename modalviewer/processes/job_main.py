@@ -1,8 +1,7 @@
 """A spectrum computation in a child process.
 
 ``python -m modalviewer.processes.job_main JOB OUT``: JOB.npz holds ``vertices``,
-``faces`` and a JSON ``params`` (operator, k, bending, membrane, accuracy, and
-``coarse_copy``: a 3D shells preview from a coarse copy of the mesh).  Progress goes to
+``faces`` and a JSON ``params`` (operator, k, bending, membrane).  Progress goes to
 stdout as JSON lines ``{"stage": ..., "fraction": ...}``, the result to OUT.npz (written
 atomically), a failure to stdout as ``{"error": ...}`` with exit code 1.  A separate
 process keeps the viewer's event loop free (sparse factorisations hold the GIL) and is
@@ -36,13 +35,6 @@ def main(argv: list[str] | None = None) -> int:
             vertices, faces = job["vertices"], job["faces"]
             params = json.loads(str(job["params"]))
         mesh = Mesh(vertices, faces)
-        accuracy = params.get("accuracy", "exact")
-        coarse = None
-        if params.get("coarse_copy") and accuracy != "exact":
-            from ..coarsen import start_preview_copy
-
-            # made in its process while compute_spectrum assembles the operator
-            coarse = start_preview_copy(mesh, params["operator"], int(params["k"]))
         spec = compute_spectrum(
             mesh,
             params["operator"],
@@ -50,8 +42,6 @@ def main(argv: list[str] | None = None) -> int:
             float(params["bending"]),
             float(params["membrane"]),
             progress=_report,
-            accuracy=accuracy,
-            coarse=coarse,
         )
         _emit({"stage": "writing the result", "fraction": 0.97})
         save_spectrum(spec, out_path)

@@ -1,8 +1,8 @@
 """Memory settings for a computation process.
 
-A spectrum computation allocates and frees many arrays of hundreds of megabytes (130k
-vertices, shells: each (N, 100) block is 313 MB), and on the reference machine first
-touches of fresh memory cost more than much of the arithmetic done with it.  Two
+A spectrum computation allocates and frees many arrays of hundreds of megabytes (an
+(N, 100) block of doubles), and first touches of fresh memory cost more than much of the
+arithmetic done with it.  Two
 settings make them cheaper:
 
 - glibc hands every array above its mmap threshold to the kernel and back
@@ -11,8 +11,7 @@ settings make them cheaper:
   columns) from the heap and not trimming it lets a process reuse what it freed
   (:func:`keep_freed_memory`), whose pages are already mapped.  Bigger arrays (the
   (N, k) blocks and bases) still go back as they are freed: served from the heap too,
-  they left holes the next ones did not fit (spot Loop x3's exact 3D shells peaked at
-  3667 MB, 3401 MB with the threshold).
+  they leave holes the next ones do not fit, which raises the peak.
 - numpy advises the kernel to back big arrays with transparent huge pages, and the
   kernel compacts memory to find them, which makes the page faults of fresh arrays
   several times slower (:func:`no_huge_page_advice`).
@@ -48,11 +47,8 @@ _M_ARENA_MAX = -8
 HEAP_ARRAY_MAX_BYTES = 32 * 2**20
 """Arrays up to this size come from the heap in a compute process and their memory is
 reused when freed; bigger ones are mapped and unmapped (glibc's mmap threshold, at its
-largest on 64-bit systems).  Against serving every array from the heap: spot Loop x3's
-(187k vertices) exact 3D shells peaked at 3401 against 3667 MB (one run each; glibc's
-defaults: 3404 MB); in paired runs its fast 3D shells preview at 2697 against 2752 MB
-in 1.04 times the time, and the cow Loop x3's Laplacian exact solve at 713 against 730
-MB in 1.02 times."""
+largest on 64-bit systems): serving every array from the heap raised the exact solves'
+peak memory."""
 
 
 def _mallopt():

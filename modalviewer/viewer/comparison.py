@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from psygnal import Signal
 
-from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
+from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from .derived import Field
 from .state import ViewerState
 
@@ -109,8 +109,7 @@ class Comparison:
             title=f"{item_label(item)} mode {j}",
         )
         lam = "0 (zero mode)" if spec.zero_mode_mask()[j] else f"{spec.eigenvalues[j]:.5g}"
-        mark = " (preview)" if spec.is_preview else ""
-        return ComparisonView(item, f"{item_label(item)}: mode {j}, lambda = {lam}{mark}", field)
+        return ComparisonView(item, f"{item_label(item)}: mode {j}, lambda = {lam}", field)
 
     def _distance_views(self) -> list[ComparisonView]:
         state, derived = self.state, self.state.derived
@@ -133,8 +132,6 @@ class Comparison:
                 )
                 views.append(ComparisonView(item, f"{item_label(item)}: {need}", marker=vertex))
                 continue
-            spec = state.spectrum(operator_for_distance(item))
-            mark = " (preview)" if spec is not None and spec.is_preview else ""
             if display.distance_display == "threshold":
                 if share is None:
                     thr = display.threshold * float(d.max())
@@ -147,5 +144,5 @@ class Comparison:
             else:
                 field = derived.scaled(Field(d, "sequential", title=item_label(item)))
                 title = f"{item_label(item)} from vertex {shown}"
-            views.append(ComparisonView(item, title + mark, field, vertex))
+            views.append(ComparisonView(item, title, field, vertex))
         return views

@@ -106,12 +106,7 @@ class Job:
 
 class SpectrumJob(Job):
     """A job computing (or loading) the spectrum ``spectrum_key`` of the loaded mesh; its
-    result is ``(Spectrum, SignatureTable or None)``.
-
-    ``preview_job``: the preview computed first for the same request (the exact
-    spectrum follows it), or None; ``is_preview``: this job computes a preview;
-    ``note``: words the status line adds to "Computing <description>" when the job
-    starts (how a shown preview starts, :func:`.model.preview_start_note`), or ""."""
+    result is ``(Spectrum, SignatureTable or None)``."""
 
     def __init__(
         self,
@@ -120,15 +115,9 @@ class SpectrumJob(Job):
         description: str,
         owner: Hashable,
         spectrum_key,
-        preview_job: SpectrumJob | None = None,
-        is_preview: bool = False,
-        note: str = "",
     ):
         super().__init__(fn, key, description, owner)
         self.spectrum_key = spectrum_key
-        self.preview_job = preview_job
-        self.is_preview = is_preview
-        self.note = note
 
     @property
     def spectrum(self):

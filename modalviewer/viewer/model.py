@@ -9,21 +9,18 @@ asked to (``show=True``) and the display has not changed since the request.
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..coarsen import COARSE_FRACTION
-from ..core.cache import SpectrumCache
-from ..core.cost import LAWS_FROM_VERTICES
+from ..core.cache import SolveRecord, SpectrumCache
 from ..core.eigen import Cancelled
 from ..core.memory import physical_memory_mb
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
 from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
-from ..core.preview import preview_possible_on
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
@@ -33,113 +30,7 @@ from .state import SpectrumKey, ViewerState
 
 PROCESS_THRESHOLD = 20000
 """Exact spectra of at least this many unknowns are computed in a separate process
-(sparse factorisations hold the GIL; a process also cancels at once); previews always
-are (:func:`_compute_preview`)."""
-
-PREVIEW_DELAY = 0.10
-"""A preview is computed first only where it is predicted to make the exact spectrum
-arrive at most this share later than without it (:func:`preview_plan`)."""
-
-
-PREVIEW_MARGIN = 2.2
-"""A preview comes first only where this many times its predicted time fits within
-:data:`PREVIEW_DELAY` of the exact solve's predicted time: the growth laws are fitted
-on plates, and on the curved benchmark meshes of 100k to 270k vertices a fast preview's
-share of the exact time was up to 2.01 times the share the laws predict (Cheburashka
-Loop x2's 3D shells: the preview, with its guard modes, took 0.44 of the exact time,
-the laws say 0.22; 0.42 and 0.37 in earlier runs without them;
-``benchmarks/results/curved.json``, which ``tests/viewer/test_state_model.py`` checks
-the margin against), and a preview that runs past its share is thrown away
-(:attr:`PreviewPlan.deadline`)."""
-
-
-NOTE_FROM_SECONDS = 10.0
-"""Requests whose exact solve is predicted to take at least this long say why they get no
-preview (quicker ones would only add noise to the status line)."""
-
-
-@dataclass(frozen=True)
-class PreviewPlan:
-    """Whether a request gets a preview first, and the predictions behind it
-    (:func:`preview_plan`)."""
-
-    pays: bool
-    preview_seconds: float
-    exact_seconds: float
-    preview_mb: float
-    exact_mb: float
-    n_vertices: int = LAWS_FROM_VERTICES
-
-    @property
-    def deadline(self) -> float:
-        """Seconds after which a running preview is given up: its share of the exact
-        solve's predicted time (:data:`PREVIEW_DELAY`), so a misprediction cannot delay
-        the exact spectrum by more."""
-        return PREVIEW_DELAY * self.exact_seconds
-
-    def reason(self) -> str:
-        """Why there is no preview, in words ("" where there is one)."""
-        if self.pays:
-            return ""
-        if self.n_vertices < LAWS_FROM_VERTICES:
-            # only requests predicted to take NOTE_FROM_SECONDS or more are told why, so
-            # the exact solve is not "quick" here: the reason is the preview's fixed costs
-            return (
-                f"no preview below {LAWS_FROM_VERTICES:,} vertices".replace(",", "\u00a0")
-                + f" (the exact solve: about {_seconds(self.exact_seconds)}): there a "
-                "preview's fixed costs take too large a share of the exact time"
-            )
-        share = PREVIEW_DELAY * self.exact_seconds
-        if PREVIEW_MARGIN * self.preview_seconds > share:
-            predicted = (
-                f"no preview: predicted {_seconds(self.preview_seconds)} against the exact "
-                f"{_seconds(self.exact_seconds)}, "
-            )
-            if self.preview_seconds > share:
-                why = (
-                    f"it would delay the exact spectrum by more than {round(100 * PREVIEW_DELAY)} %"
-                )
-            else:
-                why = (
-                    f"too close to its {round(100 * PREVIEW_DELAY)} % share (on curved meshes "
-                    f"a preview's share is up to {PREVIEW_MARGIN:g} times the predicted one)"
-                )
-            return predicted + why
-        return (
-            f"no preview: it would need about {_megabytes(self.preview_mb)}, more than the "
-            f"exact solve's {_megabytes(self.exact_mb)}"
-        )
-
-
-def _megabytes(value: float) -> str:
-    return f"{value:,.0f}".replace(",", "\u00a0") + "\u00a0MB"
-
-
-def _seconds(value: float) -> str:
-    """Seconds in words: a decimal below 10 s ("9.9 s"), none from there ("10 s")."""
-    return f"{value:.0f}\u00a0s" if round(value, 1) >= 10 else f"{value:.1f}\u00a0s"
-
-
-def preview_plan(key: SpectrumKey, n_vertices: int) -> PreviewPlan:
-    """Predict the fast preview's and the exact solve's time and memory for ``key`` on a
-    mesh of ``n_vertices``
-    (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_seconds`); a preview
-    pays when :data:`PREVIEW_MARGIN` times its predicted time is at most
-    :data:`PREVIEW_DELAY` of the exact time and it needs no more memory than the exact
-    solve, on meshes of at least
-    :data:`~modalviewer.core.cost.LAWS_FROM_VERTICES` vertices, where the laws were
-    measured (below, fixed costs make a preview take a larger share)."""
-    info, k = operator_info(key.operator), key.k
-    preview_s = info.predicted_seconds("fast preview", n_vertices, k)
-    exact_s = info.predicted_seconds("exact", n_vertices, k)
-    preview_mb = info.predicted_peak_mb("fast preview", n_vertices, k)
-    exact_mb = info.predicted_peak_mb("exact", n_vertices, k)
-    pays = (
-        n_vertices >= LAWS_FROM_VERTICES
-        and PREVIEW_MARGIN * preview_s <= PREVIEW_DELAY * exact_s
-        and preview_mb <= exact_mb
-    )
-    return PreviewPlan(pays, preview_s, exact_s, preview_mb, exact_mb, n_vertices)
+(sparse factorisations hold the GIL; a process also cancels at once)."""
 
 
 class ComputeRefused(ValueError):
@@ -168,33 +59,67 @@ def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
     its peak (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`;
     Coarse-to-fine solves on its decimated copy)."""
     info = operator_info(key.operator)
-    return info.predicted_peak_mb("exact", solved_vertices(key, n_vertices), key.k) * 2**20
+    return info.predicted_peak_mb(solved_vertices(key, n_vertices), key.k) * 2**20
 
 
-def preview_start_note(key: SpectrumKey, n_vertices: int) -> str:
-    """What the status line adds to "Computing preview of ..." for a shown (Preview only)
-    preview of ``key``: how the 3D shells' starts (from a coarse copy of the mesh, or
-    from its smooth space and why), and where the exact solve is predicted to be quick
-    (below :data:`NOTE_FROM_SECONDS`) that it would take about as long; "" otherwise."""
-    from ..coarsen import preview_copy_refusal
+ESTIMATE_RANGE = 2.0
+"""An estimate scales a recorded solve whose vertex count, or number of modes, is within
+this factor of the request's (:func:`estimated_seconds`)."""
 
-    note = ""
-    if operator_info(key.operator).preview.factor_step:
-        refusal = preview_copy_refusal(n_vertices, key.operator, key.k)
-        start = "a coarse copy of the mesh" if refusal is None else f"its smooth space ({refusal})"
-        note = f", from {start}"
-    exact = predicted_seconds(key, n_vertices)
-    if exact < NOTE_FROM_SECONDS:
-        note += f"; the exact spectrum would take about {max(exact, 1.0):.0f} s here"
-    return note
+SIZE_EXPONENT = 1.2
+"""Seconds grow as the vertex count to this power in :func:`estimated_seconds`."""
+
+MODES_EXPONENT = 0.6
+"""Seconds grow as the number of modes to this power in :func:`estimated_seconds`."""
 
 
-def predicted_seconds(key: SpectrumKey, n_vertices: int, accuracy: str = "exact") -> float:
-    """Seconds the computation of ``key`` ("exact" or "fast preview") on ``n_vertices``
-    is predicted to take (the operator's growth laws; Coarse-to-fine solves on its
-    decimated copy)."""
-    n_solved = solved_vertices(key, n_vertices)
-    return operator_info(key.operator).predicted_seconds(accuracy, n_solved, key.k)
+def estimated_seconds(
+    records: list[SolveRecord], operator: str, n_vertices: int, k: int, mesh_hash: str = ""
+) -> float | None:
+    """Seconds an exact solve of ``k`` modes of ``operator`` on a mesh of ``n_vertices``
+    (hash ``mesh_hash``) is expected to take, from this machine's own recorded solves
+    (``records``, most recent first: :meth:`.core.cache.SpectrumCache.solves`); None
+    where they do not tell.
+
+    The rule, of the same operator's records only, one scaling at a time:
+
+    - the same mesh and k solved before: that solve's seconds (the most recent);
+    - else the same mesh with the nearest number of modes k0 within a factor
+      :data:`ESTIMATE_RANGE` of k: its seconds times ``(k / k0) ** MODES_EXPONENT``;
+    - else the same k on the mesh nearest in size whose vertex count n0 is within a
+      factor :data:`ESTIMATE_RANGE` of n: its seconds times
+      ``(n / n0) ** SIZE_EXPONENT``;
+    - else None: no time is shown.
+
+    Each scaling alone keeps the estimate within 1.5 times of the solve's time on the
+    solves it was checked against (the commit that introduced it lists them); both at
+    once, or further out, do not: the time per mode falls as k grows (the factorisation
+    is shared), and the time's growth with size and with k depends on the operator and
+    on the mesh's shape."""
+    same = [r for r in records if r.operator == operator]
+    n, k = max(int(n_vertices), 1), max(int(k), 1)
+
+    def within(a: float, b: float) -> bool:
+        return b / ESTIMATE_RANGE <= a <= ESTIMATE_RANGE * b
+
+    mesh = [r for r in same if mesh_hash and r.mesh_hash == mesh_hash]
+    for r in mesh:
+        if r.k == k:
+            return r.seconds
+    modes = [r for r in mesh if within(r.k, k)]
+    if modes:
+        best = min(modes, key=lambda r: abs(np.log(r.k / k)))
+        return best.seconds * (k / best.k) ** MODES_EXPONENT
+    sizes = [r for r in same if r.k == k and within(r.n_vertices, n)]
+    if sizes:
+        best = min(sizes, key=lambda r: abs(np.log(r.n_vertices / n)))
+        return best.seconds * (n / best.n_vertices) ** SIZE_EXPONENT
+    return None
+
+
+def seconds_text(seconds: float) -> str:
+    """About how long, in words: "45 s" below two minutes, "3 min" from there."""
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
 MEMORY_SHARE = 0.75
@@ -220,31 +145,10 @@ COARSE_WORDS = "with Coarse-to-fine (a decimated copy)"
 """How :func:`what_fits` names Coarse-to-fine (the viewer's option)."""
 
 
-PREVIEW_WORDS = "as a preview (Preview only)"
-"""How :func:`what_fits` names a preview without the exact spectrum (the viewer's option)."""
-
-
-def preview_fits(key: SpectrumKey, n_vertices: int, available: int) -> bool:
-    """Whether the fast preview of ``key`` is predicted to need at most
-    :data:`MEMORY_SHARE` of ``available`` bytes (its growth law, measured at 100 modes,
-    plus the arrays each further mode adds:
-    :meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`)."""
-    info = operator_info(key.operator)
-    needed = info.predicted_peak_mb("fast preview", n_vertices, key.k) * 2**20
-    return needed <= MEMORY_SHARE * available
-
-
-def what_fits(
-    key: SpectrumKey,
-    n_vertices: int,
-    available: int,
-    coarse: str = COARSE_WORDS,
-    preview: str = PREVIEW_WORDS,
-) -> str:
-    """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``),
-    a preview without the exact spectrum (named ``preview``), or none of them.  The two
-    others only where they give ``key.k`` modes: the decimated copy has as many modes as
-    unknowns, and a preview needs a reduced space of 3 k functions."""
+def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = COARSE_WORDS) -> str:
+    """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``;
+    only where it gives ``key.k`` modes: the decimated copy has as many modes as
+    unknowns), or neither."""
     k = largest_k_that_fits(key, n_vertices, available)
     copy_modes = operator_info(key.operator).unknowns(copy_vertices(n_vertices))
     coarse_needs = memory_needed(replace(key, coarse=True), n_vertices)
@@ -256,12 +160,6 @@ def what_fits(
         options.append(f"at most {k} modes fit")
     if coarse_fits:
         options.append(f"{key.k} modes {coarse} fit")
-    if (
-        not key.coarse
-        and preview_possible_on(n_vertices, key.operator, key.k)
-        and preview_fits(key, n_vertices, available)
-    ):
-        options.append(f"{key.k} modes {preview} fit")
     if not options:
         return "Not even one mode fits: use a coarser mesh or a machine with more memory."
     text = "; ".join(options)
@@ -278,34 +176,17 @@ def _share_words(available: int) -> str:
     )
 
 
-def memory_refusal(
-    key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS, preview: str = PREVIEW_WORDS
-) -> str | None:
+def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS) -> str | None:
     """A message if computing ``key`` on ``n_vertices`` would need more than
     :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
     The viewer's refusals and ``modalviewer compute`` say the same."""
     needed = memory_needed(key, n_vertices)
-    seconds = predicted_seconds(key, n_vertices)
     available = physical_memory()
     if available and needed > MEMORY_SHARE * available:
         return (
             f"{operator_info(key.operator).label} with {key.k} modes on "
-            f"{n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory "
-            f"and {seconds / 60:.0f} min, more than {_share_words(available)}. "
-            + what_fits(key, n_vertices, available, coarse, preview)
-        )
-    return None
-
-
-def preview_refusal(key: SpectrumKey, n_vertices: int) -> str | None:
-    """A message if even the fast preview of ``key`` is predicted to need more than
-    :data:`MEMORY_SHARE` of this machine's memory; else None."""
-    available = physical_memory()
-    if available and not preview_fits(key, n_vertices, available):
-        return (
-            f"Even a preview of {operator_info(key.operator).label} with {key.k} modes on "
-            f"{n_vertices} vertices would need more than {_share_words(available)}: use a "
-            "coarser mesh or fewer modes."
+            f"{n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory, "
+            f"more than {_share_words(available)}. " + what_fits(key, n_vertices, available, coarse)
         )
     return None
 
@@ -386,20 +267,13 @@ class ViewerModel:
         display_at_request = state.display
         if state.has_spectrum(key):
             return self._answered(key, show)
-        if state.compute_settings.preview_only and not key.coarse and not self._cached(key):
-            return self._request_preview_only(key, show, display_at_request)
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
-        preview = (
-            self._add_preview(key, show, display_at_request) if self._wants_preview(key) else None
-        )
         work = self._work(key)
         job = self.jobs.add(
-            SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key, preview)
+            SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key)
         )
-        # while it runs, behind a preview (this request's, or one kept from an earlier
-        # request whose exact computation was cancelled) the exact spectrum follows
         state.set_computing(key, True)
         owner = state.mesh.hash
 
@@ -408,68 +282,19 @@ class ViewerModel:
                 self.state.set_computing(key, False)
 
         job.then(computing_ended)
-        if show and not self.preview_on_screen(key):
-            # behind a preview already on screen the exact spectrum replaces it in place
-            # (mode, pick and map stay), as after a preview of this request; a preview
-            # held but not shown (another operator on screen) is replaced where it is
-            # held, and the exact spectrum is shown as any new one
+        if show:
             job.then(self._shower(key, display_at_request))
         return job
-
-    def preview_on_screen(self, key: SpectrumKey) -> bool:
-        """Whether the picture is made of a preview of ``key`` (held from Preview only or
-        a cancelled exact computation, not this request's)."""
-        held = self.state.spectra.get(key)
-        return (
-            held is not None and held.is_preview and self.state.display_operator() == key.operator
-        )
-
-    def _request_preview_only(self, key: SpectrumKey, show: bool, before) -> SpectrumJob:
-        """Preview only (the exact spectrum not in the cache): one preview job and no
-        exact computation.  Refined where its
-        estimate calls for it if the exact solve's memory would fit (the refinement
-        factorises the operator as the exact solve does), the fast preview otherwise;
-        shown whatever its estimate (there is nothing better on its way)."""
-        if key in self.state.spectra:  # the exact spectrum or a preview of it: either answers
-            return self._answered(key, show)
-        refusal = preview_refusal(key, self.state.mesh.n_vertices)
-        if refusal:
-            raise ComputeRefused(refusal)
-        accuracy = "preview" if self.refusal(key) is None else "fast preview"
-        return self._add_preview(key, show, before, accuracy)
 
     def _answered(self, key: SpectrumKey, show: bool) -> SpectrumJob:
         """An ended job holding ``key``'s spectrum already in the state; with ``show`` its
         first mode is shown unless that operator is on screen (the mode or map stays)."""
         state = self.state
         spec = state.spectra[key]
-        job = SpectrumJob(
-            None, key, key.describe(), state.mesh.hash, key, is_preview=spec.is_preview
-        )
+        job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
         job.end_now((spec, None))
         if show and state.display_operator() != key.operator:
             self._show_first_mode(key.operator)
-        return job
-
-    def _add_preview(
-        self, key: SpectrumKey, show: bool, before, accuracy: str | None = None
-    ) -> SpectrumJob:
-        """Queue a preview job of ``key`` (``accuracy``: see :meth:`_work`), showing its
-        first mode on arrival with ``show`` if the display is still ``before``."""
-        state = self.state
-        job = self.jobs.add(
-            SpectrumJob(
-                self._work(key, preview=True, accuracy=accuracy),
-                (state.mesh.hash, key, "preview"),
-                f"preview of {key.describe()}",
-                state.mesh.hash,
-                key,
-                is_preview=True,
-                note="" if accuracy is None else preview_start_note(key, state.mesh.n_vertices),
-            )
-        )
-        if show:
-            job.then(self._shower(key, before))
         return job
 
     def computing(self, operator: str) -> bool:
@@ -484,8 +309,7 @@ class ViewerModel:
         )
 
     def cancel_running(self) -> None:
-        """Cancel the running job and the jobs of the same spectrum request (a preview
-        and the exact computation behind it)."""
+        """Cancel the running job and the other jobs of the same spectrum request."""
         running = self.jobs.running
         if running is None:
             return
@@ -495,34 +319,22 @@ class ViewerModel:
             if job is running or same:
                 self.jobs.cancel(job)
 
-    def _wants_preview(self, key: SpectrumKey) -> bool:
-        """Preview first: asked for, predicted to pay (:func:`preview_plan`), not
-        coarse-to-fine, no preview yet, not in the cache."""
-        state = self.state
-        if not state.compute_settings.preview or key.coarse:
-            return False
-        if not preview_plan(key, state.mesh.n_vertices).pays:
-            return False
-        if key in state.spectra:
-            return False
-        return not self._cached(key)
+    def estimated_seconds(self, key: SpectrumKey) -> float | None:
+        """Seconds the computation of ``key`` on the loaded mesh is expected to take:
+        :func:`estimated_seconds` from this machine's solves recorded in the cache; None
+        where those do not tell, for Coarse-to-fine (its decimation is not recorded), and
+        where the spectrum is in the cache already (nothing is solved)."""
+        if self.state.mesh is None or key.coarse or self._cached(key):
+            return None
+        mesh = self.state.compute_mesh(key)
+        return estimated_seconds(
+            self.cache.solves(), key.operator, mesh.n_vertices, key.k, mesh.hash
+        )
 
     def _cached(self, key: SpectrumKey) -> bool:
         """Whether the exact spectrum of ``key`` is in the disk cache."""
         mesh = self.state.compute_mesh(key)
         return self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
-
-    def no_preview_note(self, key: SpectrumKey) -> str:
-        """Why a request with "Preview first" on gets no preview ("" where it gets one,
-        where none was asked for, or where the exact solve is quick:
-        :data:`NOTE_FROM_SECONDS`)."""
-        state = self.state
-        if not state.compute_settings.preview:
-            return ""
-        if key.coarse:
-            return "no preview with Coarse-to-fine (itself an approximation)"
-        plan = preview_plan(key, state.mesh.n_vertices)
-        return plan.reason() if plan.exact_seconds >= NOTE_FROM_SECONDS else ""
 
     def _shower(self, key: SpectrumKey, before):
         """A job callback showing the new spectrum of ``key`` if the display has not
@@ -546,26 +358,16 @@ class ViewerModel:
     def _show_first_mode(self, operator: str) -> None:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
 
-    def _work(self, key: SpectrumKey, preview: bool = False, accuracy: str | None = None):
-        """The function a job runs for ``key``: cache, compute, signature table (a
-        ``preview``: the reduced-space approximation, never cached; ``accuracy`` given:
-        Preview only, that accuracy, neither stopped nor discarded)."""
+    def _work(self, key: SpectrumKey):
+        """The function a job runs for ``key``: cache, compute, signature table."""
         mesh = self.state.compute_mesh(key)
         cache = self.cache
         t_range = self.state.t_range
         cache_args = (mesh, key.operator, key.k, key.bending, key.membrane)
         needs_table = operator_info(key.operator).distance_kind is not None
 
-        first = preview and accuracy is None  # before an exact computation
-        deadline = preview_plan(key, mesh.n_vertices).deadline if first else None
-
         def work(progress, cancel):
-            if preview:
-                spec = _compute_preview(
-                    mesh, key, progress, cancel, deadline, accuracy or "fast preview", first
-                )
-            else:
-                spec = None if key.coarse else cache.get(*cache_args)
+            spec = None if key.coarse else cache.get(*cache_args)
             if spec is None:
                 spec = _compute(mesh, key, cache, progress, cancel)
             table = None
@@ -608,79 +410,6 @@ def _compute(mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cance
     return spec
 
 
-class PreviewGivenUp(Cancelled):
-    """A preview stopped because it would have delayed the exact spectrum too much (its
-    message says why); the exact computation behind it goes on."""
-
-
-def _compute_preview(
-    mesh: Mesh,
-    key: SpectrumKey,
-    progress,
-    cancel,
-    deadline: float | None = None,
-    accuracy: str = "fast preview",
-    discard_rough: bool = True,
-) -> Spectrum:
-    """A preview (by default the fast one, never refined: a refinement costs about half
-    the exact solve), always in a child process: the reduced-space work holds the GIL
-    long enough to stall the event loop (up to 5.6 s at 130k in a thread, and 2 to 3 s
-    in the reduced eigenproblem of the 9k-unknown spot shells, under Xvfb), and Preview
-    only computes previews of small meshes too.
-
-    Given up (:class:`PreviewGivenUp`) after ``deadline`` seconds, and (``discard_rough``)
-    where the estimated error of the lower half of its non-zero modes is above
-    :data:`~modalviewer.core.preview.REFINE_ABOVE`: such a preview misses modes (thin
-    parts a smooth space cannot bend), and only a refinement would find them.  The upper
-    half may be further off (the 3D shells' correction step preconditions the lowest 60 %
-    of the modes): each mode's legend gives its own estimate.
-    A shown preview (``discard_rough`` False: Preview only) of the 3D shells starts from
-    a coarse copy of the mesh where one can be made (``core.preview``'s coarse start): it
-    finds the modes of thin parts that the smooth space misses, at about 0.35 to 0.45 of
-    the exact time, where the smooth space's 0.25 to 0.3 would show them far off."""
-    from ..core.preview import REFINE_ABOVE
-
-    weights = (key.bending, key.membrane)
-    started = time.perf_counter()
-
-    def stop() -> bool:
-        if deadline is not None and time.perf_counter() - started > deadline:
-            raise PreviewGivenUp(
-                f"preview stopped after {_seconds(deadline)} (its share of the exact solve's "
-                f"predicted time)"
-            )
-        return cancel()
-
-    import tempfile
-
-    from . import process
-
-    folder = tempfile.mkdtemp(prefix="modalviewer-preview-")
-    target = Path(folder) / "preview.npz"
-    try:
-        spec = process.compute_in_process(
-            mesh,
-            key.operator,
-            key.k,
-            *weights,
-            target,
-            progress,
-            stop,
-            accuracy=accuracy,
-            coarse_copy=not discard_rough,
-        )
-    finally:
-        target.unlink(missing_ok=True)
-        Path(folder).rmdir()
-    lowest = spec.estimated_error_of_lowest(0.5)
-    if discard_rough and spec.is_preview and lowest > REFINE_ABOVE:
-        raise PreviewGivenUp(
-            f"preview not shown: the estimated error of its lower half of modes "
-            f"({100 * lowest:.0f} %) is above {100 * REFINE_ABOVE:.0f} %, so it may miss modes"
-        )
-    return spec
-
-
 def worst_residual(spec: Spectrum) -> float:
     return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
 
@@ -696,13 +425,18 @@ FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
 def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
     """How a finished spectrum job's status line starts: "<description> in 63.2 s", or
     for a spectrum read from the cache "<description> read from the cache in 0.3 s
-    (solved earlier in 63.2 s)", so that a cache hit does not read like a fresh solve."""
+    (solved earlier in 63.2 s)", so that a cache hit does not read like a fresh solve.
+    A solve's time is the one it stored (``parameters["seconds_total"]``, what the
+    cache keeps and the estimates use), so a solve and its reopening report the same
+    number; the job's own time where the spectrum has none (coarse-to-fine)."""
     fewer = fewer_modes_text(job, spec)
+    solved = spec.parameters.get("seconds_total")
+    if not isinstance(solved, (int, float)) or "transferred_from" in spec.parameters:
+        solved = None
     if not spec.from_cache:
-        return f"{job.description}{fewer} in {job.seconds:.1f} s"
-    earlier = spec.parameters.get("seconds_total")
-    solved = f" (solved earlier in {earlier:.1f} s)" if isinstance(earlier, (int, float)) else ""
-    return f"{job.description}{fewer} read from the cache in {job.seconds:.1f} s{solved}"
+        return f"{job.description}{fewer} in {job.seconds if solved is None else solved:.1f} s"
+    earlier = f" (solved earlier in {solved:.1f} s)" if solved is not None else ""
+    return f"{job.description}{fewer} read from the cache in {job.seconds:.1f} s{earlier}"
 
 
 def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:

@@ -108,20 +108,14 @@ def compute_in_process(
     out_path,
     progress,
     cancel,
-    accuracy="exact",
-    coarse_copy=False,
 ):
     """Run ``modalviewer.processes.job_main`` in a child Python; returns the Spectrum read back
-    from ``out_path``; the child's error message is raised as RuntimeError.
-    ``coarse_copy``: a 3D shells preview starts from a coarse copy of the mesh
-    (:func:`modalviewer.coarsen.preview_copy`) where one can be made."""
+    from ``out_path``; the child's error message is raised as RuntimeError."""
     params = {
         "operator": operator,
         "k": int(k),
         "bending": bending,
         "membrane": membrane,
-        "accuracy": accuracy,
-        "coarse_copy": bool(coarse_copy),
     }
     job_path = _temp_path(".npz")
     try:

@@ -101,8 +101,6 @@ class ComputeSettings:
     membrane: float = 1.0
     rescale: bool = False
     coarse: bool = False
-    preview: bool = True  # a preview spectrum first where it pays, the exact one after
-    preview_only: bool = False  # a preview and no exact spectrum (huge meshes)
 
     def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
         op = operator or self.operator
@@ -188,23 +186,6 @@ def _scale(t) -> float | None:
     if not (np.isfinite(t) and t > 0):
         raise ValueError("the signature scale t must be positive and finite")
     return t
-
-
-def _take_signs(spec: Spectrum, preview: Spectrum) -> None:
-    """Flip modes of ``spec`` in place so each has a non-negative Mass inner product
-    with the same mode of ``preview``: a mode's sign is arbitrary, and an exact spectrum
-    replacing its preview should not swap the colours of the mode on screen."""
-    k = min(spec.k, preview.k)
-    if spec.modes.shape[:-1] != preview.modes.shape[:-1] or k == 0:
-        return
-    if not spec.modes.flags.writeable:
-        return
-    a = spec.modes[..., :k].reshape(spec.modes.shape[0], -1, k)
-    b = preview.modes[..., :k].reshape(preview.modes.shape[0], -1, k)
-    inner = np.einsum("v,vcj,vcj->j", spec.mass, a, b)
-    flip = np.flatnonzero(inner < 0)
-    if flip.size:
-        spec.modes[..., flip] *= -1.0
 
 
 class ViewerEvents(SignalGroup):
@@ -326,11 +307,6 @@ class ViewerState:
             spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
             raise ValueError("the spectrum does not belong to the loaded mesh")
-        if spec.is_preview and self.has_spectrum(key):
-            return  # the exact spectrum is in already
-        shown = self.spectra.get(key)
-        if shown is not None and shown.is_preview and not spec.is_preview:
-            _take_signs(spec, shown)
         for other in [k for k in self.spectra if k.operator == key.operator and k != key]:
             del self.spectra[other]
         self.spectra[key] = spec
@@ -347,8 +323,7 @@ class ViewerState:
 
     def set_computing(self, key: SpectrumKey, computing: bool) -> None:
         """Whether the spectrum of ``key`` is being computed or waits its turn: the status
-        line says so while no spectrum is on screen, and behind a preview the panels and
-        the picture's legend say the exact spectrum follows (:meth:`exact_follows`)."""
+        line says so while no spectrum is on screen."""
         if computing == (key in self.computing):
             return
         if computing:
@@ -358,15 +333,6 @@ class ViewerState:
         self.events.spectra.emit(key.operator)
         if self.display_operator() == key.operator:
             self.events.display.emit()
-
-    def exact_follows(self, operator: str | None) -> bool:
-        """True if the spectrum shown for ``operator`` is a preview whose exact spectrum
-        is on its way."""
-        key = self._latest.get(operator) if operator else None
-        if key is None or key not in self.computing:
-            return False
-        spec = self.spectra.get(key)
-        return spec is not None and spec.is_preview
 
     def spectrum(self, operator: str | None) -> Spectrum | None:
         """The most recent spectrum of ``operator``, or None."""
@@ -380,9 +346,8 @@ class ViewerState:
         return [op for op in OPERATOR_INFO if op in self._latest]
 
     def has_spectrum(self, key: SpectrumKey) -> bool:
-        """Whether the exact spectrum of ``key`` is in (a preview does not count)."""
-        spec = self.spectra.get(key)
-        return spec is not None and not spec.is_preview
+        """Whether the spectrum of ``key`` is in."""
+        return key in self.spectra
 
     # --------------------------------------------------------- settings
     def set_compute_settings(self, **changes) -> None:
@@ -631,12 +596,6 @@ class ViewerState:
         if d.kind in ("distance", "signature"):
             return operator_for_distance(d.distance_kind)
         return None
-
-    def shows_preview(self) -> bool:
-        """True if the display is made of a preview spectrum (every title and legend of
-        the picture then says "preview")."""
-        spec = self.spectrum(self.display_operator())
-        return spec is not None and spec.is_preview
 
     def is_coarse(self, operator: str | None) -> bool:
         """True if the spectrum shown for ``operator`` was computed coarse-to-fine (on a

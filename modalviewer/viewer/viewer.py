@@ -52,11 +52,10 @@ from .model import (
     ended_text,
     finished_text,
     memory_text,
-    predicted_seconds,
     residual_text,
+    seconds_text,
 )
 from .state import SpectrumKey
-from .wording import percent_text
 
 log = logging.getLogger("modalviewer")
 
@@ -335,15 +334,8 @@ class Viewer:
 
     def already_here_note(self, job: SpectrumJob) -> str:
         """The status line for a request the spectrum in memory answers (Ctrl+R again):
-        that nothing is computed, and for a Preview only result how to get the exact
-        spectrum."""
-        spec = job.result[0]
-        if not spec.is_preview:
-            return f"{job.description}: already computed."
-        return (
-            f"{job.description}: its preview is already here; untick Preview only and "
-            "compute again for the exact spectrum."
-        )
+        that nothing is computed."""
+        return f"{job.description}: already computed."
 
     def _finish(self, job: SpectrumJob | None, wait: bool, then=None) -> Spectrum | None:
         if job is None:
@@ -359,20 +351,21 @@ class Viewer:
 
     def long_wait_note(self, job: SpectrumJob) -> str:
         """ "this will take about ..." for a request expected to take long with nothing on
-        screen meanwhile; "" otherwise (behind a preview the wait is behind a picture)."""
-        if job.done or job.preview_job is not None:
+        screen meanwhile (the estimate from this machine's own earlier solves,
+        :meth:`.model.ViewerModel.estimated_seconds`); "" otherwise, and where there is
+        no estimate."""
+        if job.done:
             return ""
-        accuracy = "fast preview" if job.is_preview else "exact"
-        seconds = predicted_seconds(job.spectrum_key, self.state.mesh.n_vertices, accuracy)
-        if seconds <= LONG_WAIT_SECONDS:
+        seconds = self.model.estimated_seconds(job.spectrum_key)
+        if seconds is None or seconds <= LONG_WAIT_SECONDS:
             return ""
-        about = f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+        about = seconds_text(seconds)
         faster = "" if job.spectrum_key.coarse else "; Coarse-to-fine is much faster"
         return f"this will take about {about} (Esc cancels{faster})"
 
     def cancel_computation(self) -> None:
-        """Cancel the running computation and the exact spectrum waiting behind its
-        preview; other queued requests keep their turn (the message says how many)."""
+        """Cancel the running computation; other queued requests keep their turn (the
+        message says how many)."""
         if self.jobs.running is None:
             self._status("No computation running.", 3000)
             return
@@ -417,46 +410,18 @@ class Viewer:
             self._status(message)
 
     def starting_message(self, job: Job) -> str:
-        """ "Computing ..." (a shown preview's with how it starts, :attr:`SpectrumJob.note`),
-        after the preview shown before it (with its estimated error) or with the reason a
-        big request gets no preview; after a cancel that left other
-        requests queued, first what it cancelled."""
-        how = job.note if isinstance(job, SpectrumJob) else ""
-        text = f"Computing {job.description}{how}..."
-        if isinstance(job, SpectrumJob) and not job.is_preview:
-            preview = job.preview_job
-            if preview is None:
-                held = self.state.spectra.get(job.spectrum_key)
-                if self.model.preview_on_screen(job.spectrum_key):
-                    # a preview made earlier (Preview only, or kept after a cancel)
-                    note = "the preview shown stays until it is ready"
-                elif held is not None and held.is_preview:
-                    note = "it replaces its preview when it is ready"
-                else:
-                    note = self.model.no_preview_note(job.spectrum_key)
-                if note:
-                    text = f"Computing {job.description}; {note}."
-            elif preview.status == DONE:
-                error = percent_text(preview.result[0].estimated_error)
-                text = f"Preview shown (estimated error {error}); computing the exact spectrum..."
-            elif preview.status == CANCELLED and preview.error not in (None, "cancelled"):
-                # given up by the work itself (too slow, or too far off to show)
-                text = (
-                    f"{preview.error[0].upper()}{preview.error[1:]}; computing {job.description}..."
-                )
+        """ "Computing ..."; after a cancel that left other requests queued, first what it
+        cancelled."""
+        text = f"Computing {job.description}..."
         note, self._cancel_note = self._cancel_note, ""
         return f"{note}. {text}" if note else text
 
     def _on_job_finished(self, job: Job) -> None:
         if job.status == DONE and isinstance(job, SpectrumJob):
             spec = job.result[0]
-            quality = (
-                f"estimated eigenvalue error {percent_text(spec.estimated_error)}"
-                if spec.is_preview
-                else residual_text(spec)
-            )
             # the disk note next to the time it explains: the status bar cuts long lines
-            self._status(f"{finished_text(job, spec)}{memory_text(spec)}; {quality}.", 15000)
+            text = f"{finished_text(job, spec)}{memory_text(spec)}; {residual_text(spec)}."
+            self._status(text, 15000)
         elif job.status == DONE and not isinstance(job, RepairJob):
             self._status(f"{job.description}: done in {job.seconds:.1f} s.", 15000)
         elif job.status == FAILED:
@@ -610,8 +575,6 @@ class Viewer:
                     if j.status == DONE and self.state.display == before:
                         self._show_map(share, threshold)
 
-                if job.preview_job is not None:  # the map from the preview first
-                    job.preview_job.then(show_when_ready)
                 job.then(show_when_ready)
                 note = self.long_wait_note(job)
                 self._status(
@@ -944,7 +907,7 @@ class Viewer:
         then a few Lanczos steps per scale), as a job in the queue, off this thread;
         the result is :meth:`.derived.DerivedValues.exact_curve` and
         ``state.events.signature_curve`` says it arrived.  None if there is no curve,
-        its spectrum is a preview, or the exact curve is already in."""
+        its spectrum is coarse-to-fine, or the exact curve is already in."""
         from ..core.local_signature import local_signature
 
         state, derived = self.state, self.state.derived
@@ -954,7 +917,7 @@ class Viewer:
         operator, _, vertex, _ = key
         spec = state.spectrum(operator)
         spectrum_key = state.spectrum_key(operator)
-        if spec.is_preview or spectrum_key.coarse:
+        if spectrum_key.coarse:
             return None
         mesh = state.compute_mesh(spectrum_key)
         times = derived.table(operator).times.copy()
@@ -1048,11 +1011,13 @@ class Viewer:
         needed = [operator_for_distance(i) if i in DISTANCE_KINDS else i for i in items]
         return [op for op in dict.fromkeys(needed) if self.state.spectrum(op) is None]
 
-    def comparison_cost(self, operators: list[str]) -> float:
-        """Seconds the spectra of ``operators`` are expected to take on this mesh."""
+    def comparison_cost(self, operators: list[str]) -> float | None:
+        """Seconds the spectra of ``operators`` are expected to take on this mesh (from
+        this machine's earlier solves, :meth:`.model.ViewerModel.estimated_seconds`);
+        None where one of them has no estimate."""
         settings = self.state.compute_settings
-        n = self.state.mesh.n_vertices
-        return sum(predicted_seconds(settings.key(op), n) for op in operators)
+        seconds = [self.model.estimated_seconds(settings.key(op)) for op in operators]
+        return None if any(s is None for s in seconds) else sum(seconds)
 
     def prepare_comparison(self, items: list[str], wait: bool = True, then=None):
         """Request the spectra a comparison of ``items`` needs; with ``wait`` return once

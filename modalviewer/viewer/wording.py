@@ -1,4 +1,4 @@
-"""The viewer's words: legends, the status line, preview notes and marks (no Qt, no VTK).
+"""The viewer's words: legends, the status line, notes and marks (no Qt, no VTK).
 
 Every function reads a :class:`~.state.ViewerState` and, where it needs numbers computed
 from it (distances, signature scales), its :class:`~.derived.DerivedValues`
@@ -36,11 +36,8 @@ def percent_text(fraction: float) -> str:
 
 
 def approximation_mark(state: ViewerState, operator: str | None) -> str:
-    """ " (preview)", " (coarse-to-fine)" or "": what titles and lists add to the
-    spectrum shown for ``operator`` when it is an approximation."""
-    spec = state.spectrum(operator)
-    if spec is not None and spec.is_preview:
-        return " (preview)"
+    """ " (coarse-to-fine)" or "": what titles and lists add to the spectrum shown for
+    ``operator`` when it is an approximation."""
     if state.is_coarse(operator):
         return " (coarse-to-fine)"
     return ""
@@ -51,17 +48,11 @@ def display_mark(state: ViewerState) -> str:
     return approximation_mark(state, state.display_operator())
 
 
-def preview_note(state: ViewerState, operator: str | None) -> str:
-    """ " (preview spectrum; the exact one follows)", " (preview spectrum)",
-    " (coarse-to-fine spectrum)" or "" for the spectrum shown for ``operator``."""
-    spec = state.spectrum(operator)
-    if spec is None:
+def approximation_note(state: ViewerState, operator: str | None) -> str:
+    """ " (coarse-to-fine spectrum)" or "" for the spectrum shown for ``operator``."""
+    if state.spectrum(operator) is None:
         return ""
-    if not spec.is_preview:
-        return " (coarse-to-fine spectrum)" if state.is_coarse(operator) else ""
-    if state.exact_follows(operator):
-        return " (preview spectrum; the exact one follows)"
-    return " (preview spectrum)"
+    return " (coarse-to-fine spectrum)" if state.is_coarse(operator) else ""
 
 
 def missing_distance_reason(state: ViewerState, kind: str) -> str:
@@ -88,10 +79,7 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         lam = float(spec.eigenvalues[j])
         zero = spec.zero_mode_mask()[j]
         value = "0 (zero mode)" if zero else f"{lam:.4g}"
-        if spec.is_preview:
-            error = 0.0 if zero else spec.estimated_mode_error(j)
-            value += f" (preview; estimated error {percent_text(error)})"
-        elif state.is_coarse(d.operator):
+        if state.is_coarse(d.operator):
             value += " (coarse-to-fine: approximate)"
         colours = "blue +, white 0, orange -"
         # the colours are the mode's own |Phi| (Mass-normalised), not the drawn
@@ -112,7 +100,7 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         if dist is None:
             return f"{name}: {missing_distance_reason(state, d.distance_kind)}"
         source = f"from vertex {state.picked_file_vertex}"
-        source += preview_note(state, operator_for_distance(d.distance_kind))
+        source += approximation_note(state, operator_for_distance(d.distance_kind))
         if d.distance_display == "threshold":
             thr = derived.threshold_value(dist)
             share = 100.0 * derived.surface_share(dist, thr)

@@ -1,4 +1,4 @@
-"""The cost predictions: growth laws from the measured runs, and their arithmetic."""
+"""The memory predictions: growth laws from the measured runs, and their arithmetic."""
 
 import json
 from pathlib import Path
@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.growth import _fits, mode_exponents
+from benchmarks.growth import _fits
 from benchmarks.memory import relative_differences
 from modalviewer.core.cost import FILL_MARGIN, GrowthLaw
 from modalviewer.core.operators import OPERATOR_INFO, operator_info
@@ -15,67 +15,34 @@ RESULTS = Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "grow
 MORE_MODES = RESULTS.with_name("growth_k300.json")
 
 
-def test_every_operators_growth_laws_are_the_fits_of_the_measured_runs():
+def test_every_operators_growth_law_is_the_fit_of_the_measured_runs():
     """The laws in the operator registry are not typed numbers: they are what
     benchmarks.growth fits to benchmarks/results/growth.json (rounded as it writes them)."""
-    rows = json.loads(RESULTS.read_text())["rows"]
-    fits = {(f["operator"], f["accuracy"]): f for f in _fits(rows)}
-    modes = mode_exponents(rows, json.loads(MORE_MODES.read_text())["rows"])
+    fits = {f["operator"]: f for f in _fits(json.loads(RESULTS.read_text())["rows"])}
     for name, info in OPERATOR_INFO.items():
-        measured = info.measured_as or name  # an operator borrowing another's laws
-        for accuracy, law in (("exact", info.exact_growth), ("fast preview", info.preview_growth)):
-            fit = fits[measured, accuracy]
-            assert law == GrowthLaw(
-                fit["seconds_at_100k"],
-                fit["time_exponent"],
-                fit["peak_mb_at_100k"],
-                fit["memory_exponent"],
-                modes[measured, accuracy],
-            ), (name, accuracy)
+        fit = fits[info.measured_as or name]  # an operator borrowing another's law
+        assert info.exact_growth == GrowthLaw(fit["peak_mb_at_100k"], fit["memory_exponent"])
 
 
 def test_the_laws_reproduce_the_runs_they_were_fitted_to_within_a_third():
     """A power law through 100k..1M: every measured run from 100k on within a factor 1.35
-    of its prediction (seconds and peak memory)."""
-    rows = json.loads(RESULTS.read_text())["rows"]
+    of its predicted peak memory."""
     checked = 0
-    for r in rows:
-        if "seconds" not in r or r["accuracy"] == "preview" or r["vertices"] < 100_000:
+    for r in json.loads(RESULTS.read_text())["rows"]:
+        if "peak_mb" not in r or r["vertices"] < 100_000:
             continue
         info = operator_info(r["operator"])
         # the runs kept their factors in core
-        t = info.predicted_seconds(r["accuracy"], r["vertices"], r["k"], out_of_core=False)
-        m = info.predicted_peak_mb(
-            r["accuracy"], r["vertices"], out_of_core=False, basis_float32=False
-        )
-        assert 1 / 1.35 < r["seconds"] / t < 1.35, (r, t)
+        m = info.predicted_peak_mb(r["vertices"], out_of_core=False, basis_float32=False)
         assert 1 / 1.35 < r["peak_mb"] / m < 1.35, (r, m)
         checked += 1
     assert checked >= 12
 
 
-def test_predicted_time_scales_with_size_and_modes_as_the_law_says():
-    law = GrowthLaw(10.0, 1.2, 500.0, 0.8, 0.5)
-    assert law.seconds(100_000, 100) == pytest.approx(10.0)
-    assert law.seconds(200_000, 100) == pytest.approx(10.0 * 2**1.2)
-    assert law.seconds(100_000, 400) == pytest.approx(20.0)
+def test_the_law_is_a_power_of_size():
+    law = GrowthLaw(500.0, 0.8)
+    assert law.peak_mb(100_000) == pytest.approx(500.0)
     assert law.peak_mb(400_000) == pytest.approx(500.0 * 4**0.8)
-    assert GrowthLaw(1.0, 1.0, 1.0, 1.0).seconds(100_000, 300) == pytest.approx(3.0)
-
-
-def test_the_300_mode_runs_are_predicted_from_the_laws_within_a_third():
-    """The mode exponents come from these runs (at one size), so the laws reproduce them
-    within the error of the size fit there (a factor 1.35, as above)."""
-    rows = json.loads(MORE_MODES.read_text())["rows"]
-    checked = 0
-    for r in rows:
-        if "seconds" not in r:
-            continue
-        info = operator_info(r["operator"])
-        t = info.predicted_seconds(r["accuracy"], r["vertices"], r["k"], out_of_core=False)
-        assert 1 / 1.35 < r["seconds"] / t < 1.35, (r, t)
-        checked += 1
-    assert checked >= 8
 
 
 CURVED = RESULTS.with_name("curved.json")
@@ -99,21 +66,17 @@ def test_exact_peak_memory_is_predicted_for_other_mode_counts_and_curved_meshes(
     the plate's the law comes from, so the check errs on the side of refusing there)."""
     checked = 0
     for r in json.loads(MORE_MODES.read_text())["rows"]:
-        if r["accuracy"] != "exact" or "peak_mb" not in r:
+        if "peak_mb" not in r:
             continue
         info = operator_info(r["operator"])
-        m = info.predicted_peak_mb(
-            "exact", r["vertices"], r["k"], out_of_core=False, basis_float32=False
-        )
+        m = info.predicted_peak_mb(r["vertices"], r["k"], out_of_core=False, basis_float32=False)
         assert 0.8 < r["peak_mb"] / m < 1.05, (r, m)
         checked += 1
     for r in json.loads(CURVED.read_text())["rows"]:
         if r["vertices"] < 100_000:
             continue
         info = operator_info(r["operator"])
-        m = info.predicted_peak_mb(
-            "exact", r["vertices"], r["k"], out_of_core=False, basis_float32=False
-        )
+        m = info.predicted_peak_mb(r["vertices"], r["k"], out_of_core=False, basis_float32=False)
         part_shells = r["mesh"].startswith("part") and r["operator"] == "shells"
         low = 0.6 if part_shells else 0.88
         high = 1.05
@@ -144,8 +107,8 @@ def test_more_modes_need_their_basis_and_mode_columns_and_no_more():
     info = operator_info("shells")
     n_vertices = 200_000
     n = info.unknowns(n_vertices)
-    at_100 = info.predicted_peak_mb("exact", n_vertices, 100)
-    at_300 = info.predicted_peak_mb("exact", n_vertices, 300)
+    at_100 = info.predicted_peak_mb(n_vertices, 100)
+    at_300 = info.predicted_peak_mb(n_vertices, 300)
     _, block, max_basis, _ = krylov_sizes(300, n)
     assert basis_columns(300, n) == max_basis + block
     assert max_basis - krylov_sizes(300, n)[0] <= BASIS_EXTRA_MAX + block  # a big basis: capped
@@ -153,7 +116,7 @@ def test_more_modes_need_their_basis_and_mode_columns_and_no_more():
     assert at_300 - at_100 == pytest.approx(8.0 * n * columns / 2**20, rel=1e-12)
     further_fill = (FILL_MARGIN - 1) * info.factor_memory.in_core_mb(n_vertices)
     assert at_100 == pytest.approx(info.exact_growth.peak_mb(n_vertices) + further_fill, rel=1e-12)
-    assert info.predicted_peak_mb("exact", n_vertices, 10) < at_100
+    assert info.predicted_peak_mb(n_vertices, 10) < at_100
 
 
 FACTOR_MEMORY = RESULTS.with_name("factor_memory.json")
@@ -182,23 +145,6 @@ def test_every_operators_factor_law_is_the_fit_of_the_measured_analyses():
         assert 1 / 1.15 < r["out_of_core_mb"] / law.out_of_core_mb(r["vertices"]) < 1.15, r
 
 
-def test_the_out_of_core_time_factor_is_the_measured_ratio():
-    from modalviewer.core.cost import OUT_OF_CORE_TIME_FACTOR
-
-    rows = json.loads(BIG_SOLVES.read_text())["rows"]
-    pairs = [
-        (a, b)
-        for a in rows
-        for b in rows
-        if (a["mesh"], a["operator"], a["k"]) == (b["mesh"], b["operator"], b["k"])
-        and not a["factor_out_of_core"]
-        and b["factor_out_of_core"]
-    ]
-    assert pairs
-    a, b = pairs[0]
-    assert OUT_OF_CORE_TIME_FACTOR == round(b["seconds"] / a["seconds"], 1)
-
-
 def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
     """Runs the laws were not fitted to (curved meshes, 300 modes), factor in core or out
     of core: at most 10 % more than predicted (the check keeps a quarter of the memory
@@ -210,9 +156,7 @@ def test_big_solves_need_what_the_memory_check_predicts_for_their_choice():
     for r in rows:
         info = operator_info(r["operator"])
         ooc, single = bool(r["factor_out_of_core"]), bool(r.get("basis_float32"))
-        m = info.predicted_peak_mb(
-            "exact", r["vertices"], r["k"], out_of_core=ooc, basis_float32=single
-        )
+        m = info.predicted_peak_mb(r["vertices"], r["k"], out_of_core=ooc, basis_float32=single)
         assert 0.75 < r["peak_mb"] / m < 1.1, (r["mesh"], r["limit_mb"], r["peak_mb"], m)
         # a single-precision basis on either side: the same eigenvalues within what the
         # residuals allow; double on both: to the last digit
@@ -257,8 +201,8 @@ def _residual_bounds(row: dict, reference: dict) -> np.ndarray:
 def test_the_memory_check_predicts_the_factor_out_of_core_where_it_would_not_fit():
     info = operator_info("shells")
     n, k = 520_000, 300  # 1.56M unknowns
-    in_core = info.predicted_peak_mb("exact", n, k, out_of_core=False, basis_float32=False)
-    out_of_core = info.predicted_peak_mb("exact", n, k, out_of_core=True, basis_float32=False)
+    in_core = info.predicted_peak_mb(n, k, out_of_core=False, basis_float32=False)
+    out_of_core = info.predicted_peak_mb(n, k, out_of_core=True, basis_float32=False)
     law = info.factor_memory
     saved = law.in_core_mb(n) - law.out_of_core_mb(n)
     assert in_core - out_of_core == pytest.approx(FILL_MARGIN * saved)
@@ -266,12 +210,6 @@ def test_the_memory_check_predicts_the_factor_out_of_core_where_it_would_not_fit
     # the solver's rule: out of core only where the in-core peak is above the limit
     assert info.factor_out_of_core(n, k, limit_mb=0.9 * in_core)
     assert not info.factor_out_of_core(n, k, limit_mb=1.1 * in_core)
-    seconds = info.predicted_seconds("exact", n, k, out_of_core=True)
-    from modalviewer.core.cost import OUT_OF_CORE_TIME_FACTOR
-
-    assert seconds == pytest.approx(
-        OUT_OF_CORE_TIME_FACTOR * info.predicted_seconds("exact", n, k, out_of_core=False)
-    )
     # the scalar operators' factors are small: out of core would not save memory there
     lap = operator_info("laplacian")
     assert not lap.factor_out_of_core(100_000, 100, limit_mb=1.0)
@@ -287,8 +225,8 @@ def test_a_single_precision_basis_is_predicted_as_its_buffer_and_chosen_over_the
     n = info.unknowns(n_vertices)
     _, block, max_basis, _ = krylov_sizes(k, n)
     columns = max_basis + block
-    double = info.predicted_peak_mb("exact", n_vertices, k, out_of_core=True, basis_float32=False)
-    single = info.predicted_peak_mb("exact", n_vertices, k, out_of_core=True, basis_float32=True)
+    double = info.predicted_peak_mb(n_vertices, k, out_of_core=True, basis_float32=False)
+    single = info.predicted_peak_mb(n_vertices, k, out_of_core=True, basis_float32=True)
     # the double basis and the 200 mode columns above the law's 100, against one buffer
     beside = 8.0 * n * (columns + 200) / 2**20
     assert float32_basis_saving_mb(n, k) == pytest.approx(beside - float32_basis_mb(n, columns, k))
@@ -296,26 +234,9 @@ def test_a_single_precision_basis_is_predicted_as_its_buffer_and_chosen_over_the
     # the memory check's default mirrors the solver: single precision where the peak with
     # the factor out of core is still above the limit
     limit = memory_limit_mb()
-    default = info.predicted_peak_mb("exact", n_vertices, k)
+    default = info.predicted_peak_mb(n_vertices, k)
     assert default == pytest.approx(single if double > limit else double, rel=1e-12)
     # a mesh where the double basis fits keeps it
-    assert info.predicted_peak_mb("exact", 20_000, 100) == pytest.approx(
-        info.predicted_peak_mb("exact", 20_000, 100, out_of_core=False, basis_float32=False)
+    assert info.predicted_peak_mb(20_000, 100) == pytest.approx(
+        info.predicted_peak_mb(20_000, 100, out_of_core=False, basis_float32=False)
     )
-
-
-def test_fast_preview_memory_for_more_modes_covers_the_300_mode_runs():
-    """The fast preview's memory at k modes is its law at 100 modes plus the operator's
-    preview_arrays_per_mode arrays of the unknowns' length per further mode: every
-    300-mode fast preview on the 337k plate needs at most the prediction and at least
-    0.55 of it."""
-    checked = 0
-    for r in json.loads(MORE_MODES.read_text())["rows"]:
-        if r["accuracy"] != "fast preview" or "peak_mb" not in r:
-            continue
-        predicted = operator_info(r["operator"]).predicted_peak_mb(
-            "fast preview", r["vertices"], r["k"]
-        )
-        assert 0.55 < r["peak_mb"] / predicted <= 1.0, (r["operator"], r["peak_mb"], predicted)
-        checked += 1
-    assert checked == 4

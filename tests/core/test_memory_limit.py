@@ -243,37 +243,6 @@ def test_a_failed_out_of_core_factorisation_falls_back_to_core(tmp_path, monkeyp
     assert np.linalg.norm(A @ solver.solve(B) - B) <= 1e-10 * np.linalg.norm(B)
 
 
-@needs_pardiso
-def test_a_refined_preview_keeps_its_factor_within_the_limit(tmp_path, monkeypatch):
-    # spot Loop-subdivided twice (47k vertices, 140k unknowns): where its single-precision
-    # factor does not fit (here under a 1 MB limit, taken away in the unlimited run) the
-    # 3D shells preview is refined with a double-precision factorisation, which the 1 MB
-    # limit sends out of core; same result
-    import trimesh
-
-    import modalviewer as mv
-    from modalviewer.core import preview
-
-    base = mv.load_mesh(mv.asset_path("spot.obj"))
-    mesh = mv.Mesh(*trimesh.remesh.subdivide_loop(base.vertices, base.faces, iterations=2))
-    monkeypatch.setenv("MODALVIEWER_FACTOR_DIR", str(tmp_path))
-    spectra = {}
-    for limit in ("1000000", "1"):
-        monkeypatch.setenv("MODALVIEWER_MEMORY_LIMIT_MB", limit)
-        with monkeypatch.context() as m:
-            if limit != "1":
-                m.setattr(preview, "_single_factor", lambda *args: None)
-            spectra[limit] = mv.compute_spectrum(mesh, "shells", 40, accuracy="preview")
-    free, tight = spectra["1000000"], spectra["1"]
-    assert tight.parameters["preview"]["correction"] == "two-level step"
-    assert free.is_preview and tight.is_preview
-    refinement = tight.parameters["preview"]["refinement"]
-    assert refinement["steps"] >= 1 and refinement["factor_out_of_core"]
-    assert not free.parameters["preview"]["refinement"]["factor_out_of_core"]
-    np.testing.assert_allclose(tight.eigenvalues, free.eigenvalues, rtol=1e-12, atol=1e-9)
-    assert not list(tmp_path.iterdir())
-
-
 def _traced_peak_mb(solve) -> tuple[float, object]:
     """The peak of numpy's traced allocations (PARDISO's memory is not traced) during
     ``solve()``, and its result."""

@@ -340,27 +340,3 @@ def test_too_few_modes_for_the_null_space_advise_enough_to_pass_it():
     messages = [str(w.message) for w in caught if issubclass(w.category, ZeroModesWarning)]
     assert len(messages) == 1
     assert "Ask for at least 7 modes" in messages[0], messages[0]
-
-
-@pytest.mark.parametrize(
-    ("operator", "accuracy", "k", "null"),
-    [("shells", "fast preview", 40, 18), ("laplacian", "preview", 12, 3)],
-)
-def test_a_preview_counts_and_deflates_the_null_space_as_the_exact_solve_does(
-    three_spheres, operator, accuracy, k, null
-):
-    # the reduced space holds the three components' null vectors: the preview's first
-    # modes are those exact vectors, counted and named as the exact spectrum's are
-    spec = mv.compute_spectrum(three_spheres, operator, k=k, accuracy=accuracy)
-    exact = mv.compute_spectrum(three_spheres, operator, k=k)
-    assert spec.is_preview
-    assert spec.null_space_dimension == exact.null_space_dimension == null
-    assert spec.parameters["null_space"] == exact.parameters["null_space"]
-    assert spec.eigenvalues[:null].tolist() == [0.0] * null
-    assert spec.eigenvalues[null] > 1e-3 * spec.eigenvalues[-1]
-    K, mass = operator_matrices(three_spheres, operator)
-    X = spec.modes.reshape(-1, k)
-    Z = null_space(three_spheres, operator, K, mass).vectors.toarray()
-    np.testing.assert_array_equal(X[:, :null], Z)
-    np.testing.assert_allclose(X.T @ (mass[:, None] * X), np.eye(k), atol=1e-12)
-    assert spec.residuals[:null].max() < 1e-10

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from modalviewer.core.products import threaded_product, threaded_transpose_product
+from modalviewer.core.products import threaded_product
 
 
 @pytest.fixture(scope="module")
@@ -18,10 +18,6 @@ def test_threaded_product_equals_the_plain_product(K):
     np.testing.assert_allclose(threaded_product(K, X), K @ X, rtol=1e-13, atol=1e-13)
     S = sp.random(301, 40, density=0.1, random_state=1, format="csr")
     np.testing.assert_allclose(threaded_product(K, S).toarray(), (K @ S).toarray(), atol=1e-13)
-    np.testing.assert_allclose(
-        threaded_transpose_product(S, K).toarray(), (S.T @ K).toarray(), atol=1e-13
-    )
-    np.testing.assert_allclose(threaded_transpose_product(S, X), S.T @ X, atol=1e-13)
 
 
 def test_row_halves_share_the_matrix_arrays_and_the_product_copies_none_of_them():
@@ -60,46 +56,6 @@ def test_threaded_product_writes_into_out(K):
     np.testing.assert_allclose(out32, K @ X, rtol=1e-4, atol=1e-4)
     with pytest.raises(ValueError, match="C-contiguous"):
         threaded_product(K, X, out=np.empty((5, 301)).T)
-
-
-@pytest.mark.parametrize("chunk", [7, 64, 1 << 15])
-def test_the_chunked_projection_is_p_transpose_k_p(chunk):
-    """Summed over row chunks (several per thread, one, or a single chunk for all) it
-    equals the product through the whole ``K P``."""
-    from modalviewer.core.products import chunked_projection, threaded_projection
-
-    K = sp.random(301, 301, density=0.03, random_state=5, format="csr")
-    K = (K + K.T).tocsr()
-    P = sp.random(301, 40, density=0.1, random_state=6, format="csr")
-    expected = (P.T @ K @ P).toarray()
-    for A in (chunked_projection(K, P, chunk), threaded_projection(K, P, chunk)):
-        assert sp.issparse(A) and A.shape == (40, 40)
-        np.testing.assert_allclose(A.toarray(), expected, rtol=1e-12, atol=1e-12)
-    half = chunked_projection(K, P, chunk, part=1, parts=2).toarray()
-    other = chunked_projection(K, P, chunk, part=0, parts=2).toarray()
-    np.testing.assert_allclose(half + other, expected, rtol=1e-12, atol=1e-12)
-
-
-def test_row_block_sums_add_up_the_blocks_of_k_x_and_let_each_block_write_its_rows():
-    from modalviewer.core.products import ROW_BLOCK, row_block_sums
-
-    n = 2 * ROW_BLOCK + 123  # two threads, a short last block
-    K = sp.random(n, n, density=4 / n, random_state=7, format="csr")
-    X = np.random.default_rng(3).standard_normal((n, 5))
-    seen = np.zeros((n, 5))
-
-    def fn(rows, KX):
-        seen[rows] = KX
-        return KX.sum(axis=0), np.array([rows.stop - rows.start])
-
-    total, count = row_block_sums(K, X, fn)
-    np.testing.assert_allclose(seen, K @ X, atol=1e-12)
-    np.testing.assert_allclose(total, (K @ X).sum(axis=0), atol=1e-9)
-    assert count[0] == n
-    small = sp.identity(10, format="csr")  # fewer rows than a block: one thread
-    np.testing.assert_allclose(
-        row_block_sums(small, X[:10], lambda r, KX: KX.sum(0)), X[:10].sum(0)
-    )
 
 
 @pytest.mark.parametrize("shape", [(1000, 7, 5), (1000, 7, 7), (50000, 30, 12)])

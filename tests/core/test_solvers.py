@@ -239,34 +239,3 @@ def test_pardiso_stores_vertex_blocks_as_blocks_and_scalar_operators_plainly():
     M = sp.csr_matrix(np.eye(6) + np.diag([0.1] * 5, 1) + np.diag([0.1] * 5, -1))
     assert not has_vertex_blocks(M)
     assert not has_vertex_blocks(sp.identity(7, format="csr"))
-
-
-def test_single_precision_factor_halves_the_memory_and_refuses_a_small_budget():
-    """PARDISO in single precision: float32 solutions of a well-conditioned matrix (the
-    Laplacian shifted by its mass) to 1e-5, the factor of spot's 3D shells in 0.6 of
-    the double one's memory, and FactorTooLarge (no out-of-core mode) where the budget
-    is too small."""
-    from modalviewer.core.factor import FactorTooLarge
-
-    if "pardiso" not in available_backends():
-        pytest.skip("the single-precision factor is PARDISO's")
-    mesh = mv.load_mesh(mv.asset_path("spot.obj"))
-    K, mass = operator_matrices(mesh, "laplacian")
-    A = sp.csr_matrix(K + 1e2 * sp.diags(mass))
-    B = np.random.default_rng(5).standard_normal((A.shape[0], 3))
-    double = SPDSolver(A, backend="pardiso")
-    single = SPDSolver(A, backend="pardiso", single_precision=True)
-    assert single.single_precision and not double.single_precision
-    X, Y = double.solve(B), single.solve(B)
-    assert X.dtype == np.float64 and Y.dtype == np.float32
-    assert np.linalg.norm(Y - X) <= 1e-5 * np.linalg.norm(X)
-    assert np.linalg.norm(Y - X) >= 1e-12 * np.linalg.norm(X)  # really single precision
-    # the factor's memory (beside PARDISO's symbolic data, which stays): spot's 3D shells
-    K3, mass3 = operator_matrices(mesh, "shells")
-    A3 = sp.csr_matrix(K3 + 1e2 * sp.diags(mass3))
-    ratio = SPDSolver(A3, single_precision=True).factor_mb / SPDSolver(A3).factor_mb
-    assert 0.45 < ratio < 0.7
-    with pytest.raises(FactorTooLarge, match="single-precision factor needs"):
-        SPDSolver(A, backend="pardiso", single_precision=True, memory_budget_mb=0.01)
-    # a double factor with the same budget goes out of core or stays in core instead
-    assert SPDSolver(A, backend="pardiso", memory_budget_mb=0.01).solve(B).dtype == np.float64

@@ -46,8 +46,6 @@ def test_bad_k_is_refused_naming_k_and_the_value(sphere, k, error, message):
     with pytest.raises(error, match=f"^{re.escape(message)}$"):
         mv.compute_spectrum(sphere, "laplacian", k=k)
     with pytest.raises(error, match=f"^{re.escape(message)}$"):
-        mv.compute_spectrum(sphere, "laplacian", k=k, accuracy="preview")
-    with pytest.raises(error, match=f"^{re.escape(message)}$"):
         mv.compute_spectrum_per_component(sphere, "laplacian", k=k)
 
 
@@ -239,18 +237,24 @@ def test_load_spectrum_refuses_a_hash_as_the_mesh(tmp_path, sphere, lap):
 def test_spectrum_repr_is_one_short_line(lap, shells):
     assert repr(shells) == (
         "Spectrum(operator='shells', k=12, n_vertices=162, modes=(162, 3, 12), "
-        f"eigenvalues={shells.eigenvalues.min():.3g} .. {shells.eigenvalues.max():.3g}, exact)"
+        f"eigenvalues={shells.eigenvalues.min():.3g} .. {shells.eigenvalues.max():.3g})"
     )
     text = repr(lap)
     assert text.startswith("Spectrum(operator='laplacian', k=8, n_vertices=162, modes=(162, 8)")
-    assert text.endswith(", exact)") and "\n" not in text and "array" not in text
+    assert text.endswith(")") and "\n" not in text and "array" not in text
     assert len(text) < 150
 
 
-def test_preview_repr(sphere):
-    big = icosphere(4)
-    spec = mv.compute_spectrum(big, "laplacian", k=10, accuracy="preview")
-    assert spec.is_preview and repr(spec).endswith(", preview)")
+@pytest.mark.parametrize("accuracy", ["preview", "fast preview"])
+def test_the_removed_preview_accuracies_say_what_to_use_instead(sphere, accuracy):
+    """The approximate previews are gone: asking for one is a ValueError that names the
+    callback for early modes and fewer modes, before any work."""
+    with pytest.raises(ValueError, match="preview spectrum was removed") as caught:
+        mv.compute_spectrum(sphere, "laplacian", k=8, accuracy=accuracy)
+    assert "on_modes=" in str(caught.value) and "fewer modes k" in str(caught.value)
+    with pytest.raises(ValueError, match="accuracy must be 'exact', got 'rough'"):
+        mv.compute_spectrum(sphere, "laplacian", k=8, accuracy="rough")
+    assert mv.compute_spectrum(sphere, "laplacian", k=8, accuracy="exact").k == 8
 
 
 def test_py_typed_marker_is_shipped():
@@ -261,3 +265,18 @@ def test_py_typed_marker_is_shipped():
     with open(root.parent / "pyproject.toml", "rb") as fh:
         config = tomllib.load(fh)
     assert "py.typed" in config["tool"]["setuptools"]["package-data"]["modalviewer"]
+
+
+def test_a_spectrum_file_saved_with_a_previews_fields_loads(sphere, lap, tmp_path):
+    """Files written while previews existed carry ``parameters["preview"]`` (estimates,
+    samples): they load as any spectrum, the field kept as data and used by nothing."""
+    old = mv.Spectrum(
+        lap.eigenvalues, lap.modes, lap.operator, lap.mass, lap.residuals, lap.mesh_hash,
+        {**lap.parameters, "preview": {"estimated_error": 0.02, "samples": 600}},
+    )  # fmt: skip
+    path = tmp_path / "old.npz"
+    mv.save_spectrum(old, path)
+    back = mv.load_spectrum(path, sphere)
+    np.testing.assert_array_equal(back.eigenvalues, lap.eigenvalues)
+    assert back.parameters["preview"]["samples"] == 600
+    assert not hasattr(back, "is_preview") and "preview" not in repr(back)

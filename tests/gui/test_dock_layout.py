@@ -51,28 +51,11 @@ def test_a_one_line_threshold_text_is_one_line_high(window, spot_path, qtbot):
     assert label.height() <= line + 2, (label.height(), line)
 
 
-def test_a_preview_spectrum_title_is_one_whole_line(window, spot_path, qtbot):
-    """A marked spectrum's plot title names the operator briefly (as its list does), so
-    it keeps to one line of the Modes dock, its closing parenthesis included."""
-    assert window.open_mesh(spot_path)
-    window.state.set_compute_settings(preview_only=True)
-    spec = window.compute("shells", k=12, wait=True)
-    assert spec.is_preview
-    _settle(qtbot, window)
-    plot = window.modes_panel.spectrum_plot
-    assert plot.title == "Spectrum (preview): Shells 3D"
-    assert plot.title_lines() == [plot.title]
-    assert plot.fontMetrics().horizontalAdvance(plot.title) < plot.width() - 12
-
-
-@pytest.mark.parametrize("preview", [False, True], ids=["exact", "preview"])
-def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path, preview):
+def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path):
     """Seen under Xvfb: the Speed slider lay below the Modes dock's visible part at the
-    default window size, and again below a preview's note (the right docks split the
-    height evenly). With a mode shown, of an exact spectrum or of a preview, every
-    control of the dock, Speed included, is inside the dock's scroll area without
-    scrolling (the Distances dock below takes the rest and scrolls); a preview's
-    explanation is the eigenvalue line's tooltip."""
+    default window size (the right docks split the height evenly). With a mode shown,
+    every control of the dock, Speed included, is inside the dock's scroll area without
+    scrolling (the Distances dock below takes the rest and scrolls)."""
     from qtpy import QtCore, QtWidgets
 
     from modalviewer.gui import MainWindow
@@ -84,20 +67,15 @@ def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path,
     qtbot.waitExposed(win)
     assert (win.width(), win.height()) == (1280, 820)  # the size of a first start
     _settle(qtbot, win)
-    # the first start sizes the Modes dock to its controls and a preview's note, not
-    # half the height (the offscreen platform's fonts fit either way; Xvfb's did not)
+    # the first start sizes the Modes dock to its controls and a note, not half the
+    # height (the offscreen platform's fonts fit either way; Xvfb's did not)
     dock = win.modes_dock
     line = win.modes_panel.eigen_label.fontMetrics().lineSpacing()
     frame = dock.height() - dock.widget().viewport().height()
     need = dock.widget().widget().sizeHint().height() + MODES_NOTE_LINES * line + frame
     assert abs(dock.height() - need) <= 8, (dock.height(), need)
     assert win.open_mesh(spot_path)
-    if preview:
-        win.state.set_compute_settings(preview_only=True)
-        assert win.compute("shells", k=12, wait=True).is_preview
-        win.show_mode(8)
-    else:
-        win.compute("laplacian", k=10, wait=True)
+    win.compute("laplacian", k=10, wait=True)
     _settle(qtbot, win)
     modes, animation = win.modes_panel, win.animation_panel
     scroll = animation.parentWidget()
@@ -125,14 +103,9 @@ def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path,
         assert shown.contains(where), (widget, where, shown)
     assert animation.speed_slider.width() >= 100
     label = modes.eigen_label
-    if preview:
-        assert "this mode" in label.text() and "Preview only" in label.text()
-        assert "numbers one lower" in label.toolTip()
-    else:
-        assert label.toolTip() == ""
-    # found under Xvfb: with a distance map on screen the "Not shown" note and a
-    # preview's note together pushed Amplitude, Speed and Play out of view
-    win.state.set_display(distance_kind="vibration" if preview else "hks")
+    # found under Xvfb: with a distance map on screen the "Not shown" note pushed
+    # Amplitude, Speed and Play out of view
+    win.state.set_display(distance_kind="hks")
     win.pick_vertex(300)
     win.state.set_display(kind="distance")
     _settle(qtbot, win)
@@ -146,26 +119,3 @@ def test_the_whole_modes_dock_shows_at_the_default_window_size(qtbot, spot_path,
         top_left = widget.mapTo(viewport, QtCore.QPoint(0, 0))
         assert shown.contains(QtCore.QRect(top_left, widget.size())), widget
     win.close()
-
-
-def test_the_progress_bar_shows_a_previews_stage_whole(window, qtbot):
-    """Found under Xvfb: the status bar's progress read "preview: making a c… 5 %".  A
-    preview's stage shows without its "preview: " (the job is named in the tooltip and
-    the Computations list), and the longest of them fits the bar."""
-    from types import SimpleNamespace
-
-    bar = window.status_widgets
-    for stage, shown in (
-        ("preview: making a coarse copy", "making a coarse copy 5 %"),
-        ("preview: factorising (single precision)", "factorising (single precision) 5 %"),
-        ("assembling", "assembling 5 %"),
-    ):
-        job = SimpleNamespace(
-            stage=stage, fraction=0.05, description="preview of X", is_preview=True
-        )
-        bar.jobs = SimpleNamespace(running=job, jobs=[job])
-        bar._on_job_changed(job)
-        assert bar.progress.text() == shown, bar.progress.text()
-        width = bar.progress.fontMetrics().horizontalAdvance(shown)
-        assert width < bar.progress.width() - 8, (width, bar.progress.width())
-        assert bar.progress.toolTip() == f"preview of X: {stage}"

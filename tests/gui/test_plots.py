@@ -40,12 +40,12 @@ def test_spectrum_plot_shows_zero_and_tick_labels(qtbot):
 
 
 def test_a_title_wider_than_the_plot_wraps_whole(qtbot):
-    """Seen under Xvfb: "Spectrum (preview): Discrete Shells (3D vibrations" lost its
+    """Seen under Xvfb: "Spectrum (coarse-to-fine): Discrete Shells (3D vibrations" lost its
     ")" at the Modes dock's plot width (306 pixels at the default window size)."""
     plot = LinePlot()
     qtbot.addWidget(plot)
     plot.resize(306, 140)
-    title = "Spectrum (preview): Discrete Shells (3D vibrations)"
+    title = "Spectrum (coarse-to-fine): Discrete Shells (3D vibrations)"
     plot.set_data(np.arange(10), np.arange(10.0) ** 2, title=title)
     metrics = plot.fontMetrics()
     assert metrics.horizontalAdvance(title) > plot.width() - 2 * TITLE_MARGIN

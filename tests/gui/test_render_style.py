@@ -276,15 +276,15 @@ def test_a_threshold_far_below_the_largest_distance_moves_the_map(view, spot_mod
 
 
 def test_a_long_legend_wraps_inside_the_export(view, spot_mode, tmp_path):
-    """A preview's legend is longer than a narrow export is wide: it wraps at spaces
-    instead of running off the right edge."""
+    """A legend longer than a narrow export is wide wraps at spaces instead of running
+    off the right edge."""
     mesh, field, _ = spot_mode
     scene = _scene(view, mesh)
     scene.show_field(field, "diverging", isolines=0, name="mode 9")
     plain = _export(view, tmp_path / "plain.png", legend=False, colorbar=False)
     scene.set_legend(
         "Discrete Shells, normal variations, mode 9: lambda = 2.373e+04 "
-        "(preview; estimated error 2.2 %)\nblue +, white 0, orange -"
+        "(coarse-to-fine: approximate)\nblue +, white 0, orange -"
     )
     img = _export(view, tmp_path / "long.png", colorbar=False)
     h, w = img.shape[:2]

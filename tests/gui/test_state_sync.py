@@ -10,7 +10,6 @@ from qtpy import QtCore, QtGui, QtWidgets
 
 from modalviewer.core.laplacian import lumped_masses
 from modalviewer.viewer import wording
-from modalviewer.viewer.wording import percent_text
 
 pytestmark = pytest.mark.gui
 
@@ -231,25 +230,6 @@ def test_clear_cache_from_the_window(window, spot_path):
     assert window.spectra["laplacian"].k == 10  # the spectrum on screen stays
 
 
-def test_a_pick_shows_the_distance_from_the_preview_first(
-    window, spot_path, monkeypatch, previews_pay
-):
-    """Found under Xvfb: the map waited for the exact spectrum although the preview had
-    arrived a minute earlier."""
-    window.open_mesh(spot_path)
-    window.state.set_display(distance_kind="hks")
-    window.pick_vertex(800)  # needs the Laplacian: a preview job, then the exact one
-    preview = window.running_job
-    assert preview.description.startswith("preview of")
-    window.wait_for(preview)
-    assert window.state.display.kind == "distance"
-    assert window.state.spectrum("laplacian").is_preview
-    assert "preview spectrum" in window.status_line.text()
-    window.wait_for(window.running_job)
-    assert not window.state.spectrum("laplacian").is_preview
-    assert window.state.display.kind == "distance" and window.state.picked == 800
-
-
 def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
     """Mesh > Keep the largest component through the window: the repaired mesh replaces
     the loaded one and its report is shown, with no error (the job-finished handler took
@@ -285,46 +265,6 @@ def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
     # a scripted wait on such a job ends
     if job is not None:
         assert window.wait_for(job).status == "done"
-
-
-def test_after_cancel_the_modes_panel_no_longer_promises_the_exact_spectrum(
-    window, spot_path, monkeypatch, previews_pay
-):
-    """Found under Xvfb: after Cancel the preview stayed (as it should) but the Modes
-    panel still said the exact spectrum would replace it; after opening another mesh the
-    empty plot kept the title "Spectrum (preview): ...", the signature plot its pick."""
-    window.open_mesh(spot_path)
-    window.state.set_display(distance_kind="hks")
-    window.pick_vertex(800)
-    preview = window.running_job
-    window.wait_for(preview)
-    # a preview's quality is its estimated error, not its (mesh-scale) residuals
-    assert "Preview shown (estimated error" in window.statusBar().currentMessage()
-    exact = window.running_job
-    panel = window.modes_panel
-    assert "replaces it when ready" in panel.eigen_label.text()
-    assert "not a bound" in panel.eigen_label.text()
-    # the mode on screen has its own estimate (the largest is over all modes)
-    spec = window.state.spectrum("laplacian")
-    window.show_mode(5)
-    j_text = f"; this mode {percent_text(spec.estimated_mode_error(5))}"
-    assert j_text in panel.eigen_label.text()
-    assert spec.estimated_mode_error(5) == spec.parameters["preview"]["estimated_errors"][5]
-    assert "numbers one lower" in panel.eigen_label.toolTip()
-    assert window.modes_panel.spectrum_combo.currentText().endswith("(preview)")
-    window.cancel_computation()
-    window.wait_for(exact)
-    assert exact.status == "cancelled"
-    assert window.state.spectrum("laplacian").is_preview
-    assert "replaces it when ready" not in panel.eigen_label.text()
-    assert "Ctrl+R" in panel.eigen_label.text()
-    assert window.distances_panel.signature_plot.title.startswith("Signature of vertex 800")
-    assert window.distances_panel.signature_plot.title.endswith("preview)")
-    window.cancel_computation()  # nothing runs any more
-    assert window.statusBar().currentMessage() == "No computation running."
-    window.open_mesh(spot_path)
-    assert panel.spectrum_plot.title == "Spectrum"
-    assert window.distances_panel.signature_plot.title == "Signature of the picked vertex"
 
 
 def test_ctrl_arrows_step_modes_from_a_number_field(window, spot_path, qtbot):
@@ -422,52 +362,36 @@ def test_a_closed_panel_comes_back_from_the_view_menu(window):
     assert not dock.isHidden()
 
 
-def test_a_preview_only_result_says_how_to_get_the_exact_spectrum(window, spot_path):
-    """Found under Xvfb: with Preview only ticked the Modes panel said "Compute (Ctrl+R)
-    for the exact spectrum", where Compute makes the same preview again."""
-    window.open_mesh(spot_path)
-    window.state.set_compute_settings(preview_only=True)
-    spec = window.compute("laplacian", k=30, wait=True)
-    assert spec.is_preview
-    text = window.modes_panel.eigen_label.text()
-    assert text.endswith("Untick Preview only and Compute (Ctrl+R) for the exact spectrum."), text
-    window.state.set_compute_settings(preview_only=False)
-    assert window.modes_panel.eigen_label.text().endswith(
-        " Compute (Ctrl+R) for the exact spectrum."
-    )
-    assert "Untick" not in window.modes_panel.eigen_label.text()
-
-
 def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
-    """Found under Xvfb: Coarse-to-fine, Preview first and the colour bar came back at
-    their defaults after a restart (settings.ini held operator, weights and rescale
-    only)."""
+    """Found under Xvfb: Coarse-to-fine and the colour bar came back at their defaults
+    after a restart (settings.ini held operator, weights and rescale only).  A settings
+    file that still names the removed preview options starts without them."""
     from modalviewer.gui import MainWindow, window_settings
 
-    window.state.set_compute_settings(
-        coarse=True, preview=False, preview_only=True, operator="laplacian"
-    )
+    window.state.set_compute_settings(coarse=True, operator="laplacian")
     window.state.set_colorbar(False)
     window.state.set_color_range("limits", (-0.5, 2.0))
     window.state.set_log_signature(True)
     window.remember_settings = True  # as on a desktop
+    window.settings.setValue("compute/preview_only", "true")  # an older version's option
+    window.settings.setValue("compute/preview", "false")
     window_settings.save(window)
+    assert not window.settings.contains("compute/preview_only")
+    window.settings.setValue("compute/preview_only", "true")  # left by an older version
+    window.settings.sync()
     again = MainWindow()
     qtbot.addWidget(again)
     c = again.state.compute_settings
-    assert c.coarse is True and c.preview is False and c.operator == "laplacian"
-    assert c.preview_only is True
+    assert c.coarse is True and c.operator == "laplacian"
+    assert not hasattr(c, "preview_only") and not hasattr(again.compute_panel, "preview_check")
     assert again.state.style.colorbar is False
     assert again.state.style.color_range == "limits"
     assert again.state.style.color_limits == (-0.5, 2.0)
     assert again.state.style.log_signature is True
     assert not again.colorbar_action.isChecked()
     assert again.compute_panel.coarse_check.isChecked()
-    assert not again.compute_panel.preview_check.isChecked()
-    panel = again.compute_panel
-    assert panel.preview_only_check.isChecked() and not panel.preview_check.isEnabled()
-    panel.preview_only_check.click()  # the box drives the setting
-    assert again.state.compute_settings.preview_only is False and panel.preview_check.isEnabled()
+    again.compute_panel.coarse_check.click()  # the box drives the setting
+    assert again.state.compute_settings.coarse is False
 
 
 def test_a_combo_box_names_its_whole_item_in_its_tooltip(window):
@@ -482,7 +406,7 @@ def test_a_combo_box_names_its_whole_item_in_its_tooltip(window):
 
 def test_esc_says_what_stays_queued_also_once_the_next_job_starts(window, spot_path):
     """Found under Xvfb: "Cancelling...; 2 more queued" was replaced within 0.15 s by the
-    next job's "Computing ...", and counted a preview and its exact job as two."""
+    next job's "Computing ..."."""
     window.open_mesh(spot_path)
     messages = []
     window.statusBar().messageChanged.connect(messages.append)
@@ -602,14 +526,14 @@ def test_preferences_are_written_soon_after_they_change(window, qtbot):
     from modalviewer.gui import MainWindow
 
     window.remember_settings = True  # as on a desktop
-    window.state.set_compute_settings(operator="shells_normal", preview=False)
+    window.state.set_compute_settings(operator="shells_normal", coarse=True)
     qtbot.waitUntil(
         lambda: window.settings.value("compute/operator") == "shells_normal", timeout=3000
     )
     again = MainWindow()  # no closeEvent of the first window: as after a kill
     qtbot.addWidget(again)
     assert again.state.compute_settings.operator == "shells_normal"
-    assert again.state.compute_settings.preview is False
+    assert again.state.compute_settings.coarse is True
 
 
 def test_the_computations_panel_keeps_how_the_last_computation_ended(window, spot_path, qtbot):
@@ -626,10 +550,10 @@ def test_the_computations_panel_keeps_how_the_last_computation_ended(window, spo
     qtbot.waitUntil(lambda: panel.last.text() != "", timeout=60000)
     assert panel.last.text().startswith("Last: Laplacian (cotan), 10 modes in ")
     assert panel.last.text().endswith(" s") and panel.last.isVisibleTo(window)
-    given_up = SimpleNamespace(status="cancelled", description="preview of X", error=None)
-    assert ended_text(given_up) == "preview of X: cancelled"
-    given_up.error = "preview stopped after 3 s"
-    assert ended_text(given_up) == "preview of X: preview stopped after 3 s"
+    given_up = SimpleNamespace(status="cancelled", description="X", error=None)
+    assert ended_text(given_up) == "X: cancelled"
+    given_up.error = "superseded: another mesh was opened"
+    assert ended_text(given_up) == "X: superseded: another mesh was opened"
 
 
 def test_modes_k_takes_any_number_typed(window, spot_path, qtbot):
@@ -648,21 +572,21 @@ def test_modes_k_takes_any_number_typed(window, spot_path, qtbot):
 
 
 def test_the_computations_panel_shows_what_the_status_line_said_whole(window, qtbot):
-    """Found under Xvfb: the status bar cuts long messages (how a preview starts, the
-    predicted wait); a running job's row in the Computations panel shows them whole."""
+    """Found under Xvfb: the status bar cuts long messages (the expected wait); a running
+    job's row in the Computations panel shows them whole."""
     from modalviewer.viewer.jobs import RUNNING, Job
 
     panel = window.jobs_panel
-    job = Job(lambda *_: None, "key", "preview of Discrete Shells (3D vibrations), 40 modes")
-    job.status, job.stage, job.fraction = RUNNING, "preview: factorising", 0.3
+    job = Job(lambda *_: None, "key", "Discrete Shells (3D vibrations), 400 modes")
+    job.status, job.stage, job.fraction = RUNNING, "factorising", 0.3
     long = (
-        "Computing preview of Discrete Shells (3D vibrations), 40 modes, from a coarse copy "
-        "of the mesh; the exact spectrum would take about 9 s here, the preview about 7 s."
+        "Discrete Shells (3D vibrations), 400 modes: this will take about 3 min (Esc "
+        "cancels; Coarse-to-fine is much faster)."
     )
     job.said = [long]
     panel._on_changed(job)
     label = panel.rows[job.id][1]
-    assert label.text() == f"{long}\npreview: factorising 30 %"
+    assert label.text() == f"{long}\nfactorising 30 %"
     job.status = "done"
     panel._on_changed(job)
     assert job.id not in panel.rows

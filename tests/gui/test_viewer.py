@@ -174,7 +174,6 @@ def _big_mesh_file(tmp_path):
 
 def test_cancel_a_running_computation(window, tmp_path, qtbot):
     window.open_mesh(_big_mesh_file(tmp_path))
-    window.state.set_compute_settings(preview=False)  # the exact computation alone
     window.compute("shells", k=200, wait=False)
     job = window.running_job
     assert job is not None and window.cancel_button.isVisible()

@@ -119,3 +119,24 @@ def test_a_session_keeps_the_chosen_up_axis(tmp_path):
     third = _model(tmp_path)
     restored = restore_session(third, tmp_path / "bad.json")
     assert third.state.up_axis is None and any("up axis" in n for n in restored.notes)
+
+
+def test_a_session_naming_the_removed_preview_options_opens_without_them(tmp_path):
+    """Sessions saved while the viewer offered previews hold "preview" and
+    "preview_only" among the compute settings: they open, with the other settings."""
+    mesh_path = tmp_path / "spot.obj"
+    shutil.copy(ASSETS / "spot.obj", mesh_path)
+    first = _model(tmp_path)
+    first.open_mesh(mesh_path)
+    first.state.set_compute_settings(operator="laplacian", k=25, coarse=True)
+    path = save_session(first.state, tmp_path / "old.json")
+    data = json.loads(path.read_text())
+    data["compute_settings"].update(preview=True, preview_only=True)
+    path.write_text(json.dumps(data))
+    second = _model(tmp_path)
+    restored = restore_session(second, path)
+    _wait_all(second, restored)
+    assert restored.notes == []
+    settings = second.state.compute_settings
+    assert (settings.operator, settings.k, settings.coarse) == ("laplacian", 25, True)
+    assert not hasattr(settings, "preview")

@@ -146,4 +146,5 @@ def test_the_wording_functions_give_the_legends_they_gave_as_state_methods(tmp_p
     threshold_text = "blue: heat kernel distance < 0.0621, 10.0 % of the surface\nfrom vertex 100"
     assert wording.legend(state, model.derived) == threshold_text
     assert model.derived.field().legend == threshold_text
-    assert wording.display_mark(state) == "" and wording.preview_note(state, "laplacian") == ""
+    assert wording.display_mark(state) == ""
+    assert wording.approximation_note(state, "laplacian") == ""

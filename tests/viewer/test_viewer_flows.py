@@ -189,87 +189,11 @@ def test_a_cached_spectrum_does_not_read_like_a_fresh_solve(viewer, spot_path, t
     again.close()
 
 
-def _laplacian_preview_held(viewer, spot_path, monkeypatch) -> list[str]:
-    """A Preview only result of 30 Laplacian modes of spot on screen, Preview only
-    turned off again, every request's note on (NOTE_FROM_SECONDS 0); the status-line
-    messages from the start."""
-    from modalviewer.viewer import model as model_module
-
-    monkeypatch.setattr(model_module, "NOTE_FROM_SECONDS", 0.0)
-    statuses = _statuses(viewer)
-    viewer.open_mesh(spot_path)
-    viewer.state.set_compute_settings(preview_only=True)
-    assert viewer.compute("laplacian", k=30).is_preview
-    viewer.state.set_compute_settings(preview_only=False)
-    return statuses
-
-
-def test_the_exact_solve_after_a_preview_does_not_say_there_is_no_preview(
-    viewer, spot_path, monkeypatch
-):
-    """Found under Xvfb: with a Preview only result on screen, the exact solve asked for
-    next said "no preview: predicted ..." (the note for big requests; on for every
-    request here)."""
-    statuses = _laplacian_preview_held(viewer, spot_path, monkeypatch)
-    assert not viewer.compute("laplacian", k=30).is_preview
-    started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 30 modes")]
-    assert started[-1] == (
-        "Computing Laplacian (cotan), 30 modes; the preview shown stays until it is ready."
-    ), started
-
-
-def test_the_exact_solve_behind_a_preview_not_on_screen_does_not_say_it_is_shown(
-    viewer, spot_path, monkeypatch
-):
-    """Found under Xvfb: with a Laplacian preview held and E_D^N on screen, the exact
-    Laplacian's start said "the preview shown stays until it is ready"; it is not shown.
-    The exact spectrum then comes on screen."""
-    statuses = _laplacian_preview_held(viewer, spot_path, monkeypatch)
-    viewer.compute("modified_dirichlet", k=30)
-    assert viewer.state.display_operator() == "modified_dirichlet"
-    assert not viewer.compute("laplacian", k=30).is_preview
-    started = [s for s in statuses if s.startswith("Computing Laplacian (cotan), 30 modes")]
-    assert started[-1] == (
-        "Computing Laplacian (cotan), 30 modes; it replaces its preview when it is ready."
-    ), started
-    assert viewer.state.display_operator() == "laplacian"
-
-
-def test_a_shown_shells_preview_says_how_it_starts(viewer, spot_path):
-    """Preview only of the 3D shells: the status line says whether the preview starts
-    from a coarse copy of the mesh or from its smooth space, and why (the viewer's
-    guide says it does; a newcomer under Xvfb found only "Computing preview of ..."),
-    and where the exact solve is quick, that it is (the newcomer's Laplacian preview of
-    a 47k mesh took 6.3 s, the exact spectrum 5.6 s)."""
-    statuses = _statuses(viewer)
-    viewer.open_mesh(spot_path)
-    viewer.state.set_compute_settings(preview_only=True)
-    assert viewer.compute("shells", k=20).is_preview
-    assert viewer.compute("laplacian", k=20).is_preview
-    started = list(dict.fromkeys(s for s in statuses if s.startswith("Computing preview of")))
-    # on a mesh this small the exact solve is quick, which Preview only then says
-    assert started == [
-        "Computing preview of Discrete Shells (3D vibrations), 20 modes, from its smooth "
-        "space (the mesh is too small for a coarse copy to save work); the exact spectrum "
-        "would take about 1 s here...",
-        "Computing preview of Laplacian (cotan), 20 modes; the exact spectrum would take "
-        "about 1 s here...",
-    ], started
-
-
 def test_asking_again_for_a_spectrum_in_memory_says_so(viewer, spot_path):
-    """Found under Xvfb: Ctrl+R with the Preview only result on screen did nothing and
-    said nothing."""
+    """Found under Xvfb: Ctrl+R with the spectrum on screen did nothing and said
+    nothing."""
     statuses = _statuses(viewer)
     viewer.open_mesh(spot_path)
-    viewer.state.set_compute_settings(preview_only=True)
-    viewer.compute("laplacian", k=20)
-    viewer.compute("laplacian", k=20)
-    assert statuses[-1] == (
-        "Laplacian (cotan), 20 modes: its preview is already here; untick Preview only "
-        "and compute again for the exact spectrum."
-    ), statuses[-3:]
-    viewer.state.set_compute_settings(preview_only=False)
     viewer.compute("laplacian", k=20)
     viewer.compute("laplacian", k=20)
     assert statuses[-1] == "Laplacian (cotan), 20 modes: already computed.", statuses[-3:]
@@ -338,28 +262,6 @@ def test_a_field_of_your_own(viewer, spot_path):
         viewer.show_field("missing")
     viewer.open_mesh(spot_path)
     assert viewer.state.fields == {} and viewer.state.display.kind == "none"
-
-
-def test_a_shells_preview_only_starts_from_a_coarse_copy(viewer):
-    """Preview only of the 3D shells on a mesh big enough for a coarse copy: the preview
-    starts from the copy's modes (found whole: six rigid motions), and its eigenvalues
-    are within 2 % of the exact ones in the lower half."""
-    pytest.importorskip("pymeshlab")  # the copy's decimation (an optional dependency)
-    from modalviewer.core.primitives import torus
-
-    viewer.set_mesh(torus(160, 80, minor=0.3))  # 12 800 vertices: a 3200-vertex copy
-    viewer.state.set_compute_settings(preview_only=True)
-    spec = viewer.compute("shells", k=24)
-    assert spec.is_preview
-    start = spec.parameters["preview"]["coarse_start"]
-    assert 3000 <= start["coarse_vertices"] <= 3300
-    viewer.state.set_compute_settings(preview_only=False)
-    exact = viewer.compute("shells", k=24)
-    assert not exact.is_preview
-    assert np.sum(spec.zero_mode_mask()) == 6 == np.sum(exact.zero_mode_mask())
-    lower = slice(6, 15)
-    error = spec.eigenvalues[lower] / exact.eigenvalues[lower] - 1
-    assert np.all(error > -1e-9) and error.max() < 0.02
 
 
 def test_a_request_for_more_modes_than_the_mesh_has_says_how_many_came(viewer):

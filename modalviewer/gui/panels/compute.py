@@ -6,7 +6,6 @@ from qtpy import QtCore, QtWidgets
 
 from ...core.operators import OPERATOR_INFO
 from ...viewer import wording
-from ...viewer.model import PREVIEW_DELAY
 from ...viewer.state import ViewerState
 from .common import WrappingLabel, combo, quiet, select_data
 
@@ -51,21 +50,6 @@ class ComputePanel(QtWidgets.QWidget):
             "Compute on a copy decimated to about a fifth of the vertices and carry the modes "
             "to this mesh by nearest vertex (paper Section 7): much faster on big meshes."
         )
-        self.preview_check = QtWidgets.QCheckBox("Preview first where it pays")
-        self.preview_check.setToolTip(
-            "Show a preview spectrum (a Galerkin approximation on the same mesh) while the "
-            "exact one is computed, where the preview is predicted to delay the exact "
-            f"spectrum by at most {round(100 * PREVIEW_DELAY)} %; the mode, pick and map on "
-            "screen stay when the exact spectrum replaces it. The status line says why a "
-            "request gets none. Not with Coarse-to-fine."
-        )
-        self.preview_only_check = QtWidgets.QCheckBox("Preview only (no exact spectrum)")
-        self.preview_only_check.setToolTip(
-            "Compute a preview and no exact spectrum: for meshes where the exact solve would "
-            "take many minutes or not fit in memory (refined where its estimated error is "
-            "above 2 % and the exact solve's memory would fit). Shown with its estimated "
-            "error; turn it off and compute again for the exact spectrum."
-        )
         self.compute_button = QtWidgets.QPushButton("Compute spectrum")
         self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")
         form.addRow("Operator", self.operator_combo)
@@ -74,8 +58,6 @@ class ComputePanel(QtWidgets.QWidget):
         form.addRow("Membrane weight", self.membrane_spin)
         form.addRow(self.rescale_check)
         form.addRow(self.coarse_check)
-        form.addRow(self.preview_check)
-        form.addRow(self.preview_only_check)
         form.addRow(self.compute_button)
         self.mesh_info = WrappingLabel("No mesh")
         form.addRow(self.mesh_info)
@@ -88,10 +70,6 @@ class ComputePanel(QtWidgets.QWidget):
         self.membrane_spin.valueChanged.connect(lambda v: state.set_compute_settings(membrane=v))
         self.rescale_check.toggled.connect(lambda on: state.set_compute_settings(rescale=on))
         self.coarse_check.toggled.connect(lambda on: state.set_compute_settings(coarse=on))
-        self.preview_check.toggled.connect(lambda on: state.set_compute_settings(preview=on))
-        self.preview_only_check.toggled.connect(
-            lambda on: state.set_compute_settings(preview_only=on)
-        )
         self.compute_button.clicked.connect(self.computeRequested)
         state.events.compute_settings.connect(self.update_from_state)
         state.events.mesh.connect(self.update_from_state)
@@ -106,8 +84,6 @@ class ComputePanel(QtWidgets.QWidget):
             self.membrane_spin,
             self.rescale_check,
             self.coarse_check,
-            self.preview_check,
-            self.preview_only_check,
         )
         with quiet(*widgets):
             select_data(self.operator_combo, s.operator)
@@ -116,9 +92,6 @@ class ComputePanel(QtWidgets.QWidget):
             self.membrane_spin.setValue(s.membrane)
             self.rescale_check.setChecked(s.rescale)
             self.coarse_check.setChecked(s.coarse)
-            self.preview_check.setChecked(s.preview)
-            self.preview_only_check.setChecked(s.preview_only)
-        self.preview_check.setEnabled(not s.preview_only)
         weights = OPERATOR_INFO[s.operator].has_weights
         self.bending_spin.setEnabled(weights)
         self.membrane_spin.setEnabled(weights)

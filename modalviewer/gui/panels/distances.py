@@ -312,8 +312,7 @@ class DistancesPanel(QtWidgets.QWidget):
             markers=False,
             title=(
                 f"Signature of vertex {state.picked_file_vertex} "
-                f"({OPERATOR_INFO[operator].short_label}"
-                f"{', preview' if spec.is_preview else ''})"
+                f"({OPERATOR_INFO[operator].short_label})"
             ),
         )
         self._show_exact_curve()

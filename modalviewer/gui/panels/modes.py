@@ -7,7 +7,7 @@ from qtpy import QtCore, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
-from ...viewer.wording import approximation_mark, percent_text
+from ...viewer.wording import approximation_mark
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, describe, quiet, select_data
 
@@ -78,9 +78,8 @@ class ModesPanel(QtWidgets.QWidget):
             lambda _: state.set_shell_coloring(self.color_combo.currentData())
         )
         self.iso_spin.valueChanged.connect(state.set_isolines)
-        # compute_settings: the preview's note depends on Preview only
         events = state.events
-        for event in (events.display, events.spectra, events.mesh, events.compute_settings):
+        for event in (events.display, events.spectra, events.mesh):
             event.connect(self.update_from_state)
         state.events.style.connect(self._update_style)
         self.update_from_state()
@@ -154,38 +153,16 @@ class ModesPanel(QtWidgets.QWidget):
             else:
                 text = f"lambda_{j} = {lam:.6g}   sqrt(lambda) = {np.sqrt(max(lam, 0.0)):.6g}"
         else:
-            # short (two lines), so the rows below stay in view beside a preview's note:
-            # the view's title says the rest (from which vertex, which scales)
+            # short (two lines), so the rows below stay in view beside a note: the view's
+            # title says the rest (from which vertex, which scales)
             text = f"Not shown (M shows it): {_what_is_shown(state)} on screen."
-        tip = ""
-        if spec.is_preview:
-            if state.exact_follows(op):
-                follows = "the exact spectrum replaces it when ready."
-            elif state.compute_settings.preview_only:
-                # Compute would only make the same preview again
-                follows = "untick Preview only and Compute (Ctrl+R) for the exact spectrum."
-            else:
-                follows = "Compute (Ctrl+R) for the exact spectrum."
-            this_mode = (
-                f"; this mode {percent_text(spec.estimated_mode_error(state.display.mode))}"
-                if showing_mode and not zero[min(state.display.mode, spec.k - 1)]
-                else ""
-            )
-            # short, so the animation's rows below stay in view; the rest in the tooltip
-            text += (
-                f"\nPreview, estimated error (not a bound): largest "
-                f"{percent_text(spec.estimated_error)}{this_mode}. "
-                f"{follows[0].upper()}{follows[1:]}"
-            )
-            tip = PREVIEW_TIP
-        elif state.is_coarse(op):
+        if state.is_coarse(op):
             text += (
                 "\nCoarse-to-fine: computed on a copy decimated to about a fifth and carried "
                 "to this mesh; eigenvalues and modes approximate (untick Coarse-to-fine and "
                 "Compute for the exact spectrum)."
             )
         self.eigen_label.setText(text)
-        self.eigen_label.setToolTip(tip)
         approximate = approximation_mark(state, op)
         # marked: the short name (as in the spectrum list), so the title keeps to one line
         info = OPERATOR_INFO[op]
@@ -200,15 +177,6 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.color_combo, self.iso_spin):
             select_data(self.color_combo, self.state.style.shell_coloring)
             self.iso_spin.setValue(self.state.style.isolines)
-
-
-PREVIEW_TIP = (
-    "A preview's eigenvalues lie above the exact ones. Its estimated error is an estimate "
-    "from below, not a bound. Where a preview misses a mode, the modes above it have "
-    "numbers one lower than in the exact spectrum."
-)
-"""The Modes panel's tooltip on a preview's eigenvalue line: what the line's estimate
-means, kept out of the line itself."""
 
 
 def _what_is_shown(state: ViewerState) -> str:
