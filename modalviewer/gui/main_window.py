@@ -28,6 +28,7 @@ from ..core.operators import OPERATOR_INFO
 from ..core.spectrum import Spectrum
 from ..readers import DamagedFileError
 from ..viewer.jobs import QUEUED, Job
+from ..viewer.model import seconds_text
 from ..viewer.state import SpectrumKey
 from ..viewer.viewer import ComputeError, Viewer
 from . import menus, window_settings
@@ -426,10 +427,11 @@ class MainWindow(QtWidgets.QMainWindow):
         missing = self.viewer.missing_for(items)
         if missing and not wait:
             names = ", ".join(OPERATOR_INFO[op].label for op in missing)
+            seconds = self.viewer.comparison_cost(missing)
+            about = "" if seconds is None else f"; about {seconds_text(max(seconds, 1.0))}"
             question = (
-                f"The comparison needs {names} ({self.state.compute_settings.k} modes each; "
-                f"at least {max(self.viewer.comparison_cost(missing), 1):.0f} s on an idle "
-                "machine). Compute now? The main view is not changed."
+                f"The comparison needs {names} ({self.state.compute_settings.k} modes "
+                f"each{about}). Compute now? The main view is not changed."
             )
             if not ask(self, "Compare", question, default_yes=True):
                 return None
