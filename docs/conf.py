@@ -48,7 +48,8 @@ root_doc = "index"
 exclude_patterns = ["_build", "_generated", "_ext"]
 
 # MyST: anchors for headings down to ####, spelled as GitHub spells them, so the pages'
-# links such as how-it-works.md#preview-spectra work on GitHub and in the HTML alike.
+# links such as how-it-works.md#how-the-eigenproblems-are-solved work on GitHub and in the
+# HTML alike.
 myst_heading_anchors = 4
 myst_enable_extensions = ["colon_fence", "attrs_inline"]
 

@@ -61,7 +61,7 @@ def test_threaded_product_writes_into_out(K):
 @pytest.mark.parametrize("shape", [(1000, 7, 5), (1000, 7, 7), (50000, 30, 12)])
 def test_transform_columns_in_place_is_the_product_on_the_same_memory(shape):
     """Small chunks (every chunk's writes overlap rows of the chunk being read) and
-    a float32 Y as the preview's refinement stores it."""
+    a float32 Y as a single-precision Krylov basis holds it."""
     from modalviewer.core.products import transform_columns_in_place
 
     n, w, m = shape
