@@ -80,7 +80,6 @@ class Spectrum:
         return self.modes.ndim == 3
 
     @property
-    @property
     def modes_requested(self) -> int:
         """How many modes the computation gives: more than :attr:`k` while the modes are
         handed over as they converge (``compute_spectrum(..., on_modes=...)``)."""
