@@ -8,14 +8,10 @@ range and one colour bar below (``modalviewer render MESH --operator shells --mo
 6-13 --grid 4x2 -o row.png`` from the command line).
 """
 
-from pathlib import Path
-
 import modalviewer as mv
 
-ASSETS = Path(mv.__file__).resolve().parents[1] / "assets"
-
 viewer = mv.Viewer()
-viewer.open_mesh(ASSETS / "spot.obj")
+viewer.open_mesh(mv.asset_path("spot.obj"))
 viewer.compute("shells", k=20)
 viewer.export_mode_grid("spot_modes.png", range(6, 14), grid=(4, 2), size=(300, 260))
 viewer.close()
