@@ -1,7 +1,8 @@
 """A spectrum computation in a child process.
 
 ``python -m modalviewer.processes.job_main JOB OUT``: JOB.npz holds ``vertices``,
-``faces`` and a JSON ``params`` (operator, k, bending, membrane).  Progress goes to
+``faces`` and a JSON ``params`` (operator, k, bending, membrane, and ``modes_folder``:
+where the modes are relayed as they converge).  Progress goes to
 stdout as JSON lines ``{"stage": ..., "fraction": ...}``, the result to OUT.npz (written
 atomically), a failure to stdout as ``{"error": ...}`` with exit code 1.  A separate
 process keeps the viewer's event loop free (sparse factorisations hold the GIL) and is
@@ -11,7 +12,9 @@ terminated at once to cancel.
 from __future__ import annotations
 
 import json
+import os
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -35,6 +38,7 @@ def main(argv: list[str] | None = None) -> int:
             vertices, faces = job["vertices"], job["faces"]
             params = json.loads(str(job["params"]))
         mesh = Mesh(vertices, faces)
+        folder = params.get("modes_folder")
         spec = compute_spectrum(
             mesh,
             params["operator"],
@@ -42,6 +46,7 @@ def main(argv: list[str] | None = None) -> int:
             float(params["bending"]),
             float(params["membrane"]),
             progress=_report,
+            on_modes=None if folder is None else _ModesRelay(Path(folder)),
         )
         _emit({"stage": "writing the result", "fraction": 0.97})
         save_spectrum(spec, out_path)
@@ -53,6 +58,34 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     _emit({"done": out_path})
     return 0
+
+
+class _ModesRelay:
+    """Hands the modes that converged to the viewer: each step's new modes go to a file
+    ``modes-<j>.npz`` in ``folder`` (written whole, then renamed), announced as a line
+    ``{"modes": path}``; the finished spectrum is not relayed (it is the result)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self.sent = 0
+
+    def __call__(self, spec) -> None:
+        if spec.is_complete:
+            return
+        part = slice(self.sent, spec.k)
+        path = self.folder / f"modes-{spec.k}.npz"
+        partial = path.with_suffix(".partial.npz")
+        np.savez(
+            partial,
+            eigenvalues=spec.eigenvalues[part],
+            modes=spec.modes[..., part],
+            residuals=spec.residuals[part],
+            mass=spec.mass,
+            parameters=json.dumps(spec.parameters),
+        )
+        os.replace(partial, path)
+        self.sent = spec.k
+        _emit({"modes": str(path)})
 
 
 def _report(stage: str, fraction: float) -> None:

@@ -3,12 +3,14 @@
 :class:`ViewerModel` is what the window, the CLI, the figures and scripts drive.  It
 turns a request ("the shells spectrum, 100 modes") into a :class:`~.jobs.Job` whose
 result lands in :class:`~.state.ViewerState` when it ends, if the mesh it was computed
-for is still the loaded one.  A finished job changes what is displayed only if it was
-asked to (``show=True``) and the display has not changed since the request.
+for is still the loaded one; the modes of a spectrum land there as they converge, lowest
+first, before the job ends (:class:`_ModesArriving`).  A job changes what is displayed
+only if it was asked to (``show=True``) and the display has not changed since the request.
 """
 
 from __future__ import annotations
 
+import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -270,10 +272,12 @@ class ViewerModel:
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
-        work = self._work(key)
+        arrivals = _ModesArriving(self, key, display_at_request if show else None)
+        work = self._work(key, arrivals)
         job = self.jobs.add(
             SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key)
         )
+        arrivals.job = job
         state.set_computing(key, True)
         owner = state.mesh.hash
 
@@ -358,8 +362,9 @@ class ViewerModel:
     def _show_first_mode(self, operator: str) -> None:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
 
-    def _work(self, key: SpectrumKey):
-        """The function a job runs for ``key``: cache, compute, signature table."""
+    def _work(self, key: SpectrumKey, on_modes=None):
+        """The function a job runs for ``key``: cache, compute (``on_modes`` gets the
+        modes as they converge), signature table."""
         mesh = self.state.compute_mesh(key)
         cache = self.cache
         t_range = self.state.t_range
@@ -369,7 +374,7 @@ class ViewerModel:
         def work(progress, cancel):
             spec = None if key.coarse else cache.get(*cache_args)
             if spec is None:
-                spec = _compute(mesh, key, cache, progress, cancel)
+                spec = _compute(mesh, key, cache, progress, cancel, on_modes)
             table = None
             if needs_table and (~spec.zero_mode_mask()).any():
                 # built here, off the GUI thread (on big meshes it takes a moment)
@@ -393,7 +398,55 @@ class ViewerModel:
             self.state.add_spectrum(key, spec, table)
 
 
-def _compute(mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cancel) -> Spectrum:
+class _ModesArriving:
+    """The modes of a spectrum job as they converge, from its worker thread to the state:
+    the latest spectrum so far is kept and one delivery at a time is dispatched to the
+    owner's thread (where the picture is redrawn), so a slow redraw skips steps rather
+    than queueing them.  ``show_from``: the display at a ``show`` request; the first
+    modes to arrive are shown if the display has not changed since (as a finished
+    spectrum would be)."""
+
+    def __init__(self, model: ViewerModel, key: SpectrumKey, show_from) -> None:
+        self.model, self.key, self.show_from = model, key, show_from
+        self.owner = model.state.mesh.hash
+        self.job: SpectrumJob | None = None
+        self.latest: Spectrum | None = None
+        self.pending = False
+        self.lock = threading.Lock()
+
+    def __call__(self, spec: Spectrum) -> None:
+        if spec.is_complete:
+            return  # the job's result
+        with self.lock:
+            self.latest = spec
+            if self.pending:
+                return
+            self.pending = True
+        self.model.jobs.dispatch(self.deliver)
+
+    def deliver(self) -> None:
+        with self.lock:
+            spec, self.pending = self.latest, False
+        state = self.model.state
+        job = self.job
+        if job is None or job.done or job.cancel_requested:
+            return
+        if state.mesh is None or state.mesh.hash != self.owner:
+            return
+        state.add_spectrum(self.key, spec)
+        before = self.show_from
+        if before is not None and (~spec.zero_mode_mask()).any():
+            self.show_from = None
+            if state.display in (before, before.blank()):
+                if before.kind == "mode" and before.operator == self.key.operator:
+                    state.show_mode(min(before.mode, spec.k - 1), self.key.operator)
+                else:
+                    state.show_mode(state.first_nonzero_mode(self.key.operator), self.key.operator)
+
+
+def _compute(
+    mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cancel, on_modes=None
+) -> Spectrum:
     info = operator_info(key.operator)
     weights = (key.bending, key.membrane)
     if key.coarse:
@@ -404,8 +457,12 @@ def _compute(mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cance
         from .process import compute_in_process
 
         target = cache.writable_path(mesh, key.operator, key.k, *weights)
-        return compute_in_process(mesh, key.operator, key.k, *weights, target, progress, cancel)
-    spec = compute_spectrum(mesh, key.operator, key.k, *weights, progress, cancel)
+        return compute_in_process(
+            mesh, key.operator, key.k, *weights, target, progress, cancel, on_modes
+        )
+    spec = compute_spectrum(
+        mesh, key.operator, key.k, *weights, progress, cancel, on_modes=on_modes
+    )
     cache.put(mesh, spec, key.k, *weights)
     return spec
 

@@ -28,7 +28,7 @@ import numpy as np
 from ..core.eigen import Cancelled
 from ..core.factor import remove_stale_factor_folders
 from ..core.mesh import Mesh
-from ..core.spectrum import load_spectrum
+from ..core.spectrum import Spectrum, load_spectrum
 
 
 class ChildError(RuntimeError):
@@ -36,8 +36,9 @@ class ChildError(RuntimeError):
     the child): a message for the user, not a fault of this process."""
 
 
-def _run_child(argv: list[str], progress, cancel, what: str) -> None:
-    """Run ``python -m ...argv``; relay its progress; kill it on cancel; raise its error."""
+def _run_child(argv: list[str], progress, cancel, what: str, on_modes=None) -> None:
+    """Run ``python -m ...argv``; relay its progress (and its ``{"modes": path}`` lines
+    to ``on_modes(path)``); kill it on cancel; raise its error."""
     child = subprocess.Popen(
         [sys.executable, "-m", *argv],
         stdout=subprocess.PIPE,
@@ -72,6 +73,8 @@ def _run_child(argv: list[str], progress, cancel, what: str) -> None:
                 continue
             if "stage" in message:
                 progress(message["stage"], message["fraction"])
+            elif "modes" in message and on_modes is not None:
+                on_modes(message["modes"])
             elif "error" in message:
                 error = message["error"]
     finally:
@@ -108,9 +111,13 @@ def compute_in_process(
     out_path,
     progress,
     cancel,
+    on_modes=None,
 ):
     """Run ``modalviewer.processes.job_main`` in a child Python; returns the Spectrum read back
-    from ``out_path``; the child's error message is raised as RuntimeError."""
+    from ``out_path``; the child's error message is raised as RuntimeError.
+    ``on_modes(spectrum_so_far)``: as :func:`modalviewer.compute_spectrum`'s, the modes
+    the child's solve has converged so far (relayed through files), called in this
+    thread; the finished spectrum is returned, not passed to it."""
     params = {
         "operator": operator,
         "k": int(k),
@@ -118,14 +125,55 @@ def compute_in_process(
         "membrane": membrane,
     }
     job_path = _temp_path(".npz")
-    try:
-        np.savez(job_path, vertices=mesh.vertices, faces=mesh.faces, params=json.dumps(params))
-        argv = ["modalviewer.processes.job_main", job_path, str(out_path)]
-        _run_child(argv, progress, cancel, "computation")
-    finally:
-        Path(job_path).unlink(missing_ok=True)
+    with tempfile.TemporaryDirectory(prefix="modalviewer-modes-") as folder:
+        relay = None
+        if on_modes is not None:
+            params["modes_folder"] = folder
+            relay = _ModesReceived(mesh.hash, operator, on_modes)
+        try:
+            np.savez(job_path, vertices=mesh.vertices, faces=mesh.faces, params=json.dumps(params))
+            argv = ["modalviewer.processes.job_main", job_path, str(out_path)]
+            _run_child(argv, progress, cancel, "computation", relay)
+        finally:
+            Path(job_path).unlink(missing_ok=True)
     progress("reading the result", 0.98)
     return load_spectrum(out_path, mesh_hash=mesh.hash)
+
+
+class _ModesReceived:
+    """Reads the files of modes a child relays (``processes.job_main``), gathers them in
+    one array and calls ``on_modes`` with a Spectrum of all received so far."""
+
+    def __init__(self, mesh_hash: str, operator: str, on_modes) -> None:
+        self.mesh_hash, self.operator, self.on_modes = mesh_hash, operator, on_modes
+        self.count = 0
+
+    def __call__(self, path: str) -> None:
+        with np.load(path, allow_pickle=False) as part:
+            parameters = json.loads(str(part["parameters"]))
+            new = part["modes"]
+            if self.count == 0:
+                k = int(parameters["modes_requested"])
+                self.modes = np.empty(new.shape[:-1] + (k,))
+                self.eigenvalues, self.residuals = np.zeros(k), np.zeros(k)
+                self.mass = part["mass"]
+            j0, j1 = self.count, self.count + new.shape[-1]
+            self.modes[..., j0:j1] = new
+            self.eigenvalues[j0:j1] = part["eigenvalues"]
+            self.residuals[j0:j1] = part["residuals"]
+        Path(path).unlink(missing_ok=True)
+        self.count = j1
+        self.on_modes(
+            Spectrum(
+                eigenvalues=self.eigenvalues[:j1].copy(),
+                modes=self.modes[..., :j1],
+                operator=self.operator,
+                mass=self.mass,
+                residuals=self.residuals[:j1].copy(),
+                mesh_hash=self.mesh_hash,
+                parameters=parameters,
+            )
+        )
 
 
 def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:

@@ -302,11 +302,18 @@ class ViewerState:
 
         It becomes the spectrum shown for its operator; the operator's spectra of other
         keys (another k, other weights) are dropped: nothing shows them any more, and at
-        130k vertices each holds 100 to 300 MB (exact ones come back from the cache)."""
+        130k vertices each holds 100 to 300 MB (exact ones come back from the cache).
+
+        The first modes of a computation still running (``spec.is_complete`` False) are
+        stored the same way and replaced as more arrive; they never replace a complete
+        spectrum of ``key``, and nothing the user chose (mode, pick, share, camera) is
+        reset when they are."""
         if self.mesh is not None:
             spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
             raise ValueError("the spectrum does not belong to the loaded mesh")
+        if not spec.is_complete and self.has_spectrum(key):
+            return  # the whole spectrum is in already
         for other in [k for k in self.spectra if k.operator == key.operator and k != key]:
             del self.spectra[other]
         self.spectra[key] = spec
@@ -346,8 +353,16 @@ class ViewerState:
         return [op for op in OPERATOR_INFO if op in self._latest]
 
     def has_spectrum(self, key: SpectrumKey) -> bool:
-        """Whether the spectrum of ``key`` is in."""
-        return key in self.spectra
+        """Whether the whole spectrum of ``key`` is in (its first modes, while it is
+        computed, do not count)."""
+        spec = self.spectra.get(key)
+        return spec is not None and spec.is_complete
+
+    def modes_ready(self, operator: str | None) -> tuple[int, int]:
+        """(modes in, modes asked for) of ``operator``'s spectrum: (12, 100) while the
+        first 12 of 100 have arrived, (100, 100) when all have, (0, 0) with none."""
+        spec = self.spectrum(operator)
+        return (0, 0) if spec is None else (spec.k, spec.modes_requested)
 
     # --------------------------------------------------------- settings
     def set_compute_settings(self, **changes) -> None:

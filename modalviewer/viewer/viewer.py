@@ -337,6 +337,35 @@ class Viewer:
         that nothing is computed."""
         return f"{job.description}: already computed."
 
+    def modes_ready(self, operator: str | None = None) -> tuple[int, int]:
+        """(modes in, modes asked for) of ``operator``'s spectrum (default: the current
+        operator's): ``(12, 100)`` while a computation has handed over its first 12 of
+        100 modes, ``(100, 100)`` when all are in, ``(0, 0)`` with none.  In a script
+        (no event loop) it first takes in what the computation has handed over."""
+        if isinstance(self.jobs.dispatch, ManualDispatcher):
+            self.jobs.dispatch.process()
+        return self.state.modes_ready(operator or self.state.current_operator())
+
+    def wait_for_modes(
+        self, count: int, operator: str | None = None, timeout: float | None = None
+    ) -> tuple[int, int]:
+        """Wait until at least ``count`` modes of ``operator``'s spectrum are in (or all
+        it will have, or its computation ended); returns :meth:`modes_ready`.  Default
+        operator: the last one asked for.  With
+        ``compute(..., wait=False)``: look at the first modes while the others converge."""
+        operator = operator or self.state.compute_settings.operator  # the last requested
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while True:
+            ready, asked = self.modes_ready(operator)
+            if (asked and ready >= min(count, asked)) or not self.model.computing(operator):
+                return self.modes_ready(operator)
+            if deadline is not None and time.monotonic() > deadline:
+                raise TimeoutError(f"fewer than {count} modes arrived within {timeout} s")
+            if isinstance(self.jobs.dispatch, ManualDispatcher):
+                self.jobs.dispatch.process(timeout=0.05)
+            else:
+                time.sleep(0.05)
+
     def _finish(self, job: SpectrumJob | None, wait: bool, then=None) -> Spectrum | None:
         if job is None:
             return None

@@ -35,12 +35,37 @@ def percent_text(fraction: float) -> str:
     return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
 
 
+def arrival_text(state: ViewerState, operator: str | None) -> str:
+    """ "first 20 of 100 modes" while the spectrum of ``operator`` is still arriving (its
+    modes are handed over as they converge), else ""."""
+    ready, asked = state.modes_ready(operator)
+    return f"first {ready} of {asked} modes" if ready < asked else ""
+
+
+def arrival_note(state: ViewerState, operator: str | None) -> str:
+    """A sentence on a spectrum still arriving ("12 of 100 modes ready; the others follow
+    as they converge."), or on one whose computation stopped before its last modes; ""
+    for a whole spectrum."""
+    ready, asked = state.modes_ready(operator)
+    if ready >= asked:
+        return ""
+    key = state.spectrum_key(operator)
+    if key in state.computing:
+        return f"{ready} of {asked} modes ready; the others follow as they converge."
+    return (
+        f"Only {ready} of {asked} modes: the computation stopped before the others "
+        "(Compute, Ctrl+R, computes them all)."
+    )
+
+
 def approximation_mark(state: ViewerState, operator: str | None) -> str:
-    """ " (coarse-to-fine)" or "": what titles and lists add to the spectrum shown for
-    ``operator`` when it is an approximation."""
-    if state.is_coarse(operator):
-        return " (coarse-to-fine)"
-    return ""
+    """ " (coarse-to-fine)", " (first 20 of 100 modes)" or "": what titles and lists add
+    to the spectrum shown for ``operator`` when it is an approximation or incomplete."""
+    marks = ["coarse-to-fine"] if state.is_coarse(operator) else []
+    arriving = arrival_text(state, operator)
+    if arriving:
+        marks.append(arriving)
+    return f" ({'; '.join(marks)})" if marks else ""
 
 
 def display_mark(state: ViewerState) -> str:
@@ -49,10 +74,15 @@ def display_mark(state: ViewerState) -> str:
 
 
 def approximation_note(state: ViewerState, operator: str | None) -> str:
-    """ " (coarse-to-fine spectrum)" or "" for the spectrum shown for ``operator``."""
+    """ " (coarse-to-fine spectrum)", " (from the first 20 of 100 modes)" or "" for
+    what is made of the spectrum shown for ``operator`` (a map, a signature)."""
     if state.spectrum(operator) is None:
         return ""
-    return " (coarse-to-fine spectrum)" if state.is_coarse(operator) else ""
+    notes = ["coarse-to-fine spectrum"] if state.is_coarse(operator) else []
+    arriving = arrival_text(state, operator)
+    if arriving:
+        notes.append(f"from the {arriving}")
+    return f" ({'; '.join(notes)})" if notes else ""
 
 
 def missing_distance_reason(state: ViewerState, kind: str) -> str:
@@ -117,6 +147,7 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
         word = distance_word(d.distance_kind).capitalize()
         at = "E" if derived.wave() else "t"
         text = f"{word} signature at {at} = {derived.signature_time():.3g}"
+        text += approximation_note(state, operator_for_distance(d.distance_kind))
         if state.style.log_signature:
             text += ", log10(S / smallest S)"
         note = truncation_note(state, derived)

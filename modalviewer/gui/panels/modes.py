@@ -7,7 +7,7 @@ from qtpy import QtCore, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
-from ...viewer.wording import approximation_mark
+from ...viewer.wording import approximation_mark, arrival_note
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, describe, quiet, select_data
 
@@ -162,6 +162,9 @@ class ModesPanel(QtWidgets.QWidget):
                 "to this mesh; eigenvalues and modes approximate (untick Coarse-to-fine and "
                 "Compute for the exact spectrum)."
             )
+        arriving = arrival_note(state, op)
+        if arriving:
+            text += f"\n{arriving}"
         self.eigen_label.setText(text)
         approximate = approximation_mark(state, op)
         # marked: the short name (as in the spectrum list), so the title keeps to one line
