@@ -45,6 +45,22 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
+def _counting_modes(progress, k: int):
+    """``(progress, on_modes)`` for :func:`modalviewer.compute_spectrum`: the progress
+    says how many modes have converged ("solving: 12 of 100 modes ready")."""
+    ready = [0]
+
+    def on_modes(spec) -> None:
+        ready[0] = spec.k
+
+    def counted(stage: str, fraction: float) -> None:
+        if stage == "solving" and ready[0]:
+            stage = f"solving: {ready[0]} of {k} modes ready"
+        progress(stage, fraction)
+
+    return counted, on_modes
+
+
 _BAR = {"open": False}  # a progress bar line is not finished: an error starts a new one
 
 
@@ -397,7 +413,7 @@ def _run(args) -> int:
         prepare_compute_process()  # this process exists to compute (see processes.memory)
         mesh = _load(args.mesh, args.fix_slivers, args.partial)
         _refuse_if_too_large(mesh, args.operator, args.k)
-        bar = _progress_bar()
+        bar, on_modes = _counting_modes(_progress_bar(), args.k)
         with _warnings_printed():
             spec = mv.compute_spectrum(
                 mesh,
@@ -406,6 +422,7 @@ def _run(args) -> int:
                 args.bending,
                 args.membrane,
                 progress=bar,
+                on_modes=on_modes,
             )
         mv.save_spectrum(spec, args.output)
         _wrote(args.output, f"spectrum, {spec.k} {args.operator} modes")

@@ -1,6 +1,7 @@
 """The headless command line: results, one-line errors, exit codes."""
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -548,3 +549,14 @@ def test_the_removed_preview_option_is_an_argument_error_saying_what_to_use(argv
     _assert_one_argument_error(main, argv, "--preview was removed", capsys)
     _assert_one_argument_error(main, argv, "fewer modes (-k)", capsys)
     _assert_one_argument_error(main, argv, "on_modes=callback", capsys)
+
+
+def test_compute_says_how_many_modes_are_ready(tmp_path):
+    """The progress line counts the modes that have converged while the solve runs."""
+    r = _run(
+        "compute", ASSETS / "spot.obj", "--operator", "shells", "-k", 60, "-o", tmp_path / "s.npz"
+    )
+    assert r.returncode == 0, r.stderr
+    counts = [int(n) for n in re.findall(r"solving: (\d+) of 60 modes ready", r.stderr)]
+    assert len(counts) >= 2 and counts == sorted(counts) and counts[-1] < 60
+    assert counts[0] >= 6  # the six rigid motions come with the first modes
