@@ -134,6 +134,39 @@ class RepairJob(Job):
         self.repair = repair
 
 
+class LatestModes:
+    """``on_modes`` of a spectrum computation (:func:`modalviewer.compute_spectrum`),
+    called in the worker thread, handing the modes so far to ``deliver(spectrum)`` on
+    the owner's thread (``dispatch``): the latest spectrum so far is kept and one
+    delivery at a time is dispatched, so a slow redraw skips steps rather than queueing
+    them.  The finished spectrum is the job's result, not delivered.  Nothing is
+    delivered once ``job`` (set after the job is queued) was cancelled or has ended."""
+
+    def __init__(self, dispatch: Callable[[Callable[[], None]], None], deliver) -> None:
+        self.dispatch, self.deliver = dispatch, deliver
+        self.job: Job | None = None
+        self._latest = None
+        self._pending = False
+        self._lock = threading.Lock()
+
+    def __call__(self, spectrum) -> None:
+        if spectrum.is_complete:
+            return
+        with self._lock:
+            self._latest = spectrum
+            if self._pending:
+                return
+            self._pending = True
+        self.dispatch(self._deliver)
+
+    def _deliver(self) -> None:
+        with self._lock:
+            spectrum, self._pending = self._latest, False
+        job = self.job
+        if job is not None and not job.done and not job.cancel_requested:
+            self.deliver(spectrum)
+
+
 class JobEvents(SignalGroup):
     changed = Signal(object)  # a job was queued, started, progressed or ended
     finished = Signal(object)  # a job ended (done, failed or cancelled)

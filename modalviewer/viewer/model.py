@@ -4,13 +4,12 @@
 turns a request ("the shells spectrum, 100 modes") into a :class:`~.jobs.Job` whose
 result lands in :class:`~.state.ViewerState` when it ends, if the mesh it was computed
 for is still the loaded one; the modes of a spectrum land there as they converge, lowest
-first, before the job ends (:class:`_ModesArriving`).  A job changes what is displayed
+first, before the job ends (:class:`~.jobs.LatestModes`).  A job changes what is displayed
 only if it was asked to (``show=True``) and the display has not changed since the request.
 """
 
 from __future__ import annotations
 
-import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,7 +25,7 @@ from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
-from .jobs import CANCELLED, DONE, Job, JobQueue, RepairJob, SpectrumJob
+from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
@@ -272,7 +271,10 @@ class ViewerModel:
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
-        arrivals = _ModesArriving(self, key, display_at_request if show else None)
+        arrivals = LatestModes(
+            self.jobs.dispatch,
+            self._modes_arrived(key, display_at_request if show else None),
+        )
         work = self._work(key, arrivals)
         job = self.jobs.add(
             SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key)
@@ -289,6 +291,33 @@ class ViewerModel:
         if show:
             job.then(self._shower(key, display_at_request))
         return job
+
+    def _modes_arrived(self, key: SpectrumKey, show_from):
+        """Where the modes of ``key`` go as they converge (on the owner's thread): into
+        the state, if the mesh is still the one they were computed for.  ``show_from``:
+        the display at a ``show`` request; the first modes are shown if it has not
+        changed since, as a finished spectrum would be."""
+        owner = self.state.mesh.hash
+        wanted = [show_from]
+
+        def deliver(spec: Spectrum) -> None:
+            state = self.state
+            if state.mesh is None or state.mesh.hash != owner:
+                return
+            state.add_spectrum(key, spec)
+            before = wanted[0]
+            if before is None or state.spectrum(key.operator) is not spec:
+                return  # not shown (yet): the spectrum on screen has more modes
+            if not (~spec.zero_mode_mask()).any():
+                return
+            wanted[0] = None
+            if state.display in (before, before.blank()):
+                if before.kind == "mode" and before.operator == key.operator:
+                    state.show_mode(min(before.mode, spec.k - 1), key.operator)
+                else:
+                    self._show_first_mode(key.operator)
+
+        return deliver
 
     def _answered(self, key: SpectrumKey, show: bool) -> SpectrumJob:
         """An ended job holding ``key``'s spectrum already in the state; with ``show`` its
@@ -396,52 +425,6 @@ class ViewerModel:
         spec, table = job.result
         if not self.state.has_spectrum(key) or self.state.spectra[key] is not spec:
             self.state.add_spectrum(key, spec, table)
-
-
-class _ModesArriving:
-    """The modes of a spectrum job as they converge, from its worker thread to the state:
-    the latest spectrum so far is kept and one delivery at a time is dispatched to the
-    owner's thread (where the picture is redrawn), so a slow redraw skips steps rather
-    than queueing them.  ``show_from``: the display at a ``show`` request; the first
-    modes to arrive are shown if the display has not changed since (as a finished
-    spectrum would be)."""
-
-    def __init__(self, model: ViewerModel, key: SpectrumKey, show_from) -> None:
-        self.model, self.key, self.show_from = model, key, show_from
-        self.owner = model.state.mesh.hash
-        self.job: SpectrumJob | None = None
-        self.latest: Spectrum | None = None
-        self.pending = False
-        self.lock = threading.Lock()
-
-    def __call__(self, spec: Spectrum) -> None:
-        if spec.is_complete:
-            return  # the job's result
-        with self.lock:
-            self.latest = spec
-            if self.pending:
-                return
-            self.pending = True
-        self.model.jobs.dispatch(self.deliver)
-
-    def deliver(self) -> None:
-        with self.lock:
-            spec, self.pending = self.latest, False
-        state = self.model.state
-        job = self.job
-        if job is None or job.done or job.cancel_requested:
-            return
-        if state.mesh is None or state.mesh.hash != self.owner:
-            return
-        state.add_spectrum(self.key, spec)
-        before = self.show_from
-        if before is not None and (~spec.zero_mode_mask()).any():
-            self.show_from = None
-            if state.display in (before, before.blank()):
-                if before.kind == "mode" and before.operator == self.key.operator:
-                    state.show_mode(min(before.mode, spec.k - 1), self.key.operator)
-                else:
-                    state.show_mode(state.first_nonzero_mode(self.key.operator), self.key.operator)
 
 
 def _compute(

@@ -41,7 +41,7 @@ from ..core.operators import (
     signature_kind,
 )
 from ..core.spectrum import Spectrum
-from .jobs import CANCELLED, DONE, Job, JobQueue, SpectrumJob
+from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, SpectrumJob
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
     DISTANCE_DISPLAYS,
@@ -315,20 +315,23 @@ class PairState:
         for side in SIDES:
             s = self.sides[side]
             slot = (side, s.mesh.hash, key)
-            if self.spectrum(side) is not None:
+            spec = self.spectrum(side)
+            if spec is not None and spec.is_complete:
                 continue
             job = self._pending.get(slot)
             if job is None or job.done:
                 self._failed.pop(slot, None)
+                arrivals = LatestModes(self.jobs.dispatch, self._modes_arrived(slot))
                 job = self.jobs.add(
                     SpectrumJob(
-                        self._work(side, key),
+                        self._work(side, key, arrivals),
                         (s.mesh.hash, key),
                         f"{key.describe()} of {side.upper()} ({s.name})",
                         self.owner(side),
                         key,
                     )
                 )
+                arrivals.job = job
                 self._pending[slot] = job
                 job.then(lambda j, slot=slot: self._on_job(slot, j))
             jobs.append(job)
@@ -339,7 +342,7 @@ class PairState:
         for side in SIDES:
             self.jobs.cancel_all(owner=self.owner(side), reason="cancelled")
 
-    def _work(self, side: str, key: SpectrumKey):
+    def _work(self, side: str, key: SpectrumKey, on_modes=None):
         from .model import _compute
 
         mesh = self.sides[side].compute_mesh(key.rescale)
@@ -349,10 +352,37 @@ class PairState:
         def work(progress, cancel):
             spec = cache.get(*args)
             if spec is None:
-                spec = _compute(mesh, key, cache, progress, cancel)
+                spec = _compute(mesh, key, cache, progress, cancel, on_modes)
             return spec, None
 
         return work
+
+    def _modes_arrived(self, slot):
+        """Where the modes of ``slot``'s spectrum go as they converge: the maps are made
+        of them (their legends say so) until the whole spectrum is in."""
+
+        def deliver(spec: Spectrum) -> None:
+            side, mesh_hash, key = slot
+            if mesh_hash != self.sides[side].mesh.hash:
+                return
+            self._spectra[slot] = spec
+            self.events.spectra.emit()
+            if key == self.key():
+                self.events.display.emit()
+
+        return deliver
+
+    def arrival_note(self) -> str:
+        """ "from the first 20 of 100 modes of B" while a side's spectrum is arriving (or
+        its computation stopped before its last modes), else ""."""
+        parts = []
+        for side in SIDES:
+            spec = self.spectrum(side)
+            if spec is not None and not spec.is_complete:
+                parts.append(
+                    f"the first {spec.k} of {spec.modes_requested} modes of {side.upper()}"
+                )
+        return f"from {' and '.join(parts)}" if parts else ""
 
     def _on_job(self, slot, job: Job) -> None:
         self._pending.pop(slot, None)
@@ -502,7 +532,8 @@ class PairState:
             plain.legend = f"{head}\n{name}: {self._missing()}"
             return plain
         _, w, dist = self.best_match()
-        note = f"\n{self.note}" if self.note else ""
+        notes = [n for n in (self.note, self.arrival_note()) if n]
+        note = "".join(f"\n{n}" for n in notes)
         # labels give the files' vertex numbers; markers are mesh indices
         fv = self.mesh(from_side).file_vertex(v)
         if from_side == side:

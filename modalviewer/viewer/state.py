@@ -306,14 +306,20 @@ class ViewerState:
 
         The first modes of a computation still running (``spec.is_complete`` False) are
         stored the same way and replaced as more arrive; they never replace a complete
-        spectrum of ``key``, and nothing the user chose (mode, pick, share, camera) is
+        spectrum of ``key``, nor the operator's spectrum on screen (another k, other
+        weights) while they are fewer than its modes, and nothing the user chose (mode, pick, share, camera) is
         reset when they are."""
         if self.mesh is not None:
             spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
             raise ValueError("the spectrum does not belong to the loaded mesh")
-        if not spec.is_complete and self.has_spectrum(key):
-            return  # the whole spectrum is in already
+        if not spec.is_complete:
+            if self.has_spectrum(key):
+                return  # the whole spectrum is in already
+            shown_key = self._latest.get(key.operator)
+            shown = self.spectra.get(shown_key) if shown_key not in (None, key) else None
+            if shown is not None and spec.k < shown.k:
+                return  # the operator's spectrum on screen stays until as many are in
         for other in [k for k in self.spectra if k.operator == key.operator and k != key]:
             del self.spectra[other]
         self.spectra[key] = spec

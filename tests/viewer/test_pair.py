@@ -234,3 +234,51 @@ def test_the_wave_kernel_distance_between_shapes_is_its_own(tmp_path, spot):
     np.testing.assert_allclose(wave, expected, rtol=1e-10, atol=1e-12 * expected.max())
     assert not np.allclose(wave / wave.max(), heat / heat.max())
     assert wave[700] <= 1e-8 * wave.max()
+
+
+def test_maps_are_drawn_from_the_first_modes_while_the_rest_arrive(tmp_path, spot):
+    """B's modes arrive as they converge: the pair's maps use them at once and say so,
+    and are redrawn from the whole spectra when it is in."""
+    import threading
+
+    from modalviewer.viewer import model as model_module
+
+    go, paused = threading.Event(), threading.Event()
+    solve = model_module.compute_spectrum
+
+    solves = []
+
+    def compute_spectrum(mesh, *args, on_modes=None, **kwargs):
+        solves.append(mesh)
+        second = len(solves) == 2  # A's spectrum is solved first, then B's
+
+        def hand_over(spec):
+            on_modes(spec)
+            if second and spec.k >= 10 and not spec.is_complete:
+                paused.set()
+                go.wait(120)
+
+        return solve(mesh, *args, on_modes=hand_over, **kwargs)
+
+    moved = _moved(spot)
+    pair = _pair(tmp_path, spot, moved, k=60)
+    original = model_module.compute_spectrum
+    model_module.compute_spectrum = compute_spectrum
+    try:
+        jobs = pair.request()
+        pair.pick("a", 700)
+        pair.jobs.wait(jobs[0], timeout=120)  # A's whole spectrum
+        assert paused.wait(120)  # B's solve waits after its first modes
+        pair.jobs.dispatch.process(timeout=0.5)
+        first = pair.spectrum("b")
+        assert first is not None and 10 <= first.k < 60 and not first.is_complete
+        view = pair.view("b")
+        assert view.values is not None
+        assert f"from the first {first.k} of 60 modes of B" in view.legend
+        go.set()
+        pair.jobs.wait(jobs[1], timeout=120)
+    finally:
+        go.set()
+        model_module.compute_spectrum = original
+    assert pair.spectrum("b").is_complete and "modes of B" not in pair.view("b").legend
+    assert pair.best_match()[:2] == ("b", 700)
