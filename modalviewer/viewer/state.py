@@ -307,8 +307,8 @@ class ViewerState:
         The first modes of a computation still running (``spec.is_complete`` False) are
         stored the same way and replaced as more arrive; they never replace a complete
         spectrum of ``key``, nor the operator's spectrum on screen (another k, other
-        weights) while they are fewer than its modes, and nothing the user chose (mode, pick, share, camera) is
-        reset when they are."""
+        weights) while they are fewer than its modes, and nothing the user chose (mode,
+        pick, share, camera) is reset when they are."""
         if self.mesh is not None:
             spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
