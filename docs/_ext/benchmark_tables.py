@@ -364,7 +364,25 @@ def correspondence_table(data: dict) -> str:
     return "\n".join(lines)
 
 
+def first_modes_table(data: dict) -> str:
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks import first_modes
+
+    return first_modes.table(data)
+
+
+def slicing_table(data: dict) -> str:
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks import slicing
+
+    return slicing.table(data)
+
+
 TABLES = {
+    "first-modes": (["first_modes"], lambda: first_modes_table(load("first_modes"))),
+    "slicing": (["slicing"], lambda: slicing_table(load("slicing"))),
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),
     "paper": (["latest"], lambda: paper_table(load("latest"))),
     "stages": (["latest"], lambda: stage_table(load("latest"))),
