@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 from psygnal import Signal
 
-from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO
+from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from .derived import Field
 from .state import ViewerState
+from .wording import approximation_mark
 
 
 def item_label(item: str) -> str:
@@ -109,7 +110,8 @@ class Comparison:
             title=f"{item_label(item)} mode {j}",
         )
         lam = "0 (zero mode)" if spec.zero_mode_mask()[j] else f"{spec.eigenvalues[j]:.5g}"
-        return ComparisonView(item, f"{item_label(item)}: mode {j}, lambda = {lam}", field)
+        mark = approximation_mark(self.state, item)
+        return ComparisonView(item, f"{item_label(item)}{mark}: mode {j}, lambda = {lam}", field)
 
     def _distance_views(self) -> list[ComparisonView]:
         state, derived = self.state, self.state.derived
@@ -132,6 +134,7 @@ class Comparison:
                 )
                 views.append(ComparisonView(item, f"{item_label(item)}: {need}", marker=vertex))
                 continue
+            mark = approximation_mark(state, operator_for_distance(item))
             if display.distance_display == "threshold":
                 if share is None:
                     thr = display.threshold * float(d.max())
@@ -140,9 +143,12 @@ class Comparison:
                 marked = 100.0 * derived.surface_share(d, thr)
                 field = Field(d, "threshold", title=item_label(item), threshold=thr)
                 field.share_similar = marked / 100.0
-                title = f"{item_label(item)} from vertex {shown}: blue < {thr:.3g} ({marked:.1f} %)"
+                title = (
+                    f"{item_label(item)}{mark} from vertex {shown}: blue < {thr:.3g} "
+                    f"({marked:.1f} %)"
+                )
             else:
                 field = derived.scaled(Field(d, "sequential", title=item_label(item)))
-                title = f"{item_label(item)} from vertex {shown}"
+                title = f"{item_label(item)}{mark} from vertex {shown}"
             views.append(ComparisonView(item, title, field, vertex))
         return views

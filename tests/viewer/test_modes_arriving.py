@@ -128,3 +128,26 @@ def test_cancelling_mid_way_keeps_the_modes_shown_and_caches_nothing(tmp_path, m
     assert not again.done
     viewer.wait_for(again, timeout=300)
     assert again.status == DONE and state.spectrum("shells").is_complete
+
+
+def test_the_compare_window_marks_what_is_made_of_the_first_modes(viewer):
+    from dataclasses import replace as replaced
+
+    from modalviewer.viewer.comparison import Comparison
+
+    whole = viewer.compute("laplacian", k=30)
+    first = mv.compute_spectrum(viewer.mesh, "modified_dirichlet", 30)
+    part = replaced(
+        first,
+        eigenvalues=first.eigenvalues[:12],
+        modes=first.modes[:, :12],
+        residuals=first.residuals[:12],
+        parameters={**first.parameters, "modes_requested": 30},
+    )
+    ed_key = viewer.state.compute_settings.key("modified_dirichlet", 30)
+    viewer.state.add_spectrum(ed_key, part)
+    compare = Comparison(viewer.state, ["laplacian", "modified_dirichlet"])
+    compare.show_mode(5)
+    titles = [view.title for view in compare.views()]
+    assert "first 12 of 30 modes" in titles[1] and "of 30 modes" not in titles[0]
+    assert viewer.state.spectrum("laplacian") is whole
