@@ -160,6 +160,10 @@ def measure(case, operator: str, k: int, first: int, baseline: Path) -> dict:
     }
 
 
+def _thousands(count: int) -> str:
+    return f"{count:,}".replace(",", "\u00a0")
+
+
 def table(data: dict) -> str:
     """The Markdown table of the results."""
     lines = [
@@ -170,11 +174,12 @@ def table(data: dict) -> str:
     ]
     for r in data["rows"]:
         lines.append(
-            f"| {r['case']} | {r['vertices']:,} | {r['operator']} | {r['seconds_first']:.1f} s "
+            f"| {r['case']} | {_thousands(r['vertices'])} | {r['operator']} | "
+            f"{r['seconds_first']:.1f} s "
             f"| {r['seconds_first_nonzero']:.1f} s | {r['seconds_total']:.1f} s | "
             f"{r['seconds_first'] / r['seconds_total']:.2f} | {r['seconds_few']:.1f} s | "
             f"{r['seconds_baseline']:.1f} s | {r['seconds_total'] / r['seconds_baseline']:.2f} | "
-            f"{r['peak_mb'] / r['peak_mb_baseline']:.2f} |".replace(",", "\u00a0")
+            f"{r['peak_mb'] / r['peak_mb_baseline']:.2f} |"
         )
     return "\n".join(lines)
 

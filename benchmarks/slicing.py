@@ -31,7 +31,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.first_modes import case_name, parse_case  # noqa: E402
+from benchmarks.first_modes import _thousands, case_name, parse_case  # noqa: E402
 from benchmarks.run import save_result  # noqa: E402
 
 CHILD = """
@@ -115,11 +115,9 @@ def table(data: dict) -> str:
         basis = sum(r["stages"].get(s, 0.0) for s in BASIS_STAGES)
         best = next(b for b in r["bounds"] if b["bands"] == r["best_bands"])
         lines.append(
-            f"| {r['case']} | {r['vertices']:,} | {r['k']} | {r['seconds']:.1f} s | "
+            f"| {r['case']} | {_thousands(r['vertices'])} | {r['k']} | {r['seconds']:.1f} s | "
             f"{r['stages'].get('factorisation', 0.0):.1f} s | {basis:.1f} s | "
-            f"{best['seconds']:.1f} s | {r['best_bands']} | {r['best_bound_share']:.2f} |".replace(
-                ",", "\u00a0"
-            )
+            f"{best['seconds']:.1f} s | {r['best_bands']} | {r['best_bound_share']:.2f} |"
         )
     return "\n".join(lines)
 
