@@ -585,3 +585,45 @@ def test_after_a_distance_map_fails_the_panel_says_so_and_another_kind_shows(win
     qtbot.waitUntil(lambda: window.state.display.kind == "distance", timeout=60000)
     assert window.state.display.distance_kind == "hks"
     assert panel.threshold_label.text().startswith("< ")
+
+
+def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, monkeypatch):
+    """The window draws the first modes that converged, with the Modes panel saying how
+    many of how many are in, before the computation ends."""
+    import threading
+
+    from modalviewer.viewer import model as model_module
+
+    go = threading.Event()
+    solve = model_module.compute_spectrum
+
+    def paused(*args, on_modes=None, **kwargs):
+        def hand_over(spec):
+            on_modes(spec)
+            if spec.k >= 12 and not spec.is_complete:
+                go.wait(60)
+
+        return solve(*args, on_modes=hand_over, **kwargs)
+
+    monkeypatch.setattr(model_module, "compute_spectrum", paused)
+    assert window.open_mesh(spot_path)
+    window.state.set_colorbar(False)
+    try:
+        window.compute("laplacian", k=60, wait=False)
+        deadline = QtCore.QDeadlineTimer(60000)
+        while window.state.modes_ready("laplacian")[0] < 12 and not deadline.hasExpired():
+            QtCore.QCoreApplication.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 50)
+        ready, asked = window.state.modes_ready("laplacian")
+        assert 12 <= ready < asked == 60
+        assert window.viewer.model.computing("laplacian")  # the solve waits for the test
+        assert window.state.display.kind == "mode" and window.state.display.mode == 1
+        counts = _both_sides(window)
+        assert counts["blue"] > 2000 and counts["orange"] > 2000, counts
+        assert f"{ready} of 60 modes ready" in window.modes_panel.eigen_label.text()
+    finally:
+        go.set()
+    deadline = QtCore.QDeadlineTimer(60000)
+    while window.state.modes_ready("laplacian")[0] < 60 and not deadline.hasExpired():
+        QtCore.QCoreApplication.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 50)
+    assert window.state.modes_ready("laplacian") == (60, 60)
+    assert "modes ready" not in window.modes_panel.eigen_label.text()
