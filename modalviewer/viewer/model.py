@@ -306,7 +306,8 @@ class ViewerModel:
                 return
             state.add_spectrum(key, spec)
             before = wanted[0]
-            if before is None or state.spectrum(key.operator) is not spec:
+            shown = state.spectra.get(key)  # spec, or spec in the solver's numbering
+            if before is None or shown is None or shown.k != spec.k:
                 return  # not shown (yet): the spectrum on screen has more modes
             if not (~spec.zero_mode_mask()).any():
                 return
