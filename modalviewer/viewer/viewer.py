@@ -353,6 +353,11 @@ class Viewer:
         it will have, or its computation ended); returns :meth:`modes_ready`.  Default
         operator: the last one asked for.  With
         ``compute(..., wait=False)``: look at the first modes while the others converge."""
+        if not isinstance(self.jobs.dispatch, ManualDispatcher):
+            raise RuntimeError(
+                "wait_for_modes is for scripts; in a window the modes arrive through the "
+                "event loop: connect to viewer.state.events.spectra instead"
+            )
         operator = operator or self.state.compute_settings.operator  # the last requested
         deadline = None if timeout is None else time.monotonic() + timeout
         while True:
@@ -361,10 +366,7 @@ class Viewer:
                 return self.modes_ready(operator)
             if deadline is not None and time.monotonic() > deadline:
                 raise TimeoutError(f"fewer than {count} modes arrived within {timeout} s")
-            if isinstance(self.jobs.dispatch, ManualDispatcher):
-                self.jobs.dispatch.process(timeout=0.05)
-            else:
-                time.sleep(0.05)
+            self.jobs.dispatch.process(timeout=0.05)
 
     def _finish(self, job: SpectrumJob | None, wait: bool, then=None) -> Spectrum | None:
         if job is None:

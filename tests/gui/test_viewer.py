@@ -587,7 +587,7 @@ def test_after_a_distance_map_fails_the_panel_says_so_and_another_kind_shows(win
     assert panel.threshold_label.text().startswith("< ")
 
 
-def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, monkeypatch):
+def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, monkeypatch, qtbot):
     """The window draws the first modes that converged, with the Modes panel saying how
     many of how many are in, before the computation ends."""
     import threading
@@ -610,9 +610,7 @@ def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, 
     window.state.set_colorbar(False)
     try:
         window.compute("laplacian", k=60, wait=False)
-        deadline = QtCore.QDeadlineTimer(60000)
-        while window.state.modes_ready("laplacian")[0] < 12 and not deadline.hasExpired():
-            QtCore.QCoreApplication.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 50)
+        qtbot.waitUntil(lambda: window.state.modes_ready("laplacian")[0] >= 12, timeout=60000)
         ready, asked = window.state.modes_ready("laplacian")
         assert 12 <= ready < asked == 60
         assert window.viewer.model.computing("laplacian")  # the solve waits for the test
@@ -622,8 +620,6 @@ def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, 
         assert f"{ready} of 60 modes ready" in window.modes_panel.eigen_label.text()
     finally:
         go.set()
-    deadline = QtCore.QDeadlineTimer(60000)
-    while window.state.modes_ready("laplacian")[0] < 60 and not deadline.hasExpired():
-        QtCore.QCoreApplication.processEvents(QtCore.QEventLoop.ProcessEventsFlag.AllEvents, 50)
+    qtbot.waitUntil(lambda: window.state.modes_ready("laplacian")[0] >= 60, timeout=60000)
     assert window.state.modes_ready("laplacian") == (60, 60)
     assert "modes ready" not in window.modes_panel.eigen_label.text()
