@@ -72,10 +72,9 @@ BASIS_EXTRA_MAX = 112
 BASIS_EXTRA_BYTES = 900e6
 """Where the basis's vectors beyond the working pairs would take more than
 BASIS_EXTRA_BYTES, it holds at most BASIS_EXTRA_MAX of them: there the basis is the
-largest array beside the factor, and the extra vectors buy little speed.  300 shells
-modes of the 337k plate (1M unknowns) took 444 s and 9.7 GB with 198 extra vectors,
-463 s and 9.1 GB with 112.  Smaller bases are left alone: 300 Laplacian modes there
-(198 extra vectors, 0.5 GB) took 15 % longer with 112 for 0.2 GB less."""
+largest array beside the factor, and the extra vectors buy little speed.  Smaller bases
+are left alone: there fewer extra vectors cost more time than the memory they save
+("Iteration" in docs/how-it-works.md)."""
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
 
@@ -215,13 +214,11 @@ def rounding_floors(
     """``eps * | |K| |x| | / (|lam| |M x|)`` per column: the relative residual that merely
     rounding x to double precision can cause (``|K dx| <= eps |K| |x|``), which no
     solver can go below.  It reaches 1e-4 for the lowest vibrations of fine meshes with a
-    large spread of stiffness (cheburashka subdivided twice, 107k vertices, shells:
-    floors 0.6 to 2.2e-4, residuals 0.2 to 0.6 times them).
+    large spread of stiffness (3D shells of finely subdivided curved meshes).
 
     ``columns``: the columns of X to look at (``lam`` holds their eigenvalues); None:
-    all.  They are taken 32 at a time, so no copy of the chosen columns is made (300
-    shells modes of a 427k-vertex mesh: 3 GB each for the columns and their absolute
-    values)."""
+    all.  They are taken 32 at a time, so no copy of the chosen columns (nor of their
+    absolute values), each as large as the modes, is made."""
     K_abs = abs(sp.csr_matrix(K))
     columns = np.arange(X.shape[1]) if columns is None else np.asarray(columns, dtype=np.intp)
     out = np.empty(columns.shape[0])
@@ -359,9 +356,9 @@ def solve_lowest(
                     if not d:
                         raise
                     # The tiny shift leaves K - shift M so close to singular that the
-                    # solves' rounding floor can sit above the tolerance (1225-vertex
-                    # folded plate, Laplacian, k = 99: residuals stuck at 9e-9); the
-                    # undeflated shift does not, at the cost of a compressed spectrum.
+                    # solves' rounding floor can sit above the tolerance (residuals stuck
+                    # near 1e-8); the undeflated shift does not, at the cost of a
+                    # compressed spectrum.
                     # The columns counted include the failed attempt's.
                     report("retrying with a larger shift", 0.05)
                     lam, basis, shift, backend, columns = _shift_invert(
@@ -396,8 +393,7 @@ def solve_lowest(
         d_out = Zk.shape[1]
         if basis is not None:
             # written over the Krylov basis, which is then shrunk to the modes: no (N, k)
-            # array beside the (N, 1.1 k + extra) basis (3.7 and 5.8 GB for 300 shells
-            # modes at 520k vertices)
+            # array beside the (N, 1.1 k + extra) basis, the largest arrays of a big solve
             if basis.shape[1] >= k:
                 del X
                 transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
@@ -668,7 +664,7 @@ def _orthonormal_block(
 
 def _rotate_in_place(Q: np.ndarray, j: int, S: np.ndarray, rows: int = 32768) -> None:
     """``Q[:, :p] = Q[:, :j] @ S`` (S is (j, p), p <= j) a block of rows at a time, so no
-    (N, p) temporary is needed (1 GB for 300 shells modes at 130k vertices).  A
+    (N, p) temporary, as large as the modes, is needed.  A
     single-precision Q is rotated in double precision, a block at a time, and rounded."""
     p = S.shape[1]
     for start in range(0, Q.shape[0], rows):
@@ -920,10 +916,9 @@ Cholesky-QR products; the refinement's four (N, 2 block) ones."""
 FLOAT32_BASIS_TOL = 1e-7
 """Convergence tolerance of the Krylov iteration with a single-precision basis: its
 columns are orthonormal to about 1e-7, and a tighter tolerance costs about twice the
-operator columns (spot Loop x1, 3D shells, 60 modes: 502 against 226).  The step of
-inverse iteration and Rayleigh-Ritz with K in double precision that follow bring the
-residuals to what a double-precision basis gives for the shells (spot Loop x2, 100
-modes: 3.2e-7 against 3.3e-7, eigenvalues within 4e-10)."""
+operator columns.  The step of inverse iteration and Rayleigh-Ritz with K in double
+precision that follow bring the shells' residuals to what a double-precision basis
+gives."""
 
 
 def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
@@ -941,7 +936,7 @@ def basis_in_float32(
     double-precision basis with the iteration's temporaries exceed ``limit_mb``, and
     the single-precision buffer (:func:`float32_basis_mb`) is smaller.  Double precision
     is kept wherever it fits: the Laplacian's residuals after the final step are about
-    1e-11 with it, 6e-8 without (spot Loop x2, 100 modes)."""
+    1e-11 with it and near 1e-7 without."""
     left_mb = factor_budget_mb(limit_mb, n, basis_columns, block)  # now: after the factor
     if left_mb is None or left_mb >= 0:
         return False
@@ -1009,8 +1004,8 @@ def _shift_invert(
 
     # At a restart the basis keeps the working pairs and the best third of the unwanted
     # Ritz vectors next to them, which carry the part of the spectrum the last wanted
-    # pairs must be told apart from.  10k Laplacian, 300 modes: 1152 operator columns
-    # when keeping only the working pairs, 1024 with the third (50k: 14.9 s -> 13.6 s).
+    # pairs must be told apart from: fewer operator columns than keeping only the
+    # working pairs.
     theta, Y, columns = block_krylov_schur(
         apply_op,
         N,
@@ -1048,7 +1043,7 @@ def _shift_invert(
     backend = solver.backend
     solver = None  # free the factor (apply_op's closure holds it) before the last step
     # Everything below works in place on Y, a view into the Krylov basis, or on (N, 32)
-    # pieces: at 130k vertices (shells, 300 modes) one (N, k) temporary is 0.9 GB.
+    # pieces: an (N, k) temporary would be as large as the modes.
     report("orthonormalising", 0.95)
     with timer("rayleigh_ritz"):
         lam = _rayleigh_ritz_in_place(K, inv_sqrt_m, Y)

@@ -27,9 +27,8 @@ __all__ = [
 
 
 FLOOR_FACTOR = 10.0
-"""Residuals above RESIDUAL_LIMIT are accepted up to this times their rounding floor
-(LAPACK's dense eigenvectors land at 1.4 to 2.7 times it on a small ellipsoid, the
-Krylov solver's at 0.2 to 0.6 times it on the 107k cheburashka)."""
+"""Residuals above RESIDUAL_LIMIT are accepted up to this times their rounding floor:
+LAPACK's dense eigenvectors and the Krylov solver's land within a few times it."""
 
 
 class ZeroModesWarning(UserWarning):
