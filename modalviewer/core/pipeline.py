@@ -9,7 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .assembly import operator_matrices
-from .eigen import CancelFn, EigenError, ProgressFn, relative_residuals, rounding_floors
+from .eigen import CancelFn, EigenError, ProgressFn, rounding_floors
 from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
@@ -119,7 +119,8 @@ def compute_spectrum(
         eigenvalues and modes equal the finished spectrum's to the solver's tolerance (a
         cluster of equal eigenvalues is handed over whole, as a subspace).  Its
         ``is_complete`` is False and ``modes_requested`` says how many are to come; its
-        residuals are those of the converged Ritz pairs, before the final refinement.
+        residuals are NaN (they are computed for the finished spectrum, after the final
+        refinement).
         The last call has the finished spectrum, the one returned.  Small problems
         (solved densely) get that last call only.  The callback runs in the computing
         thread; whatever it keeps stays valid (each call's arrays are new views of
@@ -252,7 +253,9 @@ class _ModesSoFar:
     def start(self, K, mass: np.ndarray, nulls, scale: float, k: int) -> None:
         self.K, self.mass, self.nulls, self.scale, self.k = K, mass, nulls, scale, k
         self.eigenvalues = np.zeros(k)
-        self.residuals = np.zeros(k)
+        # not computed for the pairs handed over (each would cost a product with K):
+        # the finished spectrum's, after the last refinement, are
+        self.residuals = np.full(k, np.nan)
         self.vectors = None  # (N, k), made at the first hand-over
 
     def __call__(self, eigenvalues: np.ndarray, vectors: np.ndarray) -> None:
@@ -261,10 +264,6 @@ class _ModesSoFar:
             self.vectors = np.empty((vectors.shape[0], self.k))
         self.eigenvalues[j0:j1] = eigenvalues
         self.vectors[:, j0:j1] = vectors
-        null_here = max(0, min(self.nulls.dimension, j1) - j0)
-        self.residuals[j0:j1] = relative_residuals(
-            self.K, self.mass, eigenvalues, vectors, self.scale, null_here
-        )
         self.count = j1
         per_vertex = operator_info(self.operator).unknowns_per_vertex
         modes = self.vectors[:, :j1]

@@ -71,6 +71,9 @@ def test_modes_handed_over_equal_the_final_ones(spot, operator):
     assert counts[0] > nulls  # the null vectors come first, with the first modes
     assert np.all(calls[0].eigenvalues[:nulls] == 0.0)
     assert calls[0].null_space_dimension == nulls
+    # residuals are computed once, for the finished spectrum
+    assert all(np.isnan(c.residuals).all() for c in calls[:-1])
+    assert np.isfinite(final.residuals).all() and final.residuals[nulls:].max() <= 1e-8
     check_equal_to_final(calls, final)
 
 
