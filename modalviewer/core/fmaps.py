@@ -41,6 +41,8 @@ DESCRIPTORS = ("wks", "hks")
 class FunctionalMap:
     """The result of :func:`functional_map`.
 
+    Attributes
+    ----------
     C : (k, k) the functional map from A's modes to B's (after ZoomOut: of its final size).
     point_map : (n_b,) for each vertex of B the index of its vertex of A (-1 where B's
         vertex is used by no face).
