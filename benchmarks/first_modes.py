@@ -61,24 +61,20 @@ print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds, "peak_mb": pe
 
 
 def case_mesh(path: str, scheme: str, level: int, zup: bool = False):
-    """The mesh of a case (see the module's docstring)."""
+    """The mesh of a case (see the module's docstring): :func:`benchmarks.curved.case_mesh`
+    (a bundled asset may be named without its ".obj"), turned so that z is up."""
     import numpy as np
-    import trimesh
 
     import modalviewer as mv
+    from benchmarks.curved import case_mesh as subdivided
 
-    if not Path(path).is_file():
-        path = mv.asset_path(path if Path(path).suffix else f"{path}.obj")
-    base = mv.load_mesh(path)
-    v, f = base.vertices, base.faces
-    if scheme == "loop" and level > 0:
-        v, f = trimesh.remesh.subdivide_loop(v, f, iterations=level)
-    else:
-        for _ in range(level):
-            v, f = trimesh.remesh.subdivide(v, f)
-    if zup:  # y up -> z up
-        v = v @ np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
-    return mv.Mesh(v, f)
+    if not Path(path).is_file() and not Path(path).suffix:
+        path = f"{path}.obj"
+    mesh = subdivided(path, scheme, level)
+    if not zup:
+        return mesh
+    y_up_to_z_up = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+    return mv.Mesh(mesh.vertices @ y_up_to_z_up, mesh.faces)
 
 
 def parse_case(text: str) -> tuple[str, str, int, bool]:

@@ -689,6 +689,12 @@ def _scale_rows(Y: np.ndarray, factors: np.ndarray) -> np.ndarray:
     return Y
 
 
+def _same_cluster(theta: np.ndarray, i: int) -> bool:
+    """Whether the Ritz values ``theta[i - 1]`` and ``theta[i]`` (descending) lie within
+    :data:`CLUSTER_RTOL` of each other."""
+    return theta[i] >= theta[i - 1] * (1.0 - CLUSTER_RTOL)
+
+
 def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> int:
     """The number of leading pairs that may be handed over: ``done`` converged ones,
     less those in a cluster that reaches past them (see :data:`CLUSTER_RTOL`).  A
@@ -696,14 +702,11 @@ def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> in
     sees at most ``block`` copies of an eigenvalue before rounding brings in the others,
     so such a cluster may have more members to come."""
 
-    def same(i: int) -> bool:  # pairs i - 1 and i belong to one cluster
-        return theta[i] >= theta[i - 1] * (1.0 - CLUSTER_RTOL)
-
     ready = min(done, theta.shape[0] - 1)  # the next Ritz value must be there to compare
-    while ready > handed and same(ready):
+    while ready > handed and _same_cluster(theta, ready):
         ready -= 1
     first = ready - 1  # the trailing cluster's first pair
-    while first > 0 and same(first):
+    while first > 0 and _same_cluster(theta, first):
         first -= 1
     if ready - first >= block:
         ready = max(handed, first)
@@ -844,7 +847,7 @@ def block_krylov_schur(
             # a few columns at a time (each piece is a new (N, m) array), clusters whole
             while handed < ready:
                 stop = min(handed + HANDOVER_COLUMNS, ready)
-                while stop < ready and theta[stop] >= theta[stop - 1] * (1.0 - CLUSTER_RTOL):
+                while stop < ready and _same_cluster(theta, stop):
                     stop += 1
                 with timer("handover"):
                     Y_new = _basis_times(Q, j, S[:, handed:stop])
