@@ -14,7 +14,7 @@ from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
 from .operators import operator_info
-from .spectrum import Spectrum, in_input_numbering
+from .spectrum import GrowingSpectrum, Spectrum, in_input_numbering
 from .validate import check_count
 
 __all__ = [
@@ -242,47 +242,34 @@ def compute_spectrum(
 
 
 class _ModesSoFar:
-    """Collects the pairs handed over during a solve (:class:`.exact.ModeSink`) into
-    one (N, k) array, and gives ``on_modes`` a Spectrum of the first j at each step."""
+    """Collects the pairs handed over during a solve (:class:`.exact.ModeSink`) in a
+    :class:`.spectrum.GrowingSpectrum`, and gives ``on_modes`` a Spectrum of the first j
+    at each step."""
 
     def __init__(self, mesh: Mesh, operator: str, bending: float, membrane: float, on_modes):
         self.mesh, self.operator, self.on_modes = mesh, operator, on_modes
         self.weights = {"bending": float(bending), "membrane": float(membrane)}
-        self.count = 0
+        self.per_vertex = operator_info(operator).unknowns_per_vertex
 
     def start(self, K, mass: np.ndarray, nulls, scale: float, k: int) -> None:
-        self.K, self.mass, self.nulls, self.scale, self.k = K, mass, nulls, scale, k
-        self.eigenvalues = np.zeros(k)
-        # not computed for the pairs handed over (each would cost a product with K):
-        # the finished spectrum's, after the last refinement, are
-        self.residuals = np.full(k, np.nan)
-        self.vectors = None  # (N, k), made at the first hand-over
+        self.mass, self.nulls, self.scale, self.k = mass, nulls, scale, k
+        self.modes = GrowingSpectrum(k)
 
     def __call__(self, eigenvalues: np.ndarray, vectors: np.ndarray) -> None:
-        j0, j1 = self.count, self.count + eigenvalues.shape[0]
-        if self.vectors is None:
-            self.vectors = np.empty((vectors.shape[0], self.k))
-        self.eigenvalues[j0:j1] = eigenvalues
-        self.vectors[:, j0:j1] = vectors
-        self.count = j1
-        per_vertex = operator_info(self.operator).unknowns_per_vertex
-        modes = self.vectors[:, :j1]
-        if per_vertex > 1:
-            modes = modes.reshape(self.mesh.n_vertices, per_vertex, j1)
+        if self.per_vertex > 1:  # rows 3i, 3i + 1, 3i + 2 are vertex i's
+            vectors = vectors.reshape(self.mesh.n_vertices, self.per_vertex, -1)
+        self.modes.append(eigenvalues, vectors)
+        j = self.modes.count
         self.on_modes(
-            Spectrum(
-                eigenvalues=self.eigenvalues[:j1].copy(),
-                modes=modes,
-                operator=self.operator,
-                mass=self.mass[::per_vertex],
-                residuals=self.residuals[:j1].copy(),
-                mesh_hash=self.mesh.hash,
-                parameters={
+            self.modes.so_far(
+                self.operator,
+                self.mass[:: self.per_vertex],
+                self.mesh.hash,
+                {
                     "k": self.k,
-                    "modes_requested": self.k,
                     **self.weights,
                     "method": "shift-invert block Krylov-Schur, converged Ritz pairs",
-                    "null_space_dimension": min(self.nulls.dimension, j1),
+                    "null_space_dimension": min(self.nulls.dimension, j),
                     "zero_mode_scale": self.scale,
                     "n_components": self.nulls.n_components,
                     "null_space": self.nulls.summary(),

@@ -288,6 +288,41 @@ def in_input_numbering(spec: Spectrum, mesh: Mesh) -> Spectrum:
     )
 
 
+class GrowingSpectrum:
+    """The modes of a spectrum as they arrive, lowest first, gathered in one array for
+    all k of them: :meth:`so_far` is a :class:`Spectrum` of those in (its modes a view of
+    the array, not written again; its residuals NaN, not computed until the spectrum is
+    whole)."""
+
+    def __init__(self, k: int) -> None:
+        self.k = int(k)
+        self.count = 0
+        self.eigenvalues = np.zeros(self.k)
+        self.modes: np.ndarray | None = None  # (n, k) or (n, 3, k), made at the first
+
+    def append(self, eigenvalues: np.ndarray, modes: np.ndarray) -> None:
+        """The next modes: (m,) eigenvalues and their (n, m) or (n, 3, m) modes."""
+        if self.modes is None:
+            self.modes = np.empty(modes.shape[:-1] + (self.k,))
+        j0, j1 = self.count, self.count + eigenvalues.shape[0]
+        self.eigenvalues[j0:j1] = eigenvalues
+        self.modes[..., j0:j1] = modes
+        self.count = j1
+
+    def so_far(self, operator: str, mass: np.ndarray, mesh_hash: str, parameters: dict):
+        """A Spectrum of the modes in (``parameters`` plus ``modes_requested``)."""
+        j = self.count
+        return Spectrum(
+            eigenvalues=self.eigenvalues[:j].copy(),
+            modes=self.modes[..., :j],
+            operator=operator,
+            mass=mass,
+            residuals=np.full(j, np.nan),
+            mesh_hash=mesh_hash,
+            parameters={**parameters, "modes_requested": self.k},
+        )
+
+
 def on_solver_mesh(spec: Spectrum, mesh: Mesh) -> Spectrum:
     """``spec`` of ``mesh.input_mesh`` (one row per input vertex) on ``mesh``, a solver
     mesh (:attr:`.mesh.Mesh.solver_mesh`); ``spec`` itself where it is in that numbering

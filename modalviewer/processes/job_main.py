@@ -79,7 +79,6 @@ class _ModesRelay:
             partial,
             eigenvalues=spec.eigenvalues[part],
             modes=spec.modes[..., part],
-            residuals=spec.residuals[part],
             mass=spec.mass,
             parameters=json.dumps(spec.parameters),
         )

@@ -28,7 +28,7 @@ import numpy as np
 from ..core.eigen import Cancelled
 from ..core.factor import remove_stale_factor_folders
 from ..core.mesh import Mesh
-from ..core.spectrum import Spectrum, load_spectrum
+from ..core.spectrum import GrowingSpectrum, load_spectrum
 
 
 class ChildError(RuntimeError):
@@ -142,38 +142,22 @@ def compute_in_process(
 
 class _ModesReceived:
     """Reads the files of modes a child relays (``processes.job_main``), gathers them in
-    one array and calls ``on_modes`` with a Spectrum of all received so far."""
+    a :class:`~modalviewer.core.spectrum.GrowingSpectrum` and calls ``on_modes`` with a
+    Spectrum of all received so far."""
 
     def __init__(self, mesh_hash: str, operator: str, on_modes) -> None:
         self.mesh_hash, self.operator, self.on_modes = mesh_hash, operator, on_modes
-        self.count = 0
+        self.modes: GrowingSpectrum | None = None
 
     def __call__(self, path: str) -> None:
         with np.load(path, allow_pickle=False) as part:
             parameters = json.loads(str(part["parameters"]))
-            new = part["modes"]
-            if self.count == 0:
-                k = int(parameters["modes_requested"])
-                self.modes = np.empty(new.shape[:-1] + (k,))
-                self.eigenvalues, self.residuals = np.zeros(k), np.zeros(k)
+            if self.modes is None:
+                self.modes = GrowingSpectrum(int(parameters["modes_requested"]))
                 self.mass = part["mass"]
-            j0, j1 = self.count, self.count + new.shape[-1]
-            self.modes[..., j0:j1] = new
-            self.eigenvalues[j0:j1] = part["eigenvalues"]
-            self.residuals[j0:j1] = part["residuals"]
+            self.modes.append(part["eigenvalues"], part["modes"])
         Path(path).unlink(missing_ok=True)
-        self.count = j1
-        self.on_modes(
-            Spectrum(
-                eigenvalues=self.eigenvalues[:j1].copy(),
-                modes=self.modes[..., :j1],
-                operator=self.operator,
-                mass=self.mass,
-                residuals=self.residuals[:j1].copy(),
-                mesh_hash=self.mesh_hash,
-                parameters=parameters,
-            )
-        )
+        self.on_modes(self.modes.so_far(self.operator, self.mass, self.mesh_hash, parameters))
 
 
 def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
