@@ -271,10 +271,10 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _read_mesh(self, path: Path, strict: bool) -> Mesh | None:
         """:func:`modalviewer.load_mesh` of ``path`` in a worker thread while the event
-        loop runs, so the window keeps drawing (a 1.5M-vertex OBJ takes 15 to 20 s to
-        read).  After :data:`READING_DIALOG_S` a modal dialog names the file with
-        a busy bar and Cancel.  Returns the mesh, None if cancelled (the thread then
-        reads on and its mesh is dropped: a parser cannot be stopped midway), or raises
+        loop runs, so the window keeps drawing while a large file is read.  After
+        :data:`READING_DIALOG_S` a modal dialog names the file with a busy bar and
+        Cancel.  Returns the mesh, None if cancelled (the thread then reads on and its
+        mesh is dropped: a parser cannot be stopped midway), or raises
         what ``load_mesh`` raises."""
         from concurrent.futures import ThreadPoolExecutor
 

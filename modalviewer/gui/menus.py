@@ -53,66 +53,7 @@ def let_shortcuts_through(win, actions) -> None:
 
 def build_menus(win) -> None:
     bar = win.menuBar()
-    m = bar.addMenu("&File")
-    _action(win, m, "&Open mesh...", lambda: file_dialogs.open_mesh_dialog(win), "Ctrl+O")
-    win.recent_menu = m.addMenu("Open &recent")
-    _action(
-        win,
-        m,
-        "Open &second mesh (shape pair)...",
-        lambda: open_second_mesh_dialog(win),
-        "Ctrl+Shift+B",
-        "Open mesh B beside this mesh: a click on one shows the similar points on the other",
-    )
-    _action(
-        win,
-        m,
-        "Open co&llection...",
-        lambda: open_collection_dialog(win),
-        tip="A store of 'modalviewer batch': its shapes nearest to this mesh; one opens beside it",
-    )
-    m.addSeparator()
-    _action(
-        win, m, "Open s&ession...", lambda: file_dialogs.open_session_dialog(win), "Ctrl+Shift+O"
-    )
-    _action(win, m, "Save se&ssion...", lambda: file_dialogs.save_session_dialog(win), "Ctrl+S")
-    m.addSeparator()
-    _action(win, m, "Export &screenshot...", lambda: file_dialogs.screenshot_dialog(win), "Ctrl+E")
-    _action(
-        win,
-        m,
-        "Export &animation (GIF/MP4)...",
-        lambda: file_dialogs.animation_dialog(win),
-        tip="One period of the mode shown, vibrating as on screen",
-    )
-    _action(
-        win,
-        m,
-        "Export mode &grid...",
-        lambda: file_dialogs.mode_grid_dialog(win),
-        tip="Several modes side by side in one picture, one camera, one colour bar",
-    )
-    _action(
-        win,
-        m,
-        "Export per-vertex &field (PLY/VTP)...",
-        lambda: file_dialogs.field_dialog(win),
-        "Ctrl+Shift+E",
-    )
-    _action(
-        win,
-        m,
-        "Export s&pectrum (.npz)...",
-        lambda: file_dialogs.spectrum_dialog(win),
-        "Ctrl+Shift+S",
-    )
-    m.addSeparator()
-    win.clear_cache_action = _action(
-        win, m, "Clear spectrum &cache...", lambda: file_dialogs.clear_cache_dialog(win)
-    )
-    m.aboutToShow.connect(lambda: file_dialogs.update_cache_label(win))
-    m.addSeparator()
-    _action(win, m, "&Quit", win.close, "Ctrl+Q")
+    _file_menu(win, bar.addMenu("&File"))
     m = bar.addMenu("&Mesh")
     for name, label in REPAIRS.items():
         _action(win, m, label + "...", lambda _=False, n=name: win.repair_mesh(n, wait=False))
@@ -120,7 +61,106 @@ def build_menus(win) -> None:
     _action(win, m, "&Compute spectrum", lambda: win.compute(wait=False), "Ctrl+R")
     _action(win, m, "C&ancel running computation", win.cancel_computation, "Esc")
     _action(win, m, "Cancel &all computations", win.cancel_all, "Ctrl+Shift+Esc")
-    m = bar.addMenu("&View")
+    _view_menu(win, bar.addMenu("&View"))
+    m = bar.addMenu("&Help")
+    _action(win, m, "&Controls", lambda: controls(win))
+    _action(win, m, "&About", lambda: about(win))
+
+
+_SEPARATOR = (None, None, None, None)
+
+
+def _file_menu(win, m) -> None:
+    d = file_dialogs
+    _action(win, m, "&Open mesh...", lambda: d.open_mesh_dialog(win), "Ctrl+O")
+    win.recent_menu = m.addMenu("Open &recent")
+    for text, slot, key, tip in (
+        (
+            "Open &second mesh (shape pair)...",
+            open_second_mesh_dialog,
+            "Ctrl+Shift+B",
+            "Open mesh B beside this mesh: a click on one shows the similar points on the other",
+        ),
+        (
+            "Open co&llection...",
+            open_collection_dialog,
+            None,
+            "A store of 'modalviewer batch': its shapes nearest to this mesh; one opens beside it",
+        ),
+        _SEPARATOR,
+        ("Open s&ession...", d.open_session_dialog, "Ctrl+Shift+O", None),
+        ("Save se&ssion...", d.save_session_dialog, "Ctrl+S", None),
+        _SEPARATOR,
+        ("Export &screenshot...", d.screenshot_dialog, "Ctrl+E", None),
+        (
+            "Export &animation (GIF/MP4)...",
+            d.animation_dialog,
+            None,
+            "One period of the mode shown, vibrating as on screen",
+        ),
+        (
+            "Export mode &grid...",
+            d.mode_grid_dialog,
+            None,
+            "Several modes side by side in one picture, one camera, one colour bar",
+        ),
+        ("Export per-vertex &field (PLY/VTP)...", d.field_dialog, "Ctrl+Shift+E", None),
+        ("Export s&pectrum (.npz)...", d.spectrum_dialog, "Ctrl+Shift+S", None),
+        _SEPARATOR,
+    ):
+        if text is None:
+            m.addSeparator()
+        else:
+            _action(win, m, text, lambda _=False, f=slot: f(win), key, tip)
+    win.clear_cache_action = _action(
+        win, m, "Clear spectrum &cache...", lambda: d.clear_cache_dialog(win)
+    )
+    m.aboutToShow.connect(lambda: d.update_cache_label(win))
+    m.addSeparator()
+    _action(win, m, "&Quit", win.close, "Ctrl+Q")
+
+
+# View menu toggles: (attribute of the window, text, key, setter, whether the style has it on)
+STYLE_TOGGLES = (
+    (
+        "colorbar_action",
+        "Colour &bar and legend",
+        "B",
+        lambda st, on: st.set_colorbar(on),
+        lambda style: style.colorbar,
+    ),
+    (
+        "shaded_action",
+        "S&haded look (light kit, greyer)",
+        "Shift+S",
+        lambda st, on: st.set_render_style("shaded" if on else "paper"),
+        lambda style: style.render == "shaded",
+    ),
+    (
+        "ghost_action",
+        "Rest shape &ghost behind deformed modes",
+        "G",
+        lambda st, on: st.set_ghost(on),
+        lambda style: style.ghost,
+    ),
+)
+
+CAMERA_PRESETS = (
+    ("+x", "From +X"),
+    ("-x", "From -X"),
+    ("+y", "From +Y"),
+    ("-y", "From -Y"),
+    ("+z", "From +Z"),
+    ("-z", "From -Z"),
+    ("isometric", "Isometric"),
+)
+
+
+def _follow_style(win, action, is_on):
+    return lambda: action.setChecked(is_on(win.state.style))
+
+
+def _view_menu(win, m) -> None:
     steps = [
         _action(win, m, "&Next mode", lambda: win.step_mode(+1), "Ctrl+Right"),
         _action(win, m, "&Previous mode", lambda: win.step_mode(-1), "Ctrl+Left"),
@@ -130,50 +170,21 @@ def build_menus(win) -> None:
     _action(win, m, "Show &mode", win.viewer.show_current_mode, "M")
     _action(win, m, "Show &distance", lambda: win.show_distance(), "D")
     _action(win, m, "Show &curvature sqrt(k1^2 + k2^2)", win.show_curvature, "C")
-    win.colorbar_action = _action(
-        win, m, "Colour &bar and legend", lambda on: win.state.set_colorbar(on), "B"
-    )
-    win.colorbar_action.setCheckable(True)
-    win.colorbar_action.setChecked(win.state.style.colorbar)
-    win.state.events.style.connect(lambda: win.colorbar_action.setChecked(win.state.style.colorbar))
-    win.shaded_action = _action(
-        win,
-        m,
-        "S&haded look (light kit, greyer)",
-        lambda on: win.state.set_render_style("shaded" if on else "paper"),
-        "Shift+S",
-    )
-    win.shaded_action.setCheckable(True)
-    win.shaded_action.setChecked(win.state.style.render == "shaded")
-    win.state.events.style.connect(
-        lambda: win.shaded_action.setChecked(win.state.style.render == "shaded")
-    )
-    win.ghost_action = _action(
-        win,
-        m,
-        "Rest shape &ghost behind deformed modes",
-        lambda on: win.state.set_ghost(on),
-        "G",
-    )
-    win.ghost_action.setCheckable(True)
-    win.ghost_action.setChecked(win.state.style.ghost)
-    win.state.events.style.connect(lambda: win.ghost_action.setChecked(win.state.style.ghost))
+    for attribute, text, key, setter, is_on in STYLE_TOGGLES:
+        action = _action(win, m, text, lambda on, f=setter: f(win.state, on), key)
+        action.setCheckable(True)
+        action.setChecked(is_on(win.state.style))
+        win.state.events.style.connect(_follow_style(win, action, is_on))
+        setattr(win, attribute, action)
     build_color_range_menu(win, m.addMenu("Colour &range"))
     panels = m.addMenu("&Panels")
     for dock in win.findChildren(QtWidgets.QDockWidget):
         panels.addAction(dock.toggleViewAction())  # a closed panel comes back from here
     _action(win, m, "&Reset camera", win.scene_view.reset_camera, "R")
     views = m.addMenu("Camera &presets")
-    for name, label, key in (
-        ("+x", "From +X", "Alt+1"),
-        ("-x", "From -X", "Alt+2"),
-        ("+y", "From +Y", "Alt+3"),
-        ("-y", "From -Y", "Alt+4"),
-        ("+z", "From +Z", "Alt+5"),
-        ("-z", "From -Z", "Alt+6"),
-        ("isometric", "Isometric", "Alt+7"),
-    ):
-        _action(win, views, label, lambda _=False, n=name: win.scene_view.camera_preset(n), key)
+    for i, (name, label) in enumerate(CAMERA_PRESETS):
+        slot = lambda _=False, n=name: win.scene_view.camera_preset(n)  # noqa: E731
+        _action(win, views, label, slot, f"Alt+{i + 1}")
     _up_axis_menu(win, m)
     m.addSeparator()
     _action(
@@ -192,9 +203,6 @@ def build_menus(win) -> None:
         lambda: win.open_comparison(["vibration", "hks"], wait=False),
         "Ctrl+2",
     )
-    m = bar.addMenu("&Help")
-    _action(win, m, "&Controls", lambda: controls(win))
-    _action(win, m, "&About", lambda: about(win))
 
 
 COLOR_RANGE_ITEMS = (

@@ -5,7 +5,7 @@ Canonical view: the up axis is the caller's (a file convention) or +Y, the conve
 most OBJ/PLY/OFF models.  Among the horizontal viewing directions (perpendicular to up,
 every 5 degrees) the viewer looks along the one from which the surface shows the largest
 silhouette (estimated from the projected vertices on a grid of 3 mean edge lengths),
-preferring a coordinate axis when it shows at least 90 % of the best; if the view from
+preferring a coordinate axis when it shows ``AXIS_PREFERENCE`` of the best; if the view from
 above shows more than ``TOP_VIEW_RATIO`` times that (a plate lying across the up axis),
 it looks from above.  Then the camera turns by a small azimuth and elevation so the
 view shows depth.  The camera sits on the side of +Z (then +X, then +Y) of its axis, the
