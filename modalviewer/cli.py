@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.operators import (
+    DEFAULT_K,
     DISTANCE_KINDS,
     OPERATOR_NAMES,
     distance_word,
@@ -204,7 +205,9 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("compute", help="compute a spectrum and save it as .npz")
     c.add_argument("mesh")
     c.add_argument("--operator", choices=OPERATORS, default="laplacian")
-    c.add_argument("-k", type=COUNT, default=100, help="number of modes (default: 100)")
+    c.add_argument(
+        "-k", type=COUNT, default=DEFAULT_K, help=f"number of modes (default: {DEFAULT_K})"
+    )
     c.add_argument("--bending", type=WEIGHT, default=1.0)
     c.add_argument("--membrane", type=WEIGHT, default=1.0)
     c.add_argument("-o", "--output", required=True)
@@ -233,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="with --modes: COLUMNSxROWS of the panels (default: rows of up to 4)",
     )
     r.add_argument(
-        "-k", type=COUNT, default=None, help="number of modes (default: the viewer's, 100)"
+        "-k", type=COUNT, default=None, help=f"number of modes (default: the viewer's, {DEFAULT_K})"
     )
     r.add_argument("--isolines", type=_whole(0), default=12)
     r.add_argument(
@@ -298,7 +301,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="vibration (3D shells), feature (E_D^N), hks (heat kernel of the Laplacian) or "
         "wks (wave kernel signature of the Laplacian, over energies)",
     )
-    d.add_argument("-k", type=COUNT, default=100, help="number of modes (default: 100)")
+    d.add_argument(
+        "-k", type=COUNT, default=DEFAULT_K, help=f"number of modes (default: {DEFAULT_K})"
+    )
     marked = d.add_mutually_exclusive_group()
     marked.add_argument(
         "--share",

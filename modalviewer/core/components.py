@@ -24,6 +24,7 @@ import numpy as np
 
 from .eigen import CancelFn, ProgressFn
 from .mesh import Mesh, MeshReport, shape_summary
+from .operators import DEFAULT_K
 from .pipeline import compute_spectrum
 from .spectrum import Spectrum
 from .validate import check_count
@@ -169,7 +170,7 @@ class ComponentSpectrum:
 def compute_spectrum_per_component(
     mesh: Mesh,
     operator: str,
-    k: int = 100,
+    k: int = DEFAULT_K,
     bending: float = 1.0,
     membrane: float = 1.0,
     progress: ProgressFn | None = None,

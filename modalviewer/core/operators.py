@@ -26,6 +26,8 @@ from .cost import (
 )
 
 __all__ = [
+    "DEFAULT_K",
+    "default_k",
     "OperatorInfo",
     "OPERATOR_INFO",
     "OPERATOR_NAMES",
@@ -36,6 +38,14 @@ __all__ = [
     "operator_for_distance",
     "signature_kind",
 ]
+
+DEFAULT_K = 100
+"""The number of modes computed where none is given (the paper's figures use 100)."""
+
+
+def default_k(n_vertices: int) -> int:
+    """A mode count suited to a mesh: :data:`DEFAULT_K`, fewer for tiny meshes."""
+    return int(max(2, min(DEFAULT_K, n_vertices // 4)))
 
 
 NULL_SPACE_RULES: dict[str, str] = {
@@ -111,7 +121,7 @@ class OperatorInfo:
     def predicted_peak_mb(
         self,
         n_vertices: int,
-        k: int = 100,
+        k: int = DEFAULT_K,
         out_of_core: bool | None = None,
         basis_float32: bool | None = None,
     ) -> float:
@@ -141,7 +151,7 @@ class OperatorInfo:
         return peak
 
     def factor_out_of_core(
-        self, n_vertices: int, k: int = 100, limit_mb: float | None = None
+        self, n_vertices: int, k: int = DEFAULT_K, limit_mb: float | None = None
     ) -> bool:
         """Whether the exact solve of ``k`` modes on ``n_vertices`` is predicted to keep
         its factor in a file: its in-core peak above ``limit_mb`` (None: this machine's

@@ -13,7 +13,7 @@ from .eigen import CancelFn, EigenError, ProgressFn, rounding_floors
 from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
-from .operators import operator_info
+from .operators import DEFAULT_K, operator_info
 from .spectrum import GrowingSpectrum, Spectrum, in_input_numbering
 from .validate import check_count
 
@@ -92,7 +92,7 @@ the command line's ``--preview`` says the same)."""
 def compute_spectrum(
     mesh: Mesh,
     operator: str,
-    k: int = 100,
+    k: int = DEFAULT_K,
     bending: float = 1.0,
     membrane: float = 1.0,
     progress: ProgressFn | None = None,

@@ -1,7 +1,6 @@
 """Colour scales that spread a field's values over the colours by area (no Qt, no VTK).
 
-A distance from a vertex is small on most of a shape and large on a little of it (the
-Stanford bunny's vibration distance runs 0 to 444 with 41 % of the surface below 9.4):
+A distance from a vertex is small on most of a shape and large on a little of it:
 coloured linearly, most of the surface takes one colour.  The "spread" scale maps a
 value to the share of the surface's area at or below it (an area-weighted rank), so
 each tenth of the colours covers about a tenth of the surface; the colour bar keeps the
@@ -11,6 +10,9 @@ true values at its ticks.
 from __future__ import annotations
 
 import numpy as np
+
+ROBUST_PERCENTILE = 99.0
+"""The robust colour range ends at this area-weighted percentile of |value|."""
 
 SPREAD_SHARE = 0.25
 """The automatic colour range spreads a one-signed field when a tenth of the linear
@@ -74,3 +76,13 @@ def auto_spread(values: np.ndarray, weights: np.ndarray):
     if crowded_share(values, weights, (0.0, float(values.max()))) <= SPREAD_SHARE:
         return None
     return spread_knots(values, weights)
+
+
+def robust_limit(values: np.ndarray, weights: np.ndarray, percent: float = ROBUST_PERCENTILE):
+    """The ``percent`` area-weighted percentile of |values|: the smallest |value| that at
+    least ``percent`` % of the total weight lies at or below."""
+    a = np.abs(np.asarray(values, dtype=np.float64))
+    order = np.argsort(a, kind="stable")
+    cumulative = np.cumsum(np.asarray(weights, dtype=np.float64)[order])
+    i = int(np.searchsorted(cumulative, percent / 100.0 * cumulative[-1]))
+    return float(a[order[min(i, len(a) - 1)]])

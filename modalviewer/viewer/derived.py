@@ -22,7 +22,6 @@ signature table holds hundreds of MB).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -37,17 +36,12 @@ from ..core.operators import (
 from ..core.signatures import SignatureTable, signature, wks_sigma
 from ..core.spectrum import Spectrum
 from . import wording
+from .color_scale import robust_limit
 from .mode_scalar import smoothed_normals, vector_mode_scalar
-
-ROBUST_PERCENTILE = 99.0
-"""The robust colour range ends at this area-weighted percentile of |value|."""
 
 TIE_TOLERANCE = 1e-7
 """Distances within this share of the largest of a threshold chosen by share are
 marked with it (:meth:`DerivedValues.threshold_for_share`)."""
-
-if TYPE_CHECKING:
-    from .state import ViewerState
 
 
 @dataclass
@@ -84,20 +78,10 @@ class Field:
     scale: tuple[np.ndarray, np.ndarray] | None = None
 
 
-def robust_limit(values: np.ndarray, weights: np.ndarray, percent: float = ROBUST_PERCENTILE):
-    """The ``percent`` area-weighted percentile of |values|: the smallest |value| that at
-    least ``percent`` % of the total weight lies at or below."""
-    a = np.abs(np.asarray(values, dtype=np.float64))
-    order = np.argsort(a, kind="stable")
-    cumulative = np.cumsum(np.asarray(weights, dtype=np.float64)[order])
-    i = int(np.searchsorted(cumulative, percent / 100.0 * cumulative[-1]))
-    return float(a[order[min(i, len(a) - 1)]])
-
-
 class DerivedValues:
     """The cached values computed from ``state``; see the module docstring."""
 
-    def __init__(self, state: ViewerState) -> None:
+    def __init__(self, state) -> None:
         self.state = state
         self._mesh = None  # the mesh the per-mesh values below belong to
         self._per_mesh: dict[str, object] = {}

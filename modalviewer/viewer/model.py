@@ -119,7 +119,7 @@ def estimated_seconds(
 
 
 def seconds_text(seconds: float) -> str:
-    """About how long, in words: "45 s" below two minutes, "3 min" from there."""
+    """About how long, in words: whole seconds below two minutes, then whole minutes."""
     return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
@@ -168,8 +168,8 @@ def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = C
 
 
 def _share_words(available: int) -> str:
-    """The memory a computation may take, in words: "the 17.6 GiB a computation may take
-    (three quarters of this machine's 23.5 GiB)"."""
+    """The memory a computation may take, in words: that share of ``available`` in GiB,
+    the share named, and the machine's total."""
     share = {0.75: "three quarters", 0.5: "half"}.get(MEMORY_SHARE, f"{MEMORY_SHARE:.0%}")
     return (
         f"the {MEMORY_SHARE * available / 2**30:.1f} GiB a computation may take ({share} of "
@@ -464,12 +464,12 @@ FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
 
 
 def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
-    """How a finished spectrum job's status line starts: "<description> in 63.2 s", or
-    for a spectrum read from the cache "<description> read from the cache in 0.3 s
-    (solved earlier in 63.2 s)", so that a cache hit does not read like a fresh solve.
-    A solve's time is the one it stored (``parameters["seconds_total"]``, what the
-    cache keeps and the estimates use), so a solve and its reopening report the same
-    number; the job's own time where the spectrum has none (coarse-to-fine)."""
+    """How a finished spectrum job's status line starts: the description and the solve's
+    time, or for a spectrum read from the cache the time reading took and the time the
+    solve took earlier, so that a cache hit does not read like a fresh solve.  A solve's
+    time is the one it stored (``parameters["seconds_total"]``, what the cache keeps and
+    the estimates use), so a solve and its reopening report the same number; the job's
+    own time where the spectrum has none (coarse-to-fine)."""
     fewer = fewer_modes_text(job, spec)
     solved = spec.parameters.get("seconds_total")
     if not isinstance(solved, (int, float)) or "transferred_from" in spec.parameters:
@@ -492,9 +492,9 @@ def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:
 
 
 def ended_text(job: Job) -> str:
-    """How ``job`` ended, in a line: "<description> in 5.6 s" (:func:`finished_text` for
-    a spectrum), "<description>: cancelled" (or why it was given up) or
-    "<description>: failed"."""
+    """How ``job`` ended, in a line: its description with its run time
+    (:func:`finished_text` for a spectrum), "<description>: cancelled" (or why it was
+    given up) or "<description>: failed"."""
     if job.status == DONE:
         if isinstance(job, SpectrumJob) and job.result:
             return finished_text(job, job.result[0])

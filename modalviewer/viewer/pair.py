@@ -36,6 +36,7 @@ from ..core.laplacian import lumped_masses
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import (
     DISTANCE_KINDS,
+    default_k,
     operator_for_distance,
     operator_info,
     signature_kind,
@@ -47,7 +48,6 @@ from .state import (
     DISTANCE_DISPLAYS,
     SpectrumKey,
     ViewerState,
-    default_k,
 )
 
 SIDES = ("a", "b")

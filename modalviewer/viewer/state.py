@@ -50,8 +50,10 @@ from psygnal import Signal, SignalGroup
 
 from ..core.mesh import Mesh
 from ..core.operators import (
+    DEFAULT_K,
     DISTANCE_KINDS,
     OPERATOR_INFO,
+    default_k,
     operator_for_distance,
     operator_info,
     signature_kind,
@@ -86,17 +88,12 @@ quarter of the surface, else robust; symmetric for modes)."""
 RENDER_STYLES = ("paper", "shaded")
 
 
-def default_k(n_vertices: int) -> int:
-    """A mode count suited to the mesh: 100 for most meshes, fewer for tiny ones."""
-    return int(max(2, min(100, n_vertices // 4)))
-
-
 @dataclass(frozen=True)
 class ComputeSettings:
     """What the next computation computes (the Compute panel's fields)."""
 
     operator: str = "modified_dirichlet"
-    k: int = 100
+    k: int = DEFAULT_K
     bending: float = 1.0
     membrane: float = 1.0
     rescale: bool = False
@@ -301,8 +298,8 @@ class ViewerState:
         """Store a computed spectrum (and its signature table, if already built).
 
         It becomes the spectrum shown for its operator; the operator's spectra of other
-        keys (another k, other weights) are dropped: nothing shows them any more, and at
-        130k vertices each holds 100 to 300 MB (exact ones come back from the cache).
+        keys (another k, other weights) are dropped: nothing shows them any more, each
+        holds n x k floats (exact ones come back from the cache).
 
         The first modes of a computation still running (``spec.is_complete`` False) are
         stored the same way and replaced as more arrive; they never replace a complete
@@ -629,8 +626,8 @@ class ViewerState:
         distance) and ``display.threshold_share`` (the share of the surface's area it
         marks) on the threshold map on screen.
 
-        The distances are so skewed that one fraction of the largest marks 95 % of the
-        surface from one vertex and 10 % from another, so with ``keep_share`` a threshold
+        The distances are so skewed that one fraction of the largest marks most of the
+        surface from one vertex and little from another, so with ``keep_share`` a threshold
         map that was not matched yet (another vertex, kind, scale range or spectrum, or a
         first map) gets the fraction that marks ``threshold_share``
         (:data:`DEFAULT_THRESHOLD_SHARE` at first).  A fraction the caller set

@@ -7,8 +7,6 @@ from it (distances, signature scales), its :class:`~.derived.DerivedValues`
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from ..core.mesh import _plural
@@ -19,30 +17,28 @@ from ..core.operators import (
     operator_for_distance,
     operator_info,
 )
-
-if TYPE_CHECKING:
-    from .derived import DerivedValues
-    from .state import ViewerState
+from .color_scale import ROBUST_PERCENTILE
 
 
 def percent_text(fraction: float) -> str:
-    """A relative error as a short percentage: "< 0.01 %", "0.24 %", "2.2 %", "21 %",
-    "135 %" (with a no-break space, so a wrapped legend keeps number and sign together);
-    below 0.01 % the digits would only show how converged a mode is, not its error."""
+    """A relative error as a short percentage: two significant digits below ten per
+    cent, whole per cents from there, and "less than a hundredth of a per cent" below
+    that, where the digits would only show how converged a mode is, not its error.  A no-break
+    space keeps number and sign together in a wrapped legend."""
     value = 100.0 * float(fraction)
     if 0 < value < 0.01:
         return "<\u00a00.01\u00a0%"
     return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
 
 
-def arrival_text(state: ViewerState, operator: str | None) -> str:
+def arrival_text(state, operator: str | None) -> str:
     """ "first 20 of 100 modes" while the spectrum of ``operator`` is still arriving (its
     modes are handed over as they converge), else ""."""
     ready, asked = state.modes_ready(operator)
     return f"first {ready} of {asked} modes" if ready < asked else ""
 
 
-def arrival_note(state: ViewerState, operator: str | None) -> str:
+def arrival_note(state, operator: str | None) -> str:
     """A sentence on a spectrum still arriving ("12 of 100 modes ready; the others follow
     as they converge."), or on one whose computation stopped before its last modes; ""
     for a whole spectrum."""
@@ -58,7 +54,7 @@ def arrival_note(state: ViewerState, operator: str | None) -> str:
     )
 
 
-def approximation_mark(state: ViewerState, operator: str | None) -> str:
+def approximation_mark(state, operator: str | None) -> str:
     """ " (coarse-to-fine)", " (first 20 of 100 modes)" or "": what titles and lists add
     to the spectrum shown for ``operator`` when it is an approximation or incomplete."""
     marks = ["coarse-to-fine"] if state.is_coarse(operator) else []
@@ -68,12 +64,12 @@ def approximation_mark(state: ViewerState, operator: str | None) -> str:
     return f" ({'; '.join(marks)})" if marks else ""
 
 
-def display_mark(state: ViewerState) -> str:
+def display_mark(state) -> str:
     """:func:`approximation_mark` of the spectrum the picture is made of."""
     return approximation_mark(state, state.display_operator())
 
 
-def approximation_note(state: ViewerState, operator: str | None) -> str:
+def approximation_note(state, operator: str | None) -> str:
     """ " (coarse-to-fine spectrum)", " (from the first 20 of 100 modes)" or "" for
     what is made of the spectrum shown for ``operator`` (a map, a signature)."""
     if state.spectrum(operator) is None:
@@ -85,7 +81,7 @@ def approximation_note(state: ViewerState, operator: str | None) -> str:
     return f" ({'; '.join(notes)})" if notes else ""
 
 
-def missing_distance_reason(state: ViewerState, kind: str) -> str:
+def missing_distance_reason(state, kind: str) -> str:
     """Why there is no distance map of ``kind``: what to do to get one."""
     if state.picked is None:
         return "pick a vertex"
@@ -95,7 +91,7 @@ def missing_distance_reason(state: ViewerState, kind: str) -> str:
     return "the spectrum has no non-zero modes; compute more modes"
 
 
-def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
+def legend(state, derived=None) -> str:
     """One or two lines naming what the surface shows, with its numbers."""
     derived = derived if derived is not None else state.derived
     d = state.display
@@ -165,8 +161,6 @@ def legend(state: ViewerState, derived: DerivedValues | None = None) -> str:
 def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool]) -> str:
     """The legend's line naming the colour range ``rule`` ("symmetric", "robust",
     "limits") of ``clim`` and the clipped ends."""
-    from .derived import ROBUST_PERCENTILE
-
     lo, hi = clim
     if rule == "spread":
         return "colours spread by area: each tenth of the bar covers a tenth of the surface"
@@ -182,7 +176,7 @@ def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool])
     return text
 
 
-def negative_weights_note(state: ViewerState) -> str:
+def negative_weights_note(state) -> str:
     """ "This mesh has 46 negative cotan weights: try the Laplacian (robust, intrinsic
     Delaunay)." where the mesh has edges whose cotan weight is negative and the registry
     has an operator whose weights never are; else ""."""
@@ -198,10 +192,10 @@ def negative_weights_note(state: ViewerState) -> str:
     )
 
 
-def truncation_note(state: ViewerState, derived: DerivedValues | None = None) -> str:
-    """ "truncation: about 12 % of the signature is missing (k = 100; k = 340 for
-    < 5 %)" when the estimated truncation error of the signature shown exceeds
-    :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`, else ""."""
+def truncation_note(state, derived=None) -> str:
+    """The share of the signature shown that truncation misses, with its k and the k
+    that would bring it below :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`,
+    when its estimate exceeds that level; else ""."""
     from ..core.truncation import TRUNCATION_LEVEL
 
     derived = derived if derived is not None else state.derived
@@ -216,7 +210,7 @@ def truncation_note(state: ViewerState, derived: DerivedValues | None = None) ->
     )
 
 
-def summary(state: ViewerState, derived: DerivedValues | None = None) -> str:
+def summary(state, derived=None) -> str:
     """The status line: the current display's live numbers, on one line."""
     if state.mesh is None:
         return "Open a mesh to begin (File > Open, Ctrl+O)."
