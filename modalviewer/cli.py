@@ -717,16 +717,10 @@ def _write_csv(path, mesh, d: np.ndarray, what: str) -> None:
 def _cached_spectrum(mesh, operator: str, k: int):
     """The spectrum from the viewer's disk cache (``$MODALVIEWER_CACHE``), or computed
     with a progress bar and cached, so a second pick on the same meshes is quick."""
-    import modalviewer as mv
-    from modalviewer.core.cache import SpectrumCache
+    from .spectra import cached_or_computed
 
-    cache = SpectrumCache()
-    spec = cache.get(mesh, operator, k)
-    if spec is None:
-        with _warnings_printed():
-            spec = mv.compute_spectrum(mesh, operator, k, progress=_progress_bar())
-        cache.put(mesh, spec, k)
-    return spec
+    with _warnings_printed():
+        return cached_or_computed(mesh, operator, k, progress=_progress_bar())
 
 
 def _distance_to(args, mesh_a) -> int:

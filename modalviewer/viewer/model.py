@@ -21,17 +21,14 @@ from ..core.eigen import Cancelled
 from ..core.memory import physical_memory_mb
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
-from ..core.pipeline import FLOOR_FACTOR, compute_spectrum
+from ..core.pipeline import FLOOR_FACTOR
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
+from ..spectra import cached_or_computed
 from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
-
-PROCESS_THRESHOLD = 20000
-"""Exact spectra of at least this many unknowns are computed in a separate process
-(sparse factorisations hold the GIL; a process also cancels at once)."""
 
 
 class ComputeRefused(ValueError):
@@ -393,18 +390,27 @@ class ViewerModel:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
 
     def _work(self, key: SpectrumKey, on_modes=None):
-        """The function a job runs for ``key``: cache, compute (``on_modes`` gets the
+        """The function a job runs for ``key``: cache or compute (``on_modes`` gets the
         modes as they converge), signature table."""
         mesh = self.state.compute_mesh(key)
         cache = self.cache
         t_range = self.state.t_range
-        cache_args = (mesh, key.operator, key.k, key.bending, key.membrane)
         needs_table = operator_info(key.operator).distance_kind is not None
 
         def work(progress, cancel):
-            spec = None if key.coarse else cache.get(*cache_args)
-            if spec is None:
-                spec = _compute(mesh, key, cache, progress, cancel, on_modes)
+            spec = cached_or_computed(
+                mesh,
+                key.operator,
+                key.k,
+                key.bending,
+                key.membrane,
+                cache=cache,
+                progress=progress,
+                cancel=cancel,
+                on_modes=on_modes,
+                coarse=key.coarse,
+                child_process=True,
+            )
             table = None
             if needs_table and (~spec.zero_mode_mask()).any():
                 # built here, off the GUI thread (on big meshes it takes a moment)
@@ -426,29 +432,6 @@ class ViewerModel:
         spec, table = job.result
         if not self.state.has_spectrum(key) or self.state.spectra[key] is not spec:
             self.state.add_spectrum(key, spec, table)
-
-
-def _compute(
-    mesh: Mesh, key: SpectrumKey, cache: SpectrumCache, progress, cancel, on_modes=None
-) -> Spectrum:
-    info = operator_info(key.operator)
-    weights = (key.bending, key.membrane)
-    if key.coarse:
-        from ..coarsen import coarse_to_fine_spectrum
-
-        return coarse_to_fine_spectrum(mesh, key.operator, key.k, *weights, progress, cancel)
-    if info.unknowns(mesh.n_vertices) >= PROCESS_THRESHOLD:
-        from .process import compute_in_process
-
-        target = cache.writable_path(mesh, key.operator, key.k, *weights)
-        return compute_in_process(
-            mesh, key.operator, key.k, *weights, target, progress, cancel, on_modes
-        )
-    spec = compute_spectrum(
-        mesh, key.operator, key.k, *weights, progress, cancel, on_modes=on_modes
-    )
-    cache.put(mesh, spec, key.k, *weights)
-    return spec
 
 
 def worst_residual(spec: Spectrum) -> float:

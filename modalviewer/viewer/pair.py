@@ -42,6 +42,7 @@ from ..core.operators import (
     signature_kind,
 )
 from ..core.spectrum import Spectrum
+from ..spectra import cached_or_computed
 from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, SpectrumJob
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
@@ -343,16 +344,22 @@ class PairState:
             self.jobs.cancel_all(owner=self.owner(side), reason="cancelled")
 
     def _work(self, side: str, key: SpectrumKey, on_modes=None):
-        from .model import _compute
-
         mesh = self.sides[side].compute_mesh(key.rescale)
         cache = self.cache
-        args = (mesh, key.operator, key.k, key.bending, key.membrane)
 
         def work(progress, cancel):
-            spec = cache.get(*args)
-            if spec is None:
-                spec = _compute(mesh, key, cache, progress, cancel, on_modes)
+            spec = cached_or_computed(
+                mesh,
+                key.operator,
+                key.k,
+                key.bending,
+                key.membrane,
+                cache=cache,
+                progress=progress,
+                cancel=cancel,
+                on_modes=on_modes,
+                child_process=True,
+            )
             return spec, None
 
         return work

@@ -592,10 +592,10 @@ def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, 
     many of how many are in, before the computation ends."""
     import threading
 
-    from modalviewer.viewer import model as model_module
+    from modalviewer import spectra as spectra_module
 
     go = threading.Event()
-    solve = model_module.compute_spectrum
+    solve = spectra_module.compute_spectrum
 
     def paused(*args, on_modes=None, **kwargs):
         def hand_over(spec):
@@ -605,7 +605,7 @@ def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, 
 
         return solve(*args, on_modes=hand_over, **kwargs)
 
-    monkeypatch.setattr(model_module, "compute_spectrum", paused)
+    monkeypatch.setattr(spectra_module, "compute_spectrum", paused)
     assert window.open_mesh(spot_path)
     window.state.set_colorbar(False)
     try:

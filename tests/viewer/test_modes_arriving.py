@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
+from modalviewer import spectra as spectra_module
 from modalviewer.core.cache import SpectrumCache
-from modalviewer.viewer import model as model_module
 from modalviewer.viewer import wording
 from modalviewer.viewer.jobs import CANCELLED, DONE
 from modalviewer.viewer.process import compute_in_process
@@ -30,7 +30,7 @@ def paused(monkeypatch):
     """The solve stops after its first hand-over of 12 modes or more until ``go`` is set,
     so that the test acts while modes are still to come."""
     go = threading.Event()
-    solve = model_module.compute_spectrum
+    solve = spectra_module.compute_spectrum
 
     def compute_spectrum(*args, on_modes=None, **kwargs):
         def hand_over(spec):
@@ -40,7 +40,7 @@ def paused(monkeypatch):
 
         return solve(*args, on_modes=hand_over, **kwargs)
 
-    monkeypatch.setattr(model_module, "compute_spectrum", compute_spectrum)
+    monkeypatch.setattr(spectra_module, "compute_spectrum", compute_spectrum)
     yield go
     go.set()
 
@@ -106,7 +106,7 @@ def test_modes_relayed_by_a_child_process_equal_the_result(tmp_path):
 
 
 def test_cancelling_mid_way_keeps_the_modes_shown_and_caches_nothing(tmp_path, monkeypatch):
-    monkeypatch.setattr(model_module, "PROCESS_THRESHOLD", 0)  # the child process path
+    monkeypatch.setattr(spectra_module, "PROCESS_THRESHOLD", 0)  # the child process path
     cache = SpectrumCache(tmp_path / "cache")
     viewer = mv.Viewer(cache=cache)
     viewer.open_mesh(SPOT)

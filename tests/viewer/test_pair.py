@@ -134,10 +134,10 @@ def test_spectra_of_a_come_from_the_main_state_and_the_disk_cache(tmp_path, spot
         model.jobs.wait(job, timeout=120)
 
     # a second pair on the same meshes reads both from the disk cache, computing nothing
-    def no_compute(*args):
+    def no_compute(*args, **kwargs):
         raise AssertionError("computed instead of read from the cache")
 
-    monkeypatch.setattr("modalviewer.viewer.model._compute", no_compute)
+    monkeypatch.setattr("modalviewer.spectra.computed_and_cached", no_compute)
     again = PairState(model.jobs, model.cache, spot, _moved(spot), k=K)
     jobs = again.request()
     for job in jobs:
@@ -185,10 +185,10 @@ def test_a_cancel_is_not_reported_as_a_failure_and_a_failure_is(tmp_path, spot, 
     pair.pick("a", 5)
     assert messages == [] and "cancelled; pick again to compute" in pair.view("b").legend
 
-    def broken(*args):
+    def broken(*args, **kwargs):
         raise ValueError("the factorisation broke")
 
-    monkeypatch.setattr("modalviewer.viewer.model._compute", broken)
+    monkeypatch.setattr("modalviewer.spectra.computed_and_cached", broken)
     for job in pair.request():  # asked again: computed again (and failing now)
         pair.jobs.wait(job, timeout=120)
     assert len(messages) == 2 and "could not be computed: the factorisation broke" in messages[0]
@@ -241,10 +241,10 @@ def test_maps_are_drawn_from_the_first_modes_while_the_rest_arrive(tmp_path, spo
     and are redrawn from the whole spectra when it is in."""
     import threading
 
-    from modalviewer.viewer import model as model_module
+    from modalviewer import spectra as spectra_module
 
     go, paused = threading.Event(), threading.Event()
-    solve = model_module.compute_spectrum
+    solve = spectra_module.compute_spectrum
 
     solves = []
 
@@ -262,8 +262,8 @@ def test_maps_are_drawn_from_the_first_modes_while_the_rest_arrive(tmp_path, spo
 
     moved = _moved(spot)
     pair = _pair(tmp_path, spot, moved, k=60)
-    original = model_module.compute_spectrum
-    model_module.compute_spectrum = compute_spectrum
+    original = spectra_module.compute_spectrum
+    spectra_module.compute_spectrum = compute_spectrum
     try:
         jobs = pair.request()
         pair.pick("a", 700)
@@ -279,6 +279,6 @@ def test_maps_are_drawn_from_the_first_modes_while_the_rest_arrive(tmp_path, spo
         pair.jobs.wait(jobs[1], timeout=120)
     finally:
         go.set()
-        model_module.compute_spectrum = original
+        spectra_module.compute_spectrum = original
     assert pair.spectrum("b").is_complete and "modes of B" not in pair.view("b").legend
     assert pair.best_match()[:2] == ("b", 700)

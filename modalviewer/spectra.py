@@ -1,0 +1,71 @@
+"""Cache or compute: how the viewer, the shape pair and the command line get a spectrum.
+
+:func:`cached_or_computed` serves a spectrum from the disk cache
+(:class:`.core.cache.SpectrumCache`) or computes it and stores it there, so every part
+of the package asks for a spectrum the same way and shares the same cache entries.
+"""
+
+from __future__ import annotations
+
+from .core.cache import SpectrumCache
+from .core.mesh import Mesh
+from .core.operators import operator_info
+from .core.pipeline import compute_spectrum
+from .core.spectrum import Spectrum
+
+PROCESS_THRESHOLD = 20000
+"""With ``child_process``, exact spectra of at least this many unknowns are computed in
+a separate process (sparse factorisations hold the GIL; a process also cancels at once)."""
+
+
+def cached_or_computed(
+    mesh: Mesh,
+    operator: str,
+    k: int,
+    bending: float = 1.0,
+    membrane: float = 1.0,
+    *,
+    cache: SpectrumCache | None = None,
+    progress=None,
+    cancel=None,
+    on_modes=None,
+    coarse: bool = False,
+    child_process: bool = False,
+) -> Spectrum:
+    """``operator``'s ``k`` lowest modes on ``mesh``: read from ``cache`` (default: the
+    user's :class:`.core.cache.SpectrumCache`) where they are there, else computed
+    (:func:`computed_and_cached`) and stored in it.
+
+    ``coarse``: the coarse-to-fine approximation (never cached).  ``child_process``:
+    exact solves of at least :data:`PROCESS_THRESHOLD` unknowns run in a child process
+    that writes the cache entry itself.  ``progress``, ``cancel`` and ``on_modes`` are
+    :func:`modalviewer.compute_spectrum`'s.
+    """
+    cache = cache if cache is not None else SpectrumCache()
+    key = (operator, k, bending, membrane)
+    spec = None if coarse else cache.get(mesh, *key)
+    if spec is None:
+        spec = computed_and_cached(
+            mesh, key, cache, progress, cancel, on_modes, coarse, child_process
+        )
+    return spec
+
+
+def computed_and_cached(
+    mesh, key, cache, progress=None, cancel=None, on_modes=None, coarse=False, child_process=False
+) -> Spectrum:
+    """The computing half of :func:`cached_or_computed`, ``key`` its ``(operator, k,
+    bending, membrane)``."""
+    operator, k, *weights = key
+    if coarse:
+        from .coarsen import coarse_to_fine_spectrum
+
+        return coarse_to_fine_spectrum(mesh, operator, k, *weights, progress, cancel)
+    if child_process and operator_info(operator).unknowns(mesh.n_vertices) >= PROCESS_THRESHOLD:
+        from .viewer.process import compute_in_process
+
+        target = cache.writable_path(mesh, operator, k, *weights)
+        return compute_in_process(mesh, operator, k, *weights, target, progress, cancel, on_modes)
+    spec = compute_spectrum(mesh, operator, k, *weights, progress, cancel, on_modes=on_modes)
+    cache.put(mesh, spec, k, *weights)
+    return spec
