@@ -53,7 +53,7 @@ def main() -> int:
     app.processEvents()
     print(f"open both meshes and the window: {time.perf_counter() - started:.1f} s")
     # seen from the palm side, so the bent fingertip shows; B follows A (linked)
-    pair.set_linked(False)
+    pair.pair.set_linked(False)
     for side in ("a", "b"):
         plotter = pair.viewports[side].plotter
         plotter.view_xy()
@@ -61,17 +61,17 @@ def main() -> int:
         plotter.camera.Elevation(35.0)
         plotter.camera.OrthogonalizeViewUp()
         plotter.reset_camera()
-    pair.set_linked(True)
-    pair.set_display("threshold", share=args.share)
+    pair.pair.set_linked(True)
+    pair.pair.set_display("threshold", share=args.share)
     for kind in ("vibration", "hks"):
         t = time.perf_counter()
-        pair.set_kind(kind)
+        pair.pair.set_kind(kind)
         pair.wait()
         print(f"{kind}: spectra of both meshes {time.perf_counter() - t:.1f} s")
         t = time.perf_counter()
-        pair.pick_a(pick)
+        pair.pair.pick("a", pick)
         app.processEvents()
-        side, w, dist = pair.best_match()
+        side, w, dist = pair.pair.best_match()
         print(f"{kind}: pick and draw {time.perf_counter() - t:.2f} s")
         near = min(tips_b, key=lambda n: float(
             ((pair.pair.mesh("b").vertices[w] - pair.pair.mesh("b").vertices[tips_b[n]]) ** 2).sum()

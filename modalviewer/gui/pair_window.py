@@ -4,14 +4,15 @@ distance between shapes on the other.
 It draws :class:`~modalviewer.viewer.pair.PairState` and keeps nothing else but VTK
 objects.  Its spectra go through the main window's job queue and disk cache (one
 computation at a time, progress in this window and in the main window's status bar);
-A's spectra are reused from the main window's state when it has them.  The main
-window's own display and pick are never changed.  Scripting::
+A's spectra are reused from the main window's state when it has them, and what a change
+of the state needs is computed.  The main window's own display and pick are never
+changed.  Scripts use the state, ``window.pair``::
 
-    pair = win.open_second_mesh("assets/demo_hand_bent.obj")   # waits for the spectra
-    pair.set_kind("vibration"); pair.wait()
-    pair.pick_a(12541); pair.best_match()                       # ("b", vertex, distance)
-    pair.set_display("threshold", share=0.05)
-    pair.export_screenshot("pair.png", scale=2)
+    window = win.open_second_mesh("assets/demo_hand_bent.obj")   # waits for the spectra
+    window.pair.set_kind("vibration"); window.wait()
+    window.pair.pick("a", 12541); window.pair.best_match()       # ("b", vertex, distance)
+    window.pair.set_display("threshold", share=0.05)
+    window.export_screenshot("pair.png", scale=2)
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtWidgets
 
-from ..core.laplacian import vertex_normals
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
@@ -68,7 +68,10 @@ class PairWindow(QtWidgets.QWidget):
         self._syncing = False
         self._link = None
         self._build(force_offscreen)
+        self._requested = self._wanted()  # what the spectra were last requested for: the
+        # first request comes once the window is shown (the progress text fits its bar)
         self.pair.events.display.connect(self.redraw)
+        self.pair.events.linked.connect(self._on_linked)
         self.pair.events.meshes.connect(self._on_meshes)
         self.pair.events.message.connect(self._on_message)
         main.model.jobs.events.changed.connect(self._on_jobs)
@@ -89,13 +92,13 @@ class PairWindow(QtWidgets.QWidget):
             "kernel or wave kernel (Laplacian)"
         )
         self.kind_combo.currentIndexChanged.connect(
-            lambda: self.set_kind(self.kind_combo.currentData())
+            lambda: self.pair.set_kind(self.kind_combo.currentData())
         )
         self.display_combo = QtWidgets.QComboBox()
         self.display_combo.addItem("Continuous", "continuous")
         self.display_combo.addItem("Threshold", "threshold")
         self.display_combo.currentIndexChanged.connect(
-            lambda: self.set_display(self.display_combo.currentData())
+            lambda: self.pair.set_display(self.display_combo.currentData())
         )
         self.share_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
         self.share_slider.setRange(1, 500)  # tenths of a percent of the other mesh's area
@@ -104,7 +107,7 @@ class PairWindow(QtWidgets.QWidget):
             "similar points)"
         )
         self.share_slider.valueChanged.connect(
-            lambda v: self.set_display("threshold", share=v / 1000.0)
+            lambda v: self.pair.set_display("threshold", share=v / 1000.0)
         )
         self.share_label = QtWidgets.QLabel()
         self.share_label.setMinimumWidth(150)
@@ -112,17 +115,17 @@ class PairWindow(QtWidgets.QWidget):
         self.k_spin.setRange(2, 1000)
         self.k_spin.setPrefix("k = ")
         self.k_spin.setToolTip("Modes computed on each mesh (the same number on both)")
-        self.k_spin.editingFinished.connect(lambda: self.set_k(self.k_spin.value()))
+        self.k_spin.editingFinished.connect(lambda: self.pair.set_k(self.k_spin.value()))
         self.rescale_check = QtWidgets.QCheckBox("Rescale both to the same area before computing")
         self.rescale_check.setToolTip(RESCALE_TIP)
-        self.rescale_check.toggled.connect(self.set_rescale)
+        self.rescale_check.toggled.connect(self.pair.set_rescale)
         self.link_check = QtWidgets.QCheckBox("Linked cameras")
         self.link_check.setToolTip(
             "Turning or zooming one view turns the other the same way (each about its own "
             "mesh's centre)"
         )
         self.link_check.setChecked(True)
-        self.link_check.toggled.connect(self.set_linked)
+        self.link_check.toggled.connect(self.pair.set_linked)
         export = QtWidgets.QPushButton("Export...")
         export.setToolTip("Save both views side by side, with their legends, as one PNG")
         export.clicked.connect(self._export_dialog)
@@ -200,6 +203,7 @@ class PairWindow(QtWidgets.QWidget):
             (self.share_slider, int(round(1000 * p.share)), "setValue"),
             (self.k_spin, p.k, "setValue"),
             (self.rescale_check, p.rescale, "setChecked"),
+            (self.link_check, p.linked, "setChecked"),
         ):
             widget.blockSignals(True)
             getattr(widget, setter)(value)
@@ -209,7 +213,7 @@ class PairWindow(QtWidgets.QWidget):
     # ============================================================ meshes
     def _on_meshes(self) -> None:
         for side in SIDES:
-            mesh = self.pair.mesh(side)
+            mesh = self.pair.drawn_mesh(side)
             scene = self.scenes[side]
             if scene is not None and scene.mesh is mesh:
                 continue
@@ -217,7 +221,7 @@ class PairWindow(QtWidgets.QWidget):
                 scene.remove()
             self._remove_back_marker(side)
             plotter = self.viewports[side].plotter
-            scene = MeshScene(plotter, mesh, vertex_normals(mesh))
+            scene = MeshScene(plotter, mesh)
             scene.overlay_scale = getattr(self.main.scene, "overlay_scale", 1.0)
             self.scenes[side] = scene
             self.titles[side].setText(
@@ -236,7 +240,6 @@ class PairWindow(QtWidgets.QWidget):
             self.close()
             return
         self.pair.set_mesh("a", mesh, self.main.state.mesh_path)
-        self.request()
 
     def open_b(self, path) -> bool:
         """Replace mesh B by the mesh file ``path``; False (after a message) if it failed."""
@@ -244,7 +247,6 @@ class PairWindow(QtWidgets.QWidget):
         if mesh is None:
             return False
         self.pair.set_mesh("b", mesh, Path(path))
-        self.request()
         return True
 
     def dragEnterEvent(self, event):  # noqa: N802
@@ -260,9 +262,12 @@ class PairWindow(QtWidgets.QWidget):
     def redraw(self) -> None:
         """Draw both sides from the pair state; a side whose picture did not change is
         left alone, and a threshold move on the same distances only changes the colour
-        table and the legend."""
+        table and the legend.  A new kind, k, scaling, mesh or pick requests the spectra
+        it needs."""
         if self._closed:
             return
+        if self._wanted() != self._requested:
+            self.request()
         for side in SIDES:
             scene = self.scenes[side]
             if scene is None:
@@ -271,6 +276,10 @@ class PairWindow(QtWidgets.QWidget):
                 self.viewports[side].request_render()
         self._sync_controls()
         self._update_status()
+
+    def _wanted(self) -> tuple:
+        p = self.pair
+        return p.key(), p.picked, p.drawn_mesh("a").hash, p.drawn_mesh("b").hash
 
     def _draw(self, side: str, scene: MeshScene, view: PairView) -> bool:
         """Bring ``scene`` to ``view``; False if it already showed it."""
@@ -288,12 +297,8 @@ class PairWindow(QtWidgets.QWidget):
         elif view.colormap == "threshold":
             scene.show_threshold(view.values, view.threshold, name=view.colorbar_title)
         else:
-            from ..core.laplacian import lumped_masses
-            from ..viewer.color_scale import auto_spread
-
-            scale = auto_spread(view.values, lumped_masses(scene.mesh))
             scene.show_field(
-                view.values, "sequential", isolines=0, name=view.colorbar_title, scale=scale
+                view.values, "sequential", isolines=0, name=view.colorbar_title, scale=view.scale
             )
         scene.set_legend(view.legend)
         if view.values is None:
@@ -335,11 +340,9 @@ class PairWindow(QtWidgets.QWidget):
         match = p.best_match()
         if match is not None:
             side, w, dist = match
-            fw = p.mesh(side).file_vertex(w)  # the files' vertex numbers
-            text = f"Best match on {side.upper()}: vertex {fw} (distance {dist:.3g})"
+            text = f"Best match on {side.upper()}: vertex {w} (distance {dist:.3g})"
             back = p.back_match()
-            fb = p.mesh(p.picked[0]).file_vertex(back)
-            text += "; mutual" if back == p.picked[1] else f"; not mutual (back: vertex {fb})"
+            text += "; mutual" if back == p.picked[1] else f"; not mutual (back: vertex {back})"
         elif p.picked is None:
             text = "Click a point on A or on B."
         else:
@@ -383,20 +386,14 @@ class PairWindow(QtWidgets.QWidget):
         return metrics.elidedText(head, elide, max(0, room - tail_width)) + tail
 
     # ========================================================== cameras
-    def set_linked(self, on: bool) -> None:
-        """Linked cameras: the two views keep the relative viewpoint they have when the
-        link is made (after opening or R: the same direction, each about its own mesh's
-        centre), so turning, zooming or panning one view does the same to the other.
-        Free cameras: turn B by hand to line it up with A (a rotated copy), then link."""
-        self.pair.set_linked(on)
-        self.link_check.blockSignals(True)
-        self.link_check.setChecked(self.pair.linked)
-        self.link_check.blockSignals(False)
+    def _on_linked(self, on: bool) -> None:
+        """Linked cameras (``pair.set_linked``): the two views keep the relative viewpoint
+        they have when the link is made (after opening or R: the same direction, each
+        about its own mesh's centre), so turning, zooming or panning one view does the
+        same to the other.  Free cameras: turn B by hand to line it up with A (a rotated
+        copy), then link."""
+        self._sync_controls()
         self._link = self._make_link() if on else None
-
-    @property
-    def linked(self) -> bool:
-        return self.pair.linked
 
     def _make_link(self):
         """(Q, s, focal A, focal B): the similarity x_B = focal_B + s Q (x_A - focal_A)
@@ -408,7 +405,7 @@ class PairWindow(QtWidgets.QWidget):
         return fb @ fa.T, db / da, focal_a, focal_b
 
     def _on_camera(self, side: str) -> None:
-        if self.linked and not self._syncing:
+        if self.pair.linked and not self._syncing:
             dst = "b" if side == "a" else "a"
             self._copy_camera(side, dst)
             self.viewports[dst].request_render()
@@ -454,7 +451,7 @@ class PairWindow(QtWidgets.QWidget):
         factor = mb.bounding_box_diagonal / (ma.bounding_box_diagonal or 1.0)
         self._link = (np.eye(3), factor, _bbox_centre(ma), _bbox_centre(mb))
         self._copy_camera("a", "b")
-        self.set_linked(self.linked)
+        self._on_linked(self.pair.linked)
 
     def reset_cameras(self) -> None:
         """Back to the first views (R): see :meth:`_start_views`."""
@@ -471,54 +468,18 @@ class PairWindow(QtWidgets.QWidget):
         scene = self.scenes[side]
         vertex = scene.vertex_at_display(x, y) if scene is not None else None
         if vertex is not None:
-            self.pick(side, vertex)
+            self._pick(side, vertex)
 
-    def pick(self, side: str, vertex: int) -> None:
-        """Pick ``vertex`` of ``side`` (as a click does); a missing spectrum is computed."""
-        self._pick_then_request(lambda: self.pair.pick(side, vertex))
-
-    def pick_a(self, vertex: int) -> None:
-        """Pick mesh vertex ``vertex`` of A (a mesh index, as a click gives it)."""
-        self.pick("a", vertex)
-
-    def pick_b(self, vertex: int) -> None:
-        self.pick("b", vertex)
-
-    def pick_file_vertex(self, side: str, number: int) -> None:
-        """Pick vertex ``number`` of the file of mesh ``side`` ("a" or "b"; the number
-        the legends show); a missing spectrum is computed."""
-        self._pick_then_request(lambda: self.pair.pick_file_vertex(side, number))
-
-    def _pick_then_request(self, pick) -> None:
-        """``pick()``, then the spectra it needs; a refused pick (ValueError) is said."""
-        try:
-            pick()
-        except ValueError as exc:
-            self._on_message(str(exc))
-            return
+    def _pick(self, side: str, vertex: int) -> None:
+        """Pick drawn vertex ``vertex`` of ``side`` (a click); a spectrum missing or
+        cancelled before is computed."""
+        self.pair.pick(side, self.pair.drawn_mesh(side).file_vertex(vertex))
         self.request()
-
-    def set_kind(self, kind: str) -> None:
-        """ "vibration" | "feature" | "hks"; its spectra are computed in the background."""
-        self.pair.set_kind(kind)
-        self.request()
-
-    def set_k(self, k: int) -> None:
-        self.pair.set_k(k)
-        self.request()
-
-    def set_rescale(self, on: bool) -> None:
-        self.pair.set_rescale(on)
-        self.request()
-
-    def set_display(self, display: str, share: float | None = None) -> None:
-        """ "continuous" or "threshold"; ``share``: the part (0..1) of the other mesh's
-        surface area the threshold marks blue."""
-        self.pair.set_display(display, share)
 
     def request(self) -> list:
         """Start the computations the current kind needs (asking first for long ones
         unless scripted); returns the pending jobs."""
+        self._requested = self._wanted()
         key = self.pair.key()
         missing = [s for s in SIDES if self.pair.spectrum(s) is None]
         seconds = self._estimated_seconds(key, missing)
@@ -560,23 +521,6 @@ class PairWindow(QtWidgets.QWidget):
         except ComputeError as exc:
             raise PairError(str(exc)) from None
         QtWidgets.QApplication.processEvents()
-
-    # ========================================================== results
-    def distance_on_b(self) -> np.ndarray | None:
-        """(n_b,) distance from the pick on A to every vertex of B (None: no pick on A,
-        or the spectra are not in)."""
-        return self.pair.distance_on("b")
-
-    def distance_on_a(self) -> np.ndarray | None:
-        return self.pair.distance_on("a")
-
-    def best_match(self) -> tuple[str, int, float] | None:
-        """(side, vertex, distance) of the best match of the pick on the other mesh."""
-        return self.pair.best_match()
-
-    def mutual_best_matches(self, vertices_a, vertices_b=None):
-        """Best matches of several vertices of A on B and whether each is mutual."""
-        return self.pair.mutual_best_matches(vertices_a, vertices_b)
 
     # =========================================================== export
     def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:

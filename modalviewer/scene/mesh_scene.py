@@ -13,6 +13,7 @@ from vtkmodules.util.numpy_support import numpy_to_vtk
 from vtkmodules.vtkCommonDataModel import vtkImageData
 from vtkmodules.vtkRenderingCore import vtkActor2D, vtkCellPicker, vtkImageMapper
 
+from ..core.laplacian import vertex_normals
 from ..core.mesh import Mesh
 from ..viewer import camera as cameras
 from .overlay import ColorBar, Overlay, draw_overlay
@@ -213,7 +214,11 @@ def fit_smaller_side(renderer) -> None:
 class MeshScene:
     """Owns the actors of one mesh on a pyvista plotter."""
 
-    def __init__(self, plotter, mesh: Mesh, normals: np.ndarray, style: str = DEFAULT_STYLE):
+    def __init__(
+        self, plotter, mesh: Mesh, normals: np.ndarray | None = None, style: str = DEFAULT_STYLE
+    ):
+        if normals is None:
+            normals = vertex_normals(mesh)
         self.plotter = plotter
         self.mesh = mesh
         self.normals = normals

@@ -14,6 +14,11 @@ The window draws :meth:`PairState.view` of each side and observes ``events``:
 - ``display()``: what either side shows changed (kind, display, share, pick, scale).
 - ``message(str)``: something the user should read (a failed computation, a warning).
 
+Every vertex a method takes or returns is in the input's numbering (row i of the arrays,
+the i-th vertex record of the file), as everywhere in modalviewer; distances have one
+row per input vertex, NaN at vertices no face uses.  Only :class:`PairView`, what the
+window draws, numbers the vertices of :meth:`PairState.drawn_mesh`.
+
 Distances are :class:`~modalviewer.core.cross.CrossTables` queries: eq. (31) with both
 signatures at the common scales, each normalised by its own Z(t).  Rescaling matters:
 Laplacian and E_D^N signatures carry a factor 1/area, and the Discrete Shells spectrum
@@ -31,7 +36,7 @@ import numpy as np
 from psygnal import Signal, SignalGroup
 
 from ..core.cache import SpectrumCache
-from ..core.cross import CrossTables, ScaleWarning
+from ..core.cross import CrossTables, Matches, ScaleWarning
 from ..core.laplacian import lumped_masses
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import (
@@ -42,7 +47,9 @@ from ..core.operators import (
     signature_kind,
 )
 from ..core.spectrum import Spectrum
+from ..core.validate import check_vertices
 from ..spectra import cached_or_computed
+from .color_scale import auto_spread
 from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, SpectrumJob
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
@@ -66,7 +73,7 @@ def _check_side(side: str) -> None:
 
 @dataclass
 class PairView:
-    """What one side of the pair draws.
+    """What one side of the pair draws, on :meth:`PairState.drawn_mesh` (its numbering).
 
     values : (n,) distances on this side from the pick on the other side, or None (the
         plain surface: nothing picked yet, the spectra are not in, or this side is the
@@ -78,6 +85,8 @@ class PairView:
         not the picked vertex (the match is not mutual); else None.
     legend : the lines drawn at the top left of the view and in exports.
     colorbar_title, colorbar_labels : the colour bar (labels for a threshold's swatches).
+    scale : the knots of a colour scale spread by area (:func:`.color_scale.auto_spread`),
+        or None for linear colours.
     """
 
     values: np.ndarray | None
@@ -88,6 +97,7 @@ class PairView:
     legend: str
     colorbar_title: str | None = None
     colorbar_labels: list[str] | None = None
+    scale: np.ndarray | None = None
 
 
 class PairEvents(SignalGroup):
@@ -102,7 +112,7 @@ class _Side:
     def __init__(self, mesh: Mesh, path) -> None:
         self.mesh = mesh.solver_mesh  # the vertices faces use; its map gives the input's numbers
         self.path = Path(path) if path is not None else None
-        self.masses = lumped_masses(mesh)
+        self.masses = lumped_masses(self.mesh)
         self.unit_mesh: Mesh | None = None
 
     @property
@@ -161,7 +171,7 @@ class PairState:
         self.rescale = bool(rescale)
         self.distance_display = "continuous"
         self.share = DEFAULT_THRESHOLD_SHARE  # of the other mesh's area, threshold display
-        self.picked: tuple[str, int] | None = None
+        self._pick: tuple[str, int] | None = None  # (side, vertex of the drawn mesh)
         self.linked = True  # the two views' cameras move together
         self.note = ""  # a warning about the current pair (scale), shown in legends
         self._spectra: dict[tuple[str, str, SpectrumKey], Spectrum] = {}
@@ -170,6 +180,7 @@ class PairState:
         self._tables: tuple | None = None  # (ids of both spectra, kind; CrossTables or error)
         self._distance: tuple | None = None  # (tables id, pick, distances)
         self._back: tuple | None = None  # (tables id, side, best match, back match)
+        self._scale: tuple | None = None  # (distances, their spread colour scale)
 
     def set_linked(self, on: bool) -> None:
         """Link the two views' cameras (they keep their relative viewpoint) or free them."""
@@ -179,6 +190,13 @@ class PairState:
 
     # ----------------------------------------------------------- meshes
     def mesh(self, side: str) -> Mesh:
+        """Mesh ``side`` as given (the input's numbering)."""
+        _check_side(side)
+        return self.sides[side].mesh.input_mesh
+
+    def drawn_mesh(self, side: str) -> Mesh:
+        """The surface the window draws of ``side``: the vertices faces use (the
+        numbering of :class:`PairView`; its ``file_vertex`` gives the input's)."""
         _check_side(side)
         return self.sides[side].mesh
 
@@ -191,7 +209,7 @@ class PairState:
         _check_side(side)
         self.jobs.cancel_all(owner=self.owner(side), reason="superseded: another mesh")
         self.sides[side] = _Side(mesh, path)
-        self.picked = None
+        self._pick = None
         self._tables = self._distance = None
         self.events.meshes.emit()
         self.events.display.emit()
@@ -251,34 +269,29 @@ class PairState:
         if changed:
             self.events.display.emit()
 
+    @property
+    def picked(self) -> tuple[str, int] | None:
+        """(side, vertex) of the pick, or None."""
+        if self._pick is None:
+            return None
+        side, v = self._pick
+        return side, self.sides[side].mesh.file_vertex(v)
+
     def pick(self, side: str, vertex: int | None) -> None:
-        """Pick mesh vertex ``vertex`` of mesh ``side`` (the loaded mesh's compact index,
-        as :meth:`.Viewer.pick_vertex`; None clears the pick).  The file's vertex
-        numbers, which differ where the file has vertices no face uses: see
-        :meth:`pick_file_vertex`."""
+        """Pick vertex ``vertex`` of mesh ``side`` (None clears the pick); a ValueError
+        for a vertex the mesh does not have or no face uses."""
         _check_side(side)
+        new = None
         if vertex is not None:
-            n = self.sides[side].mesh.n_vertices
             if isinstance(vertex, bool) or not isinstance(vertex, int | np.integer):
                 raise ValueError(f"a vertex is an integer index, got {vertex!r}")
-            vertex = int(vertex)
-            if not 0 <= vertex < n:
-                raise ValueError(f"Vertex {vertex} does not exist on {side.upper()} (0..{n - 1}).")
-        new = None if vertex is None else (side, vertex)
-        if new != self.picked:
-            self.picked = new
+            try:
+                new = (side, self.sides[side].mesh.mesh_vertex(int(vertex)))
+            except MeshError as exc:
+                raise ValueError(f"{side.upper()}: {exc}") from None
+        if new != self._pick:
+            self._pick = new
             self.events.display.emit()
-
-    def pick_file_vertex(self, side: str, number: int) -> None:
-        """Pick vertex ``number`` of mesh ``side``'s file (the number the viewer shows,
-        as ``modalviewer distance --vertex`` takes it); ValueError for one no face uses
-        or the file does not have."""
-        _check_side(side)
-        try:
-            index = self.sides[side].mesh.mesh_vertex(number)
-        except MeshError as exc:
-            raise ValueError(f"{side.upper()}: {exc}") from None
-        self.pick(side, index)
 
     # ----------------------------------------------------------- spectra
     def spectrum(self, side: str, key: SpectrumKey | None = None) -> Spectrum | None:
@@ -416,9 +429,9 @@ class PairState:
                 self.events.display.emit()
 
     # --------------------------------------------------------- distances
-    def tables(self) -> CrossTables | None:
-        """Both signature tables at the common scales, or None if a spectrum is missing
-        or the pair cannot be compared (``note`` says why)."""
+    def _cross_tables(self) -> CrossTables | None:
+        """Both signature tables at the common scales (drawn meshes' numbering), or None
+        if a spectrum is missing or the pair cannot be compared (``note`` says why)."""
         sa, sb = self.spectrum("a"), self.spectrum("b")
         if sa is None or sb is None:
             return None
@@ -442,68 +455,83 @@ class PairState:
         tables = self._tables[1]
         return tables if isinstance(tables, CrossTables) else None
 
-    def distance_on(self, side: str) -> np.ndarray | None:
-        """(n,) distance from the picked vertex (on the other side) to every vertex of
-        ``side``; None if nothing is picked there, or the spectra are not in."""
-        _check_side(side)
-        if self.picked is None or self.picked[0] == side:
+    def _drawn_distance(self, side: str) -> np.ndarray | None:
+        """:meth:`distance_on` on the drawn mesh of ``side``."""
+        if self._pick is None or self._pick[0] == side:
             return None
-        tables = self.tables()
+        tables = self._cross_tables()
         if tables is None:
             return None
-        key = (id(tables), self.picked)
+        key = (id(tables), self._pick)
         if self._distance is None or self._distance[0] != key:
-            from_side, v = self.picked
+            from_side, v = self._pick
             d = tables.a_to_b(v) if from_side == "a" else tables.b_to_a(v)
             self._distance = (key, d)
         return self._distance[1]
 
-    def best_match(self) -> tuple[str, int, float] | None:
-        """(side, vertex, distance): the vertex of the other mesh closest to the pick (a
-        mesh index; :meth:`best_file_match` gives the file's number)."""
-        if self.picked is None:
-            return None
-        side = other(self.picked[0])
-        d = self.distance_on(side)
+    def _spread(self, side: str, d: np.ndarray):
+        """:func:`auto_spread` of the distances ``d`` on ``side``, kept while they are."""
+        if self._scale is None or self._scale[0] is not d:
+            self._scale = (d, auto_spread(d, self.sides[side].masses))
+        return self._scale[1]
+
+    def _drawn_matches(self) -> tuple[str, int, float, int] | None:
+        """(side, best match, its distance, match back) on the drawn meshes."""
+        d = None if self._pick is None else self._drawn_distance(other(self._pick[0]))
         if d is None:
             return None
+        side = other(self._pick[0])
         w = int(np.argmin(d))
-        return side, w, float(d[w])
+        tables = self._cross_tables()
+        key = (id(tables), side, w)
+        if self._back is None or self._back[0] != key:
+            back = tables.a_to_b(w) if side == "a" else tables.b_to_a(w)
+            self._back = (key, int(np.argmin(back)))
+        return side, w, float(d[w]), self._back[1]
 
-    def best_file_match(self) -> tuple[str, int, float] | None:
-        """:meth:`best_match` with the vertex as its file's number (the number the
-        viewer shows)."""
-        match = self.best_match()
+    def distance_on(self, side: str) -> np.ndarray | None:
+        """(n,) distance from the picked vertex (on the other side) to every vertex of
+        ``side`` (NaN where no face uses it); None if nothing is picked there, or the
+        spectra are not in."""
+        _check_side(side)
+        d = self._drawn_distance(side)
+        return None if d is None else self.sides[side].mesh.to_file_field(d)
+
+    def best_match(self) -> tuple[str, int, float] | None:
+        """(side, vertex, distance): the vertex of the other mesh closest to the pick."""
+        match = self._drawn_matches()
         if match is None:
             return None
-        side, w, distance = match
-        return side, self.mesh(side).file_vertex(w), distance
+        side, w, distance, _ = match
+        return side, self.sides[side].mesh.file_vertex(w), distance
 
     def back_match(self) -> int | None:
         """The vertex of the picked mesh closest to the best match (the pick itself when
         the match is mutual)."""
-        match = self.best_match()
-        tables = self.tables()
-        if match is None or tables is None:
+        match = self._drawn_matches()
+        if match is None:
             return None
-        side, w, _ = match
-        key = (id(tables), side, w)
-        if self._back is None or self._back[0] != key:
-            d = tables.a_to_b(w) if side == "a" else tables.b_to_a(w)
-            self._back = (key, int(np.argmin(d)))
-        return self._back[1]
+        return self.sides[other(match[0])].mesh.file_vertex(match[3])
 
-    def mutual_best_matches(self, vertices_a, vertices_b=None):
-        """:meth:`CrossTables.mutual_best_matches` of picked vertices of A (None if the
-        spectra are not in)."""
-        tables = self.tables()
-        return None if tables is None else tables.mutual_best_matches(vertices_a, vertices_b)
+    def mutual_best_matches(self, vertices_a, vertices_b=None) -> Matches | None:
+        """:meth:`CrossTables.mutual_best_matches` of vertices of A (on vertices of B, if
+        given); None if the spectra are not in."""
+        tables = self._cross_tables()
+        if tables is None:
+            return None
+        mesh_a, mesh_b = self.sides["a"].mesh, self.sides["b"].mesh
+        va = _drawn_vertices(mesh_a, vertices_a, "A")
+        vb = None if vertices_b is None else _drawn_vertices(mesh_b, vertices_b, "B")
+        m = tables.mutual_best_matches(va, vb)
+        back = mesh_a.file_vertices[m.back_matches_a]
+        picked = mesh_a.file_vertices[m.vertices_a]
+        return Matches(picked, mesh_b.file_vertices[m.matches_b], m.distances, back, m.mutual)
 
-    def threshold(self, side: str, d: np.ndarray | None = None) -> tuple[float, float] | None:
+    def threshold(self, side: str) -> tuple[float, float] | None:
         """(distance, share of the area) of the threshold display on ``side``: the
         smallest distance whose sub-level set ``d <= t`` covers ``share`` of the mesh's
         area, and the part of the area that set really covers (>= share)."""
-        d = self.distance_on(side) if d is None else d
+        d = self._drawn_distance(side)
         if d is None:
             return None
         masses = self.sides[side].masses
@@ -527,26 +555,28 @@ class PairState:
     def view(self, side: str) -> PairView:
         """What ``side`` shows: see :class:`PairView`."""
         _check_side(side)
-        head = f"{side.upper()}: {self.name(side)}, {self.mesh(side).n_vertices} vertices"
+        drawn = self.drawn_mesh(side)
+        head = f"{side.upper()}: {self.name(side)}, {drawn.n_vertices} vertices"
         name = DISTANCE_KINDS[self.kind]
-        plain = PairView(None, "plain", None, None, None, head)
-        if self.picked is None:
+        if self._pick is None:
             return PairView(None, "plain", None, None, None, f"{head}\nclick A or B to pick")
-        from_side, v = self.picked
-        if self.tables() is None:
+        from_side, v = self._pick
+        matches = self._drawn_matches()
+        if matches is None:
             marker = v if from_side == side else None
-            plain.marker = marker
-            plain.legend = f"{head}\n{name}: {self._missing()}"
-            return plain
-        _, w, dist = self.best_match()
+            legend = f"{head}\n{name}: {self._missing()}"
+            return PairView(None, "plain", None, marker, None, legend)
+        _, w, dist, back = matches
         notes = [n for n in (self.note, self.arrival_note()) if n]
         note = "".join(f"\n{n}" for n in notes)
-        # labels give the files' vertex numbers; markers are mesh indices
-        fv = self.mesh(from_side).file_vertex(v)
+        # markers are drawn-mesh vertices, labels the input's numbers
+        fv, fw = self.picked[1], self.best_match()[1]
         if from_side == side:
-            back = self.back_match()
-            fb, fw = self.mesh(side).file_vertex(back), self.mesh(other(side)).file_vertex(w)
-            mutual = "mutual" if back == v else f"not mutual: back to vertex {fb} (yellow)"
+            mutual = (
+                "mutual"
+                if back == v
+                else f"not mutual: back to vertex {self.back_match()} (yellow)"
+            )
             return PairView(
                 None,
                 "plain",
@@ -556,11 +586,10 @@ class PairState:
                 f"{head}\npicked vertex {fv}\nbest match on {other(side).upper()}: vertex {fw}"
                 f"\n{mutual}{note}",
             )
-        d = self.distance_on(side)
-        fw = self.mesh(side).file_vertex(w)
+        d = self._drawn_distance(side)
         source = f"from vertex {fv} of {from_side.upper()}"
         if self.distance_display == "threshold":
-            thr, share = self.threshold(side, d)
+            thr, share = self.threshold(side)
             similar = f"{name.lower()} < {thr:.3g} ({100 * share:.1f} %)"
             return PairView(
                 d,
@@ -582,4 +611,15 @@ class PairState:
             f"{head}\n{name} {source}: white 0 to red {float(d.max()):.3g}\n"
             f"best match: vertex {fw} (d = {dist:.3g}){note}",
             name,
+            scale=self._spread(side, d),
         )
+
+
+def _drawn_vertices(mesh: Mesh, vertices, name: str) -> np.ndarray:
+    """The drawn mesh's vertices of input vertices ``vertices`` (a ValueError naming one
+    no face uses)."""
+    checked = check_vertices(vertices, mesh.n_file_vertices, f"vertices of {name}")
+    try:
+        return np.array([mesh.mesh_vertex(v) for v in checked], dtype=np.int64)
+    except MeshError as exc:
+        raise ValueError(f"{name}: {exc}") from None

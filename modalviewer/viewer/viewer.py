@@ -1131,11 +1131,9 @@ class Viewer:
     def pair(self, mesh_b, k: int | None = None, wait: bool = True, strict: bool = True, path=None):
         """Distances between two shapes: this viewer's mesh as A and ``mesh_b`` as B.
 
-        Use the result with ``pair.pick_file_vertex("a", n)`` (the file's vertex
-        number) or ``pair.pick("a", v)`` (a mesh index), ``pair.distance_on("b")`` and
-        ``pair.best_file_match()`` (the file's number) or ``pair.best_match()`` (a mesh
-        index).  The distance kind and the Discrete Shells weights are this
-        viewer's.
+        Use the result with ``pair.pick("a", v)``, ``pair.distance_on("b")`` and
+        ``pair.best_match()``, all in the input's numbering.  The distance kind and the
+        Discrete Shells weights are this viewer's.
 
         Parameters
         ----------

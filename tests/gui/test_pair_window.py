@@ -62,9 +62,9 @@ def test_pick_on_a_shows_the_distance_and_best_match_on_b(
     _click(qtbot, a_view, QtCore.QPoint(a_view.width() // 2, a_view.height() // 2))
     assert pair.pair.picked is not None and pair.pair.picked[0] == "a"
     v = pair.pair.picked[1]
-    d = pair.distance_on_b()
+    d = pair.pair.distance_on("b")
     assert d[v] <= 1e-8 * d.max()  # the moved copy of the pick: distance zero
-    side, w, dist = pair.best_match()
+    side, w, dist = pair.pair.best_match()
     assert (side, w) == ("b", v) and dist <= 1e-8 * d.max()
     assert pair.pair.back_match() == v  # mutual
     field = np.array(pair.scenes["b"].surface.point_data["field"])
@@ -87,7 +87,7 @@ def test_pick_on_a_shows_the_distance_and_best_match_on_b(
     pair._on_camera("b")
     assert np.linalg.norm(pair.viewports["a"].plotter.camera.GetPosition() - a_before) > 0.1
 
-    pair.set_display("threshold", share=0.05)
+    pair.pair.set_display("threshold", share=0.05)
     legend = pair.scenes["b"].legend_text
     assert "blue: heat kernel distance < " in legend and "% of B" in legend
     out = pair.export_screenshot(tmp_path / "pair.png")
@@ -117,17 +117,17 @@ def test_pick_on_a_shows_the_distance_and_best_match_on_b(
     assert big_img.mode == "RGBA" and big_img.size[0] >= 2 * img.shape[1] - 8
 
     # a click on B works the other way
-    pair.pick_b(123)
-    d_a = pair.distance_on_a()
-    assert pair.distance_on_b() is None and d_a[123] <= 1e-8 * d_a.max()
-    assert pair.best_match()[:2] == ("a", 123)
+    pair.pair.pick("b", 123)  # the window computes what the pick needs
+    d_a = pair.pair.distance_on("a")
+    assert pair.pair.distance_on("b") is None and d_a[123] <= 1e-8 * d_a.max()
+    assert pair.pair.best_match()[:2] == ("a", 123)
 
     # free cameras: turning A leaves B where it is; linked again, B follows
-    pair.set_linked(False)
+    pair.link_check.setChecked(False)
     b_before = np.array(pair.viewports["b"].plotter.camera.GetPosition())
     _drag(qtbot, a_view, 80)
     assert np.allclose(pair.viewports["b"].plotter.camera.GetPosition(), b_before)
-    pair.set_linked(True)
+    pair.link_check.setChecked(True)
     _drag(qtbot, a_view, 80)
     assert not np.allclose(pair.viewports["b"].plotter.camera.GetPosition(), b_before)
     assert pair.pair.picked == ("b", 123)  # drags are not clicks

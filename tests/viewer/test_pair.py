@@ -148,7 +148,8 @@ def test_spectra_of_a_come_from_the_main_state_and_the_disk_cache(tmp_path, spot
 
 def test_bad_input_gets_clear_errors(tmp_path, spot):
     pair = _pair(tmp_path, spot, _moved(spot), k=K)
-    with pytest.raises(ValueError, match=r"Vertex 5000 does not exist on B \(0..2929\)"):
+    in_words = r"B: vertex 5000 is not in the file \(it has 2930 vertices, numbered 0 to 2929\)"
+    with pytest.raises(ValueError, match=in_words):
         pair.pick("b", 5000)
     with pytest.raises(ValueError, match="integer"):
         pair.pick("a", 1.5)
@@ -195,26 +196,58 @@ def test_a_cancel_is_not_reported_as_a_failure_and_a_failure_is(tmp_path, spot, 
     assert "failed: the factorisation broke" in pair.view("b").legend
 
 
-def test_the_pair_takes_and_gives_the_files_vertex_numbers(tmp_path, spot):
-    # spot with 7 unused vertices at the start of its file: file vertex v + 7 is mesh
-    # vertex v; pick_file_vertex and best_file_match speak in the file's numbers, as the
-    # legends and the command line do, pick and best_match in mesh indices
-    lines = ["v 9 9 9"] * 7 + [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in spot.vertices]
-    lines += [f"f {a + 8} {b + 8} {c + 8}" for a, b, c in spot.faces]
-    path = tmp_path / "padded.obj"
-    path.write_text("\n".join(lines) + "\n")
-    padded = mv.load_mesh(path)
-    pair = _pair(tmp_path, padded, _moved(spot), k=K)
+def _with_unused(mesh, start, middle, end, at=1000):
+    """``mesh`` with vertices no face uses: ``start`` before its first vertex, ``middle``
+    before vertex ``at`` and ``end`` after its last (input vertex v is then v + start
+    below ``at``, v + start + middle from there)."""
+    far = np.full((1, 3), 9.0)
+    v = mesh.vertices
+    vertices = np.vstack([far.repeat(start, 0), v[:at], far.repeat(middle, 0), v[at:]])
+    vertices = np.vstack([vertices, far.repeat(end, 0)])
+    faces = np.where(mesh.faces < at, mesh.faces + start, mesh.faces + start + middle)
+    return mv.as_mesh((vertices, faces))
+
+
+def test_the_pair_speaks_the_input_numbering_on_meshes_with_unused_vertices(tmp_path, spot):
+    # A: spot with 3 unused vertices at the start, 4 before vertex 1000, 2 at the end;
+    # B: a moved copy with 5 at the start and 1 at the end.  Spot's vertex 700 is input
+    # vertex 703 of A and 705 of B; its vertex 2000 is 2007 of A and 2005 of B
+    a = _with_unused(spot, 3, 4, 2)
+    b = _with_unused(_moved(spot), 5, 0, 1)
+    pair = _pair(tmp_path, a, b, k=K)
+    assert pair.mesh("a").n_vertices == a.n_vertices == spot.n_vertices + 9
     _wait(pair)
-    pair.pick_file_vertex("a", 707)
-    assert pair.picked == ("a", 700)
-    assert pair.best_match()[:2] == ("b", 700)
-    assert pair.best_file_match()[:2] == ("b", 700)  # B's file has no unused vertices
-    assert "picked vertex 707\n" in pair.view("a").legend
-    pair.pick_file_vertex("b", 700)
-    assert pair.best_match()[:2] == ("a", 700) and pair.best_file_match()[:2] == ("a", 707)
-    with pytest.raises(ValueError, match="A: .*3"):
-        pair.pick_file_vertex("a", 3)  # no face uses it
+    pair.pick("a", 703)
+    assert pair.picked == ("a", 703)
+    d = pair.distance_on("b")
+    assert d.shape == (b.n_vertices,)
+    assert np.isnan(d[b.unused]).all() and np.isfinite(np.delete(d, b.unused)).all()
+    assert d[705] <= 1e-8 * np.nanmax(d)
+    side, w, dist = pair.best_match()
+    assert (side, w) == ("b", 705) and dist <= 1e-8 * np.nanmax(d)
+    assert pair.back_match() == 703
+    assert "picked vertex 703\n" in pair.view("a").legend
+    assert "best match: vertex 705 " in pair.view("b").legend
+    pair.pick("b", 2005)
+    assert pair.best_match()[:2] == ("a", 2007) and pair.back_match() == 2005
+    assert pair.distance_on("a").shape == (a.n_vertices,)
+    m = pair.mutual_best_matches([703, 2007])
+    np.testing.assert_array_equal(m.vertices_a, [703, 2007])
+    np.testing.assert_array_equal(m.matches_b, [705, 2005])
+    np.testing.assert_array_equal(m.back_matches_a, [703, 2007])
+    assert m.mutual.all()
+    # the threshold covers the share asked for of A's area (its unused vertices have none)
+    pair.set_display("threshold", share=0.1)
+    value, covered = pair.threshold("a")
+    masses = lumped_masses(a.solver_mesh)
+    d = pair.distance_on("a")[a.solver_mesh.file_vertices]
+    assert 0.1 <= covered <= 0.1 + masses.max() / masses.sum() + 1e-12
+    assert covered == pytest.approx(masses[d <= value].sum() / masses.sum(), abs=1e-12)
+    for side, vertex in (("a", 0), ("a", 1005), ("a", 2938), ("b", 2935)):
+        with pytest.raises(ValueError, match=f"{side.upper()}: .*{vertex}"):
+            pair.pick(side, vertex)  # no face uses it
+    with pytest.raises(ValueError, match="does not exist|not in"):
+        pair.pick("a", a.n_vertices)
 
 
 def test_the_wave_kernel_distance_between_shapes_is_its_own(tmp_path, spot):
