@@ -33,7 +33,13 @@ from ..core.operators import (
     operator_info,
     signature_kind,
 )
-from ..core.signatures import SignatureTable, signature, wks_sigma
+from ..core.signatures import (
+    SignatureTable,
+    default_energies,
+    default_times,
+    signature,
+    wks_sigma,
+)
 from ..core.spectrum import Spectrum
 from . import wording
 from .color_scale import robust_limit
@@ -341,6 +347,22 @@ class DerivedValues:
             return None
         return (operator, id(state.spectrum(operator)), state.picked, state.t_range)
 
+    def curve(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(scales, values): the picked vertex's signature at the scales of the display
+        kind's table (energies for the wave kernel), from the modes in; None without a
+        pick or signatures."""
+        state = self.state
+        operator = operator_for_distance(state.display.distance_kind)
+        if state.picked is None or not self.has_signatures(operator):
+            return None
+        table = self.kind_table()
+        spec, vertices = state.spectrum(operator), [state.picked]
+        if table.kind == "wks":
+            times, values = signature(spec, kind="wks", energies=table.times, vertices=vertices)
+        else:
+            times, values = signature(spec, table.times, vertices=vertices)
+        return times, values[0]
+
     def curve_truncation(self) -> float | None:
         """The estimated truncation error of the picked vertex's curve at its smallest
         scale (where it is largest), or None without a curve."""
@@ -373,6 +395,15 @@ class DerivedValues:
             return DEFAULT_UP
         detected = self._mesh_value("up", lambda m: detect_up(m.vertices, m.faces))
         return detected or DEFAULT_UP
+
+    def default_range(self) -> tuple[float, float] | None:
+        """The default scales (energies for the wave kernel) of the display kind's
+        spectrum, what an empty range field stands for; None before it is in."""
+        spec = self.state.spectrum(operator_for_distance(self.state.display.distance_kind))
+        if spec is None:
+            return None
+        times = default_energies(spec) if self.wave() else default_times(spec)
+        return float(times[0]), float(times[-1])
 
     def scale_limits(self) -> tuple[float, float]:
         """(t1, t2) the distances and signatures use: the chosen range or the default."""

@@ -10,7 +10,6 @@ from ...core.operators import (
     operator_for_distance,
     signature_kind,
 )
-from ...core.signatures import default_energies, default_times, signature
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
 from .common import WrappingLabel, combo, quiet, select_data
@@ -143,15 +142,6 @@ class DistancesPanel(QtWidgets.QWidget):
             fraction = position
         self.state.set_display(threshold=fraction)
 
-    def _default_range(self) -> tuple[float, float] | None:
-        """The range an empty field stands for: the default scales of the distance's
-        spectrum (None before it is computed)."""
-        spec = self.state.spectrum(operator_for_distance(self.state.display.distance_kind))
-        if spec is None:
-            return None
-        times = default_energies(spec) if self.state.derived.wave() else default_times(spec)
-        return float(times[0]), float(times[-1])
-
     def _on_range(self) -> None:
         """A typed t1 or t2: an empty field keeps its default (or the value in use); a
         range that is not 0 < t1 < t2 is said below the fields and not taken."""
@@ -165,7 +155,7 @@ class DistancesPanel(QtWidgets.QWidget):
         except ValueError:  # the validator lets through what it cannot finish
             self.range_label.setText("t1 and t2 are scales (positive numbers).")
             return
-        defaults = self._default_range()
+        defaults = self.state.derived.default_range()
         if None in typed and defaults is None:
             self.range_label.setText(
                 "Type both t1 and t2, or compute the distance's spectrum first (an empty "
@@ -294,20 +284,14 @@ class DistancesPanel(QtWidgets.QWidget):
     def _update_signature_plot(self) -> None:
         state = self.state
         operator = operator_for_distance(state.display.distance_kind)
-        spec = state.spectrum(operator)
-        if not state.derived.has_signatures(operator) or state.picked is None:
+        curve = state.derived.curve()
+        if curve is None:
             self.signature_plot.set_data([], [], title="Signature of the picked vertex")
             return
-        table = state.derived.kind_table()
-        if table.kind == "wks":
-            times, values = signature(
-                spec, kind="wks", energies=table.times, vertices=[state.picked]
-            )
-        else:
-            times, values = signature(spec, table.times, vertices=[state.picked])
+        times, values = curve
         self.signature_plot.set_data(
             times,
-            values[0],
+            values,
             logx=True,
             markers=False,
             title=(
