@@ -37,8 +37,9 @@ def main() -> int:
 
     import modalviewer as mv
     from modalviewer.core.laplacian import vertex_normals
+    from modalviewer.scene.colors import STYLES
     from modalviewer.scene.export import save_screenshot
-    from modalviewer.scene.mesh_scene import STYLES, MeshScene
+    from modalviewer.scene.mesh_scene import MeshScene
     from modalviewer.scene.render_metrics import saturation, white_level, zero_band_masks
 
     out = Path(args.out) if args.out else Path(os.environ.get("TMPDIR", "/tmp"))

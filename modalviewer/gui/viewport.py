@@ -15,7 +15,7 @@ import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtGui, QtWidgets
 
-from ..scene.mesh_scene import fit_smaller_side
+from ..scene.framing import fit_smaller_side
 
 CLICK_SLOP = 4  # pixels a press may move and still count as a click
 

@@ -73,8 +73,6 @@ def fit_points(
     free part of a ``size`` (width, height) picture: ``left``, ``top``, ``right`` and
     ``bottom`` pixels in from its edges, and :data:`MARGIN` more.  Pans and dollies (or scales a
     parallel projection) in :data:`FIT_STEPS` steps; no render."""
-    from .mesh_scene import view_angle_on_smaller_side
-
     w, h = (int(size[0]), int(size[1]))
     points = np.asarray(points, dtype=np.float64)
     if len(points) == 0 or w < 2 or h < 2:
@@ -134,3 +132,25 @@ def fit_points(
         else:
             camera.Dolly(1.0 / k)
     renderer.ResetCameraClippingRange()
+
+
+def view_angle_on_smaller_side(renderer) -> None:
+    """Make the active camera's view angle apply to the smaller side of the view.
+
+    VTK applies it to the height, so a view narrower than tall crops a mesh fitted in a
+    wider one at the sides.  With the angle on the smaller side, a camera fitted to the
+    mesh's bounding sphere keeps the whole mesh in sight at any shape of the view, and
+    nothing jumps at a square view.  The viewports call this before every render, and
+    fitting calls it first so the fit is computed with the setting it is drawn with."""
+    w, h = renderer.GetSize()
+    camera = renderer.GetActiveCamera()
+    narrow = bool(w < h)
+    if bool(camera.GetUseHorizontalViewAngle()) != narrow:
+        camera.SetUseHorizontalViewAngle(narrow)
+
+
+def fit_smaller_side(renderer) -> None:
+    """Before every render, let the camera's view angle apply to the smaller side of the
+    view (:func:`view_angle_on_smaller_side`): the window's views and the off-screen
+    plotter alike."""
+    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))

@@ -138,7 +138,7 @@ def mode_grid(viewer, modes, operator: str | None = None, grid=None, size=GRID_P
     canvas = arrange(panels, columns)
     title = f"{operator_info(op).label}: {'deformed shapes, ' if field.deformation else ''}"
     title += "colours over one range"
-    from .mesh_scene import COLORMAPS
+    from .colors import COLORMAPS
 
     shared = ColorBar(title, [np.asarray(c) for c in COLORMAPS[field.colormap]], limits)
     return np.vstack([canvas, bar_strip(canvas.shape[1], shared)])

@@ -2,7 +2,8 @@
 
 Only the GUI thread touches these VTK objects.  Updates reuse the existing
 ``PolyData`` and actors (no re-adding), so switching a mode or a threshold costs
-one array copy, one contour filter and a render.
+one array copy, the isolines (:mod:`.isolines`) and a render.  Colours and styles are
+in :mod:`.colors`.
 """
 
 from __future__ import annotations
@@ -16,14 +17,20 @@ from vtkmodules.vtkRenderingCore import vtkActor2D, vtkCellPicker, vtkImageMappe
 from ..core.laplacian import vertex_normals
 from ..core.mesh import Mesh
 from ..viewer import camera as cameras
+from .colors import (
+    COLORMAPS,
+    DEFAULT_STYLE,
+    DIVERGING,
+    RED,
+    SEQUENTIAL,
+    STYLES,
+    THRESHOLD,
+    WHITE,
+)
+from .framing import view_angle_on_smaller_side
+from .isolines import line_polydata, meaningful_zero_lines, segments
 from .overlay import ColorBar, Overlay, draw_overlay
 
-# The paper's colours: blue positive, white zero, orange negative.
-BLUE = np.array([0.16, 0.38, 0.78])
-WHITE = np.array([1.0, 1.0, 1.0])
-ORANGE = np.array([0.96, 0.55, 0.12])
-RED = np.array([0.78, 0.08, 0.08])
-SIMILAR_BLUE = np.array([0.20, 0.45, 0.85])
 # The rest shape behind a deformed mode: a translucent grey copy (faint but visible on
 # the white background of the paper style).
 GHOST_GREY = (0.55, 0.55, 0.6)
@@ -44,171 +51,6 @@ GHOST_FADE = (0.005, 0.02)
 ghost is not drawn there, from the second on at :data:`GHOST_OPACITY`, linearly between:
 where the displaced surface lies within a hair of the rest shape the ghost shows nothing
 but thin grey rims along the surface's outline."""
-
-
-def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
-    """A lookup table interpolating linearly through ``colors`` (RGB in [0, 1])."""
-    anchors = np.linspace(0.0, 1.0, len(colors))
-    x = np.linspace(0.0, 1.0, n)
-    rgb = np.column_stack([np.interp(x, anchors, [c[i] for c in colors]) for i in range(3)])
-    lut = pv.LookupTable()
-    lut.SetNumberOfTableValues(n)
-    for i, (r, g, b) in enumerate(rgb):
-        lut.SetTableValue(i, float(r), float(g), float(b), 1.0)
-    lut.Build()
-    return lut
-
-
-def _threshold_table(n: int = 2048) -> pv.LookupTable:
-    """The threshold maps' table: blue (similar) below its middle, white above.  Fine
-    (2048 entries), so the step of :meth:`MeshScene.show_threshold`, which looks colours up
-    after interpolation along the surface, falls within 1/2048 of the range from the
-    threshold."""
-    table = np.empty((n, 4))
-    table[:, :3] = WHITE
-    table[: n // 2, :3] = SIMILAR_BLUE
-    table[:, 3] = 1.0
-    lut = pv.LookupTable()
-    lut.SetNumberOfTableValues(n)
-    lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
-    return lut
-
-
-# Rendering styles: the light set-up and the surface's ambient/diffuse/specular balance.
-# "paper": one headlight (the light sits at the camera, like a matcap the brightness
-# depends only on the angle between the normal and the view direction) over a high
-# ambient term: brightness min(1, ambient + diffuse * cos) reaches 1 for surfaces within
-# about 39 degrees of facing the viewer and stays above 225/255 up to about 49 degrees,
-# so white stays white and blue/orange keep their full saturation where the surface faces
-# the viewer, while the shading falls to 0.3 toward silhouettes and sharp edges show as
-# steps in brightness.  No specular term (a highlight would wash the colours out).
-# Polyscope reaches its look with a matcap (an image of a lit sphere indexed by the
-# view-space normal); a headlight gives the same view-locked shading with VTK's own
-# lighting, on screen and off screen alike.
-# "shaded": pyvista's default light kit (key, fill and back lights) with plain diffuse
-# shading: more relief, colours darker (white renders grey).
-STYLES = {
-    "paper": {"ambient": 0.3, "diffuse": 0.9, "specular": 0.0, "lights": "headlight"},
-    "shaded": {"ambient": 0.0, "diffuse": 1.0, "specular": 0.0, "lights": "light kit"},
-}
-DEFAULT_STYLE = "paper"
-# The bold zero line is drawn only where the mode is meaningfully non-zero nearby: in a
-# triangle whose corner values or whose change over ZERO_LINE_LENGTH (a fraction of the
-# bounding-box diagonal, along the gradient) reach ZERO_LINE_FRACTION of max |field|, and
-# along lines connected to those where they reach a quarter of it (no dashes).  0.3 %: the
-# cow Loop x2's first Laplacian mode, whose peak is on the tail, has 0.35 to 0.92 % of it
-# (10th percentile to largest) at the corners of the triangles its zero line crosses, and
-# the body's line was dropped at 1 %; at 0.1 % the edge of a region where a mode is zero
-# up to round-off drew a line of its own.
-ZERO_LINE_FRACTION = 0.003
-ZERO_LINE_LENGTH = 0.01
-
-COLORMAPS = {  # colours from the low to the high end of each colour map
-    "diverging": [ORANGE, WHITE, BLUE],
-    "sequential": [WHITE, RED],
-    "plain": [WHITE, RED],
-    "threshold": [SIMILAR_BLUE, WHITE],
-}
-DIVERGING = lookup_table([ORANGE, WHITE, BLUE])  # negative -> zero -> positive
-SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
-THRESHOLD = _threshold_table()  # closer than threshold -> blue
-
-
-def isoline_segments(
-    points: np.ndarray,
-    faces: np.ndarray,
-    values: np.ndarray,
-    levels,
-    displacement: np.ndarray | None = None,
-) -> pv.PolyData:
-    """Isolines of a piecewise-linear field as line segments, one per crossed triangle
-    and level (vectorised, in place of VTK's slower contour filter).
-
-    points (n, 3), faces (m, 3), values (n,), levels (L,); ``displacement`` (n, 3) is
-    interpolated onto the line points as point data.  A vertex exactly at a level counts
-    as above it, so every crossed triangle yields exactly one segment.
-    """
-    seg, disp, _ = _segments(points, faces, values, levels, displacement)
-    return _line_polydata(seg, disp)
-
-
-def _line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
-    """PolyData of (s, 2, 3) segments, with (s, 2, 3) ``disp`` as point data."""
-    poly = pv.PolyData()
-    n = seg.shape[0]
-    if n == 0:
-        return poly
-    poly.points = seg.reshape(-1, 3)
-    cells = np.column_stack([np.full(n, 2), 2 * np.arange(n), 2 * np.arange(n) + 1])
-    poly.lines = cells.ravel()
-    if disp is not None:
-        poly.point_data["displacement"] = disp.reshape(-1, 3)
-    return poly
-
-
-def _segments(points, faces, values, levels, displacement=None, with_triangles=False):
-    """(segments (s, 2, 3), their displacement (s, 2, 3) or None, level of each (s,)),
-    and with ``with_triangles`` two more items: the triangle of each segment (s,) and the
-    mesh edges its two ends lie on (s, 2, 2), each edge as (smaller, larger) vertex."""
-    levels = np.sort(np.asarray(levels, dtype=np.float64))
-    # levels crossed by each triangle: those in (min, max] of its corner values
-    level = np.searchsorted(levels, values, side="right").astype(np.int32)
-    l0, l1, l2 = level[faces[:, 0]], level[faces[:, 1]], level[faces[:, 2]]
-    lo = np.minimum(np.minimum(l0, l1), l2)  # (m,); faster than min(axis=1)
-    hi = np.maximum(np.maximum(l0, l1), l2)
-    tri = np.flatnonzero(hi > lo)
-    if tri.size == 0:
-        empty = np.zeros((0, 2, 3))
-        out = (empty, (empty if displacement is not None else None), np.zeros(0))
-        none = (np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2), dtype=np.int64))
-        return (*out, *none) if with_triangles else out
-    counts = hi[tri] - lo[tri]
-    tri_rep = np.repeat(tri, counts)
-    first = np.repeat(lo[tri], counts)
-    offsets = np.arange(tri_rep.size) - np.repeat(np.cumsum(counts) - counts, counts)
-    c = levels[first + offsets]  # (s,) the level of each segment
-    ft = faces[tri_rep]  # (s, 3)
-    fv = values[ft]
-    a0, a1, a2 = (fv[:, i] >= c for i in range(3))
-    # The level separates one corner (the odd one out) from the other two; the segment
-    # joins the points where it crosses the two edges at that corner.
-    odd = np.where(a0 == a1, 2, np.where(a0 == a2, 1, 0))
-    rows = np.arange(tri_rep.size)
-    v_odd = ft[rows, odd]
-    va = np.column_stack([v_odd, v_odd])  # (s, 2) edge start vertices
-    vb = np.column_stack([ft[rows, (odd + 1) % 3], ft[rows, (odd + 2) % 3]])
-    fa, fb = values[va], values[vb]
-    t = ((c[:, None] - fa) / (fb - fa))[..., None]  # (s, 2, 1)
-    seg = points[va] * (1 - t) + points[vb] * t  # (s, 2, 3)
-    disp = None
-    if displacement is not None:
-        disp = displacement[va] * (1 - t) + displacement[vb] * t
-    if not with_triangles:
-        return seg, disp, c
-    edges = np.stack([np.minimum(va, vb), np.maximum(va, vb)], axis=-1)  # (s, 2, 2)
-    return seg, disp, c, tri_rep, edges
-
-
-def view_angle_on_smaller_side(renderer) -> None:
-    """Make the active camera's view angle apply to the smaller side of the view.
-
-    VTK applies it to the height, so a view narrower than tall crops a mesh fitted in a
-    wider one at the sides.  With the angle on the smaller side, a camera fitted to the
-    mesh's bounding sphere keeps the whole mesh in sight at any shape of the view, and
-    nothing jumps at a square view.  The viewports call this before every render, and
-    fitting calls it first so the fit is computed with the setting it is drawn with."""
-    w, h = renderer.GetSize()
-    camera = renderer.GetActiveCamera()
-    narrow = bool(w < h)
-    if bool(camera.GetUseHorizontalViewAngle()) != narrow:
-        camera.SetUseHorizontalViewAngle(narrow)
-
-
-def fit_smaller_side(renderer) -> None:
-    """Before every render, let the camera's view angle apply to the smaller side of the
-    view (:func:`view_angle_on_smaller_side`): the window's views and the off-screen
-    plotter alike."""
-    renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))
 
 
 class MeshScene:
@@ -383,7 +225,7 @@ class MeshScene:
         want_zero = count > 0 and emphasise_zero and lo < 0 < hi
         # one pass over the triangles for all levels, the zero line split off after
         everything = list(levels) + ([0.0] if want_zero else [])
-        seg, disp, level, tri, edges = _segments(
+        seg, disp, level, tri, edges = segments(
             self.rest_points,
             self.mesh.faces,
             values,
@@ -393,7 +235,14 @@ class MeshScene:
         )
         zero = level == 0.0 if want_zero else np.zeros(len(level), dtype=bool)
         if want_zero:
-            keep = self._meaningful_zero_lines(values, tri[zero], edges[zero])
+            keep = meaningful_zero_lines(
+                self.mesh.faces,
+                self.rest_points,
+                values,
+                tri[zero],
+                edges[zero],
+                self.mesh.bounding_box_diagonal,
+            )
             drop = np.flatnonzero(zero)[~keep]
             seg, disp, zero = (np.delete(x, drop, axis=0) for x in (seg, disp, zero))
         self._iso_rest, self._iso_disp = self._show_lines(
@@ -402,64 +251,6 @@ class MeshScene:
         self._zero_rest, self._zero_disp = self._show_lines(
             self.zero_line, seg[zero], disp[zero], 3.5, "zero_actor"
         )
-
-    def _meaningful_zero_lines(self, values, triangles, edges) -> np.ndarray:
-        """(s,) bool: which zero-line segments to draw, with hysteresis: a segment passing
-        :meth:`meaningful_zero` is drawn, and so is every segment connected to one through
-        segments that pass it at a quarter of the fraction, so a line does not break into
-        dashes where the field hovers around the limit.  Segments connect where they end
-        on the same mesh edge."""
-        from scipy.sparse import coo_matrix
-        from scipy.sparse.csgraph import connected_components
-
-        strong = self.meaningful_zero(values, triangles)
-        weak = np.flatnonzero(self.meaningful_zero(values, triangles, 0.25))
-        if weak.size == 0:
-            return strong
-        key = edges[weak, :, 0].astype(np.int64) * self.mesh.n_vertices + edges[weak, :, 1]
-        _, node = np.unique(key.ravel(), return_inverse=True)  # mesh edge -> graph node
-        w = weak.size
-        rows = np.repeat(np.arange(w), 2)
-        n = w + int(node.max()) + 1
-        graph = coo_matrix((np.ones(rows.size), (rows, w + node)), shape=(n, n))
-        _, label = connected_components(graph, directed=False)
-        label = label[:w]
-        has_strong = np.bincount(label, weights=strong[weak]) > 0
-        keep = strong.copy()
-        keep[weak] |= has_strong[label]
-        return keep
-
-    def meaningful_zero(
-        self, values: np.ndarray, triangles: np.ndarray, factor: float = 1.0
-    ) -> np.ndarray:
-        """(len(triangles),) bool: True where the field is meaningfully non-zero near the
-        triangle, so a zero crossing there is a real nodal line.  A triangle qualifies if a
-        corner value, or the change of the field along its gradient over
-        ``ZERO_LINE_LENGTH`` times the bounding-box diagonal, reaches ``ZERO_LINE_FRACTION``
-        of max |values|.  The gradient term keeps the zero line of low modes on fine meshes,
-        whose corner values next to the line are tiny; regions where a mode is zero up to
-        round-off (values and their changes both far below the fraction) are dropped."""
-        a = float(np.max(np.abs(values)))
-        if triangles.size == 0 or a == 0.0:
-            return np.zeros(triangles.size, dtype=bool)
-        f = self.mesh.faces[triangles]
-        fv = values[f]  # (t, 3)
-        corner = np.max(np.abs(fv), axis=1)
-        x0, x1, x2 = (self.rest_points[f[:, i]] for i in range(3))
-        e1, e2 = x1 - x0, x2 - x0
-        d1, d2 = fv[:, 1] - fv[:, 0], fv[:, 2] - fv[:, 0]
-        # gradient of the linear interpolant: solve [e1 e2]^T g = (d1, d2) in the plane
-        g11 = np.einsum("ij,ij->i", e1, e1)
-        g12 = np.einsum("ij,ij->i", e1, e2)
-        g22 = np.einsum("ij,ij->i", e2, e2)
-        det = g11 * g22 - g12 * g12
-        det = np.where(det > 0, det, np.inf)
-        c1 = (g22 * d1 - g12 * d2) / det
-        c2 = (g11 * d2 - g12 * d1) / det
-        grad = np.linalg.norm(c1[:, None] * e1 + c2[:, None] * e2, axis=1)
-        length = ZERO_LINE_LENGTH * self.mesh.bounding_box_diagonal
-        local = np.maximum(corner, grad * length)
-        return local >= factor * ZERO_LINE_FRACTION * a
 
     def _show_lines(
         self, lines: pv.PolyData, seg: np.ndarray, disp: np.ndarray, width: float, attr: str
@@ -471,7 +262,7 @@ class MeshScene:
             if actor is not None:
                 actor.SetVisibility(False)
             return None, None
-        lines.copy_from(_line_polydata(seg, disp), deep=False)
+        lines.copy_from(line_polydata(seg, disp), deep=False)
         if actor is None:
             actor = self.plotter.add_mesh(
                 lines,

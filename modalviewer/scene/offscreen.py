@@ -25,7 +25,7 @@ def offscreen_plotter(size=DEFAULT_SIZE):
     prepare_offscreen()
     import pyvista as pv
 
-    from .mesh_scene import fit_smaller_side
+    from .framing import fit_smaller_side
 
     plotter = pv.Plotter(off_screen=True, notebook=False, window_size=[int(size[0]), int(size[1])])
     plotter.set_background("white")

@@ -13,7 +13,7 @@ import numpy as np
 
 def _flat_render(scene, indicator: np.ndarray) -> np.ndarray:
     """Render the scene with the surface coloured flat: 1 -> green, 0 -> red, lines hidden."""
-    from .mesh_scene import lookup_table
+    from .colors import lookup_table
 
     actor, mapper = scene.surface_actor, scene._mapper
     prop = actor.GetProperty()

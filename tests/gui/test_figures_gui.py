@@ -130,7 +130,7 @@ def _bar_colours(panel: np.ndarray, colors) -> float:
 def test_a_compare_windows_export_has_a_colour_bar_per_continuous_view(
     window, spot_path, qtbot, tmp_path
 ):
-    from modalviewer.scene.mesh_scene import COLORMAPS
+    from modalviewer.scene.colors import COLORMAPS
 
     assert window.open_mesh(spot_path)
     for op in ("laplacian", "shells"):

@@ -186,7 +186,7 @@ def test_zero_line_absent_where_the_mode_is_dead(view):
     assert len(iso) > 100 and np.all(iso[:, 2] > -h)
     # without the filter the noise draws zero crossings all over the lower hemisphere
     tri = np.arange(mesh.n_faces)
-    keep = scene.meaningful_zero(field, tri)
+    keep = _meaningful(scene, field, tri)
     low = v[mesh.faces].mean(axis=1)[:, 2] < -h
     assert keep[low].sum() == 0 and keep[~low].sum() > 100
 
@@ -200,7 +200,7 @@ def test_zero_line_of_a_low_mode_on_a_fine_mesh_is_kept(view):
     tri = np.arange(mesh.n_faces)
     fv = field[mesh.faces]
     crossed = tri[(fv.min(axis=1) < 0) & (fv.max(axis=1) >= 0)]
-    assert scene.meaningful_zero(field, crossed).all()
+    assert _meaningful(scene, field, crossed).all()
 
 
 @pytest.mark.parametrize("umask", [0o022, 0o027])
@@ -349,3 +349,10 @@ def test_zero_line_of_a_mode_dwarfed_by_a_far_peak_is_kept(view):
     south = zero[zero[:, 2] < -0.3]
     assert len(south) > 20, len(south)
     assert np.all(np.abs(south[:, 0]) < 0.07)  # along x = 0, within an edge
+
+
+def _meaningful(scene, field, triangles):
+    from modalviewer.scene.isolines import meaningful_zero
+
+    m = scene.mesh
+    return meaningful_zero(m.faces, scene.rest_points, field, triangles, m.bounding_box_diagonal)

@@ -452,7 +452,7 @@ def test_isolines_match_vtk_contour_filter():
     import pyvista as pv
 
     from modalviewer.core.primitives import icosphere
-    from modalviewer.scene.mesh_scene import isoline_segments
+    from modalviewer.scene.isolines import isoline_segments
 
     mesh = icosphere(4)
     v, f = mesh.vertices, mesh.faces

@@ -245,7 +245,7 @@ def test_render_modes_writes_a_grid_with_one_camera_and_one_colour_bar(tmp_path,
     assert img.shape[:2] == (700, 1200)  # the size asked for, panels and bar included
     # one colour bar: the orange-white-blue gradient, 320 pixels wide in the middle of
     # a row of the strip below the panels; no panel has its own
-    from modalviewer.scene.mesh_scene import COLORMAPS
+    from modalviewer.scene.colors import COLORMAPS
 
     def deviation(row_pixels, x0, width=320):
         xs = np.arange(int(x0) + 3, int(x0 + width) - 3)

@@ -1,0 +1,72 @@
+"""The colours of the pictures: the paper's palette, the colour maps' lookup tables and
+the rendering styles."""
+
+from __future__ import annotations
+
+import numpy as np
+import pyvista as pv
+from vtkmodules.util.numpy_support import numpy_to_vtk
+
+# The paper's colours: blue positive, white zero, orange negative.
+BLUE = np.array([0.16, 0.38, 0.78])
+WHITE = np.array([1.0, 1.0, 1.0])
+ORANGE = np.array([0.96, 0.55, 0.12])
+RED = np.array([0.78, 0.08, 0.08])
+SIMILAR_BLUE = np.array([0.20, 0.45, 0.85])
+
+
+def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
+    """A lookup table interpolating linearly through ``colors`` (RGB in [0, 1])."""
+    anchors = np.linspace(0.0, 1.0, len(colors))
+    x = np.linspace(0.0, 1.0, n)
+    rgb = np.column_stack([np.interp(x, anchors, [c[i] for c in colors]) for i in range(3)])
+    lut = pv.LookupTable()
+    lut.SetNumberOfTableValues(n)
+    for i, (r, g, b) in enumerate(rgb):
+        lut.SetTableValue(i, float(r), float(g), float(b), 1.0)
+    lut.Build()
+    return lut
+
+
+def _threshold_table(n: int = 2048) -> pv.LookupTable:
+    """The threshold maps' table: blue (similar) below its middle, white above.  Fine
+    (2048 entries), so the step of :meth:`MeshScene.show_threshold`, which looks colours up
+    after interpolation along the surface, falls within 1/2048 of the range from the
+    threshold."""
+    table = np.empty((n, 4))
+    table[:, :3] = WHITE
+    table[: n // 2, :3] = SIMILAR_BLUE
+    table[:, 3] = 1.0
+    lut = pv.LookupTable()
+    lut.SetNumberOfTableValues(n)
+    lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
+    return lut
+
+
+# Rendering styles: the light set-up and the surface's ambient/diffuse/specular balance.
+# "paper": one headlight (the light sits at the camera, like a matcap the brightness
+# depends only on the angle between the normal and the view direction) over a high
+# ambient term: brightness min(1, ambient + diffuse * cos) reaches 1 for surfaces within
+# about 39 degrees of facing the viewer and stays above 225/255 up to about 49 degrees,
+# so white stays white and blue/orange keep their full saturation where the surface faces
+# the viewer, while the shading falls to 0.3 toward silhouettes and sharp edges show as
+# steps in brightness.  No specular term (a highlight would wash the colours out).
+# Polyscope reaches its look with a matcap (an image of a lit sphere indexed by the
+# view-space normal); a headlight gives the same view-locked shading with VTK's own
+# lighting, on screen and off screen alike.
+# "shaded": pyvista's default light kit (key, fill and back lights) with plain diffuse
+# shading: more relief, colours darker (white renders grey).
+STYLES = {
+    "paper": {"ambient": 0.3, "diffuse": 0.9, "specular": 0.0, "lights": "headlight"},
+    "shaded": {"ambient": 0.0, "diffuse": 1.0, "specular": 0.0, "lights": "light kit"},
+}
+DEFAULT_STYLE = "paper"
+COLORMAPS = {  # colours from the low to the high end of each colour map
+    "diverging": [ORANGE, WHITE, BLUE],
+    "sequential": [WHITE, RED],
+    "plain": [WHITE, RED],
+    "threshold": [SIMILAR_BLUE, WHITE],
+}
+DIVERGING = lookup_table([ORANGE, WHITE, BLUE])  # negative -> zero -> positive
+SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
+THRESHOLD = _threshold_table()  # closer than threshold -> blue
