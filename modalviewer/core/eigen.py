@@ -8,10 +8,10 @@ positive definite even when K is singular (constants, rigid motions).
 * The factorisation (:mod:`.factor`) is MKL PARDISO where the ``mkl`` wheel is
   installed, CHOLMOD (``cholespy``) otherwise, SuperLU as the last resort.
 * The iteration is a block Krylov-Schur method (thick-restart block Lanczos,
-  :func:`block_krylov_schur`): OP is applied to blocks of vectors, so one pass over
-  the factor serves many right-hand sides, and the full re-orthogonalisation is done
-  with matrix-matrix products.  It asks for about 10 % more pairs than wanted and stops
-  when the wanted ones have converged.
+  :func:`.krylov.block_krylov_schur`): OP is applied to blocks of vectors, so one pass
+  over the factor serves many right-hand sides, and the full re-orthogonalisation is
+  done with matrix-matrix products.  It works with a few more pairs than wanted
+  (:func:`krylov_sizes`) and stops when the wanted ones have converged.
 * One block step of inverse iteration on the converged vectors and a Rayleigh-Ritz step
   with K itself give exact Ritz values, Mass-orthonormal modes and residuals
   ``|K x - lambda M x| / |lambda M x|`` around 1e-10 on well-shaped meshes.
@@ -24,10 +24,7 @@ Every run is deterministic (fixed start block); every result carries its residua
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
-from concurrent.futures import ThreadPoolExecutor
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,6 +32,16 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 from .factor import SPDSolver
+from .krylov import (
+    ConvergedFn,
+    EigenError,
+    NotConverged,
+    ProgressFn,
+    StageTimer,
+    block_krylov_schur,
+    cholqr_in_place,
+    rotate_in_place,
+)
 from .memory import memory_limit_mb as default_memory_limit_mb
 from .memory import resident_mb
 from .products import column_block_products, threaded_product, transform_columns_in_place
@@ -89,43 +96,11 @@ against the first non-zero eigenvalue, which it compresses the spectrum towards:
 median diagonal ratio grows like 1/h^4 for bending energies (the sizes on the benchmark
 meshes: "Known null spaces" in docs/how-it-works.md)."""
 
-ProgressFn = Callable[[str, float], None]
 CancelFn = Callable[[], bool]
-ConvergedFn = Callable[[np.ndarray, np.ndarray], None]
-"""``on_converged(values, vectors)``: newly converged pairs, handed over in order."""
 
 
 class Cancelled(Exception):
     """Raised when the ``cancel`` callback asked to stop a computation."""
-
-
-class EigenError(RuntimeError):
-    """The eigensolver failed (no convergence, factorisation breakdown, bad residuals)."""
-
-
-class _NotConverged(EigenError):
-    """The Krylov iteration ran out of restarts (the solver may retry differently);
-    ``columns``: the operator columns it applied before giving up."""
-
-    def __init__(self, message: str, columns: int = 0) -> None:
-        super().__init__(message)
-        self.columns = columns
-
-
-class StageTimer:
-    """Wall-clock seconds spent per stage of a solve (accumulated over calls)."""
-
-    def __init__(self) -> None:
-        self.seconds: dict[str, float] = {}
-
-    @contextmanager
-    def __call__(self, stage: str) -> Iterator[None]:
-        start = time.perf_counter()
-        try:
-            yield
-        finally:
-            elapsed = time.perf_counter() - start
-            self.seconds[stage] = self.seconds.get(stage, 0.0) + elapsed
 
 
 @dataclass
@@ -303,83 +278,24 @@ def solve_lowest(
     iteration's, which start at zero up to rounding if K has further null vectors) and
     Mass-orthonormal vectors.
     """
-    K = sp.csr_matrix(K)
+    K, mass_diag = _checked_problem(K, mass_diag, k)
     N = K.shape[0]
-    mass_diag = np.asarray(mass_diag, dtype=np.float64)
-    if not (1 <= k <= N):
-        raise ValueError(f"k must be between 1 and {N} (the number of unknowns), got {k}")
-    if np.any(mass_diag <= 0) or not np.all(np.isfinite(mass_diag)):
-        raise EigenError("the mass matrix has non-positive entries (degenerate faces?)")
-    if not np.all(np.isfinite(K.data)):
-        raise EigenError("the operator has NaN or infinite entries")
-
-    def report(stage: str, fraction: float) -> None:
-        if cancel is not None and cancel():
-            raise Cancelled()
-        if progress is not None:
-            progress(stage, float(min(max(fraction, 0.0), 1.0)))
-
-    inv_sqrt_m = 1.0 / np.sqrt(mass_diag)
+    report = _reporter(progress, cancel)
     median_ratio = typical_eigenvalue(K, mass_diag)
     Z = _null_vectors(null_space, N, mass_diag)
     d = Z.shape[1]
-
     timer = StageTimer()
     columns = 0
     method, shift = "null space (no iteration)", 0.0
     lam, X = np.zeros(0), np.zeros((N, 0))
     basis = None  # the Krylov basis array whose first columns hold the modes
     solver_info = {"factor_mb": None, "out_of_core": False, "basis_float32": False}
-    limit = default_memory_limit_mb() if memory_limit_mb is None else float(memory_limit_mb)
-    handover = _Handover(on_modes, Z, k)
     if d < k:
-        # the standard-form null vectors M^1/2 Z are orthonormal: project them out
-        Y0 = sp.csr_matrix(sp.diags(np.sqrt(mass_diag)) @ Z)
-        Y0t = sp.csr_matrix(Y0.T)
-
-        def project(V: np.ndarray) -> np.ndarray:
-            if d:
-                V -= Y0 @ (Y0t @ V)
-            return V
-
-        lam = None
-        if N - d > dense_limit:
-            lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
-            args = (K, mass_diag, inv_sqrt_m, k - d, lam_typical, report, tol, block, timer,
-                    project, N - d, limit, solver_info, k)  # fmt: skip
-            try:
-                try:
-                    lam, basis, shift, backend, columns = _shift_invert(
-                        *args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL, handover.attempt()
-                    )
-                except _NotConverged as failed:
-                    if not d:
-                        raise
-                    # The tiny shift leaves K - shift M so close to singular that the
-                    # solves' rounding floor can sit above the tolerance (residuals stuck
-                    # near 1e-8); the undeflated shift does not, at the cost of a
-                    # compressed spectrum.
-                    # The columns counted include the failed attempt's.
-                    report("retrying with a larger shift", 0.05)
-                    lam, basis, shift, backend, columns = _shift_invert(
-                        *args, SHIFT_RTOL, handover.attempt()
-                    )
-                    columns += failed.columns
-                method = f"shift-invert block Krylov-Schur ({backend})"
-                if solver_info["out_of_core"]:
-                    method += ", factor out of core"
-                if solver_info["basis_float32"]:
-                    method += ", single-precision Krylov basis"
-                X = basis[:, : lam.shape[0]]
-            except _TooSmall:
-                lam = None
-        if lam is None:
-            report("solving (dense)", 0.1)
-            with timer("dense"):
-                lam, X = _dense_complement(K, mass_diag, Y0, k - d)
-            method, shift = "dense", 0.0
-        if d:
-            method += f", {d} null vectors deflated"
+        limit = default_memory_limit_mb() if memory_limit_mb is None else float(memory_limit_mb)
+        lam, X, basis, shift, method, columns = _complement_pairs(
+            K, mass_diag, Z, k, median_ratio, report, timer, dense_limit, tol, block, limit,
+            solver_info, _Handover(on_modes, Z, k),
+        )  # fmt: skip
     all_lam = np.concatenate([np.zeros(min(d, k)), lam])
     report("checking residuals", 0.97)
     with timer("residuals"):
@@ -391,25 +307,21 @@ def solve_lowest(
         raise EigenError("the eigensolver produced NaN values")
     with timer("copy"):  # own row-major array ((n, 3, k) shells modes are then a view)
         d_out = Zk.shape[1]
-        if basis is not None:
+        if basis is not None and basis.shape[1] >= k:
             # written over the Krylov basis, which is then shrunk to the modes: no (N, k)
             # array beside the (N, 1.1 k + extra) basis, the largest arrays of a big solve
-            if basis.shape[1] >= k:
-                del X
-                transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
-                try:
-                    basis.resize((N, k))  # refuses while another reference to it is alive
-                    out = basis
-                except ValueError:
-                    out = basis.reshape(-1)[: N * k].reshape(N, k).copy()
-            else:  # more null vectors than the basis has columns: it cannot hold them
-                out = np.empty((N, k))
-                out[:, d_out:] = X
-                del X
-            basis = None
-        else:
+            del X
+            transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
+            try:
+                basis.resize((N, k))  # refuses while another reference to it is alive
+                out = basis
+            except ValueError:
+                out = basis.reshape(-1)[: N * k].reshape(N, k).copy()
+        else:  # no basis, or more null vectors than the basis has columns
             out = np.empty((N, k))
             out[:, d_out:] = X
+            del X
+        basis = None
         out[:, :d_out] = 0.0
         coo = Zk.tocoo()
         out[coo.row, coo.col] = coo.data
@@ -418,6 +330,92 @@ def solve_lowest(
         all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1],
         solver_info["factor_mb"], solver_info["out_of_core"], solver_info["basis_float32"],
     )  # fmt: skip
+
+
+def _checked_problem(K, mass_diag, k: int) -> tuple[sp.csr_matrix, np.ndarray]:
+    """(K as CSR, the masses as float64); errors for a k out of range, non-positive or
+    non-finite masses and non-finite entries of K."""
+    K = sp.csr_matrix(K)
+    N = K.shape[0]
+    mass_diag = np.asarray(mass_diag, dtype=np.float64)
+    if not (1 <= k <= N):
+        raise ValueError(f"k must be between 1 and {N} (the number of unknowns), got {k}")
+    if np.any(mass_diag <= 0) or not np.all(np.isfinite(mass_diag)):
+        raise EigenError("the mass matrix has non-positive entries (degenerate faces?)")
+    if not np.all(np.isfinite(K.data)):
+        raise EigenError("the operator has NaN or infinite entries")
+    return K, mass_diag
+
+
+def _reporter(progress: ProgressFn | None, cancel: CancelFn | None) -> ProgressFn:
+    """``report(stage, fraction)``: raises :class:`Cancelled` when ``cancel`` asks to
+    stop, else passes the fraction, clipped to [0, 1], to ``progress``."""
+
+    def report(stage: str, fraction: float) -> None:
+        if cancel is not None and cancel():
+            raise Cancelled()
+        if progress is not None:
+            progress(stage, float(min(max(fraction, 0.0), 1.0)))
+
+    return report
+
+
+def _complement_pairs(
+    K, mass_diag, Z, k, median_ratio, report, timer, dense_limit, tol, block, limit,
+    solver_info, handover,
+):  # fmt: skip
+    """The k - d lowest pairs in the Mass-orthogonal complement of the d null vectors
+    Z: by shift-invert where the problem is large enough, densely otherwise.  Returns
+    (eigenvalues, vectors, the Krylov basis array whose first columns are the vectors or
+    None, shift, method, operator columns)."""
+    N, d = K.shape[0], Z.shape[1]
+    # the standard-form null vectors M^1/2 Z are orthonormal: project them out
+    Y0 = sp.csr_matrix(sp.diags(np.sqrt(mass_diag)) @ Z)
+    Y0t = sp.csr_matrix(Y0.T)
+
+    def project(V: np.ndarray) -> np.ndarray:
+        if d:
+            V -= Y0 @ (Y0t @ V)
+        return V
+
+    if N - d > dense_limit:
+        lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
+        args = (K, mass_diag, 1.0 / np.sqrt(mass_diag), k - d, lam_typical, report, tol, block,
+                timer, project, N - d, limit, solver_info, k)  # fmt: skip
+        try:
+            lam, basis, shift, backend, columns = _shift_invert_retrying(args, d, report, handover)
+        except _TooSmall:
+            pass
+        else:
+            method = f"shift-invert block Krylov-Schur ({backend})"
+            if solver_info["out_of_core"]:
+                method += ", factor out of core"
+            if solver_info["basis_float32"]:
+                method += ", single-precision Krylov basis"
+            if d:
+                method += f", {d} null vectors deflated"
+            return lam, basis[:, : lam.shape[0]], basis, shift, method, columns
+    report("solving (dense)", 0.1)
+    with timer("dense"):
+        lam, X = _dense_complement(K, mass_diag, Y0, k - d)
+    method = "dense" + (f", {d} null vectors deflated" if d else "")
+    return lam, X, None, 0.0, method, 0
+
+
+def _shift_invert_retrying(args, d: int, report, handover):
+    """:func:`_shift_invert` with the deflated shift where null vectors are deflated,
+    again with the larger :data:`SHIFT_RTOL` if that does not converge: the tiny shift
+    leaves K - shift M so close to singular that the solves' rounding floor can sit
+    above the tolerance (residuals stuck near 1e-8), at the cost of a compressed
+    spectrum.  The columns counted include the failed attempt's."""
+    try:
+        return _shift_invert(*args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL, handover.attempt())
+    except NotConverged as failed:
+        if not d:
+            raise
+        report("retrying with a larger shift", 0.05)
+        lam, basis, shift, backend, columns = _shift_invert(*args, SHIFT_RTOL, handover.attempt())
+        return lam, basis, shift, backend, columns + failed.columns
 
 
 class _Handover:
@@ -531,353 +529,10 @@ def factor_below_spectrum(
     )
 
 
-def _gram_cholesky(W: np.ndarray) -> np.ndarray | None:
-    """Upper Cholesky factor C of ``W.T @ W`` (so ``W @ inv(C)`` has orthonormal columns),
-    or None if W is numerically rank deficient (C's diagonal spans more than 1e7)."""
-    G = W.T @ W
-    try:
-        C = la.cholesky(0.5 * (G + G.T), lower=False)
-    except la.LinAlgError:
-        return None
-    d = np.abs(np.diag(C))
-    return None if d.min() <= 1e-7 * d.max() else C
-
-
-def _cholqr(W: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """W = V Rn with orthonormal V by two Cholesky-QR passes (BLAS-3), or None if W is
-    numerically rank deficient (then Householder QR takes over)."""
-    Rn = np.eye(W.shape[1])
-    for _ in range(2):
-        C = _gram_cholesky(W)
-        if C is None:
-            return None
-        W = W @ la.solve_triangular(C, np.eye(W.shape[1]), lower=False)
-        Rn = C @ Rn
-    return W, Rn
-
-
-def _cholqr_in_place(Y: np.ndarray) -> bool:
-    """Orthonormalise the columns of Y in place by two Cholesky-QR passes (BLAS-3, no
-    (N, k) temporary); False if Y is numerically rank deficient (Y then still spans
-    the same space, and Householder QR takes over)."""
-    for _ in range(2):
-        C = _gram_cholesky(Y)
-        if C is None:
-            return False
-        _rotate_in_place(Y, Y.shape[1], la.solve_triangular(C, np.eye(Y.shape[1])))
-    return True
-
-
-_SWEEP_ROWS = 1024
-"""Rows of the basis per step of the fused orthogonalisation sweep (1024 x 544 doubles:
-4.5 MB, inside the L3 cache)."""
-
-
-def _basis_t_times(Q: np.ndarray, W: np.ndarray) -> np.ndarray:
-    """``Q.T @ W`` in double precision.  A single-precision basis is widened a block of
-    rows at a time: numpy would otherwise convert the whole of Q into a temporary."""
-    if Q.dtype == np.float64:
-        return Q.T @ W
-    h = np.zeros((Q.shape[1], W.shape[1]))
-    for start in range(0, Q.shape[0], _SWEEP_ROWS):
-        h += Q[start : start + _SWEEP_ROWS].astype(np.float64).T @ W[start : start + _SWEEP_ROWS]
-    return h
-
-
-def _subtract_basis_times(W: np.ndarray, Q: np.ndarray, h: np.ndarray) -> None:
-    """``W -= Q @ h`` in double precision, in place (a single-precision Q is widened a
-    block of rows at a time, as in :func:`_basis_t_times`)."""
-    if Q.dtype == np.float64:
-        W -= Q @ h
-        return
-    for start in range(0, Q.shape[0], _SWEEP_ROWS):
-        W[start : start + _SWEEP_ROWS] -= Q[start : start + _SWEEP_ROWS].astype(np.float64) @ h
-
-
-def _orthonormal_block(
-    W: np.ndarray,
-    Q: np.ndarray,
-    rng: np.random.Generator,
-    local: int = 0,
-    project: Callable[[np.ndarray], np.ndarray] | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Orthonormalise W (N, b) against the orthonormal columns of Q and among itself.
-
-    Block classical Gram-Schmidt with a second pass where the first lost more than half
-    of a column's norm (DGKS), then Cholesky QR; columns that vanish (the Krylov space
-    is invariant) are replaced by random directions orthogonal to Q.
-    ``local`` > 0 says that W is orthogonal to ``Q[:, :local]`` in exact arithmetic (the
-    Lanczos recurrence): the columns from ``local`` on are projected out first, and the
-    full passes then only remove rounding errors, so they rarely need a repetition.
-    Returns (V, h, Rn) with W_in = Q h + V Rn.
-    """
-    W = np.array(W, dtype=np.float64, order="F")  # own copy; Q.T @ W is faster in F order
-    if local > 0:
-        # local pass, then full passes that only remove rounding errors: two sweeps over
-        # the basis (0.5 to 1.7 GB; these products are memory-bound), a third is rare
-        h = np.zeros((Q.shape[1], W.shape[1]))
-        Ql = Q[:, local:]
-        h[local:] = _basis_t_times(Ql, W)
-        _subtract_basis_times(W, Ql, h[local:])
-        for _ in range(2):
-            before = np.linalg.norm(W, axis=0)
-            hp = _basis_t_times(Q, W)
-            _subtract_basis_times(W, Q, hp)
-            h += hp
-            if np.all(np.linalg.norm(W, axis=0) >= 0.5 * before):
-                break
-    else:
-        before = np.linalg.norm(W, axis=0)
-        h = _basis_t_times(Q, W)
-        # The update of the first pass and the products of the second share one sweep
-        # over Q, a block of rows at a time that stays in cache: three sweeps, not four.
-        h2 = np.zeros_like(h)
-        after_sq = np.zeros(W.shape[1])
-        for start in range(0, Q.shape[0], _SWEEP_ROWS):
-            Qc = np.asarray(Q[start : start + _SWEEP_ROWS], dtype=np.float64)
-            Wc = W[start : start + _SWEEP_ROWS]
-            Wc -= Qc @ h
-            h2 += Qc.T @ Wc
-            after_sq += np.einsum("ij,ij->j", Wc, Wc)
-        if np.any(np.sqrt(after_sq) < 0.5 * before):
-            _subtract_basis_times(W, Q, h2)
-            h += h2
-    fast = _cholqr(W)
-    if fast is not None:
-        return fast[0], h, fast[1]
-    V, Rn = np.linalg.qr(W)
-    scale = np.abs(np.diag(Rn))
-    lost = scale <= 1e-12 * max(float(scale.max(initial=0.0)), 1e-300)
-    if np.any(lost):
-        # invariant subspace found: continue with fresh directions, coupling zero
-        fresh = rng.standard_normal((W.shape[0], int(lost.sum())))
-        if project is not None:
-            fresh = project(fresh)
-        for _ in range(2):
-            _subtract_basis_times(fresh, Q, _basis_t_times(Q, fresh))
-            keep = V[:, ~lost]
-            fresh -= keep @ (keep.T @ fresh)
-        V[:, lost] = np.linalg.qr(fresh)[0]
-        Rn[lost, :] = 0.0
-    return V, h, Rn
-
-
-def _rotate_in_place(Q: np.ndarray, j: int, S: np.ndarray, rows: int = 32768) -> None:
-    """``Q[:, :p] = Q[:, :j] @ S`` (S is (j, p), p <= j) a block of rows at a time, so no
-    (N, p) temporary, as large as the modes, is needed.  A
-    single-precision Q is rotated in double precision, a block at a time, and rounded."""
-    p = S.shape[1]
-    for start in range(0, Q.shape[0], rows):
-        block = Q[start : start + rows]
-        block[:, :p] = block[:, :j] @ S
-
-
-HANDOVER_COLUMNS = 32
-"""Converged pairs are handed over (``on_converged``) at most this many at a time, so
-that the new arrays they come in stay small beside the basis."""
-
-CLUSTER_RTOL = 1e-3
-"""Converged Ritz pairs are handed over early (``on_converged``) only up to a gap: a
-pair whose Ritz value lies within this relative distance of the next one's waits for
-it, so that a cluster of (nearly) equal eigenvalues is handed over whole and the modes
-handed over span the same space as the final ones."""
-
-
 def _scale_rows(Y: np.ndarray, factors: np.ndarray) -> np.ndarray:
     """``Y`` with row i multiplied by ``factors[i]``, in place; returns Y."""
     Y *= factors[:, None]
     return Y
-
-
-def _same_cluster(theta: np.ndarray, i: int) -> bool:
-    """Whether the Ritz values ``theta[i - 1]`` and ``theta[i]`` (descending) lie within
-    :data:`CLUSTER_RTOL` of each other."""
-    return theta[i] >= theta[i - 1] * (1.0 - CLUSTER_RTOL)
-
-
-def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> int:
-    """The number of leading pairs that may be handed over: ``done`` converged ones,
-    less those in a cluster that reaches past them (see :data:`CLUSTER_RTOL`).  A
-    trailing cluster of ``block`` or more equal values waits too: a block Krylov method
-    sees at most ``block`` copies of an eigenvalue before rounding brings in the others,
-    so such a cluster may have more members to come."""
-
-    ready = min(done, theta.shape[0] - 1)  # the next Ritz value must be there to compare
-    while ready > handed and _same_cluster(theta, ready):
-        ready -= 1
-    first = ready - 1  # the trailing cluster's first pair
-    while first > 0 and _same_cluster(theta, first):
-        first -= 1
-    if ready - first >= block:
-        ready = max(handed, first)
-    return ready
-
-
-def _basis_times(Q: np.ndarray, j: int, S: np.ndarray) -> np.ndarray:
-    """``Q[:, :j] @ S`` as a new float64 array, a block of rows at a time (a
-    single-precision basis is widened one block at a time), the two halves of the rows
-    on two threads (the solver's BLAS runs on one)."""
-    out = np.empty((Q.shape[0], S.shape[1]))
-
-    def half(bounds: tuple[int, int]) -> None:
-        for start in range(bounds[0], bounds[1], _SWEEP_ROWS):
-            rows = slice(start, min(start + _SWEEP_ROWS, bounds[1]))
-            out[rows] = Q[rows, :j].astype(np.float64, copy=False) @ S
-
-    middle = Q.shape[0] // 2
-    with ThreadPoolExecutor(2) as pool:
-        list(pool.map(half, [(0, middle), (middle, Q.shape[0])]))
-    return out
-
-
-def block_krylov_schur(
-    apply_op: Callable[[np.ndarray], np.ndarray],
-    N: int,
-    k: int,
-    *,
-    keep: int,
-    block: int,
-    max_basis: int,
-    tol: float,
-    report: ProgressFn,
-    max_restarts: int = 60,
-    seed: int = 12345,
-    timer: StageTimer | None = None,
-    project: Callable[[np.ndarray], np.ndarray] | None = None,
-    basis: np.ndarray | None = None,
-    on_converged: ConvergedFn | None = None,
-) -> tuple[np.ndarray, np.ndarray, int]:
-    """The k largest eigenpairs of a symmetric positive definite operator.
-
-    Block Krylov-Schur (thick-restart block Lanczos) with full re-orthogonalisation in
-    BLAS-3 blocks: the operator is applied to ``block`` vectors at a time, so a sparse
-    factorisation solves many right-hand sides per pass over its factor.  The Ritz
-    pairs are checked every 64 new vectors (and when the basis is full), so the iteration
-    stops soon after the wanted pairs have converged; a full basis is restarted with its
-    ``keep`` best Ritz vectors.
-
-    Parameters
-    ----------
-    apply_op : maps an (N, b) array to OP times it.
-    k : wanted eigenpairs; ``k <= keep``, ``keep + block <= max_basis <= N - block``.
-    tol : a pair counts as converged when ``|OP y - theta y| <= tol * theta``.
-    timer : accumulates the seconds of "solves", "orthogonalisation", "ritz", "restarts".
-    project : removes a known invariant subspace (deflated null vectors) from an (N, b)
-        array in place; applied to the start block and to fresh random directions
-        (apply_op must project its results itself).
-    basis : the (N, max_basis + block) array to hold the basis, float64 or float32 (None:
-        a new float64 one).  In single precision every product with it is still formed
-        in double precision (:func:`_basis_t_times`); its columns are then orthonormal
-        only to about 1e-7, so ``tol`` should not be below :data:`FLOAT32_BASIS_TOL`.
-    on_converged : called as ``on_converged(theta, Y)`` with the pairs that have newly
-        converged at a check, largest first, in order: the Ritz values (m,) and a new
-        (N, m) array of their Ritz vectors.  The pairs handed over so far are always
-        the leading ones, and a pair is held back while the next Ritz value lies within
-        :data:`CLUSTER_RTOL` of it (a cluster is handed over whole, in one call; the
-        pairs of one check come in calls of about :data:`HANDOVER_COLUMNS`).  With a
-        callback the Ritz pairs are also checked while the basis has fewer than k
-        columns.
-
-    Returns
-    -------
-    theta (k,) descending, Y (N, k) orthonormal Ritz vectors (a view into the basis
-    array), number of operator columns applied.
-    """
-    rng = np.random.default_rng(seed)
-    timer = timer or StageTimer()
-    b = block
-    Q = np.empty((N, max_basis + b)) if basis is None else basis
-    if Q.shape != (N, max_basis + b):
-        raise ValueError(f"the basis array must be ({N}, {max_basis + b}), not {Q.shape}")
-    T = np.zeros((max_basis, max_basis))
-    start = rng.standard_normal((N, b))
-    if project is not None:
-        start = project(start)
-    Q[:, :b] = np.linalg.qr(start)[0]
-    j = 0  # closed columns: OP already applied
-    sequence_start = 0  # j of the first block after the last (re)start
-    R = np.zeros((b, 0))  # OP Q[:, :j] = Q[:, :j] T[:j, :j] + Q[:, j:j+b] R
-    applied = 0
-    restarts = 0
-    done = 0
-    handed = 0  # leading pairs given to on_converged
-    check_every = max(1, 64 // b)
-    blocks_since_check = 0
-    while True:
-        with timer("solves"):
-            W = apply_op(Q[:, j : j + b])
-        applied += b
-        # OP times the open block couples (in exact arithmetic) only to the previous
-        # block, except right after a (re)start, where it couples to all kept vectors.
-        local = j - b if j > sequence_start else 0
-        with timer("orthogonalisation"):
-            V, h, Rn = _orthonormal_block(W, Q[:, : j + b], rng, local, project)
-            Q[:, j + b : j + 2 * b] = V
-        T[: j + b, j : j + b] = h
-        T[j : j + b, : j + b] = h.T
-        j += b
-        R = np.zeros((b, j))
-        R[:, j - b :] = Rn
-        full = j + b > max_basis
-        # Ritz pairs are checked every ``check_every`` blocks (an eigh of the projected
-        # matrix costs about as much as orthogonalising 64 vectors); where pairs are
-        # handed over as they converge, as often as an eigh costs at most a sixteenth of
-        # the orthogonalisation since the last check: it runs at about a sixth of the
-        # matrix products' rate, so it costs as much as 6 j^3 flops of them, against
-        # 4 N j b per block of orthogonalisation.
-        if on_converged is not None:
-            check_every = max(1, int(np.ceil(24.0 * j * j / (N * b))))
-        blocks_since_check = (blocks_since_check + 1) % check_every
-        too_few = j < k and on_converged is None
-        if (too_few or blocks_since_check) and not full:
-            report("solving", 0.05 + 0.85 * done / k)
-            continue
-        wanted = min(k, j)
-        with timer("ritz"):
-            theta, S = np.linalg.eigh(0.5 * (T[:j, :j] + T[:j, :j].T))
-            theta, S = theta[::-1], S[:, ::-1]
-            estimates = np.linalg.norm(R @ S[:, : min(keep, j)], axis=0)
-        # rounding floor: zero modes make theta[0] up to 1e6 times theta[k]
-        floor = 16 * np.finfo(float).eps * abs(theta[0])
-        converged = estimates[:wanted] <= np.maximum(tol * np.abs(theta[:wanted]), floor)
-        done = int(np.argmin(converged)) if not converged.all() else wanted
-        report("solving", 0.05 + 0.85 * done / k)
-        if on_converged is not None and done < k:
-            ready = _whole_clusters(theta, done, handed, b)
-            # a few columns at a time (each piece is a new (N, m) array), clusters whole
-            while handed < ready:
-                stop = min(handed + HANDOVER_COLUMNS, ready)
-                while stop < ready and _same_cluster(theta, stop):
-                    stop += 1
-                with timer("handover"):
-                    Y_new = _basis_times(Q, j, S[:, handed:stop])
-                on_converged(theta[handed:stop].copy(), Y_new)
-                del Y_new
-                handed = stop
-        if done == k:
-            with timer("restarts"):
-                _rotate_in_place(Q, j, S[:, :k])
-            return theta[:k], Q[:, :k], applied
-        if not full:
-            continue
-        if restarts == max_restarts:
-            worst = float(np.max(estimates[:k] / np.abs(theta[:k])))
-            raise _NotConverged(
-                f"the eigensolver did not converge after {restarts} restarts "
-                f"(worst relative residual {worst:.1e})",
-                columns=applied,
-            )
-        # thick restart: keep the best Ritz vectors, continue from the open block
-        restarts += 1
-        p = min(keep, j - b)
-        with timer("restarts"):
-            _rotate_in_place(Q, j, S[:, :p])
-            Q[:, p : p + b] = Q[:, j : j + b]
-        T[:] = 0.0
-        T[np.arange(p), np.arange(p)] = theta[:p]
-        R = R @ S[:, :p]
-        j = p
-        sequence_start = p
 
 
 MIN_WORKING_PAIRS = 24
@@ -975,7 +630,7 @@ def _shift_invert(
     the basis is single precision (:func:`basis_in_float32`), and the returned array is
     then exactly (N, ``out_columns``).  ``solver_info`` receives "factor_mb",
     "out_of_core" and "basis_float32".  ``on_converged(eigenvalues, vectors)`` receives
-    the pairs as they converge (:func:`block_krylov_schur`), as eigenvalues of K and
+    the pairs as they converge (:func:`.krylov.block_krylov_schur`), as eigenvalues of K and
     Mass-orthonormal vectors."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
@@ -1076,7 +731,7 @@ def _rayleigh_ritz_in_place(K, inv_sqrt_m: np.ndarray, Y: np.ndarray) -> np.ndar
     B = d[:, None] * B * d[None, :]
     gram_eigenvalues = np.linalg.eigvalsh(B)
     if not gram_eigenvalues[0] * GRAM_CONDITION_LIMIT > gram_eigenvalues[-1]:
-        if not _cholqr_in_place(Y):
+        if not cholqr_in_place(Y):
             Y[:] = np.linalg.qr(Y)[0]
         B, d = np.eye(Y.shape[1]), np.ones(Y.shape[1])
     Y *= inv_sqrt_m[:, None]
@@ -1085,7 +740,7 @@ def _rayleigh_ritz_in_place(K, inv_sqrt_m: np.ndarray, Y: np.ndarray) -> np.ndar
         G[:, cols] = Y.T @ KY
     G = d[:, None] * G * d[None, :]
     lam, W = la.eigh(0.5 * (G + G.T), 0.5 * (B + B.T))
-    _rotate_in_place(Y, Y.shape[1], d[:, None] * W)
+    rotate_in_place(Y, Y.shape[1], d[:, None] * W)
     return lam
 
 

@@ -326,7 +326,7 @@ def test_widening_a_single_precision_basis_in_place_keeps_its_columns(width, cou
 
 
 def test_products_with_a_single_precision_basis_are_formed_in_double_precision():
-    from modalviewer.core.eigen import _basis_t_times, _subtract_basis_times
+    from modalviewer.core.krylov import _basis_t_times, _subtract_basis_times
 
     rng = np.random.default_rng(2)
     Q = rng.standard_normal((5000, 30)).astype(np.float32)

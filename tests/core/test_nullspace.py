@@ -10,12 +10,12 @@ import scipy.linalg as la
 import modalviewer as mv
 from modalviewer.core.eigen import (
     EigenError,
-    block_krylov_schur,
     relative_residuals,
     rounding_floors,
     solve_lowest,
     zero_modes,
 )
+from modalviewer.core.krylov import block_krylov_schur
 from modalviewer.core.nullspace import null_space
 from modalviewer.core.pipeline import ZeroModesWarning, operator_matrices
 from modalviewer.core.primitives import grid_plate, icosphere, torus

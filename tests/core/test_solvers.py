@@ -6,8 +6,9 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 import modalviewer as mv
-from modalviewer.core.eigen import EigenError, block_krylov_schur, solve_lowest
+from modalviewer.core.eigen import EigenError, solve_lowest
 from modalviewer.core.factor import SPDSolver, available_backends
+from modalviewer.core.krylov import block_krylov_schur
 from modalviewer.core.pipeline import operator_matrices
 from modalviewer.core.primitives import grid_plate
 
@@ -135,7 +136,7 @@ def test_orthonormal_block_against_the_basis(local):
     """W = Q h + V Rn with V orthonormal and orthogonal to Q, also when the first pass
     only covers the columns from ``local`` on and W has rounding-size components along
     the others (as in the Lanczos recurrence)."""
-    from modalviewer.core.eigen import _orthonormal_block
+    from modalviewer.core.krylov import _orthonormal_block
 
     rng = np.random.default_rng(7)
     N, m, b = 3000, 56, 8
@@ -183,9 +184,9 @@ def test_final_rayleigh_ritz_in_a_non_orthonormal_basis(mixing, monkeypatch):
     from modalviewer.core.eigen import _rayleigh_ritz_in_place
 
     orthonormalised = []
-    original = eigen._cholqr_in_place
+    original = eigen.cholqr_in_place
     monkeypatch.setattr(
-        eigen, "_cholqr_in_place", lambda Y: orthonormalised.append(1) or original(Y)
+        eigen, "cholqr_in_place", lambda Y: orthonormalised.append(1) or original(Y)
     )
     rng = np.random.default_rng(5)
     K = _spd_matrix(200, seed=4)
