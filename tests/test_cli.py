@@ -361,12 +361,12 @@ def test_compute_says_when_the_factor_and_basis_were_kept_small(tmp_path):
 
 
 def test_the_progress_bar_leaves_no_end_of_a_longer_stage_behind(capsys, monkeypatch):
-    from modalviewer import cli
+    from modalviewer.cli import common
 
     clock = iter([1.0, 2.0])
-    monkeypatch.setattr(cli.time, "perf_counter", lambda: next(clock))
-    monkeypatch.setattr(cli, "_BAR", {"open": False})  # the open bar stays in this test
-    bar = cli._progress_bar()
+    monkeypatch.setattr(common.time, "perf_counter", lambda: next(clock))
+    monkeypatch.setattr(common, "BAR", {"open": False})  # the open bar stays in this test
+    bar = common.progress_bar()
     bar("computing the null space", 0.1)
     bar("factorising", 0.3)
     last = capsys.readouterr().err.split("\r")[-1]
@@ -378,12 +378,12 @@ def test_the_progress_bar_draws_a_new_stage_at_once(capsys, monkeypatch):
     """A stage that came 0.1 s after "assembling" was not drawn, though the wait it
     names then lasted seconds.  A new stage is drawn at once; the same stage's progress
     at most five times a second."""
-    from modalviewer import cli
+    from modalviewer.cli import common
 
     clock = iter([1.0, 1.1, 1.15, 1.5])
-    monkeypatch.setattr(cli.time, "perf_counter", lambda: next(clock))
-    monkeypatch.setattr(cli, "_BAR", {"open": False})
-    bar = cli._progress_bar()
+    monkeypatch.setattr(common.time, "perf_counter", lambda: next(clock))
+    monkeypatch.setattr(common, "BAR", {"open": False})
+    bar = common.progress_bar()
     bar("assembling", 0.0)
     bar("factorising", 0.05)  # 0.1 s later: a new stage
     bar("factorising", 0.06)  # 0.05 s later, same stage: not drawn

@@ -17,7 +17,7 @@ import traceback
 import weakref
 from pathlib import Path
 
-from ..cli import COUNT, MODE_INDEX
+from ..cli.common import COUNT, MODE_INDEX
 from ..core.operators import OPERATOR_NAMES
 from ..scene.platform import has_display
 

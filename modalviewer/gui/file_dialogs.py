@@ -232,7 +232,7 @@ def mode_grid_dialog(win) -> None:
     (asked as "1-8" or "2,5,9"; one camera, the view's direction; one colour bar)."""
     import argparse
 
-    from ..cli import _mode_list
+    from ..cli.common import mode_list
 
     operator = win.viewer.current_operator
     spec = win.state.spectrum(operator) if operator is not None else None
@@ -250,7 +250,7 @@ def mode_grid_dialog(win) -> None:
     if not ok:
         return
     try:
-        modes = _mode_list(text)
+        modes = mode_list(text)
     except argparse.ArgumentTypeError as exc:
         win.show_error(str(exc))
         return

@@ -1,13 +1,12 @@
-"""The collection commands of the CLI: ``modalviewer batch`` and ``modalviewer similar``
+"""``modalviewer batch`` and ``modalviewer similar``: shape collections
 (:mod:`modalviewer.collection` does the work)."""
 
 from __future__ import annotations
 
 import sys
 
-from .core.operators import DISTANCE_KINDS, OPERATOR_NAMES
-
-COMMANDS = ("batch", "similar")
+from ..core.operators import DISTANCE_KINDS, OPERATOR_NAMES
+from .common import COUNT, WEIGHT, Unavailable, number, whole
 
 
 def _kinds(text: str) -> list[str]:
@@ -23,9 +22,6 @@ def _kinds(text: str) -> list[str]:
 
 
 def add_parsers(sub) -> None:
-    """The ``batch`` and ``similar`` subcommands of the CLI's parser."""
-    from .cli import COUNT, WEIGHT, _number, _whole
-
     b = sub.add_parser(
         "batch",
         help="spectra and signatures of a whole dataset into one store (on Dask)",
@@ -53,7 +49,7 @@ def add_parsers(sub) -> None:
     where = b.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
-        type=_whole(0),
+        type=whole(0),
         default=None,
         metavar="N",
         help="a local Dask cluster of N worker processes (default: one per core); 0: one "
@@ -68,33 +64,27 @@ def add_parsers(sub) -> None:
     )
     b.add_argument(
         "--memory-limit",
-        type=_number(0.0, False),
+        type=number(0.0, False),
         default=None,
         metavar="GB",
         help="each local worker's memory limit (default: the machine's memory over the "
         "workers); tasks ask for their estimated memory out of it",
     )
     b.add_argument("--retry-failed", action="store_true", help="retry meshes recorded as failed")
+    b.set_defaults(func=batch)
     s = sub.add_parser(
         "similar", help="the meshes of a store nearest to a mesh (Shape-DNA distance)"
     )
     s.add_argument("store")
     s.add_argument("mesh", help="a mesh file, or the name of a mesh in the store")
     s.add_argument("-n", type=COUNT, default=10, help="how many to list (default 10)")
+    s.set_defaults(func=similar)
 
 
-def run(args) -> int:
-    """Run ``batch`` or ``similar``; errors propagate as in the other commands."""
-    if args.command == "batch":
-        return _batch(args)
-    return _similar(args)
-
-
-def _batch(args) -> int:
+def batch(args) -> int:
     import os
 
-    from .cli import _Unavailable
-    from .collection import progress_bar, run_batch
+    from ..collection import progress_bar, run_batch
 
     workers = args.workers  # -k, --workers and --memory-limit checked by the parser
     if workers is None:
@@ -103,7 +93,7 @@ def _batch(args) -> int:
         try:
             import distributed  # noqa: F401
         except ImportError:
-            raise _Unavailable(
+            raise Unavailable(
                 "Dask is not installed: pip install 'modalviewer[batch]' (or --workers 0: "
                 "one mesh after another in this process)"
             ) from None
@@ -139,10 +129,10 @@ def _batch(args) -> int:
     return 1 if summary.failed else 0
 
 
-def _similar(args) -> int:
+def similar(args) -> int:
     from pathlib import Path
 
-    from .collection import open_collection
+    from ..collection import open_collection
 
     collection = open_collection(args.store)
     if not collection.names:
