@@ -4,13 +4,18 @@ axis presets.
 Canonical view: the up axis is the caller's (a file convention) or +Y, the convention of
 most OBJ/PLY/OFF models.  Among the horizontal viewing directions (perpendicular to up,
 every 5 degrees) the viewer looks along the one from which the surface shows the largest
-silhouette (estimated from the projected vertices on a grid of 3 mean edge lengths),
+silhouette (estimated from points spread over the surface, projected on a grid),
 preferring a coordinate axis when it shows ``AXIS_PREFERENCE`` of the best; if the view from
 above shows more than ``TOP_VIEW_RATIO`` times that (a plate lying across the up axis),
 it looks from above.  Then the camera turns by a small azimuth and elevation so the
 view shows depth.  The camera sits on the side of +Z (then +X, then +Y) of its axis, the
 side most models face.  Without faces the principal axis of least spread stands in for
 the direction of the largest silhouette.
+
+A CAD-like part (most neighbouring faces coplanar, sharp edges along its features) seen
+that way often faces its flat side, which hides its features: the turn is then the one,
+of a few azimuths and elevations, from which its sharp edges show best (both faces of
+each seen at a good angle).
 """
 
 from __future__ import annotations
@@ -36,6 +41,11 @@ AXIS_PREFERENCE = 0.9  # a coordinate axis showing this share of the best is tak
 # which side of the viewing axis the camera sits on: the +Z side first (models face +Z)
 _FRONT = np.array([0.1, 0.2, 1.0]) / np.linalg.norm([0.1, 0.2, 1.0])
 _TURN_TOWARD = np.array([0.5, 0.0, 1.0])
+DEFAULT_TURN = (20.0, 15.0)  # azimuth, elevation of the canonical view (degrees)
+CAD_TURNS = ((20.0, 15.0), (45.0, 15.0), (20.0, 35.0), (45.0, 35.0), (60.0, 30.0))
+COPLANAR_SHARE = 0.5  # share of a CAD-like part's edges between coplanar faces
+SHARP_SHARE = 0.01  # share of a CAD-like part's edge length on sharp edges
+SHARP_DEGREES = 45.0  # the angle between the normals of a sharp edge's faces
 
 
 @dataclass(frozen=True)
@@ -157,13 +167,11 @@ def look_from(vertices, direction, up) -> Camera:
     return Camera(tuple(position), tuple(centre), tuple(u))
 
 
-def silhouette_area(vertices, directions, cell: float) -> np.ndarray:
-    """(d,) area of the silhouette seen along each unit direction (d, 3), estimated by
-    the square cells of side ``cell`` that the projected vertices fall into (take about
-    3 mean edge lengths: with less, surfaces seen face-on leave empty cells)."""
-    v = np.asarray(vertices, dtype=np.float64)
-    if len(v) > 200000:  # a regular subset of a very fine mesh covers the same cells
-        v = v[:: int(np.ceil(len(v) / 200000))]
+def silhouette_area(points, cell: float, directions) -> np.ndarray:
+    """(d,) area of the silhouette of ``points`` seen along each unit direction (d, 3),
+    estimated by the square cells of side ``cell`` that the projected points fall into
+    (:func:`_surface_points` gives points dense enough for its cell)."""
+    v = np.asarray(points, dtype=np.float64)
     v = v - v.mean(axis=0)
     out = np.zeros(len(directions))
     for i, d in enumerate(np.asarray(directions, dtype=np.float64)):
@@ -180,6 +188,25 @@ def silhouette_area(vertices, directions, cell: float) -> np.ndarray:
     return out
 
 
+def _surface_points(vertices, faces, samples: int = 40000) -> tuple[np.ndarray, float]:
+    """(points, cell): ``samples`` points spread uniformly over the surface (a fixed
+    seed, so a mesh always gets the same view) and a cell side at which a surface seen
+    face-on leaves no cell empty, whatever the size of its triangles."""
+    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
+    x0, x1, x2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(x1 - x0, x2 - x0), axis=1)
+    total = float(area.sum())
+    rng = np.random.default_rng(0)
+    face = rng.choice(len(f), samples, p=area / total)
+    r1, r2 = np.sqrt(rng.random(samples)), rng.random(samples)
+    points = (
+        (1 - r1)[:, None] * x0[face]
+        + (r1 * (1 - r2))[:, None] * x1[face]
+        + (r1 * r2)[:, None] * x2[face]
+    )
+    return points, 2.0 * np.sqrt(total / samples)
+
+
 def _largest_silhouette(vertices, faces, up_vec: np.ndarray) -> np.ndarray:
     """The viewing axis (unit, sign not chosen) showing the largest projected area."""
     if faces is None or len(faces) == 0:
@@ -194,9 +221,7 @@ def _largest_silhouette(vertices, faces, up_vec: np.ndarray) -> np.ndarray:
     horizontal = np.outer(np.cos(angles), a) + np.outer(np.sin(angles), b)
     axes = [np.array(d) for d in AXES.values() if abs(np.dot(d, up_vec)) < 1e-9]
     candidates = np.vstack([horizontal, *axes, up_vec]) if axes else np.vstack([horizontal, up_vec])
-    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
-    edge = np.linalg.norm(v[f[:, 1]] - v[f[:, 0]], axis=1).mean()
-    area = silhouette_area(v, candidates, 3.0 * edge)
+    area = silhouette_area(*_surface_points(vertices, faces), candidates)
     best_h = int(np.argmax(area[: len(horizontal)]))
     best = horizontal[best_h]
     best_area = area[best_h]
@@ -209,12 +234,48 @@ def _largest_silhouette(vertices, faces, up_vec: np.ndarray) -> np.ndarray:
     return best
 
 
+def sharp_edges(vertices, faces) -> tuple[np.ndarray, np.ndarray] | None:
+    """The sharp edges of a CAD-like surface (see the module docstring): ((s, 3) edge
+    vectors, (s, 2, 3) the unit normals of their two faces); None for other surfaces."""
+    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
+    normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
+    edges = np.sort(np.stack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]], 1).reshape(-1, 2), 1)
+    face = np.repeat(np.arange(len(f)), 3)
+    order = np.lexsort((edges[:, 1], edges[:, 0]))
+    edges, face = edges[order], face[order]
+    i = np.flatnonzero(np.all(edges[1:] == edges[:-1], axis=1))  # edges with two faces
+    if i.size == 0:
+        return None
+    pair = np.stack([normals[face[i]], normals[face[i + 1]]], axis=1)
+    cos = np.einsum("ij,ij->i", pair[:, 0], pair[:, 1])
+    vectors = v[edges[i, 1]] - v[edges[i, 0]]
+    length = np.linalg.norm(vectors, axis=1)
+    sharp = cos < np.cos(np.radians(SHARP_DEGREES))
+    coplanar = np.mean(cos > np.cos(np.radians(0.5)))
+    if coplanar < COPLANAR_SHARE or length[sharp].sum() < SHARP_SHARE * length.sum():
+        return None
+    return vectors[sharp], pair[sharp]
+
+
+def crease_visibility(edges: tuple[np.ndarray, np.ndarray], direction) -> float:
+    """How well the sharp ``edges`` (:func:`sharp_edges`) show from unit ``direction``
+    (toward the camera): their length, each weighted by the cosine between the view and
+    the less visible of its two faces (0 where one is turned away), since a crease shows
+    as the meeting of two faces both seen."""
+    vectors, normals = edges
+    seen = np.clip((normals @ _unit(direction)).min(axis=1), 0.0, None)
+    return float(np.linalg.norm(vectors, axis=1) @ seen)
+
+
 def canonical_view(
-    vertices, faces=None, up=None, azimuth: float = 20.0, elevation: float = 15.0
+    vertices, faces=None, up=None, azimuth: float | None = None, elevation: float | None = None
 ) -> Camera:
     """The canonical first view of a mesh (see the module docstring).  ``up``: an axis
     name ("+y", "z", ...) or a vector; ``azimuth``/``elevation`` in degrees turn the
-    camera about the up axis and toward it from the straight front view."""
+    camera about the up axis and toward it from the straight front view (default
+    :data:`DEFAULT_TURN`, or for a CAD-like part the turn of :data:`CAD_TURNS` that shows
+    its sharp edges best)."""
     up_vec = _up_vector(up)
     view = _largest_silhouette(vertices, faces, up_vec)
     if abs(view @ up_vec) > np.cos(np.radians(30.0)):
@@ -229,12 +290,26 @@ def canonical_view(
     else:
         view = _face_front(view)
         screen_up = _unit(up_vec - (up_vec @ view) * view)
-    # turn toward the front (+Z, then +X): of the two turns pick the one facing it more
+    edges = None
+    if azimuth is None and elevation is None and faces is not None and len(faces):
+        edges = sharp_edges(vertices, faces)
+    if edges is None:
+        az = DEFAULT_TURN[0] if azimuth is None else azimuth
+        el = DEFAULT_TURN[1] if elevation is None else elevation
+        direction = _turned(view, screen_up, az, el)
+    else:
+        turns = [_turned(view, screen_up, a, e) for a, e in CAD_TURNS]
+        direction = max(turns, key=lambda d: crease_visibility(edges, d))
+    return look_from(vertices, direction, screen_up)
+
+
+def _turned(view, screen_up, azimuth: float, elevation: float) -> np.ndarray:
+    """``view`` turned by ``azimuth`` about ``screen_up`` toward the front (+Z, then +X:
+    of the two turns the one facing it more), then by ``elevation`` toward up."""
     turns = [_rotate(view, screen_up, a) for a in (azimuth, -azimuth)]
     direction = max(turns, key=lambda d: float(d @ _TURN_TOWARD))
     right = _unit(np.cross(screen_up, direction))
-    direction = _rotate(direction, right, -elevation)
-    return look_from(vertices, direction, screen_up)
+    return _rotate(direction, right, -elevation)
 
 
 def preset_view(vertices, name: str, up=None) -> Camera:

@@ -76,6 +76,42 @@ def test_a_plate_lying_across_the_up_axis_is_seen_from_above():
     assert np.allclose(np.abs(cam.direction), [0, 0, 1], atol=1e-12)
 
 
+def _plate_part():
+    """A machined plate 2 x 1 x 0.2 (flat side toward +Z), as a CAD export gives it:
+    coplanar triangles on each face, sharp edges all round."""
+    import trimesh
+
+    box = trimesh.creation.box(extents=(2.0, 1.0, 0.2)).subdivide().subdivide()
+    return np.asarray(box.vertices), np.asarray(box.faces)
+
+
+def test_a_coarse_part_is_seen_along_its_largest_silhouette():
+    # projected vertices of large triangles filled the same few cells from every side,
+    # and the first view looked at the plate's narrow end
+    v, f = _plate_part()
+    cam = canonical_view(v, f, azimuth=0.0, elevation=0.0)
+    assert np.allclose(cam.direction, [0, 0, 1], atol=1e-12)
+
+
+def test_the_first_view_of_a_cad_like_part_shows_its_sides():
+    v, f = _plate_part()
+    d = canonical_view(v, f).direction
+    # the flat front, the narrow side and the top each seen at 30 degrees or more from
+    # grazing, so the sharp edges between them show (the default turn, 20 degrees of
+    # azimuth and 15 of elevation, sees the side and the top nearly edge-on)
+    assert np.all(np.abs(d) >= np.sin(np.radians(30.0))), d
+    assert d[1] > 0  # from above
+
+
+def test_a_smooth_mesh_keeps_the_default_turn():
+    import modalviewer as mv
+
+    spot = mv.load_mesh(mv.asset_path("spot.obj"))
+    cam = canonical_view(spot.vertices, spot.faces)
+    default = canonical_view(spot.vertices, spot.faces, azimuth=20.0, elevation=15.0)
+    assert np.allclose(cam.direction, default.direction, atol=1e-12)
+
+
 @pytest.mark.parametrize(
     "name, direction, up",
     [
