@@ -11,12 +11,14 @@ from __future__ import annotations
 import numpy as np
 
 from .mesh import Mesh
-from .operators import operator_info
+from .operators import OperatorLike, operator_info
 
 __all__ = ["operator_matrices"]
 
 
-def operator_matrices(mesh: Mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):
+def operator_matrices(
+    mesh: Mesh, operator: OperatorLike, bending: float = 1.0, membrane: float = 1.0
+):
     """(K, mass_diag) of the eigenproblem ``K phi = lambda diag(mass) phi``."""
     info = operator_info(operator)  # a ValueError naming the known operators
     K, m = info.matrices(mesh, bending, membrane)

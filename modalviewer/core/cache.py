@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .mesh import Mesh
-from .operators import operator_info
+from .operators import OperatorLike, operator_info
 from .spectrum import Spectrum, load_spectrum, save_spectrum
 
 __all__ = [
@@ -118,9 +118,12 @@ class SpectrumCache:
         self._last_stamp = 0
 
     # ---------------------------------------------------------------- keys
-    def key(self, mesh: Mesh, operator: str, k: int, bending: float, membrane: float) -> str:
-        params = {"op": operator, "k": int(k), "solver": SOLVER_VERSION}
-        if operator_info(operator).has_weights:
+    def key(
+        self, mesh: Mesh, operator: OperatorLike, k: int, bending: float, membrane: float
+    ) -> str:
+        info = operator_info(operator)
+        params = {"op": info.name, "k": int(k), "solver": SOLVER_VERSION}
+        if info.has_weights:
             params.update(bending=float(bending), membrane=float(membrane))
         blob = mesh.hash + json.dumps(params, sort_keys=True)
         return hashlib.sha256(blob.encode()).hexdigest()[:32]
@@ -178,6 +181,7 @@ class SpectrumCache:
     def get(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Spectrum | None:
         """The cached spectrum (its ``from_cache`` set), or None.  A hit counts as a use
         (for the eviction order); an entry that cannot be read is deleted with a warning."""
+        operator = operator_info(operator)
         path = self.path(mesh, operator, k, bending, membrane)
         if not path.is_file():
             return None
@@ -190,7 +194,7 @@ class SpectrumCache:
             self._unlink(path)
             return None
         if (
-            spec.operator != operator
+            spec.operator != operator.name
             or spec.k != min(k, spec.k)
             or spec.n_vertices != mesh.n_vertices
         ):

@@ -24,7 +24,7 @@ import numpy as np
 
 from .eigen import CancelFn, ProgressFn
 from .mesh import Mesh, MeshReport, shape_summary
-from .operators import DEFAULT_K
+from .operators import DEFAULT_K, OperatorLike, operator_info
 from .pipeline import compute_spectrum
 from .spectrum import Spectrum
 from .validate import check_count
@@ -169,7 +169,7 @@ class ComponentSpectrum:
 
 def compute_spectrum_per_component(
     mesh: Mesh,
-    operator: str,
+    operator: OperatorLike,
     k: int = DEFAULT_K,
     bending: float = 1.0,
     membrane: float = 1.0,
@@ -202,6 +202,7 @@ def compute_spectrum_per_component(
     ValueError
         If no component has at least ``min_vertices`` vertices.
     """
+    operator = operator_info(operator)
     k = check_count(k, "k")
     min_vertices = check_count(min_vertices, "min_vertices", 0)
     parts = [(m, v) for m, v in split_components(mesh) if m.n_vertices >= min_vertices]

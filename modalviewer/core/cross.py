@@ -49,7 +49,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .mesh import Mesh
-from .operators import operator_info
 from .signatures import SignatureTable, default_energies, default_times, normalised_signatures
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_vertex, check_vertices
@@ -131,7 +130,7 @@ def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
         )
     for name in ("bending", "membrane"):
         a, b = spec_a.parameters.get(name), spec_b.parameters.get(name)
-        weighted = operator_info(spec_a.operator).has_weights
+        weighted = spec_a.operator_info.has_weights
         if weighted and a is not None and b is not None and a != b:
             raise ValueError(f"the two shells spectra use different {name} weights ({a} and {b})")
     area_a, area_b = float(spec_a.mass.sum()), float(spec_b.mass.sum())

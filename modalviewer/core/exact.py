@@ -17,6 +17,7 @@ from .assembly import operator_matrices
 from .eigen import CancelFn, EigenResult, ProgressFn, solve_lowest, typical_eigenvalue, zero_modes
 from .mesh import Mesh
 from .nullspace import NullSpace, null_space
+from .operators import OperatorInfo
 
 __all__ = ["ExactPairs", "ModeSink", "exact_pairs"]
 
@@ -56,7 +57,7 @@ class ExactPairs:
 
 def exact_pairs(
     mesh: Mesh,
-    operator: str,
+    operator: OperatorInfo,
     k: int,
     bending: float = 1.0,
     membrane: float = 1.0,

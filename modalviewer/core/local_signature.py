@@ -32,7 +32,7 @@ from .assembly import operator_matrices
 from .factor import SPDSolver
 from .mesh import Mesh
 from .nullspace import null_space
-from .operators import operator_info
+from .operators import OperatorLike, operator_info
 from .spectrum import Spectrum
 from .validate import check_times, check_vertices
 
@@ -116,7 +116,7 @@ def _quadrature(
 
 def local_signature(
     mesh: Mesh,
-    operator: str,
+    operator: OperatorLike,
     vertices,
     times,
     include_zero: bool = False,
@@ -136,7 +136,7 @@ def local_signature(
     Parameters
     ----------
     mesh : the surface.
-    operator : one of ``OPERATORS``.
+    operator : an operator's name or :class:`.operators.OperatorInfo`.
     vertices : int or sequence of vertex indices (0-based).
     times : (T,) positive scales.
     include_zero : add the zero modes (constants, rigid motions) as ``signature`` does.
@@ -163,6 +163,7 @@ def local_signature(
     RuntimeError
         If a scale has not settled to ``rtol`` within ``max_steps`` Lanczos steps.
     """
+    operator = operator_info(operator)
     vertices = check_vertices(vertices, mesh.n_vertices)
     solver = mesh.solver_mesh
     if solver is not mesh:  # unused or merged vertices: on the vertices faces use
@@ -182,13 +183,13 @@ def local_signature(
         )
     times = check_times(times)
     K, mass = operator_matrices(mesh, operator, bending, membrane)
-    per_vertex = operator_info(operator).unknowns_per_vertex
+    per_vertex = operator.unknowns_per_vertex
     # the shift: the scales' geometric mean's rate, where exp(-t x) varies the most
     B = _ShiftedInverse(K, mass, 1.0 / float(np.sqrt(times.min() * times.max())))
     T = len(times)
     known = np.zeros((len(vertices), per_vertex, T))
     if spectrum is not None:
-        if spectrum.operator != operator or spectrum.mesh_hash != mesh.hash:
+        if spectrum.operator != operator.name or spectrum.mesh_hash != mesh.hash:
             raise ValueError("spectrum must be of this mesh and operator")
         modes = spectrum.modes.reshape(K.shape[0], spectrum.k)
         used = np.ones(spectrum.k, dtype=bool) if include_zero else ~spectrum.zero_mode_mask()

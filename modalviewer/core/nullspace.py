@@ -42,7 +42,7 @@ import scipy.sparse as sp
 
 from .laplacian import vertex_normals
 from .mesh import Mesh
-from .operators import operator_info
+from .operators import OperatorInfo, OperatorLike, operator_info
 
 __all__ = ["NullSpace", "null_space", "NULL_RTOL"]
 
@@ -60,13 +60,13 @@ class NullSpace:
     vectors : (N, d) sparse CSC matrix, N unknowns (3n for ``"shells"``, dof 3i+c),
         ``vectors.T @ diag(mass) @ vectors = I`` and ``K @ vectors = 0`` to rounding.
         Each column lives on one component; columns are ordered by component.
-    operator : the operator's name.
+    operator : the operator.
     n_components : connected components of the mesh.
     per_component : (n_components,) null vectors found on each component.
     """
 
     vectors: sp.csc_matrix
-    operator: str
+    operator: OperatorInfo
     n_components: int
     per_component: np.ndarray
 
@@ -78,7 +78,7 @@ class NullSpace:
         """One sentence on the zero modes a spectrum of this operator starts with."""
         d, c = self.dimension, self.n_components
         comps = f"{c} connected component{'s' if c != 1 else ''}"
-        kind = operator_info(self.operator).null_space
+        kind = self.operator.null_space
         if d == 0:
             return f"{comps}; no exactly known zero modes ({kind}: none)."
         with_null = self.per_component[self.per_component > 0]
@@ -126,10 +126,9 @@ def _mass_orthonormal(B: np.ndarray, w: np.ndarray, rtol: float = 1e-10) -> np.n
     return B @ (V[:, keep] / np.sqrt(ev[keep]))
 
 
-def _candidates(mesh: Mesh, operator: str, mass: np.ndarray, normals):
+def _candidates(mesh: Mesh, info: OperatorInfo, mass: np.ndarray, normals):
     """Per component: (rows of the unknowns, Mass-orthonormal dense candidate columns)."""
     x = mesh.vertices
-    info = operator_info(operator)
     rule, per_vertex = info.null_space_rule, info.unknowns_per_vertex
     for verts in _component_vertices(mesh):
         m = mass[per_vertex * verts]
@@ -158,7 +157,7 @@ def _candidates(mesh: Mesh, operator: str, mass: np.ndarray, normals):
 
 def null_space(
     mesh: Mesh,
-    operator: str,
+    operator: OperatorLike,
     K: sp.spmatrix,
     mass: np.ndarray,
     normals: np.ndarray | None = None,
@@ -178,7 +177,7 @@ def null_space(
         normals = vertex_normals(mesh)
     rows, cols, vals = [], [], []
     component = []
-    for c, (comp_rows, Z) in enumerate(_candidates(mesh, operator, mass, normals)):
+    for c, (comp_rows, Z) in enumerate(_candidates(mesh, info, mass, normals)):
         r, j = np.nonzero(Z)
         rows.append(comp_rows[r])
         cols.append(j + len(component))
@@ -200,7 +199,7 @@ def null_space(
         Z = Z[:, np.flatnonzero(exact)]
         component = np.asarray(component)[exact]
     per_component = np.bincount(np.asarray(component, dtype=np.int64), minlength=n_components)
-    return NullSpace(sp.csc_matrix(Z), operator, n_components, per_component)
+    return NullSpace(sp.csc_matrix(Z), info, n_components, per_component)
 
 
 def _column_norms(A: sp.csc_matrix) -> np.ndarray:

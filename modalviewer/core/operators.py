@@ -5,7 +5,9 @@ function that assembles the matrix, the exactly known null space, the signature 
 distance the spectrum defines, and the memory an exact solve needs.  Every other module
 (pipeline, null space, viewer, CLI, plots) asks this registry instead of keeping its own
 list or comparing operator names, so a new operator is one more :class:`OperatorInfo` in
-:data:`OPERATOR_INFO`.
+:data:`OPERATOR_INFO` and its assembly function.  The public functions accept an
+operator's name or its :class:`OperatorInfo` (:data:`OperatorLike`); each resolves it once
+with :func:`operator_info` and passes the object on.
 
 This module imports nothing of the package: the assembly functions are named by
 ``"module:function"`` inside :mod:`modalviewer.core` and imported when first used.
@@ -14,6 +16,7 @@ This module imports nothing of the package: the assembly functions are named by
 from __future__ import annotations
 
 import importlib
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from .cost import (
@@ -29,6 +32,7 @@ __all__ = [
     "DEFAULT_K",
     "default_k",
     "OperatorInfo",
+    "OperatorLike",
     "OPERATOR_INFO",
     "OPERATOR_NAMES",
     "DISTANCE_KINDS",
@@ -68,9 +72,10 @@ class OperatorInfo:
     unknowns_per_vertex : 3 for displacement fields, 1 for scalar fields.
     distance_kind : the multi-scale distance this operator's spectrum defines, or None.
     has_weights : whether the bending and membrane weights apply.
-    assemble : ``"module:function"`` in :mod:`modalviewer.core` that assembles K:
-        ``function(mesh)``, or ``function(mesh, bending, membrane)`` with weights
-        (:meth:`stiffness`); with ``assembles_mass`` it returns (K, mass).
+    assemble : the function that assembles K, or its ``"module:function"`` in
+        :mod:`modalviewer.core`: ``function(mesh)``, or ``function(mesh, bending,
+        membrane)`` with weights (:meth:`stiffness`); with ``assembles_mass`` it returns
+        (K, mass).
     null_space : the exactly known null vectors in words.
     null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
     exact_growth : measured peak memory of the exact solve against mesh size
@@ -99,7 +104,7 @@ class OperatorInfo:
     unknowns_per_vertex: int
     distance_kind: str | None
     has_weights: bool
-    assemble: str
+    assemble: str | Callable
     null_space: str
     null_space_rule: str
     exact_growth: GrowthLaw
@@ -194,8 +199,10 @@ class OperatorInfo:
     def matrices(self, mesh, bending: float = 1.0, membrane: float = 1.0):
         """(K, mass (n,) per vertex) on ``mesh``: the function :attr:`assemble`, and the
         lumped vertex areas unless it returns a mass of its own (:attr:`assembles_mass`)."""
-        module, function = self.assemble.split(":")
-        assemble = getattr(importlib.import_module(f"modalviewer.core.{module}"), function)
+        assemble = self.assemble
+        if isinstance(assemble, str):
+            module, function = assemble.split(":")
+            assemble = getattr(importlib.import_module(f"modalviewer.core.{module}"), function)
         result = assemble(mesh, bending, membrane) if self.has_weights else assemble(mesh)
         if self.assembles_mass:
             return result
@@ -315,13 +322,20 @@ DISTANCE_KINDS: dict[str, str] = {
 """Distance kinds (paper Section 6, and the wave kernel's) and their names in words."""
 
 
-def operator_info(name: str) -> OperatorInfo:
-    """The registry entry of ``name``; a ValueError naming the known operators otherwise."""
+OperatorLike = str | OperatorInfo
+"""An operator as the public functions accept it: its name or its :class:`OperatorInfo`."""
+
+
+def operator_info(operator: OperatorLike) -> OperatorInfo:
+    """The operator object of ``operator``: the registry entry of a name, an
+    :class:`OperatorInfo` as it is; a ValueError naming the known operators otherwise."""
+    if isinstance(operator, OperatorInfo):
+        return operator
     try:
-        return OPERATOR_INFO[name]
-    except KeyError:
+        return OPERATOR_INFO[operator]
+    except (KeyError, TypeError):
         raise ValueError(
-            f"unknown operator {name!r}; choose one of {', '.join(OPERATOR_NAMES)}"
+            f"unknown operator {operator!r}; choose one of {', '.join(OPERATOR_INFO)}"
         ) from None
 
 

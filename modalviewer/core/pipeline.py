@@ -13,7 +13,7 @@ from .eigen import CancelFn, EigenError, ProgressFn, rounding_floors
 from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
-from .operators import DEFAULT_K, operator_info
+from .operators import DEFAULT_K, OperatorInfo, OperatorLike, operator_info
 from .spectrum import GrowingSpectrum, Spectrum, in_input_numbering
 from .validate import check_count
 
@@ -91,7 +91,7 @@ the command line's ``--preview`` says the same)."""
 
 def compute_spectrum(
     mesh: Mesh,
-    operator: str,
+    operator: OperatorLike,
     k: int = DEFAULT_K,
     bending: float = 1.0,
     membrane: float = 1.0,
@@ -104,7 +104,8 @@ def compute_spectrum(
 
     Parameters
     ----------
-    operator : one of :data:`.operators.OPERATOR_NAMES`.
+    operator : a name of :data:`.operators.OPERATOR_INFO`, or its
+        :class:`.operators.OperatorInfo`.
     k : number of modes, an integer >= 1 (Python or numpy; not a float or a bool);
         capped at the number of unknowns.
     bending, membrane : Discrete Shells weights (ignored by the scalar energies).
@@ -113,18 +114,13 @@ def compute_spectrum(
     accuracy : "exact", the only value: every spectrum is exact.  The approximate
         "preview" and "fast preview" raise a ValueError that says what to use instead
         (:data:`PREVIEW_REMOVED`).
-    on_modes : called as ``on_modes(spectrum_so_far)`` while the solve runs, with a
-        :class:`.spectrum.Spectrum` of the first j modes whenever j grows (the exact null
-        vectors first), lowest first: the eigensolver's pairs as they converge, whose
-        eigenvalues and modes equal the finished spectrum's to the solver's tolerance (a
-        cluster of equal eigenvalues is handed over whole, as a subspace).  Its
-        ``is_complete`` is False and ``modes_requested`` says how many are to come; its
-        residuals are NaN (they are computed for the finished spectrum, after the final
-        refinement).
-        The last call has the finished spectrum, the one returned.  Small problems
-        (solved densely) get that last call only.  The callback runs in the computing
-        thread; whatever it keeps stays valid (each call's arrays are new views of
-        columns that are not written again).
+    on_modes : ``on_modes(spectrum_so_far)`` whenever more modes have converged: a
+        :class:`.spectrum.Spectrum` of the first j (null vectors first), equal to the
+        finished spectrum's to the solver's tolerance (a cluster of equal eigenvalues
+        comes whole), ``is_complete`` False, residuals NaN.  The last call has the
+        finished spectrum; small problems (solved densely) get only that one.  It runs
+        in the computing thread; what it keeps stays valid (new views of columns that
+        are not written again).
 
     Returns
     -------
@@ -137,7 +133,7 @@ def compute_spectrum(
     come first, as eigenvalue 0, counted in k; ``spec.null_space_dimension`` says how
     many, ``spec.parameters["null_space"]`` says it in words.
     """
-    operator_info(operator)  # a ValueError naming the known operators
+    operator = operator_info(operator)  # a ValueError naming the known operators
     k = check_count(k, "k")
     if accuracy in REMOVED_ACCURACIES:
         raise ValueError(f"accuracy={accuracy!r}: {PREVIEW_REMOVED}")
@@ -175,63 +171,37 @@ def compute_spectrum(
         pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel, sink)
     except EigenError as exc:
         raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
-    K, mass, nulls, result = pairs.K, pairs.mass, pairs.nulls, pairs.result
-    k, lam_typical, nonzero = result.eigenvalues.shape[0], pairs.zero_mode_scale, pairs.nonzero
-    if not nonzero.any():
+    result, nulls = pairs.result, pairs.nulls
+    if not pairs.nonzero.any():
         warnings.warn(
-            _all_zero_message(k, result, nulls, lam_typical), ZeroModesWarning, stacklevel=2
+            _all_zero_message(result.eigenvalues.shape[0], result, nulls, pairs.zero_mode_scale),
+            ZeroModesWarning,
+            stacklevel=2,
         )
-    # modes above the accuracy well-shaped meshes reach: how close to rounding are they?
-    loose = np.flatnonzero(nonzero & (result.residuals > min(WELL_SHAPED_RESIDUAL, RESIDUAL_LIMIT)))
-    floors_loose = (
-        rounding_floors(K, mass, result.eigenvalues[loose], result.vectors, columns=loose)
-        if loose.size
-        else np.zeros(0)
-    )
-    worst_floor = float(floors_loose[np.argmax(result.residuals[loose])]) if loose.size else 0.0
-    above = np.flatnonzero(nonzero & (result.residuals > RESIDUAL_LIMIT))
-    at_floor = 0
-    if above.size:
-        floors = floors_loose[np.searchsorted(loose, above)]
-        bad = above[result.residuals[above] > FLOOR_FACTOR * floors]
-        if bad.size:
-            worst = float(result.residuals[bad].max())
-            raise EigenError(
-                f"the eigensolver's residual {worst:.1e} is above {RESIDUAL_LIMIT:.0e} and "
-                f"above the rounding floor; the result is not trustworthy{_failure_hint(mesh)}"
-            )
-        at_floor = int(above.size)
-    n = mesh.n_vertices
+    at_floor, worst_floor = _checked_residuals(pairs, mesh)
+    per_vertex = operator.unknowns_per_vertex
     modes = result.vectors
-    per_vertex = operator_info(operator).unknowns_per_vertex
     if per_vertex > 1:
-        modes = modes.reshape(n, per_vertex, k)
+        modes = modes.reshape(mesh.n_vertices, per_vertex, -1)
     if progress is not None:
         progress("done", 1.0)
     spectrum = Spectrum(
         eigenvalues=result.eigenvalues,
         modes=modes,
-        operator=operator,
-        mass=mass[::per_vertex],
+        operator=operator.name,
+        mass=pairs.mass[::per_vertex],
         residuals=result.residuals,
         mesh_hash=mesh.hash,
         parameters={
-            "k": k,
+            "k": result.eigenvalues.shape[0],
             "bending": float(bending),
             "membrane": float(membrane),
-            "method": result.method,
-            "shift": result.shift,
+            **_solve_parameters(result),
             "seconds_assembly": pairs.seconds_assembly,
             "seconds_total": time.perf_counter() - started,
-            "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
-            "operator_columns": result.operator_columns,
-            "factor_mb": result.factor_mb,
-            "factor_out_of_core": result.out_of_core,
-            "basis_float32": result.basis_float32,
-            "null_space_dimension": result.null_dim,
             "modes_at_rounding_floor": at_floor,
             "worst_residual_rounding_floor": worst_floor,
-            "zero_mode_scale": lam_typical,
+            "zero_mode_scale": pairs.zero_mode_scale,
             "n_components": nulls.n_components,
             "null_space": nulls.summary(),
         },
@@ -241,15 +211,55 @@ def compute_spectrum(
     return spectrum
 
 
+def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
+    """(modes accepted at their rounding floor, the rounding floor of the worst mode
+    above :data:`WELL_SHAPED_RESIDUAL`); an EigenError where a non-zero mode's residual
+    is above :data:`RESIDUAL_LIMIT` and above ``FLOOR_FACTOR`` times its floor."""
+    K, mass, result, nonzero = pairs.K, pairs.mass, pairs.result, pairs.nonzero
+    residuals = result.residuals
+    # modes above the accuracy well-shaped meshes reach: how close to rounding are they?
+    loose = np.flatnonzero(nonzero & (residuals > min(WELL_SHAPED_RESIDUAL, RESIDUAL_LIMIT)))
+    if loose.size == 0:
+        return 0, 0.0
+    floors_loose = rounding_floors(K, mass, result.eigenvalues[loose], result.vectors, loose)
+    worst_floor = float(floors_loose[np.argmax(residuals[loose])])
+    above = np.flatnonzero(nonzero & (residuals > RESIDUAL_LIMIT))
+    floors = floors_loose[np.searchsorted(loose, above)]
+    bad = above[residuals[above] > FLOOR_FACTOR * floors]
+    if bad.size:
+        raise EigenError(
+            f"the eigensolver's residual {float(residuals[bad].max()):.1e} is above "
+            f"{RESIDUAL_LIMIT:.0e} and above the rounding floor; the result is not "
+            f"trustworthy{_failure_hint(mesh)}"
+        )
+    return int(above.size), worst_floor
+
+
+def _solve_parameters(result) -> dict:
+    """What the eigensolver's result says about the solve, for ``Spectrum.parameters``."""
+    return {
+        "method": result.method,
+        "shift": result.shift,
+        "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
+        "operator_columns": result.operator_columns,
+        "factor_mb": result.factor_mb,
+        "factor_out_of_core": result.out_of_core,
+        "basis_float32": result.basis_float32,
+        "null_space_dimension": result.null_dim,
+    }
+
+
 class _ModesSoFar:
     """Collects the pairs handed over during a solve (:class:`.exact.ModeSink`) in a
     :class:`.spectrum.GrowingSpectrum`, and gives ``on_modes`` a Spectrum of the first j
     at each step."""
 
-    def __init__(self, mesh: Mesh, operator: str, bending: float, membrane: float, on_modes):
-        self.mesh, self.operator, self.on_modes = mesh, operator, on_modes
+    def __init__(
+        self, mesh: Mesh, operator: OperatorInfo, bending: float, membrane: float, on_modes
+    ):
+        self.mesh, self.operator, self.on_modes = mesh, operator.name, on_modes
         self.weights = {"bending": float(bending), "membrane": float(membrane)}
-        self.per_vertex = operator_info(operator).unknowns_per_vertex
+        self.per_vertex = operator.unknowns_per_vertex
 
     def start(self, K, mass: np.ndarray, nulls, scale: float, k: int) -> None:
         self.mass, self.nulls, self.scale, self.k = mass, nulls, scale, k

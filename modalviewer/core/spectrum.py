@@ -12,7 +12,7 @@ import numpy as np
 from .eigen import zero_modes
 from .files import atomic_write
 from .mesh import Mesh
-from .operators import OPERATOR_NAMES, operator_info
+from .operators import OPERATOR_INFO, OPERATOR_NAMES, OperatorInfo, operator_info
 
 __all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
 
@@ -66,6 +66,11 @@ class Spectrum:
             f"modes={tuple(self.modes.shape)}, "
             f"eigenvalues={span})"
         )
+
+    @property
+    def operator_info(self) -> OperatorInfo:
+        """The operator object (:class:`.operators.OperatorInfo`) of :attr:`operator`."""
+        return operator_info(self.operator)
 
     @property
     def k(self) -> int:
@@ -249,7 +254,7 @@ def load_spectrum(
         raise
     except Exception as exc:  # any damage: zip errors, missing keys, bad JSON
         raise SpectrumFileError(f"{path} is not a readable spectrum file ({exc})") from None
-    if meta.get("format") != "modalviewer-spectrum" or spec.operator not in OPERATORS:
+    if meta.get("format") != "modalviewer-spectrum" or spec.operator not in OPERATOR_INFO:
         raise SpectrumFileError(f"{path} is not a modalviewer spectrum file")
     k = spec.eigenvalues.shape[0]
     n = spec.mass.shape[0]
