@@ -13,10 +13,11 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .core.cleaning import repair_mesh
 from .core.eigen import CancelFn, ProgressFn
 from .core.laplacian import lumped_masses
-from .core.mesh import Mesh, repair_mesh
-from .core.operators import operator_info
+from .core.mesh import Mesh
+from .core.operators import OperatorLike, operator_info
 from .core.pipeline import compute_spectrum
 from .core.spectrum import Spectrum
 
@@ -73,7 +74,7 @@ def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectr
 
 def coarse_to_fine_spectrum(
     mesh: Mesh,
-    operator: str,
+    operator: OperatorLike,
     k: int,
     bending: float = 1.0,
     membrane: float = 1.0,
@@ -86,6 +87,7 @@ def coarse_to_fine_spectrum(
     if progress is not None:
         progress("decimating", 0.0)
     coarse = decimated_copy(mesh, fraction)
-    k = min(k, operator_info(operator).unknowns(coarse.n_vertices))
+    operator = operator_info(operator)
+    k = min(k, operator.unknowns(coarse.n_vertices))
     spec = compute_spectrum(coarse, operator, k, bending, membrane, progress, cancel)
     return transfer_spectrum(spec, coarse, mesh)

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.mesh import Mesh, MeshError, MeshReport, repair_mesh, shape_summary
+from .core.cleaning import repair_mesh
+from .core.mesh import Mesh, MeshError, MeshReport, shape_summary
 from .extras import MissingExtraError, extra_needed
 from .readers import count_text, read_mesh_file, strips_to_triangles
 

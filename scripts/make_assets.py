@@ -18,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from modalviewer.core import demo_shapes  # noqa: E402
-from modalviewer.core.mesh import Mesh, repair_mesh  # noqa: E402
+from modalviewer.core.cleaning import repair_mesh  # noqa: E402
+from modalviewer.core.mesh import Mesh  # noqa: E402
 
 ASSETS = ROOT / "assets"
 

@@ -1,6 +1,7 @@
 """Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
 
 from .cache import SpectrumCache
+from .cleaning import repair_mesh
 from .components import (
     ComponentSpectrum,
     compute_spectrum_per_component,
@@ -23,7 +24,7 @@ from .eigen import Cancelled, EigenError
 from .fmaps import FunctionalMap, correspondence_errors, functional_map
 from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
 from .local_signature import local_signature
-from .mesh import Mesh, MeshError, MeshReport, remove_unused, repair_mesh
+from .mesh import Mesh, MeshError, MeshReport, remove_unused
 from .pipeline import ZeroModesWarning, compute_spectrum
 from .robust import negative_cotan_weights, robust_laplacian_matrices
 from .shells import normal_shells_hessian, shells_hessian

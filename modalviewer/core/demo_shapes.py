@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .mesh import Mesh, repair_mesh
+from .cleaning import repair_mesh
+from .mesh import Mesh
 from .primitives import grid_plate
 
 __all__ = ["plate", "folded_plate", "bumpy_plate", "voxel_surface", "double_torus",

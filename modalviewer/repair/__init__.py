@@ -4,7 +4,7 @@ The one place the viewer, the command line and the child processes learn which r
 there are.  :func:`fix_slivers` (``slivers.py``, pymeshlab imported when it runs)
 removes needle and cap triangles; ``largest_component`` keeps the largest connected
 piece (``modalviewer.core.components``).  The repairs a file gets on loading (merging
-duplicate vertices, dropping degenerate faces) are ``modalviewer.core.mesh.repair_mesh``.
+duplicate vertices, dropping degenerate faces) are ``modalviewer.core.cleaning.repair_mesh``.
 """
 
 from __future__ import annotations

@@ -28,8 +28,7 @@ from ..core.mesh import Mesh, MeshError, MeshReport, _plural
 __all__ = ["SliverReport", "fix_slivers"]
 
 SLIVER_QUALITY = 1e-3
-"""Quality below which a triangle is counted as a sliver in reports (the issue's 123k
-remesh whose shells could not be factorised had 1,282 of them)."""
+"""Quality below which a triangle is counted as a sliver in reports."""
 
 
 @dataclass
@@ -155,8 +154,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     smoothing projected back on the surface) of the slivers and the faces around them
     only.  MeshLab's collapses do not check the link condition, so on a large mesh with
     thousands of slivers one bad collapse can make an edge non-manifold; the remeshing
-    checks it but is slower (10 s for a 143k-vertex marching-cubes surface with 11k
-    slivers, against 4 s for the T-vertex removal).
+    checks it but is slower.
 
     Parameters
     ----------
@@ -204,16 +202,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         worst_quality_before=float(q0.min()),
     )
     if report.below_min_quality_before == 0:
-        out = Mesh(v0, f0, report=report, file_map=mesh.file_map, merged_into=mesh.merged_into)
-        report.triangles_after = mesh.n_faces
-        report.below_min_quality_after = 0
-        report.worst_quality_after = report.worst_quality_before
-        report.seconds = time.perf_counter() - started
-        report.add(
-            f"No triangle has quality below {min_quality:g} (worst {q0.min():.3g}); "
-            "nothing was changed."
-        )
-        return out
+        return _unchanged(mesh, report, started)
     try:
         import pymeshlab
     except ImportError:
@@ -221,69 +210,12 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
             "fix_slivers needs the optional pymeshlab package (GPL-3.0): "
             "pip install 'modalviewer[repair]' (or pip install pymeshlab)"
         ) from None
-
-    before = _topology(mesh)
-    names = (
-        "boundary edges",
-        "non-manifold edges",
-        "components",
-        "Euler characteristic",
-        "consistent orientation",
-    )
-    result, refused = None, []
-    for number, method in enumerate(_METHODS):
-        if progress is not None:
-            progress(f"fixing slivers: {_METHODS[method].split(' (')[0]}", 0.8 * number / 3)
-        try:
-            v, f, tags, ms = _run_meshlab(v0, f0, q0, method, min_quality)
-        except pymeshlab.PyMeshLabException as exc:
-            refused.append(f"{method}: {exc}")
-            continue
-        try:
-            candidate = Mesh(v, f, report=report)
-        except MeshError as exc:  # a degenerate face was left
-            refused.append(f"{method}: {exc}")
-            continue
-        after = _topology(candidate)
-        if after != before:
-            changes = [
-                f"{n} {x} -> {y}" for n, x, y in zip(names, before, after, strict=True) if x != y
-            ]
-            refused.append(f"{method}: {', '.join(changes)}")
-            continue
-        if (candidate.face_quality < min_quality).sum() >= report.below_min_quality_before:
-            refused.append(f"{method}: no better")
-            continue
-        result = candidate
-        break
-    if result is None:
-        raise MeshError(
-            "the slivers could not be removed without changing the surface's topology ("
-            + "; ".join(refused)
-            + "); remesh it in a mesh tool"
-        )
-    report.method = _METHODS[method]
-    if refused:
-        report.add(
-            "Simpler repairs were refused because they would have changed the surface: "
-            + "; ".join(refused)
-            + "."
-        )
-
+    result, method, tags, ms = _first_repair(mesh, report, min_quality, progress)
     q1 = result.face_quality
     whole = (tags == np.rint(tags)) & (tags >= 0) & (tags < mesh.n_vertices)
     origin = np.where(whole, np.rint(tags), 0).astype(np.int64)
     moved = np.linalg.norm(result.vertices - v0[origin], axis=1)
-    same = whole & (moved == 0)
-    # an input triangle is unchanged if the output has it with the same, unmoved vertices
-    still = result.faces[same[result.faces].all(axis=1)]
-    key_out = np.sort(origin[still], axis=1)
-    key_in = np.sort(f0, axis=1)
-    base = max(mesh.n_vertices, 1)
-    code_out = (key_out[:, 0] * base + key_out[:, 1]) * base + key_out[:, 2]
-    code_in = (key_in[:, 0] * base + key_in[:, 1]) * base + key_in[:, 2]
-    unchanged = np.isin(code_in, code_out)
-
+    unchanged = _unchanged_triangles(mesh, result, origin, whole & (moved == 0))
     if progress is not None:
         progress("measuring the change", 0.9)
     out_id = ms.current_mesh_id()
@@ -310,23 +242,112 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         "The repair numbers the vertices anew: vertex numbers (picks, --vertex, CSV rows, "
         "sessions) are now the repaired mesh's, not the file's."
     )
-    report.messages.insert(
-        0,
+    report.messages.insert(0, _summary(report, method == "remesh"))
+    return result
+
+
+def _unchanged(mesh: Mesh, report: SliverReport, started: float) -> Mesh:
+    """The mesh as it is, with a report that says no triangle is below the quality."""
+    out = Mesh(
+        mesh.vertices, mesh.faces, report=report, file_map=mesh.file_map,
+        merged_into=mesh.merged_into,
+    )  # fmt: skip
+    report.triangles_after = mesh.n_faces
+    report.below_min_quality_after = 0
+    report.worst_quality_after = report.worst_quality_before
+    report.seconds = time.perf_counter() - started
+    report.add(
+        f"No triangle has quality below {report.min_quality:g} (worst "
+        f"{report.worst_quality_before:.3g}); nothing was changed."
+    )
+    return out
+
+
+_TOPOLOGY_WORDS = (
+    "boundary edges",
+    "non-manifold edges",
+    "components",
+    "Euler characteristic",
+    "consistent orientation",
+)
+
+
+def _first_repair(mesh: Mesh, report: SliverReport, min_quality: float, progress):
+    """(repaired mesh, method, vertex tags, MeshSet) of the first of :data:`_METHODS`
+    whose result keeps the topology and has fewer triangles below ``min_quality``; a
+    MeshError naming why each was refused if none does.  Sets ``report.method`` and
+    notes the refused ones in it."""
+    import pymeshlab
+
+    before = _topology(mesh)
+    refused = []
+    for number, method in enumerate(_METHODS):
+        if progress is not None:
+            progress(f"fixing slivers: {_METHODS[method].split(' (')[0]}", 0.8 * number / 3)
+        try:
+            v, f, tags, ms = _run_meshlab(
+                mesh.vertices, mesh.faces, mesh.face_quality, method, min_quality
+            )
+            candidate = Mesh(v, f, report=report)
+        except (pymeshlab.PyMeshLabException, MeshError) as exc:  # MeshError: a degenerate face
+            refused.append(f"{method}: {exc}")
+            continue
+        after = _topology(candidate)
+        if after != before:
+            changes = [
+                f"{n} {x} -> {y}"
+                for n, x, y in zip(_TOPOLOGY_WORDS, before, after, strict=True)
+                if x != y
+            ]
+            refused.append(f"{method}: {', '.join(changes)}")
+            continue
+        if (candidate.face_quality < min_quality).sum() >= report.below_min_quality_before:
+            refused.append(f"{method}: no better")
+            continue
+        report.method = _METHODS[method]
+        if refused:
+            report.add(
+                "Simpler repairs were refused because they would have changed the surface: "
+                + "; ".join(refused)
+                + "."
+            )
+        return candidate, method, tags, ms
+    raise MeshError(
+        "the slivers could not be removed without changing the surface's topology ("
+        + "; ".join(refused)
+        + "); remesh it in a mesh tool"
+    )
+
+
+def _unchanged_triangles(mesh: Mesh, result: Mesh, origin, same) -> np.ndarray:
+    """(m,) bool: the input triangles the output has with the same, unmoved vertices
+    (``same``; ``origin``: each output vertex's input index)."""
+    still = result.faces[same[result.faces].all(axis=1)]
+    key_out = np.sort(origin[still], axis=1)
+    key_in = np.sort(mesh.faces, axis=1)
+    base = max(mesh.n_vertices, 1)
+    code_out = (key_out[:, 0] * base + key_out[:, 1]) * base + key_out[:, 2]
+    code_in = (key_in[:, 0] * base + key_in[:, 1]) * base + key_in[:, 2]
+    return np.isin(code_in, code_out)
+
+
+def _summary(report: SliverReport, remeshed: bool) -> str:
+    """The report's first sentence: what changed, by how much, and how far it moved."""
+    return (
         f"Changed {report.triangles_changed} of {_plural(report.triangles_before, 'triangle')}"
         f" by {report.method} ({_plural(report.triangles_after, 'triangle')} now, "
         f"{_plural(report.vertices_removed, 'vertex')} fewer): triangles below quality "
-        f"{min_quality:g} {report.below_min_quality_before} -> "
+        f"{report.min_quality:g} {report.below_min_quality_before} -> "
         f"{report.below_min_quality_after}, below {SLIVER_QUALITY:g} "
         f"{report.slivers_before} -> {report.slivers_after}, worst quality "
         f"{report.worst_quality_before:.2g} -> {report.worst_quality_after:.2g}; "
         + (
             f"new and smoothed vertices lie within {report.max_vertex_shift:.1e} of the "
             "input surface"
-            if method == "remesh"
+            if remeshed
             else f"vertices moved at most {report.max_vertex_shift:.1e}"
         )
         + " and the two surfaces are within "
         f"{report.max_deviation:.1e} of each other (of the bounding-box diagonal); "
-        f"boundary, components and Euler characteristic unchanged; {report.seconds:.2f} s.",
+        f"boundary, components and Euler characteristic unchanged; {report.seconds:.2f} s."
     )
-    return result

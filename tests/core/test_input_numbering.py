@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
+from modalviewer.core.cleaning import repair_mesh
 from modalviewer.core.components import largest_component, split_components
 from modalviewer.core.cross import rescale_to_area
-from modalviewer.core.mesh import Mesh, MeshError, remove_unused, repair_mesh
+from modalviewer.core.mesh import Mesh, MeshError, remove_unused
 from modalviewer.core.primitives import icosphere
 
 

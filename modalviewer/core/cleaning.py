@@ -1,0 +1,443 @@
+"""Load-time repair of triangle arrays: :func:`repair_mesh` merges duplicate vertices,
+collapses faces of zero area, drops repeated faces and orients the faces consistently,
+keeping every input vertex in its place, and says what it did in plain words."""
+
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+import scipy.sparse as sp
+
+from .mesh import (
+    Mesh,
+    MeshError,
+    MeshReport,
+    _plural,
+    _unique_index_rows,
+    checked_arrays,
+    shape_summary,
+)
+
+__all__ = ["repair_mesh"]
+
+
+_LISTED = 10  # vertex numbers a report lists before "and N more"
+
+
+def _listing(items: list[str], total: int) -> str:
+    """'vertex 3' or 'vertices 3, 7 and 2 more'."""
+    text = ", ".join(items)
+    if total > len(items):
+        text += f" and {total - len(items)} more"
+    return ("vertex " if total == 1 else "vertices ") + text
+
+
+def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
+    """Vertices within ``tol`` of each other merged into the first of them: (vertices,
+    faces, how many merged, each file vertex's new index, each new vertex's file
+    index).  Only vertices that faces use are merged: a vertex no face uses stays apart
+    (it is left without a value later), so a merged vertex is never named by the number
+    of one no face uses."""
+    if tol > 0:
+        key = np.round(v / tol).astype(np.int64)
+    else:
+        key = v
+    in_face = np.zeros(len(v), dtype=bool)
+    in_face[f.ravel()] = True
+    key = np.column_stack([key, np.where(in_face, -1, np.arange(len(v)))])
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    order = np.argsort(first)  # keep the original order of first occurrences
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    kept = first[order]
+    return v[kept], rank[inverse][f], len(v) - len(kept), rank[inverse], kept
+
+
+def _double_areas(v: np.ndarray, f: np.ndarray) -> np.ndarray:
+    return np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
+
+
+def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross product of (r, 3) arrays (np.cross costs 50 us per call on tiny ones)."""
+    return np.column_stack(
+        [
+            a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+            a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+            a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0],
+        ]
+    )
+
+
+def _collapsible(p: int, q: int, v, f, topo, min_area: float) -> bool:
+    """Whether merging vertex p into q keeps the surface a manifold and turns no face
+    around p upside down (``topo``: vertex-face and vertex-vertex CSR arrays, boundary
+    vertices, face counts per edge)."""
+    fi, fp, ni, nptr, on_boundary, adj = topo
+    around_p = fi[fp[p] : fp[p + 1]]
+    with_q = (f[around_p] == q).any(axis=1)
+    opposite = set(f[around_p[with_q]].ravel().tolist()) - {p, q}
+    nbrs_p, nbrs_q = ni[nptr[p] : nptr[p + 1]], ni[nptr[q] : nptr[q + 1]]
+    if set(nbrs_p.tolist()) & set(nbrs_q.tolist()) != opposite:
+        return False  # the collapse would glue two sheets together
+    if on_boundary[p] and on_boundary[q] and adj[p, q] == 2:
+        return False  # an inside edge between two boundary vertices: a pinch
+    rest = f[around_p[~with_q]]
+    if len(rest):
+        before = _cross_rows(v[rest[:, 1]] - v[rest[:, 0]], v[rest[:, 2]] - v[rest[:, 0]])
+        g = np.where(rest == p, q, rest)
+        after = _cross_rows(v[g[:, 1]] - v[g[:, 0]], v[g[:, 2]] - v[g[:, 0]])
+        big = (before * before).sum(axis=1) > (2 * min_area) ** 2
+        if np.any((before * after).sum(axis=1)[big] <= 0):
+            return False  # a neighbouring face would turn over
+    return True
+
+
+def _flippable(t: int, a: int, b: int, x: int, v, f, topo, min_area: float):
+    """(face across edge ab, its third vertex d) if the zero-area face t = (a, b, x) and
+    that face can trade their edge ab for xd: the surface stays a manifold (no edge xd
+    yet, consistent orientation) and both new faces (a, d, x), (d, b, x) have area and
+    face the way the old neighbour did; else None."""
+    fi, fp, ni, nptr, on_boundary, adj = topo
+    around_a = fi[fp[a] : fp[a + 1]]
+    across = [int(g) for g in around_a if g != t and b in f[g]]
+    if len(across) != 1:
+        return None
+    g = across[0]
+    k = int(np.flatnonzero(f[g] == b)[0])
+    if f[g][(k + 1) % 3] != a:  # the neighbour must run b -> a
+        return None
+    d = int(f[g][(k + 2) % 3])
+    if d == x or x in ni[nptr[d] : nptr[d + 1]]:
+        return None
+    old = _cross_rows(v[[a]] - v[[b]], v[[d]] - v[[b]])[0]
+    new = _cross_rows(v[[d, b]] - v[[a, d]], v[[x, x]] - v[[a, d]])
+    if np.any(0.5 * np.linalg.norm(new, axis=1) <= min_area) or np.any(new @ old <= 0):
+        return None
+    return g, d
+
+
+def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max_rounds=100):
+    """Collapse an edge, the shortest where possible, of every face of area at most
+    ``min_area``.
+
+    A zero-area face has three collinear (or nearly coincident) corners; the corner
+    between the other two (the apex, opposite the longest edge) is merged into the nearer
+    end of that edge, which moves it by the length of the face's shortest edge and
+    removes the faces on that edge (two inside the surface, one on its boundary), so a
+    closed surface stays closed.  A collapse is done only if it keeps the surface a
+    manifold (the two vertices share no neighbour except the corners opposite their
+    edge, and an inside edge does not join two boundary vertices) and turns no face
+    around the moved vertex upside down; if it would not, the face's other edges and
+    directions are tried, shortest first.  An apex well inside the longest edge (from a
+    tenth to nine tenths along it) is handled by flipping that edge instead, where the
+    result is a manifold with two faces of area: no vertex moves (a T-junction of a
+    remesh).
+    A zero-area face whose longest edge is on the boundary is removed instead: the
+    boundary then runs through its apex, along the same line, so no hole opens.
+    Collapses are done in rounds of non-adjacent edges until no zero-area face is left
+    or none can be collapsed.
+
+    Returns (faces, number of flipped edges, number of collapsed edges, faces removed
+    along the boundary, largest move, faces still of zero area, (n,) vertex each vertex
+    was merged into: itself where none).
+    """
+    n = len(v)
+    f = f.copy()
+    merged_into = np.arange(n)
+    collapsed, flipped, dropped, largest = 0, 0, 0, 0.0
+    for _ in range(max_rounds):
+        zero = np.flatnonzero(0.5 * _double_areas(v, f) <= min_area)
+        if zero.size == 0:
+            break
+        zf = f[zero]
+        lengths = np.stack(
+            [np.linalg.norm(v[zf[:, (c + 1) % 3]] - v[zf[:, c]], axis=1) for c in range(3)],
+            axis=1,
+        )  # edge c runs from corner c to corner c + 1
+        rows = np.arange(len(zf))
+        shortest = np.argmin(lengths, axis=1)
+        apex = zf[rows, (np.argmax(lengths, axis=1) + 2) % 3]
+        a, b = zf[rows, shortest], zf[rows, (shortest + 1) % 3]
+        moved = np.where(b == apex, b, a)
+        kept = np.where(b == apex, a, b)
+        order = np.argsort(lengths[rows, shortest], kind="stable")
+
+        topo = _topology(f, n)
+        adj = topo[5]
+
+        # A zero-area face along the boundary (its longest edge on no other face) is
+        # removed: the boundary then runs through its apex, along the same line.
+        lo = np.argmax(lengths, axis=1)
+        u, w = zf[rows, lo], zf[rows, (lo + 1) % 3]
+        along_boundary = np.asarray(adj[u, w]).ravel() == 1
+        drop = np.zeros(len(f), dtype=bool)
+        drop[zero[along_boundary]] = True
+
+        locked = np.zeros(n, dtype=bool)
+        locked[f[drop].ravel()] = True
+        remap = np.arange(n)
+        merged = 0
+        flipped_before = flipped
+        for i in order:
+            corners = zf[i]
+            if along_boundary[i] or locked[corners].any():
+                continue  # a neighbour changed in this round: the next round sees it
+            # an apex well inside the longest edge: flip that edge (nothing moves)
+            a_, b_, x_ = (int(corners[(lo[i] + c) % 3]) for c in range(3))
+            ab = v[b_] - v[a_]
+            t = float(np.dot(v[x_] - v[a_], ab) / max(np.dot(ab, ab), np.finfo(float).tiny))
+            if 0.1 <= t <= 0.9 and _flip(zero[i], a_, b_, x_, v, f, topo, min_area, locked):
+                flipped += 1
+                continue
+            # else collapse: the apex into the nearer end first; then the other ways of
+            # collapsing an edge of this face, shortest edge first
+            tries = [(int(moved[i]), int(kept[i]))]
+            for e in np.argsort(lengths[i], kind="stable"):
+                u, w = int(corners[e]), int(corners[(e + 1) % 3])
+                tries += [(u, w), (w, u)]
+            move = _collapse(tries, v, f, topo, min_area, locked, remap)
+            if move is not None:
+                largest = max(largest, move)
+                merged += 1
+        if merged == 0 and flipped == flipped_before and not drop.any():
+            break
+        collapsed += merged
+        dropped += int(drop.sum())
+        merged_into = remap[merged_into]
+        f = remap[f[~drop]]
+        f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
+    left = int((0.5 * _double_areas(v, f) <= min_area).sum()) if len(f) else 0
+    return f, flipped, collapsed, dropped, largest, left, merged_into
+
+
+def _topology(f: np.ndarray, n: int):
+    """(fi, fp, ni, nptr, on_boundary, adj) of the faces f on n vertices: vertex -> faces
+    (CSR indices and pointers), vertex -> neighbours, the boundary vertices and the
+    (n, n) matrix whose entry counts the faces on an edge."""
+    m = len(f)
+    vf = sp.csr_matrix(
+        (np.ones(3 * m, dtype=np.int8), (f.ravel(), np.repeat(np.arange(m), 3))),
+        shape=(n, m),
+    )
+    he = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    adj = sp.csr_matrix(
+        (np.ones(len(he), dtype=np.int32), (he.min(axis=1), he.max(axis=1))), shape=(n, n)
+    )
+    adj = (adj + adj.T).tocsr()
+    on_boundary = np.zeros(n, dtype=bool)
+    bi, bj = (adj == 1).nonzero()
+    on_boundary[bi] = on_boundary[bj] = True
+    return vf.indices, vf.indptr, adj.indices, adj.indptr, on_boundary, adj
+
+
+def _lock(locked: np.ndarray, topo, vertices) -> None:
+    """Mark ``vertices`` and their neighbours as changed in this round."""
+    ni, nptr = topo[2], topo[3]
+    for w in vertices:
+        locked[w] = True
+        locked[ni[nptr[w] : nptr[w + 1]]] = True
+
+
+def _flip(face: int, a: int, b: int, x: int, v, f, topo, min_area: float, locked) -> bool:
+    """Flip the edge (a, b) of the zero-area ``face`` (apex x) in place where
+    :func:`_flippable` allows it and the far corner is not locked; whether it did."""
+    flip = _flippable(face, a, b, x, v, f, topo, min_area)
+    if flip is None or locked[flip[1]]:
+        return False
+    other, d = flip
+    f[face] = (a, d, x)
+    f[other] = (d, b, x)
+    _lock(locked, topo, (a, b, x, d))
+    return True
+
+
+def _collapse(tries, v, f, topo, min_area: float, locked, remap) -> float | None:
+    """Merge the first vertex pair (p, q) of ``tries`` that is unlocked and
+    :func:`_collapsible` (p into q, in ``remap``); the distance p moves, or None."""
+    for p, q in tries:
+        if locked[p] or locked[q] or not _collapsible(p, q, v, f, topo, min_area):
+            continue
+        remap[p] = q
+        locked[p] = locked[q] = True
+        _lock(locked, topo, (p, q))
+        return float(np.linalg.norm(v[p] - v[q]))
+    return None
+
+
+def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
+    """Flip faces so neighbours across manifold edges agree; BFS per component.
+
+    Returns (faces, number flipped, orientable).
+    """
+    m = len(f)
+    he = np.stack([f, np.roll(f, -1, axis=1)], axis=2).reshape(-1, 2)
+    key = np.sort(he, axis=1)
+    _, inv, counts = _unique_index_rows(key, return_inverse=True, return_counts=True)
+    inv = inv.reshape(-1)
+    face_of = np.repeat(np.arange(m), 3)
+    order = np.argsort(inv, kind="stable")
+    starts = np.concatenate([[0], np.cumsum(counts)])
+    # neighbours only across manifold edges (exactly two faces)
+    manifold = np.flatnonzero(counts == 2)
+    if len(manifold) == 0:
+        return f, 0, True
+    pa = np.stack([order[starts[manifold]], order[starts[manifold] + 1]], axis=1)
+    fa, fb = face_of[pa[:, 0]], face_of[pa[:, 1]]
+    same_dir = np.all(he[pa[:, 0]] == he[pa[:, 1]], axis=1)  # same direction: inconsistent
+    if not same_dir.any():  # already consistent (the common case): nothing to walk
+        return f, 0, True
+    nbrs: list[list[tuple[int, bool]]] = [[] for _ in range(m)]
+    for x, y, s in zip(fa.tolist(), fb.tolist(), same_dir.tolist(), strict=True):
+        nbrs[x].append((y, s))
+        nbrs[y].append((x, s))
+    flip = np.zeros(m, dtype=bool)
+    seen = np.zeros(m, dtype=bool)
+    patch = np.zeros(m, dtype=np.int64)
+    orientable = True
+    for seed in range(m):
+        if seen[seed]:
+            continue
+        seen[seed] = True
+        patch[seed] = seed
+        queue = deque([seed])
+        while queue:
+            t = queue.popleft()
+            patch[t] = seed
+            for u, s in nbrs[t]:
+                want = flip[t] ^ s
+                if not seen[u]:
+                    seen[u] = True
+                    flip[u] = want
+                    queue.append(u)
+                elif flip[u] != want:
+                    orientable = False
+    # per patch, keep the majority orientation (flip the fewest faces)
+    flipped_per_patch = np.bincount(patch, flip, minlength=m)
+    size_per_patch = np.bincount(patch, minlength=m)
+    invert = flipped_per_patch > size_per_patch / 2
+    flip ^= invert[patch]
+    out = f.copy()
+    out[flip] = out[flip][:, ::-1]
+    return out, int(flip.sum()), orientable
+
+
+def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-10):
+    """Repair raw arrays into a valid :class:`Mesh` and report what was done.
+
+    Steps: check finiteness and index range (errors, not repairs), merge vertices
+    closer than ``merge_tolerance`` times the bounding-box diagonal, drop faces that
+    repeat a vertex, collapse the shortest edge of faces of (near) zero area (so a closed
+    surface stays closed; see :func:`_collapse_zero_area_faces`, which flips the longest
+    edge instead where a vertex lies inside it), drop duplicate faces,
+    drop unreferenced vertices, make the orientation consistent per component where
+    possible.
+
+    The result keeps the input's numbering: vertex i is row i of ``vertices``; only the
+    faces change.  Merged duplicates and vertices merged by a collapse are used by no
+    face and take the values of the vertex they were merged into
+    (:attr:`Mesh.merged_into`); vertices no face uses are :attr:`Mesh.unused`.  The
+    report names vertices by their numbers counting from 0.
+
+    Returns
+    -------
+    Mesh
+        With ``mesh.report`` describing every change.
+    """
+    report = MeshReport(source=source)
+    v, f, split = checked_arrays(vertices, faces, polygons=True)
+    if split:
+        report.add(split)
+    diag = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    if diag == 0:
+        raise MeshError("all vertices coincide: the mesh has no extent")
+
+    n_file = len(v)
+    v_input = v
+    v, f, merged, file_map, rep = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
+    if merged:
+        first = np.full(len(v), n_file, dtype=np.int64)
+        np.minimum.at(first, file_map, np.arange(n_file))
+        dup = np.flatnonzero(first[file_map] != np.arange(n_file))
+        pairs = [f"{int(i)} into {int(first[file_map[i]])}" for i in dup[:_LISTED]]
+        report.add(
+            f"Merged {_plural(merged, 'duplicate vertex')} ("
+            + _listing(pairs, len(dup))
+            + ", counting from 0; each takes the values of the vertex it was merged into)."
+        )
+
+    repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 0] == f[:, 2])
+    if repeated.any():
+        f = f[~repeated]
+        report.add(f"Removed {_plural(int(repeated.sum()), 'face')} that repeat a vertex.")
+    if len(f):
+        _, keep = _unique_index_rows(np.sort(f, axis=1), return_index=True)
+        if len(keep) < len(f):
+            report.add(f"Removed {_plural(len(f) - len(keep), 'duplicate face')}.")
+            f = f[np.sort(keep)]
+    min_area = 1e-14 * diag**2
+    n_collapsed = 0
+    if len(f) and np.any(0.5 * _double_areas(v, f) <= min_area):
+        f, n_flipped, n_collapsed, dropped, largest, left, merged_into = _collapse_zero_area_faces(
+            v, f, min_area
+        )
+        file_map = merged_into[file_map]
+        if n_flipped:
+            report.add(
+                f"Flipped the longest edge of {_plural(n_flipped, 'degenerate (zero-area) face')}"
+                " (a vertex lying inside that edge: the two faces on it became two faces "
+                "with area; no vertex moved, no holes opened)."
+            )
+        if n_collapsed:
+            report.add(
+                f"Collapsed {_plural(n_collapsed, 'degenerate (zero-area) face')} (merged the "
+                "two vertices of each one's shortest edge, moving none more than "
+                f"{largest / diag:.1e} of the bounding-box diagonal; no holes opened)."
+            )
+        if dropped:
+            report.add(
+                f"Removed {_plural(dropped, 'degenerate (zero-area) face')} lying along the "
+                "boundary (the boundary keeps its shape)."
+            )
+        if left:
+            f = f[0.5 * _double_areas(v, f) > min_area]
+            report.add(
+                f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
+                "flipped or collapsed without tearing or folding the surface (this can "
+                "leave holes)."
+            )
+    if len(f) == 0:
+        raise MeshError("no faces are left after removing degenerate ones: not a surface")
+
+    used = np.zeros(len(v), dtype=bool)
+    used[f.ravel()] = True
+    if not used.all():
+        remap = np.where(used, np.cumsum(used) - 1, -1)
+        file_map = remap[file_map]
+        v, f, rep = v[used], remap[f], rep[used]
+    unreferenced = np.flatnonzero(file_map < 0)  # merged ones are said above
+    if len(unreferenced):
+        them = "it has" if len(unreferenced) == 1 else "they have"
+        report.add(
+            f"{_plural(len(unreferenced), 'vertex').capitalize()} used by no face ("
+            + _listing([str(int(i)) for i in unreferenced[:_LISTED]], len(unreferenced))
+            + f", counting from 0): {them} no value (NaN) in the results; vertex numbers "
+            "stay the input's (mesh.unused lists them)."
+        )
+
+    f, flipped, orientable = _orient_faces(f)
+    if flipped:
+        report.add(f"Flipped {_plural(flipped, 'face')} to make the orientation consistent.")
+    if not orientable:
+        report.add("The surface is not orientable, so some faces disagree in orientation.")
+
+    # the input's numbering: every input vertex in its place, the faces on the vertex
+    # of each merged group that has the group's coordinates
+    merged_into = np.where(file_map >= 0, rep[np.maximum(file_map, 0)], np.arange(n_file))
+    mesh = Mesh(v_input, rep[f], report=report, merged_into=merged_into)
+    report.messages.insert(0, shape_summary(mesh))
+    problem = mesh.shell_problem()
+    if problem:
+        report.add("Shells and E_D^N cannot run: " + problem)
+    return mesh
