@@ -16,6 +16,7 @@ import pytest
 
 import modalviewer as mv
 from modalviewer import collection as coll
+from modalviewer.collection import runner
 from modalviewer.core import primitives
 
 distributed = pytest.importorskip("distributed")
@@ -148,13 +149,13 @@ def test_a_broken_file_is_recorded_not_fatal(store):
 
 def test_resume_recomputes_nothing(store, sources, client, monkeypatch):
     calls = []
-    compute = coll._compute
+    compute = runner._compute
 
     def counted(*args):
         calls.append(args[1])
         return compute(*args)
 
-    monkeypatch.setattr(coll, "_compute", counted)
+    monkeypatch.setattr(runner, "_compute", counted)
     params = dict(operator="laplacian", k=K, signatures=["vibration", "hks"], client=client)
     summary = coll.run_batch([sources], store, **params)
     assert calls == [] and summary.computed == [] and len(summary.skipped) == 7
@@ -256,7 +257,7 @@ def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
 
     running, most = [0], [0]
     lock = threading.Lock()
-    compute = coll._compute
+    compute = runner._compute
 
     def counted(*args):
         with lock:
@@ -269,10 +270,10 @@ def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
             with lock:
                 running[0] -= 1
 
-    monkeypatch.setattr(coll, "_compute", counted)
+    monkeypatch.setattr(runner, "_compute", counted)
     mesh = mv.load_mesh(sources / "torus.obj")
-    assert coll.vertex_count_hint(sources / "torus.obj") == mesh.n_vertices
-    need = coll.memory_estimate(mesh.n_vertices, coll._parameters("laplacian", K, [], 1, 1))
+    assert runner.vertex_count_hint(sources / "torus.obj") == mesh.n_vertices
+    need = runner.memory_estimate(mesh.n_vertices, runner._parameters("laplacian", K, [], 1, 1))
     with distributed.Client(
         processes=False,
         n_workers=1,
@@ -280,7 +281,7 @@ def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
         resources={"memory": int(1.5 * need)},
         dashboard_address=":0",
     ) as client:
-        assert coll._memory_resource(client) == int(1.5 * need)
+        assert runner._memory_resource(client) == int(1.5 * need)
         summary = coll.run_batch(
             [sources / f"{n}.obj" for n in ("torus", "torus_moved", "fat_torus")],
             tmp_path / "store",

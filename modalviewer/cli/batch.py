@@ -82,9 +82,12 @@ def add_parsers(sub) -> None:
 
 
 def batch(args) -> int:
+    import logging
     import os
 
-    from ..collection import progress_bar, run_batch
+    from tqdm import tqdm
+
+    from ..collection import run_batch
 
     workers = args.workers  # -k, --workers and --memory-limit checked by the parser
     if workers is None:
@@ -97,27 +100,27 @@ def batch(args) -> int:
                 "Dask is not installed: pip install 'modalviewer[batch]' (or --workers 0: "
                 "one mesh after another in this process)"
             ) from None
-    import logging
-
     # Dask's own log lines (a cancelled task on Ctrl+C, ...) would break the progress line
     logging.getLogger("distributed").setLevel(logging.ERROR)
-    summary = run_batch(
-        args.sources,
-        args.output,
-        args.operator,
-        args.k,
-        args.signatures,
-        args.bending,
-        args.membrane,
-        workers=workers,
-        scheduler=args.scheduler,
-        memory_limit=None if args.memory_limit is None else int(args.memory_limit * 2**30),
-        retry_failed=args.retry_failed,
-        progress=progress_bar(),
-        log=lambda text: sys.stderr.write(f"modalviewer: note: {text}\n"),
-    )
-    if summary.interrupted:
-        sys.stderr.write("\n")  # the progress line stopped short
+    progress = _MeshProgress()
+    try:
+        summary = run_batch(
+            args.sources,
+            args.output,
+            args.operator,
+            args.k,
+            args.signatures,
+            args.bending,
+            args.membrane,
+            workers=workers,
+            scheduler=args.scheduler,
+            memory_limit=None if args.memory_limit is None else int(args.memory_limit * 2**30),
+            retry_failed=args.retry_failed,
+            progress=progress,
+            log=lambda text: tqdm.write(f"modalviewer: note: {text}", sys.stderr),
+        )
+    finally:
+        progress.close()  # the line ends, also where the batch stopped short
     print(f"{args.output}: {summary.text()}")  # the summary first, then its details
     for name, error in summary.failed.items():
         print(f"failed: {name}: {error}")
@@ -127,6 +130,37 @@ def batch(args) -> int:
         sys.stderr.write("modalviewer: interrupted (the store holds every finished mesh)\n")
         return 130
     return 1 if summary.failed else 0
+
+
+class _MeshProgress:
+    """``run_batch``'s ``progress(done, total, failed, elapsed, already)`` as a tqdm bar on
+    stderr: the meshes done of all, the failures, the rate of this run's meshes (not the
+    ``already`` done before it) and the time left."""
+
+    def __init__(self):
+        self.bar = None
+
+    def __call__(self, done: int, total: int, failed: int, elapsed: float, already: int = 0):
+        from tqdm import tqdm
+
+        if self.bar is None:
+            self.bar = tqdm(
+                total=total,
+                initial=already,
+                file=sys.stderr,
+                unit="mesh",
+                ascii=".#",
+                smoothing=0,
+                bar_format="[{bar:30}] {n_fmt}/{total_fmt} meshes{postfix}, {rate_fmt}, "
+                "{remaining} left",
+            )
+        if failed:
+            self.bar.set_postfix_str(f"{failed} failed", refresh=False)
+        self.bar.update(done - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
 
 
 def similar(args) -> int:

@@ -1,0 +1,524 @@
+"""The batch: every mesh of a dataset into one store (:mod:`.store`), on a Dask cluster
+(``dask.distributed``: a local one, or an existing scheduler) or one mesh after another
+in this process."""
+
+from __future__ import annotations
+
+import glob
+import json
+import logging
+import os
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info, signature_kind
+from ..core.spectrum import FORMAT_VERSION as SPECTRUM_FORMAT_VERSION
+from ..core.spectrum import Spectrum
+from .store import (
+    HISTOGRAM_EDGES,
+    HISTOGRAM_SCALES,
+    STORE_FORMAT,
+    STORE_VERSION,
+    entry_key,
+    file_stat,
+    prepare_store,
+    read_entry,
+    rebuild_index,
+    shape_dna,
+    status_failed,
+    write_entry,
+    write_error,
+)
+
+
+def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
+    """The mesh files of ``sources``: folders (searched recursively for the extensions
+    :func:`.io.load_mesh` reads, meshio's too where it is installed, less those other
+    files use: :data:`.io.AMBIGUOUS_EXTENSIONS`), glob patterns, mesh files, and list
+    files (any other file: one path per line, relative to the list's folder; blank
+    lines and ``#`` comments skipped).
+    Each file once, in the order found; ValueError for a source that matches nothing."""
+    from ..io import is_mesh_file
+
+    found: list[Path] = []
+
+    def add(path: Path) -> None:
+        found.append(path)
+
+    for source in sources:
+        text = str(source)
+        path = Path(text)
+        if path.is_dir():
+            files = [p for p in sorted(path.rglob("*")) if is_mesh_file(p, True) and p.is_file()]
+            if not files:
+                raise ValueError(f"{text}: no mesh files in this folder")
+            for p in files:
+                add(p)
+        elif path.is_file() and is_mesh_file(path):
+            add(path)
+        elif path.is_file():
+            for line in path.read_text(encoding="utf-8").splitlines():
+                line = line.strip()
+                if line and not line.startswith("#"):
+                    entry = Path(line)
+                    add(entry if entry.is_absolute() else path.parent / entry)
+        elif glob.has_magic(text):
+            matches = sorted(Path(p) for p in glob.glob(text, recursive=True))
+            matches = [p for p in matches if p.is_file()]
+            if not matches:
+                raise ValueError(f"{text}: the pattern matches no file")
+            for p in matches:
+                add(p)
+        else:
+            raise ValueError(f"{text}: no such file or folder")
+    unique: dict[Path, Path] = {}
+    for p in found:
+        unique.setdefault(p.resolve(), p)
+    return list(unique.values())
+
+
+def mesh_names(paths: Sequence[Path]) -> list[str]:
+    """A name per path, unique: the file's stem, or where stems repeat the path from
+    the folder the repeated files share, with ``--`` for the folder separator, and the
+    file's suffix where that is still the same (``cow.obj`` and ``cow.stl`` side by
+    side)."""
+    stems = [p.stem for p in paths]
+    names = []
+    for p, stem in zip(paths, stems, strict=True):
+        if stems.count(stem) == 1:
+            names.append(stem)
+            continue
+        same = [q.resolve() for q, s in zip(paths, stems, strict=True) if s == stem]
+        root = Path(os.path.commonpath([str(q.parent) for q in same]))
+        here = p.resolve()
+        rel = here.relative_to(root)
+        twins = sum(q.with_suffix("") == here.with_suffix("") for q in same)
+        names.append("--".join(rel.parts if twins > 1 else rel.with_suffix("").parts))
+    return [_safe(n) for n in names]
+
+
+def _safe(name: str) -> str:
+    keep = "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name)
+    return keep.lstrip(".") or "mesh"
+
+
+def _parameters(operator, k, signatures, bending, membrane) -> dict:
+    operator_info(operator)  # ValueError for an unknown operator
+    if int(k) < 1:
+        raise ValueError("-k must be at least 1")
+    kinds = sorted(set(signatures))
+    for kind in kinds:
+        if kind not in DISTANCE_KINDS:
+            raise ValueError(
+                f"unknown signature {kind!r}; choose among {', '.join(DISTANCE_KINDS)}"
+            )
+    return {
+        "operator": operator,
+        "k": int(k),
+        "bending": float(bending),
+        "membrane": float(membrane),
+        "signatures": kinds,
+        "histogram_edges": [float(x) for x in HISTOGRAM_EDGES],
+        "histogram_scales": HISTOGRAM_SCALES,
+        "version": STORE_VERSION,
+    }
+
+
+def vertex_count_hint(path: Path) -> int:
+    """A quick estimate of a mesh file's vertex count, without reading the mesh: the
+    header of PLY and OFF, the ``v`` lines of OBJ, the triangle count of binary STL,
+    else the file size over 40 bytes."""
+    path = Path(path)
+    size = path.stat().st_size
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".ply":
+            with open(path, "rb") as fh:
+                for _ in range(50):
+                    line = fh.readline()
+                    if line.startswith(b"element vertex"):
+                        return int(line.split()[2])
+                    if line.strip() == b"end_header":
+                        break
+        elif suffix == ".off":
+            with open(path, "rb") as fh:
+                for line in fh:
+                    words = line.split(b"#")[0].split()
+                    if words and words[0].isdigit():
+                        return int(words[0])
+        elif suffix == ".obj":
+            with open(path, "rb") as fh:
+                data = fh.read()
+            return data.count(b"\nv ") + data.startswith(b"v ")
+        elif suffix == ".stl" and size > 84:
+            return max(3, (size - 84) // 50 // 2)
+    except (OSError, ValueError, IndexError):
+        pass
+    return max(3, size // 40)
+
+
+def memory_estimate(n_vertices: int, parameters: dict) -> int:
+    """Bytes one mesh's task is expected to need at its peak: the largest of its spectrum
+    computations (:meth:`~.core.operators.OperatorInfo.predicted_peak_mb`) plus the
+    kept spectra and signatures."""
+    k = parameters["k"]
+    peak, kept = 0.0, 0.0
+    for op in _operators(parameters):
+        info = operator_info(op)
+        n = info.unknowns(n_vertices)
+        kept += 8.0 * n * min(k, n)
+        peak = max(peak, info.predicted_peak_mb(n_vertices, min(k, n)) * 2**20)
+    kept += 8.0 * n_vertices * 100 * len(parameters["signatures"])
+    return int(peak + kept + 200 * n_vertices + 50e6)
+
+
+def _operators(parameters: dict) -> list[str]:
+    ops = [parameters["operator"]]
+    for kind in parameters["signatures"]:
+        op = operator_for_distance(kind)
+        if op not in ops:
+            ops.append(op)
+    return ops
+
+
+def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
+    """(HISTOGRAM_SCALES, bins) area-weighted histograms of log10(A S_t(v) / Z(t)), or
+    for ``kind="wks"`` of log10(A W_E(v)) at energies of the default band."""
+    from ..core.signatures import _used, default_energies, default_times, signature, wks_sigma
+
+    if kind == "wks":
+        energies = default_energies(spec)
+        picked = energies[np.linspace(0, len(energies) - 1, HISTOGRAM_SCALES).round().astype(int)]
+        _, w = signature(spec, kind="wks", energies=picked, sigma=wks_sigma(energies))
+        h = area * w
+    else:
+        mask = _used(spec, False)
+        times = default_times(spec)
+        picked = times[np.linspace(0, len(times) - 1, HISTOGRAM_SCALES).round().astype(int)]
+        weights = np.exp(-np.outer(spec.eigenvalues[mask], picked))  # (k, S)
+        s = spec.squared_modes()[:, mask] @ weights  # (n, S)
+        h = area * s / weights.sum(axis=0)
+    logs = np.log10(np.clip(h, 10.0 ** HISTOGRAM_EDGES[0], 10.0 ** HISTOGRAM_EDGES[-1]))
+    share = spec.mass / spec.mass.sum()
+    return np.stack(
+        [np.histogram(logs[:, j], HISTOGRAM_EDGES, weights=share)[0] for j in range(len(picked))]
+    )
+
+
+def _compute(mesh, operator: str, parameters: dict) -> Spectrum:
+    from ..core.pipeline import compute_spectrum
+
+    return compute_spectrum(
+        mesh, operator, parameters["k"], parameters["bending"], parameters["membrane"]
+    )
+
+
+def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> dict:
+    """The task of one mesh: read it, compute its spectra, signatures and descriptors.
+
+    Returns ``{"status": "computed", "arrays": {...}, "entry": {...}}``, or
+    ``{"status": "unchanged"}`` if the mesh's key equals ``known_key``, or
+    ``{"status": "failed", "error": "..."}``: errors are results, not exceptions, so
+    that one bad file does not stop the batch."""
+    import warnings
+
+    from ..core.signatures import signature
+    from ..io import load_mesh
+
+    start = time.perf_counter()
+    try:
+        mesh = load_mesh(path)
+        key = entry_key(mesh.hash, parameters)
+        if known_key is not None and key == known_key:
+            return {"status": "unchanged", "key": key}
+        area = mesh.total_area
+        arrays: dict[str, np.ndarray] = {}
+        spectra: dict[str, Spectrum] = {}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for op in _operators(parameters):
+                spectra[op] = _compute(mesh, op, parameters)
+            main = spectra[parameters["operator"]]
+            for op, spec in spectra.items():
+                prefix = "" if op == parameters["operator"] else f"{op}."
+                arrays[prefix + "eigenvalues"] = spec.eigenvalues
+                arrays[prefix + "modes"] = spec.modes
+                arrays[prefix + "mass"] = spec.mass
+                arrays[prefix + "residuals"] = spec.residuals
+                if prefix:
+                    arrays[prefix + "parameters"] = np.array(json.dumps(spec.parameters))
+            arrays["shape_dna"] = shape_dna(main, area)
+            for kind in parameters["signatures"]:
+                spec = spectra[operator_for_distance(kind)]
+                times, values = signature(spec, kind=signature_kind(kind))
+                arrays[f"sig.{kind}.times"] = times
+                arrays[f"sig.{kind}.values"] = values
+                arrays[f"hist.{kind}"] = _histogram(spec, area, signature_kind(kind))
+        arrays["meta"] = np.array(
+            json.dumps(
+                {
+                    "format": "modalviewer-spectrum",
+                    "version": SPECTRUM_FORMAT_VERSION,
+                    "operator": main.operator,
+                    "mesh_hash": main.mesh_hash,
+                    "parameters": main.parameters,
+                }
+            )
+        )
+        entry = {
+            "format": STORE_FORMAT + "-entry",
+            "version": STORE_VERSION,
+            "source": str(Path(path).resolve()),
+            "stat": file_stat(Path(path)),
+            "mesh_hash": mesh.hash,
+            "key": key,
+            "parameters": parameters,
+            "area": area,
+            "n_vertices": mesh.n_vertices,
+            "n_faces": int(len(mesh.faces)),
+            "seconds": time.perf_counter() - start,
+            "warnings": sorted({str(w.message) for w in caught}),
+        }
+        return {"status": "computed", "arrays": arrays, "entry": entry}
+    except Exception as exc:  # a bad file or a failed solve is recorded, not raised
+        return {"status": "failed", "error": _one_line(exc)}
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+@dataclass
+class BatchSummary:
+    """What a batch did: mesh names by outcome, and the time it took."""
+
+    computed: list[str] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+    failed_before: list[str] = field(default_factory=list)
+    """The skipped meshes that failed in an earlier run (``retry_failed`` retries them)."""
+    seconds: float = 0.0
+    interrupted: bool = False
+
+    @property
+    def total(self) -> int:
+        return len(self.computed) + len(self.skipped) + len(self.failed)
+
+    def text(self) -> str:
+        rate = len(self.computed) / self.seconds * 60.0 if self.seconds > 0 else 0.0
+        words = f"{len(self.computed)} computed, {len(self.skipped)} already done"
+        if self.failed_before:  # skipped as done, but they are failures
+            words += (
+                f" ({len(self.failed_before)} of them recorded failures, not tried again: "
+                "--retry-failed)"
+            )
+        words += f", {len(self.failed)} failed, in {self.seconds:.1f} s"
+        if self.computed:
+            words += f" ({rate:.1f} meshes per minute)"
+        return ("interrupted: " if self.interrupted else "") + words
+
+
+def run_batch(
+    sources: Iterable[str | os.PathLike],
+    store: str | os.PathLike,
+    operator: str = "laplacian",
+    k: int = 50,
+    signatures: Sequence[str] = (),
+    bending: float = 1.0,
+    membrane: float = 1.0,
+    workers: int = 1,
+    scheduler: str | None = None,
+    client=None,
+    memory_limit: int | None = None,
+    retry_failed: bool = False,
+    progress: Callable[..., None] | None = None,
+    log: Callable[[str], None] | None = None,
+) -> BatchSummary:
+    """Compute every mesh of ``sources`` (see :func:`find_meshes`) into ``store``.
+
+    Where it runs: ``client`` (a ``dask.distributed.Client``) if given; else the
+    scheduler at ``scheduler`` (``"tcp://host:8786"``); else a local cluster of
+    ``workers`` processes (one thread each, the cores shared among them); ``workers=0``
+    runs one mesh after another in this process, without Dask.  Each mesh is one task.
+    On a local cluster each worker's memory limit is ``memory_limit`` (default: the
+    machine's memory over the workers) and it offers that many bytes as the resource
+    ``memory``; each task asks for its :func:`memory_estimate`, so two big meshes do not
+    start together on a worker that cannot hold both.  Workers of an existing scheduler
+    are used the same way if they declare the resource (``dask worker ... --resources
+    memory=BYTES``).
+
+    A mesh whose stored key (geometry hash and parameters) is current is skipped, as is
+    a recorded failure of the same file and parameters unless ``retry_failed``.  Each
+    result is written when it arrives; a failure is recorded in ``errors/`` and the
+    batch goes on.  The index is rebuilt at the end (also when interrupted).  A store
+    holds one set of parameters: other ones raise CollectionError if it holds results.
+    """
+    store = Path(store)
+    parameters = _parameters(operator, k, signatures, bending, membrane)
+    paths = find_meshes(sources)
+    names = mesh_names(paths)
+    prepare_store(store, parameters)
+    log = log or (lambda text: None)
+    summary = BatchSummary()
+    start = time.perf_counter()
+    todo: list[tuple[str, Path, str | None]] = []
+    for name, path in zip(names, paths, strict=True):
+        status, known = _done(store, name, path, parameters, retry_failed)
+        if status == "done":
+            summary.skipped.append(name)
+            if status_failed(store, name):
+                summary.failed_before.append(name)
+        else:
+            todo.append((name, path, known))
+    total = len(paths)
+    already = len(summary.skipped)
+
+    def report() -> None:
+        if progress is not None:
+            elapsed = time.perf_counter() - start
+            progress(summary.total, total, len(summary.failed), elapsed, already)
+
+    def take(name: str, path: Path, result: dict) -> None:
+        if result["status"] == "computed":
+            write_entry(store, name, result)
+            summary.computed.append(name)
+        elif result["status"] == "unchanged":
+            summary.skipped.append(name)
+        else:
+            write_error(store, name, path, parameters, result["error"])
+            summary.failed[name] = result["error"]
+        report()
+
+    report()
+    try:
+        if not todo:
+            pass
+        elif workers == 0 and client is None and scheduler is None:
+            for name, path, known in todo:
+                take(name, path, process_mesh(str(path), parameters, known))
+        else:
+            _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, log)
+    except KeyboardInterrupt:
+        summary.interrupted = True
+    finally:
+        summary.seconds = time.perf_counter() - start
+        rebuild_index(store)
+    return summary
+
+
+def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bool):
+    """("done", None) if ``name`` needs no work; else ("todo", the stored key or None)."""
+    entry = read_entry(store / "meshes" / f"{name}.npz")
+    try:
+        stat = file_stat(path)
+    except OSError:
+        stat = None
+    if entry is not None:
+        same = entry.get("parameters") == parameters and entry.get("source") == str(path.resolve())
+        if same and entry.get("stat") == stat:
+            return "done", None
+        return "todo", entry.get("key") if entry.get("parameters") == parameters else None
+    error = store / "errors" / f"{name}.json"
+    if error.exists() and not retry_failed:
+        try:
+            record = json.loads(error.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            record = {}
+        if record.get("parameters") == parameters and record.get("stat") == stat:
+            return "done", None
+    return "todo", None
+
+
+def _import_distributed():
+    try:
+        import distributed
+    except ImportError:
+        raise ImportError(
+            "Dask is not installed: pip install 'modalviewer[batch]' (or run with --workers 0, "
+            "one mesh after another in this process)"
+        ) from None
+    return distributed
+
+
+def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, log) -> None:
+    distributed = _import_distributed()
+    cluster = None
+    own_client = client is None
+    if client is None and scheduler is not None:
+        client = distributed.Client(scheduler)
+    elif client is None:
+        from ..viewer.model import physical_memory
+
+        workers = max(1, int(workers))
+        memory_limit = memory_limit or int(physical_memory() / workers) or None
+        threads = str(max(1, (os.cpu_count() or 1) // workers))
+        cluster = distributed.LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            memory_limit=memory_limit,
+            resources={"memory": memory_limit} if memory_limit else None,
+            dashboard_address=":0",
+            env={
+                name: threads
+                for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
+            },
+        )
+        client = distributed.Client(cluster)
+        if logging.getLogger("distributed").getEffectiveLevel() >= logging.ERROR:
+            client.run(_quiet_logs)  # the local workers follow this process's quiet log
+    try:
+        capacity = _memory_resource(client)
+        if capacity is None:
+            log(
+                "the workers declare no 'memory' resource (dask worker --resources "
+                "memory=BYTES): tasks are placed without memory estimates"
+            )
+        futures = {}
+        for name, path, known in todo:
+            extra = {}
+            if capacity is not None:
+                need = memory_estimate(vertex_count_hint(path), parameters)
+                extra["resources"] = {"memory": min(need, capacity)}
+            future = client.submit(
+                process_mesh,
+                str(path),
+                parameters,
+                known,
+                pure=False,
+                key=f"modalviewer-mesh-{name}-{os.urandom(4).hex()}",
+                **extra,
+            )
+            futures[future] = (name, path)
+        for future in distributed.as_completed(futures):
+            name, path = futures.pop(future)
+            try:
+                result = future.result()
+            except Exception as exc:  # the worker died (memory limit) or was lost
+                result = {"status": "failed", "error": _one_line(exc)}
+            future.release()
+            take(name, path, result)
+    finally:
+        if own_client:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _quiet_logs() -> None:
+    """Dask's log on errors only (a worker's lines on Ctrl+C: cancelled tasks)."""
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+
+
+def _memory_resource(client) -> int | None:
+    """The smallest ``memory`` resource of the client's workers, or None if one lacks it."""
+    workers = client.scheduler_info().get("workers", {})
+    amounts = [w.get("resources", {}).get("memory") for w in workers.values()]
+    if not amounts or any(a is None for a in amounts):
+        return None
+    return int(min(amounts))
