@@ -12,7 +12,7 @@ plane (``flat``: the part keeps its sharp edges).  Writes
 ``benchmarks/results/curved.json``.  Each (case, operator) runs in a fresh Python
 process so its peak resident memory is its own.  The child processes compute with
 the memory settings of the viewer's and the command line's compute processes
-(:func:`modalviewer.processes.memory.prepare_compute_process`), so their peaks are what
+(:func:`modalviewer.core.memory.prepare_compute_process`), so their peaks are what
 a user's computation needs.
 """
 
@@ -31,7 +31,7 @@ from benchmarks.run import add_keep_others, kept_rows, save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
-from modalviewer.processes.memory import prepare_compute_process
+from modalviewer.core.memory import prepare_compute_process
 prepare_compute_process()
 import numpy as np
 import modalviewer as mv

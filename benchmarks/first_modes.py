@@ -37,7 +37,7 @@ from benchmarks.run import save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
-from modalviewer.processes.memory import prepare_compute_process
+from modalviewer.core.memory import prepare_compute_process
 prepare_compute_process()
 import numpy as np
 import modalviewer as mv

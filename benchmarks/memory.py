@@ -9,7 +9,7 @@ limit (``none``: the default, :func:`modalviewer.core.memory.memory_limit_mb`; o
 megabytes, passed as
 ``MODALVIEWER_MEMORY_LIMIT_MB``) runs ``compute_spectrum(mesh, operator, k)`` in a fresh
 process with the computation processes' memory settings
-(:func:`modalviewer.processes.memory.prepare_compute_process`), so its peak resident
+(:func:`modalviewer.core.memory.prepare_compute_process`), so its peak resident
 memory is its own.  After the peak is read the child checks the result: the largest
 relative residual and the largest deviation of ``X^T M X`` from the identity (a block of
 columns at a time, so the check adds no (N, k) array).  Each row keeps its eigenvalues;
@@ -43,7 +43,7 @@ RESULTS = ROOT / "benchmarks" / "results" / "memory.json"
 CHILD = """
 import json, resource, sys, time
 import numpy as np
-from modalviewer.processes.memory import prepare_compute_process
+from modalviewer.core.memory import prepare_compute_process
 prepare_compute_process()
 import modalviewer as mv
 mesh_arg, level, operator, k = sys.argv[1], int(sys.argv[2]), sys.argv[3], int(sys.argv[4])

@@ -36,10 +36,10 @@ sys.path.insert(0, str(ROOT))
 import modalviewer as mv  # noqa: E402
 from modalviewer.core.demo_shapes import bumpy_plate  # noqa: E402
 from modalviewer.core.eigen import solve_lowest  # noqa: E402
+from modalviewer.core.memory import prepare_compute_process  # noqa: E402
 from modalviewer.core.nullspace import null_space  # noqa: E402
 from modalviewer.core.operators import operator_info  # noqa: E402
 from modalviewer.core.pipeline import operator_matrices  # noqa: E402
-from modalviewer.processes.memory import prepare_compute_process  # noqa: E402
 
 
 def make_mesh(size: str) -> mv.Mesh:
@@ -159,7 +159,7 @@ def _baseline_row(size: str, operator: str, k: int, shift: float) -> dict:
 
 def _in_child(fn, *args):
     """``fn(*args)`` in a fresh process with the memory settings of the viewer's and the
-    command line's computation processes (``processes.memory``)."""
+    command line's computation processes (``core.memory``)."""
     import multiprocessing as mp
 
     with mp.get_context("spawn").Pool(1, initializer=prepare_compute_process) as pool:

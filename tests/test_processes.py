@@ -1,4 +1,4 @@
-"""Computation processes: their memory settings (modalviewer.processes.memory) and the
+"""Computation processes: their memory settings (modalviewer.core.memory) and the
 coarse copy's own process (modalviewer.processes.copy_main)."""
 
 import subprocess
@@ -19,7 +19,7 @@ def _printed_by_fresh_process(code: str) -> str:
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
 def test_the_memory_settings_take_effect_in_a_fresh_process():
     code = (
-        "from modalviewer.processes.memory import prepare_compute_process\n"
+        "from modalviewer.core.memory import prepare_compute_process\n"
         "import numpy as np\n"
         "ok = prepare_compute_process()\n"
         "a = np.ones((2000, 2000)); del a\n"  # 32 MB from the heap, kept
@@ -33,8 +33,7 @@ def test_the_memory_settings_take_effect_in_a_fresh_process():
 ONE_ARENA = """
 import threading
 import numpy as np
-from modalviewer.core.memory import resident_mb
-from modalviewer.processes.memory import prepare_compute_process
+from modalviewer.core.memory import prepare_compute_process, resident_mb
 
 prepare_compute_process()
 
@@ -55,8 +54,7 @@ print(resident_mb() - before)
 
 BIG_AND_SMALL = """
 import numpy as np
-from modalviewer.core.memory import resident_mb
-from modalviewer.processes.memory import prepare_compute_process
+from modalviewer.core.memory import prepare_compute_process, resident_mb
 
 prepare_compute_process()
 small = np.ones(2_500_000)  # 20 MB
@@ -118,8 +116,7 @@ def test_the_viewer_child_process_computes_with_the_memory_settings(tmp_path):
 
 RETURN_FREED = """
 import numpy as np
-from modalviewer.core.memory import resident_mb, return_freed_memory
-from modalviewer.processes.memory import prepare_compute_process
+from modalviewer.core.memory import prepare_compute_process, resident_mb, return_freed_memory
 
 prepare_compute_process()  # arrays up to 32 MiB from the heap, freed memory kept
 blocks = [np.ones(2_500_000) for _ in range(10)]  # 200 MB in 20 MB arrays
@@ -133,7 +130,7 @@ print(ran, kept - resident_mb())
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's malloc_trim")
 def test_freed_memory_goes_back_to_the_system_in_a_compute_process():
-    """A compute process keeps freed heap memory (processes.memory); the pipeline's
+    """A compute process keeps freed heap memory (core.memory); the pipeline's
     return_freed_memory at each stage gives the pages of ten freed 20 MB arrays back."""
     printed = _printed_by_fresh_process(RETURN_FREED)
     ran, returned = printed.split()

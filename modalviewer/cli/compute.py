@@ -34,11 +34,11 @@ def add_parsers(sub) -> None:
 def compute(args) -> int:
     import modalviewer as mv
 
-    from ..processes.memory import prepare_compute_process
+    from ..core.memory import prepare_compute_process
     from ..viewer.model import memory_text, residual_text
 
     make_output_folders(("-o", args.output))
-    prepare_compute_process()  # this process exists to compute (see processes.memory)
+    prepare_compute_process()  # this process exists to compute (see core.memory)
     mesh = load(args.mesh, args.fix_slivers, args.partial)
     _refuse_if_too_large(mesh, args.operator, args.k)
     bar, on_modes = _counting_modes(progress_bar(), args.k)

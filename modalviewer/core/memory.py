@@ -1,14 +1,36 @@
-"""How much memory a computation may use, and how much this process holds now.
+"""Memory: how much a computation may use, how much this process holds, and the C
+library's allocator settings for processes that compute.
 
 The exact solver keeps its working set within :func:`memory_limit_mb`: where the
 factorisation would not fit beside the Krylov basis, the factor goes out of core
 (:mod:`.factor`).  The limit is half this machine's memory, so a computation leaves room
 for the viewer, the rest of the desktop and the system's file cache (which then holds the
 out-of-core factor); ``MODALVIEWER_MEMORY_LIMIT_MB`` sets it explicitly.
+
+A computation allocates and frees many arrays of hundreds of megabytes, and first
+touches of fresh memory cost more than much of the arithmetic done with them.
+:func:`prepare_compute_process` makes them cheaper in a process that exists to compute
+(the viewer's child processes, the command line, the benchmarks):
+
+- glibc hands every array above its mmap threshold to the kernel and back, so each new
+  one starts on fresh pages.  Serving arrays up to :data:`HEAP_ARRAY_MAX_BYTES` from the
+  heap and not trimming it lets the process reuse what it freed
+  (:func:`keep_freed_memory`).  Bigger arrays (the (N, k) blocks and bases) still go
+  back as they are freed: served from the heap, they would leave holes the next ones do
+  not fit, which raises the peak.
+- numpy advises the kernel to back big arrays with transparent huge pages, and the
+  kernel compacts memory to find them, which makes page faults of fresh arrays slower
+  (:func:`no_huge_page_advice`).
+- glibc gives each thread that calls ``malloc`` an arena of its own, whose freed memory
+  no other thread reuses; one arena for the process (:func:`one_malloc_arena`) lets
+  every thread reuse it.
+
+What each setting saves and costs: "Memory" in docs/how-it-works.md.
 """
 
 from __future__ import annotations
 
+import ctypes
 import functools
 import os
 
@@ -19,6 +41,10 @@ __all__ = [
     "glibc",
     "resident_mb",
     "return_freed_memory",
+    "keep_freed_memory",
+    "no_huge_page_advice",
+    "one_malloc_arena",
+    "prepare_compute_process",
 ]
 
 MEMORY_LIMIT_SHARE = 0.5
@@ -66,32 +92,10 @@ def resident_mb() -> float:
         return peak / 1024.0 if os.uname().sysname == "Linux" else peak / MB
 
 
-def return_freed_memory() -> bool:
-    """Give the memory this process has freed back to the system (glibc's
-    ``malloc_trim(0)``: free heap pages, at its top and between the arrays still in use).
-    A computation's stages free arrays of hundreds of megabytes whose heap pages glibc
-    would otherwise keep (it serves arrays below its dynamic mmap threshold, up to 32 MB,
-    and all arrays in a compute process, from the heap) and which the next stage's
-    arrays, of other sizes, cannot always reuse; called at each new stage of
-    :func:`.pipeline.compute_spectrum`.  True where it ran (glibc), False elsewhere."""
-    import ctypes
-
-    libc = glibc()
-    trim = getattr(libc, "malloc_trim", None)
-    if trim is None:
-        return False
-    trim.argtypes = [ctypes.c_size_t]
-    trim.restype = ctypes.c_int
-    trim(0)
-    return True
-
-
 @functools.cache
 def glibc():
     """The C library as a ``ctypes.CDLL`` on Linux (glibc's ``libc.so.6``), else None,
-    loaded once: the one place its allocator settings (:func:`return_freed_memory`, at
-    each stage of a computation; :mod:`modalviewer.processes.memory`) load it from."""
-    import ctypes
+    loaded once."""
     import sys
 
     if not sys.platform.startswith("linux"):
@@ -100,3 +104,82 @@ def glibc():
         return ctypes.CDLL("libc.so.6", use_errno=True)
     except OSError:
         return None
+
+
+def return_freed_memory() -> bool:
+    """Give the memory this process has freed back to the system (glibc's
+    ``malloc_trim(0)``: free heap pages, at its top and between the arrays still in use).
+    A computation's stages free large arrays whose heap pages glibc would otherwise keep
+    and which the next stage's arrays, of other sizes, cannot always reuse; called at
+    each new stage of :func:`.pipeline.compute_spectrum`.  True where it ran (glibc),
+    False elsewhere."""
+    trim = getattr(glibc(), "malloc_trim", None)
+    if trim is None:
+        return False
+    trim.argtypes = [ctypes.c_size_t]
+    trim.restype = ctypes.c_int
+    trim(0)
+    return True
+
+
+_M_TRIM_THRESHOLD = -1
+_M_MMAP_THRESHOLD = -3
+_M_ARENA_MAX = -8
+
+HEAP_ARRAY_MAX_BYTES = 32 * 2**20
+"""Arrays up to this size come from the heap in a compute process and their memory is
+reused when freed; bigger ones are mapped and unmapped (glibc's largest mmap threshold
+on 64-bit systems): serving every array from the heap raised the exact solves' peak."""
+
+
+def _mallopt():
+    """glibc's ``mallopt`` with its argument types set, or None where the C library is
+    not glibc."""
+    mallopt = getattr(glibc(), "mallopt", None)
+    if mallopt is not None:
+        mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
+        mallopt.restype = ctypes.c_int
+    return mallopt
+
+
+def keep_freed_memory() -> bool:
+    """Ask glibc to serve allocations up to :data:`HEAP_ARRAY_MAX_BYTES` from the heap
+    (``M_MMAP_THRESHOLD``) and keep freed heap memory (``M_TRIM_THRESHOLD`` at its
+    largest).  True if both took effect; False (and nothing changed) where the C library
+    is not glibc."""
+    mallopt = _mallopt()
+    if mallopt is None:
+        return False
+    return bool(mallopt(_M_MMAP_THRESHOLD, HEAP_ARRAY_MAX_BYTES)) and bool(
+        mallopt(_M_TRIM_THRESHOLD, 2**31 - 1)
+    )
+
+
+def one_malloc_arena() -> bool:
+    """Ask glibc to serve every thread from one arena (``mallopt(M_ARENA_MAX, 1)``), so
+    memory freed on one thread is reused by the next allocation on any other.  Takes
+    effect for threads that have not yet allocated: call it when the process starts.
+    True if it took effect; False where the C library is not glibc."""
+    mallopt = _mallopt()
+    return mallopt is not None and bool(mallopt(_M_ARENA_MAX, 1))
+
+
+def no_huge_page_advice() -> bool:
+    """Stop numpy from advising huge pages for new arrays (what the environment variable
+    ``NUMPY_MADVISE_HUGEPAGE=0`` does at import).  True if the setting exists."""
+    import numpy as np
+
+    core = getattr(np, "_core", None) or np.core
+    setter = getattr(core.multiarray, "_set_madvise_hugepage", None)
+    if setter is None:
+        return False
+    setter(False)
+    return True
+
+
+def prepare_compute_process() -> bool:
+    """The three allocator settings for a process that exists to compute (memory goes
+    back to the system when it ends, not before); True if all took effect."""
+    kept = keep_freed_memory()
+    shared = one_malloc_arena()
+    return no_huge_page_advice() and kept and shared

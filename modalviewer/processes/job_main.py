@@ -27,12 +27,12 @@ def _emit(payload: dict) -> None:
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     job_path, out_path = argv
+    from ..core.memory import prepare_compute_process
     from ..core.mesh import Mesh
     from ..core.pipeline import compute_spectrum
     from ..core.spectrum import save_spectrum
-    from .memory import prepare_compute_process
 
-    prepare_compute_process()  # this process exists to compute (see processes.memory)
+    prepare_compute_process()  # this process exists to compute (see core.memory)
     try:
         with np.load(job_path, allow_pickle=False) as job:
             vertices, faces = job["vertices"], job["faces"]
