@@ -20,18 +20,13 @@ from .core.assembly import operator_matrices as _operator_matrices
 from .core.mesh import Mesh
 from .core.spectrum import Spectrum
 from .extras import extra_needed
+from .io import mesh_from_arrays, meshio_arrays
 
 __all__ = ["as_mesh", "operator_matrices", "to_pyvista", "arrays_of"]
 
 
 def _module(obj) -> str:
     return type(obj).__module__.split(".")[0]
-
-
-def _fan(cells: np.ndarray) -> np.ndarray:
-    """Polygons (m, p) as triangles (m * (p - 2), 3), fanned from each first vertex."""
-    p = cells.shape[1]
-    return np.concatenate([cells[:, [0, i, i + 1]] for i in range(1, p - 1)])
 
 
 def _from_pyvista(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -46,24 +41,6 @@ def _from_pyvista(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
         notes.append("polygons were triangulated (the vertices are kept as they are)")
     faces = np.asarray(data.faces).reshape(-1, 4)[:, 1:] if data.n_cells else np.zeros((0, 3))
     return np.asarray(data.points, dtype=np.float64), faces.astype(np.int64), notes
-
-
-def _from_meshio(m) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    triangles, notes = [], []
-    for block in m.cells:
-        data = np.asarray(block.data)
-        if block.type == "triangle":
-            triangles.append(data)
-        elif block.type in ("quad", "polygon") or block.type.startswith("polygon"):
-            triangles.append(_fan(data))
-            notes.append(f"{len(data)} {block.type} cells were triangulated")
-        elif block.type not in ("vertex", "line"):
-            notes.append(f"{len(data)} {block.type} cells are not surface cells and were skipped")
-    faces = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
-    points = np.asarray(m.points, dtype=np.float64)
-    if points.ndim == 2 and points.shape[1] == 2:  # a planar mesh: z = 0
-        points = np.column_stack([points, np.zeros(len(points))])
-    return points, faces.astype(np.int64), notes
 
 
 def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -81,7 +58,7 @@ def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
                 obj = pv.wrap(obj)
             return _from_pyvista(obj)
     if module == "meshio":
-        return _from_meshio(obj)
+        return meshio_arrays(obj)
     if isinstance(obj, (tuple, list)) and len(obj) == 2:
         return np.asarray(obj[0]), np.asarray(obj[1]), []
     raise TypeError(
@@ -125,8 +102,6 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     """
     if isinstance(obj, Mesh):
         return obj
-    from .io import mesh_from_arrays
-
     vertices, faces, notes = arrays_of(obj)
     source = name or ("arrays" if isinstance(obj, (tuple, list)) else type(obj).__name__)
     return mesh_from_arrays(vertices, faces, source, repair=repair, notes=notes)

@@ -108,10 +108,34 @@ def _meshio_extensions() -> tuple[str, ...]:
     return tuple(meshio.extension_to_filetypes)
 
 
+def _fan(cells: np.ndarray) -> np.ndarray:
+    """Polygons (m, p) as triangles (m * (p - 2), 3), fanned from each first vertex."""
+    p = cells.shape[1]
+    return np.concatenate([cells[:, [0, i, i + 1]] for i in range(1, p - 1)])
+
+
+def meshio_arrays(m) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(vertices, triangles, notes) of a ``meshio.Mesh``: its triangle cells, quads and
+    polygons fanned into triangles, other cells skipped (the notes say so)."""
+    triangles, notes = [], []
+    for block in m.cells:
+        data = np.asarray(block.data)
+        if block.type == "triangle":
+            triangles.append(data)
+        elif block.type in ("quad", "polygon") or block.type.startswith("polygon"):
+            triangles.append(_fan(data))
+            notes.append(f"{len(data)} {block.type} cells were triangulated")
+        elif block.type not in ("vertex", "line"):
+            notes.append(f"{len(data)} {block.type} cells are not surface cells and were skipped")
+    faces = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
+    points = np.asarray(m.points, dtype=np.float64)
+    if points.ndim == 2 and points.shape[1] == 2:  # a planar mesh: z = 0
+        points = np.column_stack([points, np.zeros(len(points))])
+    return points, faces.astype(np.int64), notes
+
+
 def _read_meshio(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     import meshio
-
-    from .interop import arrays_of
 
     if not path.is_file():
         raise MeshError(f"{path}: no such file")
@@ -123,7 +147,7 @@ def _read_meshio(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
             f"{path.name}: meshio could not read it{detail}; the file may be damaged, "
             "truncated or of another type"
         ) from None
-    vertices, faces, notes = arrays_of(data)
+    vertices, faces, notes = meshio_arrays(data)
     if len(vertices) == 0:
         raise MeshError(f"{path.name}: no vertices found in this file")
     return vertices, faces, notes
