@@ -104,7 +104,7 @@ class SpectrumCache:
     Parameters
     ----------
     directory : the cache folder; default :func:`default_cache_dir`.
-    max_bytes : the size limit; default :func:`default_cache_limit` (2 GiB, or
+    max_bytes : the size limit; default :func:`default_cache_limit` (or
         ``$MODALVIEWER_CACHE_MAX_MB``).  The least recently used entries are deleted
         when the limit is exceeded; the entry just written or read is always kept, even
         if it alone is larger.  0 stores nothing.

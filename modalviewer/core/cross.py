@@ -37,7 +37,7 @@ facts decide whether two meshes of different size can be compared:
 So compare meshes of the same area: :func:`rescale_to_area` returns a copy scaled to a
 given area (the viewer offers it before computing).  The cross functions warn
 (:class:`ScaleWarning`) when the two spectra's total masses (their mesh areas) differ
-by more than 5 %.
+by more than :data:`AREA_TOLERANCE`.
 """
 
 from __future__ import annotations
@@ -193,7 +193,7 @@ def common_times(
 class CrossTables:
     """The normalised signature tables of A and B at common scales, for repeated queries.
 
-    Building costs one (n, k) x (k, T) product per mesh (0.2 s at 50k vertices); each
+    Building costs one (n, k) x (k, T) product per mesh; each
     query is then one matrix-vector product over the other mesh's table.
 
     Attributes

@@ -166,7 +166,7 @@ def remove_stale_factor_folders(parent: str | None = None) -> list[str]:
 
 def has_vertex_blocks(A: sp.csr_matrix, size: int = 3) -> bool:
     """Whether A's rows come in groups of ``size`` with one sparsity pattern each (the
-    3D shells' vertex blocks): in at least 90 % of up to 256 groups spread over the
+    3D shells' vertex blocks): in nearly all of a few hundred groups spread over the
     matrix the rows have the same columns (an entry that cancels to an exact zero drops
     out of a few; a scalar operator's neighbouring rows almost never agree)."""
     n = A.shape[0]
@@ -274,7 +274,7 @@ class _Pardiso:
 
     def _out_of_core_folder(self) -> str | None:
         """A new folder for the factor file, or None (the factor stays in core) where
-        the file would not fit on the disk with 1 GB to spare."""
+        the file would not fit on the disk with a gigabyte to spare."""
         parent = factor_folder()
         remove_stale_factor_folders(parent)
         try:

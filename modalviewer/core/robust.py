@@ -55,8 +55,7 @@ def negative_cotan_weights(mesh: Mesh) -> int:
     of the cotan stiffness matrix above 0 off its diagonal.  Summed over the mesh's edge
     list (:attr:`.mesh.Mesh.face_edges`), without assembling the matrix; kept for each
     mesh object (a mesh is not changed in place), so that the window's reading thread
-    can count while the file is opened (about 1.7 s at 655k vertices) and the panel
-    asks again for free."""
+    can count while the file is opened and the panel asks again for free."""
     count = _COUNTS.get(mesh)
     if count is None:
         count = _COUNTS[mesh] = _count_negative(mesh)

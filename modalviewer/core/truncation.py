@@ -15,8 +15,8 @@ from ``lambda_k`` up to the last of the mesh's unknowns; the sum is bounded by i
 integral (closed form, incomplete gamma function) and doubled (``SAFETY_FACTOR``).
 
 The result is an upper-bound-style estimate, not a proof: on small meshes whose every
-mode is known it was at least the true share wherever that exceeded 1 % (and at most
-about 20 times it), for the Laplacian, E_D^N and the shells on spheres, tori and plates
+mode is known it was at least the true share wherever that exceeded a hundredth (and at
+most about twenty times it), for the Laplacian, E_D^N and the shells on spheres, tori and plates
 (``tests/core/test_truncation.py``).  It is a share of the whole surface's signature;
 at one vertex the missing share can be larger or smaller
 (:func:`~.local_signature.local_signature` gives the exact value there).
