@@ -74,7 +74,7 @@ class OperatorInfo:
     has_weights : whether the bending and membrane weights apply.
     assemble : the function that assembles K, or its ``"module:function"`` in
         :mod:`modalviewer.core`: ``function(mesh)``, or ``function(mesh, bending,
-        membrane)`` with weights (:meth:`stiffness`); with ``assembles_mass`` it returns
+        membrane)`` with weights ; with ``assembles_mass`` it returns
         (K, mass).
     null_space : the exactly known null vectors in words.
     null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
@@ -191,10 +191,6 @@ class OperatorInfo:
     @property
     def null_space_needs_normals(self) -> bool:
         return self.null_space_rule.startswith("normal")
-
-    def stiffness(self, mesh, bending: float = 1.0, membrane: float = 1.0):
-        """The operator's sparse matrix K on ``mesh`` (the function :attr:`assemble`)."""
-        return self.matrices(mesh, bending, membrane)[0]
 
     def matrices(self, mesh, bending: float = 1.0, membrane: float = 1.0):
         """(K, mass (n,) per vertex) on ``mesh``: the function :attr:`assemble`, and the

@@ -135,10 +135,6 @@ class Spectrum:
             raise ValueError(_unused_words(vertex))
         return vertex
 
-    def has_unused(self) -> bool:
-        """Whether some vertices have no value (NaN rows: used by no face)."""
-        return bool(np.isnan(self.modes[:, ..., 0]).any()) if self.k else False
-
     def squared_modes(self, vertices=None) -> np.ndarray:
         """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes); only the rows of
         ``vertices`` (a sequence of indices) if given."""
