@@ -74,7 +74,7 @@ class OperatorInfo:
     has_weights : whether the bending and membrane weights apply.
     assemble : the function that assembles K, or its ``"module:function"`` in
         :mod:`modalviewer.core`: ``function(mesh)``, or ``function(mesh, bending,
-        membrane)`` with weights ; with ``assembles_mass`` it returns
+        membrane)`` with weights; with ``assembles_mass`` it returns
         (K, mass).
     null_space : the exactly known null vectors in words.
     null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
