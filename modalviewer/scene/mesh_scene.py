@@ -135,6 +135,7 @@ class MeshScene:
         # an export of the plotter finds the scene's legend and colour bar
         self.up_axis: str | None = None  # None or "auto": detected (:meth:`up`)
         self._up: tuple | None = None  # (up_axis, the axis in effect) of the last call
+        self._canonical: tuple | None = None  # (up axis, its canonical camera)
         plotter._modalviewer_scene = self
 
     # ------------------------------------------------------------------ style
@@ -429,8 +430,15 @@ class MeshScene:
 
     # ----------------------------------------------------------------- camera
     def canonical_camera(self) -> cameras.Camera:
-        """The canonical first view of this mesh (see ``modalviewer.viewer.camera``)."""
-        return cameras.canonical_view(self.mesh.vertices, self.mesh.faces, up=self.up())
+        """The canonical first view of this mesh (see ``modalviewer.viewer.camera``),
+        computed once per up axis: on a large mesh it takes seconds, and R must reset the
+        view at once (the window drew nothing meanwhile, so the view seemed not to
+        reset)."""
+        up = self.up()
+        if self._canonical is None or self._canonical[0] != up:
+            camera = cameras.canonical_view(self.mesh.vertices, self.mesh.faces, up=up)
+            self._canonical = (up, camera)
+        return self._canonical[1]
 
     def up(self) -> str:
         """The up axis in effect: :attr:`up_axis` where set (the viewer sets its

@@ -241,10 +241,10 @@ def sharp_edges(vertices, faces) -> tuple[np.ndarray, np.ndarray] | None:
     normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
     edges = np.sort(np.stack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]], 1).reshape(-1, 2), 1)
-    face = np.repeat(np.arange(len(f)), 3)
-    order = np.lexsort((edges[:, 1], edges[:, 0]))
-    edges, face = edges[order], face[order]
-    i = np.flatnonzero(np.all(edges[1:] == edges[:-1], axis=1))  # edges with two faces
+    key = edges[:, 0].astype(np.int64) * len(v) + edges[:, 1]
+    order = np.argsort(key)
+    edges, face, key = edges[order], order // 3, key[order]
+    i = np.flatnonzero(key[1:] == key[:-1])  # edges with two faces
     if i.size == 0:
         return None
     pair = np.stack([normals[face[i]], normals[face[i + 1]]], axis=1)

@@ -156,3 +156,33 @@ def test_silhouette_of_a_box_mesh_picks_its_broad_side():
     # lying flat (thin in Y, the up axis): seen from above
     flat = v[:, [1, 0, 2]]
     assert np.allclose(canonical_view(flat, f, azimuth=0, elevation=0).direction, [0, 1, 0])
+
+
+def test_r_resets_the_view_at_once(monkeypatch):
+    """R right after a drag seemed not to reset the view on a large mesh: the canonical
+    view was computed again on every R (seconds at 384k vertices), and the window drew
+    nothing meanwhile.  It is computed once per up axis."""
+    import modalviewer as mv
+    from modalviewer.scene.mesh_scene import MeshScene
+    from modalviewer.scene.offscreen import offscreen_plotter
+    from modalviewer.viewer import camera
+
+    calls = []
+    real = camera.canonical_view
+    monkeypatch.setattr(camera, "canonical_view", lambda *a, **k: calls.append(1) or real(*a, **k))
+    spot = mv.load_mesh(mv.asset_path("spot.obj"))
+    plotter = offscreen_plotter((200, 150))
+    try:
+        scene = MeshScene(plotter, spot)
+        first = np.array(scene.reset_camera().direction)
+        plotter.camera.Azimuth(40.0)  # a drag
+        plotter.camera.Elevation(20.0)
+        again = scene.reset_camera()
+        cam = plotter.camera
+        shown = np.subtract(cam.GetPosition(), cam.GetFocalPoint())
+        assert np.allclose(shown / np.linalg.norm(shown), first, atol=1e-9)
+        assert np.allclose(again.direction, first) and len(calls) == 1
+        scene.up_axis = "+z"  # another up axis: its own view
+        assert abs(scene.reset_camera().up[2]) > 0.9 and len(calls) == 2
+    finally:
+        plotter.close()
