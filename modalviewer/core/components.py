@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .eigen import CancelFn, ProgressFn
-from .mesh import Mesh, MeshReport, shape_summary
+from .mesh import Mesh, MeshReport, _plural, shape_summary
 from .operators import DEFAULT_K, OperatorLike, operator_info
 from .pipeline import compute_spectrum
 from .spectrum import Spectrum
@@ -37,30 +37,10 @@ __all__ = [
 ]
 
 
-def _plural(count: int, word: str) -> str:
-    if count == 1:
-        return f"{count} {word}"
-    return f"{count} {word[:-6] + 'vertices' if word.endswith('vertex') else word + 's'}"
-
-
 def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
-    """The connected components, largest area first.
-
-    Each component is a mesh of its own, its vertices those of ``mesh`` that its faces
-    use (``vertices`` maps back).
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface, n vertices.
-
-    Returns
-    -------
-    list of (Mesh, ndarray of int, shape (n_c,))
-        Per component its mesh and its vertex indices in ``mesh``: row i of the
-        component's arrays belongs to vertex ``vertices[i]`` of ``mesh`` (ascending, so
-        the component keeps the original vertex order).
-    """
+    """The connected components, largest area first: (mesh, vertices) per component,
+    row i of the component's arrays being vertex ``vertices[i]`` of ``mesh`` (ascending:
+    the original vertex order)."""
     solver = mesh.solver_mesh
     if solver is not mesh:  # unused or merged vertices: the parts of the vertices in faces
         return [
@@ -85,23 +65,9 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
 
 
 def largest_component(mesh: Mesh) -> Mesh:
-    """A new mesh of the component with the largest area.
-
-    Vertex numbers stay the input's: the removed components' vertices are, in the
-    result, used by no face (:attr:`~modalviewer.core.mesh.Mesh.unused`).
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface.
-
-    Returns
-    -------
-    Mesh
-        The largest component; ``result.report`` says what was removed (the input's report
-        messages come first).  A mesh with one component is returned as a copy, with the
-        report saying so.
-    """
+    """A new mesh of the component with the largest area; its report says what was
+    removed.  Vertex numbers stay the input's: the removed components' vertices are
+    used by no face (:attr:`~modalviewer.core.mesh.Mesh.unused`)."""
     if not mesh.renumbered:  # the input's numbering: the other components' faces go
         solver = mesh.solver_mesh
         labels = solver.component_labels[solver.faces[:, 0]]
@@ -179,30 +145,10 @@ def compute_spectrum_per_component(
     min_vertices: int = 1,
 ) -> list[ComponentSpectrum]:
     """k modes of each connected component with at least ``min_vertices`` vertices,
-    largest area first.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface.
-    operator, bending, membrane, progress, cancel
-        As for :func:`~modalviewer.core.pipeline.compute_spectrum`; progress runs from 0 to
-        1 over all components, weighted by their vertex counts.
-    k : int
-        Modes per component, capped at each component's unknowns.
-    min_vertices : int
-        Smaller components are left out.
-
-    Returns
-    -------
-    list of ComponentSpectrum
-        One per component computed, largest area first.
-
-    Raises
-    ------
-    ValueError
-        If no component has at least ``min_vertices`` vertices.
-    """
+    largest area first (a ValueError if there is none).  The other arguments are
+    :func:`~modalviewer.core.pipeline.compute_spectrum`'s; k is capped at each
+    component's unknowns, and progress runs from 0 to 1 over all components, weighted by
+    their vertex counts."""
     operator = operator_info(operator)
     k = check_count(k, "k")
     min_vertices = check_count(min_vertices, "min_vertices", 0)

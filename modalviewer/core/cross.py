@@ -76,28 +76,9 @@ class ScaleWarning(UserWarning):
 
 
 def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
-    """A copy of ``mesh`` scaled about the origin so that its total area is ``area``.
-
-    Only the size changes (vertices times ``sqrt(area / mesh.total_area)``); faces and
-    the load report are kept.  Rescale both meshes of a comparison to the same area.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface.
-    area : float
-        The total area of the copy, positive.
-
-    Returns
-    -------
-    Mesh
-        The scaled copy.
-
-    Raises
-    ------
-    ValueError
-        If ``area`` is not a positive finite number.
-    """
+    """A copy of ``mesh`` scaled about the origin to total area ``area`` (positive;
+    a ValueError otherwise); faces and the load report are kept.  Rescale both meshes
+    of a comparison to the same area."""
     area = float(area)
     if not (np.isfinite(area) and area > 0):
         raise ValueError(f"the target area must be a positive number, got {area}")
@@ -152,27 +133,9 @@ def common_times(
 ) -> np.ndarray:
     """Log-spaced scales shared by both spectra: ``t_range`` if given, else the
     intersection of the two default ranges (see the module docstring); for
-    ``kind="wks"`` energies, the intersection of the default energy bands.
-
-    Parameters
-    ----------
-    spec_a, spec_b : Spectrum
-        The two spectra.
-    t_range : (float, float), optional
-        The scales (t1, t2).
-    samples : int
-        The number of scales, at least 2.
-
-    Returns
-    -------
-    ndarray, shape (samples,)
-        The scales, ascending.
-
-    Raises
-    ------
-    ValueError
-        If the default ranges do not overlap (the meshes differ too much in size: rescale
-        both to the same area, see :func:`rescale_to_area`, or pass ``t_range``).
+    ``kind="wks"`` energies, the intersection of the default energy bands.  (samples,)
+    ascending, ``samples`` >= 2.  A ValueError if the default ranges do not overlap
+    (the meshes differ too much in size: :func:`rescale_to_area`, or pass ``t_range``).
     """
     samples = check_count(samples, "samples", 2)
     if t_range is None:
@@ -286,31 +249,13 @@ def cross_distance(
     Both spectra must come from the same operator (the signature kind: heat kernel for
     ``"laplacian"``, feature for ``"modified_dirichlet"``, vibration for ``"shells"``).
     Each signature is normalised by its own ``Z(t)``.  Computed on the meshes as given:
-    see the module docstring on scale and :func:`rescale_to_area`.
+    see the module docstring on scale and :func:`rescale_to_area`.  ``t_range``: the
+    scales (default: :func:`common_times`), ``samples`` of them, log-spaced;
+    ``include_zero``: whether the signatures include the zero modes.
 
-    Parameters
-    ----------
-    spec_a, spec_b : Spectrum
-        The spectra of A and B.
-    vertex : int
-        A vertex of A.
-    t_range : (float, float), optional
-        The scales (default: the intersection of the two default ranges).
-    samples : int
-        The number of log-spaced scales.
-    include_zero : bool
-        Whether the signatures include the zero modes.
-
-    Returns
-    -------
-    ndarray, shape (n_b,)
-        The distance to each vertex of B (NaN at the vertices no face uses).
-
-    Raises
-    ------
-    ValueError
-        If the spectra are of different operators (or shells spectra of different
-        weights), or their default scale ranges do not overlap.
+    Returns (n_b,): the distance to each vertex of B (NaN at the vertices no face uses).
+    A ValueError if the spectra are of different operators (or shells spectra of
+    different weights), or their default scale ranges do not overlap.
     """
     v = spec_a.check_source(check_vertex(vertex, spec_a.n_vertices))
     _check_pair(spec_a, spec_b)
@@ -328,24 +273,8 @@ def best_match(
     samples: int = 100,
     include_zero: bool = False,
 ) -> tuple[int, float]:
-    """The vertex of B closest to vertex ``vertex`` of A under :func:`cross_distance`.
-
-    Parameters
-    ----------
-    spec_a, spec_b : Spectrum
-        The spectra of A and B, of the same operator.
-    vertex : int
-        A vertex of A.
-    t_range, samples, include_zero
-        As for :func:`cross_distance`.
-
-    Returns
-    -------
-    vertex_b : int
-        The closest vertex of B.
-    distance : float
-        Its distance.
-    """
+    """(vertex of B, distance): the vertex of B closest to vertex ``vertex`` of A under
+    :func:`cross_distance` (whose arguments these are)."""
     d = cross_distance(spec_a, vertex, spec_b, t_range, samples, include_zero)
     w = int(np.nanargmin(d))  # vertices no face uses have no distance (NaN)
     return w, float(d[w])
@@ -364,46 +293,17 @@ def mutual_best_matches(
 
     For each ``v`` in ``vertices_a``: ``w`` = the vertex of B closest to ``v``, then
     ``v'`` = the vertex of A closest to ``w``; the pair is mutual if ``v' == v``.
-
-    Parameters
-    ----------
-    spec_a, spec_b : Spectrum
-        The spectra of A and B, of the same operator.
-    vertices_a : int or array_like of int, shape (p,)
-        The picked vertices of A.
-    vertices_b : int or array_like of int, optional
-        Without it both searches run over all vertices; with it, ``w`` is searched among
-        ``vertices_b`` and ``v'`` among ``vertices_a`` (matching two sets of picked points,
-        e.g. landmarks, to each other).
-    t_range, samples, include_zero
-        As for :func:`cross_distance`.
-
-    Returns
-    -------
-    Matches
-        The matches, their distances, the matches back and which are mutual, each of
-        shape (p,).
-    """
+    With ``vertices_b``, ``w`` is searched among ``vertices_b`` and ``v'`` among
+    ``vertices_a`` (matching two sets of landmarks); without, over all vertices.
+    ``t_range``, ``samples``, ``include_zero``: as for :func:`cross_distance`."""
     tables = CrossTables(spec_a, spec_b, t_range, samples, include_zero)
     return tables.mutual_best_matches(vertices_a, vertices_b)
 
 
 def distance_ranks(distances: np.ndarray, vertices: Vertices) -> np.ndarray:
     """The rank of each of ``vertices`` in a distance map: 1 + the number of vertices
-    strictly closer (rank 1 = best match, ties share the better rank).
-
-    Parameters
-    ----------
-    distances : ndarray, shape (n,)
-        A distance map, one value per vertex.
-    vertices : int or array_like of int, shape (m,)
-        Vertex indices in ``0..n-1``.
-
-    Returns
-    -------
-    ndarray of int, shape (m,)
-        The 1-based ranks.
-    """
+    strictly closer (rank 1 = best match, ties share the better rank): (m,) ints for
+    ``vertices`` (m,) of the (n,) map ``distances``."""
     d = np.asarray(distances, dtype=np.float64)
     idx = check_vertices(vertices, d.shape[0])
     return 1 + np.sum(d[None, :] < d[idx, None], axis=1)

@@ -13,31 +13,14 @@ __all__ = ["modified_dirichlet_matrix"]
 
 def modified_dirichlet_matrix(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_matrix:
     """The matrix A of the modified Dirichlet energy E_D^N, ``A_ij = <N_i, N_j> S_ij`` (so
-    ``A_ii = S_ii``), with S the cotan stiffness matrix.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        A consistently oriented, edge-manifold surface (normals are otherwise ambiguous),
-        n vertices.
-    normals : ndarray, shape (n, 3), optional
-        Unit vertex normals (default: the area-weighted ones of :func:`vertex_normals`).
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (n, n)
-        Symmetric positive semi-definite.
-
-    Raises
-    ------
-    MeshError
-        If the mesh is not consistently oriented or not edge-manifold.
-    """
+    ``A_ii = S_ii``), with S the cotan stiffness matrix and N the unit vertex
+    ``normals`` (default: :func:`.laplacian.vertex_normals`); CSR, symmetric positive
+    semi-definite.  A MeshError unless the mesh is consistently oriented and
+    edge-manifold (the normals are otherwise ambiguous)."""
     problem = mesh.shell_problem()
     if problem:
         raise MeshError("E_D^N cannot run: " + problem)
     S = stiffness_matrix(mesh).tocoo()
     N = vertex_normals(mesh) if normals is None else np.asarray(normals, dtype=np.float64)
     dots = np.einsum("ij,ij->i", N[S.row], N[S.col])
-    A = sp.csr_matrix((S.data * dots, (S.row, S.col)), shape=S.shape)
-    return A
+    return sp.csr_matrix((S.data * dots, (S.row, S.col)), shape=S.shape)

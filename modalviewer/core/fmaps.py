@@ -166,39 +166,22 @@ def functional_map(
 
     Parameters
     ----------
-    spec_a, spec_b : Spectrum
-        Spectra of one scalar operator on the two shapes (Laplacian, modified_dirichlet,
-        shells_normal), at least ``k`` (and ``zoomout``) modes each; of shapes of about
-        the same area (signatures scale with it).
-    descriptors : "wks", "hks" or (array (n_a, d), array (n_b, d))
-        "wks": the wave kernel signature of each spectrum at ``samples`` energies shared
-        by both; "hks": the heat-type signature at shared scales; or your own per-vertex
-        descriptors.
-    k : int
-        The size of the map from the descriptors.
-    mu : float
-        The weight of the commutativity with the eigenvalues.  The wave kernel
-        descriptors need a weight of about 1 (pyFM's 1e-3 leaves their C far from
-        diagonal and the point map poor); the heat kernel's hardly depend on it.
-    samples : int
-        Energies or scales of the computed descriptors.
-    zoomout : int, optional
-        Refine by ZoomOut from ``k`` up to this many modes (the returned C is then
-        (zoomout, zoomout)).
-    zoomout_step : int
-        Modes added per ZoomOut step (1 as in the paper; each step costs one nearest-
-        neighbour search over all vertices).
+    spec_a, spec_b : spectra of one scalar operator on the two shapes (Laplacian,
+        modified_dirichlet, shells_normal), at least ``k`` (and ``zoomout``) modes each;
+        of shapes of about the same area (signatures scale with it).
+    descriptors : "wks": the wave kernel signature of each spectrum at ``samples``
+        energies shared by both; "hks": the heat-type signature at shared scales; or
+        your own per-vertex descriptors, (array (n_a, d), array (n_b, d)).
+    k : the size of the map from the descriptors.
+    mu : the weight of the commutativity with the eigenvalues.  The wave kernel
+        descriptors need about 1 (pyFM's 1e-3 leaves their C far from diagonal and the
+        point map poor); the heat kernel's hardly depend on it.
+    zoomout : refine by ZoomOut from ``k`` up to this many modes (C is then (zoomout,
+        zoomout)), ``zoomout_step`` modes per step (1 as in the paper; each step costs
+        one nearest-neighbour search over all vertices).
 
-    Returns
-    -------
-    FunctionalMap
-        ``C``, ``point_map`` (B's vertex -> A's vertex) and ``k``.
-
-    Raises
-    ------
-    ValueError
-        For vector modes, too few modes, unknown descriptors, descriptor arrays of the
-        wrong shape, or shapes whose signature ranges do not overlap.
+    A ValueError for vector modes, too few modes, unknown descriptors, descriptor arrays
+    of the wrong shape, or shapes whose signature ranges do not overlap.
     """
     k = check_count(k, "k", 1)
     final = k if zoomout is None else check_count(zoomout, "zoomout", k)
@@ -227,13 +210,8 @@ def correspondence_errors(
     for every ``every``-th vertex y of B, the distance on A between ``point_map[y]`` and
     ``truth[y]`` (default: y itself, two poses of one mesh), along A's edges (Dijkstra:
     at most a few per cent above the surface's geodesic distance on a fine mesh), over
-    the square root of A's area (the field's usual unit).
-
-    Returns
-    -------
-    ndarray, shape (ceil(n_b / every),)
-        The errors of the vertices checked (NaN where B's vertex has no image).
-    """
+    the square root of A's area (the field's usual unit): (ceil(n_b / every),), NaN
+    where B's vertex has no image."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 

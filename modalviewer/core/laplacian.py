@@ -27,19 +27,9 @@ def face_cotangents(mesh: Mesh) -> np.ndarray:
 
 
 def stiffness_matrix(mesh: Mesh) -> sp.csr_matrix:
-    """The cotan stiffness matrix S (the Laplacian's energy ``f^T S f``); units of
-    (length)^0.  Boundary edges get one cotangent term (natural / Neumann conditions).
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface, n vertices.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (n, n)
-        Symmetric positive semi-definite; its null space holds the constants.
-    """
+    """The (n, n) cotan stiffness matrix S (the Laplacian's energy ``f^T S f``), CSR,
+    symmetric positive semi-definite, the constants in its null space; units of
+    (length)^0.  Boundary edges get one cotangent term (natural / Neumann conditions)."""
     f = mesh.faces
     n = mesh.n_vertices
     cots = face_cotangents(mesh)
@@ -56,19 +46,8 @@ def stiffness_matrix(mesh: Mesh) -> sp.csr_matrix:
 
 
 def mass_matrix(mesh: Mesh) -> sp.dia_matrix:
-    """The lumped (barycentric) mass matrix M: ``m_i`` is a third of the area of the
-    triangles around vertex i.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface, n vertices.
-
-    Returns
-    -------
-    scipy.sparse.dia_matrix, shape (n, n)
-        Diagonal, positive where a vertex has a triangle of non-zero area.
-    """
+    """The lumped (barycentric) mass matrix M, (n, n) DIA: ``m_i`` is a third of the
+    area of the triangles around vertex i."""
     return sp.diags(lumped_masses(mesh), format="dia")
 
 
@@ -80,26 +59,8 @@ def lumped_masses(mesh: Mesh) -> np.ndarray:
 
 
 def vertex_normals(mesh: Mesh, weighting: str = "area") -> np.ndarray:
-    """Unit vertex normals.
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface, n vertices.
-    weighting : {"area", "angle"}
-        ``"area"`` sums the unnormalised face normals (area-weighted); ``"angle"`` weights
-        unit face normals by the corner angle.
-
-    Returns
-    -------
-    ndarray, shape (n, 3)
-        One unit normal per vertex.
-
-    Raises
-    ------
-    ValueError
-        For another ``weighting``.
-    """
+    """(n, 3) unit vertex normals: ``weighting="area"`` sums the unnormalised face
+    normals (area-weighted), ``"angle"`` weights unit face normals by the corner angle."""
     f = mesh.faces
     nt = mesh.face_normals_unnormalized
     if weighting == "area":

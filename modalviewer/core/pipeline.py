@@ -60,9 +60,7 @@ spectra are accepted and carry their residuals (the viewer shows the largest).""
 def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
     """Words on nearly degenerate triangles (quality 4 sqrt(3) area / sum of squared edge
     lengths below ``threshold``; 1 is equilateral), or "" if there are none."""
-    v, f = mesh.vertices, mesh.faces
-    sq = sum(((v[f[:, (c + 1) % 3]] - v[f[:, c]]) ** 2).sum(axis=1) for c in range(3))
-    quality = 4.0 * np.sqrt(3.0) * mesh.face_areas / np.maximum(sq, np.finfo(float).tiny)
+    quality = mesh.face_quality
     bad = np.flatnonzero(quality < threshold)
     if bad.size == 0:
         return ""

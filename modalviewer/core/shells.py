@@ -234,19 +234,9 @@ def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> s
     mass.  The bending part scales like 1 / length^2 and the membrane part like
     1 / length, so the spectrum depends on the mesh's absolute size.  Assembled as
     ``G^T G`` of :func:`weighted_gradient_matrix` (one sparse product on two threads).
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface, n vertices.
-    bending, membrane : float
-        The weights of the bending and the membrane (stretching) energy.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (3n, 3n)
-        Symmetric positive semi-definite; its null space holds the rigid motions.
-    """
+    ``bending``, ``membrane``: the weights of the bending and the membrane (stretching)
+    energy.  (3n, 3n) CSR, symmetric positive semi-definite, the rigid motions in its
+    null space."""
     return _gram(weighted_gradient_matrix(mesh, bending, membrane))
 
 
@@ -261,19 +251,7 @@ def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_m
 
 def normal_shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
     """``H_N = P^T H P``: the shells Hessian restricted to normal variations ``f N``, with P
-    of :func:`normal_projection` (assembled as ``(G P)^T (G P)``).
-
-    Parameters
-    ----------
-    mesh : Mesh
-        The surface, n vertices.
-    bending, membrane : float
-        The weights of the bending and the membrane energy.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (n, n)
-        Symmetric positive semi-definite.
-    """
+    of :func:`normal_projection` (assembled as ``(G P)^T (G P)``); (n, n) CSR, symmetric
+    positive semi-definite."""
     G_N = weighted_gradient_matrix(mesh, bending, membrane, normals=vertex_normals(mesh))
     return _gram(G_N)

@@ -58,27 +58,9 @@ def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
 
 def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False) -> np.ndarray:
     """Log-spaced scales from ``4 ln 10 / lambda_max`` to ``4 ln 10 / lambda_min`` (the
-    largest and the smallest non-zero eigenvalue used).
-
-    Parameters
-    ----------
-    spec : Spectrum
-        The spectrum whose eigenvalues set the range.
-    samples : int
-        The number of scales T.
-    include_zero : bool
-        Whether zero modes count (they do not change the range).
-
-    Returns
-    -------
-    ndarray, shape (T,)
-        The scales, ascending.
-
-    Raises
-    ------
-    ValueError
-        If the spectrum has no non-zero modes.
-    """
+    largest and the smallest non-zero eigenvalue), ``samples`` of them, ascending; a
+    ValueError if the spectrum has no non-zero modes.  ``include_zero`` does not change
+    the range."""
     samples = check_count(samples, "samples", 2)
     lam = spec.eigenvalues[~spec.zero_mode_mask()]
     if lam.size == 0:
@@ -90,13 +72,8 @@ def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False
 
 def default_energies(spec: Spectrum, samples: int = 100) -> np.ndarray:
     """Energies of the wave kernel signature: ``samples`` values log-spaced from the
-    smallest to the largest non-zero eigenvalue (Aubry et al.'s band).
-
-    Raises
-    ------
-    ValueError
-        If the spectrum has fewer than two distinct non-zero eigenvalues.
-    """
+    smallest to the largest non-zero eigenvalue (Aubry et al.'s band); a ValueError
+    if the spectrum has fewer than two distinct non-zero eigenvalues."""
     samples = check_count(samples, "samples", 2)
     lam = _positive_eigenvalues(spec)
     return np.exp(np.linspace(np.log(lam.min()), np.log(lam.max()), samples))
@@ -157,36 +134,18 @@ def signature(
 
     Parameters
     ----------
-    spec : Spectrum
-        The spectrum, n vertices.
-    times : float or array_like of float, optional
-        Positive, finite scales (default: :func:`default_times`).
-    include_zero : bool
-        Whether the sum includes the zero modes (``kind="heat"`` only).
-    vertices : int or array_like of int, optional
-        Vertex indices in ``0..n-1`` (default: every vertex); the rows of vertices no
-        face uses are NaN.
-    kind : {"heat", "wks"}
-        ``"wks"``: the wave kernel signature ``W_E(v)`` (module docstring) at
-        ``energies`` instead of the heat form at ``times``.
-    energies : float or array_like of float, optional
-        ``kind="wks"``: positive energies E (default: :func:`default_energies`).
-    sigma : float, optional
-        ``kind="wks"``: the kernel's width in log-energy (default: :func:`wks_sigma` of
-        the energies).
+    times : positive, finite scales (default: :func:`default_times`).
+    include_zero : whether the sum includes the zero modes (``kind="heat"`` only).
+    vertices : vertex indices (default: every vertex); vertices no face uses get NaN.
+    kind : ``"heat"``, or ``"wks"``: the wave kernel signature ``W_E(v)`` (module
+        docstring) at ``energies`` (default :func:`default_energies`) with width
+        ``sigma`` in log-energy (default :func:`wks_sigma`).
 
     Returns
     -------
-    times : ndarray, shape (T,)
-        The scales (the energies for ``kind="wks"``).
-    values : ndarray, shape (n, T) or (len(vertices), T)
-        The signature of each vertex at each scale.
-
-    Raises
-    ------
-    TypeError, ValueError, IndexError
-        For scales that are not positive and finite, or vertices that are not integer
-        indices of the mesh.
+    (times (T,), the energies for ``"wks"``; values (n, T) or (len(vertices), T)).
+    A TypeError, ValueError or IndexError for scales that are not positive and finite
+    or vertices that are not indices of the mesh.
     """
     if _check_kind(kind) == "wks":
         if times is not None or include_zero:
@@ -321,34 +280,12 @@ def multiscale_distance(
     """The multi-scale distance ``delta_[t1,t2](vertex, w)`` of eq. (31) to every vertex w.
 
     A Riemann sum over ``samples`` log-spaced scales in ``t_range``, each difference of
-    signatures normalised by ``Z(t) = sum_j exp(-lambda_j t)``.
+    signatures normalised by ``Z(t) = sum_j exp(-lambda_j t)``; ``t_range`` defaults
+    to :func:`default_times`' range, and with ``kind="wks"`` it is the energy range of
+    the wave kernel signatures (default :func:`default_energies`' range).
 
-    Parameters
-    ----------
-    spec : Spectrum
-        The spectrum, n vertices.
-    vertex : int
-        The vertex the distances are measured from.
-    t_range : (float, float), optional
-        The scales (t1, t2) (default: the range of :func:`default_times`).
-    samples : int
-        The number of scales of the sum.
-    include_zero : bool
-        Whether the signatures include the zero modes.
-    kind : {"heat", "wks"}
-        ``"wks"``: the distance of the wave kernel signatures over the energy range
-        ``t_range`` (default: :func:`default_energies`' range).
-
-    Returns
-    -------
-    ndarray, shape (n,)
-        The distance from ``vertex`` to each vertex (0 at ``vertex`` itself; NaN at the
-        vertices no face uses).
-
-    Raises
-    ------
-    ValueError
-        If the spectrum has no non-zero modes, or no face uses ``vertex``.
+    Returns (n,): 0 at ``vertex`` itself, NaN at the vertices no face uses.  A
+    ValueError if the spectrum has no non-zero modes, or no face uses ``vertex``.
     """
     vertex = spec.check_source(check_vertex(vertex, spec.n_vertices))
     table = SignatureTable(spec, t_range, samples, include_zero, kind=kind)

@@ -38,7 +38,7 @@ class Spectrum:
         mass (``mass``, repeated for each component of a vector mode), ``Phi.T @ M @ Phi``
         is the identity, so a mode's values scale with 1 / sqrt(area).
         :meth:`euclidean_modes` gives unit-length columns instead.
-    operator : one of ``OPERATORS``.
+    operator : the operator's name (:attr:`operator_info`: its registry entry).
     mass : (n,) lumped vertex masses used for orthonormality (0 at vertices no face
         uses, as the mass matrix has).
     residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
@@ -157,20 +157,8 @@ def _atomic_write(path: Path, write) -> None:
 
 def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
     """Write ``spec`` to ``path`` as ``.npz`` (atomically: a half-written file never
-    replaces a good one), with its mesh hash and parameters.
-
-    Parameters
-    ----------
-    spec : Spectrum
-        The spectrum to save.
-    path : str or os.PathLike
-        The file to write.
-
-    Raises
-    ------
-    OSError
-        If the file cannot be written.
-    """
+    replaces a good one), with its mesh hash and parameters; an OSError if it cannot
+    be written."""
     meta = {
         "format": "modalviewer-spectrum",
         "version": FORMAT_VERSION,
@@ -197,30 +185,12 @@ def load_spectrum(
     mesh: Mesh | None = None,
     mesh_hash: str | None = None,
 ) -> Spectrum:
-    """Read a spectrum written by :func:`save_spectrum`.
+    """Read a spectrum written by :func:`save_spectrum`, checked to belong to ``mesh``
+    (or to the mesh of hash ``mesh_hash``) if given.
 
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The ``.npz`` file.
-    mesh : Mesh, optional
-        The mesh the spectrum must belong to.
-    mesh_hash : str, optional
-        Instead of ``mesh``: its ``mesh.hash`` (a keyword).
-
-    Returns
-    -------
-    Spectrum
-        The spectrum as saved.
-
-    Raises
-    ------
-    SpectrumFileError
-        If the file is not a readable spectrum file (or has inconsistent shapes, NaN or
-        infinite values), or belongs to another mesh than ``mesh`` / ``mesh_hash``.
-    TypeError
-        If ``mesh`` is not a Mesh (a string passed as ``mesh``: pass a hash as
-        ``mesh_hash=``), or both are given.
+    A :class:`SpectrumFileError` if the file is not a readable spectrum file (or has
+    inconsistent shapes, NaN or infinite values) or belongs to another mesh; a TypeError
+    if ``mesh`` is not a Mesh (pass a hash as ``mesh_hash=``) or both are given.
     """
     if mesh is not None:
         if isinstance(mesh, (str, bytes)):

@@ -75,20 +75,8 @@ def _tail(lam_k: float, k: int, p: float, first: float, last: float, times) -> n
 def truncation_error(spec: Spectrum, times: float | Sequence[float] | np.ndarray) -> np.ndarray:
     """(T,) estimated share (0..1) of the signature at each scale that the modes beyond
     the spectrum's largest eigenvalue hold (zero modes left out, as signatures do by
-    default); see the module docstring.  0 where the spectrum has every mode.
-
-    Parameters
-    ----------
-    spec : Spectrum
-        The computed spectrum (its eigenvalues and mesh size are used).
-    times : float or array_like of shape (T,)
-        Scales, > 0.
-
-    Returns
-    -------
-    numpy.ndarray of shape (T,)
-        The estimated missing share at each scale, between 0 and 1.
-    """
+    default) at the positive scales ``times``; see the module docstring.  0 where the
+    spectrum has every mode."""
     lam, p, total = _law(spec)
     times = np.atleast_1d(np.asarray(times, dtype=np.float64))
     k = lam.size
@@ -104,22 +92,8 @@ def k_for_truncation(spec: Spectrum, t: float, level: float = TRUNCATION_LEVEL) 
     """The number of modes (zero modes included) whose estimated truncation error at
     scale ``t`` is at most ``level``, by the same extrapolation as
     :func:`truncation_error`; the spectrum's own k if it is already below, at most the
-    mesh's number of unknowns.
-
-    Parameters
-    ----------
-    spec : Spectrum
-        The spectrum whose eigenvalues are extrapolated.
-    t : float
-        The scale, > 0.
-    level : float
-        The largest estimated share of the signature allowed to be missing, in (0, 1).
-
-    Returns
-    -------
-    int
-        The number of modes to compute.
-    """
+    mesh's number of unknowns.  ``level``: the largest share of the signature allowed
+    to be missing, in (0, 1)."""
     lam, p, total = _law(spec)
     k = lam.size
     zeros = spec.k - k
