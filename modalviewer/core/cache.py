@@ -34,8 +34,8 @@ __all__ = [
 log = logging.getLogger("modalviewer.cache")
 
 DEFAULT_LIMIT_MB = 2048
-"""Default size limit in megabytes (2 GiB): about fifteen 120-mode shells spectra of a
-48k-vertex mesh (140 MB each), or two 300-mode shells spectra of a 130k-vertex mesh."""
+"""Default size limit in megabytes: room for a dozen shells spectra of mid-sized meshes,
+or a few of large ones."""
 
 _STALE_PART_SECONDS = 3600.0  # a temporary file this old belongs to a killed writer
 

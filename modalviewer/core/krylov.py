@@ -87,8 +87,8 @@ def cholqr_in_place(Y: np.ndarray) -> bool:
 
 
 _SWEEP_ROWS = 1024
-"""Rows of the basis per step of the fused orthogonalisation sweep (1024 x 544 doubles:
-4.5 MB, inside the L3 cache)."""
+"""Rows of the basis per step of the fused orthogonalisation sweep: a block of rows of
+a basis of a few hundred columns stays inside the L3 cache."""
 
 
 def _basis_t_times(Q: np.ndarray, W: np.ndarray) -> np.ndarray:
@@ -132,7 +132,7 @@ def _orthonormal_block(
     W = np.array(W, dtype=np.float64, order="F")  # own copy; Q.T @ W is faster in F order
     if local > 0:
         # local pass, then full passes that only remove rounding errors: two sweeps over
-        # the basis (0.5 to 1.7 GB; these products are memory-bound), a third is rare
+        # the basis (the largest array; these products are memory-bound), a third is rare
         h = np.zeros((Q.shape[1], W.shape[1]))
         Ql = Q[:, local:]
         h[local:] = _basis_t_times(Ql, W)
