@@ -80,7 +80,42 @@ def _size_boxes(form, size) -> tuple:
     return tuple(boxes)
 
 
-class ScreenshotDialog(QtWidgets.QDialog):
+class _ExportDialog(QtWidgets.QDialog):
+    """A form with the file to write (a field and a browse button) and, once
+    :meth:`_finish` is called, Save and Cancel."""
+
+    def __init__(self, parent, title: str, path: Path, filters: str):
+        super().__init__(parent)
+        self.setWindowTitle(title)
+        self.filters = filters
+        self.form = QtWidgets.QFormLayout(self)
+        self.path_edit = QtWidgets.QLineEdit(str(path))
+        self.path_edit.setMinimumWidth(420)
+        browse = QtWidgets.QPushButton("...")
+        browse.clicked.connect(self._browse)
+        row = QtWidgets.QHBoxLayout()
+        row.addWidget(self.path_edit)
+        row.addWidget(browse)
+        self.form.addRow("File", row)
+
+    def _finish(self) -> None:
+        buttons = QtWidgets.QDialogButtonBox(
+            QtWidgets.QDialogButtonBox.StandardButton.Save
+            | QtWidgets.QDialogButtonBox.StandardButton.Cancel
+        )
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        self.form.addRow(buttons)
+
+    def _browse(self) -> None:
+        path, _ = QtWidgets.QFileDialog.getSaveFileName(
+            self, self.windowTitle(), self.path_edit.text(), self.filters
+        )
+        if path:
+            self.path_edit.setText(path)
+
+
+class ScreenshotDialog(_ExportDialog):
     """File, width and height in pixels (not asked with ``size`` None), size
     multiplier, transparent background, colour bar and legend, pick marker (not asked
     with ``marker`` None)."""
@@ -88,17 +123,8 @@ class ScreenshotDialog(QtWidgets.QDialog):
     def __init__(
         self, parent, start_dir: str, colorbar: bool = False, size=(1024, 768), marker=False
     ):
-        super().__init__(parent)
-        self.setWindowTitle("Export screenshot")
-        form = QtWidgets.QFormLayout(self)
-        self.path_edit = QtWidgets.QLineEdit(str(Path(start_dir) / "figure.png"))
-        self.path_edit.setMinimumWidth(420)
-        browse = QtWidgets.QPushButton("...")
-        browse.clicked.connect(self._browse)
-        row = QtWidgets.QHBoxLayout()
-        row.addWidget(self.path_edit)
-        row.addWidget(browse)
-        form.addRow("File", row)
+        super().__init__(parent, "Export screenshot", Path(start_dir) / "figure.png", "PNG (*.png)")
+        form = self.form
         self.width_box = self.height_box = None
         if size is not None:
             self.width_box, self.height_box = _size_boxes(form, size)
@@ -115,20 +141,7 @@ class ScreenshotDialog(QtWidgets.QDialog):
         form.addRow(self.colorbar)
         if marker is not None:
             form.addRow(self.marker)
-        buttons = QtWidgets.QDialogButtonBox(
-            QtWidgets.QDialogButtonBox.StandardButton.Save
-            | QtWidgets.QDialogButtonBox.StandardButton.Cancel
-        )
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
-        form.addRow(buttons)
-
-    def _browse(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Screenshot", self.path_edit.text(), "PNG (*.png)"
-        )
-        if path:
-            self.path_edit.setText(path)
+        self._finish()
 
     def size(self) -> tuple[int, int] | None:
         if self.width_box is None:
@@ -147,24 +160,16 @@ class ScreenshotDialog(QtWidgets.QDialog):
         )
 
 
-class AnimationDialog(QtWidgets.QDialog):
+class AnimationDialog(_ExportDialog):
     """File (.gif, or .mp4 where its writer is installed), width and height, frames in
     one period and frames per second."""
 
     def __init__(self, parent, start_dir: str, size=(640, 480), frames: int = 52, fps: int = 25):
         from ..scene.animation import mp4_available
 
-        super().__init__(parent)
-        self.setWindowTitle("Export animation")
-        form = QtWidgets.QFormLayout(self)
-        self.path_edit = QtWidgets.QLineEdit(str(Path(start_dir) / "mode.gif"))
-        self.path_edit.setMinimumWidth(420)
-        browse = QtWidgets.QPushButton("...")
-        browse.clicked.connect(self._browse)
-        row = QtWidgets.QHBoxLayout()
-        row.addWidget(self.path_edit)
-        row.addWidget(browse)
-        form.addRow("File", row)
+        filters = "GIF (*.gif)" + (";;MP4 (*.mp4)" if mp4_available() else "")
+        super().__init__(parent, "Export animation", Path(start_dir) / "mode.gif", filters)
+        form = self.form
         self.width_box, self.height_box = _size_boxes(form, size)
         self.frames = QtWidgets.QSpinBox()
         self.frames.setRange(2, 1000)
@@ -174,25 +179,11 @@ class AnimationDialog(QtWidgets.QDialog):
         self.fps.setValue(int(fps))
         form.addRow("Frames in one period", self.frames)
         form.addRow("Frames per second", self.fps)
-        self.filters = "GIF (*.gif)" + (";;MP4 (*.mp4)" if mp4_available() else "")
         if not mp4_available():
             note = QtWidgets.QLabel("MP4 needs imageio-ffmpeg: pip install 'modalviewer[video]'")
             note.setWordWrap(True)
             form.addRow(note)
-        buttons = QtWidgets.QDialogButtonBox(
-            QtWidgets.QDialogButtonBox.StandardButton.Save
-            | QtWidgets.QDialogButtonBox.StandardButton.Cancel
-        )
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
-        form.addRow(buttons)
-
-    def _browse(self) -> None:
-        path, _ = QtWidgets.QFileDialog.getSaveFileName(
-            self, "Animation", self.path_edit.text(), self.filters
-        )
-        if path:
-            self.path_edit.setText(path)
+        self._finish()
 
     def values(self):
         """(path, (width, height), frames, fps)."""

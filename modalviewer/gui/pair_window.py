@@ -21,7 +21,6 @@ import logging
 from pathlib import Path
 
 import numpy as np
-import pyvista as pv
 from qtpy import QtCore, QtWidgets
 
 from ..core.mesh import Mesh, MeshError
@@ -37,7 +36,6 @@ from .window_keys import dispatch_key, install_keys
 
 log = logging.getLogger("modalviewer")
 
-BACK_MARKER_COLOR = (1.0, 0.75, 0.0)  # the best match back, when it is not the pick
 RESCALE_TIP = (
     "Scale both meshes to unit area before their spectra are computed (the distances are "
     "shown on the meshes as loaded).\nHeat kernel and feature signatures carry a factor "
@@ -177,7 +175,6 @@ class PairWindow(QtWidgets.QWidget):
         status.addWidget(self.cancel_button)
         layout.addLayout(status)
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
-        self.back_markers: dict[str, object] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
         self._keys = install_keys(
             self,
@@ -219,7 +216,6 @@ class PairWindow(QtWidgets.QWidget):
                 continue
             if scene is not None:
                 scene.remove()
-            self._remove_back_marker(side)
             plotter = self.viewports[side].plotter
             scene = MeshScene(plotter, mesh)
             scene.overlay_scale = getattr(self.main.scene, "overlay_scale", 1.0)
@@ -308,28 +304,10 @@ class PairWindow(QtWidgets.QWidget):
         if drawn is None or drawn[1] is not scene or drawn[0][3] != view.marker:
             scene.show_marker(view.marker)
         if drawn is None or drawn[1] is not scene or drawn[0][4] != view.back_marker:
-            self._remove_back_marker(side)
-            if view.back_marker is not None:
-                radius = 0.009 * scene.mesh.bounding_box_diagonal
-                sphere = pv.Sphere(radius=radius, center=scene.surface.points[view.back_marker])
-                self.back_markers[side] = scene.plotter.add_mesh(
-                    sphere,
-                    color=BACK_MARKER_COLOR,
-                    name="back_marker",
-                    render=False,
-                    reset_camera=False,
-                    show_scalar_bar=False,
-                    scalars=None,
-                )
+            scene.show_back_marker(view.back_marker)
         # keep the values alive with the record, so their id cannot be reused
         self._drawn[side] = (whole, scene, view.values)
         return True
-
-    def _remove_back_marker(self, side: str) -> None:
-        actor = self.back_markers[side]
-        if actor is not None:
-            self.viewports[side].plotter.remove_actor(actor, render=False)
-            self.back_markers[side] = None
 
     def _update_status(self) -> None:
         p = self.pair

@@ -70,10 +70,6 @@ class LinePlot(QtWidgets.QWidget):
         self.second_label = label if y is not None else ""
         self.update()
 
-    def set_highlight(self, index: int | None) -> None:
-        self.highlight = index
-        self.update()
-
     def title_lines(self) -> list[str]:
         """The title in lines no wider than the plot less its margins: broken between
         words (inside a word only if it alone is wider), so no character is cut off."""

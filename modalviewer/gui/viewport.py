@@ -28,21 +28,6 @@ def qt_opengl_available() -> bool:
     return bool(ctx.create())
 
 
-class _ClickMixin:
-    def _init_click(self):
-        self._press_pos = None
-
-    def _press(self, x, y):
-        self._press_pos = (x, y)
-
-    def _release(self, x, y) -> bool:
-        if self._press_pos is None:
-            return False
-        dx, dy = x - self._press_pos[0], y - self._press_pos[1]
-        self._press_pos = None
-        return abs(dx) <= CLICK_SLOP and abs(dy) <= CLICK_SLOP
-
-
 class OffscreenViewport(QtWidgets.QWidget):
     """A widget showing frames of an off-screen pyvista plotter, with mouse navigation.
 

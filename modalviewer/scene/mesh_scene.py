@@ -103,7 +103,7 @@ class MeshScene:
         self._iso_disp = None
         self._zero_rest = None
         self._zero_disp = None
-        self.marker_actor = None
+        self.marker_actor = self.back_marker_actor = None
         self.ghost_actor = None  # the rest shape, faint, behind a displaced surface
         self._ghost_rest = None  # its mesh
         self.picker = vtkCellPicker()
@@ -594,25 +594,35 @@ class MeshScene:
         return renderer.GetDisplayPoint()
 
     def show_marker(self, vertex: int | None) -> None:
-        if self.marker_actor is not None:
-            self.plotter.remove_actor(self.marker_actor, render=False)
-            self.marker_actor = None
+        """The pick marker, a magenta sphere, at ``vertex`` (None: none).  No render."""
+        self._sphere("marker_actor", "marker", vertex, 0.012, (0.9, 0.1, 0.6))
+
+    def show_back_marker(self, vertex: int | None) -> None:
+        """A smaller yellow sphere at ``vertex`` (None: none): where the shape pair's best
+        match leads back when that is not the pick.  No render."""
+        self._sphere("back_marker_actor", "back_marker", vertex, 0.009, (1.0, 0.75, 0.0))
+
+    def _sphere(self, attr: str, name: str, vertex, size: float, color) -> None:
+        if getattr(self, attr) is not None:
+            self.plotter.remove_actor(getattr(self, attr), render=False)
+        setattr(self, attr, None)
         if vertex is None:
             return
-        radius = 0.012 * self.mesh.bounding_box_diagonal
+        radius = size * self.mesh.bounding_box_diagonal
         sphere = pv.Sphere(radius=radius, center=self.surface.points[vertex])
-        self.marker_actor = self.plotter.add_mesh(
+        actor = self.plotter.add_mesh(
             sphere,
-            color=(0.9, 0.1, 0.6),
-            name="marker",
+            color=color,
+            name=name,
             render=False,
             reset_camera=False,
             show_scalar_bar=False,
             scalars=None,
         )
+        setattr(self, attr, actor)
 
     def remove(self) -> None:
-        for name in ("surface", "iso_actor", "zero_actor", "marker", "ghost"):
+        for name in ("surface", "iso_actor", "zero_actor", "marker", "back_marker", "ghost"):
             self.plotter.remove_actor(name, render=False)
         for actor in self.overlay_actors():
             self.plotter.renderer.RemoveViewProp(actor)
