@@ -14,11 +14,10 @@ import numpy as np
 from qtpy import QtWidgets
 
 from ..scene.comparison import caption
-from ..scene.export import png_path, save_png, side_by_side
 from ..scene.mesh_scene import MeshScene
 from ..scene.view import draw_field, label_field
 from ..viewer.comparison import Comparison, item_label
-from .viewport import make_viewport
+from .viewport import grab_views, make_viewport, save_views
 from .window_keys import dispatch_key, install_keys
 
 
@@ -114,24 +113,15 @@ class CompareWindow(QtWidgets.QWidget):
     def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
         """Each view as on screen at ``scale``, its colour bar drawn on and its title
         written above it."""
-        from ..scene.export import grab
-
-        images = []
-        for viewport, scene, title in zip(self.viewports, self.scenes, self.titles, strict=True):
-            if hasattr(viewport, "render_now"):
-                viewport.render_now()  # an off-screen view sizes its plotter here
-            image = grab(viewport.plotter, scene, scale, transparent)
-            images.append(caption(image, title.text()))
+        images = grab_views(self.viewports, self.scenes, scale, transparent)
         self.render_all()
-        return images
+        return [caption(image, t.text()) for image, t in zip(images, self.titles, strict=True)]
 
     def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
         """The views side by side, each with its title and colour bar (or a threshold
         map's legend), in one PNG (written atomically)."""
-        path = png_path(path)  # checked before rendering
-        scale = int(max(1, scale))
-        images = self.grab_images(scale, transparent)
-        return save_png(path, side_by_side(images, gap=4 * scale, transparent=transparent))
+        titles = [title.text() for title in self.titles]
+        return save_views(path, self.viewports, self.scenes, scale, transparent, titles)
 
     def export_dialog(self) -> None:
         """Ctrl+E: the export dialog (file, size multiplier, transparent background)."""

@@ -52,7 +52,7 @@ MIN_VIEW_SIZE = (320, 240)
 
 READING_WAIT_S = 0.2
 """A mesh file read within this many seconds opens without running the event loop
-(:meth:`MainWindow._read_mesh`): the bundled meshes and most scans under 100k vertices."""
+(:meth:`MainWindow._read_mesh`): the bundled meshes and most scans."""
 
 READING_DIALOG_S = 0.8
 """A reading that lasts this many seconds shows the dialog with Cancel."""

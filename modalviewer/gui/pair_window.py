@@ -31,7 +31,7 @@ from ..viewer.model import estimated_seconds, seconds_text
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from .dialogs import file_message, offer_open_anyway
-from .viewport import make_viewport
+from .viewport import make_viewport, save_views
 from .window_keys import dispatch_key, install_keys
 
 log = logging.getLogger("modalviewer")
@@ -501,28 +501,10 @@ class PairWindow(QtWidgets.QWidget):
         QtWidgets.QApplication.processEvents()
 
     # =========================================================== export
-    def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
-        """Each view rendered at ``scale`` with its legend and colour bar drawn on."""
-        from ..scene.export import grab
-
-        images = []
-        for side in SIDES:
-            viewport = self.viewports[side]
-            if hasattr(viewport, "render_now"):
-                viewport.render_now()  # an off-screen view sizes its plotter here
-            images.append(grab(viewport.plotter, self.scenes[side], scale, transparent))
-        return images
-
     def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
         """Both views side by side, with their legends, in one PNG written atomically."""
-        from ..scene.export import png_path, save_png, side_by_side
-
-        path = png_path(path)  # checked before rendering
-        scale = int(max(1, scale))
-        images = self.grab_images(scale, transparent)
-        canvas = side_by_side(images, gap=4 * scale, transparent=transparent)
-        self.render_all()
-        return save_png(path, canvas)
+        views = [self.viewports[s] for s in SIDES]
+        return save_views(path, views, [self.scenes[s] for s in SIDES], scale, transparent)
 
     def _export_dialog(self) -> None:
         from .file_dialogs import pair_screenshot_dialog

@@ -157,9 +157,8 @@ class InteractorViewport(QtCore.QObject):
         from pyvistaqt import QtInteractor
 
         # No auto_update: pyvistaqt's default re-renders the whole scene five times a
-        # second, idle or not (a full core with software OpenGL at 50k vertices, and a
-        # spectrum computed beside it took 48 s instead of 28 s); the viewer asks for a
-        # render whenever it changes the scene.
+        # second, idle or not (a full core with software OpenGL, taken from the
+        # computations); the viewer asks for a render whenever it changes the scene.
         self.plotter = QtInteractor(parent, auto_update=False)
         self.plotter.set_background("white")
         fit_smaller_side(self.plotter.renderer)
@@ -206,3 +205,32 @@ def make_viewport(parent=None, force_offscreen: bool | None = None):
     """The best viewport this platform supports."""
     offscreen = (not qt_opengl_available()) if force_offscreen is None else force_offscreen
     return OffscreenViewport(parent) if offscreen else InteractorViewport(parent)
+
+
+def save_views(path, viewports, scenes, scale: int = 1, transparent: bool = False, titles=None):
+    """The views of a window side by side in one PNG (written atomically): each
+    rendered at ``scale`` with its legend and colour bar drawn on, under its title
+    where ``titles`` are given.  Returns the path written."""
+    from ..scene.comparison import caption
+    from ..scene.export import png_path, save_png, side_by_side
+
+    path = png_path(path)  # checked before rendering
+    scale = int(max(1, scale))
+    images = grab_views(viewports, scenes, scale, transparent)
+    if titles is not None:
+        images = [caption(image, title) for image, title in zip(images, titles, strict=True)]
+    for viewport in viewports:
+        viewport.request_render()
+    return save_png(path, side_by_side(images, gap=4 * scale, transparent=transparent))
+
+
+def grab_views(viewports, scenes, scale: int = 1, transparent: bool = False) -> list:
+    """Each view as on screen at ``scale``, its legend and colour bar drawn on."""
+    from ..scene.export import grab
+
+    images = []
+    for viewport, scene in zip(viewports, scenes, strict=True):
+        if hasattr(viewport, "render_now"):
+            viewport.render_now()  # an off-screen view sizes its plotter here
+        images.append(grab(viewport.plotter, scene, scale, transparent))
+    return images

@@ -77,7 +77,7 @@ def side_by_side(images: list[np.ndarray], gap: int = 0, transparent: bool = Fal
 OTHER_PICTURE_SUFFIXES = (".jpg", ".jpeg", ".tif", ".tiff", ".bmp", ".gif", ".webp", ".pdf")
 OTHER_PICTURE_SUFFIXES += (".svg", ".eps")
 """Suffixes of picture formats other than PNG: a name ending in one is refused, where
-PNG data under it would mislead (``-o fig.jpg`` had written ``fig.png``)."""
+PNG data under it would mislead."""
 
 
 def png_path(path) -> Path:
@@ -151,9 +151,9 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
 def _write_ply(path: Path, mesh: Mesh, arrays: dict[str, np.ndarray]) -> None:
     """Binary little-endian PLY of ``mesh`` with each of ``arrays`` (n,) or (n, c) as
     vertex properties (``name``, or ``name_0 .. name_c-1``; doubles, integers as int):
-    VTK's PLY writer keeps only colours and texture coordinates, so a field exported to
-    .ply was lost.  Any PLY reader that keeps vertex properties (trimesh, Open3D's
-    tensor API, MeshLab, plyfile) reads them back."""
+    VTK's PLY writer keeps only colours and texture coordinates.  Any PLY reader that
+    keeps vertex properties (trimesh, Open3D's tensor API, MeshLab, plyfile) reads them
+    back."""
     columns = [("x", "<f8", mesh.vertices[:, 0]), ("y", "<f8", mesh.vertices[:, 1])]
     columns.append(("z", "<f8", mesh.vertices[:, 2]))
     for name, values in arrays.items():

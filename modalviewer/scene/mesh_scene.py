@@ -270,7 +270,7 @@ class MeshScene:
                 color="black",
                 line_width=width,
                 # drawn as screen-space tubes: plain wide lines leave gaps between the
-                # sub-pixel segments of fine meshes (isolines looked dotted at 130k)
+                # sub-pixel segments of fine meshes (the isolines would look dotted)
                 render_lines_as_tubes=True,
                 name=attr,
                 render=False,

@@ -66,12 +66,7 @@ class OffscreenRenderer:
             return
         from ..viewer.camera import Camera
 
-        self.scene.set_camera(
-            Camera(
-                tuple(camera["position"]), tuple(camera["focal_point"]), tuple(camera["view_up"])
-            ),
-            fit=False,
-        )
+        self.scene.set_camera(Camera.from_dict(camera), fit=False)
 
     def frame(
         self, reach: float | None = None, both: bool = False, colorbar: bool | None = None

@@ -273,12 +273,7 @@ class StateScene:
             return
         from ..viewer.camera import Camera
 
-        self.scene.set_camera(
-            Camera(
-                tuple(camera["position"]), tuple(camera["focal_point"]), tuple(camera["view_up"])
-            ),
-            fit=bool(camera.get("fit", False)),
-        )
+        self.scene.set_camera(Camera.from_dict(camera), fit=bool(camera.get("fit", False)))
         self.request_render()
 
     def current_camera(self) -> dict:

@@ -62,6 +62,11 @@ class Camera:
         d = np.subtract(self.position, self.focal_point)
         return d / np.linalg.norm(d)
 
+    @classmethod
+    def from_dict(cls, d: dict) -> Camera:
+        """The camera of :meth:`as_dict`'s plain data (a window's, a session's)."""
+        return cls(tuple(d["position"]), tuple(d["focal_point"]), tuple(d["view_up"]))
+
     def as_dict(self) -> dict:
         return {
             "position": list(self.position),
