@@ -78,27 +78,8 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     report (default: the object's type).  Vertex i of the object is vertex i of the mesh,
     always: a repair changes only the faces (vertices no face uses are ``mesh.unused``
     and have no value; a merged duplicate takes the values of the vertex it was merged
-    into).
-
-    Parameters
-    ----------
-    obj : Mesh, tuple of arrays, trimesh.Trimesh, pyvista.DataSet or meshio.Mesh
-        The mesh; arrays as ``(vertices (n, 3), faces (m, 3))``.
-    repair : bool
-        As in :func:`~modalviewer.io.load_mesh`.
-    name : str
-        The name the report gives the mesh.
-
-    Returns
-    -------
-    Mesh
-
-    Raises
-    ------
-    MeshError
-        For an object that holds no triangle surface.
-    TypeError
-        For an object of another kind.
+    into).  MeshError for an object that holds no triangle surface, TypeError for an
+    object of another kind.
     """
     if isinstance(obj, Mesh):
         return obj
@@ -117,23 +98,9 @@ def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float
     ``"shells"``) ``(3 n,)`` ordered x, y, z per vertex, as ``spec.modes`` reshaped.
     ``scipy.sparse.linalg.eigsh(K, k, M, sigma=-s)`` for a small ``s > 0`` gives the
     spectrum :func:`~modalviewer.compute_spectrum` computes (up to the signs and bases of
-    eigenspaces).
-
-    Parameters
-    ----------
-    mesh : Mesh
-    operator : str
-        ``"laplacian"``, ``"modified_dirichlet"``, ``"shells"`` or ``"shells_normal"``.
-    bending, membrane : float
-        The Discrete Shells weights (ignored by the other operators).
-
-    Returns
-    -------
-    K : scipy.sparse.csr_matrix of shape (N, N)
-        Symmetric positive semi-definite; empty rows and columns at the vertices no face
-        uses (``mesh.unused``) and at merged duplicates.
-    M : scipy.sparse.dia_matrix of shape (N, N)
-        The lumped mass (zero where K's rows are empty); N is n, or 3 n for vector modes.
+    eigenspaces).  ``bending`` and ``membrane`` weigh the Discrete Shells energies.
+    Vertices no face uses (``mesh.unused``) and merged duplicates have empty rows and
+    columns in K and zero mass.
     """
     mesh = as_mesh(mesh)
     solver = mesh.solver_mesh
@@ -157,16 +124,6 @@ def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = Non
     vertex masses as ``"mass"``; the eigenvalues go to ``field_data["eigenvalues"]``.
     ``fields``: a dict name -> (n,) or (n, c) per-vertex array.  Points are the mesh's
     vertices, one per input vertex in the input's order (NaN values at ``mesh.unused``).
-
-    Parameters
-    ----------
-    mesh : Mesh
-    spectrum : Spectrum, optional
-    fields : dict of str to array_like of shape (n,) or (n, c), optional
-
-    Returns
-    -------
-    pyvista.PolyData
     """
     import pyvista as pv
 

@@ -160,41 +160,21 @@ def read_arrays(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray]:
 
 
 def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
-    """Read a triangle mesh from ``path``.
+    """The triangle mesh of the file ``path``: OBJ, OFF, PLY, STL, VTK/VTP, or any surface
+    format meshio reads; :class:`MeshError` naming the problem for a file that cannot be
+    a surface.
 
     With ``repair=True`` (default) duplicate vertices are merged, zero-area faces
-    collapsed (a closed surface stays closed), faces repeating a vertex, duplicate faces
-    and unreferenced vertices removed, and the orientation made consistent;
-    ``mesh.report`` says what was done.  Nearly degenerate triangles (slivers) are left
-    as they are: :func:`modalviewer.fix_slivers` removes them.  With ``repair=False`` the arrays
-    are validated as they are.
+    collapsed (a closed surface stays closed), faces repeating a vertex and duplicate
+    faces removed, and the orientation made consistent; ``mesh.report`` says what was
+    done.  Slivers are left as they are (:func:`modalviewer.fix_slivers` removes them).
+    With ``repair=False`` the arrays are only validated.  Vertex i of the mesh is the
+    file's vertex i either way.
 
     A damaged file (a record cut in the middle, element counts that the data do not
     fill, faces naming vertices the file does not have) raises :class:`MeshError`
-    naming the line or element, unless ``strict=False``: then what could be read is
-    loaded and ``mesh.report`` says exactly what was dropped.  Vertices that no face
-    uses are reported (in an OBJ file they are the trace of a file cut between two
-    face records).
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        An OBJ, OFF, PLY, STL or VTK/VTP file, or any surface format meshio reads.
-    repair : bool
-        Merge, drop and orient as above (default), or only validate.
-    strict : bool
-        Refuse damaged files (default), or load their whole records.
-
-    Returns
-    -------
-    Mesh
-        Vertices (n, 3) and faces (m, 3), with ``mesh.report`` and the file's numbering
-        (``mesh.file_vertices``).
-
-    Raises
-    ------
-    MeshError
-        With a message naming the problem, for files that cannot be a surface.
+    naming the line or element, unless ``strict=False``: then the whole records are
+    loaded and ``mesh.report`` says exactly what was dropped.
     """
     path = Path(path)
     vertices, faces, notes = read_file(path, strict=strict)

@@ -276,19 +276,7 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     loop).  ``spectrum`` goes into the viewer's spectra (its first non-zero mode shown);
     ``fields`` (a dict name -> per-vertex array) are the viewer's fields
     (``window.viewer.show_field(name)`` shows another); the window opens on the first.
-
-    Parameters
-    ----------
-    mesh_or_arrays : Mesh, (vertices, faces) or another library's mesh
-        Anything :func:`~modalviewer.as_mesh` accepts.
-    spectrum : Spectrum, optional
-    fields : dict of str to array_like of shape (n,), optional
-    block : bool
-
-    Returns
-    -------
-    modalviewer.gui.MainWindow
-        The window; ``window.viewer`` is its Viewer.
+    ``mesh_or_arrays``: anything :func:`~modalviewer.as_mesh` accepts, or a file.
     """
     if isinstance(mesh_or_arrays, (str, Path)):
         from .io import load_mesh
@@ -336,22 +324,7 @@ def add_to_plotter(
         first non-zero one; vector modes by their normal component, as the viewer), or
         with ``vertex`` the multiscale distance from that vertex.  Vertex numbers and
         values are in ``mesh``'s numbering; the surface drawn is its vertices faces use.
-
-    Parameters
-    ----------
-    plotter : pyvista.Plotter
-    mesh : Mesh
-    values_or_spectrum : array_like of shape (n,) or Spectrum
-    mode : int, optional
-    vertex : int, optional
-    isolines : int
-        Number of isolines (0: none).
-    name : str
-        The colour bar's title.
-
-    Returns
-    -------
-    modalviewer.scene.mesh_scene.MeshScene
+    ``isolines``: their number (0: none); ``name``: the colour bar's title.
     """
     from .core.laplacian import vertex_normals
     from .core.signatures import multiscale_distance

@@ -1,51 +1,16 @@
 """The store of a shape collection: its files, and :class:`Collection` reading them and
 ranking them by spectral distance to a shape (:meth:`Collection.similar`).
 
-A directory::
-
-    STORE/
-      collection.json        what the store holds (format, operator, k, signatures)
-      meshes/NAME.npz        one per mesh, written atomically (temporary file + rename)
-      errors/NAME.json       one per mesh that failed: its source and the error
-      index.json             a summary of all of them, rebuilt from the files
-
-The access pattern decides it: many independent writers-of-one-mesh (a mesh finishes,
-its file appears, whole or not at all), readers that want one mesh at a time or the
-small descriptors of all.  One ``.npz`` per mesh needs nothing beyond numpy to read, a
-rename makes it atomic, a killed run loses only the meshes in flight, and two meshes
-never share a file (no locking, no corruption of the others).  A Zarr or HDF5 store
-would add a dependency and its own crash semantics (an HDF5 file interrupted while
-written can lose every group) for no gain here: meshes are read whole.  The index is a
-cache: :func:`open_collection` rebuilds it from the files when they changed since it
-was written (after a killed run, for example).
-
-Each ``meshes/NAME.npz`` is also a spectrum file of :func:`~.core.spectrum.save_spectrum`
-(``eigenvalues``, ``modes``, ``mass``, ``residuals``, ``meta``), so ``mv.load_spectrum``
-reads it too, plus:
-
-``entry``
-    JSON: name, source path and its size and modification time, ``mesh_hash``, the
-    parameters, ``key`` (SHA-256 of the geometry hash and the parameters: a second run
-    skips a mesh whose key is unchanged), area, vertex count, seconds.
-``shape_dna``
-    the non-zero eigenvalues times the surface area (Shape-DNA: scale invariant for the
-    scalar operators).
-``sig.KIND.times``, ``sig.KIND.values``
-    the signature of distance kind KIND (vibration, feature, hks, wks) at every vertex
-    and at the standard scales (:func:`~.core.signatures.default_times`; for wks the
-    energies of :func:`~.core.signatures.default_energies`), (T,) and (n, T).
-``hist.KIND``
-    (S, B) the signature histogram: at S of those scales, the area-weighted histogram of
-    ``log10(A S_t(v) / Z(t))`` over ``B`` bins :data:`HISTOGRAM_EDGES` (``A S_t / Z`` has
-    area mean 1 at every scale, so the histograms of shapes of any size compare).
-``OP.eigenvalues``, ``OP.modes``, ``OP.mass``, ``OP.residuals``
-    the spectrum of operator OP when a signature needs an operator other than the
-    store's own.
-
-Reading one without modalviewer::
-
-    data = np.load("STORE/meshes/NAME.npz")
-    data["eigenvalues"], data["modes"], json.loads(str(data["entry"]))
+A folder: ``collection.json`` (format, operator, k, signatures), ``meshes/NAME.npz`` per
+mesh (written atomically), ``errors/NAME.json`` per failure and ``index.json``, a
+summary rebuilt from those files.  One file per mesh, because workers finish meshes
+independently, each result is written whole or not at all, a killed run loses only
+what was in flight and numpy alone reads it (the library guide's "Shape collections"
+says more).  Each mesh file is a spectrum file of :func:`~.core.spectrum.save_spectrum`
+plus ``entry`` (JSON: source, its size and date, ``mesh_hash``, parameters, ``key``,
+area, vertex count), ``shape_dna``, ``sig.KIND.times`` and ``sig.KIND.values`` (T,) and
+(n, T), ``hist.KIND`` (S, B) over :data:`HISTOGRAM_EDGES`, and ``OP.eigenvalues``,
+``OP.modes``, ... for a signature whose operator is not the store's.
 """
 
 from __future__ import annotations
@@ -464,25 +429,8 @@ def _first_modes(spec: Spectrum, k: int) -> Spectrum:
 
 
 def open_collection(path: str | os.PathLike) -> Collection:
-    """The collection at ``path`` (a store of :func:`run_batch`), CollectionError if it is
-    none.  Needs numpy only.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-        The store's folder, as ``modalviewer batch -o`` wrote it.
-
-    Returns
-    -------
-    Collection
-        ``names``, ``spectrum(name)``, ``signatures(name)``, ``descriptors``, ``errors``,
-        ``similar(...)``.
-
-    Raises
-    ------
-    CollectionError
-        If ``path`` is not a collection.
-    """
+    """The :class:`Collection` in the folder ``path`` (``modalviewer batch -o`` wrote
+    it; numpy alone reads it); :class:`CollectionError` if it is none."""
     return Collection(path)
 
 
