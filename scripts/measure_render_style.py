@@ -23,6 +23,7 @@ if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
 import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 
 
 def main() -> int:
@@ -36,11 +37,11 @@ def main() -> int:
     from PIL import Image
 
     import modalviewer as mv
+    from benchmarks.render_metrics import saturation, white_level, zero_band_masks
     from modalviewer.core.laplacian import vertex_normals
     from modalviewer.scene.colors import STYLES
     from modalviewer.scene.export import save_screenshot
     from modalviewer.scene.mesh_scene import MeshScene
-    from modalviewer.scene.render_metrics import saturation, white_level, zero_band_masks
 
     out = Path(args.out) if args.out else Path(os.environ.get("TMPDIR", "/tmp"))
     w, h = (int(x) for x in args.size.split("x"))

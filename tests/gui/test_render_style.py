@@ -52,7 +52,7 @@ def _export(view, path, **kwargs):
 
 
 def _measure(view, scene, field, tmp_path):
-    from modalviewer.scene.render_metrics import saturation, white_level, zero_band_masks
+    from benchmarks.render_metrics import saturation, white_level, zero_band_masks
 
     scene.show_field(field, "diverging", isolines=0)
     img = _export(view, tmp_path / f"{scene.style}.png")[:, :, :3]
@@ -78,7 +78,7 @@ def test_paper_style_white_zero_and_saturated_colours(view, spot_mode, tmp_path)
 
 def test_paper_style_darkens_toward_silhouettes(view, spot_mode, tmp_path):
     """Shape stays readable: surfaces seen at a grazing angle render clearly darker."""
-    from modalviewer.scene.render_metrics import _flat_render, facing
+    from benchmarks.render_metrics import _flat_render, facing
 
     mesh, field, _ = spot_mode
     scene = _scene(view, mesh, "paper")

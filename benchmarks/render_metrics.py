@@ -1,5 +1,6 @@
 """Pixel measurements of a rendered scene: how white the zero band is, how saturated the
-colours are.  Used by the tests and by ``scripts/measure_render_style.py``.
+colours are (a rendered ``modalviewer.scene.mesh_scene.MeshScene``).  Used by the tests
+and by ``scripts/measure_render_style.py``.
 
 The zero band is found by rendering the same view a second time with lighting off and a
 flat indicator field (green: zero band facing the viewer, red: the rest of the surface),
@@ -13,7 +14,7 @@ import numpy as np
 
 def _flat_render(scene, indicator: np.ndarray) -> np.ndarray:
     """Render the scene with the surface coloured flat: 1 -> green, 0 -> red, lines hidden."""
-    from .colors import lookup_table
+    from modalviewer.scene.colors import lookup_table
 
     actor, mapper = scene.surface_actor, scene._mapper
     prop = actor.GetProperty()
