@@ -27,10 +27,11 @@ from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
-from ..viewer.model import estimated_seconds, seconds_text
+from ..viewer.model import seconds_text
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from .dialogs import file_message, offer_open_anyway
+from .panels.common import quiet, select_data
 from .viewport import make_viewport, save_views
 from .window_keys import dispatch_key, install_keys
 
@@ -44,6 +45,32 @@ RESCALE_TIP = (
     "scale by different powers of the size), so a larger copy vibrates differently, not "
     "just slower. Untick only for meshes known to share one scale."
 )
+
+
+KIND_TIP = (
+    "The signature compared: vibration (Discrete Shells), feature (E_D^N), heat kernel or "
+    "wave kernel (Laplacian)"
+)
+SHARE_TIP = "Threshold: the share of the other mesh's area shown blue (the most similar points)"
+LINK_TIP = "Turning or zooming one view turns the other the same way (each about its centre)"
+
+
+def _tip(widget, text: str):
+    widget.setToolTip(text)
+    return widget
+
+
+def _row(*items) -> QtWidgets.QHBoxLayout:
+    """A row of widgets; a number is a stretch, (widget, n) a widget stretched n."""
+    row = QtWidgets.QHBoxLayout()
+    for item in items:
+        if isinstance(item, int):
+            row.addStretch(item)
+        elif isinstance(item, tuple):
+            row.addWidget(*item)
+        else:
+            row.addWidget(item)
+    return row
 
 
 class PairError(RuntimeError):
@@ -80,131 +107,80 @@ class PairWindow(QtWidgets.QWidget):
 
     # ================================================================ UI
     def _build(self, force_offscreen) -> None:
-        layout = QtWidgets.QVBoxLayout(self)
-        bar = QtWidgets.QHBoxLayout()
-        self.kind_combo = QtWidgets.QComboBox()
+        p = self.pair
+        self.kind_combo = _tip(QtWidgets.QComboBox(), KIND_TIP)
         for kind, label in DISTANCE_KINDS.items():
             self.kind_combo.addItem(label, kind)
-        self.kind_combo.setToolTip(
-            "The signature compared: vibration (Discrete Shells), feature (E_D^N), heat "
-            "kernel or wave kernel (Laplacian)"
-        )
         self.kind_combo.currentIndexChanged.connect(
-            lambda: self.pair.set_kind(self.kind_combo.currentData())
+            lambda: p.set_kind(self.kind_combo.currentData())
         )
         self.display_combo = QtWidgets.QComboBox()
         self.display_combo.addItem("Continuous", "continuous")
         self.display_combo.addItem("Threshold", "threshold")
         self.display_combo.currentIndexChanged.connect(
-            lambda: self.pair.set_display(self.display_combo.currentData())
+            lambda: p.set_display(self.display_combo.currentData())
         )
-        self.share_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+        self.share_slider = _tip(QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal), SHARE_TIP)
         self.share_slider.setRange(1, 500)  # tenths of a percent of the other mesh's area
-        self.share_slider.setToolTip(
-            "Threshold: the share of the other mesh's surface area shown blue (the most "
-            "similar points)"
-        )
-        self.share_slider.valueChanged.connect(
-            lambda v: self.pair.set_display("threshold", share=v / 1000.0)
-        )
+        self.share_slider.valueChanged.connect(lambda v: p.set_display("threshold", v / 1000))
         self.share_label = QtWidgets.QLabel()
         self.share_label.setMinimumWidth(150)
-        self.k_spin = QtWidgets.QSpinBox()
+        self.k_spin = _tip(QtWidgets.QSpinBox(), "Modes computed on each mesh (the same on both)")
         self.k_spin.setRange(2, 1000)
         self.k_spin.setPrefix("k = ")
-        self.k_spin.setToolTip("Modes computed on each mesh (the same number on both)")
-        self.k_spin.editingFinished.connect(lambda: self.pair.set_k(self.k_spin.value()))
-        self.rescale_check = QtWidgets.QCheckBox("Rescale both to the same area before computing")
-        self.rescale_check.setToolTip(RESCALE_TIP)
-        self.rescale_check.toggled.connect(self.pair.set_rescale)
-        self.link_check = QtWidgets.QCheckBox("Linked cameras")
-        self.link_check.setToolTip(
-            "Turning or zooming one view turns the other the same way (each about its own "
-            "mesh's centre)"
+        self.k_spin.editingFinished.connect(lambda: p.set_k(self.k_spin.value()))
+        self.rescale_check = _tip(
+            QtWidgets.QCheckBox("Rescale both to the same area before computing"), RESCALE_TIP
         )
-        self.link_check.setChecked(True)
-        self.link_check.toggled.connect(self.pair.set_linked)
-        export = QtWidgets.QPushButton("Export...")
-        export.setToolTip("Save both views side by side, with their legends, as one PNG")
+        self.rescale_check.toggled.connect(p.set_rescale)
+        self.link_check = _tip(QtWidgets.QCheckBox("Linked cameras"), LINK_TIP)
+        self.link_check.toggled.connect(p.set_linked)
+        export = _tip(QtWidgets.QPushButton("Export..."), "Both views side by side in one PNG")
         export.clicked.connect(self._export_dialog)
-        for widget in (
-            QtWidgets.QLabel("Distance"),
-            self.kind_combo,
-            self.display_combo,
-            self.share_slider,
-            self.share_label,
-            self.k_spin,
-        ):
-            bar.addWidget(widget)
-        bar.addStretch(1)
-        bar.addWidget(export)
-        layout.addLayout(bar)
-        bar2 = QtWidgets.QHBoxLayout()
-        bar2.addWidget(self.rescale_check)
-        bar2.addWidget(self.link_check)
-        bar2.addStretch(1)
-        layout.addLayout(bar2)
+        layout = QtWidgets.QVBoxLayout(self)
+        controls = (self.kind_combo, self.display_combo, self.share_slider, self.share_label)
+        layout.addLayout(_row(QtWidgets.QLabel("Distance"), *controls, self.k_spin, 1, export))
+        layout.addLayout(_row(self.rescale_check, self.link_check, 1))
         views = QtWidgets.QHBoxLayout()
         self.viewports, self.titles = {}, {}
         for side in SIDES:
             column = QtWidgets.QVBoxLayout()
-            title = QtWidgets.QLabel()
-            column.addWidget(title)
-            viewport = make_viewport(self, force_offscreen)
+            self.titles[side] = QtWidgets.QLabel()
+            viewport = self.viewports[side] = make_viewport(self, force_offscreen)
             viewport.clicked.connect(lambda x, y, s=side: self._on_click(s, x, y))
             if hasattr(viewport, "cameraChanged"):
                 viewport.cameraChanged.connect(lambda s=side: self._on_camera(s))
+            column.addWidget(self.titles[side])
             column.addWidget(viewport.widget, 1)
             views.addLayout(column, 1)
-            self.viewports[side], self.titles[side] = viewport, title
         layout.addLayout(views, 1)
-        status = QtWidgets.QHBoxLayout()
         self.status = QtWidgets.QLabel()
         self.status.setWordWrap(True)
         self.progress = QtWidgets.QProgressBar()
         self.progress.setRange(0, 1000)
         self.progress.setMinimumWidth(240)  # room for "Discrete Shells ... of B"
         self.progress.setMaximumWidth(320)
-        self.progress.hide()
-        self.cancel_button = QtWidgets.QPushButton("Cancel")
-        self.cancel_button.setToolTip("Cancel this window's computations")
-        self.cancel_button.clicked.connect(self.pair.cancel)
-        self.cancel_button.hide()
-        status.addWidget(self.status, 1)
-        status.addWidget(self.progress)
-        status.addWidget(self.cancel_button)
-        layout.addLayout(status)
+        self.cancel_button = _tip(QtWidgets.QPushButton("Cancel"), "Cancel this window's work")
+        self.cancel_button.clicked.connect(p.cancel)
+        for widget in (self.progress, self.cancel_button):
+            widget.hide()
+        layout.addLayout(_row((self.status, 1), self.progress, self.cancel_button))
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
-        self._keys = install_keys(
-            self,
-            [
-                ("Escape", self._escape),
-                ("Ctrl+W", self.close),
-                ("R", self.reset_cameras),
-                ("Ctrl+E", self._export_dialog),
-            ],
-        )
+        keys = [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]
+        self._keys = install_keys(self, [*keys, ("Ctrl+E", self._export_dialog)])
         self._sync_controls()
 
     def _sync_controls(self) -> None:
         p = self.pair
-        for widget, value in (
-            (self.kind_combo, p.kind),
-            (self.display_combo, p.distance_display),
-        ):
-            widget.blockSignals(True)
-            widget.setCurrentIndex(widget.findData(value))
-            widget.blockSignals(False)
-        for widget, value, setter in (
-            (self.share_slider, int(round(1000 * p.share)), "setValue"),
-            (self.k_spin, p.k, "setValue"),
-            (self.rescale_check, p.rescale, "setChecked"),
-            (self.link_check, p.linked, "setChecked"),
-        ):
-            widget.blockSignals(True)
-            getattr(widget, setter)(value)
-            widget.blockSignals(False)
+        with quiet(self.kind_combo, self.display_combo, self.share_slider, self.k_spin):
+            select_data(self.kind_combo, p.kind)
+            select_data(self.display_combo, p.distance_display)
+            self.share_slider.setValue(int(round(1000 * p.share)))
+            self.k_spin.setValue(p.k)
+        with quiet(self.rescale_check, self.link_check):
+            self.rescale_check.setChecked(p.rescale)
+            self.link_check.setChecked(p.linked)
         self.share_slider.setEnabled(p.distance_display == "threshold")
 
     # ============================================================ meshes
@@ -455,40 +431,19 @@ class PairWindow(QtWidgets.QWidget):
         self.request()
 
     def request(self) -> list:
-        """Start the computations the current kind needs (asking first for long ones
-        unless scripted); returns the pending jobs."""
+        """Start the computations the current kind needs (the status says how long they
+        take where that is long); returns the pending jobs."""
         self._requested = self._wanted()
-        key = self.pair.key()
-        missing = [s for s in SIDES if self.pair.spectrum(s) is None]
-        seconds = self._estimated_seconds(key, missing)
-        if missing and seconds is not None and seconds > LONG_WAIT_SECONDS:
-            about = seconds_text(seconds)
+        seconds = self.pair.estimated_seconds()
+        if seconds is not None and seconds > LONG_WAIT_SECONDS:
+            label = operator_info(self.pair.operator).label
             self.status.setText(
-                f"Computing the {operator_info(key.operator).label} spectra of both meshes "
-                f"takes about {about} (Cancel stops it)."
+                f"Computing the {label} spectra of both meshes takes about "
+                f"{seconds_text(seconds)} (Cancel stops it)."
             )
         jobs = self.pair.request()
         self._on_jobs()
         return jobs
-
-    def _estimated_seconds(self, key, sides) -> float | None:
-        """Seconds the spectra of ``key`` on ``sides`` are expected to take, from this
-        machine's recorded solves (:func:`.viewer.model.estimated_seconds`); None where
-        one of them has no estimate or is in the cache, and for Coarse-to-fine."""
-        if key.coarse:
-            return None
-        records = self.pair.cache.solves()
-        total = 0.0
-        for side in sides:
-            mesh = self.pair.sides[side].compute_mesh(key.rescale)
-            args = (mesh, key.operator, key.k, key.bending, key.membrane)
-            if self.pair.cache.path(*args).is_file():
-                return None
-            seconds = estimated_seconds(records, key.operator, mesh.n_vertices, key.k, mesh.hash)
-            if seconds is None:
-                return None
-            total += seconds
-        return total
 
     def wait(self, timeout: float | None = None) -> None:
         """Run the event loop until this window's spectra for the current kind are in;

@@ -351,6 +351,28 @@ class PairState:
             jobs.append(job)
         return [job for job in jobs if not job.done]
 
+    def estimated_seconds(self) -> float | None:
+        """Seconds the missing spectra of the current key are expected to take, from this
+        machine's recorded solves (:func:`.model.estimated_seconds`); None where nothing
+        is missing, one of them has no estimate or is in the cache, and for
+        Coarse-to-fine."""
+        from .model import estimated_seconds
+
+        key = self.key()
+        missing = [side for side in SIDES if self.spectrum(side) is None]
+        if key.coarse or not missing:
+            return None
+        records, total = self.cache.solves(), 0.0
+        for side in missing:
+            mesh = self.sides[side].compute_mesh(key.rescale)
+            if self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file():
+                return None
+            seconds = estimated_seconds(records, key.operator, mesh.n_vertices, key.k, mesh.hash)
+            if seconds is None:
+                return None
+            total += seconds
+        return total
+
     def cancel(self) -> None:
         """Cancel this pair's jobs (queued and running)."""
         for side in SIDES:

@@ -315,3 +315,19 @@ def test_maps_are_drawn_from_the_first_modes_while_the_rest_arrive(tmp_path, spo
         spectra_module.compute_spectrum = original
     assert pair.spectrum("b").is_complete and "modes of B" not in pair.view("b").legend
     assert pair.best_match()[:2] == ("b", 700)
+
+
+def test_the_pair_estimates_the_time_of_its_missing_spectra(tmp_path, spot):
+    from modalviewer.core.cache import SolveRecord
+
+    pair = _pair(tmp_path, spot, _moved(spot), k=K)
+    key = pair.key()
+    meshes = [pair.sides[side].compute_mesh(key.rescale) for side in ("a", "b")]
+    records = [
+        SolveRecord(key.operator, mesh.hash, mesh.n_vertices, K, seconds)
+        for mesh, seconds in zip(meshes, (3.0, 5.0), strict=True)
+    ]
+    pair.cache.solves = lambda: records  # this machine's recorded solves of both
+    assert pair.estimated_seconds() == pytest.approx(8.0)
+    _wait(pair)
+    assert pair.estimated_seconds() is None  # nothing is missing
