@@ -151,9 +151,11 @@ def local_signature(
         little.  Without one, scales far above ``4 ln 10 / lambda_1`` on fine meshes can
         need many thousands of steps.
 
-    Returns (len(vertices), T); a single vertex gives (1, T).  A TypeError, IndexError
-    or ValueError for bad vertex indices or scales (:mod:`.validate`); a RuntimeError if
-    a scale has not settled to ``rtol`` within ``max_steps`` Lanczos steps.
+    Returns
+    -------
+    (len(vertices), T); a single vertex gives (1, T).  A TypeError, IndexError or
+    ValueError for bad vertex indices or scales (:mod:`.validate`); a RuntimeError if a
+    scale has not settled to ``rtol`` within ``max_steps`` Lanczos steps.
     """
     operator = operator_info(operator)
     vertices = check_vertices(vertices, mesh.n_vertices)
