@@ -27,6 +27,7 @@ from ..core.mesh import Mesh, MeshError
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
+from ..viewer.camera import Camera, CameraLink
 from ..viewer.model import seconds_text
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
@@ -349,14 +350,11 @@ class PairWindow(QtWidgets.QWidget):
         self._sync_controls()
         self._link = self._make_link() if on else None
 
-    def _make_link(self):
-        """(Q, s, focal A, focal B): the similarity x_B = focal_B + s Q (x_A - focal_A)
-        that maps A's camera onto B's as they are now."""
+    def _make_link(self) -> CameraLink | None:
+        """The link that carries A's camera to B's as they are now."""
         if self.scenes["a"] is None or self.scenes["b"] is None:
             return None
-        fa, da, focal_a = _camera_frame(self.viewports["a"].plotter.camera)
-        fb, db, focal_b = _camera_frame(self.viewports["b"].plotter.camera)
-        return fb @ fa.T, db / da, focal_a, focal_b
+        return CameraLink.between(*(_camera(self.viewports[s].plotter.camera) for s in SIDES))
 
     def _on_camera(self, side: str) -> None:
         if self.pair.linked and not self._syncing:
@@ -366,33 +364,17 @@ class PairWindow(QtWidgets.QWidget):
 
     def _copy_camera(self, src: str, dst: str) -> None:
         """Move ``dst``'s camera to the image of ``src``'s under the link."""
-        if getattr(self, "_link", None) is None:
+        if self._link is None:
             return
-        q, s, focal_a, focal_b = self._link
-        if src == "a":
-
-            def to_dst(x):
-                return focal_b + s * q @ (np.asarray(x) - focal_a)
-
-            rot, factor = q, s
-        else:
-
-            def to_dst(x):
-                return focal_a + q.T @ (np.asarray(x) - focal_b) / s
-
-            rot, factor = q.T, 1.0 / s
         a = self.viewports[src].plotter.camera
-        b = self.viewports[dst].plotter.camera
+        carried, factor = self._link.carry(_camera(a), from_a=src == "a")
         self._syncing = True
         try:
-            b.SetFocalPoint(*to_dst(a.GetFocalPoint()))
-            b.SetPosition(*to_dst(a.GetPosition()))
-            b.SetViewUp(*(rot @ np.asarray(a.GetViewUp())))
+            self.scenes[dst].set_camera(carried, fit=False)
+            b = self.viewports[dst].plotter.camera
             b.SetViewAngle(a.GetViewAngle())
             b.SetParallelProjection(a.GetParallelProjection())
             b.SetParallelScale(a.GetParallelScale() * factor)
-            b.OrthogonalizeViewUp()
-            self.viewports[dst].plotter.renderer.ResetCameraClippingRange()
         finally:
             self._syncing = False
 
@@ -400,10 +382,10 @@ class PairWindow(QtWidgets.QWidget):
         """A's canonical view; B seen from the same direction, about its own centre and
         at its own size (meshes in one frame, like a shape and its deformed copy, then
         show the same side); linked cameras are linked anew."""
-        ma, mb = self.pair.mesh("a"), self.pair.mesh("b")
+        ma, mb = self.pair.drawn_mesh("a"), self.pair.drawn_mesh("b")
         self.scenes["a"].reset_camera()
         factor = mb.bounding_box_diagonal / (ma.bounding_box_diagonal or 1.0)
-        self._link = (np.eye(3), factor, _bbox_centre(ma), _bbox_centre(mb))
+        self._link = CameraLink(np.eye(3), factor, _bbox_centre(ma), _bbox_centre(mb))
         self._copy_camera("a", "b")
         self._on_linked(self.pair.linked)
 
@@ -504,17 +486,8 @@ def _bbox_centre(mesh: Mesh) -> np.ndarray:
     return 0.5 * (v.min(axis=0) + v.max(axis=0))
 
 
-def _camera_frame(camera) -> tuple[np.ndarray, float, np.ndarray]:
-    """((3, 3) columns right, up, back of ``camera``; distance to the focal point; the
-    focal point)."""
-    focal = np.asarray(camera.GetFocalPoint(), dtype=float)
-    d = focal - np.asarray(camera.GetPosition(), dtype=float)
-    distance = float(np.linalg.norm(d)) or 1.0
-    back = -d / distance
-    up = np.asarray(camera.GetViewUp(), dtype=float)
-    up = up - back * float(up @ back)
-    up /= np.linalg.norm(up) or 1.0
-    return np.column_stack([np.cross(up, back), up, back]), distance, focal
+def _camera(vtk_camera) -> Camera:
+    return Camera(vtk_camera.GetPosition(), vtk_camera.GetFocalPoint(), vtk_camera.GetViewUp())
 
 
 def _load(main, path, strict: bool = True) -> Mesh | None:

@@ -75,6 +75,48 @@ class Camera:
         }
 
 
+@dataclass(frozen=True)
+class CameraLink:
+    """The similarity ``x_B = focal_b + scale * rotation @ (x_A - focal_a)`` that carries
+    the camera of one view (A) to another's (B): two views of two meshes that turn,
+    zoom and pan together, each about its own mesh."""
+
+    rotation: np.ndarray
+    scale: float
+    focal_a: np.ndarray
+    focal_b: np.ndarray
+
+    @classmethod
+    def between(cls, a: Camera, b: Camera) -> CameraLink:
+        """The link that carries ``a`` to ``b`` as they are (their relative viewpoint)."""
+        (fa, da), (fb, db) = _frame(a), _frame(b)
+        return cls(fb @ fa.T, db / da, np.asarray(a.focal_point), np.asarray(b.focal_point))
+
+    def carry(self, camera: Camera, from_a: bool = True) -> tuple[Camera, float]:
+        """``camera`` of A carried to B (or of B to A), and the factor its size (a
+        parallel projection's scale) is multiplied by."""
+        rot, s, src, dst = self.rotation, self.scale, self.focal_a, self.focal_b
+        if not from_a:
+            rot, s, src, dst = rot.T, 1.0 / s, dst, src
+
+        def to_dst(x):
+            return tuple(dst + s * rot @ (np.asarray(x) - src))
+
+        up = tuple(rot @ np.asarray(camera.up))
+        return Camera(to_dst(camera.position), to_dst(camera.focal_point), up), s
+
+
+def _frame(camera: Camera) -> tuple[np.ndarray, float]:
+    """((3, 3) columns right, up, back of ``camera``; its distance to the focal point)."""
+    d = np.subtract(camera.focal_point, camera.position)
+    distance = float(np.linalg.norm(d)) or 1.0
+    back = -d / distance
+    up = np.asarray(camera.up, dtype=float)
+    up = up - back * float(up @ back)
+    up /= np.linalg.norm(up) or 1.0
+    return np.column_stack([np.cross(up, back), up, back]), distance
+
+
 def _unit(v) -> np.ndarray:
     v = np.asarray(v, dtype=np.float64)
     n = np.linalg.norm(v)

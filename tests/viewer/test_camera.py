@@ -186,3 +186,27 @@ def test_r_resets_the_view_at_once(monkeypatch):
         assert abs(scene.reset_camera().up[2]) > 0.9 and len(calls) == 2
     finally:
         plotter.close()
+
+
+def test_a_camera_link_carries_turns_and_zooms_of_one_view_to_the_other():
+    from modalviewer.viewer.camera import Camera, CameraLink
+
+    a = Camera((0.0, 0.0, 5.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    b = Camera((10.0, 11.0, 1.0), (10.0, 1.0, 1.0), (1.0, 0.0, 0.0))  # elsewhere, 2x as far
+    link = CameraLink.between(a, b)
+    carried, factor = link.carry(a)
+    assert np.allclose(carried.position, b.position) and np.allclose(carried.up, b.up)
+    assert factor == pytest.approx(2.0)
+    # A turned 90 degrees about its focal point (to look from +X) and brought closer:
+    # B turns the same way relative to its own view, about its own focal point
+    turned = Camera((2.5, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    moved, _ = link.carry(turned)
+    assert np.allclose(moved.focal_point, b.focal_point)
+    assert np.linalg.norm(np.subtract(moved.position, moved.focal_point)) == pytest.approx(5.0)
+    assert np.allclose(moved.up, b.up)
+    # A's right (+X) is B's right, rot @ x for the rotation taking A's frame to B's
+    right_b = np.cross(np.subtract(b.focal_point, b.position), b.up)
+    direction = np.subtract(moved.position, moved.focal_point) / 5.0
+    assert np.allclose(direction, right_b / np.linalg.norm(right_b))
+    back, inverse = link.carry(moved, from_a=False)
+    assert np.allclose(back.position, turned.position) and inverse == pytest.approx(0.5)
