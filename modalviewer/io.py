@@ -20,9 +20,9 @@ import numpy as np
 from .core.cleaning import repair_mesh
 from .core.mesh import Mesh, MeshError, MeshReport, shape_summary
 from .extras import MissingExtraError, extra_needed
-from .readers import count_text, read_mesh_file, strips_to_triangles
+from .readers import count_text, read_mesh_file
 
-__all__ = ["load_mesh", "read_arrays", "read_file", "strips_to_triangles", "SUPPORTED_EXTENSIONS"]
+__all__ = ["load_mesh", "read_file", "SUPPORTED_EXTENSIONS"]
 
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 
@@ -151,12 +151,6 @@ def _read_meshio(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     if len(vertices) == 0:
         raise MeshError(f"{path.name}: no vertices found in this file")
     return vertices, faces, notes
-
-
-def read_arrays(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray]:
-    """Raw (vertices (n, 3), faces (m, 3)) of a mesh file, polygons triangulated."""
-    vertices, faces, _ = read_file(path, strict=strict)
-    return vertices, faces
 
 
 def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:

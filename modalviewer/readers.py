@@ -14,6 +14,12 @@ naming the file, the place (line or element) and what is missing.  With ``strict
 what could be read is returned, and ``notes`` says exactly what was dropped.  Vertices
 that no face uses are never an error: :func:`read_mesh_file` adds a note with their
 number, since a file cut between two face records leaves such vertices behind.
+
+Well-formed files of triangles (OBJ, OFF, ASCII PLY) are parsed by numpy in one go and
+binary PLY and STL read as numpy records; any file such a path does not take as it is
+goes to the record-by-record reader, which finds and names the damage.  The strict
+checks are why these readers are the package's own: trimesh, for one, loads an OBJ cut
+short without a word and refuses a cut PLY without saying where.
 """
 
 from __future__ import annotations
@@ -231,9 +237,60 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
 # --------------------------------------------------------------------------- OFF
 
 
+def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
+    """(len(rows), width) numbers of text rows that each hold exactly ``width`` of them,
+    parsed by numpy in one go; None where a row holds another count or a word that is
+    not a number (the record-by-record reader then finds and names it)."""
+    if any(len(row.split()) != width for row in rows):
+        return None
+    try:
+        return np.array(" ".join(rows).split(), dtype=dtype).reshape(len(rows), width)
+    except ValueError:
+        return None
+
+
+def _triangle_rows(rows: list[str], n_vertices: int) -> np.ndarray | None:
+    """(m, 3) triangles of rows "3 a b c" (OFF, ASCII PLY) naming existing vertices, or
+    None for any other rows."""
+    table = _numbers(rows, 4, np.int64)
+    if table is None or not (table[:, 0] == 3).all():
+        return None
+    faces = table[:, 1:]
+    if len(faces) and (faces.min() < 0 or faces.max() >= n_vertices):
+        return None
+    return faces
+
+
+def _read_off_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """Vertices and triangles of a well-formed OFF of triangles without comments or
+    colours (the counts met exactly); None for any other file, which the record-by-record
+    reader then reads and checks."""
+    if "#" in text:
+        return None
+    rows = [row for row in text.splitlines() if row.strip()]
+    head = rows[0].split() if rows else []
+    if not head or head[0] != "OFF":
+        return None
+    if len(head) == 1:
+        head, rows = rows[1].split() if len(rows) > 1 else [], rows[1:]
+    try:
+        n, m = int(head[0]), int(head[1])
+    except (ValueError, IndexError):
+        return None
+    if len(rows) != 1 + n + m:
+        return None
+    vertices = _numbers(rows[1 : 1 + n], 3, np.float64)
+    faces = None if vertices is None else _triangle_rows(rows[1 + n :], n)
+    return None if faces is None else (vertices, faces)
+
+
 def _read_off(path: Path, strict: bool) -> MeshFile:
     damage = _Damage(path.name, strict)
     text = path.read_bytes().decode("utf-8", "replace")
+    fast = _read_off_fast(text)
+    if fast is not None:
+        _check_last_line(text, damage, "")
+        return MeshFile(fast[0], fast[1], damage.notes)
     lines = []
     for number, line in enumerate(text.splitlines(), start=1):
         words = line.split("#", 1)[0].split()
@@ -424,12 +481,38 @@ def _ply_ascii(name, count, props, lines, line_index, damage):
     return columns, line_index, count
 
 
+def _read_ply_ascii_fast(elements, body: bytes) -> tuple[np.ndarray, np.ndarray] | None:
+    """Vertices and triangles of a well-formed ASCII PLY of scalar vertex properties and
+    triangles only (the counts met exactly); None for any other file, which the
+    record-by-record reader then reads and checks."""
+    if [name for name, _, _ in elements] != ["vertex", "face"]:
+        return None
+    (_, n, vertex_props), (_, m, face_props) = elements
+    names = [prop for prop, _ in vertex_props]
+    if any(types[0] == "list" for _, types in vertex_props) or not {"x", "y", "z"} <= set(names):
+        return None
+    if len(face_props) != 1 or face_props[0][0] not in _FACE_LISTS:
+        return None
+    rows = [row for row in body.decode("ascii", "replace").splitlines() if row.strip()]
+    if len(rows) != n + m:
+        return None
+    table = _numbers(rows[:n], len(names), np.float64)
+    faces = None if table is None else _triangle_rows(rows[n:], n)
+    if faces is None:
+        return None
+    return np.ascontiguousarray(table[:, [names.index(c) for c in "xyz"]]), faces
+
+
 def _read_ply(path: Path, strict: bool) -> MeshFile:
     damage = _Damage(path.name, strict)
     data = path.read_bytes()
     fmt, elements, body = _ply_header(path, data)
     header_lines = data[: len(data) - len(body)].count(b"\n")
     order = "<" if fmt == "binary_little_endian" else ">"
+    fast = _read_ply_ascii_fast(elements, body) if fmt == "ascii" else None
+    if fast is not None:
+        _check_last_line(body.decode("ascii", "replace"), damage, "")
+        return MeshFile(fast[0], fast[1], damage.notes)
     if fmt == "ascii":
         lines = []
         for number, line in enumerate(body.decode("ascii", "replace").splitlines()):
@@ -546,14 +629,21 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
 def _stl_vertices(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(vertices, triangles) of an STL file's triangle corners (3 m, 3): STL names a
     vertex by its position only, so its vertices are the distinct corner positions in
-    the order they first appear (vertex i is the i-th distinct one)."""
+    the order they first appear (vertex i is the i-th distinct one).  One stable sort
+    of the coordinates' bits finds them (``np.unique(axis=0)`` compares rows element by
+    element, slower)."""
     if len(corners) == 0:
         return corners, np.zeros((0, 3), dtype=np.int64)
-    _, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
-    order = np.argsort(first, kind="stable")
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    return corners[first[order]], rank[inverse.reshape(-1)].reshape(-1, 3)
+    bits = np.ascontiguousarray(corners + 0.0).view(np.uint64)  # + 0.0: -0.0 is 0.0
+    order = np.lexsort(bits.T[::-1])  # stable: each position's first corner comes first
+    new = np.ones(len(order), dtype=bool)
+    new[1:] = (np.diff(bits[order], axis=0) != 0).any(axis=1)
+    first = order[new]  # the first corner of each distinct position, sorted by position
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
+    group = np.empty(len(order), dtype=np.int64)
+    group[order] = np.cumsum(new) - 1
+    return corners[np.sort(first)], rank[group].reshape(-1, 3)
 
 
 STL_COORDINATE_LIMIT = 1e30

@@ -357,6 +357,8 @@ def run_batch(
     result is written when it arrives; a failure is recorded in ``errors/`` and the
     batch goes on.  The index is rebuilt at the end (also when interrupted).  A store
     holds one set of parameters: other ones raise CollectionError if it holds results.
+    ``progress(done, total, failed, seconds, already)`` is called after each mesh
+    (``already``: the meshes done before this run); ``log(text)`` gets notes.
     """
     store = Path(store)
     parameters = _parameters(operator, k, signatures, bending, membrane)

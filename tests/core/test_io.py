@@ -37,6 +37,50 @@ def test_formats_round_trip(tmp_path, ext):
     assert loaded.total_area == pytest.approx(mesh.total_area, rel=1e-6)
 
 
+@pytest.mark.parametrize(
+    ("ext", "fast_path"),
+    [(".off", "_read_off_fast"), (".ply", "_read_ply_ascii_fast"), (".obj", "_read_obj_fast")],
+)
+def test_the_fast_readers_read_what_the_record_readers_read(tmp_path, monkeypatch, ext, fast_path):
+    """Well-formed text files go through numpy in one go; the arrays are those of the
+    record-by-record reader (which reads and checks every other file) to the bit."""
+    import trimesh
+
+    from modalviewer import readers
+
+    rng = np.random.default_rng(3)
+    mesh = icosphere(2)
+    vertices = mesh.vertices + rng.normal(scale=1e-3, size=mesh.vertices.shape)
+    path = tmp_path / f"sphere{ext}"
+    tm = trimesh.Trimesh(vertices, mesh.faces, process=False)
+    if ext == ".ply":
+        path.write_bytes(trimesh.exchange.ply.export_ply(tm, encoding="ascii"))
+    else:
+        tm.export(path)
+    fast = readers.read_mesh_file(path)
+    monkeypatch.setattr(readers, fast_path, lambda *args: None)
+    slow = readers.read_mesh_file(path)
+    assert fast.vertices.shape == (mesh.n_vertices, 3) and fast.faces.shape == (mesh.n_faces, 3)
+    np.testing.assert_array_equal(fast.vertices, slow.vertices)
+    np.testing.assert_array_equal(fast.faces, slow.faces)
+    assert fast.notes == slow.notes
+
+
+def test_stl_vertices_are_the_distinct_corners_in_the_order_they_first_appear():
+    from modalviewer.readers import _stl_vertices
+
+    rng = np.random.default_rng(5)
+    corners = rng.integers(0, 6, size=(3000, 3)).astype(np.float64) / 4
+    corners[7], corners[8] = [-0.0, 0.0, 0.0], [0.0, 0.0, 0.0]  # one position
+    corners[9], corners[10] = [1.0 + 1e-12, 0.0, 0.0], [1.0, 0.0, 0.0]  # two
+    vertices, triangles = _stl_vertices(corners)
+    _, first, inverse = np.unique(corners, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)
+    np.testing.assert_array_equal(vertices, corners[first[order]])
+    np.testing.assert_array_equal(vertices[triangles.ravel()], corners)
+    assert len(vertices) == len(first) and (np.diff(first[order]) > 0).all()
+
+
 def test_an_unstructured_grid_file_reads_without_a_warning(tmp_path):
     # pyvista's extract_surface warned (FutureWarning) for every .vtk grid read, also in
     # batch output
