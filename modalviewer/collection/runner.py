@@ -188,7 +188,7 @@ def _operators(parameters: dict) -> list[str]:
 def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
     """(HISTOGRAM_SCALES, bins) area-weighted histograms of log10(A S_t(v) / Z(t)), or
     for ``kind="wks"`` of log10(A W_E(v)) at energies of the default band."""
-    from ..core.signatures import _used, default_energies, default_times, signature, wks_sigma
+    from ..core.signatures import default_energies, default_times, signature, wks_sigma
 
     if kind == "wks":
         energies = default_energies(spec)
@@ -196,12 +196,11 @@ def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
         _, w = signature(spec, kind="wks", energies=picked, sigma=wks_sigma(energies))
         h = area * w
     else:
-        mask = _used(spec, False)
         times = default_times(spec)
         picked = times[np.linspace(0, len(times) - 1, HISTOGRAM_SCALES).round().astype(int)]
-        weights = np.exp(-np.outer(spec.eigenvalues[mask], picked))  # (k, S)
-        s = spec.squared_modes()[:, mask] @ weights  # (n, S)
-        h = area * s / weights.sum(axis=0)
+        _, s = signature(spec, times=picked)  # (n, S)
+        z = np.exp(-np.outer(spec.eigenvalues[~spec.zero_mode_mask()], picked)).sum(axis=0)
+        h = area * s / z
     logs = np.log10(np.clip(h, 10.0 ** HISTOGRAM_EDGES[0], 10.0 ** HISTOGRAM_EDGES[-1]))
     share = spec.mass / spec.mass.sum()
     return np.stack(
