@@ -18,9 +18,10 @@ import logging
 import os
 import time
 from concurrent.futures import TimeoutError as FutureTimeout
+from contextlib import contextmanager
 from pathlib import Path
 
-from qtpy import QtCore, QtWidgets
+from qtpy import QtCore, QtGui, QtWidgets
 
 from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh, MeshError
@@ -56,6 +57,22 @@ READING_WAIT_S = 0.2
 
 READING_DIALOG_S = 0.8
 """A reading that lasts this many seconds shows the dialog with Cancel."""
+
+
+@contextmanager
+def _shortcuts_off(window):
+    """Disable ``window``'s actions and shortcuts that have a key for the duration, then
+    give each back the state it had: keys pressed meanwhile are dropped, all of them."""
+    keyed = [a for a in window.findChildren(QtGui.QAction) if not a.shortcut().isEmpty()]
+    keyed += window.findChildren(QtGui.QShortcut)
+    enabled = [item.isEnabled() for item in keyed]
+    for item in keyed:
+        item.setEnabled(False)
+    try:
+        yield
+    finally:
+        for item, on in zip(keyed, enabled, strict=True):
+            item.setEnabled(on)
 
 
 class MainWindow(QtWidgets.QMainWindow):
@@ -275,7 +292,9 @@ class MainWindow(QtWidgets.QMainWindow):
         :data:`READING_DIALOG_S` a modal dialog names the file with a busy bar and
         Cancel.  Returns the mesh, None if cancelled (the thread then reads on and its
         mesh is dropped: a parser cannot be stopped midway), or raises
-        what ``load_mesh`` raises."""
+        what ``load_mesh`` raises.  The window's shortcuts are off while the file is
+        read (:func:`_shortcuts_off`): a key pressed then is dropped, none is applied
+        to the old mesh or queued for the new one."""
         from concurrent.futures import ThreadPoolExecutor
 
         from ..core.robust import negative_cotan_weights
@@ -315,7 +334,8 @@ class MainWindow(QtWidgets.QMainWindow):
         timer.timeout.connect(tick)
         dialog.canceled.connect(loop.quit)
         timer.start()
-        loop.exec()
+        with _shortcuts_off(self):
+            loop.exec()
         timer.stop()
         cancelled = not future.done()
         dialog.reset()

@@ -266,6 +266,39 @@ def test_a_slow_reading_can_be_cancelled_and_keeps_the_mesh(window, spot_path, m
     assert "cancelled" in window.statusBar().currentMessage()
 
 
+def test_keys_pressed_while_a_mesh_opens_are_all_dropped(window, spot_path, monkeypatch):
+    """While a file is read, every keyed action and shortcut of the window is disabled
+    (a key then does nothing, now or after loading) and gets its state back after: Ctrl+R
+    starts no computation, C shows no curvature on the old or the new mesh."""
+    from qtpy import QtCore, QtGui
+
+    window.open_mesh(spot_path)
+    keyed = {
+        a.shortcut().toString(): a
+        for a in window.findChildren(QtGui.QAction)
+        if not a.shortcut().isEmpty()
+    }
+    before = {key: a.isEnabled() for key, a in keyed.items()}
+    assert before["Ctrl+R"] and before["C"] and before["M"]
+    _slow_reading(monkeypatch, 1.0)
+    during, ran = {}, []
+    monkeypatch.setattr(window.viewer, "compute", lambda *a, **kw: ran.append("compute"))
+    monkeypatch.setattr(window.viewer, "show_curvature", lambda: ran.append("curvature"))
+
+    def press():  # what the keys' shortcuts would run, as a person presses them
+        during.update({key: a.isEnabled() for key, a in keyed.items()})
+        for key in ("Ctrl+R", "C", "M", "R"):
+            keyed[key].trigger()
+
+    QtCore.QTimer.singleShot(500, press)
+    assert window.open_mesh(spot_path.with_name("demo_hand.obj"))
+    assert during and not any(during.values()), during
+    assert {key: a.isEnabled() for key, a in keyed.items()} == before
+    assert ran == []
+    window.show_curvature()  # the same slot with the keys back on: it runs
+    assert ran == ["curvature"]
+
+
 def test_bad_file_gives_a_message_and_keeps_the_mesh(window, spot_path, tmp_path):
     window.open_mesh(spot_path)
     bad = tmp_path / "broken.obj"
