@@ -39,18 +39,8 @@ def assets_dir() -> Path:
 
 
 def asset_path(name: str) -> Path:
-    """The path of a bundled file, e.g. ``asset_path("spot.obj")``.
-
-    Parameters
-    ----------
-    name : str
-        A file name of the bundled assets (``spot.obj``, ``demo_hand.obj``, ...).
-
-    Returns
-    -------
-    pathlib.Path
-        Its path, in a checkout or an installed package.
-    """
+    """The path of a bundled file (``spot.obj``, ``demo_hand.obj``, ...), in a checkout
+    or an installed package; a FileNotFoundError listing the bundled files."""
     path = assets_dir() / name
     if not path.is_file():
         names = sorted(p.name for p in assets_dir().iterdir() if p.is_file())

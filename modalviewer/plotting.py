@@ -319,11 +319,11 @@ def add_to_plotter(
     ``pyvista.Plotter``); returns the :class:`~modalviewer.scene.mesh_scene.MeshScene`
     holding its actors.
 
-    values_or_spectrum : per-vertex values ((n,); signed: the modes' diverging colours,
-        otherwise white to red) or a :class:`Spectrum`: its mode ``mode`` (default the
-        first non-zero one; vector modes by their normal component, as the viewer), or
-        with ``vertex`` the multiscale distance from that vertex.  Vertex numbers and
-        values are in ``mesh``'s numbering; the surface drawn is its vertices faces use.
+    ``values_or_spectrum``: per-vertex values ((n,); signed: the modes' diverging
+    colours, otherwise white to red) or a :class:`Spectrum`: its mode ``mode`` (default
+    the first non-zero one; vector modes by their normal component, as the viewer), or
+    with ``vertex`` the multiscale distance from that vertex.  Vertex numbers and values
+    are in ``mesh``'s numbering; the surface drawn is its vertices faces use.
     ``isolines``: their number (0: none); ``name``: the colour bar's title.
     """
     from .core.laplacian import vertex_normals
