@@ -38,7 +38,7 @@ def build_figures(out_dir, progress=print) -> list[Path]:
     try:
         # Fig. 1: folded plate, Laplacian / E_D^N / shells normal, same mode index
         viewer.open_mesh(ASSETS / "demo_folded_plate.obj")
-        state.set_isolines(10)
+        state.style.isolines = 10
         compare = viewer.comparison(["laplacian", "modified_dirichlet", "shells_normal"])
         compare.show_mode(5)
         save("fig1_folded_plate_modes", compare)
@@ -49,8 +49,8 @@ def build_figures(out_dir, progress=print) -> list[Path]:
         save("fig3_double_torus_modes", compare)
         # Fig. 4: a vibration mode as the deformed shape over the rest shape's ghost,
         # soft and stiff membrane
-        state.set_shell_coloring("deformed")
-        state.set_ghost(True)
+        state.style.shell_coloring = "deformed"
+        state.style.ghost = True
         for membrane in (0.01, 100.0):
             state.set_compute_settings(membrane=membrane)
             viewer.compute("shells", k=16)

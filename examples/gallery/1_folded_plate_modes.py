@@ -12,7 +12,7 @@ import modalviewer as mv
 
 viewer = mv.Viewer()
 viewer.open_mesh(mv.asset_path("demo_folded_plate.obj"))
-viewer.state.set_isolines(10)
+viewer.state.style.isolines = 10
 viewer.compute("laplacian", k=12)
 viewer.compute("modified_dirichlet", k=12)
 compare = viewer.comparison(["laplacian", "modified_dirichlet"])

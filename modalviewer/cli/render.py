@@ -139,8 +139,8 @@ def render(args) -> int:
     _check(args)
     mesh = load(args.mesh, args.fix_slivers, args.partial)
     viewer = viewer_of(mesh, args.mesh)
-    viewer.state.set_isolines(args.isolines)
-    viewer.state.set_shell_coloring(args.show)
+    viewer.state.style.isolines = args.isolines
+    viewer.state.style.shell_coloring = args.show
     with warnings_printed():
         spec = viewer.compute(args.operator, k=args.k, wait=True)
     asked = [args.mode] if args.modes is None else args.modes

@@ -105,7 +105,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.dispatcher = QtDispatcher(self)
         self._waits: list[QtCore.QEventLoop] = []
         self.viewer.use_event_loop(self.dispatcher, self.wait_for)
-        self.model = self.viewer.model
         self.state = self.viewer.state
         self.cache = self.viewer.cache
         self.message_box: QtWidgets.QMessageBox | None = None  # the last one opened
@@ -125,11 +124,11 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.compute_panel = ComputePanel(self.state)
         self.compute_panel.computeRequested.connect(lambda: self.compute(wait=False))
-        self.jobs_panel = JobsPanel(self.model.jobs, self.state)
+        self.jobs_panel = JobsPanel(self.viewer.jobs, self.state)
         self.modes_panel = ModesPanel(self.state)
         self.animation_panel = AnimationPanel(self.state)
-        self.distances_panel = DistancesPanel(self.state, computing=self.model.computing)
-        self.model.jobs.events.changed.connect(self._tell_distances_panel)
+        self.distances_panel = DistancesPanel(self.state, computing=self.viewer.computing)
+        self.viewer.jobs.events.changed.connect(self._tell_distances_panel)
         self.distances_panel.showDistanceRequested.connect(lambda: self.show_distance())
         self.distances_panel.showSignatureRequested.connect(
             lambda: self.show_signature(self.state.display.signature_sample)
@@ -137,7 +136,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.distances_panel.exactCurveRequested.connect(self.viewer.request_exact_curve)
         build_docks(self)
         menus.build_menus(self)
-        self.status_widgets = StatusBarWidgets(self.statusBar(), self.state, self.model.jobs)
+        self.status_widgets = StatusBarWidgets(self.statusBar(), self.state, self.viewer.jobs)
         self.status_widgets.cancel_button.clicked.connect(self.cancel_computation)
         self.status_line = self.status_widgets.status_line
         self.progress = self.status_widgets.progress
@@ -210,7 +209,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.state.set_animation(playing=False)
         if self.compare is not None:
             self.compare.close()
-        self.model.jobs.shutdown(5.0)
+        self.viewer.jobs.shutdown(5.0)
         for loop in self._waits:
             loop.quit()
         window_settings.save(self)
@@ -587,8 +586,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     @property
     def running_job(self) -> Job | None:
-        return self.model.jobs.running
+        return self.viewer.jobs.running
 
     @property
     def busy(self) -> bool:
-        return self.model.jobs.busy
+        return self.viewer.jobs.busy

@@ -100,7 +100,7 @@ class PairWindow(QtWidgets.QWidget):
         self.pair.events.linked.connect(self._on_linked)
         self.pair.events.meshes.connect(self._on_meshes)
         self.pair.events.message.connect(self._on_message)
-        main.model.jobs.events.changed.connect(self._on_jobs)
+        main.viewer.jobs.events.changed.connect(self._on_jobs)
         state_a.events.mesh.connect(self._on_main_mesh)
         main.installEventFilter(self)
         self._on_meshes()
@@ -471,7 +471,7 @@ class PairWindow(QtWidgets.QWidget):
         if not self._closed:
             self._closed = True
             self.pair.cancel()
-            self.main.model.jobs.events.changed.disconnect(self._on_jobs)
+            self.main.viewer.jobs.events.changed.disconnect(self._on_jobs)
             self.main.state.events.mesh.disconnect(self._on_main_mesh)
             self.main.removeEventFilter(self)
             for viewport in self.viewports.values():

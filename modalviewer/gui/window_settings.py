@@ -48,15 +48,15 @@ def restore(win) -> None:
     else:  # once the window is laid out
         QtCore.QTimer.singleShot(0, win, lambda: fit_modes_dock(win))
     st = win.state
-    st.set_isolines(int(s.value("view/isolines", 12)))
+    st.style.isolines = int(s.value("view/isolines", 12))
     coloring = str(s.value("view/shell_color", "deformed"))  # a former "auto": deformed
-    st.set_shell_coloring(coloring if coloring in SHELL_COLORINGS else "deformed")
-    st.set_ghost(_flag(s, "view/ghost", True))
+    st.style.shell_coloring = coloring if coloring in SHELL_COLORINGS else "deformed"
+    st.style.ghost = _flag(s, "view/ghost", True)
     style = str(s.value("view/style", "paper"))
-    st.set_render_style(style if style in RENDER_STYLES else "paper")
-    st.set_colorbar(_flag(s, "view/colorbar", True))
+    st.style.render = style if style in RENDER_STYLES else "paper"
+    st.style.colorbar = _flag(s, "view/colorbar", True)
     _restore_color_range(st, s)
-    st.set_log_signature(_flag(s, "view/log_signature", False))
+    st.style.log_signature = _flag(s, "view/log_signature", False)
     st.set_animation(
         # the largest displacement of the deformed shape and of the animation
         amplitude=int(s.value("view/mode_amplitude", 40)),

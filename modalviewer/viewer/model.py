@@ -190,14 +190,16 @@ def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS
 
 
 class ViewerModel:
-    """State + jobs + cache; every scripted or clicked action of the viewer ends here."""
+    """The state, the job queue and the spectrum cache, and the requests that fill the
+    state (no messages for the user: :class:`.viewer.Viewer`, which is this model, adds
+    them and the scripting API)."""
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None):
         self.state = ViewerState()
         self.derived = self.state.derived  # the values computed from the state
         self.jobs = JobQueue(dispatch)
         self.cache = cache or SpectrumCache()
-        self.jobs.events.finished.connect(self._on_job_finished)
+        self.jobs.events.finished.connect(self._store_result)
 
     # -------------------------------------------------------------- mesh
     def set_mesh(self, mesh: Mesh, path=None, repairs: list[str] | None = None) -> None:
@@ -234,8 +236,30 @@ class ViewerModel:
         return job.then(replace_mesh)
 
     def open_mesh(self, path, strict: bool = True) -> Mesh:
-        """Load and show a mesh file; raises MeshError or OSError with a user message
-        (``strict`` as in :func:`modalviewer.load_mesh`)."""
+        """Load a mesh file and show it.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            An OBJ, PLY, OFF or STL file.
+        strict : bool
+            With False, a damaged or truncated file loads its whole records and the mesh's
+            report says what was dropped.
+
+        Returns
+        -------
+        Mesh
+            The loaded (and repaired) mesh.
+
+        Raises
+        ------
+        modalviewer.readers.DamagedFileError
+            For a damaged or truncated file with ``strict=True``.
+        MeshError
+            For other unusable meshes.
+        OSError
+            If the file cannot be read.
+        """
         from ..io import load_mesh
 
         mesh = load_mesh(Path(path), strict=strict)
@@ -422,7 +446,7 @@ class ViewerModel:
 
         return work
 
-    def _on_job_finished(self, job: Job) -> None:
+    def _store_result(self, job: Job) -> None:
         mesh = self.state.mesh
         if not isinstance(job, SpectrumJob):
             return

@@ -154,11 +154,11 @@ def restore_session(model, path) -> Restored:
             "recomputed and the pick may point elsewhere"
         )
     style = data.get("style") or {}
-    state.set_isolines(int(style.get("isolines", state.style.isolines)))
-    state.set_shell_coloring(str(style.get("shell_coloring", state.style.shell_coloring)))
-    state.set_colorbar(bool(style.get("colorbar", True)))
-    state.set_render_style(str(style.get("render", "paper")))
-    state.set_ghost(bool(style.get("ghost", True)))
+    state.style.isolines = int(style.get("isolines", state.style.isolines))
+    state.style.shell_coloring = str(style.get("shell_coloring", state.style.shell_coloring))
+    state.style.colorbar = bool(style.get("colorbar", True))
+    state.style.render = str(style.get("render", "paper"))
+    state.style.ghost = bool(style.get("ghost", True))
     limits = style.get("color_limits")
     state.set_color_range(str(style.get("color_range", "auto")), limits)
     anim = data.get("animation") or {}

@@ -46,7 +46,7 @@ from functools import cached_property
 from pathlib import Path
 
 import numpy as np
-from psygnal import Signal, SignalGroup
+from psygnal import Signal, SignalGroup, evented
 
 from ..core.mesh import Mesh
 from ..core.operators import (
@@ -82,7 +82,7 @@ COLOR_RANGES = ("auto", "symmetric", "robust", "spread", "limits")
 largest value), "robust" (the 99th area-weighted percentile of |value|, beyond it
 clipped), "spread" (one-signed fields: colours by the share of the area below each value,
 the colour bar labelled with the values; see :mod:`.color_scale`), "limits"
-(:attr:`_Style.color_limits`), "auto" (for distances, signatures and curvature, where
+(:attr:`Style.color_limits`), "auto" (for distances, signatures and curvature, where
 one extreme dominates: spread where a tenth of the robust range would cover more than a
 quarter of the surface, else robust; symmetric for modes)."""
 RENDER_STYLES = ("paper", "shaded")
@@ -199,16 +199,34 @@ class ViewerEvents(SignalGroup):
     signature_curve = Signal()
 
 
+@evented
 @dataclass
-class _Style:
-    isolines: int = 12
-    shell_coloring: str = "deformed"  # 3D modes: one of SHELL_COLORINGS
+class Style:
+    """How the picture is drawn; setting a field validates it and emits
+    ``style.events.<field>`` (and the state's ``style`` event) if it changed.  The colour
+    range and its limits are set together by :meth:`ViewerState.set_color_range`."""
+
+    isolines: int = 12  # clipped to 0..60
+    shell_coloring: str = "deformed"  # 3D modes: one of SHELL_COLORINGS ("auto": deformed)
     ghost: bool = True  # the rest shape, faint, behind a deformed 3D mode
     color_range: str = "auto"  # one of COLOR_RANGES
     color_limits: tuple[float, float] | None = None  # (low, high) of the "limits" range
     render: str = "paper"  # paper: white zero, saturated colours; shaded: light kit
     colorbar: bool = True  # legend and colour bar, on screen and in exports
     log_signature: bool = False  # signatures coloured by log10(S / smallest S)
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "isolines":
+            value = int(np.clip(value, 0, 60))
+        elif name == "shell_coloring":
+            value = "deformed" if value == "auto" else value
+            if value not in SHELL_COLORINGS:
+                raise ValueError(f"colouring must be one of {SHELL_COLORINGS}")
+        elif name == "render" and value not in RENDER_STYLES:
+            raise ValueError(f"render style must be one of {RENDER_STYLES}")
+        elif name in ("ghost", "colorbar", "log_signature"):
+            value = bool(value)
+        super().__setattr__(name, value)
 
 
 @dataclass
@@ -236,7 +254,8 @@ class ViewerState:
         self.display = Display()
         self.picked: int | None = None
         self.t_range: tuple[float, float] | None = None
-        self.style = _Style()
+        self.style = Style()
+        self.style.events.all.connect(lambda _info: self.events.style.emit())
         self.animation = Animation()
         self.camera: dict | None = None
         self.up_axis: str | None = None
@@ -381,30 +400,9 @@ class ViewerState:
             self.compute_settings = new
             self.events.compute_settings.emit()
 
-    def set_isolines(self, count: int) -> None:
-        count = int(np.clip(count, 0, 60))
-        if count != self.style.isolines:
-            self.style.isolines = count
-            self.events.style.emit()
-
-    def set_shell_coloring(self, coloring: str) -> None:
-        """How 3D modes are shown, one of :data:`SHELL_COLORINGS` ("auto" -> "deformed")."""
-        coloring = "deformed" if coloring == "auto" else coloring
-        if coloring not in SHELL_COLORINGS:
-            raise ValueError(f"colouring must be one of {SHELL_COLORINGS}")
-        if coloring != self.style.shell_coloring:
-            self.style.shell_coloring = coloring
-            self.events.style.emit()
-
-    def set_ghost(self, on: bool) -> None:
-        """Show the rest shape as a faint ghost behind a deformed 3D mode."""
-        if bool(on) != self.style.ghost:
-            self.style.ghost = bool(on)
-            self.events.style.emit()
-
     def set_color_range(self, mode: str, limits: tuple[float, float] | None = None) -> None:
         """The colour range, one of :data:`COLOR_RANGES`; ``limits`` (low < high) sets
-        :attr:`_Style.color_limits` ("limits" needs them, given now or before)."""
+        :attr:`Style.color_limits` ("limits" needs them, given now or before)."""
         if mode not in COLOR_RANGES:
             raise ValueError(f"colour range must be one of {COLOR_RANGES}")
         if limits is not None:
@@ -417,19 +415,8 @@ class ViewerState:
         if mode == "limits" and limits is None:
             raise ValueError("the 'limits' colour range needs limits (low, high)")
         if (mode, limits) != (self.style.color_range, self.style.color_limits):
-            self.style.color_range, self.style.color_limits = mode, limits
-            self.events.style.emit()
-
-    def set_render_style(self, style: str) -> None:
-        if style not in RENDER_STYLES:
-            raise ValueError(f"render style must be one of {RENDER_STYLES}")
-        if style != self.style.render:
-            self.style.render = style
-            self.events.style.emit()
-
-    def set_colorbar(self, on: bool) -> None:
-        if bool(on) != self.style.colorbar:
-            self.style.colorbar = bool(on)
+            with self.style.events.all.blocked():  # one redraw for both
+                self.style.color_range, self.style.color_limits = mode, limits
             self.events.style.emit()
 
     def set_animation(self, **changes) -> None:
@@ -469,12 +456,6 @@ class ViewerState:
         if axis != self.up_axis:
             self.up_axis = axis
             self.events.up_axis.emit()
-
-    def set_log_signature(self, on: bool) -> None:
-        """Colour signatures by log10 of the signature over its smallest value."""
-        if bool(on) != self.style.log_signature:
-            self.style.log_signature = bool(on)
-            self.events.style.emit()
 
     def set_camera(self, camera: dict | None) -> None:
         """Set the camera (position, focal_point, view_up, parallel_scale); the scene

@@ -75,7 +75,7 @@ class ViewerMessages(SignalGroup):
     sliver_failure = Signal(object, str)  # SpectrumKey, text
 
 
-class Viewer:
+class Viewer(ViewerModel):
     """The viewer without a window; see the module docstring.
 
     cache : where spectra are kept on disk (default: ``$MODALVIEWER_CACHE`` or the
@@ -85,10 +85,7 @@ class Viewer:
     """
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None, waiter=None):
-        self.model = ViewerModel(cache=cache, dispatch=dispatch or ManualDispatcher())
-        self.state = self.model.state
-        self.jobs = self.model.jobs
-        self.cache = self.model.cache
+        super().__init__(cache=cache, dispatch=dispatch or ManualDispatcher())
         self.events = ViewerMessages()
         self.last_error: str | None = None
         self.sliver_failure: SpectrumKey | None = None  # failed on slivers, to retry
@@ -138,9 +135,6 @@ class Viewer:
 
     def report_error(self, text: str, title: str = "modalviewer") -> None:
         """Tell the user ``text`` (a window shows a dialog); kept as :attr:`last_error`."""
-        self._error(text, title)
-
-    def _error(self, text: str, title: str = "modalviewer") -> None:
         self.last_error = text
         log.warning("%s", text)
         self.events.error.emit(title, text)
@@ -158,37 +152,6 @@ class Viewer:
             return spec
         return in_input_numbering(spec, self.state.mesh.input_mesh)
 
-    def open_mesh(self, path, strict: bool = True) -> Mesh:
-        """Load a mesh file and show it.
-
-        Parameters
-        ----------
-        path : str or os.PathLike
-            An OBJ, PLY, OFF or STL file.
-        strict : bool
-            With False, a damaged or truncated file loads its whole records and the mesh's
-            report says what was dropped.
-
-        Returns
-        -------
-        Mesh
-            The loaded (and repaired) mesh.
-
-        Raises
-        ------
-        modalviewer.readers.DamagedFileError
-            For a damaged or truncated file with ``strict=True``.
-        MeshError
-            For other unusable meshes.
-        OSError
-            If the file cannot be read.
-        """
-        return self.model.open_mesh(Path(path), strict=strict)
-
-    def set_mesh(self, mesh: Mesh, path=None) -> None:
-        """Show ``mesh``; the previous mesh's spectra are dropped and its jobs cancelled."""
-        self.model.set_mesh(mesh, path)
-
     def _on_mesh(self) -> None:
         if self.state.mesh is not None:  # what loading or a repair found and changed
             self._status(str(self.state.mesh.report), 15000)
@@ -197,7 +160,7 @@ class Viewer:
         """Apply repair ``name`` ("fix_slivers", "largest_component") to the loaded mesh in
         the background; the repaired mesh replaces it (its report says what changed).
         With ``wait`` returns the repaired mesh (ComputeError if the repair failed)."""
-        job = self.model.repair(name)
+        job = self.repair(name)
         job.then(self._on_repaired)
         if not wait:
             return None
@@ -210,7 +173,7 @@ class Viewer:
         if job.status == DONE:
             self._status(str(job.result.report), 20000)
         elif job.status == FAILED:
-            self._error(f"{job.description} failed: {job.error}", "Repair failed")
+            self.report_error(f"{job.description} failed: {job.error}", "Repair failed")
 
     def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
         """Fix the loaded mesh's slivers (as Mesh > Fix slivers), report it and request
@@ -223,12 +186,12 @@ class Viewer:
             return None
         missing = repair_unavailable("fix_slivers")
         if missing:
-            self._error(missing, "Fix slivers")
+            self.report_error(missing, "Fix slivers")
             return None
         try:
-            job = self.model.repair("fix_slivers")
+            job = self.repair("fix_slivers")
         except ValueError as exc:
-            self._error(str(exc))
+            self.report_error(str(exc))
             return None
         retried: list[SpectrumJob] = []
 
@@ -296,7 +259,7 @@ class Viewer:
             was too large to start.
         """
         if self.state.mesh is None:
-            self._error("Open a mesh first.")
+            self.report_error("Open a mesh first.")
             if wait:
                 raise ComputeError("Open a mesh first.")
             return None
@@ -312,30 +275,22 @@ class Viewer:
             raise ComputeError(self.last_error or "the computation was refused")
         return self._finish(job, wait, then)
 
-    def request_spectrum(self, operator: str, k: int | None = None, show: bool = False):
-        """The job computing (or loading) ``operator``'s spectrum, or None (with an
-        error message) if it is too large to start."""
-        return self._request(operator, k, show)
-
-    def _request(self, operator, k, show) -> SpectrumJob | None:
+    def _request(self, operator, k=None, show: bool = False) -> SpectrumJob | None:
+        """:meth:`~.model.ViewerModel.request_spectrum`, said on the status line; None (with
+        an error message) if it is too large to start."""
         try:
-            job = self.model.request_spectrum(operator, k, show=show)
+            job = self.request_spectrum(operator, k, show=show)
         except ComputeRefused as exc:
-            self._error(str(exc), "Computation too large")
+            self.report_error(str(exc), "Computation too large")
             return None
         if job.status == DONE:  # answered at once: the spectrum is here already
-            self._status(self.already_here_note(job), 8000)
+            self._status(f"{job.description}: already computed.", 8000)
             return job
         note = self.long_wait_note(job)
         if note:
             job.said.append(f"{job.description}: {note}.")
             self._status(job.said[-1], 20000)
         return job
-
-    def already_here_note(self, job: SpectrumJob) -> str:
-        """The status line for a request the spectrum in memory answers (Ctrl+R again):
-        that nothing is computed."""
-        return f"{job.description}: already computed."
 
     def modes_ready(self, operator: str | None = None) -> tuple[int, int]:
         """(modes in, modes asked for) of ``operator``'s spectrum (default: the current
@@ -362,7 +317,7 @@ class Viewer:
         deadline = None if timeout is None else time.monotonic() + timeout
         while True:
             ready, asked = self.modes_ready(operator)
-            if (asked and ready >= min(count, asked)) or not self.model.computing(operator):
+            if (asked and ready >= min(count, asked)) or not self.computing(operator):
                 return self.modes_ready(operator)
             if deadline is not None and time.monotonic() > deadline:
                 raise TimeoutError(f"fewer than {count} modes arrived within {timeout} s")
@@ -387,7 +342,7 @@ class Viewer:
         no estimate."""
         if job.done:
             return ""
-        seconds = self.model.estimated_seconds(job.spectrum_key)
+        seconds = self.estimated_seconds(job.spectrum_key)
         if seconds is None or seconds <= LONG_WAIT_SECONDS:
             return ""
         about = seconds_text(seconds)
@@ -400,7 +355,7 @@ class Viewer:
         if self.jobs.running is None:
             self._status("No computation running.", 3000)
             return
-        self.model.cancel_running()
+        self.cancel_running()
         left = {
             job.spectrum_key if isinstance(job, SpectrumJob) else job.key
             for job in self.jobs.jobs
@@ -435,17 +390,13 @@ class Viewer:
     def _on_job_changed(self, job: Job) -> None:
         running = self.jobs.running
         if running is not None and job is running and job.stage == "starting":
-            message = self.starting_message(job)
+            # "Computing ..."; after a cancel that left requests queued, first that
+            message = f"Computing {job.description}..."
+            if self._cancel_note:
+                message, self._cancel_note = f"{self._cancel_note}. {message}", ""
             if message not in job.said:  # "starting" may be reported more than once
                 job.said.insert(0, message)
             self._status(message)
-
-    def starting_message(self, job: Job) -> str:
-        """ "Computing ..."; after a cancel that left other requests queued, first what it
-        cancelled."""
-        text = f"Computing {job.description}..."
-        note, self._cancel_note = self._cancel_note, ""
-        return f"{note}. {text}" if note else text
 
     def _on_job_finished(self, job: Job) -> None:
         if job.status == DONE and isinstance(job, SpectrumJob):
@@ -473,7 +424,7 @@ class Viewer:
                 log.warning("%s", self.last_error)
                 self.events.sliver_failure.emit(job.spectrum_key, self.last_error)
             else:
-                self._error(f"The computation failed: {job.error}", "Computation failed")
+                self.report_error(f"The computation failed: {job.error}", "Computation failed")
         elif job.status == CANCELLED:
             self._status(f"{ended_text(job)}.", 5000)
 
@@ -779,7 +730,7 @@ class Viewer:
 
         path = png_path(path)  # a wrong name is refused before any drawing
         if colorbar is not None:
-            self.state.set_colorbar(colorbar)
+            self.state.style.colorbar = colorbar
         return save_png(path, self.image(scale, transparent, size, marker, fit))
 
     @extra_needed("Viewer.image")
@@ -819,25 +770,16 @@ class Viewer:
     def _offscreen_at(self, size):
         """(an off-screen renderer of the state at ``size``, whether it is a temporary
         one to close): this viewer's own without a window; with a window a new one,
-        looking from the window's camera."""
-        if self._picture is None:
-            return self._renderer_sized(size), False
-        from ..scene.offscreen import OffscreenRenderer
+        looking from the window's camera.  A size does not carry over from an earlier
+        call, as :meth:`renderer`'s does."""
+        from ..scene.offscreen import DEFAULT_SIZE, OffscreenRenderer
 
-        renderer = OffscreenRenderer(self.state, size or self._picture_size())
+        if self._picture is None:
+            return self.renderer(size or DEFAULT_SIZE), False
+        w, h = self._picture.plotter.window_size
+        renderer = OffscreenRenderer(self.state, size or (int(w), int(h)))
         renderer.set_camera(self.current_camera())
         return renderer, True
-
-    def _picture_size(self) -> tuple[int, int]:
-        w, h = self._picture.plotter.window_size
-        return int(w), int(h)
-
-    def _renderer_sized(self, size):
-        """:meth:`renderer` at ``size``, or the default size where None: a picture's
-        size does not carry over from an earlier call, as :meth:`renderer`'s does."""
-        from ..scene.offscreen import DEFAULT_SIZE
-
-        return self.renderer(size or DEFAULT_SIZE)
 
     @extra_needed("Viewer.animation_images")
     def animation_images(
@@ -1027,7 +969,7 @@ class Viewer:
         Raises SessionError, MeshError or OSError for a file that cannot be restored."""
         from .session import restore_session
 
-        restored = restore_session(self.model, path)
+        restored = restore_session(self, path)
         if wait:
             for job in restored.jobs:
                 self.wait_for(job)
@@ -1047,7 +989,7 @@ class Viewer:
         this machine's earlier solves, :meth:`.model.ViewerModel.estimated_seconds`);
         None where one of them has no estimate."""
         settings = self.state.compute_settings
-        seconds = [self.model.estimated_seconds(settings.key(op)) for op in operators]
+        seconds = [self.estimated_seconds(settings.key(op)) for op in operators]
         return None if any(s is None for s in seconds) else sum(seconds)
 
     def prepare_comparison(self, items: list[str], wait: bool = True, then=None):

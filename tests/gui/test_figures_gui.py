@@ -39,7 +39,7 @@ def test_a_1600x1200_export_from_a_small_window_holds_the_shape_clear_of_the_leg
     window, spot_path, qtbot, tmp_path
 ):
     _shells_mode_with_a_pick(window, spot_path, qtbot)
-    window.state.set_colorbar(True)
+    window.state.style.colorbar = True
     out = window.export_screenshot(tmp_path / "big.png", size=(1600, 1200))
     img = np.asarray(Image.open(out))
     assert img.shape[:2] == (1200, 1600)

@@ -13,7 +13,7 @@ def test_ghost_and_colour_range_follow_the_state(window, spot_path):
     assert window.ghost_action.shortcut().toString() == "G"
     window.ghost_action.trigger()
     assert state.style.ghost is False
-    state.set_ghost(True)
+    state.style.ghost = True
     assert window.ghost_action.isChecked()
     actions = window.color_range_actions
     assert actions["auto"].isChecked()

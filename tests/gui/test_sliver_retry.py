@@ -56,7 +56,7 @@ def test_without_pymeshlab_the_button_says_how_to_install_it(window, qtbot, sliv
     hint = window.message_box
     assert hint is not box and hint.isVisible()
     assert "pip install 'modalviewer[repair]'" in hint.text() and "pymeshlab" in hint.text()
-    assert window.mesh is slivered and window.model.jobs.jobs == []  # nothing started
+    assert window.mesh is slivered and window.viewer.jobs.jobs == []  # nothing started
     assert isinstance(hint, QtWidgets.QMessageBox)
 
 

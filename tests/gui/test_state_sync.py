@@ -161,7 +161,7 @@ def test_a_restored_session_draws_the_same_picture(qtbot, spot_path, tmp_path):
     first.open_mesh(spot_path)
     first.compute("modified_dirichlet", k=30, wait=True)
     first.show_mode(7)
-    first.state.set_isolines(5)
+    first.state.style.isolines = 5
     first.pick_vertex(1234)
     first.show_distance("feature", display="threshold", share=0.25)
     first.plotter.camera.Azimuth(70)
@@ -256,7 +256,7 @@ def test_keep_the_largest_component_from_the_window(window, qtbot, tmp_path):
     errors = []
     window.viewer.events.error.connect(lambda *args: errors.append(args))
     window.repair_mesh("largest_component", wait=False)
-    job = window.model.jobs.jobs[-1] if window.model.jobs.jobs else None
+    job = window.viewer.jobs.jobs[-1] if window.viewer.jobs.jobs else None
     qtbot.waitUntil(lambda: window.mesh.n_components == 1, timeout=30000)
     assert window.mesh.n_vertices == big.n_vertices
     assert isinstance(window.mesh, mv.Mesh)
@@ -339,7 +339,7 @@ def test_the_status_bar_ends_every_job_and_the_colour_bar_tick_matches_at_start(
     spec = window.compute("laplacian", k=10, wait=True)
     bar = window.statusBar()
     for result, description in (((spec, None), "spectrum of B"), (42, "other work")):
-        job = window.model.jobs.submit(
+        job = window.viewer.jobs.submit(
             lambda p, c, r=result: r, ("test", description), description, None
         )
         window.wait_for(job)
@@ -369,9 +369,9 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     from modalviewer.gui import MainWindow, window_settings
 
     window.state.set_compute_settings(coarse=True, operator="laplacian")
-    window.state.set_colorbar(False)
+    window.state.style.colorbar = False
     window.state.set_color_range("limits", (-0.5, 2.0))
-    window.state.set_log_signature(True)
+    window.state.style.log_signature = True
     window.remember_settings = True  # as on a desktop
     window.settings.setValue("compute/preview_only", "true")  # an older version's option
     window.settings.setValue("compute/preview", "false")
@@ -410,9 +410,9 @@ def test_esc_says_what_stays_queued_also_once_the_next_job_starts(window, spot_p
     window.open_mesh(spot_path)
     messages = []
     window.statusBar().messageChanged.connect(messages.append)
-    first = window.model.request_spectrum("shells", k=30)
-    window.model.request_spectrum("laplacian", k=15)
-    last = window.model.request_spectrum("modified_dirichlet", k=15)
+    first = window.viewer.request_spectrum("shells", k=30)
+    window.viewer.request_spectrum("laplacian", k=15)
+    last = window.viewer.request_spectrum("modified_dirichlet", k=15)
     assert window.running_job is first
     window.cancel_computation()
     assert window.statusBar().currentMessage() == (

@@ -37,7 +37,7 @@ def _both_sides(window):
 
 def test_mode_colours_and_isolines(window, spot_path):
     assert window.open_mesh(spot_path)
-    window.state.set_colorbar(False)  # the legend's black text would count as lines
+    window.state.style.colorbar = False  # the legend's black text would count as lines
     spec = window.compute("laplacian", k=20, wait=True)
     assert spec.k == 20 and window.current_operator == "laplacian"
     window.show_mode(6)
@@ -83,7 +83,7 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     window.open_mesh(spot_path)
     window.compute("shells", k=12, wait=True)
     window.show_mode(8)
-    window.state.set_shell_coloring("normal")  # a still picture on the rest shape
+    window.state.style.shell_coloring = "normal"  # a still picture on the rest shape
     rest = np.array(window.scene.surface.points)
     before = window.viewport.render_now()
     window.animation_panel.play_button.click()
@@ -100,7 +100,7 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     assert not window.scene_view.timer.isActive()
     np.testing.assert_allclose(window.scene.surface.points, rest)
     # the deformed shape: still at the amplitude, the animation swings about the rest
-    window.state.set_shell_coloring("deformed")
+    window.state.style.shell_coloring = "deformed"
     peak = np.linalg.norm(window.scene.surface.points - rest, axis=1).max()
     assert peak == pytest.approx(0.1 * window.mesh.bounding_box_diagonal, rel=1e-6)
     window.animation_panel.play_button.click()
@@ -561,7 +561,7 @@ def test_a_narrow_view_keeps_the_whole_mesh_in_sight(window, spot_path, qtbot):
     view stays whole when the view is made narrower than tall (it was cropped at the
     sides until the camera was reset)."""
     assert window.open_mesh(spot_path)
-    window.state.set_colorbar(False)
+    window.state.style.colorbar = False
 
     def surface_columns():
         img = window.viewport.render_now().astype(int)
@@ -640,13 +640,13 @@ def test_the_first_modes_are_drawn_while_the_others_converge(window, spot_path, 
 
     monkeypatch.setattr(spectra_module, "compute_spectrum", paused)
     assert window.open_mesh(spot_path)
-    window.state.set_colorbar(False)
+    window.state.style.colorbar = False
     try:
         window.compute("laplacian", k=60, wait=False)
         qtbot.waitUntil(lambda: window.state.modes_ready("laplacian")[0] >= 12, timeout=60000)
         ready, asked = window.state.modes_ready("laplacian")
         assert 12 <= ready < asked == 60
-        assert window.viewer.model.computing("laplacian")  # the solve waits for the test
+        assert window.viewer.computing("laplacian")  # the solve waits for the test
         assert window.state.display.kind == "mode" and window.state.display.mode == 1
         counts = _both_sides(window)
         assert counts["blue"] > 2000 and counts["orange"] > 2000, counts

@@ -150,7 +150,7 @@ def test_plot_animate_returns_a_gif_shown_inline(spot, tmp_path):
 
 def test_a_picture_at_a_chosen_size_holds_the_shape_clear_of_legend_and_bar(spot, tmp_path):
     spot.show_mode(8, "shells")  # deformed, over its ghost
-    spot.state.set_colorbar(True)
+    spot.state.style.colorbar = True
     path = spot.export_screenshot(tmp_path / "big.png", size=(1600, 1200))
     with Image.open(path) as image:
         assert image.size == (1600, 1200)
@@ -212,7 +212,7 @@ def test_a_continuous_distance_map_spreads_its_colours_over_the_visible_surface(
     leaves most of the visible surface in its lowest tenth; the automatic range spreads
     the colours by area, so no tenth of the scale covers more than a quarter of the
     surface's pixels, and the colour bar's ticks are the true distances."""
-    spot.state.set_colorbar(False)  # the bar's own colours are not the surface's
+    spot.state.style.colorbar = False  # the bar's own colours are not the surface's
     spot.pick_vertex(1500, show=False)
     spot.show_distance("vibration", display="continuous")
     try:
@@ -223,7 +223,7 @@ def test_a_continuous_distance_map_spreads_its_colours_over_the_visible_surface(
         linear = _largest_tenth(spot)
     finally:
         spot.state.set_color_range("auto")
-        spot.state.set_colorbar(True)
+        spot.state.style.colorbar = True
     assert spread < 0.25 < linear, (spread, linear)
     bar = spot.renderer().scene.colorbar()
     d = spot.state.derived.distance_map()

@@ -19,7 +19,7 @@ SIZE = (400, 300)
 def machined():
     v = Viewer()
     v.open_mesh(ASSETS / "demo_machined_part.obj")
-    v.state.set_colorbar(False)
+    v.state.style.colorbar = False
     v.compute("shells", k=16)
     v.show_mode(8)
     yield v
@@ -35,15 +35,15 @@ def _silhouette(viewer) -> np.ndarray:
 def test_a_deformed_mode_export_differs_from_the_rest_shape(machined):
     state = machined.state
     assert state.style.shell_coloring == "deformed"  # the default
-    state.set_ghost(False)
+    state.style.ghost = False
     deformed = _silhouette(machined)
-    state.set_shell_coloring("normal")
+    state.style.shell_coloring = "normal"
     try:
         rest = _silhouette(machined)
         assert state.derived.field().deformation == 0.0
     finally:
-        state.set_shell_coloring("deformed")
-        state.set_ghost(True)
+        state.style.shell_coloring = "deformed"
+        state.style.ghost = True
     changed = np.logical_xor(deformed, rest).sum() / np.logical_or(deformed, rest).sum()
     assert changed > 0.05, changed  # 17.5 % for mode 8 at the default amplitude
 
@@ -79,21 +79,21 @@ def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
     surface in mode 8, 30 % of the teapot's in its mode 21 and 14 % of the cow Loop x2's
     in its mode 10 changed with the ghost."""
     state = machined.state
-    state.set_ghost(True)
+    state.style.ghost = True
     with_ghost = machined.image(size=SIZE).astype(int)
     scene = machined.renderer(SIZE).scene
     assert scene.ghost_visible
     assert "grey: rest shape" in state.derived.field().legend
-    state.set_ghost(False)
+    state.style.ghost = False
     try:
         without = machined.image(size=SIZE, fit=False).astype(int)
         assert not scene.ghost_visible
         deformed = _silhouette(machined)
-        state.set_shell_coloring("normal")
+        state.style.shell_coloring = "normal"
         rest = _silhouette(machined)
     finally:
-        state.set_shell_coloring("deformed")
-        state.set_ghost(True)
+        state.style.shell_coloring = "deformed"
+        state.style.ghost = True
     changed = np.abs(with_ghost - without).max(axis=2) > 8
     beside = rest & ~deformed
     assert beside.sum() > 1000, beside.sum()
@@ -101,12 +101,12 @@ def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
     inside = binary_erosion(deformed, iterations=2)  # not the antialiased outline
     assert changed[inside].mean() < 0.002, changed[inside].mean()
     # a mode on the rest shape has no ghost
-    state.set_shell_coloring("magnitude")
+    state.style.shell_coloring = "magnitude"
     try:
         machined.image(size=SIZE)
         assert not scene.ghost_visible
     finally:
-        state.set_shell_coloring("deformed")
+        state.style.shell_coloring = "deformed"
 
 
 def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
@@ -118,13 +118,13 @@ def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
     scene = machined.renderer(SIZE).scene
     state.set_animation(amplitude=1)
     try:
-        state.set_ghost(True)
+        state.style.ghost = True
         with_ghost = machined.image(size=SIZE).astype(int)
         assert scene.ghost_visible
-        state.set_ghost(False)
+        state.style.ghost = False
         without = machined.image(size=SIZE, fit=False).astype(int)
     finally:
-        state.set_ghost(True)
+        state.style.ghost = True
         state.set_animation(amplitude=40)
     changed = (np.abs(with_ghost - without).max(axis=2) > 8).mean()
     assert changed < 0.002, changed
@@ -132,8 +132,8 @@ def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
 
 def test_old_settings_asking_for_automatic_get_the_deformed_shape(machined):
     state = machined.state
-    state.set_shell_coloring("normal")
-    state.set_shell_coloring("auto")
+    state.style.shell_coloring = "normal"
+    state.style.shell_coloring = "auto"
     assert state.style.shell_coloring == "deformed"
 
 
@@ -243,10 +243,10 @@ def test_sessions_keep_the_mode_display_and_colour_range(spot, tmp_path):
     import json
 
     state = spot.state
-    state.set_ghost(False)
+    state.style.ghost = False
     state.set_color_range("limits", (0.0, 2.0))
     path = spot.save_session(tmp_path / "s.json")
-    state.set_ghost(True)
+    state.style.ghost = True
     state.set_color_range("auto")
     data = json.loads(path.read_text())
     assert data["style"]["ghost"] is False and data["style"]["color_limits"] == [0.0, 2.0]

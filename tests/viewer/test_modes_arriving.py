@@ -110,7 +110,7 @@ def test_cancelling_mid_way_keeps_the_modes_shown_and_caches_nothing(tmp_path, m
     cache = SpectrumCache(tmp_path / "cache")
     viewer = mv.Viewer(cache=cache)
     viewer.open_mesh(SPOT)
-    job = viewer.model.request_spectrum("shells", k=200, show=True)
+    job = viewer.request_spectrum("shells", k=200, show=True)
     ready, asked = viewer.wait_for_modes(8, "shells", timeout=120)
     assert 8 <= ready < asked == 200
     viewer.cancel_computation()
@@ -124,7 +124,7 @@ def test_cancelling_mid_way_keeps_the_modes_shown_and_caches_nothing(tmp_path, m
     assert not cache.path(mesh, "shells", 200, 1.0, 1.0).is_file()
     assert cache.get(mesh, "shells", 200, 1.0, 1.0) is None
     # asking again computes the whole spectrum
-    again = viewer.model.request_spectrum("shells", k=200)
+    again = viewer.request_spectrum("shells", k=200)
     assert not again.done
     viewer.wait_for(again, timeout=300)
     assert again.status == DONE and state.spectrum("shells").is_complete

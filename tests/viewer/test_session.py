@@ -30,7 +30,7 @@ def test_a_restored_session_shows_the_same_picture(tmp_path):
     first.open_mesh(mesh_path)
     s = first.state
     first.jobs.wait(first.request_spectrum("laplacian", k=25))
-    s.set_isolines(7)
+    s.style.isolines = 7
     s.set_scale_range((0.01, 2.0))
     s.set_pick(321)
     s.set_display(kind="distance", distance_kind="hks", distance_display="threshold")

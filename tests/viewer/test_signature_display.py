@@ -42,7 +42,7 @@ def test_the_log_colouring_shows_log10_over_the_smallest_value(viewer):
     state = viewer.state
     viewer.show_signature(40)
     plain = state.derived.field().values
-    state.set_log_signature(True)
+    state.style.log_signature = True
     field = state.derived.field()
     np.testing.assert_allclose(field.values, np.log10(plain / plain.min()))
     assert field.values.min() == 0

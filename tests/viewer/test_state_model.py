@@ -279,8 +279,8 @@ def test_events_fire_once_per_change(model):
     seen = []
     state.events.display.connect(lambda: seen.append("display"))
     state.events.style.connect(lambda: seen.append("style"))
-    state.set_isolines(5)
-    state.set_isolines(5)  # no change, no event
+    state.style.isolines = 5
+    state.style.isolines = 5  # no change, no event
     state.set_display(distance_display="threshold")
     state.set_display(distance_display="threshold")
     assert seen == ["style", "display"]

@@ -131,7 +131,7 @@ def test_a_session_restores_the_same_picture(tmp_path, spot_path):
     first.open_mesh(spot_path)
     first.compute("modified_dirichlet", k=30)
     first.show_mode(7)
-    first.state.set_isolines(5)
+    first.state.style.isolines = 5
     first.pick_vertex(1234)
     first.show_distance("feature", display="threshold", share=0.25)
     image = first.image(size=(500, 400))
@@ -294,11 +294,11 @@ def test_a_script_picks_without_computing_the_default_kinds_spectrum(viewer, spo
     viewer.open_mesh(spot_path)
     viewer.state.set_compute_settings(k=12)
     viewer.pick_file_vertex(123, show=False)
-    assert viewer.picked == 123 and viewer.model.jobs.jobs == []
+    assert viewer.picked == 123 and viewer.jobs.jobs == []
     viewer.show_distance("hks")
-    operators = [job.spectrum_key.operator for job in viewer.model.jobs.jobs]
+    operators = [job.spectrum_key.operator for job in viewer.jobs.jobs]
     assert operators == ["laplacian"]
-    for job in list(viewer.model.jobs.jobs):
+    for job in list(viewer.jobs.jobs):
         viewer.wait_for(job)
     d = viewer.show_distance("hks")
     assert d.shape == (viewer.mesh.n_vertices,) and d[123] == 0.0

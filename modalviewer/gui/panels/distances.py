@@ -103,7 +103,9 @@ class DistancesPanel(QtWidgets.QWidget):
         self.distance_button.clicked.connect(self.showDistanceRequested)
         self.scale_slider.valueChanged.connect(self._on_scale)
         self.scale_edit.editingFinished.connect(self._on_scale_typed)
-        self.log_check.toggled.connect(lambda on: self.state.set_log_signature(bool(on)))
+        self.log_check.toggled.connect(
+            lambda on: setattr(self.state.style, "log_signature", bool(on))
+        )
         state.events.style.connect(self._update_log_check)
         state.events.signature_curve.connect(self._update_signature_plot)
         for event in (

@@ -75,9 +75,9 @@ class ModesPanel(QtWidgets.QWidget):
         self.mode_spin.valueChanged.connect(self._on_mode_input)
         self.spectrum_plot.sampleClicked.connect(self._on_mode_input)
         self.color_combo.currentIndexChanged.connect(
-            lambda _: state.set_shell_coloring(self.color_combo.currentData())
+            lambda _: setattr(state.style, "shell_coloring", self.color_combo.currentData())
         )
-        self.iso_spin.valueChanged.connect(state.set_isolines)
+        self.iso_spin.valueChanged.connect(lambda n: setattr(state.style, "isolines", n))
         events = state.events
         for event in (events.display, events.spectra, events.mesh):
             event.connect(self.update_from_state)
