@@ -221,6 +221,18 @@ class JobQueue:
         self._start_next()
         return job
 
+    def add_spectrum(
+        self, make_work, key: Hashable, description: str, owner: Hashable, spectrum_key, deliver
+    ) -> SpectrumJob:
+        """Queue a :class:`SpectrumJob` (see :meth:`add`) running ``make_work(on_modes)``:
+        the modes its solve hands to ``on_modes`` as they converge reach
+        ``deliver(spectrum)`` on the owner's thread (:class:`LatestModes`).  The viewer's
+        and the shape pair's requests both go through here."""
+        arrivals = LatestModes(self.dispatch, deliver)
+        job = self.add(SpectrumJob(make_work(arrivals), key, description, owner, spectrum_key))
+        arrivals.job = job
+        return job
+
     @property
     def running(self) -> Job | None:
         return next((job for job in self.jobs if job.status == RUNNING), None)

@@ -26,7 +26,7 @@ from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
 from ..spectra import cached_or_computed
-from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, RepairJob, SpectrumJob
+from .jobs import CANCELLED, DONE, Job, JobQueue, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
@@ -292,15 +292,14 @@ class ViewerModel:
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
-        arrivals = LatestModes(
-            self.jobs.dispatch,
+        job = self.jobs.add_spectrum(
+            lambda on_modes: self._work(key, on_modes),
+            (state.mesh.hash, key),
+            key.describe(),
+            state.mesh.hash,
+            key,
             self._modes_arrived(key, display_at_request if show else None),
         )
-        work = self._work(key, arrivals)
-        job = self.jobs.add(
-            SpectrumJob(work, (state.mesh.hash, key), key.describe(), state.mesh.hash, key)
-        )
-        arrivals.job = job
         state.set_computing(key, True)
         owner = state.mesh.hash
 

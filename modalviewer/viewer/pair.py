@@ -50,7 +50,7 @@ from ..core.spectrum import Spectrum
 from ..core.validate import check_vertices
 from ..spectra import cached_or_computed
 from .color_scale import auto_spread
-from .jobs import CANCELLED, DONE, Job, JobQueue, LatestModes, SpectrumJob
+from .jobs import CANCELLED, DONE, Job, JobQueue
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
     DISTANCE_DISPLAYS,
@@ -335,17 +335,14 @@ class PairState:
             job = self._pending.get(slot)
             if job is None or job.done:
                 self._failed.pop(slot, None)
-                arrivals = LatestModes(self.jobs.dispatch, self._modes_arrived(slot))
-                job = self.jobs.add(
-                    SpectrumJob(
-                        self._work(side, key, arrivals),
-                        (s.mesh.hash, key),
-                        f"{key.describe()} of {side.upper()} ({s.name})",
-                        self.owner(side),
-                        key,
-                    )
+                job = self.jobs.add_spectrum(
+                    lambda on_modes, side=side: self._work(side, key, on_modes),
+                    (s.mesh.hash, key),
+                    f"{key.describe()} of {side.upper()} ({s.name})",
+                    self.owner(side),
+                    key,
+                    self._modes_arrived(slot),
                 )
-                arrivals.job = job
                 self._pending[slot] = job
                 job.then(lambda j, slot=slot: self._on_job(slot, j))
             jobs.append(job)

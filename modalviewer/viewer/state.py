@@ -255,7 +255,7 @@ class ViewerState:
         self.picked: int | None = None
         self.t_range: tuple[float, float] | None = None
         self.style = Style()
-        self.style.events.all.connect(lambda _info: self.events.style.emit())
+        self.style.events.all.connect(self._style_changed)
         self.animation = Animation()
         self.camera: dict | None = None
         self.up_axis: str | None = None
@@ -266,6 +266,9 @@ class ViewerState:
         ``display.threshold`` and ``display.threshold_share`` were last matched; None
         before the first (it gets the share), :data:`NEXT_MAP` after a fraction was set
         while no threshold map was on screen (the next one keeps it)."""
+
+    def _style_changed(self) -> None:
+        self.events.style.emit()
 
     @cached_property
     def derived(self) -> DerivedValues:
