@@ -199,7 +199,16 @@ class ViewerModel:
         self.derived = self.state.derived  # the values computed from the state
         self.jobs = JobQueue(dispatch)
         self.cache = cache or SpectrumCache()
+        self._waiter = None  # how a window waits (Viewer.use_event_loop)
         self.jobs.events.finished.connect(self._store_result)
+
+    def wait_for(self, job: Job, timeout: float | None = None) -> Job:
+        """Wait until ``job`` has ended (its callbacks have run)."""
+        if job.done:
+            return job
+        if self._waiter is not None:
+            return self._waiter(job)
+        return self.jobs.wait(job, timeout)
 
     # -------------------------------------------------------------- mesh
     def set_mesh(self, mesh: Mesh, path=None, repairs: list[str] | None = None) -> None:
@@ -444,6 +453,53 @@ class ViewerModel:
             return spec, table
 
         return work
+
+    def request_exact_curve(self, wait: bool = False) -> Job | None:
+        """Sum the picked vertex's signature curve (over the scales of the distance
+        kind's table) over all modes, by :func:`~modalviewer.core.local_signature.
+        local_signature` with the spectrum shown (one factorisation of the operator,
+        then a few Lanczos steps per scale), as a job in the queue, off this thread;
+        the result is :meth:`.derived.DerivedValues.exact_curve` and
+        ``state.events.signature_curve`` says it arrived.  None if there is no curve,
+        its spectrum is coarse-to-fine, or the exact curve is already in."""
+        from ..core.local_signature import local_signature
+
+        state, derived = self.state, self.state.derived
+        key = derived.curve_key()
+        if key is None or derived.exact_curve() is not None:
+            return None
+        operator, _, vertex, _ = key
+        spec = state.spectrum(operator)
+        spectrum_key = state.spectrum_key(operator)
+        if spectrum_key.coarse:
+            return None
+        mesh = state.compute_mesh(spectrum_key)
+        times = derived.table(operator).times.copy()
+
+        def run(progress, cancel):
+            progress("exact signature", 0.0)
+            return local_signature(
+                mesh,
+                operator,
+                [vertex],
+                times,
+                bending=spectrum_key.bending,
+                membrane=spectrum_key.membrane,
+                spectrum=spec,
+            )[0]
+
+        number = state.picked_file_vertex
+        job = self.jobs.submit(
+            run, ("exact curve", *key), f"exact signature of vertex {number}", owner=state.mesh.hash
+        )
+
+        def arrived(j: Job) -> None:
+            if j.status == DONE:
+                derived.keep_exact_curve(key, times, j.result)
+                state.events.signature_curve.emit()
+
+        job.then(arrived)
+        return self.wait_for(job) if wait else job
 
     def _store_result(self, job: Job) -> None:
         mesh = self.state.mesh

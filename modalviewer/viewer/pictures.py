@@ -1,0 +1,316 @@
+"""The Viewer's pictures: what the surface shows as values, PNG screenshots, animations,
+mode grids and comparisons, drawn by :mod:`modalviewer.scene` (loaded on the first
+picture, so the rest of the viewer needs no VTK).  A part of :class:`.viewer.Viewer`.
+
+Without a window the pictures come from an off-screen renderer of the state; a window
+attaches its own view (:meth:`Pictures.attach_picture`), and screenshots without a size
+are taken from it as on screen.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..extras import extra_needed
+
+
+class Pictures:
+    """The picture methods of :class:`.viewer.Viewer` (which sets ``state``,
+    ``_picture`` and ``_renderer``)."""
+
+    def attach_picture(self, source) -> None:
+        """Exports and sessions take their picture and camera from ``source`` (a window's
+        view: ``source.plotter``, ``source.scene``, ``source.current_camera()``) instead
+        of an off-screen renderer; None detaches it."""
+        self._picture = source
+        if source is not None and self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def current_field(self) -> tuple[str, np.ndarray] | None:
+        """(name, per-vertex values) of what the surface shows, or None without a mesh.
+        Without a field (a fresh mesh) the values are zeros."""
+        if self.state.mesh is None:
+            return None
+        field = self.state.derived.field()
+        if field is None or field.colormap == "plain":
+            return "field", self._input_field(np.zeros(self.state.mesh.n_vertices))
+        title = field.title or "field"
+        if field.colormap == "threshold":  # the values are the distances: their name only,
+            title = title.split(" <")[0]  # not the threshold, which the slider moves
+        return title, self._input_field(np.asarray(field.values, dtype=np.float64))
+
+    @extra_needed("Viewer.export_field")
+    def export_field(self, path) -> Path:
+        """Write the mesh with the field shown as point data (.vtp or .ply)."""
+        from ..scene.export import save_field_mesh
+
+        field = self.current_field()
+        if field is None:
+            raise ValueError("nothing to export: open a mesh first")
+        name, values = field
+        return save_field_mesh(Path(path), self.mesh, {name: values})
+
+    @extra_needed("the viewer's pictures")
+    def renderer(self, size=None):
+        """The off-screen renderer drawing this viewer (made on first use; ``size``
+        (width, height) in pixels, default 1024x768)."""
+        from ..scene.offscreen import DEFAULT_SIZE, OffscreenRenderer
+
+        if self._renderer is None:
+            self._renderer = OffscreenRenderer(self.state, size or DEFAULT_SIZE)
+        elif size is not None:
+            self._renderer.resize(size)
+        return self._renderer
+
+    @extra_needed("Viewer.export_screenshot")
+    def export_screenshot(
+        self,
+        path,
+        scale: int = 1,
+        transparent: bool = False,
+        colorbar: bool | None = None,
+        size=None,
+        marker: bool | None = None,
+        fit: bool = True,
+    ) -> Path:
+        """Save the picture as PNG (atomically).
+
+        With a window attached and no ``size``, its view as on screen.  Otherwise the
+        same scene drawn off screen at ``size``, seen from the picture's direction with
+        the camera fitted so that the whole shape (deformed as drawn) lies inside the
+        frame, clear of the legend and the colour bar.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The PNG to write.
+        scale : int
+            Magnification: the PNG is ``scale`` times the picture's width and height.
+        transparent : bool
+            A transparent background.
+        colorbar : bool, optional
+            With the colour bar and legend (None: as the state says).
+        size : (int, int), optional
+            (width, height) in pixels (before ``scale``); without a window the default
+            is 1024 x 768 (a size given to one call does not carry over to the next).
+        marker : bool, optional
+            With the pick marker (None: on distance maps, not on other pictures).
+        fit : bool
+            Fit the camera to the shape (off screen); False keeps the camera as it is
+            (pictures of several displays from one camera).
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
+        from ..scene.export import png_path, save_png
+
+        path = png_path(path)  # a wrong name is refused before any drawing
+        if colorbar is not None:
+            self.state.style.colorbar = colorbar
+        return save_png(path, self.image(scale, transparent, size, marker, fit))
+
+    @extra_needed("Viewer.image")
+    def image(
+        self,
+        scale: int = 1,
+        transparent: bool = False,
+        size=None,
+        marker: bool | None = None,
+        fit: bool = True,
+    ) -> np.ndarray:
+        """The picture as an (h, w, 3 or 4) uint8 array (for notebooks); ``size``,
+        ``marker`` and ``fit`` as in :meth:`export_screenshot`."""
+        marker = self.marker_shown(marker)
+        if self._picture is not None and size is None:
+            from ..scene.export import grab
+
+            return grab(
+                self._picture.plotter, self._picture.scene, scale, transparent, marker=marker
+            )
+        renderer, temporary = self._offscreen_at(size)
+        try:
+            if fit:
+                renderer.frame()
+            return renderer.image(scale, transparent, marker=marker)
+        finally:
+            if temporary:
+                renderer.close()
+
+    def marker_shown(self, marker: bool | None = None) -> bool:
+        """Whether a picture shows the pick marker: ``marker`` where given, else on
+        distance maps only (a mode's picture is the same whatever vertex was picked)."""
+        if marker is not None:
+            return bool(marker)
+        return self.state.display.kind == "distance"
+
+    def _offscreen_at(self, size):
+        """(an off-screen renderer of the state at ``size``, whether it is a temporary
+        one to close): this viewer's own without a window; with a window a new one,
+        looking from the window's camera.  A size does not carry over from an earlier
+        call, as :meth:`renderer`'s does."""
+        from ..scene.offscreen import DEFAULT_SIZE, OffscreenRenderer
+
+        if self._picture is None:
+            return self.renderer(size or DEFAULT_SIZE), False
+        w, h = self._picture.plotter.window_size
+        renderer = OffscreenRenderer(self.state, size or (int(w), int(h)))
+        renderer.set_camera(self.current_camera())
+        return renderer, True
+
+    @extra_needed("Viewer.animation_images")
+    def animation_images(
+        self, frames: int | None = None, fps: float | None = None, size=None, marker=None
+    ) -> list[np.ndarray]:
+        """The frames of one period of the mode shown vibrating, as the window animates
+        it (RGB uint8 arrays, ``size`` (width, height), default 640 x 480): ``frames``
+        frames (default: as many as play one period at ``fps`` at the window's speed),
+        the camera from the picture's direction fitted to the whole motion, legend and
+        colour bar drawn on; the pick marker only if ``marker``.  ValueError when no
+        mode is shown."""
+        from ..scene.animation import ANIMATION_SIZE, DEFAULT_FPS, frame_phases, period_frames
+        from ..scene.offscreen import OffscreenRenderer
+
+        state = self.state
+        d = state.display
+        if state.mesh is None or d.kind != "mode" or state.spectrum(d.operator) is None:
+            raise ValueError("an animation shows a vibration mode: show a mode first")
+        fps = DEFAULT_FPS if fps is None else float(fps)
+        if fps <= 0:
+            raise ValueError(f"fps must be positive, got {fps:g}")
+        n = period_frames(state.animation.speed, fps) if frames is None else int(frames)
+        if n < 2:
+            raise ValueError(f"an animation needs at least 2 frames, got {n}")
+        size = tuple(int(x) for x in (size or ANIMATION_SIZE))
+        camera = self.current_camera()
+        renderer = OffscreenRenderer(state, size)
+        try:
+            renderer.set_camera(camera)
+            reach = state.derived.amplitude_length()
+            renderer.frame(reach=reach, both=True)
+            marker = bool(marker)
+            images = []
+            for phase in frame_phases(n):
+                renderer.drawing.animation_frame(phase)
+                images.append(renderer.image(marker=marker)[..., :3])
+        finally:
+            renderer.close()
+        return images
+
+    @extra_needed("Viewer.export_animation")
+    def export_animation(
+        self,
+        path,
+        frames: int | None = None,
+        fps: float | None = None,
+        size=None,
+        marker: bool | None = None,
+    ) -> Path:
+        """Write one period of the mode shown, vibrating as the window shows it, to a GIF
+        or (where imageio and imageio-ffmpeg are installed) an MP4, atomically; it loops
+        without a jump.  ``frames``, ``fps``, ``size`` and ``marker`` as in
+        :meth:`animation_images` (``fps`` default 25).  Returns the path written."""
+        from ..scene.animation import (
+            ANIMATION_SIZE,
+            DEFAULT_FPS,
+            animation_path,
+            check_size,
+            write_animation,
+        )
+
+        path = animation_path(path)  # a wrong name is refused before any drawing
+        check_size(path, size or ANIMATION_SIZE)
+        images = self.animation_images(frames, fps, size, marker)
+        return write_animation(path, images, DEFAULT_FPS if fps is None else fps)
+
+    def mode_grid(self, modes, operator: str | None = None, grid=None, size=None) -> np.ndarray:
+        """Modes ``modes`` of ``operator`` (default: the one shown) side by side in one
+        picture (RGB uint8): panels of ``size`` (width, height) pixels (default 400 x
+        340) in a ``grid`` (columns, rows; default rows of up to 4), one camera fitted to
+        all, each captioned with its mode number and eigenvalue, one colour bar for the
+        range they share (see :func:`modalviewer.scene.grid.mode_grid`)."""
+        from ..scene.grid import GRID_PANEL, mode_grid
+
+        return mode_grid(self, modes, operator, grid, size or GRID_PANEL)
+
+    def export_mode_grid(
+        self, path, modes, operator: str | None = None, grid=None, size=None
+    ) -> Path:
+        """Write :meth:`mode_grid` to a PNG (atomically); returns the path."""
+        from ..scene.export import png_path, save_png
+
+        path = png_path(path)
+        return save_png(path, self.mode_grid(modes, operator, grid, size))
+
+    def animation_frame(self, phase: float, size=None) -> float:
+        """Move the picture's surface to ``phase`` (radians) of the vibration shown (a
+        still of the animation, kept until the display changes); returns the time this
+        took in s."""
+        source = self._picture or self.renderer(size)
+        drawing = getattr(source, "drawing", source)
+        return drawing.animation_frame(phase)
+
+    def set_view(self, view="canonical", up=None) -> dict | None:
+        """Turn the camera to ``view``: "canonical", a preset ("+x" ... "-z",
+        "isometric"/"iso") or (azimuth, elevation) in degrees about the up axis (also as
+        "AZ,EL"); ``up`` ("auto", "+x" ... "-z") chooses the up axis first.  Returns
+        the camera set (position, focal_point, view_up), None without a mesh."""
+        from .camera import parse_view, view_camera
+
+        view = parse_view(view) if isinstance(view, str) else tuple(float(x) for x in view)
+        if up is not None:
+            self.state.set_up_axis(up)
+        mesh = self.state.mesh
+        if mesh is None:
+            return None
+        camera = view_camera(mesh.vertices, mesh.faces, view, up=self.state.derived.up_axis())
+        data = {**camera.as_dict(), "fit": True}
+        self.state.set_camera(data)
+        return data
+
+    def current_camera(self) -> dict | None:
+        """The camera of the picture (window or off screen) as plain data."""
+        source = self._picture or self._renderer
+        if source is None:
+            return self.state.camera
+        drawing = getattr(source, "drawing", source)
+        return drawing.current_camera()
+
+    @extra_needed("Viewer.export_comparison")
+    def export_comparison(self, comparison, path, size=None, scale: int = 1) -> Path:
+        """Write the views of ``comparison`` side by side to a PNG, seen from the camera of
+        this viewer's picture.
+
+        Parameters
+        ----------
+        comparison : Comparison or list of str
+            A :meth:`comparison`, or its items (two or three operators or distance kinds; their
+            missing spectra are computed first).
+        path : str or os.PathLike
+            The PNG to write.
+        size : (int, int), optional
+            (width, height) of each view in pixels.
+        scale : int
+            Magnification: each view is ``scale`` times ``size``.
+
+        Returns
+        -------
+        pathlib.Path
+            The file written.
+        """
+        from ..scene.comparison import VIEW_SIZE, save_comparison
+        from .camera import Camera
+
+        if not hasattr(comparison, "views"):
+            comparison = self.comparison(comparison)
+        cam = self.current_camera()
+        camera = None
+        if cam is not None:
+            camera = Camera(
+                tuple(cam["position"]), tuple(cam["focal_point"]), tuple(cam["view_up"])
+            )
+        return save_comparison(comparison, path, size or VIEW_SIZE, camera, scale)
