@@ -1,22 +1,17 @@
 """Values computed from the viewer's state and kept until it changes (no Qt, no VTK).
 
-:class:`DerivedValues` holds every cached value the viewer computes from a
-:class:`~.state.ViewerState`: vertex normals, smoothed normals, the scale a deformed 3D
-mode is drawn at, colour ranges, curvature, vertex areas, signature tables, the distance
-map of the pick, and :meth:`DerivedValues.field`, the per-vertex picture the scene
-draws.  None of it is part of the state: it can be dropped and recomputed at any time.
-
-Ownership: each state has one, created on first use as :attr:`ViewerState.derived
-<.state.ViewerState.derived>` (the state's threshold rule needs the distances, and the
-panels reach it through the state they observe); :class:`~.model.ViewerModel` exposes the
-same object as ``model.derived``.
+:class:`DerivedValues` (``state.derived``, created on first use: the state's threshold
+rule needs the distances) holds every cached value computed from the state: normals,
+the scale a deformed 3D mode is drawn at, colour ranges, curvature, vertex areas,
+signature tables, the distance map of the pick, and :meth:`DerivedValues.field`, the
+per-vertex picture the scene draws.  None of it is part of the state: it can be dropped
+and recomputed at any time.
 
 Every cached value remembers what it was computed from (the mesh, the spectrum object,
 the pick, the scale range) and is recomputed when that is no longer the state's, so a
 reader is never served a stale value, whatever order the state's event callbacks run
-in.  The object also subscribes to the state's ``mesh``, ``spectra`` and
-``scale_range`` events to release what nothing shows any more (at 130k vertices a
-signature table holds hundreds of MB).
+in.  It also subscribes to the state's ``mesh``, ``spectra`` and ``scale_range`` events
+to release what nothing shows any more (a signature table holds n x T floats).
 """
 
 from __future__ import annotations

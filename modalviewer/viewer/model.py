@@ -196,7 +196,6 @@ class ViewerModel:
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None):
         self.state = ViewerState()
-        self.derived = self.state.derived  # the values computed from the state
         self.jobs = JobQueue(dispatch)
         self.cache = cache or SpectrumCache()
         self._waiter = None  # how a window waits (Viewer.use_event_loop)

@@ -1,16 +1,14 @@
 """The viewer's state: what is loaded, computed, displayed and picked (no Qt, no VTK).
 
-:class:`ViewerState` is the single source of truth of the viewer.  The 3D scene, every
-panel, the status bar and the plots observe its events and redraw from it; they keep
-no state of their own.  Input (a click, a slider, a script, the CLI) goes through its
-setters, which validate, store and emit.  Everything shown is derived from it: the
-values computed from it (the per-vertex picture :meth:`.derived.DerivedValues.field`,
-distances, signature tables, normals) live in :attr:`ViewerState.derived`, a
-:class:`~.derived.DerivedValues` created on first use (``ViewerModel.derived`` is the
-same object), and the words (legends, the status line, notes) are the functions of
-:mod:`.wording`.
+:class:`ViewerState` is the single source of truth of the viewer (``viewer.state``).
+The 3D scene, every panel, the status bar and the plots observe its events and redraw
+from it; they keep no state of their own.  Fields that only need validating are
+evented (:class:`Style`: ``state.style.isolines = 8``); changes that do more go through
+methods (:meth:`ViewerState.set_display`, ``set_pick``, ``set_scale_range``, ...).  The
+values computed from it live in :attr:`ViewerState.derived` (:mod:`.derived`), the words
+shown in :mod:`.wording`.
 
-A setter changes only what it is given, with one exception, the threshold rule
+A method changes only what it is given, with one exception, the threshold rule
 (:meth:`ViewerState._match_threshold`): a threshold map marks the share
 :attr:`Display.threshold_share` of the surface's area; with :attr:`Display.keep_share`
 a new map (another pick, kind, scale range or spectrum) gets the threshold fraction that
@@ -18,25 +16,15 @@ marks that share; a fraction the caller sets (``set_display(threshold=...)``) se
 share it marks, and a share the caller sets (``set_display(threshold_share=...)``) the
 fraction that marks it.
 
-Events (``state.events.<name>.connect(callback)``), all emitted on the thread that
-changed the state (the GUI thread in the viewer):
-
-- ``mesh()``: a new mesh (or none) is loaded; spectra, pick and display were reset.
-- ``spectra(operator)``: a spectrum of ``operator`` was added or replaced.
-- ``display()``: what is drawn changed (:class:`Display`), including the threshold
-  (also when the threshold rule gave a new map its fraction).
-- ``style()``: isolines, how 3D modes are shown, the rest-shape ghost, the colour range,
-  colour bar, render style.
-- ``pick()``: the picked vertex changed (:attr:`ViewerState.picked` is the mesh's index;
-  what is shown and saved is :attr:`ViewerState.picked_file_vertex`, the file's number).
-- ``compute_settings()``: operator, k, weights or options of the next computation.
-- ``scale_range()``: the distance scale range (t1, t2) changed.
-- ``animation()``: playing, amplitude or speed changed.
-- ``camera()``: a camera was set through the state (a preset, a restored session).
-- ``signature_curve()``: the picked vertex's exact signature curve was computed
-  (:meth:`.derived.DerivedValues.exact_curve`).
-- ``up_axis()``: the up axis was chosen (:attr:`ViewerState.up_axis`); the scene turns to
-  the canonical view for it.
+Events (``state.events.<name>.connect(callback)``), emitted on the thread that changed
+the state (the GUI thread in the viewer): ``mesh()`` (a new mesh or none: spectra, pick
+and display were reset), ``spectra(operator)`` (added or replaced), ``display()`` (what
+is drawn, including a threshold the rule matched), ``style()`` (any :class:`Style`
+field), ``pick()`` (:attr:`ViewerState.picked` is the mesh's index,
+:attr:`ViewerState.picked_file_vertex` the file's number shown and saved),
+``compute_settings()``, ``scale_range()``, ``animation()``, ``camera()`` (set through
+the state: a preset, a restored session), ``signature_curve()`` (the exact curve
+arrived) and ``up_axis()`` (the scene turns to the canonical view for it).
 """
 
 from __future__ import annotations
@@ -273,7 +261,7 @@ class ViewerState:
     @cached_property
     def derived(self) -> DerivedValues:
         """The values computed from this state (:class:`~.derived.DerivedValues`),
-        created on first use; ``ViewerModel.derived`` is the same object."""
+        created on first use."""
         return DerivedValues(self)
 
     # ------------------------------------------------------------- mesh

@@ -33,9 +33,11 @@ def marked(state) -> float:
     return float(areas[d <= state.display.threshold * d.max()].sum() / areas.sum())
 
 
-def test_the_model_and_the_state_share_one_derived_object(model):
-    assert isinstance(model.derived, DerivedValues)
-    assert model.derived is model.state.derived and model.derived.state is model.state
+def test_the_state_owns_the_one_derived_object(model):
+    derived = model.state.derived
+    assert isinstance(derived, DerivedValues)
+    assert model.state.derived is derived and derived.state is model.state
+    assert not hasattr(model, "derived")  # no second name for it
 
 
 def test_a_share_set_by_the_user_is_kept_across_a_new_pick_and_a_new_spectrum(model):
@@ -89,7 +91,7 @@ def test_a_fraction_set_explicitly_is_kept_as_a_fraction(model):
 
 
 def test_the_derived_values_follow_the_mesh_the_spectra_and_the_pick(model):
-    state, derived = model.state, model.derived
+    state, derived = model.state, model.state.derived
     model.jobs.wait(model.request_spectrum("laplacian", k=30))
     state.set_display(kind="distance", distance_kind="hks")
     assert derived.distance_map() is None  # no pick yet
@@ -137,14 +139,14 @@ def test_the_wording_functions_give_the_legends_they_gave_as_state_methods(tmp_p
     model.jobs.wait(model.request_spectrum("laplacian", k=30))
     state.show_mode(5, "laplacian")
     mode_text = "Laplacian (cotan), mode 5: lambda = 10.75\nblue +, white 0, orange -"
-    assert wording.legend(state, model.derived) == mode_text
+    assert wording.legend(state, model.state.derived) == mode_text
     # the picture's legend also names the colour range
-    assert model.derived.field().legend == mode_text + "\nrange: the largest |value|"
+    assert model.state.derived.field().legend == mode_text + "\nrange: the largest |value|"
     assert wording.summary(state) == mode_text.replace("\n", "; ")
     state.set_pick(100)
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
     threshold_text = "blue: heat kernel distance < 0.0621, 10.0 % of the surface\nfrom vertex 100"
-    assert wording.legend(state, model.derived) == threshold_text
-    assert model.derived.field().legend == threshold_text
+    assert wording.legend(state, model.state.derived) == threshold_text
+    assert model.state.derived.field().legend == threshold_text
     assert wording.display_mark(state) == ""
     assert wording.approximation_note(state, "laplacian") == ""
