@@ -303,7 +303,7 @@ def test_compute_refuses_what_does_not_fit_and_says_what_would(tmp_path, monkeyp
     from modalviewer import cli
     from modalviewer.viewer import model
 
-    monkeypatch.setattr(model, "physical_memory", lambda: 64 * 2**20)  # 64 MiB
+    monkeypatch.setattr(model, "physical_memory_mb", lambda: 64.0)  # 64 MiB
     code = cli.main(
         [
             "compute",

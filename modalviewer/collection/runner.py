@@ -453,10 +453,11 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
     if client is None and scheduler is not None:
         client = distributed.Client(scheduler)
     elif client is None:
-        from ..viewer.model import physical_memory
+        from ..core.memory import physical_memory_mb
 
         workers = max(1, int(workers))
-        memory_limit = memory_limit or int(physical_memory() / workers) or None
+        physical = (physical_memory_mb() or 0.0) * 2**20
+        memory_limit = memory_limit or int(physical / workers) or None
         threads = str(max(1, (os.cpu_count() or 1) // workers))
         cluster = distributed.LocalCluster(
             n_workers=workers,

@@ -35,12 +35,6 @@ class ComputeRefused(ValueError):
     """A computation was refused before it started; the message says why and what to do."""
 
 
-def physical_memory() -> int:
-    """Bytes of physical memory, or 0 if unknown (:func:`.core.memory.physical_memory_mb`)."""
-    megabytes = physical_memory_mb()
-    return 0 if megabytes is None else int(megabytes * 2**20)
-
-
 def copy_vertices(n_vertices: int) -> int:
     """Vertices of the decimated copy Coarse-to-fine solves on (:data:`COARSE_FRACTION`)."""
     return round(COARSE_FRACTION * n_vertices)
@@ -179,7 +173,7 @@ def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS
     :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
     The viewer's refusals and ``modalviewer compute`` say the same."""
     needed = memory_needed(key, n_vertices)
-    available = physical_memory()
+    available = (physical_memory_mb() or 0.0) * 2**20  # bytes; 0 if unknown
     if available and needed > MEMORY_SHARE * available:
         return (
             f"{operator_info(key.operator).label} with {key.k} modes on "

@@ -459,7 +459,7 @@ def test_too_large_computation_is_refused_up_front(window, spot_path, monkeypatc
     from modalviewer.viewer import model
 
     window.open_mesh(spot_path)
-    monkeypatch.setattr(model, "physical_memory", lambda: 64 * 2**20)  # 64 MiB
+    monkeypatch.setattr(model, "physical_memory_mb", lambda: 64.0)  # 64 MiB
     with pytest.raises(main_window.ComputeError, match="GiB of memory"):
         window.compute("shells", k=300, wait=True)
     assert "Coarse-to-fine" in window.last_error and not window.busy

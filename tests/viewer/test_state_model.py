@@ -403,7 +403,7 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     # memory for about 150 of the 300 modes asked for
     needed = model_module.memory_needed(replace(key, k=150), n)
     available = int(needed / model_module.MEMORY_SHARE)
-    monkeypatch.setattr(model_module, "physical_memory", lambda: available)
+    monkeypatch.setattr(model_module, "physical_memory_mb", lambda: available / 2**20)
     message = m.refusal(key)
     k = model_module.largest_k_that_fits(key, n, available)
     assert 1 <= k < 300 and f"at most {k} modes fit" in message.lower()
@@ -417,7 +417,7 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
         f"more than the {limit / 2**30:.1f} GiB a computation may take (three quarters of "
         f"this machine's {available / 2**30:.1f} GiB)" in message
     ), message
-    monkeypatch.setattr(model_module, "physical_memory", lambda: 1024)
+    monkeypatch.setattr(model_module, "physical_memory_mb", lambda: 1024 / 2**20)
     assert "Not even one mode fits" in m.refusal(key)
 
 
@@ -445,7 +445,7 @@ def test_a_refusal_offers_no_option_that_cannot_give_the_modes_asked_for(monkeyp
         / model_module.MEMORY_SHARE
     )
     assert model_module.memory_needed(too_many, n) > model_module.MEMORY_SHARE * available
-    monkeypatch.setattr(model_module, "physical_memory", lambda: available)
+    monkeypatch.setattr(model_module, "physical_memory_mb", lambda: available / 2**20)
     message = m.refusal(too_many)
     assert "Coarse-to-fine" not in message, message
     assert "modes fit" in message
