@@ -58,6 +58,7 @@ __all__ = [
     "typical_eigenvalue",
     "zero_mode_size",
     "rounding_floors",
+    "progress_reporter",
     "ZERO_MODE_RTOL",
 ]
 
@@ -280,7 +281,7 @@ def solve_lowest(
     """
     K, mass_diag = _checked_problem(K, mass_diag, k)
     N = K.shape[0]
-    report = _reporter(progress, cancel)
+    report = progress_reporter(progress, cancel)
     median_ratio = typical_eigenvalue(K, mass_diag)
     Z = _null_vectors(null_space, N, mass_diag)
     d = Z.shape[1]
@@ -347,7 +348,7 @@ def _checked_problem(K, mass_diag, k: int) -> tuple[sp.csr_matrix, np.ndarray]:
     return K, mass_diag
 
 
-def _reporter(progress: ProgressFn | None, cancel: CancelFn | None) -> ProgressFn:
+def progress_reporter(progress: ProgressFn | None, cancel: CancelFn | None) -> ProgressFn:
     """``report(stage, fraction)``: raises :class:`Cancelled` when ``cancel`` asks to
     stop, else passes the fraction, clipped to [0, 1], to ``progress``."""
 

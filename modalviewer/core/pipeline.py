@@ -9,7 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .assembly import operator_matrices
-from .eigen import CancelFn, EigenError, ProgressFn, rounding_floors
+from .eigen import CancelFn, EigenError, ProgressFn, progress_reporter, rounding_floors
 from .exact import exact_pairs
 from .memory import return_freed_memory
 from .mesh import Mesh
@@ -151,17 +151,8 @@ def compute_spectrum(
         )
         return in_input_numbering(solved, mesh)
     progress = _returning_freed_memory(progress)
-
-    def report(stage: str, fraction: float) -> None:
-        if cancel is not None and cancel():
-            from .eigen import Cancelled
-
-            raise Cancelled()
-        if progress is not None:
-            progress(stage, fraction)
-
     started = time.perf_counter()
-    report("assembling", 0.0)
+    progress_reporter(progress, cancel)("assembling", 0.0)
     try:
         sink = (
             None if on_modes is None else _ModesSoFar(mesh, operator, bending, membrane, on_modes)
@@ -177,32 +168,31 @@ def compute_spectrum(
             stacklevel=2,
         )
     at_floor, worst_floor = _checked_residuals(pairs, mesh)
+    progress("done", 1.0)
+    parameters = {
+        "k": result.eigenvalues.shape[0],
+        "bending": float(bending),
+        "membrane": float(membrane),
+        **_solve_parameters(result),
+        "seconds_assembly": pairs.seconds_assembly,
+        "seconds_total": time.perf_counter() - started,
+        "modes_at_rounding_floor": at_floor,
+        "worst_residual_rounding_floor": worst_floor,
+        "zero_mode_scale": pairs.zero_mode_scale,
+        "n_components": nulls.n_components,
+        "null_space": nulls.summary(),
+    }
     per_vertex = operator.unknowns_per_vertex
-    modes = result.vectors
-    if per_vertex > 1:
-        modes = modes.reshape(mesh.n_vertices, per_vertex, -1)
-    if progress is not None:
-        progress("done", 1.0)
     spectrum = Spectrum(
         eigenvalues=result.eigenvalues,
-        modes=modes,
+        modes=result.vectors.reshape(mesh.n_vertices, per_vertex, -1)
+        if per_vertex > 1
+        else result.vectors,
         operator=operator.name,
         mass=pairs.mass[::per_vertex],
         residuals=result.residuals,
         mesh_hash=mesh.hash,
-        parameters={
-            "k": result.eigenvalues.shape[0],
-            "bending": float(bending),
-            "membrane": float(membrane),
-            **_solve_parameters(result),
-            "seconds_assembly": pairs.seconds_assembly,
-            "seconds_total": time.perf_counter() - started,
-            "modes_at_rounding_floor": at_floor,
-            "worst_residual_rounding_floor": worst_floor,
-            "zero_mode_scale": pairs.zero_mode_scale,
-            "n_components": nulls.n_components,
-            "null_space": nulls.summary(),
-        },
+        parameters=parameters,
     )
     if on_modes is not None:
         on_modes(spectrum)
