@@ -377,36 +377,8 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
             report.add(f"Removed {_plural(len(f) - len(keep), 'duplicate face')}.")
             f = f[np.sort(keep)]
     min_area = 1e-14 * diag**2
-    n_collapsed = 0
     if len(f) and np.any(0.5 * _double_areas(v, f) <= min_area):
-        f, n_flipped, n_collapsed, dropped, largest, left, merged_into = _collapse_zero_area_faces(
-            v, f, min_area
-        )
-        file_map = merged_into[file_map]
-        if n_flipped:
-            report.add(
-                f"Flipped the longest edge of {_plural(n_flipped, 'degenerate (zero-area) face')}"
-                " (a vertex lying inside that edge: the two faces on it became two faces "
-                "with area; no vertex moved, no holes opened)."
-            )
-        if n_collapsed:
-            report.add(
-                f"Collapsed {_plural(n_collapsed, 'degenerate (zero-area) face')} (merged the "
-                "two vertices of each one's shortest edge, moving none more than "
-                f"{largest / diag:.1e} of the bounding-box diagonal; no holes opened)."
-            )
-        if dropped:
-            report.add(
-                f"Removed {_plural(dropped, 'degenerate (zero-area) face')} lying along the "
-                "boundary (the boundary keeps its shape)."
-            )
-        if left:
-            f = f[0.5 * _double_areas(v, f) > min_area]
-            report.add(
-                f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
-                "flipped or collapsed without tearing or folding the surface (this can "
-                "leave holes)."
-            )
+        f, file_map = _repair_zero_area(v, f, file_map, min_area, diag, report)
     if len(f) == 0:
         raise MeshError("no faces are left after removing degenerate ones: not a surface")
 
@@ -441,3 +413,38 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if problem:
         report.add("Shells and E_D^N cannot run: " + problem)
     return mesh
+
+
+def _repair_zero_area(v, f, file_map, min_area: float, diag: float, report: MeshReport):
+    """Flip, collapse or remove the faces of area at most ``min_area``
+    (:func:`_collapse_zero_area_faces`), saying so in ``report``: (faces, file_map with
+    the collapsed vertices merged)."""
+    f, n_flipped, n_collapsed, dropped, largest, left, merged_into = _collapse_zero_area_faces(
+        v, f, min_area
+    )
+    file_map = merged_into[file_map]
+    if n_flipped:
+        report.add(
+            f"Flipped the longest edge of {_plural(n_flipped, 'degenerate (zero-area) face')}"
+            " (a vertex lying inside that edge: the two faces on it became two faces "
+            "with area; no vertex moved, no holes opened)."
+        )
+    if n_collapsed:
+        report.add(
+            f"Collapsed {_plural(n_collapsed, 'degenerate (zero-area) face')} (merged the "
+            "two vertices of each one's shortest edge, moving none more than "
+            f"{largest / diag:.1e} of the bounding-box diagonal; no holes opened)."
+        )
+    if dropped:
+        report.add(
+            f"Removed {_plural(dropped, 'degenerate (zero-area) face')} lying along the "
+            "boundary (the boundary keeps its shape)."
+        )
+    if left:
+        f = f[0.5 * _double_areas(v, f) > min_area]
+        report.add(
+            f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
+            "flipped or collapsed without tearing or folding the surface (this can "
+            "leave holes)."
+        )
+    return f, file_map

@@ -351,17 +351,10 @@ def block_krylov_schur(
                 f"(worst relative residual {worst:.1e})",
                 columns=applied,
             )
-        # thick restart: keep the best Ritz vectors, continue from the open block
         restarts += 1
-        p = min(keep, j - b)
         with timer("restarts"):
-            rotate_in_place(Q, j, S[:, :p])
-            Q[:, p : p + b] = Q[:, j : j + b]
-        T[:] = 0.0
-        T[np.arange(p), np.arange(p)] = theta[:p]
-        R = R @ S[:, :p]
-        j = p
-        sequence_start = p
+            R, j = _thick_restart(Q, T, R, theta, S, j, min(keep, j - b), b)
+        sequence_start = j
 
 
 def _start_basis(N, b, max_basis, rng, project, basis) -> np.ndarray:
@@ -403,3 +396,13 @@ def _ritz_pairs(T, R, j: int, wanted: int, keep: int, tol: float):
     converged = estimates[:wanted] <= np.maximum(tol * np.abs(theta[:wanted]), floor)
     done = int(np.argmin(converged)) if not converged.all() else wanted
     return theta, S, estimates, done
+
+
+def _thick_restart(Q, T, R, theta, S, j: int, p: int, b: int):
+    """Keep the p best Ritz vectors (rotated into ``Q[:, :p]``, ``T`` their Ritz values)
+    and continue from the open block; returns the new (R, j = p)."""
+    rotate_in_place(Q, j, S[:, :p])
+    Q[:, p : p + b] = Q[:, j : j + b]
+    T[:] = 0.0
+    T[np.arange(p), np.arange(p)] = theta[:p]
+    return R @ S[:, :p], p
