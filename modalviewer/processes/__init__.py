@@ -1,4 +1,3 @@
-"""Plumbing of the processes that exist to compute: the viewer's child process
-(``python -m modalviewer.processes.job_main``) and the memory settings, which the
-command line and the benchmarks apply too.  Nothing here imports the viewer or Qt, so a
-child starts with the numerical core alone."""
+"""The viewer's child processes: a spectrum computation (``job_main``) and a mesh repair
+(``repair_main``).  Nothing here imports the viewer or Qt, so a child starts with the
+numerical core alone; a computation applies :func:`.core.memory.prepare_compute_process`."""

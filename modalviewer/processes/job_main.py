@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 
 
-def _emit(payload: dict) -> None:
+def emit(payload: dict) -> None:
+    """One JSON line to the viewer on stdout (progress, a result or an error)."""
     sys.stdout.write(json.dumps(payload) + "\n")
     sys.stdout.flush()
 
@@ -48,15 +49,15 @@ def main(argv: list[str] | None = None) -> int:
             progress=_report,
             on_modes=None if folder is None else _ModesRelay(Path(folder)),
         )
-        _emit({"stage": "writing the result", "fraction": 0.97})
+        emit({"stage": "writing the result", "fraction": 0.97})
         save_spectrum(spec, out_path)
     except MemoryError:
-        _emit({"error": "not enough memory for this computation; try fewer modes"})
+        emit({"error": "not enough memory for this computation; try fewer modes"})
         return 1
     except Exception as exc:  # reported to the viewer as a message
-        _emit({"error": str(exc) or type(exc).__name__})
+        emit({"error": str(exc) or type(exc).__name__})
         return 1
-    _emit({"done": out_path})
+    emit({"done": out_path})
     return 0
 
 
@@ -84,7 +85,7 @@ class _ModesRelay:
         )
         os.replace(partial, path)
         self.sent = spec.k
-        _emit({"modes": str(path)})
+        emit({"modes": str(path)})
 
 
 def _report(stage: str, fraction: float) -> None:
@@ -92,7 +93,7 @@ def _report(stage: str, fraction: float) -> None:
     (the spectrum is still written, read back and prepared), so it stops below 1."""
     if stage == "done":
         return
-    _emit({"stage": stage, "fraction": min(float(fraction), 0.96)})
+    emit({"stage": stage, "fraction": min(float(fraction), 0.96)})
 
 
 if __name__ == "__main__":

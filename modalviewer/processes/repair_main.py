@@ -7,14 +7,10 @@ IN is a pickle of (repair name, vertices, faces, report, file_map, merged_into) 
 
 from __future__ import annotations
 
-import json
 import pickle
 import sys
 
-
-def _emit(payload: dict) -> None:
-    sys.stdout.write(json.dumps(payload) + "\n")
-    sys.stdout.flush()
+from .job_main import emit
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -27,15 +23,15 @@ def main(argv: list[str] | None = None) -> int:
             name, vertices, faces, report, file_map, merged_into = pickle.load(fh)
         mesh = Mesh(vertices, faces, report=report, file_map=file_map, merged_into=merged_into)
         repaired = apply_repair(
-            name, mesh, progress=lambda stage, f: _emit({"stage": stage, "fraction": f})
+            name, mesh, progress=lambda stage, f: emit({"stage": stage, "fraction": f})
         )
         with open(out_path, "wb") as fh:
             pickle.dump(repaired, fh)
     except MemoryError:
-        _emit({"error": "not enough memory for this repair"})
+        emit({"error": "not enough memory for this repair"})
         return 1
     except Exception as exc:  # reported to the viewer as a message
-        _emit({"error": str(exc) or type(exc).__name__})
+        emit({"error": str(exc) or type(exc).__name__})
         return 1
     return 0
 
