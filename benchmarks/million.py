@@ -58,8 +58,8 @@ def run(grid: int, k: int) -> dict:
         started = time.perf_counter()
         win.compute(operator, k=k, wait=False)  # a refusal is an error on the status line
         first_on_screen = None
-        while win.viewer.busy:
-            running = win.viewer.running_job
+        while win.viewer.jobs.busy:
+            running = win.viewer.jobs.running
             if running is not None and (not stages or stages[-1] != running.stage):
                 stages.append(running.stage)
             if first_on_screen is None and win.state.spectrum(operator) is not None:

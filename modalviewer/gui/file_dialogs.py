@@ -234,7 +234,7 @@ def mode_grid_dialog(win) -> None:
 
     from ..cli.common import mode_list
 
-    operator = win.viewer.current_operator
+    operator = win.viewer.state.current_operator()
     spec = win.state.spectrum(operator) if operator is not None else None
     if spec is None:
         win.show_error("Compute a spectrum first: a mode grid shows its modes.")

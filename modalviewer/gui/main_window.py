@@ -374,7 +374,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.viewer.cancel_computation()
 
     def cancel_all(self) -> None:
-        self.viewer.cancel_all()
+        self.viewer.jobs.cancel_all()
 
     def show_mode(self, index: int, operator: str | None = None) -> None:
         self.viewer.show_mode(index, operator)
@@ -383,10 +383,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.viewer.step_mode(step)
 
     def toggle_animation(self) -> None:
-        self.viewer.toggle_animation()
+        self.state.set_animation(playing=not self.state.animation.playing)
 
     def set_animating(self, on: bool) -> None:
-        self.viewer.set_animating(on)
+        self.state.set_animation(playing=bool(on))
 
     def animation_frame(self, phase: float) -> float:
         """Move the surface to the given phase (radians); returns the app's time in s."""
@@ -548,7 +548,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     @property
     def current_operator(self) -> str | None:
-        return self.viewer.current_operator
+        return self.state.current_operator()
 
     @property
     def display(self) -> str:

@@ -97,7 +97,7 @@ def mode_grid(viewer, modes, operator: str | None = None, grid=None, size=GRID_P
     from .overlay import ColorBar
 
     state = viewer.state
-    op = operator or viewer.current_operator
+    op = operator or viewer.state.current_operator()
     spec = state.spectrum(op) if op is not None else None
     if spec is None:
         raise ValueError("compute a spectrum first: a mode grid shows its modes")

@@ -352,23 +352,11 @@ class Viewer(ViewerModel, Pictures):
         )
         self._status(self._cancel_note or "Cancelling...", 5000)
 
-    def cancel_all(self) -> None:
-        """Cancel every queued and running computation."""
-        self.jobs.cancel_all()
-
     def clear_cache(self) -> int:
         """Delete every cached spectrum; returns the bytes freed."""
         size = self.cache.clear()
         self._status(f"Cache cleared: {size / 2**20:.0f} MB freed.", 8000)
         return size
-
-    @property
-    def running_job(self) -> Job | None:
-        return self.jobs.running
-
-    @property
-    def busy(self) -> bool:
-        return self.jobs.busy
 
     def _on_job_changed(self, job: Job) -> None:
         running = self.jobs.running
@@ -412,15 +400,10 @@ class Viewer(ViewerModel, Pictures):
             self._status(f"{ended_text(job)}.", 5000)
 
     # =============================================================== modes
-    @property
-    def current_operator(self) -> str | None:
-        """The operator of the mode shown or last shown, else the first one computed."""
-        return self.state.current_operator()
-
     def show_mode(self, index: int, operator: str | None = None) -> None:
         """Colour the surface by mode ``index`` of ``operator`` (default: the spectrum
         shown or last shown)."""
-        op = operator or self.current_operator
+        op = operator or self.state.current_operator()
         if op is None or self.state.spectrum(op) is None:
             return
         self.state.show_mode(index, op)
@@ -428,7 +411,7 @@ class Viewer(ViewerModel, Pictures):
     def step_mode(self, step: int) -> None:
         """The next (``step`` = 1) or previous (-1) mode of the current spectrum."""
         d = self.state.display
-        op = self.current_operator
+        op = self.state.current_operator()
         if op is None:
             return
         self.state.show_mode((d.mode if d.kind == "mode" and d.operator == op else 0) + step, op)
@@ -436,16 +419,10 @@ class Viewer(ViewerModel, Pictures):
     def show_current_mode(self) -> None:
         """Back to the mode last shown, or the current spectrum's first non-zero mode."""
         d = self.state.display
-        op = self.current_operator
+        op = self.state.current_operator()
         if op is not None:
             mode = d.mode if op == d.operator else self.state.first_nonzero_mode(op)
             self.show_mode(mode, op)
-
-    def set_animating(self, on: bool) -> None:
-        self.state.set_animation(playing=bool(on))
-
-    def toggle_animation(self) -> None:
-        self.state.set_animation(playing=not self.state.animation.playing)
 
     # ======================================================== picks, maps
     @property
@@ -625,10 +602,6 @@ class Viewer(ViewerModel, Pictures):
         """Colour by the total curvature."""
         if self.state.mesh is not None:
             self.state.set_display(kind="curvature")
-
-    @property
-    def display(self) -> str:
-        return self.state.display.kind
 
     # ============================================================ closing
     def close(self) -> None:

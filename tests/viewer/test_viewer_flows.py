@@ -51,11 +51,11 @@ def test_a_waiting_compute_returns_its_own_spectrum(viewer, spot_path):
     """A request queued meanwhile keeps its turn and its own result."""
     viewer.open_mesh(spot_path)
     first = viewer.compute("shells", k=20, wait=False)
-    assert first is None and viewer.busy
+    assert first is None and viewer.jobs.busy
     spec = viewer.compute("laplacian", k=37)
     assert spec.operator == "laplacian" and spec.k == 37
-    while viewer.busy:
-        viewer.wait_for(viewer.running_job or viewer.jobs.jobs[0])
+    while viewer.jobs.busy:
+        viewer.wait_for(viewer.jobs.running or viewer.jobs.jobs[0])
     assert viewer.spectra["shells"].k == 20
 
 
