@@ -473,7 +473,7 @@ class DerivedValues:
         value = float(d[order[min(i, len(order) - 1)]])
         # distances equal up to round-off (a region where the signatures all but vanish
         # at every scale has one value to 1e-9) are marked all or none: a threshold inside
-        # them marked them at random (speckles on the cow's legs, 6.9 % of its area)
+        # them would mark them at random (speckles)
         sorted_d = d[order]
         j = int(np.searchsorted(sorted_d, value + TIE_TOLERANCE * float(d.max()), "right"))
         value = float(sorted_d[max(j - 1, 0)])

@@ -49,7 +49,7 @@ def smoothed_normals(mesh: Mesh, radius: float | None = None) -> np.ndarray:
         return normals
     m = lumped_masses(mesh)
     # symmetric positive definite: a Cholesky factorisation (PARDISO where available),
-    # fast enough for the GUI thread at 130k vertices, unlike SuperLU's LU
+    # fast enough for the GUI thread on scanned meshes, unlike SuperLU's LU
     system = sp.diags(m) + r * r * stiffness_matrix(mesh)
     smooth = SPDSolver(system).solve(m[:, None] * normals)
     norm = np.linalg.norm(smooth, axis=1, keepdims=True)

@@ -1,11 +1,12 @@
 """The viewer's model: its state, the jobs that fill it, and the spectrum cache (no Qt).
 
-:class:`ViewerModel` is what the window, the CLI, the figures and scripts drive.  It
-turns a request ("the shells spectrum, 100 modes") into a :class:`~.jobs.Job` whose
-result lands in :class:`~.state.ViewerState` when it ends, if the mesh it was computed
-for is still the loaded one; the modes of a spectrum land there as they converge, lowest
-first, before the job ends (:class:`~.jobs.LatestModes`).  A job changes what is displayed
-only if it was asked to (``show=True``) and the display has not changed since the request.
+:class:`ViewerModel` (the :class:`~.viewer.Viewer` is one) turns a request ("the shells
+spectrum, 100 modes") into a :class:`~.jobs.Job` whose result lands in the state when it
+ends, if the mesh it was computed for is still the loaded one; the modes of a spectrum
+land there as they converge, lowest first, before the job ends.  A job changes what is
+displayed only if it was asked to (``show=True``) and the display has not changed since
+the request.  The functions around it estimate a request's time and memory and word
+how a job ended.
 """
 
 from __future__ import annotations
@@ -83,11 +84,10 @@ def estimated_seconds(
       ``(n / n0) ** SIZE_EXPONENT``;
     - else None: no time is shown.
 
-    Each scaling alone keeps the estimate within 1.5 times of the solve's time on the
-    solves it was checked against (the commit that introduced it lists them); both at
-    once, or further out, do not: the time per mode falls as k grows (the factorisation
-    is shared), and the time's growth with size and with k depends on the operator and
-    on the mesh's shape."""
+    One scaling at a time, and only within :data:`ESTIMATE_RANGE`: the time per mode
+    falls as k grows (the factorisation is shared), and the time's growth with size and
+    with k depends on the operator and on the mesh's shape, so both at once, or further
+    out, would guess."""
     same = [r for r in records if r.operator == operator]
     n, k = max(int(n_vertices), 1), max(int(k), 1)
 
