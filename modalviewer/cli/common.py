@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -202,23 +204,17 @@ def progress_bar():
     return progress
 
 
-class warnings_printed:
+@contextmanager
+def warnings_printed():
     """Warnings of the core raised inside the block (mv.ZeroModesWarning, ...) printed as
     one ``modalviewer: warning:`` line each on stderr, no source line."""
-
-    def __enter__(self):
-        import warnings
-
-        self._catch = warnings.catch_warnings(record=True)
-        self.caught = self._catch.__enter__()
+    with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        return self
-
-    def __exit__(self, *exc):
-        self._catch.__exit__(*exc)
-        for warning in self.caught:
-            sys.stderr.write(f"modalviewer: warning: {warning.message}\n")
-        return False
+        try:
+            yield
+        finally:
+            for warning in caught:
+                sys.stderr.write(f"modalviewer: warning: {warning.message}\n")
 
 
 # ------------------------------------------------------------------ input and output
