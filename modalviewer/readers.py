@@ -147,41 +147,55 @@ def _triangles(polygons: list) -> np.ndarray:
     return np.array(tris, dtype=np.int64).reshape(-1, 3)
 
 
+def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
+    """(len(rows), width) numbers of text rows that each hold exactly ``width`` of them,
+    parsed by numpy in one go; None where a row holds another count or a word that is
+    not a number (the record-by-record reader then finds and names it)."""
+    if any(len(row.split()) != width for row in rows):
+        return None
+    try:
+        return np.array(" ".join(rows).split(), dtype=dtype).reshape(len(rows), width)
+    except ValueError:
+        return None
+
+
+def _triangle_rows(rows: list[str], n_vertices: int) -> np.ndarray | None:
+    """(m, 3) triangles of rows "3 a b c" (OFF, ASCII PLY) naming existing vertices, or
+    None for any other rows."""
+    table = _numbers(rows, 4, np.int64)
+    if table is None or not (table[:, 0] == 3).all():
+        return None
+    faces = table[:, 1:]
+    if len(faces) and (faces.min() < 0 or faces.max() >= n_vertices):
+        return None
+    return faces
+
+
 # --------------------------------------------------------------------------- OBJ
 
 
 def _read_obj_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
     """Vertices and triangles of a well-formed OBJ of triangles (every ``v`` line with
-    three coordinates, every ``f`` line three positive indices); None for any other
-    file, which the line-by-line reader then reads and checks."""
+    the same count of numbers, at least three, every ``f`` line three positive indices);
+    None for any other file, which the line-by-line reader then reads and checks."""
     lines = text.splitlines()
     if any(line.rstrip() in ("v", "f") for line in lines):  # a bare record: cut there
         return None
-    v_lines = [line[2:] for line in lines if line[:2] == "v "]
-    face_records = [line[2:] for line in lines if line[:2] == "f "]
-    face_text = "\n".join(face_records)
-    widths = {len(line.split()) for line in v_lines}  # x y z, maybe w or r g b after
-    if len(widths) != 1 or min(widths) < 3:
-        return None
-    width = widths.pop()
+    v_rows = [line[2:] for line in lines if line[:2] == "v "]
+    f_rows = [line[2:] for line in lines if line[:2] == "f "]
+    face_text = "\n".join(f_rows)
     if "/" in face_text:
         face_text = re.sub(r"/\S*", "", face_text)
-    # split on "\n", not splitlines(): a last record with nothing after "f " (a file cut
-    # there) must stay a line of its own, which splitlines() drops
-    f_lines = face_text.split("\n") if face_records else []
-    if any(len(line.split()) != 3 for line in f_lines):
+    width = len(v_rows[0].split()) if v_rows else 0  # x y z, maybe w or r g b after
+    vertices = _numbers(v_rows, width, np.float64) if width >= 3 else None
+    # split on "\n", not splitlines(): a record cut right after "f " stays a row
+    faces = _numbers(face_text.split("\n"), 3, np.int64) if f_rows else np.ones((0, 3), int)
+    if vertices is None or faces is None:
         return None
-    try:
-        table = np.array(" ".join(v_lines).split(), dtype=np.float64).reshape(-1, width)
-        vertices = np.ascontiguousarray(table[:, :3])
-        faces = np.array(face_text.split(), dtype=np.int64).reshape(-1, 3) - 1 if f_lines else None
-    except ValueError:
+    faces = faces - 1
+    if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
         return None
-    if faces is None:
-        return vertices, np.zeros((0, 3), dtype=np.int64)
-    if faces.min() < 0 or faces.max() >= len(vertices):
-        return None
-    return vertices, faces
+    return np.ascontiguousarray(vertices[:, :3]), faces
 
 
 def _read_obj(path: Path, strict: bool) -> MeshFile:
@@ -235,30 +249,6 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
 
 
 # --------------------------------------------------------------------------- OFF
-
-
-def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
-    """(len(rows), width) numbers of text rows that each hold exactly ``width`` of them,
-    parsed by numpy in one go; None where a row holds another count or a word that is
-    not a number (the record-by-record reader then finds and names it)."""
-    if any(len(row.split()) != width for row in rows):
-        return None
-    try:
-        return np.array(" ".join(rows).split(), dtype=dtype).reshape(len(rows), width)
-    except ValueError:
-        return None
-
-
-def _triangle_rows(rows: list[str], n_vertices: int) -> np.ndarray | None:
-    """(m, 3) triangles of rows "3 a b c" (OFF, ASCII PLY) naming existing vertices, or
-    None for any other rows."""
-    table = _numbers(rows, 4, np.int64)
-    if table is None or not (table[:, 0] == 3).all():
-        return None
-    faces = table[:, 1:]
-    if len(faces) and (faces.min() < 0 or faces.max() >= n_vertices):
-        return None
-    return faces
 
 
 def _read_off_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
