@@ -20,27 +20,13 @@ from .core.assembly import operator_matrices as _operator_matrices
 from .core.mesh import Mesh
 from .core.spectrum import Spectrum
 from .extras import extra_needed
-from .io import mesh_from_arrays, meshio_arrays
+from .io import mesh_from_arrays, meshio_arrays, pyvista_arrays
 
 __all__ = ["as_mesh", "operator_matrices", "to_pyvista", "arrays_of"]
 
 
 def _module(obj) -> str:
     return type(obj).__module__.split(".")[0]
-
-
-def _from_pyvista(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    import pyvista as pv
-
-    notes = []
-    if not isinstance(data, pv.PolyData):
-        data = data.extract_surface()
-        notes.append("the data set's outer surface is used")
-    if data.n_cells and not data.is_all_triangles:
-        data = data.triangulate()
-        notes.append("polygons were triangulated (the vertices are kept as they are)")
-    faces = np.asarray(data.faces).reshape(-1, 4)[:, 1:] if data.n_cells else np.zeros((0, 3))
-    return np.asarray(data.points, dtype=np.float64), faces.astype(np.int64), notes
 
 
 def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -56,7 +42,7 @@ def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
                 import pyvista as pv
 
                 obj = pv.wrap(obj)
-            return _from_pyvista(obj)
+            return pyvista_arrays(obj)
     if module == "meshio":
         return meshio_arrays(obj)
     if isinstance(obj, (tuple, list)) and len(obj) == 2:

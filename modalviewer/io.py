@@ -27,19 +27,30 @@ __all__ = ["load_mesh", "read_file", "SUPPORTED_EXTENSIONS"]
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 
 
-def _read_vtk(path: Path):
+def _read_vtk(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     with extra_needed(f"reading {path.suffix.lower()} files"):
         import pyvista as pv
 
-    data = pv.read(str(path))
+    return pyvista_arrays(pv.read(str(path)))
+
+
+def pyvista_arrays(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """(vertices, triangles, notes) of a pyvista data set: its outer surface where it is
+    not a ``PolyData``, polygons triangulated by pyvista (the notes say both)."""
+    import pyvista as pv
+
+    notes = []
     if not isinstance(data, pv.PolyData):
         try:  # the algorithm named: pyvista 0.47+ warns that its default will change
             data = data.extract_surface(algorithm="dataset_surface")
         except TypeError:  # an older pyvista, which has only this one
             data = data.extract_surface()
-    data = data.triangulate()
+        notes.append("the data set's outer surface is used")
+    if data.n_cells and not data.is_all_triangles:
+        data = data.triangulate()
+        notes.append("polygons were triangulated (the vertices are kept as they are)")
     faces = np.asarray(data.faces).reshape(-1, 4)[:, 1:] if data.n_cells else np.zeros((0, 3))
-    return np.asarray(data.points, dtype=np.float64), np.asarray(faces, dtype=np.int64)
+    return np.asarray(data.points, dtype=np.float64), faces.astype(np.int64), notes
 
 
 def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -63,8 +74,7 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
         raise MeshError(f"{path.name}: the file is empty")
     try:
         if ext in (".vtk", ".vtp"):
-            vertices, faces = _read_vtk(path)
-            notes: list[str] = []
+            vertices, faces, notes = _read_vtk(path)
         else:
             found = read_mesh_file(path, strict=strict)
             vertices, faces, notes = found.vertices, found.faces, found.notes

@@ -76,6 +76,25 @@ def test_pyvista_round_trip_and_triangulation(plate):
     assert "triangulated" in str(mesh.report)
 
 
+def test_a_pyvista_grid_gives_its_surface_without_a_warning():
+    """as_mesh of an UnstructuredGrid takes its outer surface as load_mesh of a .vtk grid
+    does (pyvista 0.47+ warned of extract_surface's changing default there)."""
+    import warnings
+
+    pv = pytest.importorskip("pyvista")
+    from modalviewer.core.primitives import icosphere
+
+    sphere = icosphere(2)
+    cells = np.hstack([np.full((sphere.n_faces, 1), 3), sphere.faces]).ravel()
+    grid = pv.UnstructuredGrid(
+        cells, np.full(sphere.n_faces, pv.CellType.TRIANGLE), sphere.vertices
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        mesh = mv.as_mesh(grid)
+    assert mesh.n_faces == sphere.n_faces and "outer surface is used" in str(mesh.report)
+
+
 def test_meshio_round_trip_and_files(plate, tmp_path):
     meshio = pytest.importorskip("meshio")
     m = meshio.Mesh(plate.vertices, [("triangle", plate.faces)])
