@@ -18,7 +18,7 @@ run: $(STAMP)
 	$(PY) -m modalviewer
 
 test: $(STAMP)
-	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q
+	QT_QPA_PLATFORM=offscreen $(PY) -m pytest -q -n 2 --dist worksteal
 	$(PY) -m ruff check modalviewer tests benchmarks scripts examples docs/_ext
 	$(PY) -m ruff format --check modalviewer tests benchmarks scripts examples docs/_ext
 
