@@ -1,15 +1,25 @@
-"""Memory predictions of an exact spectrum computation, from its size alone (the
-memory check that refuses what would not fit)."""
+"""The memory of an exact spectrum computation: the exact solver's plan (the Krylov
+basis's size, the memory its factor may take, when the basis is kept in single
+precision) and the predictions from the mesh's size alone (the memory check that
+refuses what would not fit)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+import numpy as np
+
+from .memory import resident_mb
 
 __all__ = [
     "FILL_MARGIN",
     "FactorLaw",
     "GrowthLaw",
     "basis_columns",
+    "basis_in_float32",
+    "factor_budget_mb",
+    "float32_basis_mb",
+    "krylov_sizes",
     "exact_peak_mb",
     "factor_goes_out_of_core",
     "float32_basis_saving_mb",
@@ -26,11 +36,80 @@ LAWS_FROM_VERTICES = 100_000
 (``benchmarks.growth``); below it fixed costs dominate."""
 
 
+BASIS_EXTRA = 0.6
+"""The Krylov basis holds (1 + BASIS_EXTRA) times the working number of pairs (fewer
+extra vectors for big solves: :data:`BASIS_EXTRA_MAX`): more converges in fewer operator
+applications but costs memory and orthogonalisation time (the basis sizes and the
+choice: "Iteration" in docs/how-it-works.md)."""
+BASIS_EXTRA_MAX = 112
+BASIS_EXTRA_BYTES = 900e6
+"""Where the basis's vectors beyond the working pairs would take more than
+BASIS_EXTRA_BYTES, it holds at most BASIS_EXTRA_MAX of them: there the basis is the
+largest array beside the factor, and the extra vectors buy little speed.  Smaller bases
+are left alone: there fewer extra vectors cost more time than the memory they save
+("Iteration" in docs/how-it-works.md)."""
+MIN_WORKING_PAIRS = 24
+"""The iteration works with at least this many pairs (where the space allows): with a
+basis of 20 columns for a few wanted pairs, clustered spectra (a mesh of many similar
+parts) did not converge in 60 restarts."""
+
+
+def krylov_sizes(k: int, n_free: int, block: int | None = None) -> tuple[int, int, int, int]:
+    """(working pairs, block size, basis size, pairs kept at a restart) for k pairs in a
+    space of dimension ``n_free``; the basis array has ``basis size + block`` columns."""
+    k_work = max(k, min(n_free // 2, max(k + max(8, k // 10), MIN_WORKING_PAIRS)))
+    if block is None:
+        block = int(np.clip(k_work // 16, 4, 16))
+    extra = int(BASIS_EXTRA * k_work)
+    if 8.0 * n_free * extra > BASIS_EXTRA_BYTES:
+        extra = min(extra, BASIS_EXTRA_MAX)
+    max_basis = k_work + max(2 * block, extra)
+    max_basis = ((max_basis + block - 1) // block) * block
+    return k_work, block, max_basis, k_work + (max_basis - k_work) // 3
+
+
+def factor_budget_mb(limit_mb: float | None, n: int, basis_columns: int, block: int):
+    """The memory (MB) a factor may take so that the solve stays within ``limit_mb``:
+    what is left after this process's resident memory, the Krylov basis array and the
+    iteration's (N, block) temporaries (at most :data:`TEMPORARY_BLOCKS` of them,
+    the refinement's double blocks included); None if there is no limit."""
+    if limit_mb is None:
+        return None
+    arrays = 8.0 * n * (basis_columns + TEMPORARY_BLOCKS * block) / 2**20
+    return limit_mb - resident_mb() - arrays
+
+
+TEMPORARY_BLOCKS = 8
+"""(N, block) arrays alive beside the basis during the iteration: the operator's
+scaled right-hand sides, PARDISO's solution, the orthogonalisation's copy and its
+Cholesky-QR products; the refinement's four (N, 2 block) ones."""
+
+
+def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
+    """Memory (MB) of the buffer that holds a single-precision Krylov basis of
+    ``basis_columns`` columns and, after it, the ``out_columns`` double-precision
+    modes in the same memory (:func:`.eigen._widen_in_place`)."""
+    return max(8.0 * n * out_columns, 4.0 * n * basis_columns) / 2**20
+
+
+def basis_in_float32(
+    limit_mb: float | None, n: int, basis_columns: int, out_columns: int, block: int
+) -> bool:
+    """Whether the Krylov basis is stored in single precision: where the process's
+    resident memory (the factor included, out of core if it did not fit) and a
+    double-precision basis with the iteration's temporaries exceed ``limit_mb``, and
+    the single-precision buffer (:func:`float32_basis_mb`) is smaller.  Double precision
+    is kept wherever it fits: the Laplacian's residuals after the final step are about
+    1e-11 with it and near 1e-7 without."""
+    left_mb = factor_budget_mb(limit_mb, n, basis_columns, block)  # now: after the factor
+    if left_mb is None or left_mb >= 0:
+        return False
+    return float32_basis_mb(n, basis_columns, out_columns) < 8.0 * n * basis_columns / 2**20
+
+
 def basis_columns(k: int, n_unknowns: int) -> int:
     """Columns of the exact solver's Krylov basis array for ``k`` modes of ``n_unknowns``
-    (:func:`.eigen.krylov_sizes`): with the modes, the arrays whose size grows with k."""
-    from .eigen import krylov_sizes  # the solver's own rule; imported late (no cycle)
-
+    (:func:`krylov_sizes`): with the modes, the arrays whose size grows with k."""
     n = max(int(n_unknowns), 2)
     k = max(1, min(int(k), n))
     _, block, max_basis, _ = krylov_sizes(k, n)
@@ -39,12 +118,10 @@ def basis_columns(k: int, n_unknowns: int) -> int:
 
 def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
     """Memory (MB) the exact solver saves with a single-precision Krylov basis
-    (:func:`.eigen.basis_in_float32`) against :func:`exact_peak_mb`: its
+    (:func:`basis_in_float32`) against :func:`exact_peak_mb`: its
     double-precision basis array and the mode columns counted beside it above
     :data:`GROWTH_MODES`, less the one buffer that holds the single-precision basis and
     then the modes (checked against the measured runs of ``benchmarks/memory.py``)."""
-    from .eigen import float32_basis_mb  # the solver's own rule; imported late (no cycle)
-
     n = max(int(n_unknowns), 2)
     k = max(1, min(int(k), n))
     columns = basis_columns(k, n)

@@ -11,13 +11,13 @@ positive definite even when K is singular (constants, rigid motions).
   :func:`.krylov.block_krylov_schur`): OP is applied to blocks of vectors, so one pass
   over the factor serves many right-hand sides, and the full re-orthogonalisation is
   done with matrix-matrix products.  It works with a few more pairs than wanted
-  (:func:`krylov_sizes`) and stops when the wanted ones have converged.
+  (:func:`.cost.krylov_sizes`) and stops when the wanted ones have converged.
 * One block step of inverse iteration on the converged vectors and a Rayleigh-Ritz step
   with K itself give exact Ritz values, Mass-orthonormal modes and residuals
   ``|K x - lambda M x| / |lambda M x|`` around 1e-10 on well-shaped meshes.
 * The solve plans to stay within a memory limit (:mod:`.memory`): where the factor
   would not fit beside the Krylov basis, PARDISO keeps it in a file
-  (:func:`factor_budget_mb`, :mod:`.factor`); the modes are written over the basis.
+  (:func:`.cost.factor_budget_mb`, :mod:`.factor`); the modes are written over the basis.
 
 Every run is deterministic (fixed start block); every result carries its residuals.
 """
@@ -31,6 +31,7 @@ import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
 
+from .cost import basis_in_float32, factor_budget_mb, float32_basis_mb, krylov_sizes
 from .factor import SPDSolver
 from .krylov import (
     ConvergedFn,
@@ -43,7 +44,6 @@ from .krylov import (
     rotate_in_place,
 )
 from .memory import memory_limit_mb as default_memory_limit_mb
-from .memory import resident_mb
 from .products import column_block_products, threaded_product, transform_columns_in_place
 from .threads import single_blas_thread
 
@@ -71,18 +71,6 @@ about 1e-16 to 1e-13 of it, while the first non-zero eigenvalue of a bending ene
 falls like h^4 against it, so a larger factor would take the first vibrations of fine
 meshes for zero modes (see "Zero modes, one rule" in docs/how-it-works.md)."""
 
-BASIS_EXTRA = 0.6
-"""The Krylov basis holds (1 + BASIS_EXTRA) times the working number of pairs (fewer
-extra vectors for big solves: :data:`BASIS_EXTRA_MAX`): more converges in fewer operator
-applications but costs memory and orthogonalisation time (the basis sizes and the
-choice: "Iteration" in docs/how-it-works.md)."""
-BASIS_EXTRA_MAX = 112
-BASIS_EXTRA_BYTES = 900e6
-"""Where the basis's vectors beyond the working pairs would take more than
-BASIS_EXTRA_BYTES, it holds at most BASIS_EXTRA_MAX of them: there the basis is the
-largest array beside the factor, and the extra vectors buy little speed.  Smaller bases
-are left alone: there fewer extra vectors cost more time than the memory they save
-("Iteration" in docs/how-it-works.md)."""
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
 
@@ -128,7 +116,7 @@ class EigenResult:
     basis_float32: bool = False
     """True if the Krylov basis was stored in single precision because even with the
     factor out of core a double-precision basis would not fit the memory limit
-    (:func:`basis_in_float32`)."""
+    (:func:`.cost.basis_in_float32`)."""
 
 
 def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
@@ -264,7 +252,7 @@ def solve_lowest(
         :func:`.memory.memory_limit_mb`.  Where the factor would not fit beside the
         Krylov basis and what the process already holds, PARDISO keeps it out of core
         (slower solves, much less memory); where even then the basis would not fit, it
-        is stored in single precision (:func:`basis_in_float32`).
+        is stored in single precision (:func:`.cost.basis_in_float32`).
     on_modes : called as ``on_modes(eigenvalues, vectors)`` with pairs as they
         converge, lowest first and in order, before the solve ends: (m,) eigenvalues and a
         new (N, m) array of Mass-orthonormal vectors (signs as in the result), the null
@@ -536,70 +524,12 @@ def _scale_rows(Y: np.ndarray, factors: np.ndarray) -> np.ndarray:
     return Y
 
 
-MIN_WORKING_PAIRS = 24
-"""The iteration works with at least this many pairs (where the space allows): with a
-basis of 20 columns for a few wanted pairs, clustered spectra (a mesh of many similar
-parts) did not converge in 60 restarts."""
-
-
-def krylov_sizes(k: int, n_free: int, block: int | None = None) -> tuple[int, int, int, int]:
-    """(working pairs, block size, basis size, pairs kept at a restart) for k pairs in a
-    space of dimension ``n_free``; the basis array has ``basis size + block`` columns."""
-    k_work = max(k, min(n_free // 2, max(k + max(8, k // 10), MIN_WORKING_PAIRS)))
-    if block is None:
-        block = int(np.clip(k_work // 16, 4, 16))
-    extra = int(BASIS_EXTRA * k_work)
-    if 8.0 * n_free * extra > BASIS_EXTRA_BYTES:
-        extra = min(extra, BASIS_EXTRA_MAX)
-    max_basis = k_work + max(2 * block, extra)
-    max_basis = ((max_basis + block - 1) // block) * block
-    return k_work, block, max_basis, k_work + (max_basis - k_work) // 3
-
-
-def factor_budget_mb(limit_mb: float | None, n: int, basis_columns: int, block: int):
-    """The memory (MB) a factor may take so that the solve stays within ``limit_mb``:
-    what is left after this process's resident memory, the Krylov basis array and the
-    iteration's (N, block) temporaries (at most :data:`TEMPORARY_BLOCKS` of them,
-    the refinement's double blocks included); None if there is no limit."""
-    if limit_mb is None:
-        return None
-    arrays = 8.0 * n * (basis_columns + TEMPORARY_BLOCKS * block) / 2**20
-    return limit_mb - resident_mb() - arrays
-
-
-TEMPORARY_BLOCKS = 8
-"""(N, block) arrays alive beside the basis during the iteration: the operator's
-scaled right-hand sides, PARDISO's solution, the orthogonalisation's copy and its
-Cholesky-QR products; the refinement's four (N, 2 block) ones."""
-
 FLOAT32_BASIS_TOL = 1e-7
 """Convergence tolerance of the Krylov iteration with a single-precision basis: its
 columns are orthonormal to about 1e-7, and a tighter tolerance costs about twice the
 operator columns.  The step of inverse iteration and Rayleigh-Ritz with K in double
 precision that follow bring the shells' residuals to what a double-precision basis
 gives."""
-
-
-def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
-    """Memory (MB) of the buffer that holds a single-precision Krylov basis of
-    ``basis_columns`` columns and, after it, the ``out_columns`` double-precision
-    modes in the same memory (:func:`_widen_in_place`)."""
-    return max(8.0 * n * out_columns, 4.0 * n * basis_columns) / 2**20
-
-
-def basis_in_float32(
-    limit_mb: float | None, n: int, basis_columns: int, out_columns: int, block: int
-) -> bool:
-    """Whether the Krylov basis is stored in single precision: where the process's
-    resident memory (the factor included, out of core if it did not fit) and a
-    double-precision basis with the iteration's temporaries exceed ``limit_mb``, and
-    the single-precision buffer (:func:`float32_basis_mb`) is smaller.  Double precision
-    is kept wherever it fits: the Laplacian's residuals after the final step are about
-    1e-11 with it and near 1e-7 without."""
-    left_mb = factor_budget_mb(limit_mb, n, basis_columns, block)  # now: after the factor
-    if left_mb is None or left_mb >= 0:
-        return False
-    return float32_basis_mb(n, basis_columns, out_columns) < 8.0 * n * basis_columns / 2**20
 
 
 def _widen_in_place(buffer: np.ndarray, n: int, width: int, count: int, out_width: int):
@@ -627,8 +557,8 @@ def _shift_invert(
     complement's dimension): (eigenvalues, an array (N, w) whose first k columns are the
     Mass-orthonormal modes, w >= ``out_columns``, shift, backend name, operator
     columns).  The factor keeps within the memory ``limit_mb`` leaves
-    (:func:`factor_budget_mb`); where even then a double-precision basis would not fit,
-    the basis is single precision (:func:`basis_in_float32`), and the returned array is
+    (:func:`.cost.factor_budget_mb`); where even then a double-precision basis would not fit,
+    the basis is single precision (:func:`.cost.basis_in_float32`), and the returned array is
     then exactly (N, ``out_columns``).  ``solver_info`` receives "factor_mb",
     "out_of_core" and "basis_float32".  ``on_converged(eigenvalues, vectors)`` receives
     the pairs as they converge (:func:`.krylov.block_krylov_schur`), as eigenvalues of K and

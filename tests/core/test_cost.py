@@ -101,8 +101,7 @@ def test_the_fill_margin_covers_the_curved_factors_measured():
 def test_more_modes_need_their_basis_and_mode_columns_and_no_more():
     """Between two mode counts the prediction differs by exactly the Krylov basis
     columns (the solver's own sizes) and the mode columns of N doubles each."""
-    from modalviewer.core.cost import basis_columns
-    from modalviewer.core.eigen import BASIS_EXTRA_MAX, krylov_sizes
+    from modalviewer.core.cost import BASIS_EXTRA_MAX, basis_columns, krylov_sizes
 
     info = operator_info("shells")
     n_vertices = 200_000
@@ -216,8 +215,7 @@ def test_the_memory_check_predicts_the_factor_out_of_core_where_it_would_not_fit
 
 
 def test_a_single_precision_basis_is_predicted_as_its_buffer_and_chosen_over_the_limit():
-    from modalviewer.core.cost import float32_basis_saving_mb
-    from modalviewer.core.eigen import float32_basis_mb, krylov_sizes
+    from modalviewer.core.cost import float32_basis_mb, float32_basis_saving_mb, krylov_sizes
     from modalviewer.core.memory import memory_limit_mb
 
     info = operator_info("shells")
