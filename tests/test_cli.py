@@ -326,7 +326,7 @@ def test_compute_says_when_the_factor_and_basis_were_kept_small(tmp_path):
     # a 1 MB limit, so it goes out of core; the spectrum is the one computed in core
     from modalviewer.core.demo_shapes import bumpy_plate
     from modalviewer.core.factor import available_backends
-    from modalviewer.viewer.model import FLOAT32_BASIS_WORDS, OUT_OF_CORE_WORDS
+    from modalviewer.viewer.wording import FLOAT32_BASIS_WORDS, OUT_OF_CORE_WORDS
 
     if "pardiso" not in available_backends():
         pytest.skip("out of core is PARDISO's (the mkl wheel)")

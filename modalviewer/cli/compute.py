@@ -35,7 +35,7 @@ def compute(args) -> int:
     import modalviewer as mv
 
     from ..core.memory import prepare_compute_process
-    from ..viewer.model import memory_text, residual_text
+    from ..viewer.wording import memory_text, residual_text
 
     make_output_folders(("-o", args.output))
     prepare_compute_process()  # this process exists to compute (see core.memory)

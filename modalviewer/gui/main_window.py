@@ -29,9 +29,9 @@ from ..core.operators import OPERATOR_INFO
 from ..core.spectrum import Spectrum
 from ..readers import DamagedFileError
 from ..viewer.jobs import QUEUED, Job
-from ..viewer.model import seconds_text
 from ..viewer.state import SpectrumKey
 from ..viewer.viewer import ComputeError, Viewer
+from ..viewer.wording import seconds_text
 from . import menus, window_settings
 from .application import ensure_application
 from .compare import CompareWindow

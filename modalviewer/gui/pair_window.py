@@ -28,9 +28,9 @@ from ..core.operators import DISTANCE_KINDS, operator_info
 from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
 from ..viewer.camera import Camera, CameraLink
-from ..viewer.model import seconds_text
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
+from ..viewer.wording import seconds_text
 from .dialogs import file_message, offer_open_anyway
 from .panels.common import quiet, select_data
 from .viewport import make_viewport, save_views

@@ -22,12 +22,11 @@ from ..core.eigen import Cancelled
 from ..core.memory import physical_memory_mb
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
-from ..core.pipeline import FLOOR_FACTOR
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
 from ..spectra import cached_or_computed
-from .jobs import CANCELLED, DONE, Job, JobQueue, RepairJob, SpectrumJob
+from .jobs import DONE, Job, JobQueue, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
 
@@ -107,11 +106,6 @@ def estimated_seconds(
         best = min(sizes, key=lambda r: abs(np.log(r.n_vertices / n)))
         return best.seconds * (n / best.n_vertices) ** SIZE_EXPONENT
     return None
-
-
-def seconds_text(seconds: float) -> str:
-    """About how long, in words: whole seconds below two minutes, then whole minutes."""
-    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
 MEMORY_SHARE = 0.75
@@ -504,93 +498,3 @@ class ViewerModel:
         spec, table = job.result
         if not self.state.has_spectrum(key) or self.state.spectra[key] is not spec:
             self.state.add_spectrum(key, spec, table)
-
-
-def worst_residual(spec: Spectrum) -> float:
-    return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
-
-
-OUT_OF_CORE_WORDS = "factor kept on disk"
-"""What a spectrum whose solve kept its factor out of core says of it (the status line
-and ``modalviewer compute``)."""
-
-FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
-"""What a spectrum whose solve kept its Krylov basis in single precision says of it."""
-
-
-def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
-    """How a finished spectrum job's status line starts: the description and the solve's
-    time, or for a spectrum read from the cache the time reading took and the time the
-    solve took earlier, so that a cache hit does not read like a fresh solve.  A solve's
-    time is the one it stored (``parameters["seconds_total"]``, what the cache keeps and
-    the estimates use), so a solve and its reopening report the same number; the job's
-    own time where the spectrum has none (coarse-to-fine)."""
-    fewer = fewer_modes_text(job, spec)
-    solved = spec.parameters.get("seconds_total")
-    if not isinstance(solved, (int, float)) or "transferred_from" in spec.parameters:
-        solved = None
-    if not spec.from_cache:
-        return f"{job.description}{fewer} in {job.seconds if solved is None else solved:.1f} s"
-    earlier = f" (solved earlier in {solved:.1f} s)" if solved is not None else ""
-    return f"{job.description}{fewer} read from the cache in {job.seconds:.1f} s{earlier}"
-
-
-def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:
-    """``" (only 126: all the mesh has)"`` where the spectrum holds fewer modes than the
-    job asked for (a mesh has as many modes as unknowns), else ``""``: the description
-    names the number asked for."""
-    if spec.k >= job.spectrum_key.k:
-        return ""
-    unknowns = operator_info(spec.operator).unknowns(spec.n_vertices)
-    why = ": all the mesh has" if spec.k >= unknowns else ""
-    return f" (only {spec.k}{why})"
-
-
-def ended_text(job: Job) -> str:
-    """How ``job`` ended, in a line: its description with its run time
-    (:func:`finished_text` for a spectrum), "<description>: cancelled" (or why it was
-    given up) or "<description>: failed"."""
-    if job.status == DONE:
-        if isinstance(job, SpectrumJob) and job.result:
-            return finished_text(job, job.result[0])
-        return f"{job.description} in {job.seconds:.1f} s"
-    if job.status == CANCELLED:
-        return f"{job.description}: {job.error or 'cancelled'}"
-    return f"{job.description}: failed"
-
-
-def memory_text(spec: Spectrum) -> str:
-    """``"; ... (memory limit)"`` with :data:`OUT_OF_CORE_WORDS` where the exact solve
-    kept its factor out of core (the reason it took longer) and
-    :data:`FLOAT32_BASIS_WORDS` where it kept its basis in single precision (the reason
-    its residuals are about 1e-7), else ``""``."""
-    said = [
-        words
-        for words, key in ((OUT_OF_CORE_WORDS, "factor_out_of_core"),
-                           (FLOAT32_BASIS_WORDS, "basis_float32"))
-        if spec.parameters.get(key)
-    ]  # fmt: skip
-    return f"; {' and '.join(said)} (memory limit)" if said else ""
-
-
-def residual_text(spec: Spectrum) -> str:
-    """'largest relative residual 1.3e-05' and, where that is above what well-shaped
-    meshes reach, the mode's rounding floor: the residual that rounding the mode to
-    double precision alone causes on this mesh (an estimate: no solver goes much below
-    it)."""
-    worst = worst_residual(spec)
-    text = f"largest relative residual {worst:.1e}"
-    floor = float(spec.parameters.get("worst_residual_rounding_floor", 0.0))
-    if floor > 0.0 and worst <= 1.5 * floor:
-        # the floor is an estimate, not a bound: the residual may be a little below it
-        text += (
-            f" (at the rounding floor of double precision for that mode here, about {floor:.1e})"
-        )
-    elif floor > 0.0 and worst <= FLOOR_FACTOR * floor:
-        text += (
-            f" ({worst / floor:.0f} times the rounding floor of double precision for that "
-            f"mode here, about {floor:.1e}: as close as solvers come)"
-        )
-    elif floor > 0.0:
-        text += f" (rounding floor {floor:.1e})"
-    return text

@@ -45,17 +45,10 @@ from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distanc
 from ..core.spectrum import Spectrum, in_input_numbering
 from ..repair import repair_for_failure, repair_unavailable
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
-from .model import (
-    ComputeRefused,
-    ViewerModel,
-    ended_text,
-    finished_text,
-    memory_text,
-    residual_text,
-    seconds_text,
-)
+from .model import ComputeRefused, ViewerModel
 from .pictures import Pictures
 from .state import SpectrumKey
+from .wording import ended_text, finished_text, memory_text, residual_text, seconds_text
 
 log = logging.getLogger("modalviewer")
 

@@ -9,7 +9,7 @@ import pytest
 import modalviewer as mv
 from modalviewer.core.pipeline import FLOOR_FACTOR, WELL_SHAPED_RESIDUAL, operator_matrices
 from modalviewer.core.primitives import icosphere
-from modalviewer.viewer.model import residual_text
+from modalviewer.viewer.wording import residual_text
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 

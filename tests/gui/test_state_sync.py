@@ -552,7 +552,7 @@ def test_the_computations_panel_keeps_how_the_last_computation_ended(window, spo
     seconds, and the time was lost; the Computations panel keeps the last one."""
     from types import SimpleNamespace
 
-    from modalviewer.viewer.model import ended_text
+    from modalviewer.viewer.wording import ended_text
 
     panel = window.jobs_panel
     assert not panel.last.isVisibleTo(window)

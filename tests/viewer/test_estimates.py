@@ -12,8 +12,8 @@ from modalviewer.viewer.model import (
     SIZE_EXPONENT,
     ViewerModel,
     estimated_seconds,
-    finished_text,
 )
+from modalviewer.viewer.wording import finished_text
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 

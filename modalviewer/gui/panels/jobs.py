@@ -6,7 +6,7 @@ from __future__ import annotations
 from qtpy import QtCore, QtWidgets
 
 from ...viewer.jobs import RUNNING, Job, JobQueue
-from ...viewer.model import ended_text
+from ...viewer.wording import ended_text
 from .common import WrappingLabel
 
 
