@@ -305,7 +305,12 @@ class ViewerModel:
 
         job.then(computing_ended)
         if show:
-            job.then(self._shower(key, display_at_request))
+
+            def show_when_done(j: Job) -> None:
+                if j.status == DONE and key in self.state.spectra:
+                    self._show_if_unchanged(key.operator, display_at_request)
+
+            job.then(show_when_done)
         return job
 
     def _modes_arrived(self, key: SpectrumKey, show_from):
@@ -328,11 +333,7 @@ class ViewerModel:
             if not (~spec.zero_mode_mask()).any():
                 return
             wanted[0] = None
-            if state.display in (before, before.blank()):
-                if before.kind == "mode" and before.operator == key.operator:
-                    state.show_mode(min(before.mode, spec.k - 1), key.operator)
-                else:
-                    self._show_first_mode(key.operator)
+            self._show_if_unchanged(key.operator, before)
 
         return deliver
 
@@ -386,24 +387,17 @@ class ViewerModel:
         mesh = self.state.compute_mesh(key)
         return self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
 
-    def _shower(self, key: SpectrumKey, before):
-        """A job callback showing the new spectrum of ``key`` if the display has not
-        changed since the request (``before``): at the mode shown then if it was one of
-        the same operator's (a new k keeps the user's place; the last mode if there are
-        fewer now), else at its first non-zero mode."""
-
-        def show_when_done(j: Job) -> None:
-            if (
-                j.status == DONE
-                and key in self.state.spectra
-                and self.state.display in (before, before.blank())
-            ):
-                if before.kind == "mode" and before.operator == key.operator:
-                    self.state.show_mode(before.mode, key.operator)
-                else:
-                    self._show_first_mode(key.operator)
-
-        return show_when_done
+    def _show_if_unchanged(self, operator: str, before) -> None:
+        """Show ``operator``'s spectrum if the display has not changed since a request
+        (``before``): at the mode shown then if it was one of the same operator's (a new
+        k keeps the user's place; the last mode if there are fewer now), else at its
+        first non-zero mode."""
+        if self.state.display not in (before, before.blank()):
+            return
+        if before.kind == "mode" and before.operator == operator:
+            self.state.show_mode(before.mode, operator)
+        else:
+            self._show_first_mode(operator)
 
     def _show_first_mode(self, operator: str) -> None:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
