@@ -1,43 +1,17 @@
 """Distances between two shapes: a vertex of mesh A against every vertex of mesh B.
 
-The multi-scale distance of eq. (31) compares two signature curves ``S_t(v) / Z(t)``
-over a range of scales.  Between two meshes each curve is normalised by its own mesh's
-``Z(t) = sum_j exp(-lambda_j t)`` and both are sampled at the same scales:
+Eq. (31) with one signature from each mesh, each divided by its own mesh's
+``Z(t) = sum_j exp(-lambda_j t)``, both sampled at the same scales:
 
 ``delta(v, w) = sqrt( sum_i ((S^A_{t_i}(v) / Z^A(t_i) - S^B_{t_i}(w) / Z^B(t_i))^2 * dlogt) )``
 
-with ``v`` on A and ``w`` on B.  On one mesh this is :func:`multiscale_distance`; it is
-symmetric (``delta_AB(v, w) = delta_BA(w, v)``), and a rigid motion of B changes nothing.
-
-Common scales
--------------
-Each spectrum has its own default range ``[4 ln 10 / lambda_max, 4 ln 10 / lambda_min]``
-(CONVENTIONS.md).  The common range is their intersection,
-``t1 = max(t1_A, t1_B)``, ``t2 = min(t2_A, t2_B)``: the scales that both truncated
-spectra resolve (below ``t1`` of a spectrum its missing high modes would still weigh;
-above its ``t2`` only its first mode is left).  Two meshes of the same shape and size
-with the same number of modes have nearly the same range, whatever their resolution.
-If the ranges do not overlap the meshes differ in size too much to be compared as they
-are, and an error says so; a ``t_range`` given by the caller is used as it is.
-
-Scale
------
-The API computes on the geometry as given (CONVENTIONS.md) and never rescales.  Two
-facts decide whether two meshes of different size can be compared:
-
-- Laplacian (heat kernel) and E_D^N (feature) spectra scale with the area: scaling a
-  mesh by ``s`` divides the eigenvalues by ``s^2`` and the squared modes by ``s^2``
-  (the mass grows by ``s^2``), so ``S_t / Z(t)`` at the scaled times ``s^2 t`` is the
-  original divided by ``s^2``.  The normalised signatures, and hence the distances,
-  carry a factor ``1 / area``.
-- The Discrete Shells spectrum is not scale covariant: bending, stretching and area
-  terms scale by different powers of ``s``, so a scaled copy vibrates differently, not
-  just faster or slower.
-
-So compare meshes of the same area: :func:`rescale_to_area` returns a copy scaled to a
-given area (the viewer offers it before computing).  The cross functions warn
-(:class:`ScaleWarning`) when the two spectra's total masses (their mesh areas) differ
-by more than :data:`AREA_TOLERANCE`.
+The common scales are the intersection of the two default ranges (CONVENTIONS.md), the
+scales both truncated spectra resolve; ranges that do not overlap are refused.  The
+meshes are used as given: signatures carry a factor ``1 / area`` (and the shells
+spectrum is not scale covariant at all), so compare meshes of the same area
+(:func:`rescale_to_area`); a :class:`ScaleWarning` says when the areas differ by more
+than :data:`AREA_TOLERANCE`.  Details and measurements: docs/library-guide.md,
+"Comparing two shapes".
 """
 
 from __future__ import annotations

@@ -1,36 +1,18 @@
 """The exactly known null spaces of the operators, per connected component.
 
-Each operator's energy is a sum over the mesh's connected components, so its null space
-is the direct sum of the components' null spaces.  What is known exactly:
+Each energy is a sum over the connected components, so its null space is the direct sum
+of theirs.  Known exactly, per component: ``laplacian`` the constant; ``shells`` the
+six rigid motions (every term of the energy is invariant under them);
+``modified_dirichlet`` the constant on a *flat* component only (``f_i N_i`` constant);
+``shells_normal`` the three affine functions of the plane on a flat component only
+(``f_i N_i`` a rigid motion).  Each rule lives in the registry
+(:attr:`.operators.OperatorInfo.null_space_rule`).  Other null vectors (pieces of a
+shells component meeting at one vertex) are not deflated; the eigensolver finds them
+like any other mode.
 
-=====================  ==============================================================
-operator               null vectors per component
-=====================  ==============================================================
-``laplacian``          the constant (the cotan rows sum to zero): 1 per component
-``shells``             the six rigid motions (3 translations, 3 infinitesimal rotations
-                       about the component's centre of mass): every term of the energy
-                       (lengths, areas, dihedral angles) is invariant under them
-``modified_dirichlet`` ``f`` with ``f_i N_i`` constant (``f^T A f`` is the Dirichlet
-                       energy of the vector field ``f N``): only on a *flat* component,
-                       where it is the constant; none on a curved one
-``shells_normal``      ``f`` with ``f_i N_i`` a rigid motion (``H_N = P^T H P``): only on
-                       a flat component, where these are the affine functions of the
-                       plane (3 per component); none on a curved one
-=====================  ==============================================================
-
-Other null vectors can exist (a Discrete Shells component whose pieces meet at a single
-vertex can rotate them about it); they are not deflated and the eigensolver finds them
-like any other mode.  Each operator's rule (:attr:`.operators.OperatorInfo.null_space_rule`)
-and its words (:attr:`.operators.OperatorInfo.null_space`) are in the registry.
-
-Every candidate is checked numerically on the assembled matrix before it is used: it
-must satisfy ``|K z| <= NULL_RTOL * | |K| |z| |`` (the rounding bound of the product,
-so exact null vectors pass at about 1e-15 and a nearly flat component's constant fails
-for E_D^N).  The accepted vectors are Mass-orthonormal: ``Z^T Mass Z = I``.
-
->>> ns = null_space(mesh, "shells", K, mass)          # doctest: +SKIP
->>> ns.dimension, ns.n_components, ns.summary()       # doctest: +SKIP
-(264, 44, '44 connected components: ...')
+Every candidate is checked on the assembled matrix against :data:`NULL_RTOL` before it
+is used (a nearly flat component's constant fails for E_D^N); the accepted vectors are
+Mass-orthonormal, ``Z^T Mass Z = I``.
 """
 
 from __future__ import annotations

@@ -1,18 +1,10 @@
 """Sliver repair: needle and cap triangles removed by edge flips and collapses (PyMeshLab).
 
-Meshes from remeshers, iso-surfaces and scans often hold triangles that are nearly
-degenerate: *needles* (one edge much shorter than the others) and *caps* (one vertex
-almost on the opposite edge).  The Laplacian tolerates them, but they make the Discrete
-Shells Hessian numerically indefinite, so its factorisation fails.  :func:`fix_slivers`
-removes them with MeshLab's filters through ``pymeshlab``: T-vertex removal (vcglib
-``Clean::RemoveTVertexByFlip``: the longest edge of a sliver is flipped where that makes
-both triangles better; ``RemoveTVertexByCollapse``: the apex is merged into the nearer
-end of the longest edge) and, where those would change the surface's topology, isotropic
-remeshing restricted to the slivers and their neighbours.  No face is simply deleted, so
-a closed surface stays closed; every result is checked before it is returned.
-
-``pymeshlab`` is imported only when :func:`fix_slivers` runs, so ``import modalviewer``
-stays light.
+Nearly degenerate triangles, *needles* (one edge much shorter than the others) and
+*caps* (one vertex almost on the opposite edge), make the Discrete Shells Hessian
+numerically indefinite, so its factorisation fails.  :func:`fix_slivers` removes them
+with MeshLab's filters and never simply deletes a face, so a closed surface stays
+closed.  ``pymeshlab`` is imported only when it runs.
 """
 
 from __future__ import annotations
@@ -146,41 +138,32 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     """A copy of ``mesh`` without needle and cap triangles, made by edge flips and
     collapses; ``result.report`` is a :class:`SliverReport`.
 
-    Three repairs are tried in turn, and the first whose result has the input's
-    topology (boundary edges, non-manifold edges, components, Euler characteristic,
-    consistent orientation), no degenerate face and fewer triangles below
-    ``min_quality`` is returned: MeshLab's T-vertex removal by edge flips, then edge
-    collapses; by collapses alone; isotropic remeshing (splits, collapses, flips and
-    smoothing projected back on the surface) of the slivers and the faces around them
-    only.  MeshLab's collapses do not check the link condition, so on a large mesh with
-    thousands of slivers one bad collapse can make an edge non-manifold; the remeshing
-    checks it but is slower.
+    Three repairs are tried in turn and the first is returned whose result keeps the
+    input's topology (boundary and non-manifold edges, components, Euler characteristic,
+    orientation), has no degenerate face and fewer triangles below ``min_quality``:
+    MeshLab's T-vertex removal by flips then collapses; by collapses alone; isotropic
+    remeshing of the slivers and the faces around them.  MeshLab's collapses do not
+    check the link condition (one bad collapse can make an edge non-manifold); the
+    remeshing does, more slowly.
 
     Parameters
     ----------
     mesh : the mesh to repair (not changed).
+    min_quality : the quality every triangle should have afterwards.  MeshLab's
+        criterion is applied as ``L / height >= sqrt(3) / min_quality`` (L the longest
+        edge), so the triangles left have quality above about ``min_quality`` and the
+        ones treated are below ``1.33 * min_quality``.
     progress : optional ``progress(stage, fraction)``, called before each repair tried
-        and before the measurements (each MeshLab filter runs to its end).
-    min_quality : the quality every triangle should have afterwards.  A thin triangle
-        whose longest edge L is r times the height onto it has quality between
-        sqrt(3) / r and 4 / (sqrt(3) r); MeshLab's criterion is applied with
-        ``L / height >= sqrt(3) / min_quality`` (34.6 for the default 0.05), so the
-        triangles left have quality above about ``min_quality`` and the ones treated
-        are below ``1.33 * min_quality``.
+        and before the measurements.
 
     Returns
     -------
     Mesh
-        With the same vertices where nothing was changed (bit for bit) and the same
-        boundary, components and Euler characteristic.  ``report.max_vertex_shift`` is
-        the largest move of a vertex kept from the input, or after remeshing the largest
-        distance of a vertex from the input surface; ``report.max_deviation`` the
-        Hausdorff distance between the two surfaces, at their vertices (both relative
-        to the bounding-box diagonal).
-
-        Where nothing was changed the result keeps the input's vertices and numbering; a
-        repaired mesh has new vertex numbers (MeshLab renumbers, removes and adds
-        vertices: its numbering is its own) and its report says so.
+        Where nothing was changed, the input's vertices and numbering; else MeshLab's
+        own vertex numbering (the report says so).
+        ``report.max_vertex_shift`` (largest move of a kept vertex, or after remeshing
+        distance from the input surface) and ``report.max_deviation`` (Hausdorff
+        distance at the vertices) are relative to the bounding-box diagonal.
 
     Raises
     ------
