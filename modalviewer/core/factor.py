@@ -1,27 +1,16 @@
 """Sparse symmetric positive definite factorisations: factor once, solve many right-hand sides.
 
-Backends, tried in this order by ``backend="auto"``:
+Backends, tried in this order by ``backend="auto"``: ``"pardiso"`` (Intel MKL PARDISO
+through ``ctypes``, x86_64: supernodal Cholesky with parallel METIS ordering and
+parallel solves, the fastest; "Spectra" in docs/performance.md), ``"cholmod"``
+(``cholespy``), ``"superlu"`` (``scipy.sparse.linalg.splu``, always available).
 
-``"pardiso"``
-    Intel MKL PARDISO (the ``mkl`` wheel, x86_64), called through ``ctypes``: supernodal
-    Cholesky with a parallel nested-dissection (METIS) ordering and parallel blocked
-    triangular solves; the fastest of the three on the benchmark meshes ("Spectra" in
-    docs/performance.md).
-``"cholmod"``
-    CHOLMOD through ``cholespy`` (wheels for every platform).
-``"superlu"``
-    ``scipy.sparse.linalg.splu`` with diagonal pivoting (always available).
-
-Out of core: given ``memory_budget_mb``, PARDISO keeps its factor in memory only if the
-analysis says it fits that budget; otherwise it writes the factor to a file in a
-temporary folder (PARDISO's out-of-core mode, ``iparm[59] = 2``) and keeps only its
-symbolic data and a working buffer in memory.  Each solve then reads the factor back
-(from the page cache while the system has memory to spare, else from disk): less
-memory, slower solves ("Memory of big exact solves" in docs/performance.md).  The folder
-is removed with the factor.  CHOLMOD and SuperLU have no such mode and ignore the budget.
-
-Every backend raises :class:`numpy.linalg.LinAlgError` if the matrix is not positive
-definite.
+Out of core: given ``memory_budget_mb``, PARDISO keeps its factor in memory only if its
+analysis says it fits; otherwise it writes the factor to a temporary folder
+(``iparm[59] = 2``), removed with the factor, and each solve reads it back: less memory,
+slower solves ("Memory of big exact solves" in docs/performance.md).  CHOLMOD and
+SuperLU ignore the budget.  Every backend raises :class:`numpy.linalg.LinAlgError` if
+the matrix is not positive definite.
 """
 
 from __future__ import annotations

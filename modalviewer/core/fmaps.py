@@ -1,23 +1,17 @@
 """Functional maps (Ovsjanikov et al. 2012) on the modes of any scalar operator.
 
 A functional map ``C`` (k_b, k_a) takes a function on shape A, written in A's first
-``k_a`` modes, to its coefficients in B's first ``k_b`` modes.  It is found from
-descriptors that should agree on corresponding points (wave or heat kernel signatures of
-each shape's own spectrum, or arrays of your own), projected on the modes, with the
-commutativity with the operators' eigenvalues as the regulariser:
+``k_a`` modes, to its coefficients in B's first ``k_b`` modes.  From descriptors that
+should agree on corresponding points (wave or heat kernel signatures, or your own),
+projected on the modes as ``A = Phi_a^T M_a F_a`` and ``B = Phi_b^T M_b F_b`` (each
+column of unit M-norm), it solves row by row in closed form
 
     C = argmin |C A - B|^2 + mu sum_ij C_ij^2 (lambda^b_i - lambda^a_j)^2 / s,
 
-``A = Phi_a^T M_a F_a`` and ``B = Phi_b^T M_b F_b`` the projected descriptors (each
-descriptor column scaled to unit M-norm on its shape), ``s`` the Frobenius norm of the
-squared eigenvalue differences (as pyFM normalises them), solved row by row in closed
-form.  The point-to-point map sends vertex y of B to the vertex x of A whose mode values
-``Phi_a[x]`` are nearest ``Phi_b[y] C``; ``zoomout`` refines it by ZoomOut
-(Melzi et al. 2019): map, re-estimate ``C`` from the point map one mode larger, repeat.
-
-The modes can be any scalar operator's: the Laplacian (the usual basis), E_D^N, the
-normal Discrete Shells.  The 3D shells' modes are vector fields, not a basis of functions;
-they are refused.
+``s`` the Frobenius norm of the squared eigenvalue differences (as pyFM).  The point map
+sends vertex y of B to the vertex x of A with ``Phi_a[x]`` nearest ``Phi_b[y] C``;
+``zoomout`` refines it by ZoomOut (Melzi et al. 2019).  Any scalar operator's modes
+serve (Laplacian, E_D^N, normal shells); the 3D shells' vector modes are refused.
 """
 
 from __future__ import annotations

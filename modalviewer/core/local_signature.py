@@ -1,25 +1,15 @@
 """Signatures at chosen vertices without a truncated spectrum (paper Section 6, Lemma 2).
 
-The signature of :func:`.signatures.signature`,
-``S_t(v) = sum_j exp(-lambda_j t) |phi_j(v)|^2`` over *all* modes (M-orthonormal
-``phi_j``), is the diagonal of the kernel of the linearised gradient flow (eq. 26):
-for each unknown ``r`` of vertex ``v`` (one for the scalar energies, three for the 3D
-shells, the sum over alpha of Lemma 2),
-
-    S_t(v) = sum_r  e_r^T M^-1/2 exp(-t M^-1/2 K M^-1/2) M^-1/2 e_r,
-
-a quadratic form of the matrix exponential.  It is evaluated by Lanczos quadrature
-(Golub and Meurant) on the shifted inverse ``(A + sigma I)^-1`` of
-``A = M^-1/2 K M^-1/2`` (shift-and-invert Lanczos for the exponential, as van den
-Eshof and Hochbruck): one factorisation of ``K + sigma M``, then ``m`` steps started at
-``e_r`` give the Gauss rule ``|b|^2 [exp(-t (T_m^-1 - sigma))]_11`` for every ``t`` at
-once.  The steps needed do not grow with the stiffest mode of the mesh.  They stop
-when every requested scale has settled to ``rtol``.
-
-Zero modes are left out (as by default in :func:`.signatures.signature`) by starting
-from ``b = P e_r``, where ``P`` projects out the operator's exactly known null vectors
-(:mod:`.nullspace`); ``P`` commutes with ``A``, so ``b^T exp(-tA) b`` is the sum over
-the other modes.
+The signature over *all* modes, ``S_t(v) = sum_j exp(-lambda_j t) |phi_j(v)|^2``, is
+the diagonal of the kernel of the linearised gradient flow (eq. 26): summed over the
+unknowns ``r`` of vertex ``v`` (three for the 3D shells),
+``S_t(v) = sum_r e_r^T M^-1/2 exp(-t M^-1/2 K M^-1/2) M^-1/2 e_r``.  Each quadratic form
+is evaluated by Lanczos quadrature (Golub and Meurant) on the shifted inverse of
+``A = M^-1/2 K M^-1/2`` (van den Eshof and Hochbruck): one factorisation of
+``K + sigma M``, then Lanczos steps from ``e_r`` give the Gauss rule for every ``t`` at
+once, until every scale has settled; the steps needed do not grow with the stiffest
+mode.  Zero modes are left out by starting from ``P e_r``, ``P`` projecting out the
+exactly known null vectors (:mod:`.nullspace`), which commutes with ``A``.
 """
 
 from __future__ import annotations
@@ -129,9 +119,7 @@ def local_signature(
     """The signature at ``vertices`` and scales ``times``, summed over all modes.
 
     The same quantity as ``signature(compute_spectrum(mesh, operator, k=all), times,
-    include_zero, vertices)[1]`` (heat kernel signature for ``"laplacian"``, feature
-    signature for ``"modified_dirichlet"``, vibration signature for ``"shells"``), with no
-    truncation error, computed without any eigenvectors (Lemma 2 of the paper).
+    include_zero, vertices)[1]``, with no truncation error and no eigenvectors (Lemma 2).
 
     Parameters
     ----------
@@ -144,12 +132,10 @@ def local_signature(
     rtol : relative accuracy at which each scale's value is accepted.
     max_steps : Lanczos steps allowed per unknown; the cost grows with
         ``sqrt(max(times) * lambda_max)``.
-    spectrum : an exact spectrum of the same mesh and operator.  Its modes are summed
-        directly and the quadrature computes only the rest (the modes above its largest
-        eigenvalue), which at large scales is negligible after a few steps: with a
-        spectrum the result is still the sum over all modes, and large scales cost
-        little.  Without one, scales far above ``4 ln 10 / lambda_1`` on fine meshes can
-        need many thousands of steps.
+    spectrum : an exact spectrum of the same mesh and operator: its modes are summed
+        directly and the quadrature adds only the modes above its largest eigenvalue,
+        so large scales cost a few steps (without one, scales far above
+        ``4 ln 10 / lambda_1`` on fine meshes can need thousands).
 
     Returns
     -------

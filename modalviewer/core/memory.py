@@ -1,31 +1,19 @@
 """Memory: how much a computation may use, how much this process holds, and the C
 library's allocator settings for processes that compute.
 
-The exact solver keeps its working set within :func:`memory_limit_mb`: where the
-factorisation would not fit beside the Krylov basis, the factor goes out of core
-(:mod:`.factor`).  The limit is half this machine's memory, so a computation leaves room
-for the viewer, the rest of the desktop and the system's file cache (which then holds the
-out-of-core factor); ``MODALVIEWER_MEMORY_LIMIT_MB`` sets it explicitly.
+The exact solver keeps its working set within :func:`memory_limit_mb` (half this
+machine's memory, or ``MODALVIEWER_MEMORY_LIMIT_MB``), leaving room for the viewer, the
+desktop and the file cache that holds an out-of-core factor (:mod:`.factor`).
 
 A computation allocates and frees many arrays of hundreds of megabytes, and first
-touches of fresh memory cost more than much of the arithmetic done with them.
-:func:`prepare_compute_process` makes them cheaper in a process that exists to compute
-(the viewer's child processes, the command line, the benchmarks):
-
-- glibc hands every array above its mmap threshold to the kernel and back, so each new
-  one starts on fresh pages.  Serving arrays up to :data:`HEAP_ARRAY_MAX_BYTES` from the
-  heap and not trimming it lets the process reuse what it freed
-  (:func:`keep_freed_memory`).  Bigger arrays (the (N, k) blocks and bases) still go
-  back as they are freed: served from the heap, they would leave holes the next ones do
-  not fit, which raises the peak.
-- numpy advises the kernel to back big arrays with transparent huge pages, and the
-  kernel compacts memory to find them, which makes page faults of fresh arrays slower
-  (:func:`no_huge_page_advice`).
-- glibc gives each thread that calls ``malloc`` an arena of its own, whose freed memory
-  no other thread reuses; one arena for the process (:func:`one_malloc_arena`) lets
-  every thread reuse it.
-
-What each setting saves and costs: "Memory" in docs/how-it-works.md.
+touches of fresh pages cost more than much of the arithmetic.
+:func:`prepare_compute_process` makes them cheaper in a process that exists to compute:
+arrays up to :data:`HEAP_ARRAY_MAX_BYTES` are reused from the heap instead of going to
+the kernel and back (:func:`keep_freed_memory`; bigger ones would leave holes the next
+do not fit), numpy stops advising huge pages, whose compaction slows page faults
+(:func:`no_huge_page_advice`), and all threads share one malloc arena
+(:func:`one_malloc_arena`).  What each saves and costs: "Memory" in
+docs/how-it-works.md.
 """
 
 from __future__ import annotations

@@ -1,24 +1,16 @@
 """Triangle mesh container: validation and topology queries.
 
-A :class:`Mesh` holds ``vertices`` (n, 3) float64 and ``faces`` (m, 3) int64 and is
-immutable after construction.  Construction validates; it never repairs.  Repairs
-(merging duplicates, collapsing zero-area faces, re-orienting) happen only in
-:func:`.cleaning.repair_mesh`, which returns a new mesh and a report in plain words.
+A :class:`Mesh` holds ``vertices`` (n, 3) float64 and ``faces`` (m, 3) int64, is
+immutable, and its construction validates but never repairs (repairs:
+:func:`.cleaning.repair_mesh`, which keeps every input vertex in its place).
 
-One vertex numbering, the user's own.  Vertex i of a mesh is row i of the arrays, or
-the i-th vertex record of the file, it was made from: :func:`.cleaning.repair_mesh` keeps every
-input vertex in its place and changes only the faces.  A vertex no face uses (see
-:attr:`Mesh.unused`) has no value: NaN in every per-vertex result, an empty row of the
-stiffness and a zero of the mass, as libigl's matrices have.  A duplicate merged into
-another vertex (:attr:`Mesh.merged_into`) is used by no face either and takes that
-vertex's values.
-
-The solvers work on :attr:`Mesh.solver_mesh`, the used vertices only (for a mesh without
-unused vertices the mesh itself); it is a mesh of another numbering, which it carries
-the map back from (:attr:`Mesh.file_to_mesh`, :meth:`Mesh.to_file_field`, ...).
-Results come back in the input's numbering (:func:`~.pipeline.compute_spectrum`
-expands them); nobody outside the library sees the solver's numbering.
-:func:`remove_unused` gives a compact mesh with its map, for those who want one.
+One vertex numbering, the user's own: vertex i is row i of the arrays or the i-th vertex
+record of the file.  A vertex no face uses (:attr:`Mesh.unused`) has no value: NaN in
+every per-vertex result, an empty stiffness row and a zero mass, as in libigl; a merged
+duplicate (:attr:`Mesh.merged_into`) takes the values of the vertex it was merged into.
+The solvers work on :attr:`Mesh.solver_mesh`, the used vertices only, which carries the
+map back (:attr:`Mesh.file_to_mesh`, :meth:`Mesh.to_file_field`); results come back in
+the input's numbering.  :func:`remove_unused` gives a compact mesh and its map.
 """
 
 from __future__ import annotations

@@ -1,25 +1,16 @@
 """How much of a signature a truncated spectrum misses (the modes beyond lambda_k).
 
-A spectrum of ``k`` modes sums the signature ``S_t(v) = sum_j exp(-lambda_j t)
-|phi_j(v)|^2`` (:mod:`.signatures`) over its modes only.  The modes are M-orthonormal,
-``sum_v m_v |phi_j(v)|^2 = 1``, so the signature's area-weighted total over the surface
-is ``Z(t) = sum_j exp(-lambda_j t)`` and the share of it the missing modes hold,
-
-    E(t) = tail(t) / (Z_k(t) + tail(t)),   tail(t) = sum_{j>k} exp(-lambda_j t),
-
-depends on the eigenvalues alone.  The missing eigenvalues are extrapolated from the
-computed ones: a power law ``lambda_j ~ j^p`` (Weyl's law gives ``p = 1`` for the
-Laplacian of a surface, ``lambda_j ~ 4 pi j / area``) is fitted on the upper half of the
-computed non-zero eigenvalues, its exponent lowered by ``SAFETY_EXPONENT`` and continued
-from ``lambda_k`` up to the last of the mesh's unknowns; the sum is bounded by its
-integral (closed form, incomplete gamma function) and doubled (``SAFETY_FACTOR``).
-
-The result is an upper-bound-style estimate, not a proof: on small meshes whose every
-mode is known it was at least the true share wherever that exceeded a hundredth (and at
-most about twenty times it), for the Laplacian, E_D^N and the shells on spheres, tori and plates
-(``tests/core/test_truncation.py``).  It is a share of the whole surface's signature;
-at one vertex the missing share can be larger or smaller
-(:func:`~.local_signature.local_signature` gives the exact value there).
+The modes are M-orthonormal, so the signature's area-weighted total over the surface is
+``Z(t) = sum_j exp(-lambda_j t)`` and the share the missing modes hold,
+``E(t) = tail(t) / (Z_k(t) + tail(t))`` with ``tail(t) = sum_{j>k} exp(-lambda_j t)``,
+depends on the eigenvalues alone.  The missing eigenvalues are extrapolated by a power
+law ``lambda_j ~ j^p`` (Weyl's law: ``p = 1`` for a surface's Laplacian) fitted on the
+upper half of the computed non-zero ones, its exponent lowered by ``SAFETY_EXPONENT``;
+the tail is bounded by its integral (incomplete gamma function) and doubled
+(``SAFETY_FACTOR``).  An upper-bound-style estimate, not a proof
+(``tests/core/test_truncation.py`` compares it with meshes whose every mode is known),
+of the whole surface's share; at one vertex
+:func:`~.local_signature.local_signature` gives the exact value.
 """
 
 from __future__ import annotations
