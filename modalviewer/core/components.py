@@ -1,18 +1,10 @@
 """Meshes of several connected components: keep the largest, or compute per component.
 
-A spectrum of a mesh with c components starts with c constants (Laplacian) or 6 c rigid
-motions (Discrete Shells): :func:`~modalviewer.core.pipeline.compute_spectrum` returns
-them as exact zero modes and says how many (``spec.null_space_dimension``,
-``spec.parameters["null_space"]``), but k must then exceed that number before any
-vibration shows up, and the non-zero modes of all components are interleaved in one
-list.  Two ways out, both plain functions of the mesh:
-
-* :func:`largest_component` returns a new :class:`Mesh` of the component with the
-  largest area (scanner debris and loose parts dropped), with a report of what was
-  removed, like every repair.
-* :func:`compute_spectrum_per_component` computes k modes of each component on its own
-  and returns one :class:`ComponentSpectrum` per component, largest first.
-
+A mesh of c components has c constants (Laplacian) or 6 c rigid motions (shells) as
+exact zero modes, so k must exceed that before any vibration shows, and the components'
+modes are interleaved in one list.  :func:`largest_component` keeps the component of
+largest area (with a report of what was removed); :func:`compute_spectrum_per_component`
+computes k modes of each component on its own, largest first;
 :func:`split_components` gives the components themselves.
 """
 

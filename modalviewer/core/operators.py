@@ -1,16 +1,11 @@
 """The one list of operators modalviewer computes spectra of, and what each one is.
 
-Every per-operator fact lives here: the label, the number of unknowns per vertex, the
-function that assembles the matrix, the exactly known null space, the signature and
-distance the spectrum defines, and the memory an exact solve needs.  Every other module
-(pipeline, null space, viewer, CLI, plots) asks this registry instead of keeping its own
-list or comparing operator names, so a new operator is one more :class:`OperatorInfo` in
-:data:`OPERATOR_INFO` and its assembly function.  The public functions accept an
-operator's name or its :class:`OperatorInfo` (:data:`OperatorLike`); each resolves it once
-with :func:`operator_info` and passes the object on.
-
-This module imports nothing of the package: the assembly functions are named by
-``"module:function"`` inside :mod:`modalviewer.core` and imported when first used.
+Every per-operator fact lives in its :class:`OperatorInfo` in :data:`OPERATOR_INFO`;
+other modules ask the registry instead of comparing names, so a new operator is one
+more entry and its assembly function.  Public functions accept a name or an
+:class:`OperatorInfo` (:data:`OperatorLike`), resolve it once with
+:func:`operator_info` and pass the object on.  This module imports nothing of the
+package: assembly functions are named ``"module:function"`` and imported when used.
 """
 
 from __future__ import annotations
@@ -73,29 +68,24 @@ class OperatorInfo:
     distance_kind : the multi-scale distance this operator's spectrum defines, or None.
     has_weights : whether the bending and membrane weights apply.
     assemble : the function that assembles K, or its ``"module:function"`` in
-        :mod:`modalviewer.core`: ``function(mesh)``, or ``function(mesh, bending,
-        membrane)`` with weights; with ``assembles_mass`` it returns
-        (K, mass).
+        :mod:`modalviewer.core`, called as ``function(mesh)`` or, with weights,
+        ``function(mesh, bending, membrane)``.
     null_space : the exactly known null vectors in words.
     null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
     exact_growth : measured peak memory of the exact solve against mesh size
         (:class:`.cost.GrowthLaw`), which the memory check predicts from.
-    factor_memory : the exact solver's factor in core and out of core against mesh
-        size (:class:`.cost.FactorLaw`), which predicts the memory of a solve whose
-        factor goes out of core.
+    factor_memory : the factor's size in core and out of core against mesh size
+        (:class:`.cost.FactorLaw`).
     signature_word : the signature (and distance) its spectrum defines, in words
         ("heat kernel"), or None.
-    assembles_mass : whether :attr:`assemble` returns the (n,) masses with K (an
-        operator with a mass of its own); otherwise the mass is the lumped vertex area.
-    measured_as : the operator whose measured laws (:attr:`exact_growth`,
-        :attr:`factor_memory`) this one borrows, or None: its own
-        runs in ``benchmarks/results/growth.json``.
-    nonnegative_weights : whether its weights stay non-negative on any mesh, so that the
-        viewer suggests it where the cotan weights go negative.
-    wave_distance_kind : the distance of the wave kernel signature of its spectrum
-        offered by the viewer and the CLI (``"wks"`` for the Laplacian), or None; the
-        library computes that signature for any spectrum
-        (:func:`.signatures.signature`).
+    assembles_mass : whether :attr:`assemble` returns (K, mass (n,)); otherwise the mass
+        is the lumped vertex area.
+    measured_as : the operator whose measured laws this one borrows, or None (its own
+        runs are in ``benchmarks/results/growth.json``).
+    nonnegative_weights : whether its weights stay non-negative on any mesh (the viewer
+        suggests it where the cotan weights go negative).
+    wave_distance_kind : the wave kernel distance the viewer and the CLI offer for its
+        spectrum (``"wks"`` for the Laplacian), or None.
     """
 
     name: str
@@ -130,16 +120,11 @@ class OperatorInfo:
         out_of_core: bool | None = None,
         basis_float32: bool | None = None,
     ) -> float:
-        """Peak memory (MB) of an exact solve of ``k`` modes on ``n_vertices``: the law
-        with the arrays that grow with k (:func:`.cost.exact_peak_mb`), less the factor's
-        in-core size plus its out-of-core size where the factor goes out of core
-        (``out_of_core``; None: as :meth:`factor_out_of_core` predicts), plus the factor's
-        further fill on curved meshes (:data:`.cost.FILL_MARGIN` times the factor's law
-        for the place it is kept), less what a
-        single-precision Krylov basis saves where it is kept so
-        (:func:`.cost.float32_basis_saving_mb`; ``basis_float32``; None: as the solver
-        decides, where the peak so far is above this machine's
-        :func:`.memory.memory_limit_mb`)."""
+        """Predicted peak memory (MB) of an exact solve of ``k`` modes on ``n_vertices``
+        (:func:`.cost.exact_peak_mb` with :data:`.cost.FILL_MARGIN` on the factor).
+        ``out_of_core``: the factor kept in a file; ``basis_float32``: a single-precision
+        Krylov basis (:func:`.cost.float32_basis_saving_mb`); None for either: as the
+        solver decides against :func:`.memory.memory_limit_mb`."""
         peak = self._in_core_peak_mb(n_vertices, k)
         if self._out_of_core(n_vertices, k, out_of_core):
             factor = self.factor_memory

@@ -31,16 +31,13 @@ class Spectrum:
     Attributes
     ----------
     eigenvalues : (k,) ascending, units 1/time^2 for vibrations (frequency = sqrt).
-    modes : (n, k), or (n, 3, k) for ``"shells"``, one row per vertex of the mesh (its
-        input numbering); NaN at the vertices no face uses (``mesh.unused``), a merged
-        duplicate's row that of the vertex it was merged into.  M-orthonormal: with the
-        rows of the vertices faces use, ``Phi = modes.reshape(-1, k)`` and ``M`` the lumped
-        mass (``mass``, repeated for each component of a vector mode), ``Phi.T @ M @ Phi``
-        is the identity, so a mode's values scale with 1 / sqrt(area).
-        :meth:`euclidean_modes` gives unit-length columns instead.
+    modes : (n, k), or (n, 3, k) for ``"shells"``, one row per vertex in the input
+        numbering: NaN at the vertices no face uses, a merged duplicate's row that of
+        its vertex.  M-orthonormal (``Phi.T @ M @ Phi = I`` over the used rows, ``M`` the
+        lumped ``mass`` per component), so values scale with 1 / sqrt(area);
+        :meth:`euclidean_modes` gives unit-length columns.
     operator : the operator's name (:attr:`operator_info`: its registry entry).
-    mass : (n,) lumped vertex masses used for orthonormality (0 at vertices no face
-        uses, as the mass matrix has).
+    mass : (n,) lumped vertex masses (0 at vertices no face uses).
     residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
     mesh_hash : SHA-256 of the mesh geometry the spectrum belongs to.
     parameters : bending and membrane weights, solver information.
@@ -103,10 +100,8 @@ class Spectrum:
         return int(self.parameters.get("null_space_dimension", 0))
 
     def zero_mode_mask(self) -> np.ndarray:
-        """(k,) True for the zero modes: the deflated null vectors, and modes whose
-        eigenvalue is below 1e-8 times the largest (or the operator's typical
-        eigenvalue size, if larger); the rule of :func:`.eigen.zero_modes`, the same the
-        residual check used."""
+        """(k,) True for the zero modes: the deflated null vectors and the eigenvalues
+        :func:`.eigen.zero_modes` counts as zero (the rule the residual check used)."""
         return zero_modes(
             self.eigenvalues,
             float(self.parameters.get("zero_mode_scale", 0.0)),

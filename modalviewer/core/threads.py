@@ -1,19 +1,12 @@
 """OpenBLAS at one thread during an eigensolve, set at run time.
 
-MKL PARDISO (Intel OpenMP threads) and the OpenBLAS of numpy and scipy take turns on
-the same cores, hundreds of times per eigensolve.  OpenBLAS keeps its threads spinning
-for a while after each call, and they slow PARDISO's threads down.  The idle timeout
-(``OPENBLAS_THREAD_TIMEOUT``, set by ``import modalviewer``) is read only when OpenBLAS
-loads, so it has no effect when numpy was imported first.  :func:`single_blas_thread`
-works whatever the import order: through threadpoolctl, OpenBLAS runs on one thread for
-the duration of the decorated call (the eigensolver), so no OpenBLAS thread spins beside
-PARDISO.  PARDISO keeps all its threads, and Intel OpenMP's ``KMP_BLOCKTIME`` needs no
-run-time setting: its library loads at the first PARDISO call, after
-``import modalviewer``.  Measured by ``benchmarks/import_order.py``
-(``benchmarks/results/import_order.json``).
-
-Without threadpoolctl or without OpenBLAS (another BLAS) the call runs as it is;
-``MODALVIEWER_SINGLE_BLAS_THREAD=0`` turns the limit off.
+MKL PARDISO and numpy's OpenBLAS take turns on the same cores hundreds of times per
+eigensolve, and OpenBLAS threads left spinning after each call slow PARDISO's down.
+``OPENBLAS_THREAD_TIMEOUT`` (set by ``import modalviewer``) is read only when OpenBLAS
+loads, too late if numpy was imported first; :func:`single_blas_thread` works whatever
+the import order, limiting OpenBLAS to one thread through threadpoolctl for the
+decorated call (``benchmarks/import_order.py`` measures it).  Without threadpoolctl or
+OpenBLAS the call runs as it is; ``MODALVIEWER_SINGLE_BLAS_THREAD=0`` turns it off.
 """
 
 from __future__ import annotations
