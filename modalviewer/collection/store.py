@@ -3,14 +3,13 @@ ranking them by spectral distance to a shape (:meth:`Collection.similar`).
 
 A folder: ``collection.json`` (format, operator, k, signatures), ``meshes/NAME.npz`` per
 mesh (written atomically), ``errors/NAME.json`` per failure and ``index.json``, a
-summary rebuilt from those files.  One file per mesh, because workers finish meshes
-independently, each result is written whole or not at all, a killed run loses only
-what was in flight and numpy alone reads it (the library guide's "Shape collections"
-says more).  Each mesh file is a spectrum file of :func:`~.core.spectrum.save_spectrum`
-plus ``entry`` (JSON: source, its size and date, ``mesh_hash``, parameters, ``key``,
-area, vertex count), ``shape_dna``, ``sig.KIND.times`` and ``sig.KIND.values`` (T,) and
-(n, T), ``hist.KIND`` (S, B) over :data:`HISTOGRAM_EDGES`, and ``OP.eigenvalues``,
-``OP.modes``, ... for a signature whose operator is not the store's.
+summary rebuilt from those.  One file per mesh, so that workers finish independently, a
+killed run loses only what was in flight and numpy alone reads it.  A mesh file is a
+spectrum file (:func:`~.core.spectrum.save_spectrum`) plus ``entry`` (JSON: source,
+size, date, ``mesh_hash``, parameters, ``key``, area, vertex count), ``shape_dna``,
+``sig.KIND.times`` (T,) and ``sig.KIND.values`` (n, T), ``hist.KIND`` (S, B) over
+:data:`HISTOGRAM_EDGES`, and ``OP.eigenvalues``, ``OP.modes``, ... for a signature
+whose operator is not the store's.
 """
 
 from __future__ import annotations

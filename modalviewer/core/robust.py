@@ -1,14 +1,10 @@
 """The robust Laplacian: the intrinsic Delaunay Laplacian of the tufted cover (Sharp and
-Crane, *A Laplacian for Nonmanifold Triangle Meshes*, SGP 2020), from the optional
-``robust-laplacian`` package.
+Crane, SGP 2020), from the optional ``robust-laplacian`` package.
 
-The cotan weights of a mesh with obtuse or sliver triangles go negative (the sum of the
-two angles opposite an edge exceeds pi), which breaks the maximum principle and can make
-signatures and distances oscillate.  The intrinsic Delaunay triangulation of the same
-surface has non-negative weights everywhere, and the tufted cover also accepts
-non-manifold edges and vertices.  :func:`negative_cotan_weights` counts the edges of a
-mesh whose cotan weight is negative: the viewer suggests the robust Laplacian where it
-finds some.
+Obtuse and sliver triangles make cotan weights negative, which breaks the maximum
+principle and can make signatures oscillate; the intrinsic Delaunay weights are
+non-negative, and the tufted cover accepts non-manifold meshes.  The viewer suggests it
+where :func:`negative_cotan_weights` finds negative weights.
 """
 
 from __future__ import annotations
@@ -50,12 +46,9 @@ _COUNTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def negative_cotan_weights(mesh: Mesh) -> int:
-    """The number of edges whose cotan weight ``(cot alpha + cot beta) / 2`` (one term on
-    a boundary) is negative, beyond round-off (1e-12 of the largest weight): the entries
-    of the cotan stiffness matrix above 0 off its diagonal.  Summed over the mesh's edge
-    list (:attr:`.mesh.Mesh.face_edges`), without assembling the matrix; kept for each
-    mesh object (a mesh is not changed in place), so that the window's reading thread
-    can count while the file is opened and the panel asks again for free."""
+    """The number of edges whose cotan weight ``(cot alpha + cot beta) / 2`` is negative
+    beyond round-off (1e-12 of the largest), counted without assembling the matrix and
+    kept per mesh object, so the window counts while reading and asks again for free."""
     count = _COUNTS.get(mesh)
     if count is None:
         count = _COUNTS[mesh] = _count_negative(mesh)

@@ -1,21 +1,13 @@
 """Cameras for a mesh, as plain numbers (no Qt, no VTK): the canonical first view and the
 axis presets.
 
-Canonical view: the up axis is the caller's (a file convention) or +Y, the convention of
-most OBJ/PLY/OFF models.  Among the horizontal viewing directions (perpendicular to up,
-every 5 degrees) the viewer looks along the one from which the surface shows the largest
-silhouette (estimated from points spread over the surface, projected on a grid),
-preferring a coordinate axis when it shows ``AXIS_PREFERENCE`` of the best; if the view from
-above shows more than ``TOP_VIEW_RATIO`` times that (a plate lying across the up axis),
-it looks from above.  Then the camera turns by a small azimuth and elevation so the
-view shows depth.  The camera sits on the side of +Z (then +X, then +Y) of its axis, the
-side most models face.  Without faces the principal axis of least spread stands in for
-the direction of the largest silhouette.
-
-A CAD-like part (most neighbouring faces coplanar, sharp edges along its features) seen
-that way often faces its flat side, which hides its features: the turn is then the one,
-of a few azimuths and elevations, from which its sharp edges show best (both faces of
-each seen at a good angle).
+Canonical view: up is the caller's axis or +Y (most OBJ/PLY/OFF models).  The viewer
+looks along the horizontal direction (every 5 degrees) with the largest silhouette,
+preferring a coordinate axis within ``AXIS_PREFERENCE`` of the best, or from above when
+that shows ``TOP_VIEW_RATIO`` times more (a plate); then it turns by a small azimuth and
+elevation to show depth, from the +Z (then +X, +Y) side most models face.  A CAD-like
+part (mostly coplanar neighbours, sharp feature edges) is turned instead to the view
+that shows its sharp edges best.  Without faces the axis of least spread stands in.
 """
 
 from __future__ import annotations
