@@ -3,21 +3,14 @@
 The public API re-exports the numerical core (numpy/scipy only) and
 :class:`~modalviewer.viewer.Viewer`, the viewer without a window (loaded on first use).
 Importing this package never imports Qt or VTK; the windows live in ``modalviewer.gui``.
-
->>> import modalviewer as mv
->>> mesh = mv.load_mesh("assets/bumpy_plate.obj")          # doctest: +SKIP
->>> spec = mv.compute_spectrum(mesh, "modified_dirichlet", k=50)  # doctest: +SKIP
 """
 
 import os as _os
 
-# MKL PARDISO (Intel OpenMP threads) and numpy's OpenBLAS take turns on the same cores.
-# By default both keep their threads spinning after each call (KMP_BLOCKTIME 200 ms,
-# OpenBLAS about 0.1 s), so each slows the other down; the eigensolver alternates
-# between them hundreds of times (benchmarks/import_order.py measures it).  Set before numpy
-# loads OpenBLAS; an explicit setting in the environment wins.  When numpy was imported
-# first, the OpenBLAS timeout comes too late: the eigensolver then runs OpenBLAS on one
-# thread at run time (core/threads.py), whatever the import order.
+# MKL PARDISO and numpy's OpenBLAS take turns on the same cores hundreds of times per
+# eigensolve, and threads left spinning after each call slow the other down; these make
+# them sleep soon after each call.  Set before numpy loads OpenBLAS (an explicit setting
+# wins); when numpy came first, core/threads.py limits OpenBLAS at run time instead.
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 

@@ -1,16 +1,11 @@
 """Checks of the arguments at the public API's edge: counts, vertex indices, scales.
 
-One place for the rules, so that every function that takes ``k``, a vertex index or
-scales rejects the same inputs with the same words (the parameter's name and the
-value given):
-
-- counts (``k``, ``samples``): Python or numpy integers, not bools, not floats
-  (``2.5`` would silently become 2), not strings; at least a minimum;
-- vertex indices: integers (``2.0`` is refused), in ``0..n-1`` (negative indices, which
-  numpy would count from the end, are refused too);
-- scales (``times``, ``t_range``): positive and finite.
-
-Wrong types raise TypeError, wrong values ValueError, indices out of range IndexError.
+One place for the rules, so that every function rejects the same inputs with the same
+words (the parameter's name and the value given): counts (``k``, ``samples``) are
+integers, not bools, floats or strings, and at least a minimum; vertex indices are
+integers in ``0..n-1`` (no negative indices counted from the end); scales (``times``,
+``t_range``) are positive and finite.  Wrong types raise TypeError, wrong values
+ValueError, indices out of range IndexError.
 """
 
 from __future__ import annotations
