@@ -1,33 +1,18 @@
 """The Viewer: everything the modalviewer window does, scripted without a window (no Qt).
 
-A :class:`Viewer` is the viewer's model (:class:`~.model.ViewerModel`: the evented state,
-the job queue and the spectrum cache) with the scripting API, messages for the user and
-pictures (:class:`~.pictures.Pictures`).  Scripts, notebooks, the command line and the
-windows all drive the same object::
+A :class:`Viewer` is the viewer's model (:class:`~.model.ViewerModel`: the evented
+state, the job queue and the spectrum cache) with the scripting API, messages for the
+user and pictures (:class:`~.pictures.Pictures`).  Scripts, notebooks, the command line
+and the windows all drive the same object (docs/viewer-guide.md shows a script); a
+window only wires widgets to it: what a click does, the matching method here does.
 
-    import modalviewer as mv
-
-    viewer = mv.Viewer()
-    viewer.open_mesh("bunny.obj")
-    viewer.compute("shells", k=50)                 # waits; returns the Spectrum
-    viewer.show_mode(7)
-    viewer.export_screenshot("mode7.png", scale=2)
-    viewer.pick_file_vertex(123)
-    viewer.show_distance("vibration", display="threshold", share=0.1)
-    name, values = viewer.current_field()
-
-A window (``modalviewer.gui.MainWindow(viewer=viewer)``) only wires widgets to it: what
-a click does, the matching method here does.
-
-Messages for the user are emitted as ``viewer.events.status(text, milliseconds)``,
-``viewer.events.error(title, text)`` and ``viewer.events.info(title, text)``; without a
-window nothing listens and scripts get return values and exceptions instead.
-``viewer.events.sliver_failure(key, text)``: a computation failed on sliver triangles
-and :meth:`Viewer.fix_slivers_and_retry` may help (the window offers it as a button).
-
-Waiting: without a window, jobs run in worker threads and their results are handed
-back to the calling thread while a ``wait`` call waits (:class:`~.jobs.ManualDispatcher`).
-A window replaces the dispatcher by its event loop (:meth:`Viewer.use_event_loop`).
+Messages are events: ``viewer.events.status(text, milliseconds)``, ``error(title,
+text)``, ``info(title, text)`` and ``sliver_failure(key, text)`` (a computation failed
+on slivers; :meth:`Viewer.fix_slivers_and_retry` may help).  Without a window nothing
+listens, and scripts get return values and exceptions.  Without a window, jobs run in
+worker threads and their results are handed back while a ``wait`` call waits
+(:class:`~.jobs.ManualDispatcher`); a window installs its event loop instead
+(:meth:`Viewer.use_event_loop`).
 """
 
 from __future__ import annotations
@@ -213,15 +198,10 @@ class Viewer(ViewerModel, Pictures):
 
         Parameters
         ----------
-        operator : str, optional
-            ``"laplacian"``, ``"modified_dirichlet"``, ``"shells"`` or ``"shells_normal"``
-            (default: the compute settings' operator).
-        k : int, optional
-            The number of modes (default: the compute settings').
-        wait : bool
-            Return once the spectrum is in.
-        then : callable, optional
-            Called with the spectrum when it arrives.
+        operator : an operator's name (default: the compute settings').
+        k : the number of modes (default: the compute settings').
+        wait : return once the spectrum is in.
+        then : called with the spectrum when it arrives.
 
         Returns
         -------
@@ -231,8 +211,8 @@ class Viewer(ViewerModel, Pictures):
         Raises
         ------
         ComputeError
-            With ``wait=True``, if no mesh is open, or the computation failed, was cancelled or
-            was too large to start.
+            With ``wait=True``, if no mesh is open, or the computation failed, was
+            cancelled or was too large to start.
         """
         if self.state.mesh is None:
             self.report_error("Open a mesh first.")
@@ -448,21 +428,16 @@ class Viewer(ViewerModel, Pictures):
         share: float | None = None,
         threshold: float | None = None,
     ) -> np.ndarray | None:
-        """The distance map from the picked vertex, shown on the surface.
-
-        A missing spectrum is computed in the background; the map appears when it is ready
+        """The distance map from the picked vertex, shown on the surface; a missing
+        spectrum is computed in the background and the map appears when it is ready
         (unless the display changed meanwhile).
 
         Parameters
         ----------
-        kind : {"vibration", "feature", "hks"}, optional
-            The distance (default: the display's).
-        display : {"continuous", "threshold"}, optional
-            A continuous map (white to red) or a threshold map (blue where similar).
-        share : float, optional
-            A threshold map marking this share (0..1] of the surface's area similar.
-        threshold : float, optional
-            A threshold map at this absolute distance (marks distance <= it).
+        kind : ``"vibration"``, ``"feature"`` or ``"hks"`` (default: the display's).
+        display : ``"continuous"`` (white to red) or ``"threshold"`` (blue where similar).
+        share : a threshold map marking this share (0..1] of the surface's area similar.
+        threshold : a threshold map at this absolute distance (marks distance <= it).
 
         Returns
         -------
@@ -472,8 +447,8 @@ class Viewer(ViewerModel, Pictures):
         Raises
         ------
         ValueError
-            For both ``share`` and ``threshold``, a share outside (0, 1], a negative threshold
-            or an unknown kind.
+            For both ``share`` and ``threshold``, a share outside (0, 1], a negative
+            threshold or an unknown kind.
         """
         if share is not None and threshold is not None:
             raise ValueError("give either share (of the area) or threshold (a distance)")
@@ -690,21 +665,16 @@ class Viewer(ViewerModel, Pictures):
         """Distances between two shapes: this viewer's mesh as A and ``mesh_b`` as B.
 
         Use the result with ``pair.pick("a", v)``, ``pair.distance_on("b")`` and
-        ``pair.best_match()``, all in the input's numbering.  The distance kind and the
+        ``pair.best_match()``, all in the input's numbering; the distance kind and the
         Discrete Shells weights are this viewer's.
 
         Parameters
         ----------
-        mesh_b : Mesh, str or os.PathLike
-            Mesh B, or its file.
-        k : int, optional
-            Modes per spectrum (default 100, fewer on tiny meshes).
-        wait : bool
-            Return once the spectra of both meshes are in.
-        strict : bool
-            As for :meth:`open_mesh`, for a file.
-        path : str or os.PathLike, optional
-            The file a given Mesh was read from (its name labels B).
+        mesh_b : Mesh B (:class:`Mesh`), or its file.
+        k : modes per spectrum (default: :func:`.operators.default_k`).
+        wait : return once the spectra of both meshes are in.
+        strict : as for :meth:`open_mesh`, for a file.
+        path : the file a given Mesh was read from (its name labels B).
 
         Returns
         -------
