@@ -1,29 +1,18 @@
 """Two meshes side by side: a pick on one, the distance between shapes on the other (no Qt).
 
-:class:`PairState` holds mesh A and mesh B, the distance kind (vibration, feature or
-heat kernel), how the distance is shown (continuous, or a threshold given as a share of
-the other mesh's surface area), whether both meshes are rescaled to unit area before
-their spectra are computed, and the picked vertex (on A or on B).  It asks a
-:class:`~.jobs.JobQueue` (the main window's, so one computation runs at a time and its
-progress shows there) for the spectra both meshes need, reads them from the disk cache
-when they are there, and reuses a spectrum of A the main window's state already holds.
-The window draws :meth:`PairState.view` of each side and observes ``events``:
+:class:`PairState` holds meshes A and B, the distance kind and how it is shown
+(continuous, or a threshold as a share of the other mesh's area), whether both are
+rescaled to unit area before their spectra are computed (signatures carry a factor
+1/area and the shells spectrum is not scale covariant: :mod:`.core.cross`), and the
+pick.  Its spectra go through the main window's :class:`~.jobs.JobQueue` and the disk
+cache, reusing a spectrum of A the main window already holds.  Distances are
+:class:`~modalviewer.core.cross.CrossTables` queries.  The window draws
+:meth:`PairState.view` of each side and observes ``events``: ``meshes()`` (A or B
+replaced: spectra and pick dropped), ``spectra()``, ``display()`` and ``message(str)``
+(something the user should read).
 
-- ``meshes()``: mesh A or B was replaced (its spectra and the pick were dropped).
-- ``spectra()``: a spectrum of either side arrived.
-- ``display()``: what either side shows changed (kind, display, share, pick, scale).
-- ``message(str)``: something the user should read (a failed computation, a warning).
-
-Every vertex a method takes or returns is in the input's numbering (row i of the arrays,
-the i-th vertex record of the file), as everywhere in modalviewer; distances have one
-row per input vertex, NaN at vertices no face uses.  Only :class:`PairView`, what the
-window draws, numbers the vertices of :meth:`PairState.drawn_mesh`.
-
-Distances are :class:`~modalviewer.core.cross.CrossTables` queries: eq. (31) with both
-signatures at the common scales, each normalised by its own Z(t).  Rescaling matters:
-Laplacian and E_D^N signatures carry a factor 1/area, and the Discrete Shells spectrum
-is not scale covariant at all (a larger copy vibrates differently, not just slower), so
-two meshes of different size are only comparable after both are brought to one area.
+Vertices and distances are in the input's numbering (NaN at vertices no face uses);
+only :class:`PairView` numbers the vertices of :meth:`PairState.drawn_mesh`.
 """
 
 from __future__ import annotations
@@ -75,14 +64,12 @@ def _check_side(side: str) -> None:
 class PairView:
     """What one side of the pair draws, on :meth:`PairState.drawn_mesh` (its numbering).
 
-    values : (n,) distances on this side from the pick on the other side, or None (the
-        plain surface: nothing picked yet, the spectra are not in, or this side is the
-        picked one).
+    values : (n,) distances from the pick on the other side, or None (the plain surface).
     colormap : "sequential" (white 0 to red), "threshold" (blue below ``threshold``) or
         "plain".
     marker : the picked vertex (picked side) or the best match (other side).
-    back_marker : on the picked side, the best match back from the best match when it is
-        not the picked vertex (the match is not mutual); else None.
+    back_marker : on the picked side, the best match back when the match is not mutual;
+        else None.
     legend : the lines drawn at the top left of the view and in exports.
     colorbar_title, colorbar_labels : the colour bar (labels for a threshold's swatches).
     scale : the knots of a colour scale spread by area (:func:`.color_scale.auto_spread`),
@@ -138,8 +125,9 @@ class PairState:
 
     ``jobs`` and ``cache``: the queue and disk cache the spectra go through.
     ``state_a``: a viewer state whose spectra of mesh A may be reused (the main window's).
-    ``k``: modes per spectrum (the same on both meshes), by default 100 or fewer for tiny
-    meshes.  ``weights``: the Discrete Shells (bending, membrane) weights.
+    ``k``: modes per spectrum on both meshes (default:
+    :func:`~modalviewer.core.operators.default_k`).
+    ``weights``: the Discrete Shells (bending, membrane) weights.
     """
 
     def __init__(

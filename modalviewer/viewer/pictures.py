@@ -78,29 +78,21 @@ class Pictures:
     ) -> Path:
         """Save the picture as PNG (atomically).
 
-        With a window attached and no ``size``, its view as on screen.  Otherwise the
-        same scene drawn off screen at ``size``, seen from the picture's direction with
-        the camera fitted so that the whole shape (deformed as drawn) lies inside the
-        frame, clear of the legend and the colour bar.
+        With a window attached and no ``size``, its view as on screen; otherwise the same
+        scene drawn off screen, the camera fitted so the whole (deformed) shape lies in
+        the frame, clear of the legend and the colour bar.
 
         Parameters
         ----------
-        path : str or os.PathLike
-            The PNG to write.
-        scale : int
-            Magnification: the PNG is ``scale`` times the picture's width and height.
-        transparent : bool
-            A transparent background.
-        colorbar : bool, optional
-            With the colour bar and legend (None: as the state says).
-        size : (int, int), optional
-            (width, height) in pixels (before ``scale``); without a window the default
-            is 1024 x 768 (a size given to one call does not carry over to the next).
-        marker : bool, optional
-            With the pick marker (None: on distance maps, not on other pictures).
-        fit : bool
-            Fit the camera to the shape (off screen); False keeps the camera as it is
-            (pictures of several displays from one camera).
+        path : the PNG to write.
+        scale : magnification: the PNG is ``scale`` times the picture's width and height.
+        transparent : a transparent background.
+        colorbar : with the colour bar and legend (None: as the state says).
+        size : (width, height) in pixels before ``scale``; without a window 1024 x 768
+            by default (a size given to one call does not carry over).
+        marker : with the pick marker (None: on distance maps only).
+        fit : fit the camera to the shape (off screen); False keeps the camera (pictures
+            of several displays from one camera).
 
         Returns
         -------
@@ -287,15 +279,11 @@ class Pictures:
 
         Parameters
         ----------
-        comparison : Comparison or list of str
-            A :meth:`comparison`, or its items (two or three operators or distance kinds; their
-            missing spectra are computed first).
-        path : str or os.PathLike
-            The PNG to write.
-        size : (int, int), optional
-            (width, height) of each view in pixels.
-        scale : int
-            Magnification: each view is ``scale`` times ``size``.
+        comparison : a :meth:`comparison`, or its items (two or three operators or
+            distance kinds; their missing spectra are computed first).
+        path : the PNG to write.
+        size : (width, height) of each view in pixels.
+        scale : magnification: each view is ``scale`` times ``size``.
 
         Returns
         -------

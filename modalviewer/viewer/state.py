@@ -1,30 +1,18 @@
 """The viewer's state: what is loaded, computed, displayed and picked (no Qt, no VTK).
 
-:class:`ViewerState` is the single source of truth of the viewer (``viewer.state``).
-The 3D scene, every panel, the status bar and the plots observe its events and redraw
-from it; they keep no state of their own.  Fields that only need validating are
-evented (:class:`Style`: ``state.style.isolines = 8``); changes that do more go through
-methods (:meth:`ViewerState.set_display`, ``set_pick``, ``set_scale_range``, ...).  The
-values computed from it live in :attr:`ViewerState.derived` (:mod:`.derived`), the words
-shown in :mod:`.wording`.
-
-A method changes only what it is given, with one exception, the threshold rule
-(:meth:`ViewerState._match_threshold`): a threshold map marks the share
-:attr:`Display.threshold_share` of the surface's area; with :attr:`Display.keep_share`
-a new map (another pick, kind, scale range or spectrum) gets the threshold fraction that
-marks that share; a fraction the caller sets (``set_display(threshold=...)``) sets the
-share it marks, and a share the caller sets (``set_display(threshold_share=...)``) the
-fraction that marks it.
+:class:`ViewerState` (``viewer.state``) is the single source of truth: the scene, the
+panels, the status bar and the plots observe its events and redraw from it.  Fields that
+only need validating are evented (:class:`Style`: ``state.style.isolines = 8``); changes
+that do more go through methods (``set_display``, ``set_pick``, ...).  Values computed
+from it live in :attr:`ViewerState.derived`, the words shown in :mod:`.wording`.  A
+method changes only what it is given, except for the threshold rule
+(:meth:`ViewerState._match_threshold`).
 
 Events (``state.events.<name>.connect(callback)``), emitted on the thread that changed
-the state (the GUI thread in the viewer): ``mesh()`` (a new mesh or none: spectra, pick
-and display were reset), ``spectra(operator)`` (added or replaced), ``display()`` (what
-is drawn, including a threshold the rule matched), ``style()`` (any :class:`Style`
-field), ``pick()`` (:attr:`ViewerState.picked` is the mesh's index,
-:attr:`ViewerState.picked_file_vertex` the file's number shown and saved),
-``compute_settings()``, ``scale_range()``, ``animation()``, ``camera()`` (set through
-the state: a preset, a restored session), ``signature_curve()`` (the exact curve
-arrived) and ``up_axis()`` (the scene turns to the canonical view for it).
+the state: ``mesh()`` (new mesh or none; spectra, pick and display reset),
+``spectra(operator)``, ``display()``, ``style()``, ``pick()``, ``compute_settings()``,
+``scale_range()``, ``animation()``, ``camera()`` (set through the state: a preset, a
+restored session), ``signature_curve()`` (the exact curve arrived) and ``up_axis()``.
 """
 
 from __future__ import annotations
@@ -128,22 +116,19 @@ class SpectrumKey:
 class Display:
     """What the surface shows.
 
-    kind : "none" | "mode" | "distance" | "signature" | "curvature".
+    kind : "none" | "mode" | "distance" | "signature" | "curvature" | "field".
     operator : the spectrum a mode belongs to.
     mode : index of the mode shown.
     distance_kind : "vibration" | "feature" | "hks" | "wks" (also picks the signature's
         spectrum and kind).
     distance_display : "continuous" | "threshold".
     threshold : threshold as a fraction of the largest distance (0..1].
-    threshold_share : the share (0..1) of the surface's area the threshold map marks;
-        without ``keep_share``, the share the fraction marked on the last threshold map.
-    keep_share : a new threshold map (another pick, kind, scale range or spectrum)
-        marks ``threshold_share`` of the surface (its fraction is set to match), instead
-        of keeping the fraction; see :meth:`ViewerState._match_threshold`.
+    threshold_share : the share (0..1) of the surface's area the threshold map marks.
+    keep_share : a new threshold map keeps ``threshold_share`` rather than the fraction
+        (:meth:`ViewerState._match_threshold`).
     signature_sample : index of the scale a signature is shown at (0..99).
     signature_time : a scale t typed for the signature, or None: the sample's scale.
-    field : the name of the per-vertex field shown with kind "field" (one of
-        :attr:`ViewerState.fields`: values a script gave).
+    field : the name of the field shown with kind "field" (:attr:`ViewerState.fields`).
     """
 
     kind: str = "none"
@@ -305,17 +290,12 @@ class ViewerState:
 
     # ---------------------------------------------------------- spectra
     def add_spectrum(self, key: SpectrumKey, spec: Spectrum, table=None) -> None:
-        """Store a computed spectrum (and its signature table, if already built).
-
-        It becomes the spectrum shown for its operator; the operator's spectra of other
-        keys (another k, other weights) are dropped: nothing shows them any more, each
-        holds n x k floats (exact ones come back from the cache).
-
-        The first modes of a computation still running (``spec.is_complete`` False) are
-        stored the same way and replaced as more arrive; they never replace a complete
-        spectrum of ``key``, nor the operator's spectrum on screen (another k, other
-        weights) while they are fewer than its modes, and nothing the user chose (mode,
-        pick, share, camera) is reset when they are."""
+        """Store a computed spectrum (and its signature table, if already built) as the
+        one shown for its operator; the operator's spectra of other keys are dropped
+        (nothing shows them, and exact ones come back from the cache).  The first modes
+        of a running computation (``spec.is_complete`` False) are stored the same way but
+        never replace a complete spectrum of ``key``, nor one on screen with more modes,
+        and reset nothing the user chose."""
         if self.mesh is not None:
             spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
@@ -598,17 +578,13 @@ class ViewerState:
         distance) and ``display.threshold_share`` (the share of the surface's area it
         marks) on the threshold map on screen.
 
-        The distances are so skewed that one fraction of the largest marks most of the
-        surface from one vertex and little from another, so with ``keep_share`` a threshold
-        map that was not matched yet (another vertex, kind, scale range or spectrum, or a
-        first map) gets the fraction that marks ``threshold_share``
-        (:data:`DEFAULT_THRESHOLD_SHARE` at first).  A fraction the caller set
-        (``fraction_set``; also one set before its map is on screen, as
-        ``show_distance(threshold=...)`` does), or any fraction without ``keep_share``,
-        sets the share it marks instead; a share the caller set (``share_set``) sets the
-        fraction.  Every setter that changes the map calls this before emitting; it is
-        the only place a setter changes display fields it was not given.  Emits nothing:
-        the caller's event redraws."""
+        The distances are so skewed that one fraction marks most of the surface from one
+        vertex and little from another, so with ``keep_share`` a map not matched yet
+        (another vertex, kind, scale range or spectrum) gets the fraction that marks
+        ``threshold_share``.  A fraction the caller set (``fraction_set``, also before its
+        map is on screen), or any fraction without ``keep_share``, sets the share instead;
+        a share the caller set (``share_set``) sets the fraction.  The only place a setter
+        changes display fields it was not given; emits nothing."""
         d = self.display
         on_screen = d.kind == "distance" and d.distance_display == "threshold"
         dist = self.derived.distance_map() if on_screen else None  # none for other pictures

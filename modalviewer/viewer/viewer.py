@@ -671,7 +671,7 @@ class Viewer(ViewerModel, Pictures):
         Parameters
         ----------
         mesh_b : Mesh B (:class:`Mesh`), or its file.
-        k : modes per spectrum (default: :func:`.operators.default_k`).
+        k : modes per spectrum (default: :func:`~modalviewer.core.operators.default_k`).
         wait : return once the spectra of both meshes are in.
         strict : as for :meth:`open_mesh`, for a file.
         path : the file a given Mesh was read from (its name labels B).
