@@ -26,9 +26,11 @@ def _directive(obj) -> str:
     return "autodata"
 
 
-def _options(directive: str) -> list[str]:
+def _options(directive: str, name: str = "") -> list[str]:
     if directive in ("autoclass", "autoexception"):
-        return ["   :members:", "   :show-inheritance:"]
+        # the Viewer is its model and its pictures: their methods are its own
+        inherited = ["   :inherited-members:"] if name == "Viewer" else []
+        return ["   :members:", "   :show-inheritance:", *inherited]
     if directive == "autodata":
         return ["   :annotation:"]
     return []
@@ -51,7 +53,7 @@ def _section(module_name: str, entries: list[tuple[str, str]], public: str) -> l
         lines += [summary, ""]
     lines += [f".. currentmodule:: {public}", ""]
     for directive, name in entries:
-        lines += [f".. {directive}:: {name}", *_options(directive), ""]
+        lines += [f".. {directive}:: {name}", *_options(directive, name), ""]
     return lines
 
 
@@ -98,7 +100,7 @@ def api_source() -> str:
         lines += _heading("The viewer", "-")
         for module_name, obj in viewer:
             lines += [f".. currentmodule:: {module_name}", ""]
-            lines += [f".. autoclass:: {obj.__name__}", *_options("autoclass"), ""]
+            lines += [f".. autoclass:: {obj.__name__}", *_options("autoclass", obj.__name__), ""]
     return "\n".join(lines).rstrip() + "\n"
 
 
