@@ -1,17 +1,12 @@
 """Values computed from the viewer's state and kept until it changes (no Qt, no VTK).
 
-:class:`DerivedValues` (``state.derived``, created on first use: the state's threshold
-rule needs the distances) holds every cached value computed from the state: normals,
-the scale a deformed 3D mode is drawn at, colour ranges, curvature, vertex areas,
-signature tables, the distance map of the pick, and :meth:`DerivedValues.field`, the
-per-vertex picture the scene draws.  None of it is part of the state: it can be dropped
-and recomputed at any time.
-
-Every cached value remembers what it was computed from (the mesh, the spectrum object,
-the pick, the scale range) and is recomputed when that is no longer the state's, so a
-reader is never served a stale value, whatever order the state's event callbacks run
-in.  It also subscribes to the state's ``mesh``, ``spectra`` and ``scale_range`` events
-to release what nothing shows any more (a signature table holds n x T floats).
+:class:`DerivedValues` (``state.derived``) caches everything computed from the state:
+normals, the deformed mode's scale, colour ranges, curvature, vertex areas, signature
+tables, the pick's distance map, and :meth:`DerivedValues.field`, the picture the scene
+draws.  Every value remembers what it was computed from (mesh, spectrum object, pick,
+scale range) and is recomputed when that changed, so no reader gets a stale value
+whatever order the event callbacks run in; the state's ``mesh``, ``spectra`` and
+``scale_range`` events release what nothing shows any more.
 """
 
 from __future__ import annotations
@@ -50,17 +45,16 @@ class Field:
     """A per-vertex picture derived from the state, ready for the scene to draw.
 
     colormap : "diverging" (blue / white / orange), "sequential" (white to red),
-    "threshold" (blue = similar) or "plain" (no field: the grey surface).
+        "threshold" (blue = similar) or "plain" (the grey surface).
     threshold : for "threshold": values (the distances) up to it are blue.
     displacement : (n, 3) the mode's shape, its largest vector of length 1.
-    deformation : the scale the surface is drawn displaced by, rest + deformation *
-        displacement (a deformed 3D mode; 0: the rest shape); the animation replaces it.
+    deformation : the surface is drawn at rest + deformation * displacement (0: the rest
+        shape); the animation replaces it.
     ghost : draw the rest shape faint behind the displaced surface.
-    clim : the colour range; ``clipped`` (low, high): values lie beyond that end (drawn
-        in the end's colour, marked on the colour bar); ``color_range`` the range's rule.
-    scale : None (colours linear in the value) or (knot values, knot positions), the
-        piecewise-linear map of a "spread" range from value to colour position (0..1,
-        :mod:`.color_scale`).
+    clim : the colour range; ``clipped`` (low, high): values lie beyond that end (marked
+        on the colour bar); ``color_range`` the range's rule.
+    scale : None (linear colours) or (knot values, knot positions), the piecewise-linear
+        map of a "spread" range to colour positions (:mod:`.color_scale`).
     """
 
     values: np.ndarray

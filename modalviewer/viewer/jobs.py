@@ -1,16 +1,12 @@
 """Computations as job objects: each its own progress, cancel, result or error (no Qt).
 
-Policy: one job runs at a time (a spectrum computation already uses every core), the
-others wait in a first-in first-out queue.  A request identical to a queued or running
-job (same ``key``) joins that job instead of starting another.  Nothing is cancelled
-except by :meth:`Job.cancel` (the user's Cancel, or the viewer when the mesh a job
-belongs to is replaced), and a cancelled or failed job reports so to whoever waits for
-it: a new request never swallows another one.
-
-Threads: the job's function runs in a worker thread; every state change of a job is
-handed to ``dispatch`` (a callable that runs a function on the owner's thread: Qt's
-event loop in the viewer, :class:`ManualDispatcher` in scripts and tests), so the
-``events`` are always emitted on the owner's thread.
+One job runs at a time (a spectrum computation already uses every core), the others
+wait first in, first out; a request with the ``key`` of a queued or running job joins
+it.  Only :meth:`Job.cancel` cancels (the user, or the viewer when the job's mesh is
+replaced), and a cancelled or failed job says so to whoever waits for it.  The job's
+function runs in a worker thread; every state change is handed to ``dispatch`` (Qt's
+event loop, or :class:`ManualDispatcher` in scripts), so ``events`` are always emitted
+on the owner's thread.
 """
 
 from __future__ import annotations

@@ -1,24 +1,14 @@
 """The scalar that colours a mode: the mode itself for scalar operators; for 3D vibration
 modes (Discrete Shells) its magnitude or its normal component.
 
-- The normal component is taken against *smoothed* vertex normals: the area-weighted
-  normals diffused by one implicit heat step of radius ``NORMAL_SMOOTHING`` mean edge
-  lengths, then normalised.  At a sharp edge the plain vertex normals jump from one face
-  orientation to the other within one ring of triangles, and so does the component of a
-  smooth displacement along them: jagged isolines and small loops along the edges.  The
-  smoothed normals turn over a few triangles, so the coloured scalar is smoother.  It
-  stays signed, so the colouring keeps the zero line where the surface does not move
-  along its normal.
-- On a mesh with sharp features the normal itself turns by up to 90 degrees across an
-  edge, so any normal component changes quickly there; the magnitude |Phi| does not: it
-  is as smooth as the mode's x, y, z components.
-
-How much smoother each choice is (the Rayleigh quotient of the coloured scalar under the
-cotan Laplacian) is in the viewer guide, "How the pictures are drawn".
-
-The viewer draws 3D modes as the deformed shape by default (the surface displaced by the
-mode, coloured by |Phi|: :meth:`.derived.DerivedValues.deformation`); these colourings
-on the rest shape are the options.
+The normal component is taken against *smoothed* vertex normals (area-weighted normals
+diffused by one implicit heat step of ``NORMAL_SMOOTHING`` mean edge lengths): plain
+normals jump across a sharp edge within one ring of triangles and make jagged isolines;
+the component stays signed, so the zero line shows where the surface does not move
+along its normal.  The magnitude |Phi| is as smooth as the mode's components even where
+the normal turns by 90 degrees.  How smooth each is: the viewer guide, "How the
+pictures are drawn".  The viewer draws 3D modes as the deformed shape by default
+(:meth:`.derived.DerivedValues.deformation`); these colourings are the options.
 """
 
 from __future__ import annotations

@@ -1,12 +1,10 @@
 """The viewer's model: its state, the jobs that fill it, and the spectrum cache (no Qt).
 
-:class:`ViewerModel` (the :class:`~.viewer.Viewer` is one) turns a request ("the shells
-spectrum, 100 modes") into a :class:`~.jobs.Job` whose result lands in the state when it
-ends, if the mesh it was computed for is still the loaded one; the modes of a spectrum
-land there as they converge, lowest first, before the job ends.  A job changes what is
-displayed only if it was asked to (``show=True``) and the display has not changed since
-the request.  The functions around it estimate a request's time and memory and word
-how a job ended.
+:class:`ViewerModel` (the :class:`~.viewer.Viewer` is one) turns a request into a
+:class:`~.jobs.Job` whose result, and before it the modes as they converge, land in the
+state if the mesh it was computed for is still loaded.  A job changes the display only if
+asked (``show=True``) and the display has not changed since the request.  The functions
+around it estimate a request's time and memory.
 """
 
 from __future__ import annotations
@@ -69,24 +67,15 @@ def estimated_seconds(
     records: list[SolveRecord], operator: str, n_vertices: int, k: int, mesh_hash: str = ""
 ) -> float | None:
     """Seconds an exact solve of ``k`` modes of ``operator`` on a mesh of ``n_vertices``
-    (hash ``mesh_hash``) is expected to take, from this machine's own recorded solves
-    (``records``, most recent first: :meth:`.core.cache.SpectrumCache.solves`); None
-    where they do not tell.
+    (hash ``mesh_hash``) is expected to take, from this machine's recorded solves
+    (``records``, most recent first: :meth:`.core.cache.SpectrumCache.solves`), or None.
 
-    The rule, of the same operator's records only, one scaling at a time:
-
-    - the same mesh and k solved before: that solve's seconds (the most recent);
-    - else the same mesh with the nearest number of modes k0 within a factor
-      :data:`ESTIMATE_RANGE` of k: its seconds times ``(k / k0) ** MODES_EXPONENT``;
-    - else the same k on the mesh nearest in size whose vertex count n0 is within a
-      factor :data:`ESTIMATE_RANGE` of n: its seconds times
-      ``(n / n0) ** SIZE_EXPONENT``;
-    - else None: no time is shown.
-
-    One scaling at a time, and only within :data:`ESTIMATE_RANGE`: the time per mode
-    falls as k grows (the factorisation is shared), and the time's growth with size and
-    with k depends on the operator and on the mesh's shape, so both at once, or further
-    out, would guess."""
+    From the same operator's records: the same mesh and k (the most recent); else the
+    same mesh at the nearest k0 within a factor :data:`ESTIMATE_RANGE`, times
+    ``(k / k0) ** MODES_EXPONENT``; else the same k on the mesh nearest in size n0
+    within that factor, times ``(n / n0) ** SIZE_EXPONENT``; else None.  One scaling at
+    a time and only that near: the time's growth with size and k depends on the operator
+    and the shape, so anything further would guess."""
     same = [r for r in records if r.operator == operator]
     n, k = max(int(n_vertices), 1), max(int(k), 1)
 
@@ -232,15 +221,13 @@ class ViewerModel:
         return job.then(replace_mesh)
 
     def open_mesh(self, path, strict: bool = True) -> Mesh:
-        """Load a mesh file and show it.
+        """Load a mesh file (OBJ, PLY, OFF or STL) and show it.
 
         Parameters
         ----------
-        path : str or os.PathLike
-            An OBJ, PLY, OFF or STL file.
-        strict : bool
-            With False, a damaged or truncated file loads its whole records and the mesh's
-            report says what was dropped.
+        path : the file.
+        strict : with False, a damaged or truncated file loads its whole records and the
+            mesh's report says what was dropped.
 
         Returns
         -------

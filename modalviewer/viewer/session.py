@@ -1,16 +1,11 @@
 """Sessions: the viewer state to and from a versioned JSON file (no Qt).
 
-A session stores the mesh file (path and geometry hash), the spectra by their keys (not
-their arrays: they come back from the spectrum cache, or are recomputed), and what is
-displayed: the display, pick, threshold, scale range, isolines, colouring, colour bar
-and camera.  Restoring it draws the same picture.  A mesh whose file changed on disk is
-opened all the same, with a note; what no longer fits (a picked vertex beyond the new
-mesh) is dropped with a note.
-
-Vertex numbers are the file's (version 2): ``picked`` is the picked vertex's number in
-the mesh file, whatever loading dropped or merged (see
-:attr:`modalviewer.core.mesh.Mesh.file_to_mesh`).  Version 1 sessions stored the
-mesh's compact index; they are read as such.
+A session stores the mesh file (path and geometry hash), the spectra by their keys (the
+arrays come back from the cache, or are recomputed) and what is displayed, so restoring
+it draws the same picture.  A mesh whose file changed is opened with a note; what no
+longer fits (a pick beyond the new mesh) is dropped with a note.  ``picked`` is the
+file's vertex number (version 2, :attr:`modalviewer.core.mesh.Mesh.file_to_mesh`);
+version 1 files, which stored the mesh's compact index, are read as such.
 """
 
 from __future__ import annotations
