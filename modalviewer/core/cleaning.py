@@ -122,22 +122,17 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
     """Collapse an edge, the shortest where possible, of every face of area at most
     ``min_area``.
 
-    A zero-area face has three collinear (or nearly coincident) corners; the corner
-    between the other two (the apex, opposite the longest edge) is merged into the nearer
-    end of that edge, which moves it by the length of the face's shortest edge and
-    removes the faces on that edge (two inside the surface, one on its boundary), so a
-    closed surface stays closed.  A collapse is done only if it keeps the surface a
-    manifold (the two vertices share no neighbour except the corners opposite their
-    edge, and an inside edge does not join two boundary vertices) and turns no face
-    around the moved vertex upside down; if it would not, the face's other edges and
-    directions are tried, shortest first.  An apex well inside the longest edge (from a
-    tenth to nine tenths along it) is handled by flipping that edge instead, where the
-    result is a manifold with two faces of area: no vertex moves (a T-junction of a
-    remesh).
-    A zero-area face whose longest edge is on the boundary is removed instead: the
-    boundary then runs through its apex, along the same line, so no hole opens.
-    Collapses are done in rounds of non-adjacent edges until no zero-area face is left
-    or none can be collapsed.
+    A zero-area face's apex (the corner opposite its longest edge) is merged into the
+    nearer end of that edge, which removes the faces on the edge, so a closed surface
+    stays closed.  A collapse is done only if the surface stays a manifold (the two
+    vertices share no neighbour but the corners opposite their edge; an inside edge does
+    not join two boundary vertices) and no face around the moved vertex turns over;
+    otherwise the face's other edges are tried, shortest first.  An apex from a tenth to
+    nine tenths along the longest edge (a remesh's T-junction) is handled by flipping
+    that edge instead, where the result is a manifold with two faces of area: no vertex
+    moves.  A face whose longest edge is on the boundary is removed: the boundary then
+    runs through its apex, so no hole opens.  Rounds of non-adjacent edges go on until no
+    zero-area face is left or none can be collapsed.
 
     Returns (faces, number of flipped edges, number of collapsed edges, faces removed
     along the boundary, largest move, faces still of zero area, (n,) vertex each vertex
@@ -326,19 +321,13 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
 def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-10):
     """Repair raw arrays into a valid :class:`Mesh` and report what was done.
 
-    Steps: check finiteness and index range (errors, not repairs), merge vertices
-    closer than ``merge_tolerance`` times the bounding-box diagonal, drop faces that
-    repeat a vertex, collapse the shortest edge of faces of (near) zero area (so a closed
-    surface stays closed; see :func:`_collapse_zero_area_faces`, which flips the longest
-    edge instead where a vertex lies inside it), drop duplicate faces,
-    drop unreferenced vertices, make the orientation consistent per component where
-    possible.
-
-    The result keeps the input's numbering: vertex i is row i of ``vertices``; only the
-    faces change.  Merged duplicates and vertices merged by a collapse are used by no
-    face and take the values of the vertex they were merged into
-    (:attr:`Mesh.merged_into`); vertices no face uses are :attr:`Mesh.unused`.  The
-    report names vertices by their numbers counting from 0.
+    Steps: check finiteness and index range (errors, not repairs), merge vertices closer
+    than ``merge_tolerance`` times the bounding-box diagonal, drop faces that repeat a
+    vertex, collapse or flip faces of (near) zero area (:func:`_collapse_zero_area_faces`),
+    drop duplicate faces, make the orientation consistent per component where possible.
+    Only the faces change: vertex i is row i of ``vertices``; merged vertices take the
+    values of the one they were merged into (:attr:`Mesh.merged_into`), vertices no face
+    uses are :attr:`Mesh.unused`, and the report names vertices by their numbers from 0.
 
     Returns
     -------

@@ -1,25 +1,18 @@
 """Lowest eigenpairs of ``K phi = lambda M phi`` with a diagonal mass.
 
-The problem is solved in the standard form ``C = M^-1/2 K M^-1/2`` (Vallet and Levy
-2008) by shift-invert: the largest eigenvalues ``theta = 1 / (lambda - shift)`` of
-``OP = M^1/2 (K - shift M)^-1 M^1/2`` with a shift below zero, so the factored matrix is
-positive definite even when K is singular (constants, rigid motions).
-
-* The factorisation (:mod:`.factor`) is MKL PARDISO where the ``mkl`` wheel is
-  installed, CHOLMOD (``cholespy``) otherwise, SuperLU as the last resort.
-* The iteration is a block Krylov-Schur method (thick-restart block Lanczos,
-  :func:`.krylov.block_krylov_schur`): OP is applied to blocks of vectors, so one pass
-  over the factor serves many right-hand sides, and the full re-orthogonalisation is
-  done with matrix-matrix products.  It works with a few more pairs than wanted
-  (:func:`.cost.krylov_sizes`) and stops when the wanted ones have converged.
-* One block step of inverse iteration on the converged vectors and a Rayleigh-Ritz step
-  with K itself give exact Ritz values, Mass-orthonormal modes and residuals
-  ``|K x - lambda M x| / |lambda M x|`` around 1e-10 on well-shaped meshes.
-* The solve plans to stay within a memory limit (:mod:`.memory`): where the factor
-  would not fit beside the Krylov basis, PARDISO keeps it in a file
-  (:func:`.cost.factor_budget_mb`, :mod:`.factor`); the modes are written over the basis.
-
-Every run is deterministic (fixed start block); every result carries its residuals.
+Solved in the standard form ``C = M^-1/2 K M^-1/2`` (Vallet and Levy 2008) by
+shift-invert: the largest ``theta = 1 / (lambda - shift)`` of
+``OP = M^1/2 (K - shift M)^-1 M^1/2``, with a shift below zero so the factored matrix is
+positive definite even when K is singular.  The factorisation is :mod:`.factor`'s; the
+iteration is block Krylov-Schur (:func:`.krylov.block_krylov_schur`), so one pass over
+the factor serves a block of right-hand sides, with a few more pairs than wanted
+(:func:`.cost.krylov_sizes`).  A block step of inverse iteration and a Rayleigh-Ritz
+step with K give Mass-orthonormal modes and residuals
+``|K x - lambda M x| / |lambda M x|`` near 1e-10 on well-shaped meshes.  Within the
+memory limit (:mod:`.memory`) the factor goes out of core where it would not fit beside
+the Krylov basis (:func:`.cost.factor_budget_mb`), and the modes are written over the
+basis.  Every run is deterministic (fixed start block) and reports its residuals;
+docs/how-it-works.md, "How the eigenproblems are solved", gives the reasons.
 """
 
 from __future__ import annotations
@@ -121,14 +114,10 @@ class EigenResult:
 
 def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
     """Boolean mask (k,) of the zero modes, the one rule for masks, signatures and
-    residual checks.
-
-    The first ``null_dim`` modes are the deflated exact null vectors
-    (:mod:`.nullspace`): zero modes whatever k is.  Any other mode is a zero mode if
-    ``lam < ZERO_MODE_RTOL * largest |lam|`` (the convention; rounding can make it
-    slightly negative) or ``lam < ZERO_NOISE_RTOL * lam_scale``: ``lam_scale`` (a
-    typical eigenvalue size, :func:`typical_eigenvalue`) keeps a spectrum of only
-    undeflated zero modes from judging itself by its own rounding noise.
+    residual checks: the first ``null_dim`` modes (the deflated null vectors), and any
+    mode with ``lam < ZERO_MODE_RTOL * largest |lam|`` or ``lam < ZERO_NOISE_RTOL *
+    lam_scale`` (:func:`typical_eigenvalue`, so a spectrum of only undeflated zero modes
+    is not judged by its own rounding noise).
     """
     lam = np.asarray(lam, dtype=np.float64)
     largest = max(float(np.abs(lam).max(initial=0.0)), np.finfo(float).tiny)
@@ -176,13 +165,10 @@ def rounding_floors(
     K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray, columns=None
 ) -> np.ndarray:
     """``eps * | |K| |x| | / (|lam| |M x|)`` per column: the relative residual that merely
-    rounding x to double precision can cause (``|K dx| <= eps |K| |x|``), which no
-    solver can go below.  It reaches 1e-4 for the lowest vibrations of fine meshes with a
-    large spread of stiffness (3D shells of finely subdivided curved meshes).
-
-    ``columns``: the columns of X to look at (``lam`` holds their eigenvalues); None:
-    all.  They are taken 32 at a time, so no copy of the chosen columns (nor of their
-    absolute values), each as large as the modes, is made."""
+    rounding x to double precision can cause, which no solver can go below (large on
+    fine meshes with a wide spread of stiffness).  ``columns``: the columns of X to look
+    at (``lam`` their eigenvalues; None: all), taken 32 at a time to avoid (N, k)
+    copies."""
     K_abs = abs(sp.csr_matrix(K))
     columns = np.arange(X.shape[1]) if columns is None else np.asarray(columns, dtype=np.intp)
     out = np.empty(columns.shape[0])
@@ -243,28 +229,22 @@ def solve_lowest(
     k : number of eigenpairs, 1 <= k <= N.
     progress : called as ``progress(stage, fraction)``.
     cancel : polled during the solve; returning True raises :class:`Cancelled`.
-    null_space : (N, d) exact null vectors of K, Mass-orthonormal
-        (:func:`.nullspace.null_space`).  They are returned first, as eigenvalue 0,
-        counted in k; the iteration works in their Mass-orthogonal complement (the start
-        block and every solve are projected), so it cannot return them again or miss
-        any.  With d >= k the first k are returned without any factorisation.
-    memory_limit_mb : the process's memory (MB) the solve plans to stay within; None:
-        :func:`.memory.memory_limit_mb`.  Where the factor would not fit beside the
-        Krylov basis and what the process already holds, PARDISO keeps it out of core
-        (slower solves, much less memory); where even then the basis would not fit, it
-        is stored in single precision (:func:`.cost.basis_in_float32`).
+    null_space : (N, d) exact Mass-orthonormal null vectors of K
+        (:func:`.nullspace.null_space`), returned first as eigenvalue 0 and counted in
+        k; the iteration works in their Mass-orthogonal complement, so it neither
+        returns them again nor misses any.  With d >= k no factorisation is made.
+    memory_limit_mb : the memory (MB) the solve plans to stay within (None:
+        :func:`.memory.memory_limit_mb`); beyond it the factor goes out of core, and
+        then the basis to single precision (:func:`.cost.basis_in_float32`).
     on_modes : called as ``on_modes(eigenvalues, vectors)`` with pairs as they
-        converge, lowest first and in order, before the solve ends: (m,) eigenvalues and a
-        new (N, m) array of Mass-orthonormal vectors (signs as in the result), the null
-        vectors first.  They equal the result's pairs to the solver's tolerance (a
-        cluster of equal eigenvalues as a subspace); the result itself, from a last step
-        of inverse iteration and Rayleigh-Ritz, is not handed over.  Not called by the
-        dense solver (small problems) nor where the null vectors fill all k.
+        converge, lowest first: (m,) eigenvalues and a new (N, m) array of
+        Mass-orthonormal vectors, the null vectors first, equal to the result's to the
+        solver's tolerance.  Not called by the dense solver nor where the null vectors
+        fill all k.
 
     Returns
     -------
-    EigenResult with eigenvalues ascending (the d deflated zeros first, then the
-    iteration's, which start at zero up to rounding if K has further null vectors) and
+    EigenResult with eigenvalues ascending (the d deflated zeros first) and
     Mass-orthonormal vectors.
     """
     K, mass_diag = _checked_problem(K, mass_diag, k)
@@ -553,16 +533,13 @@ def _shift_invert(
     limit_mb, solver_info, out_columns, shift_rtol, on_converged=None,
 ):  # fmt: skip
     """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2`` in the
-    complement of the deflated null vectors (``project`` removes them, ``n_free`` is the
-    complement's dimension): (eigenvalues, an array (N, w) whose first k columns are the
-    Mass-orthonormal modes, w >= ``out_columns``, shift, backend name, operator
-    columns).  The factor keeps within the memory ``limit_mb`` leaves
-    (:func:`.cost.factor_budget_mb`); where even then a double-precision basis would not fit,
-    the basis is single precision (:func:`.cost.basis_in_float32`), and the returned array is
-    then exactly (N, ``out_columns``).  ``solver_info`` receives "factor_mb",
-    "out_of_core" and "basis_float32".  ``on_converged(eigenvalues, vectors)`` receives
-    the pairs as they converge (:func:`.krylov.block_krylov_schur`), as eigenvalues of K and
-    Mass-orthonormal vectors."""
+    complement (dimension ``n_free``) of the deflated null vectors that ``project``
+    removes: (eigenvalues, (N, w) array whose first k columns are the Mass-orthonormal
+    modes, shift, backend name, operator columns).  The factor and basis keep within
+    ``limit_mb`` (:func:`.cost.factor_budget_mb`, :func:`.cost.basis_in_float32`; with
+    a single-precision basis w is exactly ``out_columns``); ``solver_info`` receives
+    "factor_mb", "out_of_core" and "basis_float32"; ``on_converged`` the pairs of K as
+    they converge."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
     # A few more pairs than requested: the last requested pairs then converge as fast
@@ -650,12 +627,10 @@ def _rayleigh_ritz_in_place(K, inv_sqrt_m: np.ndarray, Y: np.ndarray) -> np.ndar
     """Rayleigh-Ritz with K on the span of Y, in place: ascending Ritz values (k,).
 
     Y (N, k) holds standard-form vectors (``x = M^-1/2 y``) and becomes the
-    Mass-orthonormal Ritz vectors in the original variables.  After a step of inverse
-    iteration on converged Ritz vectors, Y's columns are nearly orthogonal, only scaled
-    by the eigenvalues of OP (1e6 apart with zero modes): scaled to unit length, their
-    Gram matrix B is the identity up to the residuals, and the generalised projected
-    problem ``G w = lam B w`` replaces an orthonormalisation of Y (one product over Y
-    instead of four: two Cholesky-QR passes).
+    Mass-orthonormal Ritz vectors.  After inverse iteration on converged vectors, Y's
+    columns scaled to unit length have a Gram matrix B near the identity, so the
+    generalised problem ``G w = lam B w`` replaces an orthonormalisation of Y (one
+    product over Y instead of four).
     """
     B = Y.T @ Y
     d = 1.0 / np.sqrt(np.diag(B))

@@ -104,32 +104,24 @@ def compute_spectrum(
     ----------
     operator : a name of :data:`.operators.OPERATOR_INFO`, or its
         :class:`.operators.OperatorInfo`.
-    k : number of modes, an integer >= 1 (Python or numpy; not a float or a bool);
-        capped at the number of unknowns.
+    k : number of modes, an integer >= 1 (:mod:`.validate`); capped at the number of
+        unknowns.
     bending, membrane : Discrete Shells weights (ignored by the scalar energies).
     progress : ``progress(stage, fraction)`` with fraction in [0, 1].
     cancel : polled; returning True raises :class:`Cancelled`.
-    accuracy : "exact", the only value: every spectrum is exact.  The approximate
-        "preview" and "fast preview" raise a ValueError that says what to use instead
-        (:data:`PREVIEW_REMOVED`).
-    on_modes : ``on_modes(spectrum_so_far)`` whenever more modes have converged: a
-        :class:`.spectrum.Spectrum` of the first j (null vectors first), equal to the
-        finished spectrum's to the solver's tolerance (a cluster of equal eigenvalues
-        comes whole), ``is_complete`` False, residuals NaN.  The last call has the
-        finished spectrum; small problems (solved densely) get only that one.  It runs
-        in the computing thread; what it keeps stays valid (new views of columns that
-        are not written again).
+    accuracy : "exact", the only value; the removed "preview" and "fast preview" raise a
+        ValueError saying what to use instead (:data:`PREVIEW_REMOVED`).
+    on_modes : ``on_modes(spectrum_so_far)`` whenever more modes have converged, in the
+        computing thread: a :class:`.spectrum.Spectrum` of the first j (as
+        :func:`.eigen.solve_lowest` hands them over), ``is_complete`` False, residuals
+        NaN; the last call has the finished spectrum (the only one for small problems).
 
     Returns
     -------
     Spectrum with ascending eigenvalues and Mass-orthonormal modes, (n, k) or (n, 3, k),
-    one row per vertex of ``mesh``: the solver works on the vertices faces use
-    (``mesh.solver_mesh``); rows of ``mesh.unused`` vertices are NaN, a merged
-    duplicate's row is that of the vertex it was merged into.
-    The exactly known null vectors of the operator (:mod:`.nullspace`: a constant per
-    component for the Laplacian, six rigid motions per component for the shells, ...)
-    come first, as eigenvalue 0, counted in k; ``spec.null_space_dimension`` says how
-    many, ``spec.parameters["null_space"]`` says it in words.
+    one row per vertex of ``mesh`` (NaN for ``mesh.unused``, a merged duplicate's row
+    that of its vertex).  The operator's exact null vectors (:mod:`.nullspace`) come
+    first as eigenvalue 0, counted in k (``spec.null_space_dimension``).
     """
     operator = operator_info(operator)  # a ValueError naming the known operators
     k = check_count(k, "k")
