@@ -1,14 +1,8 @@
-"""Meshes in from other libraries, matrices and point data out.
-
-* :func:`as_mesh`: ``(V, F)`` arrays, a ``trimesh.Trimesh``, a ``pyvista.PolyData`` (or
-  any pyvista data set: its surface) or a ``meshio.Mesh`` as a :class:`~.core.mesh.Mesh`,
-  through the same repair and report as :func:`~modalviewer.io.load_mesh`.  Vertex i of
-  the object is vertex i of the mesh.
-* :func:`operator_matrices`: the sparse ``(K, M)`` of an operator's eigenproblem.
-* :func:`to_pyvista`: the mesh with modes and fields as point arrays.
-
-None of these imports trimesh, pyvista or meshio: an object is recognised by its type's
-module, and pyvista is imported by :func:`to_pyvista` only.
+"""Meshes in from other libraries, matrices and point data out: :func:`as_mesh`
+(arrays, trimesh, pyvista, meshio objects, repaired and reported as
+:func:`~modalviewer.io.load_mesh` does), :func:`operator_matrices` (an operator's sparse
+``(K, M)``) and :func:`to_pyvista` (modes and fields as point arrays).  No module-level
+import of trimesh, pyvista or meshio: objects are recognised by their type's module.
 """
 
 from __future__ import annotations
@@ -57,15 +51,12 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     """A :class:`Mesh` from arrays or another library's mesh object.
 
     ``obj``: a :class:`Mesh` (returned as it is), ``(vertices (n, 3), faces (m, 3))``, a
-    ``trimesh.Trimesh``, a ``pyvista.PolyData`` (other pyvista data sets: their outer
-    surface; polygons are triangulated, which ``mesh.report`` says) or a ``meshio.Mesh``
-    (its triangle cells; quads and polygons are triangulated, volume cells skipped).
-    ``repair`` as in :func:`~modalviewer.io.load_mesh`; ``name`` names the mesh in the
-    report (default: the object's type).  Vertex i of the object is vertex i of the mesh,
-    always: a repair changes only the faces (vertices no face uses are ``mesh.unused``
-    and have no value; a merged duplicate takes the values of the vertex it was merged
-    into).  MeshError for an object that holds no triangle surface, TypeError for an
-    object of another kind.
+    ``trimesh.Trimesh``, a ``pyvista.PolyData`` (other data sets: their outer surface;
+    polygons triangulated, as ``mesh.report`` says) or a ``meshio.Mesh`` (its triangles;
+    quads and polygons triangulated, volume cells skipped).  ``repair`` as in
+    :func:`~modalviewer.io.load_mesh`; ``name`` names the mesh in the report (default: the
+    object's type).  Vertex i of the object is vertex i of the mesh (:mod:`.core.mesh`).
+    MeshError for an object that holds no triangle surface, TypeError for another kind.
     """
     if isinstance(obj, Mesh):
         return obj
@@ -77,16 +68,13 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
 def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float = 1.0):
     """``(K, M)``: the sparse matrices of ``operator``'s eigenproblem ``K x = lambda M x``.
 
-    K (scipy.sparse CSR, symmetric positive semi-definite; its null space is the one
-    ``spec.null_space_dimension`` counts) and M, the lumped mass: a diagonal matrix
-    (scipy.sparse DIA) of the vertex areas, repeated for each unknown of a vertex.  The
-    unknowns are per vertex, ``(n,)``, or for vector modes (``spec.is_vector``, e.g.
-    ``"shells"``) ``(3 n,)`` ordered x, y, z per vertex, as ``spec.modes`` reshaped.
-    ``scipy.sparse.linalg.eigsh(K, k, M, sigma=-s)`` for a small ``s > 0`` gives the
-    spectrum :func:`~modalviewer.compute_spectrum` computes (up to the signs and bases of
-    eigenspaces).  ``bending`` and ``membrane`` weigh the Discrete Shells energies.
-    Vertices no face uses (``mesh.unused``) and merged duplicates have empty rows and
-    columns in K and zero mass.
+    K is CSR, symmetric positive semi-definite (its null space is the one
+    ``spec.null_space_dimension`` counts); M the lumped mass, a DIA matrix of the vertex
+    areas repeated for each unknown: ``(n,)`` unknowns, or ``(3 n,)`` ordered x, y, z per
+    vertex for vector modes, as ``spec.modes`` reshaped.  ``eigsh(K, k, M, sigma=-s)``
+    for a small ``s > 0`` gives :func:`~modalviewer.compute_spectrum`'s spectrum (up to
+    signs and bases of eigenspaces).  ``bending``, ``membrane``: the shells weights.
+    Vertices no face uses and merged duplicates have empty rows in K and zero mass.
     """
     mesh = as_mesh(mesh)
     solver = mesh.solver_mesh

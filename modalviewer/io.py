@@ -1,14 +1,10 @@
 """Reading meshes from files, with repair and a report (OBJ, PLY, STL, OFF, VTK, VTP,
 and whatever meshio reads).
 
-OBJ, PLY, STL and OFF are read by :mod:`modalviewer.readers`, which keeps every vertex
-in the file's order and refuses damaged or truncated files with a message naming the
-place.  VTK and VTP files are read with pyvista, imported only when such a file is
-opened, so that ``import modalviewer`` stays free of VTK.  Other files (Gmsh ``.msh``,
-``.vtu``, ``.xdmf``, Medit ``.mesh``, Abaqus ``.inp``, Exodus ``.e``, Nastran ``.bdf``,
-``.med``, ``.su2``, ...: every extension of ``meshio.extension_to_filetypes``) are read
-with meshio where it is installed (``pip install modalviewer[meshio]``), their triangle
-cells kept and quads and polygons triangulated.
+OBJ, PLY, STL and OFF go through the strict :mod:`modalviewer.readers`; VTK and VTP
+through pyvista, imported only then (``import modalviewer`` stays free of VTK); every
+other extension of ``meshio.extension_to_filetypes`` through meshio where it is
+installed (the ``meshio`` extra), triangles kept and quads and polygons triangulated.
 """
 
 from __future__ import annotations
@@ -168,17 +164,13 @@ def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
     format meshio reads; :class:`MeshError` naming the problem for a file that cannot be
     a surface.
 
-    With ``repair=True`` (default) duplicate vertices are merged, zero-area faces
-    collapsed (a closed surface stays closed), faces repeating a vertex and duplicate
-    faces removed, and the orientation made consistent; ``mesh.report`` says what was
-    done.  Slivers are left as they are (:func:`modalviewer.fix_slivers` removes them).
-    With ``repair=False`` the arrays are only validated.  Vertex i of the mesh is the
-    file's vertex i either way.
-
-    A damaged file (a record cut in the middle, element counts that the data do not
-    fill, faces naming vertices the file does not have) raises :class:`MeshError`
-    naming the line or element, unless ``strict=False``: then the whole records are
-    loaded and ``mesh.report`` says exactly what was dropped.
+    With ``repair=True`` (default) the arrays are repaired as by
+    :func:`~modalviewer.core.cleaning.repair_mesh` and ``mesh.report`` says what was
+    done; slivers are left (:func:`modalviewer.fix_slivers` removes them).  With
+    ``repair=False`` they are only validated.  Vertex i is the file's vertex i either
+    way.  A damaged file (:mod:`modalviewer.readers`) raises :class:`MeshError` naming
+    the line or element, unless ``strict=False``: then the whole records are loaded and
+    ``mesh.report`` says what was dropped.
     """
     path = Path(path)
     vertices, faces, notes = read_file(path, strict=strict)

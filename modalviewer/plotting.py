@@ -184,33 +184,31 @@ def plot(
     grid=None,
 ):
     """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`; with
-    ``interactive``, the same scene as an :class:`InteractivePicture` to turn in the
-    notebook (it needs the ``notebook`` extra; without it a :class:`Picture`, with a
-    warning saying how to install it); with ``animate``, the mode vibrating as an
-    :class:`~modalviewer.scene.animation.Animation` (a looping GIF shown inline).
+    ``interactive``, an :class:`InteractivePicture` to turn in the notebook (the
+    ``notebook`` extra; without it a :class:`Picture` and a warning saying how to
+    install it); with ``animate``, the mode vibrating as a looping GIF
+    (:class:`~modalviewer.scene.animation.Animation`).
 
     Parameters
     ----------
     mesh : anything :func:`~modalviewer.as_mesh` takes (a file path too).
     spectrum, mode : show mode ``mode`` of ``spectrum`` (default its first non-zero one).
-    field : per-vertex values to colour by instead: an (n,) array, one value per vertex
-        of ``mesh`` (``mesh.n_vertices``, NaN allowed at ``mesh.unused`` vertices), a
-        ``(name, values)`` pair or a dict (its first item); signed values in the modes'
-        diverging colours, others white to red.
+    field : per-vertex values to colour by instead: an (n,) array in ``mesh``'s
+        numbering (NaN allowed at ``mesh.unused``), a ``(name, values)`` pair or a dict
+        (its first item); signed values in the modes' diverging colours, others white
+        to red.
     vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks", "wks") from
-        ``vertex`` (the input's vertex number); by default the distance of ``spectrum``
-        (heat kernel for a Laplacian spectrum, feature for E_D^N, vibration for the 3D
-        shells), or "vibration" without one.  A spectrum of the kind's operator is used
-        if given, otherwise ``k`` modes are computed (cached on disk as in the viewer).
+        ``vertex`` (the input's numbering); by default the distance of ``spectrum``'s
+        operator, or "vibration".  A spectrum of the kind's operator is used if given,
+        otherwise ``k`` modes are computed (cached on disk as in the viewer).
     screenshot : also write the PNG there (the page, .html, for an interactive one).
     size : (width, height) in pixels.
     interactive : a page with the 3D scene instead of an image.
-    modes, grid : several modes of ``spectrum`` side by side in one picture, one
-        camera and one colour bar (``grid`` (columns, rows), default rows of up to 4;
-        ``size`` is then each panel's).
-    animate, frames, fps : one period of the mode vibrating, ``frames`` frames (default:
-        one period at the window's speed) played at ``fps``; ``screenshot`` then names a
-        .gif (or .mp4 where imageio-ffmpeg is installed).
+    modes, grid : several modes of ``spectrum`` side by side with one camera and colour
+        bar (``grid`` (columns, rows), default rows of up to 4; ``size`` per panel).
+    animate, frames, fps : one period of the mode vibrating in ``frames`` frames
+        (default: the window's speed) at ``fps``; ``screenshot`` then names a .gif (or
+        .mp4 where imageio-ffmpeg is installed).
     """
     if isinstance(mesh, (str, Path)):
         from .io import load_mesh
@@ -271,12 +269,11 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     """Open the desktop viewer on in-memory data; returns the window (``.viewer`` its
     :class:`~modalviewer.viewer.Viewer`).
 
-    With ``block=True`` (default) it returns when the window closes; with ``block=False``
-    at once (in a notebook kernel with ``%gui qt``, or a script that runs the Qt event
-    loop).  ``spectrum`` goes into the viewer's spectra (its first non-zero mode shown);
-    ``fields`` (a dict name -> per-vertex array) are the viewer's fields
-    (``window.viewer.show_field(name)`` shows another); the window opens on the first.
     ``mesh_or_arrays``: anything :func:`~modalviewer.as_mesh` accepts, or a file.
+    ``spectrum`` is added to the viewer (its first non-zero mode shown); ``fields`` (name
+    -> per-vertex array) become the viewer's fields, the first shown.  ``block=False``
+    returns at once (a notebook with ``%gui qt``, or a script running the Qt loop);
+    otherwise when the window closes.
     """
     if isinstance(mesh_or_arrays, (str, Path)):
         from .io import load_mesh
@@ -319,12 +316,11 @@ def add_to_plotter(
     ``pyvista.Plotter``); returns the :class:`~modalviewer.scene.mesh_scene.MeshScene`
     holding its actors.
 
-    ``values_or_spectrum``: per-vertex values ((n,); signed: the modes' diverging
-    colours, otherwise white to red) or a :class:`Spectrum`: its mode ``mode`` (default
-    the first non-zero one; vector modes by their normal component, as the viewer), or
-    with ``vertex`` the multiscale distance from that vertex.  Vertex numbers and values
-    are in ``mesh``'s numbering; the surface drawn is its vertices faces use.
-    ``isolines``: their number (0: none); ``name``: the colour bar's title.
+    ``values_or_spectrum``: per-vertex values (n,) (signed: diverging colours, else
+    white to red) or a :class:`Spectrum`: its mode ``mode`` (default the first non-zero
+    one; vector modes by their normal component) or, with ``vertex``, the multiscale
+    distance from it.  In ``mesh``'s numbering; the surface drawn is its vertices faces
+    use.  ``isolines``: their number (0: none); ``name``: the colour bar's title.
     """
     from .core.laplacian import vertex_normals
     from .core.signatures import multiscale_distance

@@ -1,25 +1,16 @@
 """Strict readers of OBJ, PLY (ASCII and binary), OFF and STL files.
 
-Each reader returns every vertex of the file in the file's order (vertices that no face
-uses included, so that vertex ``i`` is the file's vertex ``i``) and the faces as
-triangles (polygons fanned).  Damage is detected rather than loaded as part of a mesh:
-
-- a record cut in the middle (a ``v`` line with fewer than three numbers, a face with
-  fewer than three corners, a PLY/OFF/STL element whose data end early),
-- element counts that the data do not fill (PLY, OFF, binary STL),
-- faces that name vertices the file does not have.
-
-With ``strict=True`` each of these raises :class:`~modalviewer.core.mesh.MeshError`
-naming the file, the place (line or element) and what is missing.  With ``strict=False``
-what could be read is returned, and ``notes`` says exactly what was dropped.  Vertices
-that no face uses are never an error: :func:`read_mesh_file` adds a note with their
-number, since a file cut between two face records leaves such vertices behind.
-
-Well-formed files of triangles (OBJ, OFF, ASCII PLY) are parsed by numpy in one go and
-binary PLY and STL read as numpy records; any file such a path does not take as it is
-goes to the record-by-record reader, which finds and names the damage.  The strict
-checks are why these readers are the package's own: trimesh, for one, loads an OBJ cut
-short without a word and refuses a cut PLY without saying where.
+Each reader returns every vertex of the file in its order (vertex ``i`` is the file's
+vertex ``i``, used by a face or not) and the faces as triangles (polygons fanned).
+Damage is detected rather than loaded: a record cut in the middle, element counts the
+data do not fill, faces naming vertices the file does not have.  With ``strict=True``
+each raises :class:`~modalviewer.core.mesh.MeshError` naming the file, the line or
+element and what is missing; with ``strict=False`` what could be read is returned and
+``notes`` says what was dropped (vertices no face uses get a note, since a file cut
+between face records leaves them behind).  Well-formed files are parsed by numpy in one
+go; anything else goes to the record-by-record reader, which names the damage.  These
+checks are why the readers are the package's own: trimesh loads an OBJ cut short
+without a word and refuses a cut PLY without saying where.
 """
 
 from __future__ import annotations
