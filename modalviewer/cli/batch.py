@@ -87,19 +87,16 @@ def batch(args) -> int:
 
     from tqdm import tqdm
 
-    from ..collection import run_batch
+    from ..collection.runner import import_distributed, run_batch
 
     workers = args.workers  # -k, --workers and --memory-limit checked by the parser
     if workers is None:
         workers = os.cpu_count() or 1
     if workers > 0 or args.scheduler:
         try:
-            import distributed  # noqa: F401
-        except ImportError:
-            raise Unavailable(
-                "Dask is not installed: pip install 'modalviewer[batch]' (or --workers 0: "
-                "one mesh after another in this process)"
-            ) from None
+            import_distributed()
+        except ImportError as exc:
+            raise Unavailable(str(exc)) from None
     # Dask's own log lines (a cancelled task on Ctrl+C, ...) would break the progress line
     logging.getLogger("distributed").setLevel(logging.ERROR)
     progress = _MeshProgress()

@@ -435,19 +435,20 @@ def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bo
     return "todo", None
 
 
-def _import_distributed():
+def import_distributed():
+    """``dask.distributed``, or an ImportError saying how to install it or run without it."""
     try:
         import distributed
     except ImportError:
         raise ImportError(
-            "Dask is not installed: pip install 'modalviewer[batch]' (or run with --workers 0, "
+            "Dask is not installed: pip install 'modalviewer[batch]' (or --workers 0: "
             "one mesh after another in this process)"
         ) from None
     return distributed
 
 
 def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, log) -> None:
-    distributed = _import_distributed()
+    distributed = import_distributed()
     cluster = None
     own_client = client is None
     if client is None and scheduler is not None:
