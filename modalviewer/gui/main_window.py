@@ -3,13 +3,8 @@ and the menus.
 
 The viewer (``win.viewer``) owns the state, the jobs and the cache; panels and the
 scene observe its state, and the window shows its messages.  The window's scripting
-methods are the viewer's (each a one-line delegation), so a script drives the window as
-it drives a :class:`~modalviewer.viewer.Viewer`::
-
-    win = MainWindow()          # creates the QApplication it needs, off screen if no display
-    win.open_mesh(path); win.compute("shells", k=50, wait=True); win.show_mode(7)
-    win.pick_file_vertex(123); win.show_distance("vibration", display="threshold", share=0.1)
-    win.export_screenshot("fig.png", scale=2, transparent=True)
+methods delegate to the viewer, so a script drives the window as it drives a
+:class:`~modalviewer.viewer.Viewer` (docs/viewer-guide.md shows one).
 """
 
 from __future__ import annotations
@@ -252,14 +247,10 @@ class MainWindow(QtWidgets.QMainWindow):
             QtCore.QTimer.singleShot(0, lambda: self.open_mesh(path))
 
     def open_mesh(self, path, strict: bool = True) -> bool:
-        """Load a mesh file and show it; returns False (after a message) if it failed or
-        was cancelled.
-
-        The file is read in a worker thread (:meth:`_read_mesh`): the window keeps
-        drawing, and a reading that lasts shows a dialog with Cancel.  A damaged or
-        truncated file is named with the place of the damage, and the dialog offers
-        "Open anyway": what the file holds of whole records is loaded (``strict=False``)
-        and the report says what was dropped."""
+        """Load a mesh file and show it (read by :meth:`_read_mesh`); returns False
+        (after a message) if it failed or was cancelled.  A damaged file is named with
+        the place of the damage, and the dialog offers "Open anyway" (``strict=False``:
+        the whole records are loaded and the report says what was dropped)."""
         path = Path(path)
         try:
             mesh = self._read_mesh(path, strict)
@@ -286,14 +277,12 @@ class MainWindow(QtWidgets.QMainWindow):
         return True
 
     def _read_mesh(self, path: Path, strict: bool) -> Mesh | None:
-        """:func:`modalviewer.load_mesh` of ``path`` in a worker thread while the event
-        loop runs, so the window keeps drawing while a large file is read.  After
-        :data:`READING_DIALOG_S` a modal dialog names the file with a busy bar and
-        Cancel.  Returns the mesh, None if cancelled (the thread then reads on and its
-        mesh is dropped: a parser cannot be stopped midway), or raises
-        what ``load_mesh`` raises.  The window's shortcuts are off while the file is
-        read (:func:`_shortcuts_off`): a key pressed then is dropped, none is applied
-        to the old mesh or queued for the new one."""
+        """:func:`modalviewer.load_mesh` of ``path`` in a worker thread, so the window
+        keeps drawing; after :data:`READING_DIALOG_S` a modal dialog with Cancel.
+        Returns the mesh, None if cancelled (the parser cannot be stopped: its mesh is
+        dropped), or raises what ``load_mesh`` raises.  Shortcuts are off meanwhile
+        (:func:`_shortcuts_off`), so no key applies to the old mesh or queues for the
+        new one."""
         from concurrent.futures import ThreadPoolExecutor
 
         from ..core.robust import negative_cotan_weights

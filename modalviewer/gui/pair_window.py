@@ -1,18 +1,10 @@
 """The shape pair window: mesh A (the main window's) beside mesh B, a pick on one shows the
 distance between shapes on the other.
 
-It draws :class:`~modalviewer.viewer.pair.PairState` and keeps nothing else but VTK
-objects.  Its spectra go through the main window's job queue and disk cache (one
-computation at a time, progress in this window and in the main window's status bar);
-A's spectra are reused from the main window's state when it has them, and what a change
-of the state needs is computed.  The main window's own display and pick are never
-changed.  Scripts use the state, ``window.pair``::
-
-    window = win.open_second_mesh("assets/demo_hand_bent.obj")   # waits for the spectra
-    window.pair.set_kind("vibration"); window.wait()
-    window.pair.pick("a", 12541); window.pair.best_match()       # ("b", vertex, distance)
-    window.pair.set_display("threshold", share=0.05)
-    window.export_screenshot("pair.png", scale=2)
+It draws :class:`~modalviewer.viewer.pair.PairState` (``window.pair``, which scripts
+drive) and keeps nothing else but VTK objects.  Its spectra go through the main window's
+job queue and disk cache, reusing A's from the main window's state; the main window's
+own display and pick are never changed.
 """
 
 from __future__ import annotations

@@ -1,12 +1,10 @@
 """The 3D view: pyvistaqt's ``QtInteractor`` where Qt can make an OpenGL context, else an
 off-screen pyvista plotter (EGL or OSMesa) whose frames are painted into a plain widget.
 
-Both expose the same small interface: ``plotter`` (a pyvista plotter), ``widget``
-(the QWidget to embed), ``request_render()``, and the ``clicked(x, y)`` signal with
-VTK display coordinates (origin bottom left) of a left click that did not drag.
-The off-screen variant is what runs under ``QT_QPA_PLATFORM=offscreen`` (tests, CI,
-machines without a display); it renders with the same VTK pipeline, so pixels
-checked there are real renders.
+Both expose ``plotter``, ``widget``, ``request_render()`` and the ``clicked(x, y)``
+signal (VTK display coordinates of a left click that did not drag).  The off-screen
+variant runs under ``QT_QPA_PLATFORM=offscreen`` with the same VTK pipeline, so pixels
+checked in tests are real renders.
 """
 
 from __future__ import annotations
