@@ -45,10 +45,6 @@ def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
     from ..io import is_mesh_file
 
     found: list[Path] = []
-
-    def add(path: Path) -> None:
-        found.append(path)
-
     for source in sources:
         text = str(source)
         path = Path(text)
@@ -56,23 +52,19 @@ def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
             files = [p for p in sorted(path.rglob("*")) if is_mesh_file(p, True) and p.is_file()]
             if not files:
                 raise ValueError(f"{text}: no mesh files in this folder")
-            for p in files:
-                add(p)
+            found += files
         elif path.is_file() and is_mesh_file(path):
-            add(path)
+            found.append(path)
         elif path.is_file():
             for line in path.read_text(encoding="utf-8").splitlines():
                 line = line.strip()
                 if line and not line.startswith("#"):
-                    entry = Path(line)
-                    add(entry if entry.is_absolute() else path.parent / entry)
+                    found.append(path.parent / line)  # an absolute line stays absolute
         elif glob.has_magic(text):
-            matches = sorted(Path(p) for p in glob.glob(text, recursive=True))
-            matches = [p for p in matches if p.is_file()]
+            matches = [p for p in sorted(map(Path, glob.glob(text, recursive=True))) if p.is_file()]
             if not matches:
                 raise ValueError(f"{text}: the pattern matches no file")
-            for p in matches:
-                add(p)
+            found += matches
         else:
             raise ValueError(f"{text}: no such file or folder")
     unique: dict[Path, Path] = {}
