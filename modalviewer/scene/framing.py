@@ -138,10 +138,8 @@ def view_angle_on_smaller_side(renderer) -> None:
     """Make the active camera's view angle apply to the smaller side of the view.
 
     VTK applies it to the height, so a view narrower than tall crops a mesh fitted in a
-    wider one at the sides.  With the angle on the smaller side, a camera fitted to the
-    mesh's bounding sphere keeps the whole mesh in sight at any shape of the view, and
-    nothing jumps at a square view.  The viewports call this before every render, and
-    fitting calls it first so the fit is computed with the setting it is drawn with."""
+    wider one; on the smaller side, a camera fitted to the bounding sphere keeps the whole
+    mesh in sight at any shape of the view.  Called before every render and before a fit."""
     w, h = renderer.GetSize()
     camera = renderer.GetActiveCamera()
     narrow = bool(w < h)

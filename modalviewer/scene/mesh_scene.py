@@ -1,9 +1,8 @@
 """What is drawn: the surface with a per-vertex field, isolines, a pick marker, animation.
 
-Only the GUI thread touches these VTK objects.  Updates reuse the existing
-``PolyData`` and actors (no re-adding), so switching a mode or a threshold costs
-one array copy, the isolines (:mod:`.isolines`) and a render.  Colours and styles are
-in :mod:`.colors`.
+Only the GUI thread touches these VTK objects.  Updates reuse the ``PolyData`` and
+actors, so switching a mode or a threshold costs one array copy, the isolines and a
+render.  Colours and styles are in :mod:`.colors`.
 """
 
 from __future__ import annotations
@@ -171,14 +170,12 @@ class MeshScene:
         """Colour the surface by ``values`` (n,).
 
         kind: "diverging" (symmetric about zero, orange/white/blue), "sequential"
-        (white to red), "threshold" (values are 0/1: blue/white) or "plain".
-        clim: the colour range (values beyond it take the end colours); ``clipped``
-        (low, high) says which ends values lie beyond (the colour bar marks them).
-        isolines: number of isolines (the zero level drawn bold for diverging fields).
+        (white to red), "threshold" (values 0/1: blue/white) or "plain".
+        clim: the colour range; ``clipped`` (low, high): values lie beyond that end.
+        isolines: number of isolines (the zero level bold for diverging fields).
         displacement: (n, 3) shape of the animation, carried along by the isolines.
-        scale: (knot values, knot positions) of a spread colour scale (a sequential field
-        coloured by ``np.interp(values, *scale)`` over 0..1; the colour bar keeps the
-        values, its ticks placed by the scale; the isolines divide the colours evenly).
+        scale: (knot values, knot positions) of a spread scale: a sequential field is
+        coloured by ``np.interp(values, *scale)``, the colour bar keeps the values.
         """
         values = np.array(values, dtype=np.float64)  # the animation rewrites the copy drawn
         self.scale = None
@@ -285,14 +282,10 @@ class MeshScene:
 
     def show_threshold(self, distances: np.ndarray, threshold: float, name: str = "") -> None:
         """Threshold map drawn from the distances themselves: blue where d <= threshold,
-        white elsewhere.  The colour is looked up after interpolation along the surface,
-        so the boundary follows the line where the interpolated distance crosses the
-        threshold instead of a staircase along triangle edges (which colouring the 0/1
-        indicator gives).  The table is blue below the middle of the scalar range and
-        white above, and :meth:`set_threshold` centres the range on the threshold: the
-        step lies exactly on it however small it is beside the largest distance (a table
-        spread from 0 to the largest distance would draw every threshold below its
-        first entry's width as that entry)."""
+        white elsewhere.  The colour is looked up after interpolation, so the boundary
+        follows the interpolated crossing instead of a staircase along triangle edges;
+        the table steps at the middle of the scalar range, which :meth:`set_threshold`
+        centres on the threshold, so the step lies exactly on it however small."""
         values = np.asarray(distances, dtype=np.float64)
         self.surface.point_data["field"] = values
         self.scale = None

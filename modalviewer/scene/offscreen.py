@@ -1,10 +1,6 @@
 """The viewer's picture without a window: a :class:`~.view.StateScene` on an off-screen
-pyvista plotter (EGL where there is no display, no Qt).
-
-:meth:`modalviewer.viewer.Viewer.export_screenshot` uses it when no window shows the
-viewer, and so do ``modalviewer render``, ``modalviewer distance -o`` and
-``modalviewer figures``: the same surface, colours, isolines, legend, colour bar and
-first camera as the window.
+pyvista plotter (EGL where there is no display, no Qt), for exports without a window,
+``modalviewer render``, ``distance -o`` and ``figures``.
 """
 
 from __future__ import annotations

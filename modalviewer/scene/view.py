@@ -1,11 +1,9 @@
 """The 3D picture of the viewer state: draws ``state.derived.field()``, the pick, the legend.
 
 :class:`StateScene` observes a :class:`~modalviewer.viewer.state.ViewerState` and keeps
-nothing the state does not say, except VTK objects.  It draws on any pyvista plotter:
-the window's view (``modalviewer.gui.scene_view`` adds the animation clock) and the
-off-screen plotter of :class:`~.offscreen.OffscreenRenderer` run the same code, so an
-export from a script shows what the window shows.  Only the thread that owns the
-plotter runs it.  No Qt.
+nothing but VTK objects.  The window's view and the off-screen renderer run the same
+code on their pyvista plotters, so an export from a script shows what the window shows.
+Only the thread that owns the plotter runs it.  No Qt.
 """
 
 from __future__ import annotations
