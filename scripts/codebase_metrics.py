@@ -141,7 +141,9 @@ def docstring_measurements(trees: dict[Path, ast.AST]) -> list[tuple[str, str]]:
             if not doc:
                 continue
             where = module_name(path) + ("" if isinstance(node, ast.Module) else f".{node.name}")
-            found += [(where, line.strip()) for line in doc.splitlines() if MEASUREMENT.search(line)]
+            found += [
+                (where, line.strip()) for line in doc.splitlines() if MEASUREMENT.search(line)
+            ]
     return found
 
 
