@@ -85,16 +85,11 @@ def checked_arrays(vertices, faces, polygons: bool = False):
     """``(vertices (n, 3) float64, faces (m, 3) int64, note)`` of raw arrays, checked
     before anything is done with them; never reshaped.
 
-    Faces must be an (m, 3) array of integers, or of floats that are whole numbers;
-    a (3, m) array is refused (its transpose is meant: ``faces.T``).  With ``polygons``
-    an (m, p) array of quads or polygons (p > 3) is split into triangles fanned from each
-    first vertex and ``note`` says so ("" otherwise); without it, it is refused.
-    Vertices must be (n, 3) and finite, and face indices in 0..n-1.
-
-    Raises
-    ------
-    MeshError
-        Naming what is wrong and how to fix it.
+    Faces are an (m, 3) array of integers or whole floats (a (3, m) array is refused:
+    ``faces.T`` is meant); with ``polygons`` an (m, p) array (p > 3) is fanned into
+    triangles from each first vertex and ``note`` says so.  Vertices are (n, 3) and
+    finite, face indices in 0..n-1.  A :class:`MeshError` naming what is wrong and how
+    to fix it otherwise.
     """
     try:
         v = np.array(vertices, dtype=np.float64)
@@ -181,20 +176,14 @@ class Mesh:
 
     Parameters
     ----------
-    vertices : array_like, shape (n, 3)
-        Vertex positions (any length unit); converted to float64.
-    faces : array_like, shape (m, 3)
-        Vertex indices of each triangle; converted to int64.
-
-    report : MeshReport, optional
-        What loading found and repaired.
-    file_map : array_like, shape (n_file,), optional
-        Only for a solver mesh (:attr:`solver_mesh`): for each vertex of the input its
-        vertex in this mesh, or -1 where the input's vertex is used by no face (see
-        :attr:`file_to_mesh`).  None: the mesh's numbering is the input's.
-    merged_into : array_like, shape (n,), optional
-        For each vertex the vertex it was merged into (itself where none): a merged
-        vertex is used by no face and takes the values of the one it was merged into.
+    vertices : (n, 3) vertex positions (any length unit); converted to float64.
+    faces : (m, 3) vertex indices of each triangle; converted to int64.
+    report : what loading found and repaired (:class:`MeshReport`).
+    file_map : only for a solver mesh (:attr:`solver_mesh`): (n_file,), for each vertex
+        of the input its vertex in this mesh, or -1 where no face uses it
+        (:attr:`file_to_mesh`).  None: the mesh's numbering is the input's.
+    merged_into : (n,) for each vertex the vertex it was merged into (itself where none);
+        a merged vertex is used by no face and takes that vertex's values.
 
     Raises
     ------
@@ -307,13 +296,9 @@ class Mesh:
     @cached_property
     def solver_mesh(self) -> Mesh:
         """The mesh the solvers work on: this one's vertices that faces use, in their
-        order; the mesh itself where every vertex is used by a face (and none merged).
-
-        Its :attr:`file_to_mesh` maps this mesh's vertices to it (a merged vertex to
-        the vertex it was merged into, -1 for :attr:`unused` ones), its
-        :attr:`file_vertices` back, and :meth:`to_file_field` expands its per-vertex
-        results to this mesh's numbering (NaN at unused vertices).
-        """
+        order (the mesh itself where all are used and none merged).  Its
+        :attr:`file_to_mesh`, :attr:`file_vertices` and :meth:`to_file_field` map to and
+        from this mesh's numbering (NaN at unused vertices)."""
         if self._file_map is not None or (self._merged is None and self._in_face.all()):
             return self
         rep = np.flatnonzero(self._in_face)
@@ -640,17 +625,10 @@ def shape_summary(mesh: Mesh) -> str:
 
 
 def remove_unused(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
-    """A compact copy of ``mesh``: its vertices that faces use, in their order, and the
-    map back.
-
-    Returns
-    -------
-    compact : Mesh
-        No unused or merged vertices; vertex i of it is vertex ``kept[i]`` of ``mesh``.
-    kept : ndarray of int64, shape (n_compact,)
-        For each vertex of ``compact`` its index in ``mesh`` (ascending).  Values of
-        ``mesh``'s numbering are ``values[kept]`` in ``compact``'s.
-    """
+    """A compact copy of ``mesh``, its vertices that faces use in their order, and the
+    map back: ``(compact, kept)``, vertex i of ``compact`` being vertex ``kept[i]``
+    (ascending int64) of ``mesh``, so values in ``mesh``'s numbering are
+    ``values[kept]`` in ``compact``'s."""
     solver = mesh.solver_mesh
     kept = np.array(solver.file_vertices if solver is not mesh else np.arange(mesh.n_vertices))
     compact = Mesh(solver.vertices, solver.faces, report=mesh.report)
