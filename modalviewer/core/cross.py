@@ -128,15 +128,13 @@ def common_times(
 
 
 class CrossTables:
-    """The normalised signature tables of A and B at common scales, for repeated queries.
-
-    Building costs one (n, k) x (k, T) product per mesh; each
-    query is then one matrix-vector product over the other mesh's table.
+    """The normalised signature tables of A and B at common scales, for repeated queries:
+    one (n, k) x (k, T) product per mesh to build, one matrix-vector product per query.
 
     Attributes
     ----------
     times : (T,) the common scales (:func:`common_times`; with ``kind="wks"`` the common
-        energies of the wave kernel signatures, whose width is then the same on both).
+        energies, so the wave kernels have the same width on both).
     a, b : :class:`SignatureTable` of each mesh at ``times``.
     """
 
@@ -218,18 +216,14 @@ def cross_distance(
     samples: int = 100,
     include_zero: bool = False,
 ) -> np.ndarray:
-    """The distance of eq. (31) from vertex ``vertex`` of A to every vertex of B.
+    """The distance of eq. (31) from vertex ``vertex`` of A to every vertex of B (module
+    docstring), each signature normalised by its own ``Z(t)``, on the meshes as given.
 
-    Both spectra must come from the same operator (the signature kind: heat kernel for
-    ``"laplacian"``, feature for ``"modified_dirichlet"``, vibration for ``"shells"``).
-    Each signature is normalised by its own ``Z(t)``.  Computed on the meshes as given:
-    see the module docstring on scale and :func:`rescale_to_area`.  ``t_range``: the
-    scales (default: :func:`common_times`), ``samples`` of them, log-spaced;
-    ``include_zero``: whether the signatures include the zero modes.
-
-    Returns (n_b,): the distance to each vertex of B (NaN at the vertices no face uses).
-    A ValueError if the spectra are of different operators (or shells spectra of
-    different weights), or their default scale ranges do not overlap.
+    ``t_range``: the scales (default: :func:`common_times`), ``samples`` of them,
+    log-spaced; ``include_zero``: whether the signatures include the zero modes.
+    Returns (n_b,), NaN at the vertices no face uses.  A ValueError if the spectra are of
+    different operators (or shells spectra of different weights), or their default
+    scale ranges do not overlap.
     """
     v = spec_a.check_source(check_vertex(vertex, spec_a.n_vertices))
     _check_pair(spec_a, spec_b)

@@ -1,16 +1,12 @@
 """Multi-scale signatures and the distance of eq. (31) (paper Section 6).
 
-The heat kernel signature (Laplacian modes), the feature signature (E_D^N modes) and
-the vibration signature (3-vector shells modes) share one formula, ``kind="heat"``:
-``S_t(v) = sum_j exp(-lambda_j t) |phi_j(v)|^2``; zero modes are left out by default.
-
-``kind="wks"`` is the wave kernel signature of Aubry, Schlickewei and Cremers (2011), a
-band-pass filter in log-eigenvalue instead of the heat kernel's low-pass one, for any
-operator's spectrum: at energy ``E`` (``e = log E``)
-``W_E(v) = sum_j exp(-(e - log lambda_j)^2 / (2 sigma^2)) |phi_j(v)|^2 / C_E`` with
-``C_E = sum_j exp(-(e - log lambda_j)^2 / (2 sigma^2))``, over the non-zero modes.  Its
-distance is eq. (31) with the energies in place of the scales: the Euclidean distance of
-the rows ``W_E(v) sqrt(d log E)`` (docs/conventions.md).
+``kind="heat"``: ``S_t(v) = sum_j exp(-lambda_j t) |phi_j(v)|^2``, the heat kernel
+(Laplacian), feature (E_D^N) or vibration (3D shells) signature; zero modes left out by
+default.  ``kind="wks"``: the wave kernel signature of Aubry, Schlickewei and Cremers
+(2011), a band-pass filter in log-eigenvalue over the non-zero modes,
+``W_E(v) = sum_j g_j(E) |phi_j(v)|^2 / sum_j g_j(E)`` with
+``g_j(E) = exp(-(log E - log lambda_j)^2 / (2 sigma^2))``; its distance is eq. (31) over
+log-energies (docs/conventions.md).
 """
 
 from __future__ import annotations
@@ -129,23 +125,22 @@ def signature(
     sigma: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The signature ``sum_j exp(-lambda_j t) |phi_j(v)|^2`` at every vertex (or at
-    ``vertices``) and scale: the heat kernel signature for the Laplacian, the feature
-    signature for E_D^N, the vibration signature for the Discrete Shells.
+    ``vertices``) and scale (module docstring for the kinds).
 
     Parameters
     ----------
     times : positive, finite scales (default: :func:`default_times`).
     include_zero : whether the sum includes the zero modes (``kind="heat"`` only).
     vertices : vertex indices (default: every vertex); vertices no face uses get NaN.
-    kind : ``"heat"``, or ``"wks"``: the wave kernel signature ``W_E(v)`` (module
-        docstring) at ``energies`` (default :func:`default_energies`) with width
-        ``sigma`` in log-energy (default :func:`wks_sigma`).
+    kind : ``"heat"``, or ``"wks"``: ``W_E(v)`` at ``energies`` (default
+        :func:`default_energies`) with width ``sigma`` in log-energy (default
+        :func:`wks_sigma`).
 
     Returns
     -------
-    (times (T,), the energies for ``"wks"``; values (n, T) or (len(vertices), T)).
-    A TypeError, ValueError or IndexError for scales that are not positive and finite
-    or vertices that are not indices of the mesh.
+    (times (T,) or the energies; values (n, T) or (len(vertices), T)).  A TypeError,
+    ValueError or IndexError for scales not positive and finite or vertices not of the
+    mesh.
     """
     if _check_kind(kind) == "wks":
         if times is not None or include_zero:
@@ -238,13 +233,9 @@ class SignatureTable:
         self._norms2 = np.einsum("ij,ij->i", value, value)  # (n,) squared row norms
 
     def distance_from(self, vertex: int) -> np.ndarray:
-        """(n,) distance from ``vertex`` to every vertex.
-
-        ``|F[v] - F[w]|^2 = |F[v]|^2 + |F[w]|^2 - 2 F[v].F[w]``: one pass over the table
-        (a matrix-vector product) instead of three.  Where that difference cancels
-        (distance below 1e-3 of the signature norms) the entries are recomputed directly,
-        so near-zero distances keep full relative accuracy and d(v, v) = 0 exactly.
-        """
+        """(n,) distance from ``vertex`` to every vertex: one matrix-vector product by
+        ``|F[v] - F[w]|^2 = |F[v]|^2 + |F[w]|^2 - 2 F[v].F[w]``, the entries where that
+        cancels recomputed directly, so d(v, v) = 0 exactly."""
         row = self.table[check_vertex(vertex, self.table.shape[0])]
         if np.isnan(row).any():
             from .mesh import _unused_words
@@ -277,15 +268,13 @@ def multiscale_distance(
     include_zero: bool = False,
     kind: str = "heat",
 ) -> np.ndarray:
-    """The multi-scale distance ``delta_[t1,t2](vertex, w)`` of eq. (31) to every vertex w.
+    """The multi-scale distance ``delta_[t1,t2](vertex, w)`` of eq. (31) to every vertex w:
+    a Riemann sum over ``samples`` log-spaced scales in ``t_range`` (default
+    :func:`default_times`' range; for ``kind="wks"`` energies, :func:`default_energies`)
+    of signature differences normalised by ``Z(t) = sum_j exp(-lambda_j t)``.
 
-    A Riemann sum over ``samples`` log-spaced scales in ``t_range``, each difference of
-    signatures normalised by ``Z(t) = sum_j exp(-lambda_j t)``; ``t_range`` defaults
-    to :func:`default_times`' range, and with ``kind="wks"`` it is the energy range of
-    the wave kernel signatures (default :func:`default_energies`' range).
-
-    Returns (n,): 0 at ``vertex`` itself, NaN at the vertices no face uses.  A
-    ValueError if the spectrum has no non-zero modes, or no face uses ``vertex``.
+    Returns (n,): 0 at ``vertex``, NaN at the vertices no face uses.  A ValueError if the
+    spectrum has no non-zero modes, or no face uses ``vertex``.
     """
     vertex = spec.check_source(check_vertex(vertex, spec.n_vertices))
     table = SignatureTable(spec, t_range, samples, include_zero, kind=kind)
