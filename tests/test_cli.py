@@ -322,15 +322,16 @@ def test_compute_refuses_what_does_not_fit_and_says_what_would(tmp_path, monkeyp
 
 
 def test_compute_says_when_the_factor_and_basis_were_kept_small(tmp_path):
-    # 40k vertices, 120k unknowns: the shells factor (about 300 MB in core) does not fit
-    # a 1 MB limit, so it goes out of core; the spectrum is the one computed in core
+    # 29k vertices, 88k unknowns: the shells factor (about 180 MB in core, above the
+    # 140 MB working buffer out of core) does not fit a 1 MB limit, so it goes out of
+    # core; the spectrum is the one computed in core
     from modalviewer.core.demo_shapes import bumpy_plate
     from modalviewer.core.factor import available_backends
     from modalviewer.viewer.wording import FLOAT32_BASIS_WORDS, OUT_OF_CORE_WORDS
 
     if "pardiso" not in available_backends():
         pytest.skip("out of core is PARDISO's (the mkl wheel)")
-    plate = bumpy_plate(200)
+    plate = bumpy_plate(170)
     path = tmp_path / "plate.obj"
     lines = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in plate.vertices]
     path.write_text("\n".join(lines + [f"f {a} {b} {c}" for a, b, c in plate.faces + 1]) + "\n")
