@@ -1,11 +1,10 @@
 """Coarse-to-fine (paper Section 7, Fig. 9): the spectrum of a decimated copy, carried
 to the mesh.
 
-The one module of the option: the share of vertices the copy keeps
-(:data:`COARSE_FRACTION`), the decimation (:func:`decimated_copy`), the transfer of the
-spectrum (:func:`transfer_spectrum`) and both together (:func:`coarse_to_fine_spectrum`).
-It lives outside :mod:`modalviewer.core`, which needs numpy and scipy only, because the
-decimation is VTK's (through pyvista, imported when a copy is made).
+The share of vertices kept (:data:`COARSE_FRACTION`), the decimation
+(:func:`decimated_copy`), the transfer (:func:`transfer_spectrum`) and both
+(:func:`coarse_to_fine_spectrum`).  Outside :mod:`modalviewer.core` (numpy and scipy
+only) because the decimation is VTK's, through pyvista, imported when a copy is made.
 """
 
 from __future__ import annotations

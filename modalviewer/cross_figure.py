@@ -1,11 +1,10 @@
 """Images of a distance between two shapes, rendered by the viewer's own scene.
 
 Panels side by side in one PNG: mesh A with the picked vertex, then mesh B coloured by
-a distance from that vertex with its best match marked.  Each panel is drawn off-screen
-by the viewer's :class:`~modalviewer.scene.mesh_scene.MeshScene` (the same surface, colour
-maps and marker as the viewer's distance display: white = similar, red = the largest
-distance; or blue where the distance is below the threshold) and captioned.  Used by
-``modalviewer distance A --to B -o fig.png`` and ``scripts/hand_correspondence.py``.
+a distance from it (as the viewer's distance display) with its best match marked, each
+drawn off screen by :class:`~modalviewer.scene.mesh_scene.MeshScene` and captioned.
+Used by ``modalviewer distance A --to B -o fig.png`` and
+``scripts/hand_correspondence.py``.
 """
 
 from __future__ import annotations

@@ -1,12 +1,10 @@
-"""A spectrum computation in a child process.
+"""A spectrum computation in a child process (why: :mod:`modalviewer.viewer.process`).
 
 ``python -m modalviewer.processes.job_main JOB OUT``: JOB.npz holds ``vertices``,
-``faces`` and a JSON ``params`` (operator, k, bending, membrane, and ``modes_folder``:
-where the modes are relayed as they converge).  Progress goes to
-stdout as JSON lines ``{"stage": ..., "fraction": ...}``, the result to OUT.npz (written
-atomically), a failure to stdout as ``{"error": ...}`` with exit code 1.  A separate
-process keeps the viewer's event loop free (sparse factorisations hold the GIL) and is
-terminated at once to cancel.
+``faces`` and a JSON ``params`` (operator, k, bending, membrane, and ``modes_folder``
+where the modes are relayed as they converge).  Progress goes to stdout as JSON lines
+``{"stage": ..., "fraction": ...}``, the result to OUT.npz (atomically), a failure to
+stdout as ``{"error": ...}`` with exit code 1.
 """
 
 from __future__ import annotations

@@ -1,10 +1,9 @@
 """Mesh repairs: what exists, what each needs, and how to apply one.
 
 The one place the viewer, the command line and the child processes learn which repairs
-there are.  :func:`fix_slivers` (``slivers.py``, pymeshlab imported when it runs)
-removes needle and cap triangles; ``largest_component`` keeps the largest connected
-piece (``modalviewer.core.components``).  The repairs a file gets on loading (merging
-duplicate vertices, dropping degenerate faces) are ``modalviewer.core.cleaning.repair_mesh``.
+there are: :func:`fix_slivers` (needle and cap triangles) and ``largest_component``
+(:mod:`modalviewer.core.components`).  The repairs every file gets on loading are
+:func:`modalviewer.core.cleaning.repair_mesh`'s.
 """
 
 from __future__ import annotations

@@ -1,14 +1,10 @@
 """Work in a child process, with progress relayed and cancel at once.
 
-- Spectra: sparse factorisations hold the GIL, so a big computation in a thread would
-  stall the viewer's event loop; a child process keeps it free and is killed to cancel.
-- Mesh repairs: MeshLab (pymeshlab) run in a thread of a process that later runs MKL's
-  solver corrupts the heap (the process aborts at exit with "malloc_consolidate():
-  unaligned fastbin chunk"); in a child process it cannot, and a long repair can be
-  cancelled.
-
-The child reports progress as JSON lines ``{"stage": ..., "fraction": ...}`` on stdout
-and a failure as ``{"error": message}`` with exit code 1.
+Spectra: sparse factorisations hold the GIL, so a computation in a thread would stall
+the viewer's event loop; a child keeps it free and is killed to cancel.  Mesh repairs:
+MeshLab run in a thread of a process that later runs MKL's solver corrupts the heap
+(abort at exit: "malloc_consolidate(): unaligned fastbin chunk"); a child cannot, and
+can be cancelled.  A child reports JSON lines on stdout (:mod:`modalviewer.processes.job_main`).
 """
 
 from __future__ import annotations
