@@ -95,12 +95,11 @@ def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
 def basis_in_float32(
     limit_mb: float | None, n: int, basis_columns: int, out_columns: int, block: int
 ) -> bool:
-    """Whether the Krylov basis is stored in single precision: where the process's
-    resident memory (the factor included, out of core if it did not fit) and a
-    double-precision basis with the iteration's temporaries exceed ``limit_mb``, and
-    the single-precision buffer (:func:`float32_basis_mb`) is smaller.  Double precision
-    is kept wherever it fits: the Laplacian's residuals after the final step are about
-    1e-11 with it and near 1e-7 without."""
+    """Whether the Krylov basis is stored in single precision: where resident memory (the
+    factor included) and a double-precision basis with the iteration's temporaries
+    exceed ``limit_mb`` and the single-precision buffer (:func:`float32_basis_mb`) is
+    smaller.  Double precision is kept wherever it fits: single precision limits the
+    tolerance to :data:`.eigen.FLOAT32_BASIS_TOL`."""
     left_mb = factor_budget_mb(limit_mb, n, basis_columns, block)  # now: after the factor
     if left_mb is None or left_mb >= 0:
         return False
@@ -117,11 +116,9 @@ def basis_columns(k: int, n_unknowns: int) -> int:
 
 
 def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
-    """Memory (MB) the exact solver saves with a single-precision Krylov basis
-    (:func:`basis_in_float32`) against :func:`exact_peak_mb`: its
-    double-precision basis array and the mode columns counted beside it above
-    :data:`GROWTH_MODES`, less the one buffer that holds the single-precision basis and
-    then the modes (checked against the measured runs of ``benchmarks/memory.py``)."""
+    """Memory (MB) a single-precision Krylov basis saves against :func:`exact_peak_mb`:
+    the double-precision basis and the mode columns counted beside it, less the one
+    buffer that holds the single-precision basis and then the modes."""
     n = max(int(n_unknowns), 2)
     k = max(1, min(int(k), n))
     columns = basis_columns(k, n)
@@ -131,14 +128,11 @@ def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
 
 def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> float:
     """Peak memory (MB) of an exact solve of ``k`` modes: the measured law at
-    :data:`GROWTH_MODES` modes plus, for each further mode, its share of the arrays that
-    grow with k: the Krylov basis (:func:`basis_columns`) and the modes themselves, one
-    column of ``n_unknowns`` doubles each (fewer modes: less of them).  The memory check
-    adds the factor's further fill on curved meshes (:data:`FILL_MARGIN`,
-    :meth:`.operators.OperatorInfo.predicted_peak_mb`).  Every further column is counted
-    in full, more than the solve's peak holds at once, so the prediction errs on the
-    side of refusing ("Memory check" in docs/performance.md compares it with the
-    measured runs)."""
+    :data:`GROWTH_MODES` modes plus, per further mode, its columns of the Krylov basis
+    (:func:`basis_columns`) and of the modes, ``n_unknowns`` doubles each.  Every further
+    column is counted in full, more than the peak holds at once, so the prediction errs
+    on the side of refusing ("Memory check" in docs/performance.md); the factor's fill on
+    curved meshes is added by :meth:`.operators.OperatorInfo.predicted_peak_mb`."""
     n = max(int(n_unknowns), 1)
     k, k0 = min(int(k), n), min(GROWTH_MODES, n)
     columns = basis_columns(k, n) - basis_columns(k0, n) + (k - k0)
@@ -197,11 +191,10 @@ checks it), so on the plates themselves the check errs on the side of refusing."
 def factor_goes_out_of_core(
     in_core_peak_mb: float, factor: FactorLaw | None, n_vertices: int, limit_mb: float | None
 ) -> bool:
-    """Whether the exact solver will keep its factor in a file: where the in-core peak
-    is above the memory limit (:func:`.memory.memory_limit_mb`), out of core needs less,
-    and PARDISO (the only backend with an out-of-core mode) is there.  The solver
-    decides on the factor's real size (:func:`.eigen.factor_budget_mb`); this is the
-    same rule on the predicted sizes."""
+    """Whether the exact solver will keep its factor in a file: the in-core peak above
+    the memory limit (:func:`.memory.memory_limit_mb`), out of core needing less, and
+    PARDISO (the only backend with that mode) there.  The rule of
+    :func:`factor_budget_mb`, on the predicted sizes."""
     if factor is None or limit_mb is None or in_core_peak_mb <= limit_mb:
         return False
     if factor.out_of_core_mb(n_vertices) >= factor.in_core_mb(n_vertices):

@@ -66,11 +66,10 @@ def exact_pairs(
     on_modes: ModeSink | None = None,
 ) -> ExactPairs:
     """The ``min(k, unknowns)`` lowest eigenpairs of ``operator`` on ``mesh``, the exact
-    null vectors first.  Raises what the assembly, the null space and
-    :func:`.eigen.solve_lowest` raise (:class:`.mesh.MeshError`, :class:`.eigen.EigenError`,
-    :class:`.eigen.Cancelled`).  ``on_modes``: told the problem first
-    (:meth:`ModeSink.start`), then given the pairs as they converge
-    (:func:`.eigen.solve_lowest`'s ``on_modes``)."""
+    null vectors first.  ``on_modes`` is told the problem (:meth:`ModeSink.start`), then
+    given the pairs as they converge.  Raises what the assembly, the null space and
+    :func:`.eigen.solve_lowest` raise (:class:`.mesh.MeshError`,
+    :class:`.eigen.EigenError`, :class:`.eigen.Cancelled`)."""
     started = time.perf_counter()
     K, mass = operator_matrices(mesh, operator, bending, membrane)
     seconds_assembly = time.perf_counter() - started

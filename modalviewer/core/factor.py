@@ -350,15 +350,14 @@ class SPDSolver:
     Parameters
     ----------
     A : (N, N) sparse symmetric positive definite matrix.
-    backend : "auto" | "pardiso" | "cholmod" | "superlu".
-    memory_budget_mb : the memory (MB) the factor may take; PARDISO writes a factor
-        that needs more to a file (out of core) if that needs less.  None: in core.
+    backend : "auto" | "pardiso" | "cholmod" | "superlu" (module docstring).
+    memory_budget_mb : the memory (MB) the factor may take; PARDISO writes a larger
+        factor to a file (out of core).  None: in core.
 
     Attributes
     ----------
     out_of_core : True if the factor lives in a file.
-    factor_mb : memory the factor needs in core (PARDISO's analysis; None for the
-        other backends).
+    factor_mb : the factor's in-core size (PARDISO's analysis; None for the others).
 
     Raises :class:`numpy.linalg.LinAlgError` if A is not positive definite.
     """

@@ -160,19 +160,17 @@ def functional_map(
 
     Parameters
     ----------
-    spec_a, spec_b : spectra of one scalar operator on the two shapes (Laplacian,
-        modified_dirichlet, shells_normal), at least ``k`` (and ``zoomout``) modes each;
-        of shapes of about the same area (signatures scale with it).
-    descriptors : "wks": the wave kernel signature of each spectrum at ``samples``
-        energies shared by both; "hks": the heat-type signature at shared scales; or
-        your own per-vertex descriptors, (array (n_a, d), array (n_b, d)).
+    spec_a, spec_b : spectra of one scalar operator on two shapes of about the same area,
+        at least ``k`` (and ``zoomout``) modes each.
+    descriptors : "wks" (wave kernel signatures at ``samples`` shared energies), "hks"
+        (heat-type signatures at shared scales), or your own per-vertex arrays
+        ((n_a, d), (n_b, d)).
     k : the size of the map from the descriptors.
-    mu : the weight of the commutativity with the eigenvalues.  The wave kernel
-        descriptors need about 1 (pyFM's 1e-3 leaves their C far from diagonal and the
-        point map poor); the heat kernel's hardly depend on it.
-    zoomout : refine by ZoomOut from ``k`` up to this many modes (C is then (zoomout,
-        zoomout)), ``zoomout_step`` modes per step (1 as in the paper; each step costs
-        one nearest-neighbour search over all vertices).
+    mu : the weight of the commutativity with the eigenvalues; the wave kernel
+        descriptors need about 1 (pyFM's 1e-3 leaves C far from diagonal), the heat
+        kernel's hardly depend on it.
+    zoomout : refine by ZoomOut up to this many modes (C then (zoomout, zoomout)),
+        ``zoomout_step`` modes per step (1 as in the paper).
 
     A ValueError for vector modes, too few modes, unknown descriptors, descriptor arrays
     of the wrong shape, or shapes whose signature ranges do not overlap.

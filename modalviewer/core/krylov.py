@@ -261,11 +261,9 @@ def block_krylov_schur(
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """The k largest eigenpairs of a symmetric positive definite operator.
 
-    The operator is applied to ``block`` vectors at a time, so a sparse factorisation
-    solves many right-hand sides per pass over its factor.  The Ritz pairs are checked
-    every 64 new vectors (and when the basis is full), so the iteration stops soon after
-    the wanted pairs have converged; a full basis is restarted with its ``keep`` best
-    Ritz vectors.
+    The operator is applied to ``block`` vectors at a time (one pass over a factor serves
+    many right-hand sides).  Ritz pairs are checked every 64 new vectors and when the
+    basis is full, which restarts with its ``keep`` best Ritz vectors.
 
     Parameters
     ----------
@@ -274,17 +272,15 @@ def block_krylov_schur(
     tol : a pair counts as converged when ``|OP y - theta y| <= tol * theta``.
     timer : accumulates the seconds of "solves", "orthogonalisation", "ritz", "restarts".
     project : removes a known invariant subspace (deflated null vectors) from an (N, b)
-        array in place; applied to the start block and to fresh random directions
-        (apply_op must project its results itself).
-    basis : the (N, max_basis + block) array to hold the basis, float64 or float32 (None:
-        a new float64 one).  Products with a float32 basis are formed in double
-        precision (:func:`_basis_t_times`); its columns are orthonormal to about 1e-7
-        only, so ``tol`` should not be below :data:`.eigen.FLOAT32_BASIS_TOL`.
-    on_converged : ``on_converged(theta, Y)`` with the newly converged leading pairs,
-        largest first: Ritz values (m,) and a new (N, m) array of Ritz vectors, in
-        pieces of about :data:`HANDOVER_COLUMNS`; a cluster (:data:`CLUSTER_RTOL`) is
-        handed over whole.  With it, Ritz pairs are checked before the basis has k
-        columns too.
+        array in place, applied to the start block and fresh random directions (apply_op
+        projects its results itself).
+    basis : the (N, max_basis + block) float64 or float32 array for the basis (None: a
+        new float64 one).  A float32 basis is orthonormal to about 1e-7 only (products
+        in double, :func:`_basis_t_times`): ``tol`` >= :data:`.eigen.FLOAT32_BASIS_TOL`.
+    on_converged : ``on_converged(theta, Y)`` with newly converged leading pairs, largest
+        first, (m,) values and a new (N, m) array, in pieces of about
+        :data:`HANDOVER_COLUMNS`, a cluster (:data:`CLUSTER_RTOL`) whole.  With it,
+        pairs are checked before the basis has k columns too.
 
     Returns
     -------

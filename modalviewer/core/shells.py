@@ -39,10 +39,8 @@ __all__ = [
 
 # ----------------------------------------------------------------- topology
 def hinges(mesh: Mesh) -> np.ndarray:
-    """(h, 4) interior-edge stencils ``[x0, x1, x2, x3]``.
-
-    The edge runs x0 -> x1 in the first triangle (x0, x1, x2); the second triangle is
-    (x1, x0, x3).  Requires an edge-manifold, consistently oriented mesh.
+    """(h, 4) interior-edge stencils ``[x0, x1, x2, x3]``: the edge x0 -> x1, triangles
+    (x0, x1, x2) and (x1, x0, x3).  Requires an edge-manifold, consistently oriented mesh.
     """
     problem = mesh.shell_problem()
     if problem:
@@ -71,11 +69,8 @@ def _rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def dihedral_angles(x: np.ndarray, hinge: np.ndarray) -> np.ndarray:
-    """(h,) signed dihedral angles in radians (0 for a flat hinge, via atan2).
-
-    Positive when the hinge folds towards the side the normals point to... the sign
-    convention is irrelevant for the Hessian at rest.
-    """
+    """(h,) signed dihedral angles in radians (0 for a flat hinge, via atan2); the sign
+    convention does not matter for the Hessian at rest."""
     x0, x1, x2, x3 = (x[hinge[:, k]] for k in range(4))
     e = x1 - x0
     n1 = np.cross(e, x2 - x0)
@@ -228,15 +223,12 @@ def _gram(G: sp.csr_matrix) -> sp.csr_matrix:
 
 
 def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
-    """The Hessian H of the Discrete Shells energy at rest (Lemma 1).
-
-    Degrees of freedom in vertex-major order ``3 * i + c``; pair it with ``kron(M, I3)`` as
-    mass.  The bending part scales like 1 / length^2 and the membrane part like
-    1 / length, so the spectrum depends on the mesh's absolute size.  Assembled as
-    ``G^T G`` of :func:`weighted_gradient_matrix` (one sparse product on two threads).
-    ``bending``, ``membrane``: the weights of the bending and the membrane (stretching)
-    energy.  (3n, 3n) CSR, symmetric positive semi-definite, the rigid motions in its
-    null space."""
+    """The Hessian H of the Discrete Shells energy at rest (Lemma 1): (3n, 3n) CSR,
+    symmetric positive semi-definite, the rigid motions in its null space; dofs
+    ``3 * i + c``, mass ``kron(M, I3)``.  ``bending``, ``membrane``: the energies'
+    weights.  Bending scales like 1 / length^2 and membrane like 1 / length, so the
+    spectrum depends on the mesh's absolute size.  Assembled as ``G^T G`` of
+    :func:`weighted_gradient_matrix`."""
     return _gram(weighted_gradient_matrix(mesh, bending, membrane))
 
 
