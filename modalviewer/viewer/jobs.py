@@ -131,12 +131,11 @@ class RepairJob(Job):
 
 
 class LatestModes:
-    """``on_modes`` of a spectrum computation (:func:`modalviewer.compute_spectrum`),
-    called in the worker thread, handing the modes so far to ``deliver(spectrum)`` on
-    the owner's thread (``dispatch``): the latest spectrum so far is kept and one
-    delivery at a time is dispatched, so a slow redraw skips steps rather than queueing
-    them.  The finished spectrum is the job's result, not delivered.  Nothing is
-    delivered once ``job`` (set after the job is queued) was cancelled or has ended."""
+    """``on_modes`` of a spectrum computation, called in the worker thread: keeps the
+    latest spectrum so far and dispatches one ``deliver(spectrum)`` at a time to the
+    owner's thread, so a slow redraw skips steps rather than queueing them.  The
+    finished spectrum is the job's result, not delivered; nothing is delivered once
+    ``job`` was cancelled or has ended."""
 
     def __init__(self, dispatch: Callable[[Callable[[], None]], None], deliver) -> None:
         self.dispatch, self.deliver = dispatch, deliver

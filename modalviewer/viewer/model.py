@@ -257,13 +257,10 @@ class ViewerModel:
     def request_spectrum(
         self, operator: str | None = None, k: int | None = None, show: bool = False
     ) -> SpectrumJob:
-        """A job computing (or loading from the cache) ``operator``'s spectrum.
-
-        Uses the current compute settings for what is not given.  If the spectrum is
-        already in the state, the returned job has ended already.  ``show``: display
-        its first non-zero mode when it arrives, unless the display changed meanwhile
-        (or, for a spectrum in the state, unless it is the one on screen).
-        Raises ComputeRefused if the computation is too large for this machine.
+        """A job computing (or loading from the cache) ``operator``'s spectrum, with the
+        compute settings for what is not given; one that has ended if the spectrum is in
+        the state.  ``show``: display its first non-zero mode when it arrives, unless the
+        display changed meanwhile.  ComputeRefused if too large for this machine.
         """
         state = self.state
         if state.mesh is None:
@@ -423,13 +420,12 @@ class ViewerModel:
         return work
 
     def request_exact_curve(self, wait: bool = False) -> Job | None:
-        """Sum the picked vertex's signature curve (over the scales of the distance
-        kind's table) over all modes, by :func:`~modalviewer.core.local_signature.
-        local_signature` with the spectrum shown (one factorisation of the operator,
-        then a few Lanczos steps per scale), as a job in the queue, off this thread;
-        the result is :meth:`.derived.DerivedValues.exact_curve` and
-        ``state.events.signature_curve`` says it arrived.  None if there is no curve,
-        its spectrum is coarse-to-fine, or the exact curve is already in."""
+        """Sum the picked vertex's signature curve over all modes
+        (:func:`~modalviewer.core.local_signature.local_signature` with the spectrum
+        shown) as a job in the queue; the result is
+        :meth:`.derived.DerivedValues.exact_curve`, announced by
+        ``state.events.signature_curve``.  None if there is no curve, its spectrum is
+        coarse-to-fine, or the exact curve is already in."""
         from ..core.local_signature import local_signature
 
         state, derived = self.state, self.state.derived

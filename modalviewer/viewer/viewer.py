@@ -408,13 +408,11 @@ class Viewer(ViewerModel, Pictures):
         self.pick_vertex(number, show)
 
     def pick_vertex(self, index: int, show: bool = True) -> None:
-        """Pick vertex ``index`` of :attr:`mesh` (the input's numbering: row ``index`` of
-        the arrays, the ``index``-th vertex record of the file, as ``modalviewer distance
-        --vertex`` takes it; a ValueError for one no face uses): marker and, with
-        ``show``, the distance map of the display's kind, whose spectrum is computed if
-        missing.  A script that shows another kind next picks with ``show=False``, so
-        that no spectrum it does not need is computed (the 3D shells for the default
-        vibration distance)."""
+        """Pick vertex ``index`` of :attr:`mesh` (the input's numbering, as ``modalviewer
+        distance --vertex`` takes it; a ValueError for one no face uses): the marker and,
+        with ``show``, the distance map of the display's kind, its spectrum computed if
+        missing.  ``show=False`` spares a script that shows another kind next a spectrum
+        it does not need."""
         if self.state.mesh is None:
             return
         self.state.set_pick_file_vertex(index)

@@ -251,11 +251,9 @@ FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
 
 def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
     """How a finished spectrum job's status line starts: the description and the solve's
-    time, or for a spectrum read from the cache the time reading took and the time the
-    solve took earlier, so that a cache hit does not read like a fresh solve.  A solve's
-    time is the one it stored (``parameters["seconds_total"]``, what the cache keeps and
-    the estimates use), so a solve and its reopening report the same number; the job's
-    own time where the spectrum has none (coarse-to-fine)."""
+    stored time (``parameters["seconds_total"]``, so a solve and its reopening report the
+    same number), and for a cache hit also the time reading took, so it does not read
+    like a fresh solve; the job's own time where the spectrum has none."""
     fewer = fewer_modes_text(job, spec)
     solved = spec.parameters.get("seconds_total")
     if not isinstance(solved, (int, float)) or "transferred_from" in spec.parameters:
