@@ -59,10 +59,9 @@ ZERO_MODE_RTOL = 1e-8
 """Eigenvalues below this times the largest computed one count as zero modes."""
 ZERO_NOISE_RTOL = 1e-12
 """Eigenvalues below this times the typical eigenvalue size (median diag(K) / mass) are
-zero modes whatever else was computed: rounding noise of undeflated null vectors is
-about 1e-16 to 1e-13 of it, while the first non-zero eigenvalue of a bending energy
-falls like h^4 against it, so a larger factor would take the first vibrations of fine
-meshes for zero modes (see "Zero modes, one rule" in docs/how-it-works.md)."""
+zero modes whatever else was computed: above the rounding noise of undeflated null
+vectors, below the first bending vibrations of fine meshes, which fall like h^4 ("Zero
+modes, one rule" in docs/how-it-works.md)."""
 
 DENSE_LIMIT = 1200
 """Problems with at most this many unknowns are solved densely (exact, fast)."""
@@ -73,10 +72,9 @@ deflated: far enough below zero that rounding in the solves cannot blow up the n
 vectors' components (OP multiplies them by 1 / |shift|)."""
 DEFLATED_SHIFT_RTOL = 1e-10
 """The shift's relative size when the exactly known null vectors are deflated (every
-solve is projected, so their amplification does no harm).  The shift must stay small
-against the first non-zero eigenvalue, which it compresses the spectrum towards: the
-median diagonal ratio grows like 1/h^4 for bending energies (the sizes on the benchmark
-meshes: "Known null spaces" in docs/how-it-works.md)."""
+solve is projected, so their amplification does no harm); small against the first
+non-zero eigenvalue, since the median diagonal ratio grows like 1/h^4 for bending
+energies ("Known null spaces" in docs/how-it-works.md)."""
 
 CancelFn = Callable[[], bool]
 
@@ -505,11 +503,9 @@ def _scale_rows(Y: np.ndarray, factors: np.ndarray) -> np.ndarray:
 
 
 FLOAT32_BASIS_TOL = 1e-7
-"""Convergence tolerance of the Krylov iteration with a single-precision basis: its
-columns are orthonormal to about 1e-7, and a tighter tolerance costs about twice the
-operator columns.  The step of inverse iteration and Rayleigh-Ritz with K in double
-precision that follow bring the shells' residuals to what a double-precision basis
-gives."""
+"""Convergence tolerance of the Krylov iteration with a single-precision basis (its
+columns are orthonormal to about that); the final inverse iteration and Rayleigh-Ritz
+in double precision bring the residuals to what a double-precision basis gives."""
 
 
 def _widen_in_place(buffer: np.ndarray, n: int, width: int, count: int, out_width: int):

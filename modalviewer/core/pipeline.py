@@ -40,21 +40,17 @@ class ZeroModesWarning(UserWarning):
 
 
 WELL_SHAPED_RESIDUAL = 1e-8
-"""The relative residual the tests require on well-shaped meshes.  Where a spectrum's
-largest residual is above it, the rounding floor of that mode is computed and kept in
-``parameters["worst_residual_rounding_floor"]``, so that the residual can be reported
-with what double precision allows on this mesh."""
+"""The relative residual the tests require on well-shaped meshes; above it, the worst
+mode's rounding floor is kept in ``parameters["worst_residual_rounding_floor"]`` to
+report the residual beside what double precision allows."""
 
 RESIDUAL_LIMIT = 1e-4
 """A spectrum whose non-zero modes have a larger relative residual is rejected, unless
 the residual is within ``FLOOR_FACTOR`` of the mode's rounding floor
-(:func:`.eigen.rounding_floors`: what rounding the mode to double precision alone can
-cause; no solver does better).
-
-On well-shaped meshes the residuals are around 1e-10 (the tests require 1e-8); sliver
-triangles make the operator ill-conditioned (largest/smallest eigenvalue ~1e13 on an
-iso-surface mesh) and put a floor of about 1e-6 under any solver's residual.  Such
-spectra are accepted and carry their residuals (the viewer shows the largest)."""
+(:func:`.eigen.rounding_floors`, below which no solver goes).  Sliver triangles make the
+operator so ill-conditioned that the floor rises far above the residuals of well-shaped
+meshes; such spectra are accepted and carry their residuals (the viewer shows the
+largest)."""
 
 
 def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:

@@ -38,18 +38,14 @@ SURFACE_DEPTH_OFFSET = (2.0, 4.0)
 """Polygon offset (factor, units) of the surface: it stands back in depth from its
 isolines, which lie on it."""
 GHOST_DEPTH_OFFSET = (0.0, 1e8)
-"""Polygon offset (factor, units) of the rest shape's ghost: a hundred million of the
-depth buffer's smallest steps push every ghost fragment to the back of the depth range,
-so the ghost shows only where no surface is drawn, beside the deformed shape, as
-structural-analysis tools draw the undeformed shape.  At its true depth the ghost stands
-in front of the surface wherever that moved behind the rest shape, and greys it over in
-patches with stair-stepped edges where the two cross (the teapot's body, the cow's
-neck)."""
+"""Polygon offset (factor, units) of the rest shape's ghost: it pushes every ghost
+fragment to the back of the depth range, so the ghost shows only where no surface is
+drawn, as structural-analysis tools draw the undeformed shape; at its true depth it
+would grey the surface over in stair-stepped patches wherever the two cross."""
 GHOST_FADE = (0.005, 0.02)
-"""Where a vertex moves less than the first share of the bounding-box diagonal the
-ghost is not drawn there, from the second on at :data:`GHOST_OPACITY`, linearly between:
-where the displaced surface lies within a hair of the rest shape the ghost shows nothing
-but thin grey rims along the surface's outline."""
+"""Shares of the bounding-box diagonal: the ghost is not drawn where a vertex moves less
+than the first, drawn at :data:`GHOST_OPACITY` from the second, linearly between (near
+the rest shape it would only add grey rims along the outline)."""
 
 
 class MeshScene:
