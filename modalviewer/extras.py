@@ -1,10 +1,9 @@
 """Optional dependencies: the extra that installs each, and one-line errors naming it.
 
-``import modalviewer`` needs numpy and scipy only.  Pictures, the window, some file
-formats, sliver repair, batch runs and interactive notebook pictures need optional
-packages, installed by the extras of ``pyproject.toml``.  Where one is missing, the
-call that needs it raises :class:`MissingExtraError` (a ``ModuleNotFoundError``) with
-one line saying what needs which package and the ``pip install`` that brings it.
+``import modalviewer`` needs numpy and scipy only.  Where an optional package is
+missing, the call that needs it raises :class:`MissingExtraError` (a
+``ModuleNotFoundError``) saying what needs which package and the ``pip install`` that
+brings it.
 """
 
 from __future__ import annotations

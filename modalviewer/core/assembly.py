@@ -1,9 +1,6 @@
-"""``operator_matrices``: the (K, mass) of an operator's eigenproblem on a mesh.
-
-The assembly function of each operator comes from the registry
-(:attr:`.operators.OperatorInfo.assemble`); the mass is the lumped vertex area (or the
-operator's own, :attr:`.operators.OperatorInfo.assembles_mass`), repeated for each
-unknown of a vertex.
+"""``operator_matrices``: the (K, mass) of an operator's eigenproblem on a mesh, K from
+the registry's assembly function (:attr:`.operators.OperatorInfo.assemble`), the mass
+the lumped vertex area (or the operator's own) repeated for each unknown of a vertex.
 """
 
 from __future__ import annotations

@@ -1,12 +1,10 @@
 """On-disk cache of computed spectra, keyed by mesh hash, operator and parameters.
 
-The cache is a folder of ``.npz`` files, one per spectrum, with a size limit: when the
-files add up to more than ``max_bytes``, the least recently used ones are deleted first.
-A file's modification time is its last use: :meth:`SpectrumCache.get` touches the file
-it serves, and a new file is written (atomically, through a temporary file and a rename)
-with the current time.  Every entry is checked when it is read (zip member checksums,
-format, shapes, finite values, mesh hash); a damaged or foreign one is deleted with a
-warning in the ``modalviewer.cache`` log and counts as a miss.
+A folder of ``.npz`` files, one per spectrum, at most ``max_bytes`` in all: the least
+recently used go first, a file's modification time being its last use (:meth:`SpectrumCache.get`
+touches it; files are written atomically).  Every entry is checked when read (zip
+checksums, format, shapes, finite values, mesh hash); a damaged or foreign one is
+deleted with a warning in the ``modalviewer.cache`` log and counts as a miss.
 """
 
 from __future__ import annotations

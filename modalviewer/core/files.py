@@ -1,10 +1,7 @@
 """Writing files atomically (a temporary file beside the target, then a rename) with the
-permissions of the user's umask.
-
-``tempfile.mkstemp`` creates its file with mode 0600 whatever the umask, and a rename keeps
-that mode, so every file written this way would be private; :func:`atomic_write` gives the
-temporary file the mode a plain ``open(path, "w")`` would have (0666 minus the umask)
-before renaming it.
+permissions of the user's umask: ``tempfile.mkstemp`` creates mode 0600 and a rename
+keeps it, so :func:`atomic_write` gives the temporary file what ``open(path, "w")``
+would (0666 minus the umask) before renaming it.
 """
 
 from __future__ import annotations

@@ -1,10 +1,9 @@
 """Colour scales that spread a field's values over the colours by area (no Qt, no VTK).
 
-A distance from a vertex is small on most of a shape and large on a little of it:
-coloured linearly, most of the surface takes one colour.  The "spread" scale maps a
-value to the share of the surface's area at or below it (an area-weighted rank), so
-each tenth of the colours covers about a tenth of the surface; the colour bar keeps the
-true values at its ticks.
+A distance from a vertex is small on most of a shape, so linear colours paint most of
+the surface alike.  The "spread" scale maps a value to the share of the area at or below
+it (an area-weighted rank), so each tenth of the colours covers about a tenth of the
+surface; the colour bar keeps the true values at its ticks.
 """
 
 from __future__ import annotations

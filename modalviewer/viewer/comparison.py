@@ -1,10 +1,10 @@
 """Side-by-side comparison of two or three operators (the paper's Fig. 1) or distance
 kinds (Figs. 6, 7) on the loaded mesh, without Qt or VTK.
 
-A :class:`Comparison` reads the viewer's state (spectra, pick, threshold, isolines) and
-never changes it; it keeps only its own mode index.  :meth:`Comparison.views` is what
-each view shows, a :class:`~.derived.Field` and a title; the compare window draws
-them in linked views, :func:`modalviewer.scene.comparison.comparison_image` off screen.
+A :class:`Comparison` reads the viewer's state and never changes it (it keeps only its
+mode index); :meth:`Comparison.views` gives each view's :class:`~.derived.Field` and
+title, drawn by the compare window or
+:func:`modalviewer.scene.comparison.comparison_image` off screen.
 """
 
 from __future__ import annotations
