@@ -247,25 +247,11 @@ class MainWindow(QtWidgets.QMainWindow):
             QtCore.QTimer.singleShot(0, lambda: self.open_mesh(path))
 
     def open_mesh(self, path, strict: bool = True) -> bool:
-        """Load a mesh file and show it (read by :meth:`_read_mesh`); returns False
-        (after a message) if it failed or was cancelled.  A damaged file is named with
-        the place of the damage, and the dialog offers "Open anyway" (``strict=False``:
-        the whole records are loaded and the report says what was dropped)."""
+        """Load a mesh file (:meth:`read_mesh_file`) and show it; returns False (after a
+        message) if it failed or was cancelled."""
         path = Path(path)
-        try:
-            mesh = self._read_mesh(path, strict)
-        except DamagedFileError as exc:
-            return offer_open_anyway(self, path, exc) and self.open_mesh(path, strict=False)
-        except MeshError as exc:  # e.g. a point cloud: the message names the file
-            self.show_error(file_message(path, str(exc)), "Cannot open mesh")
-            return False
-        except OSError as exc:
-            self.show_error(
-                f"{path.name}: cannot be read ({exc.strerror or exc})", "Cannot open mesh"
-            )
-            return False
+        mesh = self.read_mesh_file(path, strict)
         if mesh is None:
-            self.statusBar().showMessage(f"Opening {path.name} was cancelled", 8000)
             return False
         # the scene is built here, on the window's thread (VTK's objects belong to it)
         QtWidgets.QApplication.setOverrideCursor(QtCore.Qt.CursorShape.WaitCursor)
@@ -275,6 +261,30 @@ class MainWindow(QtWidgets.QMainWindow):
             QtWidgets.QApplication.restoreOverrideCursor()
         window_settings.remember_file(self, path.resolve())
         return True
+
+    def read_mesh_file(self, path, strict: bool = True) -> Mesh | None:
+        """The mesh of the file ``path`` (read by :meth:`_read_mesh`), or None (after a
+        message) if it failed or was cancelled.  A damaged file is named with the place
+        of the damage, and the dialog offers "Open anyway" (``strict=False``: the whole
+        records are loaded and the report says what was dropped)."""
+        path = Path(path)
+        try:
+            mesh = self._read_mesh(path, strict)
+        except DamagedFileError as exc:
+            if offer_open_anyway(self, path, exc):
+                return self.read_mesh_file(path, strict=False)
+            return None
+        except MeshError as exc:  # e.g. a point cloud: the message names the file
+            self.show_error(file_message(path, str(exc)), "Cannot open mesh")
+            return None
+        except OSError as exc:
+            self.show_error(
+                f"{path.name}: cannot be read ({exc.strerror or exc})", "Cannot open mesh"
+            )
+            return None
+        if mesh is None:
+            self.statusBar().showMessage(f"Opening {path.name} was cancelled", 8000)
+        return mesh
 
     def _read_mesh(self, path: Path, strict: bool) -> Mesh | None:
         """:func:`modalviewer.load_mesh` of ``path`` in a worker thread, so the window

@@ -15,15 +15,13 @@ from pathlib import Path
 import numpy as np
 from qtpy import QtCore, QtWidgets
 
-from ..core.mesh import Mesh, MeshError
+from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, operator_info
-from ..readers import DamagedFileError
 from ..scene.mesh_scene import MeshScene
 from ..viewer.camera import Camera, CameraLink
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from ..viewer.wording import seconds_text
-from .dialogs import file_message, offer_open_anyway
 from .panels.common import quiet, select_data
 from .viewport import make_viewport, save_views
 from .window_keys import dispatch_key, install_keys
@@ -208,7 +206,7 @@ class PairWindow(QtWidgets.QWidget):
 
     def open_b(self, path) -> bool:
         """Replace mesh B by the mesh file ``path``; False (after a message) if it failed."""
-        mesh = _load(self.main, path)
+        mesh = self.main.read_mesh_file(path)
         if mesh is None:
             return False
         self.pair.set_mesh("b", mesh, Path(path))
@@ -482,22 +480,6 @@ def _camera(vtk_camera) -> Camera:
     return Camera(vtk_camera.GetPosition(), vtk_camera.GetFocalPoint(), vtk_camera.GetViewUp())
 
 
-def _load(main, path, strict: bool = True) -> Mesh | None:
-    from ..io import load_mesh
-
-    path = Path(path)
-    try:
-        return load_mesh(path, strict=strict)
-    except DamagedFileError as exc:  # as the main window: name the place, offer to go on
-        if offer_open_anyway(main, path, exc):
-            return _load(main, path, strict=False)
-    except MeshError as exc:
-        main.show_error(file_message(path, str(exc)), "Cannot open mesh")
-    except OSError as exc:
-        main.show_error(f"{path.name}: cannot be read ({exc.strerror or exc})", "Cannot open mesh")
-    return None
-
-
 def open_pair_window(main, path, wait: bool = True, k: int | None = None) -> PairWindow | None:
     """Open ``path`` as mesh B beside the main window's mesh A (a previous pair window is
     closed).  With ``wait`` the call returns once both spectra are in (PairError if one
@@ -507,7 +489,7 @@ def open_pair_window(main, path, wait: bool = True, k: int | None = None) -> Pai
         if wait:
             raise PairError("Open a mesh first: it becomes mesh A of the pair.")
         return None
-    mesh = _load(main, path)
+    mesh = main.read_mesh_file(path)
     if mesh is None:
         if wait:
             raise PairError(main.last_error or f"cannot open {path}")
