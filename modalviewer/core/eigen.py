@@ -591,10 +591,8 @@ def _shift_invert(
             buffer.resize((N, out_columns))
             Y = buffer[:, : theta.shape[0]]
     # One block step of inverse iteration on the converged subspace, then Rayleigh-Ritz
-    # with the operator itself.  Rounding in the Gram-Schmidt steps leaves noise of
-    # relative size 1e-16 in every direction, which K multiplies by its largest
-    # eigenvalue (1e10 times the lowest on fine meshes); one application of OP damps the
-    # noise by the same factor, so |K x - lam M x| / |lam M x| reaches 1e-10.
+    # with K itself: K amplifies the Gram-Schmidt rounding noise by its largest
+    # eigenvalue, and one application of OP damps it by the same factor.
     report("refining", 0.9)
     step = 2 * block  # each step has four (N, step) temporaries
     for start in range(0, Y.shape[1], step):

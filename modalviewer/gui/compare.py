@@ -1,9 +1,9 @@
 """Side-by-side views with one shared camera: operators (Fig. 1) or distance kinds (Figs. 6, 7).
 
-The window shows a :class:`~modalviewer.viewer.comparison.Comparison` (what each view
-shows, Qt-free): each view draws its own :class:`MeshScene` of the main window's mesh
-and all renderers use the same VTK camera, so rotating one rotates all.  The views
-follow the main window's state (pick, threshold, isolines) and never change it.
+Each view draws its own :class:`MeshScene` of the main window's mesh, as the
+:class:`~modalviewer.viewer.comparison.Comparison` says, and all renderers share one VTK
+camera, so rotating one rotates all.  The views follow the main window's state and
+never change it.
 """
 
 from __future__ import annotations

@@ -1,9 +1,7 @@
-"""Keys of the secondary windows (compare, shape pair), one table per window.
-
-One table serves two routes: on a desktop the focused 3D view (pyvistaqt's
-QtInteractor) takes key presses before the window's keyPressEvent sees them, and window
-shortcuts come first; without an active window (off-screen) shortcuts do not fire and
-keyPressEvent handles the keys.
+"""Keys of the secondary windows (compare, shape pair), one table per window, serving
+two routes: on a desktop the focused 3D view takes key presses before keyPressEvent, so
+window shortcuts come first; off screen shortcuts do not fire and keyPressEvent handles
+the keys.
 """
 
 from __future__ import annotations

@@ -43,19 +43,12 @@ def _threshold_table(n: int = 2048) -> pv.LookupTable:
     return lut
 
 
-# Rendering styles: the light set-up and the surface's ambient/diffuse/specular balance.
-# "paper": one headlight (the light sits at the camera, like a matcap the brightness
-# depends only on the angle between the normal and the view direction) over a high
-# ambient term: brightness min(1, ambient + diffuse * cos) reaches 1 for surfaces within
-# about 39 degrees of facing the viewer and stays above 225/255 up to about 49 degrees,
-# so white stays white and blue/orange keep their full saturation where the surface faces
-# the viewer, while the shading falls to 0.3 toward silhouettes and sharp edges show as
-# steps in brightness.  No specular term (a highlight would wash the colours out).
-# Polyscope reaches its look with a matcap (an image of a lit sphere indexed by the
-# view-space normal); a headlight gives the same view-locked shading with VTK's own
-# lighting, on screen and off screen alike.
-# "shaded": pyvista's default light kit (key, fill and back lights) with plain diffuse
-# shading: more relief, colours darker (white renders grey).
+# Rendering styles.  "paper": one headlight (view-locked shading, as Polyscope's matcap
+# gives, with VTK's own lighting on and off screen) over a high ambient term, so
+# min(1, ambient + diffuse * cos) keeps white white and colours saturated where the
+# surface faces the viewer and falls to 0.3 toward silhouettes; no specular term (a
+# highlight would wash the colours out).  "shaded": pyvista's light kit with plain
+# diffuse shading: more relief, darker colours.
 STYLES = {
     "paper": {"ambient": 0.3, "diffuse": 0.9, "specular": 0.0, "lights": "headlight"},
     "shaded": {"ambient": 0.0, "diffuse": 1.0, "specular": 0.0, "lights": "light kit"},

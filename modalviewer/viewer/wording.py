@@ -1,9 +1,7 @@
 """The viewer's words: legends, the status line, notes and marks, and how a job ended
-(no Qt, no VTK).
-
-Every function reads a :class:`~.state.ViewerState` and, where it needs numbers computed
-from it (distances, signature scales), its :class:`~.derived.DerivedValues`
-(``state.derived`` when not given).  Nothing here changes or caches anything.
+(no Qt, no VTK).  Functions read a :class:`~.state.ViewerState` and, for numbers
+computed from it, its :class:`~.derived.DerivedValues`; nothing here changes or caches
+anything.
 """
 
 from __future__ import annotations
