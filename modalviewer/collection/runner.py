@@ -36,12 +36,11 @@ from .store import (
 
 
 def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
-    """The mesh files of ``sources``: folders (searched recursively for the extensions
-    :func:`.io.load_mesh` reads, meshio's too where it is installed, less those other
-    files use: :data:`.io.AMBIGUOUS_EXTENSIONS`), glob patterns, mesh files, and list
-    files (any other file: one path per line, relative to the list's folder; blank
-    lines and ``#`` comments skipped).
-    Each file once, in the order found; ValueError for a source that matches nothing."""
+    """The mesh files of ``sources``, each once in the order found: folders (searched
+    recursively for the extensions :func:`.io.load_mesh` reads, less
+    :data:`.io.AMBIGUOUS_EXTENSIONS`), glob patterns, mesh files, and list files (one
+    path per line, relative to the list's folder; blanks and ``#`` comments skipped).
+    ValueError for a source that matches nothing."""
     from ..io import is_mesh_file
 
     found: list[Path] = []
@@ -330,26 +329,22 @@ def run_batch(
     progress: Callable[..., None] | None = None,
     log: Callable[[str], None] | None = None,
 ) -> BatchSummary:
-    """Compute every mesh of ``sources`` (see :func:`find_meshes`) into ``store``.
+    """Compute every mesh of ``sources`` (see :func:`find_meshes`) into ``store``, one task
+    per mesh.
 
-    Where it runs: ``client`` (a ``dask.distributed.Client``) if given; else the
-    scheduler at ``scheduler`` (``"tcp://host:8786"``); else a local cluster of
-    ``workers`` processes (one thread each, the cores shared among them); ``workers=0``
-    runs one mesh after another in this process, without Dask.  Each mesh is one task.
-    On a local cluster each worker's memory limit is ``memory_limit`` (default: the
-    machine's memory over the workers) and it offers that many bytes as the resource
-    ``memory``; each task asks for its :func:`memory_estimate`, so two big meshes do not
-    start together on a worker that cannot hold both.  Workers of an existing scheduler
-    are used the same way if they declare the resource (``dask worker ... --resources
-    memory=BYTES``).
-
-    A mesh whose stored key (geometry hash and parameters) is current is skipped, as is
-    a recorded failure of the same file and parameters unless ``retry_failed``.  Each
-    result is written when it arrives; a failure is recorded in ``errors/`` and the
-    batch goes on.  The index is rebuilt at the end (also when interrupted).  A store
-    holds one set of parameters: other ones raise CollectionError if it holds results.
-    ``progress(done, total, failed, seconds, already)`` is called after each mesh
-    (``already``: the meshes done before this run); ``log(text)`` gets notes.
+    Where it runs: ``client`` (a ``dask.distributed.Client``); else the scheduler at
+    ``scheduler`` (``"tcp://host:8786"``); else a local cluster of ``workers``
+    single-threaded processes; ``workers=0``: one mesh after another here, without Dask.
+    Each task asks for its :func:`memory_estimate` of the resource ``memory``, which local
+    workers offer as their ``memory_limit`` (default: the machine's memory over the
+    workers) and a scheduler's workers if they declare it (``--resources
+    memory=BYTES``), so two big meshes do not start together on a worker that cannot hold
+    both.  Meshes whose stored key is current are skipped, and recorded failures unless
+    ``retry_failed``; results are written as they arrive, failures recorded in
+    ``errors/``, and the index rebuilt at the end (also when interrupted).  A store holds
+    one set of parameters: others raise CollectionError if it holds results.
+    ``progress(done, total, failed, seconds, already)`` is called after each mesh;
+    ``log(text)`` gets notes.
     """
     store = Path(store)
     parameters = _parameters(operator, k, signatures, bending, membrane)
