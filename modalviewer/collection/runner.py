@@ -38,9 +38,9 @@ from .store import (
 def find_meshes(sources: Iterable[str | os.PathLike]) -> list[Path]:
     """The mesh files of ``sources``, each once in the order found: folders (searched
     recursively for the extensions :func:`.io.load_mesh` reads, less
-    :data:`.io.AMBIGUOUS_EXTENSIONS`), glob patterns, mesh files, and list files (one
-    path per line, relative to the list's folder; blanks and ``#`` comments skipped).
-    ValueError for a source that matches nothing."""
+    :data:`.io.AMBIGUOUS_EXTENSIONS`), glob patterns, mesh files, and list files (any
+    other file: one path per line, relative to the list's folder; blanks and ``#``
+    comments skipped).  ValueError for a source that matches nothing."""
     from ..io import is_mesh_file
 
     found: list[Path] = []
