@@ -1,5 +1,6 @@
-"""Meshes in from other libraries, matrices and point data out: :func:`as_mesh`
-(arrays, trimesh, pyvista, meshio objects, repaired and reported as
+"""Meshes in from other libraries, matrices and point data out.
+
+:func:`as_mesh` (arrays, trimesh, pyvista, meshio objects, repaired and reported as
 :func:`~modalviewer.io.load_mesh` does), :func:`operator_matrices` (an operator's sparse
 ``(K, M)``) and :func:`to_pyvista` (modes and fields as point arrays).  No module-level
 import of trimesh, pyvista or meshio: objects are recognised by their type's module.
