@@ -33,12 +33,9 @@ default; the viewer's cost estimates use it too)."""
 
 
 def decimated_copy(mesh: Mesh, fraction: float = COARSE_FRACTION) -> Mesh:
-    """The mesh decimated to about ``fraction`` of its vertices, repaired and reported.
-
-    VTK's progressive decimation with topology preserved: quadric decimation left slivers
-    (triangle quality 7e-7) on flat regions of subdivided meshes, which make the shells
-    Hessian numerically indefinite.
-    """
+    """The mesh decimated to about ``fraction`` of its vertices, repaired and reported, by
+    VTK's progressive decimation with topology preserved (quadric decimation leaves
+    slivers on flat regions, which make the shells Hessian numerically indefinite)."""
     import pyvista as pv
 
     faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()

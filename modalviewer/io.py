@@ -50,11 +50,8 @@ def pyvista_arrays(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
 
 
 def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """Raw vertices (n, 3), triangles (m, 3) and damage notes of a mesh file.
-
-    Every vertex of the file is returned, in the file's order.  ``strict`` as in
-    :func:`load_mesh`.
-    """
+    """Raw vertices (n, 3) (every vertex of the file, in its order), triangles (m, 3) and
+    damage notes of a mesh file; ``strict`` as in :func:`load_mesh`."""
     path = Path(path)
     ext = path.suffix.lower()
     if ext not in SUPPORTED_EXTENSIONS and ext in _meshio_extensions():

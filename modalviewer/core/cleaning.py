@@ -262,10 +262,8 @@ def _collapse(tries, v, f, topo, min_area: float, locked, remap) -> float | None
 
 
 def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
-    """Flip faces so neighbours across manifold edges agree; BFS per component.
-
-    Returns (faces, number flipped, orientable).
-    """
+    """Flip faces so neighbours across manifold edges agree (BFS per component): (faces,
+    number flipped, orientable)."""
     m = len(f)
     he = np.stack([f, np.roll(f, -1, axis=1)], axis=2).reshape(-1, 2)
     key = np.sort(he, axis=1)

@@ -11,11 +11,9 @@ __all__ = ["total_curvature"]
 
 
 def total_curvature(mesh: Mesh) -> np.ndarray:
-    """(n,) sqrt(k1^2 + k2^2) = sqrt(4 H^2 - 2 K), units 1/length.
-
-    H from the cotan mean-curvature normal ``|S x| / (2 m_i)``; K from the angle
-    defect divided by the vertex mass.  Boundary vertices use the defect pi - sum.
-    """
+    """(n,) sqrt(k1^2 + k2^2) = sqrt(4 H^2 - 2 K), units 1/length: H from the cotan
+    mean-curvature normal ``|S x| / (2 m_i)``, K from the angle defect (pi - sum on the
+    boundary) over the vertex mass."""
     v, f = mesh.vertices, mesh.faces
     m = lumped_masses(mesh)
     hn = stiffness_matrix(mesh) @ v

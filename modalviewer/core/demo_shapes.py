@@ -78,11 +78,9 @@ def bumpy_plate(n: int = 80, seed: int = 3) -> Mesh:
 
 
 def voxel_surface(solid: np.ndarray, size: float = 1.0) -> Mesh:
-    """Outward-oriented boundary of a union of cubes ``solid[i, j, k]`` (edge ``size``).
-
-    Each boundary square becomes two triangles; coinciding corners are merged.  The
-    solid must not touch itself along an edge only (that would be non-manifold).
-    """
+    """Outward-oriented boundary of a union of cubes ``solid[i, j, k]`` (edge ``size``),
+    two triangles per square, coinciding corners merged.  The solid must not touch
+    itself along an edge only (non-manifold)."""
     solid = np.pad(np.asarray(solid, dtype=bool), 1)
     quads = []
     # for each axis and direction, faces where solid meets empty
@@ -110,10 +108,8 @@ def voxel_surface(solid: np.ndarray, size: float = 1.0) -> Mesh:
 
 
 def double_torus(cells: int = 4) -> Mesh:
-    """A slab with two square holes: genus two, flat faces bounded by sharp edges (Fig. 3).
-
-    ``cells`` voxels per unit length; the slab is 7 x 4 x 1 units.
-    """
+    """A 7 x 4 x 1 slab with two square holes, ``cells`` voxels per unit length: genus two,
+    flat faces bounded by sharp edges (Fig. 3)."""
     c = cells
     solid = np.zeros((7 * c, 4 * c, 1 * c), dtype=bool)
     solid[:, :, :] = True

@@ -144,11 +144,8 @@ def relative_residuals(
     lam_scale: float = 0.0,
     null_dim: int = 0,
 ) -> np.ndarray:
-    """|K x - lam M x| / |lam M x| per column; for zero modes |K x| / (lam_max |M x|).
-
-    Zero modes are those of :func:`zero_modes` (``lam_scale`` and ``null_dim`` are
-    passed on).
-    """
+    """|K x - lam M x| / |lam M x| per column; |K x| / (lam_max |M x|) for the zero modes
+    of :func:`zero_modes` (``lam_scale`` and ``null_dim`` are passed on)."""
     scale = np.abs(lam).copy()
     scale[zero_modes(lam, lam_scale, null_dim)] = zero_mode_size(lam, lam_scale)
     out = np.empty(X.shape[1])

@@ -253,8 +253,8 @@ class _Pardiso:
     def _factor_in_core_again(self) -> None:
         """Drop a failed out-of-core factorisation and its folder: a fresh handle with
         the in-core setting (the next call must be phase 12).  The failed handle is not
-        released: PARDISO's release of it crashed the process in 1 of 5 runs (error -2,
-        64k unknowns), so its analysis's memory is left to the process's end."""
+        released (PARDISO's release of it can crash the process after error -2), so its
+        analysis's memory is left to the process's end."""
         self._pt = np.zeros(64, dtype=np.int64)
         self._iparm[59] = 0
         self.out_of_core = False

@@ -66,11 +66,9 @@ def _unused_words(index: int) -> str:
 
 
 def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(m,) shape quality ``4 sqrt(3) area / (l0^2 + l1^2 + l2^2)`` of each triangle.
-
-    1 for an equilateral triangle, 0 for a degenerate one; about 2 h / L for a needle or
-    cap whose longest edge L is much longer than the height h onto it.
-    """
+    """(m,) shape quality ``4 sqrt(3) area / (l0^2 + l1^2 + l2^2)`` of each triangle: 1
+    equilateral, 0 degenerate, about 2 h / L for a needle or cap of longest edge L and
+    height h onto it."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     e0 = v[f[:, 1]] - v[f[:, 0]]

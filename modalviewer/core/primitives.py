@@ -10,10 +10,8 @@ __all__ = ["add_slivers", "grid_plate", "icosphere", "torus"]
 
 
 def grid_plate(nx: int = 10, ny: int = 10, width: float = 1.0, height: float = 1.0) -> Mesh:
-    """Flat rectangle [0, width] x [0, height] in z = 0 with (nx+1)(ny+1) vertices.
-
-    Each grid cell is split along alternating diagonals (a symmetric "criss" pattern).
-    """
+    """Flat rectangle [0, width] x [0, height] in z = 0 with (nx+1)(ny+1) vertices, each
+    cell split along alternating diagonals (a symmetric "criss" pattern)."""
     xs, ys = np.linspace(0, width, nx + 1), np.linspace(0, height, ny + 1)
     X, Y = np.meshgrid(xs, ys, indexing="xy")
     v = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])

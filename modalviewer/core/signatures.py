@@ -244,11 +244,8 @@ class SignatureTable:
         return self.distance_to(row)
 
     def distance_to(self, row: np.ndarray) -> np.ndarray:
-        """(n,) distance from a normalised signature ``row`` (T,) to every vertex.
-
-        ``row`` must be sampled at the same :attr:`times`, for example a row of another
-        mesh's table (the distance between shapes of :mod:`modalviewer.core.cross`).
-        """
+        """(n,) distance from a normalised signature ``row`` (T,) sampled at the same
+        :attr:`times` to every vertex (another mesh's row: :mod:`.cross`)."""
         row = np.asarray(row, dtype=np.float64)
         if row.shape != (self.table.shape[1],):
             raise ValueError(f"row must have shape ({self.table.shape[1]},), got {row.shape}")

@@ -22,11 +22,9 @@ from .window_keys import dispatch_key, install_keys
 
 
 class CompareWindow(QtWidgets.QWidget):
-    """Two or three linked views; ``items`` are operators or distance kinds.
-
-    Operator views keep their own mode index (the comparison's), starting at the first
-    non-zero mode; Left / Right step it, Esc and Ctrl+W close the window.
-    """
+    """Two or three linked views of ``items`` (operators or distance kinds).  Operator
+    views share the comparison's mode index, starting at the first non-zero mode; Left /
+    Right step it, Esc and Ctrl+W close the window."""
 
     def __init__(self, main, items: list[str], force_offscreen: bool | None = None):
         super().__init__()

@@ -27,10 +27,8 @@ def qt_opengl_available() -> bool:
 
 
 class OffscreenViewport(QtWidgets.QWidget):
-    """A widget showing frames of an off-screen pyvista plotter, with mouse navigation.
-
-    Left drag rotates, right drag or wheel zooms, middle drag pans, left click picks.
-    """
+    """A widget showing frames of an off-screen pyvista plotter, with mouse navigation:
+    left drag rotates, right drag or wheel zooms, middle drag pans, left click picks."""
 
     clicked = QtCore.Signal(float, float)
     cameraChanged = QtCore.Signal()

@@ -26,11 +26,8 @@ SLIVER_QUALITY = 1e-3
 @dataclass
 class SliverReport(MeshReport):
     """What :func:`fix_slivers` changed, as numbers and as sentences (``str(report)``).
-
-    Quality is ``4 sqrt(3) area / (sum of squared edge lengths)``: 1 for an equilateral
-    triangle, 0 for a degenerate one.  Distances are relative to the bounding-box
-    diagonal of the input.
-    """
+    Quality is :func:`~modalviewer.core.mesh.triangle_quality`'s; distances are relative
+    to the input's bounding-box diagonal."""
 
     min_quality: float = 0.05
     triangles_before: int = 0

@@ -13,11 +13,8 @@ from .common import WrappingLabel, combo, describe, quiet, select_data
 
 
 class ModesPanel(QtWidgets.QWidget):
-    """Shows and sets ``state.display`` for modes and ``state.style``.
-
-    When the surface shows something else (a distance, a signature), the panel says so
-    instead of naming a mode that is not on screen.
-    """
+    """Shows and sets ``state.display`` for modes and ``state.style``; while the surface
+    shows something else, it says so instead of naming a mode not on screen."""
 
     def __init__(self, state: ViewerState, parent=None):
         super().__init__(parent)
