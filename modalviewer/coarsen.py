@@ -47,13 +47,10 @@ def decimated_copy(mesh: Mesh, fraction: float = COARSE_FRACTION) -> Mesh:
 
 
 def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectrum:
-    """Carry a coarse mesh's spectrum to the fine mesh by nearest-vertex lookup.
-
-    Eigenvalues are kept; each fine vertex takes the modes of the nearest coarse vertex.
-    The transferred modes are not Mass-orthonormal on the fine mesh; signatures and
-    distances computed from them approximate the fine ones (correlation 0.94 for the
-    vibration distance on the demo hand decimated to a fifth).
-    """
+    """Carry a coarse mesh's spectrum to the fine mesh by nearest-vertex lookup: the
+    eigenvalues are kept and each fine vertex takes the modes of the nearest coarse
+    vertex.  The modes are not Mass-orthonormal on the fine mesh; signatures and
+    distances from them approximate the fine ones."""
     _, nearest = cKDTree(coarse.vertices).query(fine.vertices)
     params = dict(coarse_spec.parameters)
     params.update(transferred_from=coarse.hash, coarse_vertices=coarse.n_vertices)

@@ -93,13 +93,10 @@ def operator_matrices(mesh, operator: str, bending: float = 1.0, membrane: float
 
 @extra_needed("mv.to_pyvista")
 def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = None):
-    """A ``pyvista.PolyData`` of ``mesh`` with point arrays.
-
-    ``spectrum``: each mode as ``"mode_<j>"`` ((n,), or (n, 3) for vector modes) and the
-    vertex masses as ``"mass"``; the eigenvalues go to ``field_data["eigenvalues"]``.
-    ``fields``: a dict name -> (n,) or (n, c) per-vertex array.  Points are the mesh's
-    vertices, one per input vertex in the input's order (NaN values at ``mesh.unused``).
-    """
+    """A ``pyvista.PolyData`` of ``mesh``, one point per input vertex in the input's order
+    (NaN values at ``mesh.unused``), with ``spectrum``'s modes as ``"mode_<j>"`` ((n,) or
+    (n, 3)), its masses as ``"mass"`` and eigenvalues as ``field_data["eigenvalues"]``,
+    and ``fields`` (name -> (n,) or (n, c) array) as point arrays."""
     import pyvista as pv
 
     mesh = as_mesh(mesh)

@@ -209,11 +209,9 @@ def _compute(mesh, operator: str, parameters: dict) -> Spectrum:
 
 def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> dict:
     """The task of one mesh: read it, compute its spectra, signatures and descriptors.
-
-    Returns ``{"status": "computed", "arrays": {...}, "entry": {...}}``, or
-    ``{"status": "unchanged"}`` if the mesh's key equals ``known_key``, or
-    ``{"status": "failed", "error": "..."}``: errors are results, not exceptions, so
-    that one bad file does not stop the batch."""
+    Returns ``{"status": "computed", "arrays": {...}, "entry": {...}}``, ``{"status":
+    "unchanged"}`` if its key equals ``known_key``, or ``{"status": "failed", "error":
+    "..."}``: errors are results, so one bad file does not stop the batch."""
     import warnings
 
     from ..core.signatures import signature

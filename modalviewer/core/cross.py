@@ -257,13 +257,11 @@ def mutual_best_matches(
     samples: int = 100,
     include_zero: bool = False,
 ) -> Matches:
-    """Best match on B of each picked vertex of A, and whether the match is mutual.
-
-    For each ``v`` in ``vertices_a``: ``w`` = the vertex of B closest to ``v``, then
-    ``v'`` = the vertex of A closest to ``w``; the pair is mutual if ``v' == v``.
-    With ``vertices_b``, ``w`` is searched among ``vertices_b`` and ``v'`` among
-    ``vertices_a`` (matching two sets of landmarks); without, over all vertices.
-    ``t_range``, ``samples``, ``include_zero``: as for :func:`cross_distance`."""
+    """Best match on B of each picked vertex of A, and whether the match is mutual: for
+    each ``v`` in ``vertices_a``, ``w`` the vertex of B closest to ``v`` and ``v'`` the
+    vertex of A closest to ``w``; mutual if ``v' == v``.  With ``vertices_b`` the
+    searches run over the two sets of picks only (matching landmarks).  ``t_range``,
+    ``samples``, ``include_zero``: as for :func:`cross_distance`."""
     tables = CrossTables(spec_a, spec_b, t_range, samples, include_zero)
     return tables.mutual_best_matches(vertices_a, vertices_b)
 

@@ -174,10 +174,8 @@ def has_vertex_blocks(A: sp.csr_matrix, size: int = 3) -> bool:
 
 class _Pardiso:
     """MKL PARDISO, real symmetric positive definite (mtype 2), upper triangle in CSR.
-
-    Analysis (phase 11) first: it tells the memory the factor needs in core
-    (``in_core_mb``); if that exceeds ``memory_budget_mb`` and out of core needs less,
-    the numerical factorisation (phase 22) writes the factor to a file."""
+    The analysis (phase 11) tells the factor's in-core size (``in_core_mb``); above
+    ``memory_budget_mb``, where out of core needs less, phase 22 writes it to a file."""
 
     MTYPE = 2
 

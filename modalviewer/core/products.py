@@ -23,12 +23,9 @@ __all__ = [
 
 
 def csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
-    """Rows ``start:stop`` of a CSR matrix as a matrix sharing its arrays (no copy).
-
-    The arrays are set on an empty matrix: scipy's constructor from (data, indices,
-    indptr) prunes them, which copies any view smaller than half its base array, so the
-    two row halves of :func:`row_halves` would copy all of K's entries at every
-    product."""
+    """Rows ``start:stop`` of a CSR matrix as a matrix sharing its arrays (no copy): set
+    on an empty matrix, because scipy's constructor prunes (copies) any view smaller than
+    half its base array, which would copy all of K at every :func:`row_halves` product."""
     p = K.indptr
     a, b = int(p[start]), int(p[stop])
     rows = sp.csr_matrix((stop - start, K.shape[1]), dtype=K.dtype)

@@ -21,13 +21,10 @@ def grab(
     colorbar: bool | None = None,
     marker: bool = True,
 ) -> np.ndarray:
-    """The plotter's view rendered at ``scale`` times its size, (h, w, 3 or 4) uint8.
-
-    The scene's legend (if ``legend`` and the scene has one) and colour bar (as shown on
-    screen when ``colorbar`` is None, else forced on or off; a two-swatch legend for
-    threshold maps) are drawn onto the image at the same scale, also on a transparent
-    background.  ``scene`` defaults to the scene drawn on the plotter; without
-    ``marker`` its pick marker is left out."""
+    """The plotter's view rendered at ``scale`` times its size, (h, w, 3 or 4) uint8, with
+    the legend (if ``legend``) and colour bar (None: as on screen; a two-swatch legend for
+    threshold maps) drawn at the same scale, also on a transparent background.  ``scene``
+    defaults to the plotter's; without ``marker`` its pick marker is left out."""
     from .overlay import draw_overlay
 
     scale = int(max(1, scale))
@@ -124,12 +121,9 @@ def save_screenshot(
 
 
 def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Path:
-    """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply.
-
-    The points are the mesh's vertices, one per input vertex in the input's order (the
-    fields' values NaN at vertices no face uses); a solver's mesh of another numbering
-    (:attr:`~modalviewer.core.mesh.Mesh.solver_mesh`) gets a point-data array
-    ``file_vertex``: each point's vertex number in the input."""
+    """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply, one point
+    per input vertex in its order (NaN at vertices no face uses); a solver mesh of
+    another numbering also gets ``file_vertex``, each point's input vertex number."""
     import pyvista as pv
 
     path = Path(path)

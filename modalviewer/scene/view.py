@@ -63,11 +63,9 @@ def label_field(scene: MeshScene, field: Field | None) -> None:
 
 
 class StateScene:
-    """Keeps a :class:`MeshScene` on ``plotter`` in step with ``state``.
-
-    ``request_render()`` is called after every change (the window's view schedules a
-    repaint; off screen nothing is needed, an export renders).  ``on_animation`` is
-    called when the state starts or stops the animation (the window runs its clock)."""
+    """Keeps a :class:`MeshScene` on ``plotter`` in step with ``state``, calling
+    ``request_render()`` after every change and ``on_animation`` when the state starts or
+    stops the animation (the window runs its clock)."""
 
     def __init__(self, state: ViewerState, plotter, request_render=None, on_animation=None):
         self.state = state

@@ -39,13 +39,10 @@ class ComparisonView:
 
 
 class Comparison:
-    """Two or three ``items``, all operators or all distance kinds, on ``state``'s mesh.
-
-    Operator views show the same mode index (from the first non-zero mode of the first
-    operator); distance views the distance from the picked vertex, as a threshold map
-    marking the share of the surface the main display's map marks.  ``changed`` is
-    emitted when the mode index changes (the state's own events cover the rest).
-    """
+    """Two or three ``items``, all operators or all distance kinds, on ``state``'s mesh:
+    operator views show one mode index (from the first operator's first non-zero mode),
+    distance views the threshold map from the pick marking the share the main display's
+    map marks.  ``changed`` is emitted when the mode index changes."""
 
     changed = Signal()
 

@@ -38,13 +38,10 @@ QUEUED, RUNNING, DONE, FAILED, CANCELLED = "queued", "running", "done", "failed"
 
 
 class Job:
-    """One computation: ``fn(progress, cancel)`` returns the result.
-
-    Attributes set on the owner's thread: ``status``, ``stage``, ``fraction``,
-    ``result``, ``error`` (a message for users), ``details`` (a traceback for the log),
-    ``seconds`` (run time), ``said`` (what the status line said of the job, whole: the
-    Computations panel shows it where a status bar cuts long messages).
-    """
+    """One computation: ``fn(progress, cancel)`` returns the result.  Set on the owner's
+    thread: ``status``, ``stage``, ``fraction``, ``result``, ``error`` (for users),
+    ``details`` (a traceback for the log), ``seconds`` and ``said`` (what the status line
+    said of the job, whole, for the Computations panel)."""
 
     def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None):
         self.id = next(_ids)

@@ -112,12 +112,9 @@ def _known(cls, values: dict) -> dict:
 
 
 def restore_session(model, path) -> Restored:
-    """Open the session's mesh and restore its state in ``model`` (a ViewerModel).
-
-    Spectra are requested from the model (the cache answers at once; others are
-    recomputed in the background): the returned jobs end when they are in.  The display
-    is set once every spectrum it needs has arrived.
-    """
+    """Open the session's mesh and restore its state in ``model`` (a ViewerModel): the
+    spectra are requested (the cache answers at once, others are recomputed) and the
+    returned jobs end when they are in; the display is set once all it needs arrived."""
     path = Path(path)
     data = read_session(path)
     out = Restored()

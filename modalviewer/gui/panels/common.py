@@ -35,10 +35,8 @@ def _refresh_tooltip(box: QtWidgets.QComboBox) -> None:
 
 
 class WrappingLabel(QtWidgets.QLabel):
-    """A word-wrapped label as high as its text at its width (minimum and hinted height).
-
-    Layouts inside a scroll area (the docks) size a wrapped label once and do not
-    follow its height-for-width when the text changes: a plain label whose text goes
+    """A word-wrapped label as high as its text at its width (minimum and hinted height):
+    layouts in a scroll area size a wrapped label once, so a plain one whose text grows
     from two lines to six stays two lines high, cut at top and bottom."""
 
     def __init__(self, text: str = "", parent=None):
