@@ -32,14 +32,12 @@ def cached_or_computed(
     coarse: bool = False,
     child_process: bool = False,
 ) -> Spectrum:
-    """``operator``'s ``k`` lowest modes on ``mesh``: read from ``cache`` (default: the
-    user's :class:`.core.cache.SpectrumCache`) where they are there, else computed
-    (:func:`computed_and_cached`) and stored in it.
-
-    ``coarse``: the coarse-to-fine approximation (never cached).  ``child_process``:
-    exact solves of at least :data:`PROCESS_THRESHOLD` unknowns run in a child process
-    that writes the cache entry itself.  ``progress``, ``cancel`` and ``on_modes`` are
-    :func:`modalviewer.compute_spectrum`'s.
+    """``operator``'s ``k`` lowest modes on ``mesh``, read from ``cache`` (default: the
+    user's :class:`.core.cache.SpectrumCache`) or computed (:func:`computed_and_cached`)
+    and stored there.  ``coarse``: the coarse-to-fine approximation (never cached);
+    ``child_process``: exact solves of at least :data:`PROCESS_THRESHOLD` unknowns run
+    in a child process that writes the cache entry itself; ``progress``, ``cancel`` and
+    ``on_modes``: :func:`modalviewer.compute_spectrum`'s.
     """
     cache = cache if cache is not None else SpectrumCache()
     key = (operator, k, bending, membrane)

@@ -50,13 +50,11 @@ def _quadrature(
     known: np.ndarray,
 ) -> np.ndarray:
     """(T,) ``b^T exp(-t A) b`` for each t by Lanczos quadrature on the shifted inverse
-    ``B``: the Ritz values ``mu`` of ``B`` stand for ``x = 1/mu - sigma`` of ``A``, so
-    the steps needed do not grow with the stiffest mode (the membrane stiffness of small
-    triangles makes ``A``'s largest eigenvalue huge for the 3D shells).  No
-    reorthogonalisation: the
-    Gauss rule of finite-precision Lanczos still converges to the quadratic form.
-    A value has settled when it changes by less than ``rtol`` of itself plus ``known``
-    (the part of the signature already summed from a spectrum)."""
+    ``B``, whose Ritz values ``mu`` stand for ``x = 1/mu - sigma`` of ``A``, so the steps
+    needed do not grow with the stiffest mode (huge for the 3D shells' small triangles).
+    No reorthogonalisation: finite-precision Lanczos' Gauss rule still converges.  A
+    value has settled when it changes by less than ``rtol`` of itself plus ``known`` (the
+    part already summed from a spectrum)."""
     beta0 = float(np.linalg.norm(b))
     if beta0 <= 1e-10:  # e_r lies in the null space to rounding: b^T exp(-tA) b <= |b|^2
         return np.zeros(len(times))

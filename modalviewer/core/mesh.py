@@ -373,14 +373,9 @@ class Mesh:
         return index if self._file_map is None else int(self._first_file_vertex[index])
 
     def mesh_vertex(self, file_index: int) -> int:
-        """The mesh vertex of vertex ``file_index`` of the file.
-
-        Raises
-        ------
-        MeshError
-            If the file has no such vertex, or no face uses it (it was dropped, so
-            distances and modes are undefined there).
-        """
+        """The mesh vertex of vertex ``file_index`` of the file; a :class:`MeshError` if
+        the file has no such vertex or no face uses it (distances and modes are
+        undefined there)."""
         file_index = int(file_index)
         n = self.n_file_vertices
         if not 0 <= file_index < n:

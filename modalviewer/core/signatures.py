@@ -186,13 +186,10 @@ def normalised_signatures(
 
 
 class SignatureTable:
-    """Normalised signatures of all vertices, ready for fast distance queries.
-
-    Holds ``F = S_t(v) / Z(t) * sqrt(dlogt)`` as (n, T) so that
-    ``delta(v, w) = |F[v] - F[w]|``; with ``kind="wks"`` ``F = W_E(v) sqrt(dlogE)`` over
-    energies, ``t_range`` then being the energy range (default
-    :func:`default_energies`).  Building costs one (n, k) x (k, T) product; each query
-    then costs O(n T).
+    """Normalised signatures of all vertices, ready for fast distance queries: ``F =
+    S_t(v) / Z(t) * sqrt(dlogt)`` as (n, T), so ``delta(v, w) = |F[v] - F[w]|`` (with
+    ``kind="wks"``, ``W_E(v) sqrt(dlogE)`` over the energy range ``t_range``).  One
+    (n, k) x (k, T) product to build, O(n T) per query.
     """
 
     def __init__(

@@ -180,12 +180,10 @@ def load_spectrum(
     mesh: Mesh | None = None,
     mesh_hash: str | None = None,
 ) -> Spectrum:
-    """Read a spectrum written by :func:`save_spectrum`, checked to belong to ``mesh``
-    (or to the mesh of hash ``mesh_hash``) if given.
-
-    A :class:`SpectrumFileError` if the file is not a readable spectrum file (or has
-    inconsistent shapes, NaN or infinite values) or belongs to another mesh; a TypeError
-    if ``mesh`` is not a Mesh (pass a hash as ``mesh_hash=``) or both are given.
+    """Read a spectrum written by :func:`save_spectrum`, checked to belong to ``mesh`` (or
+    to the mesh of hash ``mesh_hash``) if given.  A :class:`SpectrumFileError` if the file
+    is not a readable, consistent and finite spectrum file or belongs to another mesh; a
+    TypeError if ``mesh`` is not a Mesh (pass a hash as ``mesh_hash=``) or both are given.
     """
     if mesh is not None:
         if isinstance(mesh, (str, bytes)):

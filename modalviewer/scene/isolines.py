@@ -24,11 +24,9 @@ def isoline_segments(
     displacement: np.ndarray | None = None,
 ) -> pv.PolyData:
     """Isolines of a piecewise-linear field as line segments, one per crossed triangle
-    and level (vectorised, in place of VTK's slower contour filter).
-
-    points (n, 3), faces (m, 3), values (n,), levels (L,); ``displacement`` (n, 3) is
-    interpolated onto the line points as point data.  A vertex exactly at a level counts
-    as above it, so every crossed triangle yields exactly one segment.
+    and level (vectorised; VTK's contour filter is slower): points (n, 3), faces (m, 3),
+    values (n,), levels (L,), ``displacement`` (n, 3) interpolated onto the line points.
+    A vertex exactly at a level counts as above it, so each crossing gives one segment.
     """
     seg, disp, _ = segments(points, faces, values, levels, displacement)
     return line_polydata(seg, disp)
@@ -100,13 +98,11 @@ def meaningful_zero(
     factor: float = 1.0,
 ) -> np.ndarray:
     """(len(triangles),) bool: True where the field is meaningfully non-zero near the
-    triangle, so a zero crossing there is a real nodal line.  A triangle qualifies if a
-    corner value, or the change of the field along its gradient over ``ZERO_LINE_LENGTH``
-    times the mesh's bounding-box ``diagonal``, reaches ``factor`` times
-    ``ZERO_LINE_FRACTION`` of max |values|.  The gradient term keeps the zero line of low
-    modes on fine meshes, whose corner values next to the line are tiny; regions where a
-    mode is zero up to round-off (values and their changes both far below the fraction)
-    are dropped."""
+    triangle, so a zero crossing there is a real nodal line: a corner value, or the
+    change along the gradient over ``ZERO_LINE_LENGTH`` times ``diagonal``, reaches
+    ``factor`` times ``ZERO_LINE_FRACTION`` of max |values|.  The gradient term keeps the
+    zero line of low modes on fine meshes (tiny corner values beside it); regions zero
+    up to round-off are dropped."""
     a = float(np.max(np.abs(values)))
     if triangles.size == 0 or a == 0.0:
         return np.zeros(triangles.size, dtype=bool)

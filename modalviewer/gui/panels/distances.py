@@ -18,13 +18,11 @@ SLIDER_STEPS = 1000
 
 
 class DistancesPanel(QtWidgets.QWidget):
-    """Shows and sets the distance part of ``state.display`` and the scale range.
-
-    The threshold slider moves, by default, through the share of the surface marked
-    similar (a quantile of the distances), so its whole travel is useful whatever the
-    distribution; "by value" makes it linear in the fraction of the largest distance.
-    Its label shows both numbers.  Actions needing a spectrum go to the window through
-    ``showDistanceRequested`` (it may start a computation).
+    """Shows and sets the distance part of ``state.display`` and the scale range.  The
+    threshold slider moves by default through the share of the surface marked similar (a
+    quantile), so its whole travel is useful whatever the distribution; "by value" makes
+    it linear in the fraction of the largest distance.  Actions needing a spectrum go to
+    the window through ``showDistanceRequested``.
     """
 
     showDistanceRequested = QtCore.Signal()
