@@ -20,10 +20,8 @@ from .viewer.state import DEFAULT_THRESHOLD_FRACTION
 @dataclass
 class Panel:
     """One view: ``mesh`` coloured by ``distances`` (None: plain) with ``marker`` shown,
-    seen from the viewer's default direction turned by ``azimuth`` and ``elevation``.
-
-    display: "continuous" or "threshold" (blue where the distance is at most
-    ``threshold`` times its largest value).
+    seen from the viewer's default direction turned by ``azimuth`` and ``elevation``;
+    ``display`` "continuous" or "threshold" (blue up to ``threshold`` times the largest).
     """
 
     mesh: object

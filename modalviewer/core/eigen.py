@@ -615,14 +615,11 @@ beyond it the basis is orthonormalised first."""
 
 
 def _rayleigh_ritz_in_place(K, inv_sqrt_m: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """Rayleigh-Ritz with K on the span of Y, in place: ascending Ritz values (k,).
-
-    Y (N, k) holds standard-form vectors (``x = M^-1/2 y``) and becomes the
-    Mass-orthonormal Ritz vectors.  After inverse iteration on converged vectors, Y's
-    columns scaled to unit length have a Gram matrix B near the identity, so the
-    generalised problem ``G w = lam B w`` replaces an orthonormalisation of Y (one
-    product over Y instead of four).
-    """
+    """Rayleigh-Ritz with K on the span of Y, in place: ascending Ritz values (k,); Y
+    (N, k), standard-form vectors (``x = M^-1/2 y``), becomes the Mass-orthonormal Ritz
+    vectors.  After inverse iteration, Y's unit-scaled columns have a Gram matrix B near
+    the identity, so ``G w = lam B w`` replaces orthonormalising Y (one product over Y
+    instead of four)."""
     B = Y.T @ Y
     d = 1.0 / np.sqrt(np.diag(B))
     B = d[:, None] * B * d[None, :]

@@ -198,12 +198,10 @@ def functional_map(
 def correspondence_errors(
     mesh_a, point_map: np.ndarray, truth: np.ndarray | None = None, every: int = 1
 ) -> np.ndarray:
-    """Geodesic errors of a point map of B's vertices to A's against the true one:
-    for every ``every``-th vertex y of B, the distance on A between ``point_map[y]`` and
-    ``truth[y]`` (default: y itself, two poses of one mesh), along A's edges (Dijkstra:
-    at most a few per cent above the surface's geodesic distance on a fine mesh), over
-    the square root of A's area (the field's usual unit): (ceil(n_b / every),), NaN
-    where B's vertex has no image."""
+    """Geodesic errors of a point map of B's vertices to A's: for every ``every``-th vertex
+    y of B, the distance on A between ``point_map[y]`` and ``truth[y]`` (default: y, two
+    poses of one mesh) along A's edges (Dijkstra, a little above the geodesic distance),
+    over sqrt(area of A): (ceil(n_b / every),), NaN where y has no image."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 

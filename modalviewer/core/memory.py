@@ -96,11 +96,9 @@ def glibc():
 
 def return_freed_memory() -> bool:
     """Give the memory this process has freed back to the system (glibc's
-    ``malloc_trim(0)``: free heap pages, at its top and between the arrays still in use).
-    A computation's stages free large arrays whose heap pages glibc would otherwise keep
-    and which the next stage's arrays, of other sizes, cannot always reuse; called at
-    each new stage of :func:`.pipeline.compute_spectrum`.  True where it ran (glibc),
-    False elsewhere."""
+    ``malloc_trim(0)``), called at each stage of :func:`.pipeline.compute_spectrum`: a
+    stage's freed heap pages are not always reusable by the next stage's arrays of other
+    sizes.  True where it ran (glibc), False elsewhere."""
     trim = getattr(glibc(), "malloc_trim", None)
     if trim is None:
         return False

@@ -433,12 +433,10 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ========================================================= comparison
     def open_comparison(self, items: list[str], wait: bool = True) -> CompareWindow | None:
-        """Linked side-by-side views of two or three operators or distance kinds.
-
-        A script (``wait=True``) computes missing spectra and returns the window once
-        they are ready; from the menu (``wait=False``) the user is asked first.  The
-        main window's display is never changed.
-        """
+        """Linked side-by-side views of two or three operators or distance kinds; never
+        changes the main window's display.  With ``wait=True`` (scripts) missing spectra
+        are computed and the window returned once they are in; from the menu the user is
+        asked first."""
         if self.state.mesh is None:
             self.show_error("Open a mesh first.")
             return None

@@ -11,12 +11,9 @@ from .common import WrappingLabel
 
 
 class JobsPanel(QtWidgets.QWidget):
-    """One row per queued or running job: description, progress, Cancel; and "Last:",
-    how the last job of the mesh on screen ended.
-
-    ``state`` (the :class:`~modalviewer.viewer.state.ViewerState`): "Last:" is cleared
-    when another mesh is opened, and a job of another mesh (one the new mesh cancelled)
-    does not fill it again."""
+    """One row per queued or running job (description, progress, Cancel) and "Last:", how
+    the last job of the mesh on screen ended, cleared when another mesh is opened (a job
+    of the old mesh does not fill it again)."""
 
     def __init__(self, jobs: JobQueue, state, parent=None):
         super().__init__(parent)
