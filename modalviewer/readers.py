@@ -654,15 +654,10 @@ READERS = {".obj": _read_obj, ".off": _read_off, ".ply": _read_ply, ".stl": _rea
 
 
 def read_mesh_file(path, strict: bool = True) -> MeshFile:
-    """Vertices, triangles and damage notes of an OBJ, PLY, OFF or STL file.
-
-    Raises
-    ------
-    MeshError
-        With ``strict=True``, at the first damaged or missing record, naming the file,
-        the line or element and what is missing; for any ``strict``, where the file is
-        not of its format at all.
-    """
+    """Vertices, triangles and damage notes of an OBJ, PLY, OFF or STL file.  A
+    :class:`MeshError` where the file is not of its format at all, and with
+    ``strict=True`` at the first damaged or missing record, naming the file, the line or
+    element and what is missing."""
     path = Path(path)
     result = READERS[path.suffix.lower()](path, strict)
     used = np.zeros(len(result.vertices), dtype=bool)

@@ -119,14 +119,12 @@ def _orthonormal_block(
     local: int = 0,
     project: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Orthonormalise W (N, b) against the orthonormal columns of Q and among itself.
-
-    Block classical Gram-Schmidt with a second pass where the first lost more than half
-    of a column's norm (DGKS), then Cholesky QR; columns that vanish (the Krylov space
-    is invariant) are replaced by random directions orthogonal to Q.
-    ``local`` > 0 says that W is orthogonal to ``Q[:, :local]`` in exact arithmetic (the
-    Lanczos recurrence): the columns from ``local`` on are projected out first, and the
-    full passes then only remove rounding errors, so they rarely need a repetition.
+    """Orthonormalise W (N, b) against the orthonormal columns of Q and among itself:
+    block classical Gram-Schmidt, a second pass where the first lost more than half a
+    column's norm (DGKS), then Cholesky QR; vanishing columns (an invariant Krylov space)
+    are replaced by random directions orthogonal to Q.  ``local`` > 0: W is orthogonal
+    to ``Q[:, :local]`` in exact arithmetic (the Lanczos recurrence), so the columns
+    from ``local`` on go first and the full passes only remove rounding errors.
     Returns (V, h, Rn) with W_in = Q h + V Rn.
     """
     W = np.array(W, dtype=np.float64, order="F")  # own copy; Q.T @ W is faster in F order

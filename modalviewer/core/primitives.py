@@ -85,14 +85,10 @@ def add_slivers(
     mesh: Mesh, needles: int, caps: int, eps: float, seed: int = 0, at: float = 0.5
 ) -> tuple[np.ndarray, np.ndarray]:
     """(vertices, faces) of ``mesh`` with nearly degenerate triangles, as remeshers and
-    iso-surfaces make them (for tests and benchmarks of the repairs).
-
-    ``caps`` faces (a, b, c) are split at x = (1 - at) a + at b moved ``eps`` (relative)
-    towards c: the cap (a, b, x) has a vertex almost on its longest edge (zero area for
-    eps = 0).  ``needles`` edges are split at ``eps`` of their length from one end (two
-    needle triangles each).  Random faces (``seed``); a closed mesh stays closed.  The
-    arrays are raw: ``Mesh`` refuses faces of zero area, ``repair_mesh`` repairs them.
-    """
+    iso-surfaces make them, for tests of the repairs: ``caps`` random faces (a, b, c)
+    split at x = (1 - at) a + at b moved ``eps`` (relative) towards c, ``needles`` edges
+    split at ``eps`` of their length from one end.  A closed mesh stays closed; the raw
+    arrays hold faces of zero area for eps = 0, which ``repair_mesh`` repairs."""
     rng = np.random.default_rng(seed)
     v = [np.asarray(p) for p in mesh.vertices]
     f = np.array(mesh.faces)

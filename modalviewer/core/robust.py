@@ -24,14 +24,9 @@ __all__ = ["robust_laplacian_matrices", "negative_cotan_weights"]
 def robust_laplacian_matrices(mesh: Mesh) -> tuple[sp.csr_matrix, np.ndarray]:
     """(L, m): the intrinsic Delaunay stiffness matrix (symmetric positive semi-definite,
     non-positive off the diagonal) and the (n,) lumped masses of
-    ``robust_laplacian.mesh_laplacian`` (its default mollification, 1e-5 of the mean
-    edge length), so that ``L phi = lambda diag(m) phi`` is its eigenproblem.
-
-    Raises
-    ------
-    MissingExtraError
-        Without the optional ``robust-laplacian`` package (``pip install
-        "modalviewer[robust]"``).
+    ``robust_laplacian.mesh_laplacian`` (default mollification), the eigenproblem being
+    ``L phi = lambda diag(m) phi``.  A :class:`MissingExtraError` without the
+    ``robust-laplacian`` package (``pip install "modalviewer[robust]"``).
     """
     with extra_needed("the operator laplacian_robust"):
         import robust_laplacian

@@ -183,13 +183,10 @@ def weighted_gradient_matrix(
     membrane: float = 1.0,
     normals: np.ndarray | None = None,
 ) -> sp.csr_matrix:
-    """G with one row ``sqrt(w_i) grad f_i^T`` per term, so that the Hessian at rest is
-    ``G^T G`` (Lemma 1).
-
-    Rows: interior edges (flexural), edges (length), faces (area), in that order, for the
-    terms with a non-zero weight.  Columns: the 3n vertex-major dofs, or with ``normals``
-    (n, 3) the n normal variations (each gradient block dotted with the vertex normal,
-    which gives ``H_N = G_N^T G_N`` without forming the 3n Hessian).
+    """G with one row ``sqrt(w_i) grad f_i^T`` per term of non-zero weight (interior
+    edges, edges, faces, in that order), so that the Hessian at rest is ``G^T G``
+    (Lemma 1).  Columns: the 3n vertex-major dofs, or with ``normals`` (n, 3) the n
+    normal variations, which gives ``H_N = G_N^T G_N`` without the 3n Hessian.
     """
     _check_weights(bending, membrane)
     x = mesh.vertices
