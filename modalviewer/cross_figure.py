@@ -21,8 +21,7 @@ from .viewer.state import DEFAULT_THRESHOLD_FRACTION
 class Panel:
     """One view: ``mesh`` coloured by ``distances`` (None: plain) with ``marker`` shown,
     seen from the viewer's default direction turned by ``azimuth`` and ``elevation``;
-    ``display`` "continuous" or "threshold" (blue up to ``threshold`` times the largest).
-    """
+    ``display`` "continuous" or "threshold" (blue up to ``threshold`` times the largest)."""
 
     mesh: object
     title: str

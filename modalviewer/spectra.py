@@ -37,8 +37,7 @@ def cached_or_computed(
     and stored there.  ``coarse``: the coarse-to-fine approximation (never cached);
     ``child_process``: exact solves of at least :data:`PROCESS_THRESHOLD` unknowns run
     in a child process that writes the cache entry itself; ``progress``, ``cancel`` and
-    ``on_modes``: :func:`modalviewer.compute_spectrum`'s.
-    """
+    ``on_modes``: :func:`modalviewer.compute_spectrum`'s."""
     cache = cache if cache is not None else SpectrumCache()
     key = (operator, k, bending, membrane)
     spec = None if coarse else cache.get(mesh, *key)

@@ -109,8 +109,7 @@ def common_times(
     intersection of the two default ranges (see the module docstring); for
     ``kind="wks"`` energies, the intersection of the default energy bands.  (samples,)
     ascending, ``samples`` >= 2.  A ValueError if the default ranges do not overlap
-    (the meshes differ too much in size: :func:`rescale_to_area`, or pass ``t_range``).
-    """
+    (the meshes differ too much in size: :func:`rescale_to_area`, or pass ``t_range``)."""
     samples = check_count(samples, "samples", 2)
     if t_range is None:
         ends = default_energies if kind == "wks" else default_times

@@ -115,8 +115,7 @@ def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np
     residual checks: the first ``null_dim`` modes (the deflated null vectors), and any
     mode with ``lam < ZERO_MODE_RTOL * largest |lam|`` or ``lam < ZERO_NOISE_RTOL *
     lam_scale`` (:func:`typical_eigenvalue`, so a spectrum of only undeflated zero modes
-    is not judged by its own rounding noise).
-    """
+    is not judged by its own rounding noise)."""
     lam = np.asarray(lam, dtype=np.float64)
     largest = max(float(np.abs(lam).max(initial=0.0)), np.finfo(float).tiny)
     mask = (lam < ZERO_MODE_RTOL * largest) | (lam < ZERO_NOISE_RTOL * lam_scale)

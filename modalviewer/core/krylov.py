@@ -125,8 +125,7 @@ def _orthonormal_block(
     are replaced by random directions orthogonal to Q.  ``local`` > 0: W is orthogonal
     to ``Q[:, :local]`` in exact arithmetic (the Lanczos recurrence), so the columns
     from ``local`` on go first and the full passes only remove rounding errors.
-    Returns (V, h, Rn) with W_in = Q h + V Rn.
-    """
+    Returns (V, h, Rn) with W_in = Q h + V Rn."""
     W = np.array(W, dtype=np.float64, order="F")  # own copy; Q.T @ W is faster in F order
     if local > 0:
         # local pass, then full passes that only remove rounding errors: two sweeps over

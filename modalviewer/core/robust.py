@@ -26,8 +26,7 @@ def robust_laplacian_matrices(mesh: Mesh) -> tuple[sp.csr_matrix, np.ndarray]:
     non-positive off the diagonal) and the (n,) lumped masses of
     ``robust_laplacian.mesh_laplacian`` (default mollification), the eigenproblem being
     ``L phi = lambda diag(m) phi``.  A :class:`MissingExtraError` without the
-    ``robust-laplacian`` package (``pip install "modalviewer[robust]"``).
-    """
+    ``robust-laplacian`` package (``pip install "modalviewer[robust]"``)."""
     with extra_needed("the operator laplacian_robust"):
         import robust_laplacian
     L, M = robust_laplacian.mesh_laplacian(

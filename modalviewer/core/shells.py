@@ -40,8 +40,7 @@ __all__ = [
 # ----------------------------------------------------------------- topology
 def hinges(mesh: Mesh) -> np.ndarray:
     """(h, 4) interior-edge stencils ``[x0, x1, x2, x3]``: the edge x0 -> x1, triangles
-    (x0, x1, x2) and (x1, x0, x3).  Requires an edge-manifold, consistently oriented mesh.
-    """
+    (x0, x1, x2) and (x1, x0, x3).  Requires an edge-manifold, consistently oriented mesh."""
     problem = mesh.shell_problem()
     if problem:
         raise MeshError("Discrete Shells cannot run: " + problem)
@@ -186,8 +185,7 @@ def weighted_gradient_matrix(
     """G with one row ``sqrt(w_i) grad f_i^T`` per term of non-zero weight (interior
     edges, edges, faces, in that order), so that the Hessian at rest is ``G^T G``
     (Lemma 1).  Columns: the 3n vertex-major dofs, or with ``normals`` (n, 3) the n
-    normal variations, which gives ``H_N = G_N^T G_N`` without the 3n Hessian.
-    """
+    normal variations, which gives ``H_N = G_N^T G_N`` without the 3n Hessian."""
     _check_weights(bending, membrane)
     x = mesh.vertices
     n = mesh.n_vertices

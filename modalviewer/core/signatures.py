@@ -189,8 +189,7 @@ class SignatureTable:
     """Normalised signatures of all vertices, ready for fast distance queries: ``F =
     S_t(v) / Z(t) * sqrt(dlogt)`` as (n, T), so ``delta(v, w) = |F[v] - F[w]|`` (with
     ``kind="wks"``, ``W_E(v) sqrt(dlogE)`` over the energy range ``t_range``).  One
-    (n, k) x (k, T) product to build, O(n T) per query.
-    """
+    (n, k) x (k, T) product to build, O(n T) per query."""
 
     def __init__(
         self,

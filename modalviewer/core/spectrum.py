@@ -183,8 +183,7 @@ def load_spectrum(
     """Read a spectrum written by :func:`save_spectrum`, checked to belong to ``mesh`` (or
     to the mesh of hash ``mesh_hash``) if given.  A :class:`SpectrumFileError` if the file
     is not a readable, consistent and finite spectrum file or belongs to another mesh; a
-    TypeError if ``mesh`` is not a Mesh (pass a hash as ``mesh_hash=``) or both are given.
-    """
+    TypeError if ``mesh`` is not a Mesh (pass a hash as ``mesh_hash=``) or both are given."""
     if mesh is not None:
         if isinstance(mesh, (str, bytes)):
             raise TypeError(

@@ -26,8 +26,7 @@ def isoline_segments(
     """Isolines of a piecewise-linear field as line segments, one per crossed triangle
     and level (vectorised; VTK's contour filter is slower): points (n, 3), faces (m, 3),
     values (n,), levels (L,), ``displacement`` (n, 3) interpolated onto the line points.
-    A vertex exactly at a level counts as above it, so each crossing gives one segment.
-    """
+    A vertex exactly at a level counts as above it, so each crossing gives one segment."""
     seg, disp, _ = segments(points, faces, values, levels, displacement)
     return line_polydata(seg, disp)
 

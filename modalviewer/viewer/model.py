@@ -260,8 +260,7 @@ class ViewerModel:
         """A job computing (or loading from the cache) ``operator``'s spectrum, with the
         compute settings for what is not given; one that has ended if the spectrum is in
         the state.  ``show``: display its first non-zero mode when it arrives, unless the
-        display changed meanwhile.  ComputeRefused if too large for this machine.
-        """
+        display changed meanwhile.  ComputeRefused if too large for this machine."""
         state = self.state
         if state.mesh is None:
             raise ComputeRefused("Open a mesh first.")

@@ -22,8 +22,7 @@ class DistancesPanel(QtWidgets.QWidget):
     threshold slider moves by default through the share of the surface marked similar (a
     quantile), so its whole travel is useful whatever the distribution; "by value" makes
     it linear in the fraction of the largest distance.  Actions needing a spectrum go to
-    the window through ``showDistanceRequested``.
-    """
+    the window through ``showDistanceRequested``."""
 
     showDistanceRequested = QtCore.Signal()
     showSignatureRequested = QtCore.Signal()
