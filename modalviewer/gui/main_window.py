@@ -21,7 +21,6 @@ from qtpy import QtCore, QtGui, QtWidgets
 from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import OPERATOR_INFO
-from ..core.spectrum import Spectrum
 from ..readers import DamagedFileError
 from ..viewer.jobs import QUEUED, Job
 from ..viewer.state import SpectrumKey
@@ -52,6 +51,15 @@ READING_WAIT_S = 0.2
 
 READING_DIALOG_S = 0.8
 """A reading that lasts this many seconds shows the dialog with Cancel."""
+
+FROM_VIEWER = frozenset(
+    "compute cancel_computation set_mesh show_mode step_mode show_distance distance_map "
+    "set_threshold show_signature show_curvature export_screenshot current_field "
+    "export_field fix_slivers_and_retry clear_cache save_session mesh spectra picked "
+    "last_distance sliver_failure".split()
+)
+"""What the window passes on to its :class:`~modalviewer.viewer.Viewer` unchanged, so a
+script drives the window as it drives a viewer."""
 
 
 @contextmanager
@@ -340,9 +348,6 @@ class MainWindow(QtWidgets.QMainWindow):
         dialog.deleteLater()
         return None if cancelled else future.result()
 
-    def set_mesh(self, mesh: Mesh, path: Path | None = None) -> None:
-        self.viewer.set_mesh(mesh, path)
-
     def _on_mesh(self) -> None:
         if self.compare is not None:
             self.compare.close()
@@ -352,9 +357,11 @@ class MainWindow(QtWidgets.QMainWindow):
         self.meshLoaded.emit(str(path) if path else "")
 
     # ================================================ scripting (the Viewer)
-    def compute(self, operator=None, k=None, wait: bool = True, then=None):
-        """:meth:`Viewer.compute <modalviewer.viewer.Viewer.compute>`."""
-        return self.viewer.compute(operator, k, wait, then)
+    def __getattr__(self, name: str):
+        """The viewer's scripting methods and read-only values (:data:`FROM_VIEWER`)."""
+        if name in FROM_VIEWER:
+            return getattr(self.viewer, name)
+        raise AttributeError(f"'MainWindow' object has no attribute {name!r}")
 
     def wait_for(self, job: Job) -> Job:
         """Run the event loop until ``job`` (and only it) has ended."""
@@ -369,23 +376,11 @@ class MainWindow(QtWidgets.QMainWindow):
             self._waits.remove(loop)
         return job
 
-    def cancel_computation(self) -> None:
-        self.viewer.cancel_computation()
-
     def cancel_all(self) -> None:
         self.viewer.jobs.cancel_all()
 
-    def show_mode(self, index: int, operator: str | None = None) -> None:
-        self.viewer.show_mode(index, operator)
-
-    def step_mode(self, step: int) -> None:
-        self.viewer.step_mode(step)
-
     def toggle_animation(self) -> None:
         self.state.set_animation(playing=not self.state.animation.playing)
-
-    def set_animating(self, on: bool) -> None:
-        self.state.set_animation(playing=bool(on))
 
     def animation_frame(self, phase: float) -> float:
         """Move the surface to the given phase (radians); returns the app's time in s."""
@@ -402,21 +397,6 @@ class MainWindow(QtWidgets.QMainWindow):
             self.viewer.pick_vertex(index, show)
         except ValueError as exc:
             self.show_error(str(exc))
-
-    def show_distance(self, kind=None, display=None, share=None, threshold=None):
-        return self.viewer.show_distance(kind, display, share, threshold)
-
-    def distance_map(self, kind: str):
-        return self.viewer.distance_map(kind)
-
-    def set_threshold(self, fraction: float) -> float:
-        return self.viewer.set_threshold(fraction)
-
-    def show_signature(self, sample: int) -> None:
-        self.viewer.show_signature(sample)
-
-    def show_curvature(self) -> None:
-        self.viewer.show_curvature()
 
     def _on_view_clicked(self, x: float, y: float) -> None:
         scene = self.scene
@@ -468,29 +448,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self.compare.refresh()
         return self.compare
 
-    # ===================================================== export, repairs
-    def export_screenshot(
-        self, path, scale: int = 1, transparent: bool = False, colorbar=None, size=None, marker=None
-    ):
-        """:meth:`Viewer.export_screenshot <modalviewer.viewer.Viewer.export_screenshot>`
-        of this window's view (at ``size``: drawn at that size from the view's camera)."""
-        return self.viewer.export_screenshot(path, scale, transparent, colorbar, size, marker)
-
-    def current_field(self):
-        return self.viewer.current_field()
-
-    def export_field(self, path) -> Path:
-        return self.viewer.export_field(path)
-
+    # ============================================================ repairs
     def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
         try:
             return self.viewer.repair_mesh(name, wait)
         except ValueError as exc:
             self.show_error(str(exc))
             return None
-
-    def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
-        return self.viewer.fix_slivers_and_retry(key, wait)
 
     def _offer_sliver_fix(self, key: SpectrumKey, message: str) -> None:
         """A failure on sliver triangles, with a "Fix slivers and retry" button (the
@@ -503,16 +467,10 @@ class MainWindow(QtWidgets.QMainWindow):
             "Computation failed",
             f"{message}.\n\nFix slivers and retry: repair the mesh (Mesh > Fix slivers), "
             f"then compute {key.describe()} again.",
-            ("Fix slivers and retry", lambda: self.fix_slivers_and_retry(key)),
+            ("Fix slivers and retry", lambda: self.viewer.fix_slivers_and_retry(key)),
         )
 
-    def clear_cache(self) -> int:
-        return self.viewer.clear_cache()
-
     # ============================================================ sessions
-    def save_session(self, path) -> Path:
-        return self.viewer.save_session(path)
-
     def open_session(self, path, wait: bool = True) -> list[str]:
         """Restore a session (:meth:`Viewer.open_session
         <modalviewer.viewer.Viewer.open_session>`); a file that cannot be restored is
@@ -532,16 +490,8 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # ==================================================== read-only views
     @property
-    def mesh(self) -> Mesh | None:
-        return self.state.mesh
-
-    @property
     def scene(self):
         return self.scene_view.scene
-
-    @property
-    def spectra(self) -> dict[str, Spectrum]:
-        return self.viewer.spectra
 
     @property
     def current_operator(self) -> str | None:
@@ -558,24 +508,12 @@ class MainWindow(QtWidgets.QMainWindow):
             self.distances_panel.update_from_state()
 
     @property
-    def picked(self) -> int | None:
-        return self.viewer.picked  # the input's number
-
-    @property
-    def last_distance(self):
-        return self.viewer.last_distance
-
-    @property
     def last_error(self) -> str | None:
         return self.viewer.last_error
 
     @last_error.setter
     def last_error(self, message: str | None) -> None:
         self.viewer.last_error = message
-
-    @property
-    def sliver_failure(self) -> SpectrumKey | None:
-        return self.viewer.sliver_failure
 
     @property
     def frame_times(self) -> list[float]:
