@@ -1,9 +1,7 @@
-"""Start the viewer: ``modalviewer [MESH]``.
-
-Without a display (no ``DISPLAY``/``WAYLAND_DISPLAY`` on Linux) the viewer runs
-off-screen: it opens the mesh, computes a spectrum, writes a screenshot made by the
-window's own export and exits, saying so.  ``--screenshot PATH`` does the same on
-purpose, on any machine.
+"""Start the viewer: ``modalviewer [MESH]``.  Without a display (no ``DISPLAY`` or
+``WAYLAND_DISPLAY`` on Linux), or with ``--screenshot PATH``, it opens the mesh,
+computes a spectrum, writes a screenshot with the window's own export and exits,
+saying so.
 """
 
 from __future__ import annotations

@@ -1,8 +1,6 @@
-"""Folders the viewer uses: the bundled meshes and screenshots.
-
-The bundled meshes come from :func:`modalviewer.data.assets_dir` (the checkout's
-``assets/`` or the wheel's data files).  Screenshots go to the checkout's
-``screenshots/`` in a checkout, to ``screenshots/`` in the current folder otherwise.
+"""Folders the viewer uses: the bundled meshes (:func:`modalviewer.data.assets_dir`) and
+screenshots (the checkout's ``screenshots/``, else ``screenshots/`` in the current
+folder).
 """
 
 from pathlib import Path
