@@ -43,11 +43,10 @@ screen") beyond the one line it has at the start."""
 
 
 def fit_modes_dock(win) -> None:
-    """Give the Modes dock the height its controls need, the Amplitude and Speed rows
-    and the eigenvalue line's note included (:data:`MODES_NOTE_LINES`), and the Distances dock
-    below it the rest (it scrolls): an even split leaves the Modes dock's last rows out
-    of view at the default window size.  For a first start; a remembered layout is
-    kept."""
+    """Give the Modes dock the height its controls need (the eigenvalue note's
+    :data:`MODES_NOTE_LINES` included) and the Distances dock below it the rest (it
+    scrolls): an even split hides the Modes dock's last rows at the default window size.
+    For a first start; a remembered layout is kept."""
     modes, distances = win.modes_dock, win.distances_dock
     total = modes.height() + distances.height()
     content = modes.widget().widget()

@@ -100,11 +100,10 @@ def animation_dialog(win) -> None:
 
 
 def window_screenshot_dialog(window, name: str, title: str) -> None:
-    """Export a window of several views (shape pair, comparison) as one picture: the
-    main window's dialog (file, size multiplier, transparent background; the views keep
-    their on-screen size, their legends and colour bars are part of the picture),
-    starting where the main window's screenshots go.  The result is said in the
-    window's status line, or the main window's status bar."""
+    """Export a window of several views (shape pair, comparison) as one picture with the
+    main window's dialog (file, size multiplier, transparent background; the views at
+    their on-screen size with legends and colour bars), starting where the main window's
+    screenshots go; the result is said in the window's status line, or the main one's."""
     win = window.main
     start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
     dialog = ScreenshotDialog(window, start, size=None, marker=None)

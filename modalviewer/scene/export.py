@@ -144,10 +144,8 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
 
 def _write_ply(path: Path, mesh: Mesh, arrays: dict[str, np.ndarray]) -> None:
     """Binary little-endian PLY of ``mesh`` with each of ``arrays`` (n,) or (n, c) as
-    vertex properties (``name``, or ``name_0 .. name_c-1``; doubles, integers as int):
-    VTK's PLY writer keeps only colours and texture coordinates.  Any PLY reader that
-    keeps vertex properties (trimesh, Open3D's tensor API, MeshLab, plyfile) reads them
-    back."""
+    vertex properties (``name``, or ``name_0 .. name_c-1``; doubles, integers as int),
+    which VTK's PLY writer would drop (it keeps only colours and texture coordinates)."""
     columns = [("x", "<f8", mesh.vertices[:, 0]), ("y", "<f8", mesh.vertices[:, 1])]
     columns.append(("z", "<f8", mesh.vertices[:, 2]))
     for name, values in arrays.items():

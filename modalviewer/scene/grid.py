@@ -83,12 +83,11 @@ def padded(img: np.ndarray, total) -> np.ndarray:
 
 
 def mode_grid(viewer, modes, operator: str | None = None, grid=None, size=GRID_PANEL):
-    """The picture (RGB uint8) of ``modes`` of ``operator`` (default: the one shown)
-    of ``viewer``'s mesh: panels of ``size`` pixels in a ``grid`` (columns, rows),
-    each drawn as the viewer draws the mode (deformed over its ghost for the 3D shells)
-    from one camera (the picture's direction, fitted to every panel's shape), captioned
-    "mode j: lambda = ...", and one colour bar: every panel coloured over the same range,
-    the largest |value| of the modes shown.  The viewer's display is restored after."""
+    """The picture (RGB uint8) of ``modes`` of ``operator`` (default: the one shown) of
+    ``viewer``'s mesh: panels of ``size`` pixels in a ``grid`` (columns, rows), each
+    drawn as the viewer draws the mode, from one camera fitted to every panel, captioned
+    "mode j: lambda = ...", coloured over one range (the largest |value| shown) with one
+    colour bar.  The viewer's display is restored after."""
     from ..core.operators import operator_info
     from .comparison import caption
     from .export import grab
