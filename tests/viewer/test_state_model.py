@@ -286,6 +286,32 @@ def test_events_fire_once_per_change(model):
     assert seen == ["style", "display"]
 
 
+def test_the_style_fields_are_validated_when_set_and_say_so_once():
+    from modalviewer.viewer import Viewer
+    from modalviewer.viewer.state import ViewerState
+
+    viewer = Viewer()
+    assert isinstance(viewer, ViewerModel) and isinstance(viewer.state, ViewerState)
+    style, seen = viewer.state.style, []
+    viewer.state.events.style.connect(lambda: seen.append("style"))
+    style.isolines = 99
+    assert style.isolines == 60 and seen == ["style"]  # clipped to 0..60
+    style.isolines = -3
+    assert style.isolines == 0 and len(seen) == 2
+    style.shell_coloring = "auto"  # the former name of the deformed shape
+    assert style.shell_coloring == "deformed" and len(seen) == 2  # unchanged: no event
+    with pytest.raises(ValueError, match="colouring must be one of"):
+        style.shell_coloring = "wavy"
+    with pytest.raises(ValueError, match="render style must be one of"):
+        style.render = "cartoon"
+    assert (style.shell_coloring, style.render, len(seen)) == ("deformed", "paper", 2)
+    style.ghost = 0
+    assert style.ghost is False and len(seen) == 3
+    viewer.state.set_color_range("limits", (0.0, 2.0))  # range and limits: one event
+    assert (style.color_range, style.color_limits, len(seen)) == ("limits", (0.0, 2.0), 4)
+    viewer.close()
+
+
 def test_a_new_spectrum_of_an_operator_replaces_its_other_keys(model):
     """Every k used to stay in memory (3.0 GB after 18 requests at 130k) and in saved
     sessions, with one of them shown."""
