@@ -33,6 +33,27 @@ def _mesh_stem(win) -> str:
     return Path(path).stem if path is not None else "mesh"
 
 
+def _picture_folder(win) -> str:
+    """Where the last picture went, else the mesh's folder (:func:`_mesh_folder`)."""
+    return str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+
+
+def _save(win, what: str, write, say=None, **remember) -> Path | None:
+    """Run ``write()`` and say the file it wrote (by ``say``, default the status bar), or
+    that the ``what`` could not be saved (by ``say``, default an error message); then
+    remember the settings ``remember`` (key: value) where the window remembers them."""
+    try:
+        out = write()
+    except (OSError, ValueError) as exc:
+        (say or win.show_error)(f"Could not save the {what}: {exc}")
+        return None
+    if win.remember_settings:
+        for key, value in remember.items():
+            win.settings.setValue(f"files/{key}", value)
+    (say or (lambda text: win.statusBar().showMessage(text, 8000)))(f"Saved {out}")
+    return out
+
+
 def open_mesh_dialog(win) -> None:
     start = str(win.settings.value("files/last_dir", str(ASSETS)))
     patterns = " ".join(f"*{e}" for e in SUPPORTED_EXTENSIONS)
@@ -53,22 +74,20 @@ def _saved_size(win, key: str, default) -> tuple[int, int]:
 
 
 def screenshot_dialog(win) -> None:
-    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    start = _picture_folder(win)
     size = _saved_size(win, "files/screenshot_size", (1024, 768))
     marker = win.viewer.marker_shown()
     dialog = ScreenshotDialog(win, start, win.state.style.colorbar, size, marker)
     if dialog.exec() != QtWidgets.QDialog.DialogCode.Accepted:
         return
     path, scale, transparent, colorbar, size, marker = dialog.values()
-    try:
-        out = win.export_screenshot(path, scale, transparent, colorbar, size=size, marker=marker)
-    except (OSError, ValueError) as exc:
-        win.show_error(f"Could not save the screenshot: {exc}")
-        return
-    if win.remember_settings:
-        win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
-        win.settings.setValue("files/screenshot_size", f"{size[0]}x{size[1]}")
-    win.statusBar().showMessage(f"Saved {out}", 8000)
+    _save(
+        win,
+        "screenshot",
+        lambda: win.export_screenshot(path, scale, transparent, colorbar, size, marker),
+        screenshot_dir=str(Path(path).parent),
+        screenshot_size=f"{size[0]}x{size[1]}",
+    )
 
 
 def animation_dialog(win) -> None:
@@ -79,7 +98,7 @@ def animation_dialog(win) -> None:
     if d.kind != "mode" or win.state.spectrum(d.operator) is None:
         win.show_error("Show a vibration mode first: an animation shows a mode vibrating.")
         return
-    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    start = _picture_folder(win)
     size = _saved_size(win, "files/animation_size", ANIMATION_SIZE)
     frames = period_frames(win.state.animation.speed, DEFAULT_FPS)
     dialog = AnimationDialog(win, start, size, frames, DEFAULT_FPS)
@@ -88,15 +107,13 @@ def animation_dialog(win) -> None:
     path, size, frames, fps = dialog.values()
     win.statusBar().showMessage(f"Writing {Path(path).name} ({frames} frames)...")
     QtWidgets.QApplication.processEvents()
-    try:
-        out = win.viewer.export_animation(path, frames=frames, fps=fps, size=size)
-    except (OSError, ValueError) as exc:
-        win.show_error(f"Could not save the animation: {exc}")
-        return
-    if win.remember_settings:
-        win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
-        win.settings.setValue("files/animation_size", f"{size[0]}x{size[1]}")
-    win.statusBar().showMessage(f"Saved {out}", 8000)
+    _save(
+        win,
+        "animation",
+        lambda: win.viewer.export_animation(path, frames=frames, fps=fps, size=size),
+        screenshot_dir=str(Path(path).parent),
+        animation_size=f"{size[0]}x{size[1]}",
+    )
 
 
 def window_screenshot_dialog(window, name: str, title: str) -> None:
@@ -105,7 +122,7 @@ def window_screenshot_dialog(window, name: str, title: str) -> None:
     their on-screen size with legends and colour bars), starting where the main window's
     screenshots go; the result is said in the window's status line, or the main one's."""
     win = window.main
-    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
+    start = _picture_folder(win)
     dialog = ScreenshotDialog(window, start, size=None, marker=None)
     dialog.setWindowTitle(title)
     dialog.path_edit.setText(str(Path(start) / name))
@@ -114,21 +131,9 @@ def window_screenshot_dialog(window, name: str, title: str) -> None:
         return
     path, scale, transparent, _, _, _ = dialog.values()
     status = getattr(window, "status", None)
-
-    def say(text: str) -> None:
-        if status is not None:
-            status.setText(text)
-        else:
-            win.statusBar().showMessage(text, 8000)
-
-    try:
-        out = window.export_screenshot(path, scale, transparent)
-    except (OSError, ValueError) as exc:
-        say(f"Could not save the screenshot: {exc}")
-        return
-    if win.remember_settings:
-        win.settings.setValue("files/screenshot_dir", str(Path(path).parent))
-    say(f"Saved {out}")
+    say = status.setText if status is not None else lambda t: win.statusBar().showMessage(t, 8000)
+    write = lambda: window.export_screenshot(path, scale, transparent)  # noqa: E731
+    _save(win, "screenshot", write, say, screenshot_dir=str(Path(path).parent))
 
 
 def pair_screenshot_dialog(pair_window) -> None:
@@ -146,10 +151,7 @@ def field_dialog(win) -> None:
         "VTK PolyData (*.vtp);;PLY (*.ply)",
     )
     if path:
-        try:
-            win.export_field(path)
-        except (OSError, ValueError) as exc:
-            win.show_error(f"Could not export the field: {exc}")
+        _save(win, "field", lambda: win.export_field(path))
 
 
 def spectrum_to_export(state):
@@ -171,15 +173,12 @@ def spectrum_dialog(win) -> None:
     folder = Path(win.state.mesh_path).parent if win.state.mesh_path else Path.cwd()
     path, _ = QtWidgets.QFileDialog.getSaveFileName(
         win,
-        f"Export spectrum: {operator_info(spec.operator).label}",
+        f"Export spectrum: {spec.operator_info.label}",
         str(folder / f"{spec.operator}.npz"),
         "NumPy (*.npz)",
     )
     if path:
-        try:
-            save_spectrum(spec, path)
-        except OSError as exc:
-            win.show_error(f"Could not save the spectrum: {exc}")
+        _save(win, "spectrum", lambda: save_spectrum(spec, path) or path)
 
 
 def update_cache_label(win) -> None:
@@ -210,12 +209,7 @@ def save_session_dialog(win) -> None:
         "Session (*.json)",
     )
     if path:
-        try:
-            out = win.save_session(path)
-        except (OSError, ValueError) as exc:
-            win.show_error(f"Could not save the session: {exc}")
-            return
-        win.statusBar().showMessage(f"Saved {out}", 8000)
+        _save(win, "session", lambda: win.save_session(path))
 
 
 def open_session_dialog(win) -> None:
@@ -253,15 +247,8 @@ def mode_grid_dialog(win) -> None:
     except argparse.ArgumentTypeError as exc:
         win.show_error(str(exc))
         return
-    start = str(win.settings.value("files/screenshot_dir", str(_mesh_folder(win))))
     path, _ = QtWidgets.QFileDialog.getSaveFileName(
-        win, "Export mode grid", str(Path(start) / "modes.png"), "PNG (*.png)"
+        win, "Export mode grid", str(Path(_picture_folder(win)) / "modes.png"), "PNG (*.png)"
     )
-    if not path:
-        return
-    try:
-        out = win.viewer.export_mode_grid(path, modes, operator)
-    except (OSError, ValueError) as exc:
-        win.show_error(f"Could not save the mode grid: {exc}")
-        return
-    win.statusBar().showMessage(f"Saved {out}", 8000)
+    if path:
+        _save(win, "mode grid", lambda: win.viewer.export_mode_grid(path, modes, operator))

@@ -145,15 +145,8 @@ STYLE_TOGGLES = (
     ),
 )
 
-CAMERA_PRESETS = (
-    ("+x", "From +X"),
-    ("-x", "From -X"),
-    ("+y", "From +Y"),
-    ("-y", "From -Y"),
-    ("+z", "From +Z"),
-    ("-z", "From -Z"),
-    ("isometric", "Isometric"),
-)
+AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
+CAMERA_PRESETS = (*((a, f"From {a.upper()}") for a in AXES), ("isometric", "Isometric"))
 
 
 def _follow_style(win, action, is_on):
@@ -313,15 +306,7 @@ def _up_axis_menu(win, menu) -> None:
     up = menu.addMenu("&Up axis")
     group = QtGui.QActionGroup(win)
     win.up_axis_actions = {}
-    for axis, label in (
-        (None, "&Automatic"),
-        ("+x", "+X"),
-        ("-x", "-X"),
-        ("+y", "+Y"),
-        ("-y", "-Y"),
-        ("+z", "+Z"),
-        ("-z", "-Z"),
-    ):
+    for axis, label in ((None, "&Automatic"), *((a, a.upper()) for a in AXES)):
         action = up.addAction(label)
         action.setCheckable(True)
         group.addAction(action)
