@@ -17,13 +17,12 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from ..core.files import atomic_write
-from ..core.operators import operator_info
 from ..core.spectrum import Spectrum
 
 STORE_FORMAT = "modalviewer-collection"
@@ -362,7 +361,13 @@ class Collection:
                 mesh, self.operator, self.k, self.info["bending"], self.info["membrane"]
             )
         else:
-            spectrum = _first_modes(spectrum, self.k)
+            k = self.k
+            spectrum = replace(
+                spectrum,
+                eigenvalues=spectrum.eigenvalues[:k],
+                modes=spectrum.modes[..., :k],
+                residuals=spectrum.residuals[:k],
+            )
         return shape_dna(spectrum, mesh.total_area), mesh.hash
 
     def spectrum_fits(self, spectrum: Spectrum | None) -> bool:
@@ -370,11 +375,10 @@ class Collection:
         least its k modes."""
         if spectrum is None or spectrum.operator != self.operator:
             return False
-        if spectrum.k < min(
-            self.k, spectrum.n_vertices * operator_info(self.operator).unknowns_per_vertex
-        ):
+        info = spectrum.operator_info
+        if spectrum.k < min(self.k, spectrum.n_vertices * info.unknowns_per_vertex):
             return False
-        if operator_info(self.operator).has_weights:
+        if info.has_weights:
             for weight in ("bending", "membrane"):
                 if float(spectrum.parameters.get(weight, 1.0)) != float(self.info[weight]):
                     return False
@@ -411,18 +415,6 @@ class Collection:
         ranked.sort()
         ranked = [(name, d) for _, d, name in ranked]
         return ranked if n is None else ranked[: max(0, int(n))]
-
-
-def _first_modes(spec: Spectrum, k: int) -> Spectrum:
-    return Spectrum(
-        eigenvalues=spec.eigenvalues[:k],
-        modes=spec.modes[..., :k],
-        operator=spec.operator,
-        mass=spec.mass,
-        residuals=spec.residuals[:k],
-        mesh_hash=spec.mesh_hash,
-        parameters=spec.parameters,
-    )
 
 
 def open_collection(path: str | os.PathLike) -> Collection:
