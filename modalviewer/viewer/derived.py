@@ -496,9 +496,9 @@ class DerivedValues:
         state = self.state
         if state.mesh is None:
             return None
-        d = state.display
+        d, isolines = state.display, state.style.isolines
         plain = Field(np.zeros(state.mesh.n_vertices), "plain")
-        mark = wording.display_mark(state)
+        mark, legend = wording.display_mark(state), wording.legend(state, self)
         if d.kind == "mode":
             spec = state.spectrum(d.operator)
             if spec is None:
@@ -506,70 +506,38 @@ class DerivedValues:
             j = int(np.clip(d.mode, 0, spec.k - 1))
             scalar, disp = self.mode_fields(spec, j)
             magnitude = spec.is_vector and self.vector_coloring() == "magnitude"
+            deformation = self.deformation()
+            title = f"{operator_info(d.operator).short_label} mode {j}{mark}"
+            colormap = "sequential" if magnitude else "diverging"
             return self._ranged(
-                Field(
-                    scalar,
-                    "sequential" if magnitude else "diverging",
-                    isolines=state.style.isolines,
-                    displacement=disp,
-                    deformation=self.deformation(),
-                    ghost=state.style.ghost and self.deformation() > 0,
-                    title=f"{operator_info(d.operator).short_label} mode {j}{mark}",
-                    legend=wording.legend(state, self),
-                )
-            )
+                Field(scalar, colormap, isolines, disp, title=title, legend=legend,
+                      deformation=deformation, ghost=state.style.ghost and deformation > 0)
+            )  # fmt: skip
         if d.kind == "distance":
             dist = self.distance_map()
             if dist is None:
                 return plain
             name = DISTANCE_KINDS[d.distance_kind]
-            if d.distance_display == "threshold":
-                thr = self.threshold_value(dist)
-                return Field(
-                    dist,
-                    "threshold",
-                    threshold=thr,
-                    title=f"{name} < {thr:.3g}{mark}",
-                    legend=wording.legend(state, self),
-                    share_similar=self.surface_share(dist, thr),
-                )
-            return self._ranged(
-                Field(dist, "sequential", title=name + mark, legend=wording.legend(state, self))
-            )
+            if d.distance_display != "threshold":
+                return self._ranged(Field(dist, "sequential", title=name + mark, legend=legend))
+            thr = self.threshold_value(dist)
+            return Field(dist, "threshold", title=f"{name} < {thr:.3g}{mark}", legend=legend,
+                         share_similar=self.surface_share(dist, thr), threshold=thr)  # fmt: skip
         if d.kind == "signature":
             operator = operator_for_distance(d.distance_kind)
             if not self.has_signatures(operator):
                 return plain
             t = self.signature_time()
-            values = self.signature_values(operator, t, signature_kind(d.distance_kind))[:, None]
-            return self._ranged(
-                Field(
-                    values[:, 0],
-                    "sequential",
-                    isolines=state.style.isolines,
-                    title=f"signature {'E' if self.wave() else 't'} = {t:.3g}{mark}",
-                    legend=wording.legend(state, self),
-                )
-            )
+            values = self.signature_values(operator, t, signature_kind(d.distance_kind))
+            title = f"signature {'E' if self.wave() else 't'} = {t:.3g}{mark}"
+            return self._ranged(Field(values, "sequential", isolines, title=title, legend=legend))
         if d.kind == "curvature":
             return self._ranged(
-                Field(
-                    self.curvature(),
-                    "sequential",
-                    title="curvature",
-                    legend=wording.legend(state, self),
-                )
+                Field(self.curvature(), "sequential", title="curvature", legend=legend)
             )
         if d.kind == "field" and d.field in state.fields:
             values = state.fields[d.field]
             signed = float(values.min()) < 0.0 < float(values.max())
-            return self._ranged(
-                Field(
-                    values,
-                    "diverging" if signed else "sequential",
-                    isolines=state.style.isolines,
-                    title=d.field,
-                    legend=wording.legend(state, self),
-                )
-            )
+            colormap = "diverging" if signed else "sequential"
+            return self._ranged(Field(values, colormap, isolines, title=d.field, legend=legend))
         return plain
