@@ -55,7 +55,7 @@ READING_DIALOG_S = 0.8
 FROM_VIEWER = frozenset(
     "compute cancel_computation set_mesh show_mode step_mode show_distance distance_map "
     "set_threshold show_signature show_curvature export_screenshot current_field "
-    "export_field fix_slivers_and_retry clear_cache save_session mesh spectra picked "
+    "export_field fix_slivers_and_retry clear_cache save_session spectra picked "
     "last_distance sliver_failure".split()
 )
 """What the window passes on to its :class:`~modalviewer.viewer.Viewer` unchanged, so a
@@ -489,6 +489,10 @@ class MainWindow(QtWidgets.QMainWindow):
         return notes
 
     # ==================================================== read-only views
+    @property
+    def mesh(self) -> Mesh | None:
+        return self.state.mesh
+
     @property
     def scene(self):
         return self.scene_view.scene
