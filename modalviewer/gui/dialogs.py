@@ -7,6 +7,8 @@ from pathlib import Path
 
 from qtpy import QtWidgets
 
+from .panels.common import row, spin_box
+
 
 def file_message(path, message: str) -> str:
     """``message`` about the file ``path``, naming the file (prefixed unless it does)."""
@@ -64,20 +66,9 @@ def offer_open_anyway(window, path, error: Exception) -> bool:
 
 def _size_boxes(form, size) -> tuple:
     """Width and height spin boxes (pixels) on one row of ``form``, set to ``size``."""
-    boxes = []
-    row = QtWidgets.QHBoxLayout()
-    for value in size:
-        box = QtWidgets.QSpinBox()
-        box.setRange(16, 8192)
-        box.setValue(int(value))
-        box.setSuffix(" px")
-        boxes.append(box)
-    row.addWidget(boxes[0])
-    row.addWidget(QtWidgets.QLabel("x"))
-    row.addWidget(boxes[1])
-    row.addStretch(1)
-    form.addRow("Width x height", row)
-    return tuple(boxes)
+    width, height = (spin_box(16, 8192, value, suffix=" px") for value in size)
+    form.addRow("Width x height", row(width, "x", height, 1))
+    return width, height
 
 
 class _ExportDialog(QtWidgets.QDialog):
@@ -93,10 +84,7 @@ class _ExportDialog(QtWidgets.QDialog):
         self.path_edit.setMinimumWidth(420)
         browse = QtWidgets.QPushButton("...")
         browse.clicked.connect(self._browse)
-        row = QtWidgets.QHBoxLayout()
-        row.addWidget(self.path_edit)
-        row.addWidget(browse)
-        self.form.addRow("File", row)
+        self.form.addRow("File", row(self.path_edit, browse))
 
     def _finish(self) -> None:
         buttons = QtWidgets.QDialogButtonBox(
@@ -128,8 +116,7 @@ class ScreenshotDialog(_ExportDialog):
         self.width_box = self.height_box = None
         if size is not None:
             self.width_box, self.height_box = _size_boxes(form, size)
-        self.scale = QtWidgets.QSpinBox()
-        self.scale.setRange(1, 8)
+        self.scale = spin_box(1, 8)
         self.transparent = QtWidgets.QCheckBox("Transparent background")
         self.colorbar = QtWidgets.QCheckBox("Colour bar and legend")
         self.colorbar.setChecked(colorbar)
@@ -171,12 +158,8 @@ class AnimationDialog(_ExportDialog):
         super().__init__(parent, "Export animation", Path(start_dir) / "mode.gif", filters)
         form = self.form
         self.width_box, self.height_box = _size_boxes(form, size)
-        self.frames = QtWidgets.QSpinBox()
-        self.frames.setRange(2, 1000)
-        self.frames.setValue(int(frames))
-        self.fps = QtWidgets.QSpinBox()
-        self.fps.setRange(1, 100)
-        self.fps.setValue(int(fps))
+        self.frames = spin_box(2, 1000, frames)
+        self.fps = spin_box(1, 100, fps)
         form.addRow("Frames in one period", self.frames)
         form.addRow("Frames per second", self.fps)
         if not mp4_available():

@@ -22,7 +22,7 @@ from ..viewer.camera import Camera, CameraLink
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from ..viewer.wording import seconds_text
-from .panels.common import quiet, select_data
+from .panels.common import quiet, row, select_data, slider, spin_box
 from .viewport import make_viewport, save_views
 from .window_keys import dispatch_key, install_keys
 
@@ -49,19 +49,6 @@ LINK_TIP = "Turning or zooming one view turns the other the same way (each about
 def _tip(widget, text: str):
     widget.setToolTip(text)
     return widget
-
-
-def _row(*items) -> QtWidgets.QHBoxLayout:
-    """A row of widgets; a number is a stretch, (widget, n) a widget stretched n."""
-    row = QtWidgets.QHBoxLayout()
-    for item in items:
-        if isinstance(item, int):
-            row.addStretch(item)
-        elif isinstance(item, tuple):
-            row.addWidget(*item)
-        else:
-            row.addWidget(item)
-    return row
 
 
 class PairError(RuntimeError):
@@ -111,13 +98,11 @@ class PairWindow(QtWidgets.QWidget):
         self.display_combo.currentIndexChanged.connect(
             lambda: p.set_display(self.display_combo.currentData())
         )
-        self.share_slider = _tip(QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal), SHARE_TIP)
-        self.share_slider.setRange(1, 500)  # tenths of a percent of the other mesh's area
+        self.share_slider = slider(1, 500, SHARE_TIP)  # tenths of a percent of the other's area
         self.share_slider.valueChanged.connect(lambda v: p.set_display("threshold", v / 1000))
         self.share_label = QtWidgets.QLabel()
         self.share_label.setMinimumWidth(150)
-        self.k_spin = _tip(QtWidgets.QSpinBox(), "Modes computed on each mesh (the same on both)")
-        self.k_spin.setRange(2, 1000)
+        self.k_spin = spin_box(2, 1000, tip="Modes computed on each mesh (the same on both)")
         self.k_spin.setPrefix("k = ")
         self.k_spin.editingFinished.connect(lambda: p.set_k(self.k_spin.value()))
         self.rescale_check = _tip(
@@ -130,8 +115,8 @@ class PairWindow(QtWidgets.QWidget):
         export.clicked.connect(self._export_dialog)
         layout = QtWidgets.QVBoxLayout(self)
         controls = (self.kind_combo, self.display_combo, self.share_slider, self.share_label)
-        layout.addLayout(_row(QtWidgets.QLabel("Distance"), *controls, self.k_spin, 1, export))
-        layout.addLayout(_row(self.rescale_check, self.link_check, 1))
+        layout.addLayout(row("Distance", *controls, self.k_spin, 1, export))
+        layout.addLayout(row(self.rescale_check, self.link_check, 1))
         views = QtWidgets.QHBoxLayout()
         self.viewports, self.titles = {}, {}
         for side in SIDES:
@@ -155,7 +140,7 @@ class PairWindow(QtWidgets.QWidget):
         self.cancel_button.clicked.connect(p.cancel)
         for widget in (self.progress, self.cancel_button):
             widget.hide()
-        layout.addLayout(_row((self.status, 1), self.progress, self.cancel_button))
+        layout.addLayout(row((self.status, 1), self.progress, self.cancel_button))
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
         keys = [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]

@@ -76,13 +76,21 @@ class StateScene:
         self.field: Field | None = None
         self.outline_actor = None
         self._drawn = None  # (display, style, pick, spectra ids) the picture was drawn for
-        state.events.mesh.connect(self._on_mesh)
-        state.events.display.connect(self.redraw)
-        state.events.style.connect(self.redraw)
-        state.events.pick.connect(self._on_pick)
-        state.events.animation.connect(self._on_animation)
-        state.events.camera.connect(self._apply_camera)
-        state.events.up_axis.connect(self._on_up_axis)
+        for event, slot in self._connections():
+            event.connect(slot)
+
+    def _connections(self) -> tuple:
+        """(event of the state, slot) of every state change the picture follows."""
+        events = self.state.events
+        return (
+            (events.mesh, self._on_mesh),
+            (events.display, self.redraw),
+            (events.style, self.redraw),
+            (events.pick, self._on_pick),
+            (events.animation, self._on_animation),
+            (events.camera, self._apply_camera),
+            (events.up_axis, self._on_up_axis),
+        )
 
     # -------------------------------------------------------------- mesh
     def sync(self) -> None:
@@ -95,16 +103,7 @@ class StateScene:
 
     def close(self) -> None:
         """Stop observing the state and drop the actors."""
-        events = self.state.events
-        for event, slot in (
-            (events.mesh, self._on_mesh),
-            (events.display, self.redraw),
-            (events.style, self.redraw),
-            (events.pick, self._on_pick),
-            (events.animation, self._on_animation),
-            (events.camera, self._apply_camera),
-            (events.up_axis, self._on_up_axis),
-        ):
+        for event, slot in self._connections():
             event.disconnect(slot)
         if self.scene is not None:
             self.scene.remove()

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from qtpy import QtCore, QtWidgets
+from qtpy import QtWidgets
 
 from ...viewer.state import ViewerState
-from .common import quiet
+from .common import quiet, row, slider
 
 
 class AnimationPanel(QtWidgets.QWidget):
@@ -18,22 +18,17 @@ class AnimationPanel(QtWidgets.QWidget):
         self.play_button = QtWidgets.QPushButton("Play")
         self.play_button.setCheckable(True)
         self.play_button.setToolTip("Animate the mode (Space)")
-        self.amp_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-        self.amp_slider.setRange(0, 100)
-        self.amp_slider.setToolTip(
+        self.amp_slider = slider(
+            0,
+            100,
             "Largest displacement of the deformed shape and the animation: percent of a "
-            "quarter of the bounding-box diagonal (40: a tenth of the diagonal)"
+            "quarter of the bounding-box diagonal (40: a tenth of the diagonal)",
         )
-        self.speed_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-        self.speed_slider.setRange(1, 100)
-        self.speed_slider.setToolTip("Speed of the animation")
+        self.speed_slider = slider(1, 100, "Speed of the animation")
+        form.addRow("Amplitude", self.amp_slider)
         # Speed and Play share a row: the Modes dock shows the whole panel at the
         # default window size, under the spectrum plot
-        speed_row = QtWidgets.QHBoxLayout()
-        speed_row.addWidget(self.speed_slider, 1)
-        speed_row.addWidget(self.play_button)
-        form.addRow("Amplitude", self.amp_slider)
-        form.addRow("Speed", speed_row)
+        form.addRow("Speed", row((self.speed_slider, 1), self.play_button))
         self.play_button.toggled.connect(lambda on: state.set_animation(playing=on))
         self.amp_slider.valueChanged.connect(lambda v: state.set_animation(amplitude=v))
         self.speed_slider.valueChanged.connect(lambda v: state.set_animation(speed=v))

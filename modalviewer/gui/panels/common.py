@@ -68,6 +68,41 @@ class WrappingLabel(QtWidgets.QLabel):
         self.setMinimumHeight(needed if needed > 0 else kept)
 
 
+def slider(low: int, high: int, tip: str = "") -> QtWidgets.QSlider:
+    """A horizontal slider over ``low`` .. ``high`` with the tooltip ``tip``."""
+    widget = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
+    widget.setRange(low, high)
+    widget.setToolTip(tip)
+    return widget
+
+
+def spin_box(low, high, value=None, tip: str = "", suffix: str = "") -> QtWidgets.QSpinBox:
+    """A whole-number box over ``low`` .. ``high`` set to ``value`` (if given)."""
+    box = QtWidgets.QSpinBox()
+    box.setRange(low, high)
+    if value is not None:
+        box.setValue(int(value))
+    box.setToolTip(tip)
+    box.setSuffix(suffix)
+    return box
+
+
+def row(*items) -> QtWidgets.QHBoxLayout:
+    """A row of widgets; a number is a stretch, (widget, n) a widget stretched n, a
+    string a label."""
+    layout = QtWidgets.QHBoxLayout()
+    for item in items:
+        if isinstance(item, int):
+            layout.addStretch(item)
+        elif isinstance(item, str):
+            layout.addWidget(QtWidgets.QLabel(item))
+        elif isinstance(item, tuple):
+            layout.addWidget(*item)
+        else:
+            layout.addWidget(item)
+    return layout
+
+
 def select_data(box: QtWidgets.QComboBox, data) -> None:
     index = box.findData(data)
     if index >= 0 and index != box.currentIndex():

@@ -12,7 +12,7 @@ from ...core.operators import (
 )
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
-from .common import WrappingLabel, combo, quiet, select_data
+from .common import WrappingLabel, combo, quiet, row, select_data, slider
 
 SLIDER_STEPS = 1000
 
@@ -40,9 +40,7 @@ class DistancesPanel(QtWidgets.QWidget):
         self.display_combo = combo()
         self.display_combo.addItem("Continuous (white to red)", "continuous")
         self.display_combo.addItem("Threshold (blue = similar)", "threshold")
-        self.threshold_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-        self.threshold_slider.setRange(1, SLIDER_STEPS)
-        self.threshold_slider.setToolTip("Threshold of the blue (similar) region")
+        self.threshold_slider = slider(1, SLIDER_STEPS, "Threshold of the blue (similar) region")
         self.by_share_check = QtWidgets.QCheckBox("Slider by share of surface")
         self.by_share_check.setChecked(True)
         self.by_share_check.setToolTip(
@@ -71,9 +69,7 @@ class DistancesPanel(QtWidgets.QWidget):
         form.addRow(self.range_label)
         form.addRow(self.pick_label)
         form.addRow(self.distance_button)
-        self.scale_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-        self.scale_slider.setRange(0, 99)
-        self.scale_slider.setToolTip("Show the signature at this scale")
+        self.scale_slider = slider(0, 99, "Show the signature at this scale")
         form.addRow("Signature at scale", self.scale_slider)
         self.scale_edit = QtWidgets.QLineEdit()
         self.scale_edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
@@ -83,11 +79,8 @@ class DistancesPanel(QtWidgets.QWidget):
         )
         self.log_check = QtWidgets.QCheckBox("Log colours")
         self.log_check.setToolTip("Colour the signature by log10(S / smallest S)")
-        scale_row = QtWidgets.QHBoxLayout()
-        scale_row.addWidget(self.scale_edit, 1)
-        scale_row.addWidget(self.log_check)
-        self.scale_row = scale_row
-        form.addRow("t", scale_row)
+        self.scale_row = row((self.scale_edit, 1), self.log_check)
+        form.addRow("t", self.scale_row)
         self.signature_plot = LinePlot("Signature of the picked vertex", "t (log)", "S_t")
         form.addRow(self.signature_plot)
 

@@ -9,7 +9,7 @@ from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
 from ...viewer.wording import approximation_mark, arrival_note
 from ..plots import LinePlot
-from .common import WrappingLabel, combo, describe, quiet, select_data
+from .common import WrappingLabel, combo, describe, quiet, row, select_data, slider, spin_box
 
 
 class ModesPanel(QtWidgets.QWidget):
@@ -22,18 +22,10 @@ class ModesPanel(QtWidgets.QWidget):
         lay = QtWidgets.QVBoxLayout(self)
         self.spectrum_combo = combo()
         describe(self.spectrum_combo, "The computed spectrum whose modes are shown")
-        row = QtWidgets.QHBoxLayout()
-        row.addWidget(QtWidgets.QLabel("Spectrum"))
-        row.addWidget(self.spectrum_combo, 1)
-        lay.addLayout(row)
-        row = QtWidgets.QHBoxLayout()
-        self.mode_slider = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-        self.mode_slider.setToolTip("Mode index (arrow keys step while the slider has focus)")
+        lay.addLayout(row("Spectrum", (self.spectrum_combo, 1)))
+        self.mode_slider = slider(0, 0, "Mode index (arrow keys step while the slider has focus)")
         self.mode_spin = QtWidgets.QSpinBox()
-        row.addWidget(QtWidgets.QLabel("Mode"))
-        row.addWidget(self.mode_slider, 1)
-        row.addWidget(self.mode_spin)
-        lay.addLayout(row)
+        lay.addLayout(row("Mode", (self.mode_slider, 1), self.mode_spin))
         self.eigen_label = WrappingLabel("No spectrum yet.")
         lay.addWidget(self.eigen_label)
         self.spectrum_plot = LinePlot("Spectrum", "mode index", "\u03bb")
@@ -60,9 +52,7 @@ class ModesPanel(QtWidgets.QWidget):
                 self.color_combo.count() - 1, tip, QtCore.Qt.ItemDataRole.ToolTipRole
             )
         describe(self.color_combo, "How 3D vibration modes are shown")
-        self.iso_spin = QtWidgets.QSpinBox()
-        self.iso_spin.setRange(0, 60)
-        self.iso_spin.setToolTip("Number of isolines (0: none)")
+        self.iso_spin = spin_box(0, 60, tip="Number of isolines (0: none)")
         form.addRow("Show 3D modes as", self.color_combo)
         form.addRow("Isolines", self.iso_spin)
         lay.addLayout(form)
