@@ -48,6 +48,15 @@ than the first, drawn at :data:`GHOST_OPACITY` from the second, linearly between
 the rest shape it would only add grey rims along the outline)."""
 
 
+def add_actor(plotter, data, name: str, **options):
+    """``plotter.add_mesh`` of an actor beside the surface: no render, the camera kept,
+    no scalar bar of pyvista's own, one colour unless ``options`` give scalars."""
+    options = {"scalars": None, **options}
+    return plotter.add_mesh(
+        data, name=name, render=False, reset_camera=False, show_scalar_bar=False, **options
+    )
+
+
 class MeshScene:
     """Owns the actors of one mesh on a pyvista plotter."""
 
@@ -258,19 +267,10 @@ class MeshScene:
             return None, None
         lines.copy_from(line_polydata(seg, disp), deep=False)
         if actor is None:
-            actor = self.plotter.add_mesh(
-                lines,
-                color="black",
-                line_width=width,
-                # drawn as screen-space tubes: plain wide lines leave gaps between the
-                # sub-pixel segments of fine meshes (the isolines would look dotted)
-                render_lines_as_tubes=True,
-                name=attr,
-                render=False,
-                reset_camera=False,
-                show_scalar_bar=False,
-                scalars=None,
-            )
+            # drawn as screen-space tubes: plain wide lines leave gaps between the
+            # sub-pixel segments of fine meshes (the isolines would look dotted)
+            tubes = {"render_lines_as_tubes": True}
+            actor = add_actor(self.plotter, lines, attr, color="black", line_width=width, **tubes)
             setattr(self, attr, actor)
         actor.SetVisibility(True)
         # copies: the animation writes into the line points in place
@@ -518,15 +518,13 @@ class MeshScene:
             rgba[:, :3] = np.round(np.asarray(GHOST_GREY) * 255).astype(np.uint8)
             rest.point_data["ghost_rgba"] = rgba  # the opacities follow the mode shown
             self._ghost_rest = rest
-            self.ghost_actor = self.plotter.add_mesh(
+            self.ghost_actor = add_actor(
+                self.plotter,
                 rest,
+                "ghost",
                 scalars="ghost_rgba",
                 rgba=True,
                 interpolation="phong",
-                name="ghost",
-                render=False,
-                reset_camera=False,
-                show_scalar_bar=False,
                 pickable=False,
             )
             # at the back of the depth range (GHOST_DEPTH_OFFSET): the surface always
@@ -599,16 +597,7 @@ class MeshScene:
             return
         radius = size * self.mesh.bounding_box_diagonal
         sphere = pv.Sphere(radius=radius, center=self.surface.points[vertex])
-        actor = self.plotter.add_mesh(
-            sphere,
-            color=color,
-            name=name,
-            render=False,
-            reset_camera=False,
-            show_scalar_bar=False,
-            scalars=None,
-        )
-        setattr(self, attr, actor)
+        setattr(self, attr, add_actor(self.plotter, sphere, name, color=color))
 
     def remove(self) -> None:
         for name in ("surface", "iso_actor", "zero_actor", "marker", "back_marker", "ghost"):

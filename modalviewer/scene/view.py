@@ -16,7 +16,7 @@ import numpy as np
 from ..viewer import wording
 from ..viewer.derived import Field
 from ..viewer.state import ViewerState
-from .mesh_scene import MeshScene
+from .mesh_scene import MeshScene, add_actor
 
 
 def draw_field(scene: MeshScene, field: Field | None) -> None:
@@ -203,14 +203,8 @@ class StateScene:
             return
         cells = np.column_stack([np.full(len(boundary), 2), boundary]).ravel()
         lines = pv.PolyData(np.asarray(mesh.vertices, dtype=np.float64), lines=cells)
-        self.outline_actor = self.plotter.add_mesh(
-            lines,
-            color=(0.45, 0.45, 0.45),
-            line_width=1.5,
-            name="outline",
-            render=False,
-            reset_camera=False,
-            show_scalar_bar=False,
+        self.outline_actor = add_actor(
+            self.plotter, lines, "outline", color=(0.45, 0.45, 0.45), line_width=1.5
         )
 
     def _on_pick(self) -> None:
