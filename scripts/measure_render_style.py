@@ -15,7 +15,6 @@ import argparse
 import os
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -40,7 +39,7 @@ def main() -> int:
     from benchmarks.render_metrics import saturation, white_level, zero_band_masks
     from modalviewer.core.laplacian import vertex_normals
     from modalviewer.scene.colors import STYLES
-    from modalviewer.scene.export import save_screenshot
+    from modalviewer.scene.export import grab, save_png
     from modalviewer.scene.mesh_scene import MeshScene
 
     out = Path(args.out) if args.out else Path(os.environ.get("TMPDIR", "/tmp"))
@@ -51,7 +50,6 @@ def main() -> int:
         plotter = pv.Plotter(off_screen=True, window_size=(w, h))
         plotter.set_background("white")
         plotter.show(auto_close=False, interactive=False)
-        view = SimpleNamespace(plotter=plotter)
         scene = MeshScene(plotter, mesh, vertex_normals(mesh))
         scene.reset_camera()
         for j in args.modes:
@@ -59,7 +57,7 @@ def main() -> int:
             for style in STYLES:
                 scene.set_style(style)
                 scene.show_field(field, "diverging", isolines=0)
-                png = save_screenshot(view, out / f"{Path(path).stem}_mode{j}_{style}.png")
+                png = save_png(out / f"{Path(path).stem}_mode{j}_{style}.png", grab(plotter))
                 img = np.asarray(Image.open(png))[:, :, :3]
                 mesh_px, band = zero_band_masks(scene, field)
                 wl, sat = white_level(img, band), saturation(img, mesh_px)

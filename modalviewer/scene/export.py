@@ -101,25 +101,6 @@ def save_png(path, img: np.ndarray) -> Path:
     return path
 
 
-def save_screenshot(
-    viewport,
-    path: Path,
-    scale: int = 1,
-    transparent: bool = False,
-    legend: bool = True,
-    colorbar: bool | None = None,
-    scene=None,
-    marker: bool = True,
-) -> Path:
-    """Render the viewport's (or plotter's) view to a PNG at ``scale`` times its size,
-    with legend, colour bar and pick marker as :func:`grab` draws them; written
-    atomically."""
-    plotter = getattr(viewport, "plotter", viewport)
-    path = png_path(path)
-    img = grab(plotter, scene, scale, transparent, legend, colorbar, marker)
-    return save_png(path, img)
-
-
 def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Path:
     """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply, one point
     per input vertex in its order (NaN at vertices no face uses); a solver mesh of

@@ -45,9 +45,9 @@ def _scene(view, mesh, style="paper"):
 
 
 def _export(view, path, **kwargs):
-    from modalviewer.scene.export import save_screenshot
+    from modalviewer.scene.export import grab, save_png
 
-    out = save_screenshot(view, path, **kwargs)
+    out = save_png(path, grab(view.plotter, **kwargs))
     return np.asarray(Image.open(out))
 
 
