@@ -55,11 +55,8 @@ class CompareWindow(QtWidgets.QWidget):
             self.viewports.append(viewport)
             self.scenes.append(scene)
             self.titles.append(title)
-        for event in (self.state.events.pick, self.state.events.display, self.state.events.style):
+        for event in self._followed():  # also a spectrum replaced (another k, weights)
             event.connect(self.refresh)
-        # a spectrum replaced (another k, other weights) redraws the views
-        self.state.events.spectra.connect(self._on_spectra)
-        self.comparison.changed.connect(self.refresh)
         self._keys = install_keys(
             self,
             [
@@ -81,8 +78,10 @@ class CompareWindow(QtWidgets.QWidget):
         if not dispatch_key(self._keys, event):
             super().keyPressEvent(event)
 
-    def _on_spectra(self, _operator: str | None = None) -> None:
-        self.refresh()
+    def _followed(self) -> tuple:
+        """The events the views are redrawn on."""
+        events = self.state.events
+        return events.pick, events.display, events.style, events.spectra, self.comparison.changed
 
     def render_all(self) -> None:
         for viewport in self.viewports:
@@ -128,10 +127,8 @@ class CompareWindow(QtWidgets.QWidget):
         window_screenshot_dialog(self, "compare.png", "Export the comparison")
 
     def closeEvent(self, event):  # noqa: N802
-        for event_ in (self.state.events.pick, self.state.events.display, self.state.events.style):
-            event_.disconnect(self.refresh)
-        self.state.events.spectra.disconnect(self._on_spectra)
-        self.comparison.changed.disconnect(self.refresh)
+        for followed in self._followed():
+            followed.disconnect(self.refresh)
         for viewport in self.viewports:
             viewport.close_plotter()
         if self.main.compare is self:

@@ -171,18 +171,13 @@ class LinePlot(QtWidgets.QWidget):
         )
         self._draw_ylabel(p, rect)
         p.setPen(QtGui.QPen(QtGui.QColor(40, 90, 180), 1.5))
-        path = QtGui.QPainterPath(QtCore.QPointF(px[0], py[0]))
-        for a, b in zip(px[1:], py[1:], strict=True):
-            path.lineTo(a, b)
-        p.drawPath(path)
+        p.drawPolyline(QtGui.QPolygonF([QtCore.QPointF(a, b) for a, b in zip(px, py, strict=True)]))
         if self._second_py is not None and len(self._second_py) == len(px):
             pen = QtGui.QPen(QtGui.QColor(230, 120, 20), 1.5)
             pen.setStyle(QtCore.Qt.PenStyle.DashLine)
             p.setPen(pen)
-            second = QtGui.QPainterPath(QtCore.QPointF(px[0], self._second_py[0]))
-            for a, b in zip(px[1:], self._second_py[1:], strict=True):
-                second.lineTo(a, b)
-            p.drawPath(second)
+            points = zip(px, self._second_py, strict=True)
+            p.drawPolyline(QtGui.QPolygonF([QtCore.QPointF(a, b) for a, b in points]))
             p.drawText(rect.left() + 4, rect.bottom() - 4, self.second_label)
         if self.markers and len(px) <= 400:
             p.setBrush(QtGui.QColor(40, 90, 180))
