@@ -153,9 +153,9 @@ def distance_kind_of(spectrum: Spectrum | None, kind: str | None) -> str:
         return kind
     if spectrum is None:
         return "vibration"
-    from .core.operators import DISTANCE_KINDS, operator_info
+    from .core.operators import DISTANCE_KINDS
 
-    own = operator_info(spectrum.operator).distance_kind
+    own = spectrum.operator_info.distance_kind
     if own is None:
         raise ValueError(
             f"a {spectrum.operator} spectrum defines no distance; pass kind= (one of "

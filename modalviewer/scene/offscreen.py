@@ -7,8 +7,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 from .platform import prepare_offscreen
 from .view import StateScene
 
@@ -98,14 +96,7 @@ class OffscreenRenderer:
         (and the pick marker if ``marker``)."""
         from .export import grab
 
-        return grab(
-            self.plotter,
-            self.scene,
-            scale=scale,
-            transparent=transparent,
-            colorbar=colorbar,
-            marker=marker,
-        )
+        return grab(self.plotter, self.scene, scale, transparent, colorbar=colorbar, marker=marker)
 
     def screenshot(
         self,
@@ -118,8 +109,7 @@ class OffscreenRenderer:
         """Write the picture to a PNG (atomically); returns its path."""
         from .export import save_png
 
-        img = self.image(scale, transparent, colorbar, marker)
-        return save_png(path, np.ascontiguousarray(img))
+        return save_png(path, self.image(scale, transparent, colorbar, marker))
 
     def close(self) -> None:
         self.drawing.close()
