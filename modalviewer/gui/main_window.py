@@ -33,6 +33,7 @@ from .dialogs import ask, file_message, offer_open_anyway
 from .docks import build_docks
 from .pair_window import PairWindow, open_pair_window
 from .panels import AnimationPanel, ComputePanel, DistancesPanel, JobsPanel, ModesPanel
+from .panels.common import follow
 from .qt_dispatch import QtDispatcher
 from .scene_view import SceneView
 from .status_bar import StatusBarWidgets
@@ -158,12 +159,8 @@ class MainWindow(QtWidgets.QMainWindow):
         self._settings_timer.setSingleShot(True)
         self._settings_timer.setInterval(1000)
         self._settings_timer.timeout.connect(lambda: window_settings.save(self))
-        for event in (
-            self.state.events.compute_settings,
-            self.state.events.style,
-            self.state.events.animation,
-        ):
-            event.connect(lambda *_: self._settings_timer.start())
+        save_soon = lambda *_: self._settings_timer.start()  # noqa: E731
+        follow(self.state, save_soon, "compute_settings", "style", "animation")
         if self.state.mesh is not None:  # a viewer already in use: show what it shows
             self.scene_view.drawing.sync()
             self._on_mesh()

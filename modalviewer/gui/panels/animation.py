@@ -5,7 +5,7 @@ from __future__ import annotations
 from qtpy import QtWidgets
 
 from ...viewer.state import ViewerState
-from .common import quiet, row, slider
+from .common import follow, quiet, row, slider
 
 
 class AnimationPanel(QtWidgets.QWidget):
@@ -32,9 +32,7 @@ class AnimationPanel(QtWidgets.QWidget):
         self.play_button.toggled.connect(lambda on: state.set_animation(playing=on))
         self.amp_slider.valueChanged.connect(lambda v: state.set_animation(amplitude=v))
         self.speed_slider.valueChanged.connect(lambda v: state.set_animation(speed=v))
-        state.events.animation.connect(self.update_from_state)
-        state.events.display.connect(self.update_from_state)
-        state.events.mesh.connect(self.update_from_state)
+        follow(state, self.update_from_state, "animation", "display", "mesh")
         self.update_from_state()
 
     def update_from_state(self) -> None:

@@ -103,6 +103,12 @@ def row(*items) -> QtWidgets.QHBoxLayout:
     return layout
 
 
+def follow(state, slot, *names: str) -> None:
+    """Call ``slot`` on each of ``state``'s events ``names`` ("display", "mesh", ...)."""
+    for name in names:
+        getattr(state.events, name).connect(slot)
+
+
 def select_data(box: QtWidgets.QComboBox, data) -> None:
     index = box.findData(data)
     if index >= 0 and index != box.currentIndex():

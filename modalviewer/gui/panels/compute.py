@@ -7,7 +7,7 @@ from qtpy import QtCore, QtWidgets
 from ...core.operators import OPERATOR_INFO
 from ...viewer import wording
 from ...viewer.state import ViewerState
-from .common import WrappingLabel, combo, quiet, select_data
+from .common import WrappingLabel, combo, follow, quiet, select_data
 
 K_MAX = 1_000_000
 """The Modes k box's maximum: no limit a mesh could reach before the memory check."""
@@ -71,8 +71,7 @@ class ComputePanel(QtWidgets.QWidget):
         self.rescale_check.toggled.connect(lambda on: state.set_compute_settings(rescale=on))
         self.coarse_check.toggled.connect(lambda on: state.set_compute_settings(coarse=on))
         self.compute_button.clicked.connect(self.computeRequested)
-        state.events.compute_settings.connect(self.update_from_state)
-        state.events.mesh.connect(self.update_from_state)
+        follow(state, self.update_from_state, "compute_settings", "mesh")
         self.update_from_state()
 
     def update_from_state(self) -> None:

@@ -12,7 +12,7 @@ from ...core.operators import (
 )
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
-from .common import WrappingLabel, combo, quiet, row, select_data, slider
+from .common import WrappingLabel, combo, follow, quiet, row, select_data, slider
 
 SLIDER_STEPS = 1000
 
@@ -98,14 +98,7 @@ class DistancesPanel(QtWidgets.QWidget):
         )
         state.events.style.connect(self._update_log_check)
         state.events.signature_curve.connect(self._update_signature_plot)
-        for event in (
-            state.events.display,
-            state.events.pick,
-            state.events.spectra,
-            state.events.mesh,
-            state.events.scale_range,
-        ):
-            event.connect(self.update_from_state)
+        follow(state, self.update_from_state, "display", "pick", "spectra", "mesh", "scale_range")
         self.update_from_state()
 
     # ------------------------------------------------------------- input

@@ -9,7 +9,17 @@ from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
 from ...viewer.wording import approximation_mark, arrival_note
 from ..plots import LinePlot
-from .common import WrappingLabel, combo, describe, quiet, row, select_data, slider, spin_box
+from .common import (
+    WrappingLabel,
+    combo,
+    describe,
+    follow,
+    quiet,
+    row,
+    select_data,
+    slider,
+    spin_box,
+)
 
 
 class ModesPanel(QtWidgets.QWidget):
@@ -65,9 +75,7 @@ class ModesPanel(QtWidgets.QWidget):
             lambda _: setattr(state.style, "shell_coloring", self.color_combo.currentData())
         )
         self.iso_spin.valueChanged.connect(lambda n: setattr(state.style, "isolines", n))
-        events = state.events
-        for event in (events.display, events.spectra, events.mesh):
-            event.connect(self.update_from_state)
+        follow(state, self.update_from_state, "display", "spectra", "mesh")
         state.events.style.connect(self._update_style)
         self.update_from_state()
         self._update_style()

@@ -6,6 +6,7 @@ from qtpy import QtCore, QtGui, QtWidgets
 
 from ...viewer.state import ViewerState
 from ...viewer.wording import summary
+from .common import follow
 
 
 class StatusLine(QtWidgets.QLabel):
@@ -17,14 +18,7 @@ class StatusLine(QtWidgets.QLabel):
         # framed, so a temporary message to its left ("Computing ...") does not read as
         # the start of the same line
         self.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
-        for event in (
-            state.events.display,
-            state.events.pick,
-            state.events.spectra,
-            state.events.mesh,
-            state.events.style,
-        ):
-            event.connect(self.update_from_state)
+        follow(state, self.update_from_state, "display", "pick", "spectra", "mesh", "style")
         self.update_from_state()
 
     def update_from_state(self, *_args) -> None:
