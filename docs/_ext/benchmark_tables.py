@@ -380,7 +380,19 @@ def slicing_table(data: dict) -> str:
     return slicing.table(data)
 
 
+def out_of_core_threads_table(data: dict) -> str:
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks import out_of_core_threads
+
+    return out_of_core_threads.table(data)
+
+
 TABLES = {
+    "out-of-core-threads": (
+        ["out_of_core_threads"],
+        lambda: out_of_core_threads_table(load("out_of_core_threads")),
+    ),
     "first-modes": (["first_modes"], lambda: first_modes_table(load("first_modes"))),
     "slicing": (["slicing"], lambda: slicing_table(load("slicing"))),
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),

@@ -172,6 +172,16 @@ def has_vertex_blocks(A: sp.csr_matrix, size: int = 3) -> bool:
     return agree >= 0.9 * groups.size
 
 
+@contextmanager
+def _one_mkl_thread(lib):
+    """MKL on one thread in this thread for the duration (``mkl_set_num_threads_local``)."""
+    previous = lib.MKL_Set_Num_Threads_Local(ctypes.c_int(1))
+    try:
+        yield
+    finally:
+        lib.MKL_Set_Num_Threads_Local(ctypes.c_int(previous))
+
+
 class _Pardiso:
     """MKL PARDISO, real symmetric positive definite (mtype 2), upper triangle in CSR.
     The analysis (phase 11) tells the factor's in-core size (``in_core_mb``); above
@@ -307,7 +317,13 @@ class _Pardiso:
     def solve(self, b: np.ndarray) -> np.ndarray:
         one = b.ndim == 1
         B = np.asfortranarray(b.reshape(self.n, -1), dtype=self.dtype)
-        error, X = self._call(33, B)
+        if self.out_of_core:
+            # out of core, PARDISO's parallel substitution reads the factor file many
+            # times slower than one thread does (benchmarks/out_of_core_threads.py)
+            with _one_mkl_thread(self._lib):
+                error, X = self._call(33, B)
+        else:
+            error, X = self._call(33, B)
         if error != 0:
             raise np.linalg.LinAlgError(f"PARDISO solve failed (error {error})")
         return X[:, 0].copy() if one else X

@@ -59,6 +59,38 @@ def test_a_factor_over_the_budget_goes_to_a_file_and_solves_the_same(tmp_path, m
 
 
 @needs_pardiso
+def test_out_of_core_solves_run_on_one_mkl_thread_and_give_the_threads_back(tmp_path, monkeypatch):
+    """PARDISO's parallel substitution reads a factor file many times slower than one
+    thread (benchmarks/out_of_core_threads.py): an out-of-core solve runs on one MKL
+    thread, an in-core one on MKL's own count, and the count is the same after."""
+    monkeypatch.setenv("MODALVIEWER_FACTOR_DIR", str(tmp_path))
+    lib = factor_module._load_mkl()
+    A = _laplacian_3d(40)  # 64 000 unknowns
+    B = np.random.default_rng(1).standard_normal((A.shape[0], 3))
+    seen = []
+    real_call = factor_module._Pardiso._call
+
+    def call(self, phase, b):
+        if phase == 33:
+            seen.append((self.out_of_core, lib.MKL_Get_Max_Threads()))
+        return real_call(self, phase, b)
+
+    monkeypatch.setattr(factor_module._Pardiso, "_call", call)
+    previous = lib.MKL_Set_Num_Threads_Local(2)
+    try:
+        in_core = SPDSolver(A)
+        ooc = SPDSolver(A, memory_budget_mb=0.5 * in_core.factor_mb)
+        assert ooc.out_of_core and not in_core.out_of_core
+        X, X_ooc = in_core.solve(B), ooc.solve(B)
+        after = lib.MKL_Get_Max_Threads()
+    finally:
+        lib.MKL_Set_Num_Threads_Local(previous)
+    assert seen == [(False, 2), (True, 1)]
+    assert after == 2
+    np.testing.assert_allclose(X_ooc, X, rtol=0, atol=1e-12 * np.abs(X).max())
+
+
+@needs_pardiso
 def test_a_factor_stays_in_core_where_the_disk_has_no_room(tmp_path, monkeypatch):
     monkeypatch.setenv("MODALVIEWER_FACTOR_DIR", str(tmp_path))
 
