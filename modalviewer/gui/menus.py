@@ -68,6 +68,12 @@ def build_menus(win) -> None:
 
 
 _SEPARATOR = (None, None, None, None)
+PAIR_TIP = "Open mesh B beside this mesh: a click on one shows the similar points on the other"
+COLLECTION_TIP = (
+    "A store of 'modalviewer batch': its shapes nearest to this mesh; one opens beside it"
+)
+ANIMATION_TIP = "One period of the mode shown, vibrating as on screen"
+GRID_TIP = "Several modes side by side in one picture, one camera, one colour bar"
 
 
 def _file_menu(win, m) -> None:
@@ -75,35 +81,15 @@ def _file_menu(win, m) -> None:
     _action(win, m, "&Open mesh...", lambda: d.open_mesh_dialog(win), "Ctrl+O")
     win.recent_menu = m.addMenu("Open &recent")
     for text, slot, key, tip in (
-        (
-            "Open &second mesh (shape pair)...",
-            open_second_mesh_dialog,
-            "Ctrl+Shift+B",
-            "Open mesh B beside this mesh: a click on one shows the similar points on the other",
-        ),
-        (
-            "Open co&llection...",
-            open_collection_dialog,
-            None,
-            "A store of 'modalviewer batch': its shapes nearest to this mesh; one opens beside it",
-        ),
+        ("Open &second mesh (shape pair)...", open_second_mesh_dialog, "Ctrl+Shift+B", PAIR_TIP),
+        ("Open co&llection...", open_collection_dialog, None, COLLECTION_TIP),
         _SEPARATOR,
         ("Open s&ession...", d.open_session_dialog, "Ctrl+Shift+O", None),
         ("Save se&ssion...", d.save_session_dialog, "Ctrl+S", None),
         _SEPARATOR,
         ("Export &screenshot...", d.screenshot_dialog, "Ctrl+E", None),
-        (
-            "Export &animation (GIF/MP4)...",
-            d.animation_dialog,
-            None,
-            "One period of the mode shown, vibrating as on screen",
-        ),
-        (
-            "Export mode &grid...",
-            d.mode_grid_dialog,
-            None,
-            "Several modes side by side in one picture, one camera, one colour bar",
-        ),
+        ("Export &animation (GIF/MP4)...", d.animation_dialog, None, ANIMATION_TIP),
+        ("Export mode &grid...", d.mode_grid_dialog, None, GRID_TIP),
         ("Export per-vertex &field (PLY/VTP)...", d.field_dialog, "Ctrl+Shift+E", None),
         ("Export s&pectrum (.npz)...", d.spectrum_dialog, "Ctrl+Shift+S", None),
         _SEPARATOR,
@@ -120,37 +106,24 @@ def _file_menu(win, m) -> None:
     _action(win, m, "&Quit", win.close, "Ctrl+Q")
 
 
-# View menu toggles: (attribute of the window, text, key, setter, whether the style has it on)
 STYLE_TOGGLES = (
-    (
-        "colorbar_action",
-        "Colour &bar and legend",
-        "B",
-        lambda st, on: setattr(st.style, "colorbar", on),
-        lambda style: style.colorbar,
-    ),
-    (
-        "shaded_action",
-        "S&haded look (light kit, greyer)",
-        "Shift+S",
-        lambda st, on: setattr(st.style, "render", "shaded" if on else "paper"),
-        lambda style: style.render == "shaded",
-    ),
-    (
-        "ghost_action",
-        "Rest shape &ghost behind deformed modes",
-        "G",
-        lambda st, on: setattr(st.style, "ghost", on),
-        lambda style: style.ghost,
-    ),
+    # (attribute of the window, text, key, style field, its value when on, when off)
+    ("colorbar_action", "Colour &bar and legend", "B", "colorbar", True, False),
+    ("shaded_action", "S&haded look (light kit, greyer)", "Shift+S", "render", "shaded", "paper"),
+    ("ghost_action", "Rest shape &ghost behind deformed modes", "G", "ghost", True, False),
+)
+OPERATORS_COMPARED = ["laplacian", "modified_dirichlet", "shells_normal"]
+COMPARISONS = (  # View menu: (text, key, what is compared)
+    ("Compare &operators (Laplacian, E_D^N, shells normal)...", "Ctrl+1", OPERATORS_COMPARED),
+    ("Compare d&istances (vibration, heat kernel)...", "Ctrl+2", ["vibration", "hks"]),
 )
 
 AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 CAMERA_PRESETS = (*((a, f"From {a.upper()}") for a in AXES), ("isometric", "Isometric"))
 
 
-def _follow_style(win, action, is_on):
-    return lambda: action.setChecked(is_on(win.state.style))
+def _follow_style(win, action, field: str, on_value):
+    return lambda: action.setChecked(getattr(win.state.style, field) == on_value)
 
 
 def _view_menu(win, m) -> None:
@@ -163,11 +136,14 @@ def _view_menu(win, m) -> None:
     _action(win, m, "Show &mode", win.viewer.show_current_mode, "M")
     _action(win, m, "Show &distance", lambda: win.show_distance(), "D")
     _action(win, m, "Show &curvature sqrt(k1^2 + k2^2)", win.show_curvature, "C")
-    for attribute, text, key, setter, is_on in STYLE_TOGGLES:
-        action = _action(win, m, text, lambda on, f=setter: f(win.state, on), key)
+    for attribute, text, key, field, on_value, off_value in STYLE_TOGGLES:
+        values = (off_value, on_value)
+        slot = lambda on, f=field, v=values: setattr(win.state.style, f, v[bool(on)])  # noqa: E731
+        action = _action(win, m, text, slot, key)
         action.setCheckable(True)
-        action.setChecked(is_on(win.state.style))
-        win.state.events.style.connect(_follow_style(win, action, is_on))
+        follow = _follow_style(win, action, field, on_value)
+        follow()
+        win.state.events.style.connect(follow)
         setattr(win, attribute, action)
     build_color_range_menu(win, m.addMenu("Colour &range"))
     panels = m.addMenu("&Panels")
@@ -180,22 +156,9 @@ def _view_menu(win, m) -> None:
         _action(win, views, label, slot, f"Alt+{i + 1}")
     _up_axis_menu(win, m)
     m.addSeparator()
-    _action(
-        win,
-        m,
-        "Compare &operators (Laplacian, E_D^N, shells normal)...",
-        lambda: win.open_comparison(
-            ["laplacian", "modified_dirichlet", "shells_normal"], wait=False
-        ),
-        "Ctrl+1",
-    )
-    _action(
-        win,
-        m,
-        "Compare d&istances (vibration, heat kernel)...",
-        lambda: win.open_comparison(["vibration", "hks"], wait=False),
-        "Ctrl+2",
-    )
+    for text, key, items in COMPARISONS:
+        slot = lambda _=False, i=items: win.open_comparison(i, wait=False)  # noqa: E731
+        _action(win, m, text, slot, key)
 
 
 COLOR_RANGE_ITEMS = (
