@@ -50,14 +50,12 @@ def add_parsers(sub) -> None:
     where.add_argument(
         "--workers",
         type=whole(0),
-        default=None,
         metavar="N",
         help="a local Dask cluster of N worker processes (default: one per core); 0: one "
         "mesh after another in this process, without Dask",
     )
     where.add_argument(
         "--scheduler",
-        default=None,
         metavar="ADDRESS",
         help="an existing Dask scheduler, e.g. tcp://host:8786 (the workers must see the "
         "mesh paths and have modalviewer installed)",
@@ -65,7 +63,6 @@ def add_parsers(sub) -> None:
     b.add_argument(
         "--memory-limit",
         type=number(0.0, False),
-        default=None,
         metavar="GB",
         help="each local worker's memory limit (default: the machine's memory over the "
         "workers); tasks ask for their estimated memory out of it",

@@ -65,7 +65,6 @@ def add_parsers(sub) -> None:
         type=number(0.0, False, 1.0),
         nargs="?",
         const=DEFAULT_THRESHOLD_SHARE,
-        default=None,
         metavar="F",
         help="threshold map marking this share (0..1] of the surface's area similar, as the "
         f"viewer's threshold display (--share alone: {DEFAULT_THRESHOLD_SHARE:g}, the "
@@ -74,22 +73,19 @@ def add_parsers(sub) -> None:
     marked.add_argument(
         "--threshold",
         type=number(0.0, False),
-        default=None,
         metavar="D",
         help="threshold map at this absolute distance (marks where distance <= D)",
     )
     d.add_argument("--size", type=size, default=(1024, 768))
-    d.add_argument("-o", "--output", default=None, help="PNG of the distance map")
+    d.add_argument("-o", "--output", help="PNG of the distance map")
     add_camera_arguments(d)
     d.add_argument(
         "--csv",
-        default=None,
         help="write vertex,distance rows: one per vertex of the file, numbered as in the "
         "file, the distance empty where no face uses the vertex",
     )
     d.add_argument(
         "--to",
-        default=None,
         metavar="MESH_B",
         help="distance to every vertex of this second mesh instead (vertex of MESH_B, distance)",
     )

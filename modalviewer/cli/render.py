@@ -52,12 +52,9 @@ def add_parsers(sub) -> None:
     r.add_argument(
         "--grid",
         type=_grid,
-        default=None,
         help="with --modes: COLUMNSxROWS of the panels (default: rows of up to 4)",
     )
-    r.add_argument(
-        "-k", type=COUNT, default=None, help=f"number of modes (default: the viewer's, {DEFAULT_K})"
-    )
+    r.add_argument("-k", type=COUNT, help=f"number of modes (default: the viewer's, {DEFAULT_K})")
     r.add_argument("--isolines", type=whole(0), default=12)
     r.add_argument(
         "--show",
@@ -69,7 +66,6 @@ def add_parsers(sub) -> None:
     r.add_argument(
         "--size",
         type=size,
-        default=None,
         help="WIDTHxHEIGHT in pixels (default 1024x768; 640x480 with --animate)",
     )
     r.add_argument("--transparent", action="store_true")
@@ -82,7 +78,6 @@ def add_parsers(sub) -> None:
     r.add_argument(
         "--frames",
         type=whole(2),
-        default=None,
         help="with --animate: frames in the period (default: one period at the window's "
         "speed, 52 at 25 fps)",
     )

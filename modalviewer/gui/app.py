@@ -43,13 +43,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("mesh", nargs="?", help="mesh file to open (default: the bundled mesh)")
     p.add_argument(
         "--operator",
-        default=None,
         choices=list(OPERATOR_NAMES),
         help="spectrum to compute at start (headless default: modified_dirichlet)",
     )
-    p.add_argument("--mode", type=MODE_INDEX, default=None, help="mode to show (from 0)")
-    p.add_argument("-k", type=COUNT, default=None, help="number of modes")
-    p.add_argument("--screenshot", default=None, help="render to this PNG and exit")
+    p.add_argument("--mode", type=MODE_INDEX, help="mode to show (from 0)")
+    p.add_argument("-k", type=COUNT, help="number of modes")
+    p.add_argument("--screenshot", help="render to this PNG and exit")
     p.add_argument(
         "--partial",
         action="store_true",
@@ -58,7 +57,6 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--session",
-        default=None,
         help="restore a session file (File > Save Session) instead of opening a mesh",
     )
     return p
