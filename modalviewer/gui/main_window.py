@@ -381,7 +381,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def animation_frame(self, phase: float) -> float:
         """Move the surface to the given phase (radians); returns the app's time in s."""
-        return self.scene_view.animation_frame(phase)
+        return self.scene_view.drawing.animation_frame(phase)
 
     def pick_file_vertex(self, number: int) -> None:
         try:

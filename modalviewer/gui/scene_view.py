@@ -38,15 +38,6 @@ class SceneView(QtCore.QObject):
         """The mesh's canonical view, fitted to the window (R)."""
         self.drawing.reset_camera()
 
-    def camera_preset(self, name: str) -> None:
-        self.drawing.camera_preset(name)
-
-    def current_camera(self) -> dict:
-        return self.drawing.current_camera()
-
-    def animation_frame(self, phase: float) -> float:
-        return self.drawing.animation_frame(phase)
-
     def _restart_phase(self) -> None:
         self._phase = 0.0
 
