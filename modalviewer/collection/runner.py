@@ -233,10 +233,8 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
             main = spectra[parameters["operator"]]
             for op, spec in spectra.items():
                 prefix = "" if op == parameters["operator"] else f"{op}."
-                arrays[prefix + "eigenvalues"] = spec.eigenvalues
-                arrays[prefix + "modes"] = spec.modes
-                arrays[prefix + "mass"] = spec.mass
-                arrays[prefix + "residuals"] = spec.residuals
+                for part in ("eigenvalues", "modes", "mass", "residuals"):
+                    arrays[prefix + part] = getattr(spec, part)
                 if prefix:
                     arrays[prefix + "parameters"] = np.array(json.dumps(spec.parameters))
             arrays["shape_dna"] = shape_dna(main, area)

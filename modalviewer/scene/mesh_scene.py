@@ -101,12 +101,9 @@ class MeshScene:
         self._mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(*SURFACE_DEPTH_OFFSET)
         self.isolines = pv.PolyData()
         self.zero_line = pv.PolyData()
-        self.iso_actor = None
-        self.zero_actor = None
-        self._iso_rest = None
-        self._iso_disp = None
-        self._zero_rest = None
-        self._zero_disp = None
+        self.iso_actor = self.zero_actor = None
+        # (rest points, displacement) of the isolines and the zero line, for the animation
+        self._iso_rest = self._iso_disp = self._zero_rest = self._zero_disp = None
         self.marker_actor = self.back_marker_actor = None
         self.ghost_actor = None  # the rest shape, faint, behind a displaced surface
         self._ghost_rest = None  # its mesh
