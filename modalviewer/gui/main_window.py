@@ -143,7 +143,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.status_widgets = StatusBarWidgets(self.statusBar(), self.state, self.viewer.jobs)
         self.status_widgets.cancel_button.clicked.connect(self.cancel_computation)
         self.status_line = self.status_widgets.status_line
-        self.progress = self.status_widgets.progress
         self.cancel_button = self.status_widgets.cancel_button
 
         self.state.events.mesh.connect(self._on_mesh)

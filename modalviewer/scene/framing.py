@@ -86,12 +86,8 @@ def fit_points(
     y0 = -1.0 + 2.0 * (bottom / h + MARGIN)
     y1 = 1.0 - 2.0 * (top / h + MARGIN)
     if y1 - y0 < 0.2 or x1 - x0 < 0.2:  # a picture too small for its legend: use all of it
-        x0, y0, x1, y1 = (
-            -1.0 + 2.0 * MARGIN,
-            -1.0 + 2.0 * MARGIN,
-            1.0 - 2 * MARGIN,
-            1.0 - 2 * MARGIN,
-        )
+        x0 = y0 = -1.0 + 2.0 * MARGIN
+        x1 = y1 = 1.0 - 2.0 * MARGIN
     lo, hi = points.min(0), points.max(0)
     centre = 0.5 * (lo + hi)
     direction = np.array(camera.GetDirectionOfProjection())
