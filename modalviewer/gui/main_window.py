@@ -172,8 +172,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     def _show_error_box(self, title: str, message: str) -> None:
         self.statusBar().showMessage(message, 10000)
-        if not os.environ.get("MODALVIEWER_NO_DIALOGS"):
-            self._open_box(QtWidgets.QMessageBox.Icon.Warning, title, message)
+        self._open_box(QtWidgets.QMessageBox.Icon.Warning, title, message)
 
     def show_info(self, message: str, title: str = "modalviewer") -> None:
         """A non-blocking information dialog (and the status bar)."""
@@ -182,12 +181,14 @@ class MainWindow(QtWidgets.QMainWindow):
     def _show_info_box(self, title: str, message: str) -> None:
         log.info("%s", message)
         self.statusBar().showMessage(message.replace("\n", " "), 20000)
-        if not os.environ.get("MODALVIEWER_NO_DIALOGS"):
-            self._open_box(QtWidgets.QMessageBox.Icon.Information, title, message)
+        self._open_box(QtWidgets.QMessageBox.Icon.Information, title, message)
 
-    def _open_box(self, icon, title: str, message: str, action=None) -> QtWidgets.QMessageBox:
-        """Open a non-blocking message box (``self.message_box``); ``action``: (label,
-        callback) of a button that is the default, beside Close."""
+    def _open_box(self, icon, title: str, message: str, action=None) -> None:
+        """Open a non-blocking message box (``self.message_box``), unless
+        MODALVIEWER_NO_DIALOGS is set; ``action``: (label, callback) of a button that is
+        the default, beside Close."""
+        if os.environ.get("MODALVIEWER_NO_DIALOGS"):
+            return
         buttons = QtWidgets.QMessageBox.StandardButton
         box = QtWidgets.QMessageBox(icon, title, message, buttons.NoButton, self)
         if action is None:
@@ -201,7 +202,6 @@ class MainWindow(QtWidgets.QMainWindow):
         box.setAttribute(QtCore.Qt.WidgetAttribute.WA_DeleteOnClose)
         box.open()
         self.message_box = box
-        return box
 
     # =========================================================== settings
     def closeEvent(self, event):  # noqa: N802
@@ -456,8 +456,6 @@ class MainWindow(QtWidgets.QMainWindow):
         """A failure on sliver triangles, with a "Fix slivers and retry" button (the
         default)."""
         self.statusBar().showMessage(message, 10000)
-        if os.environ.get("MODALVIEWER_NO_DIALOGS"):
-            return
         self._open_box(
             QtWidgets.QMessageBox.Icon.Warning,
             "Computation failed",
