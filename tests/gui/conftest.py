@@ -41,7 +41,12 @@ def answer_next_dialog(qtbot, monkeypatch):
         asked = {}
 
         def press_enter():
+            # the question may open later than delay_ms (a file is still being read, in a
+            # loaded machine's time): look again until a message box is up
             box = QtWidgets.QApplication.activeModalWidget()
+            if not isinstance(box, QtWidgets.QMessageBox):
+                QtCore.QTimer.singleShot(50, press_enter)
+                return
             asked["title"] = box.windowTitle()
             asked["default"] = box.defaultButton().text().replace("&", "")
             asked["text"] = box.text()
