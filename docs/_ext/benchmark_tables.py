@@ -388,7 +388,16 @@ def out_of_core_threads_table(data: dict) -> str:
     return out_of_core_threads.table(data)
 
 
+def readers_table(data: dict) -> str:
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from benchmarks import readers
+
+    return readers.table(data)
+
+
 TABLES = {
+    "readers": (["readers"], lambda: readers_table(load("readers"))),
     "out-of-core-threads": (
         ["out_of_core_threads"],
         lambda: out_of_core_threads_table(load("out_of_core_threads")),
