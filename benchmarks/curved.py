@@ -27,7 +27,6 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.run import add_keep_others, kept_rows, save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
@@ -128,6 +127,7 @@ def run(case: tuple[str, str, int], operator: str, k: int) -> dict:
 
 
 def main(argv=None) -> int:
+    from benchmarks.run import add_keep_others, kept_rows, save_result
     from modalviewer.core.operators import OPERATOR_NAMES
 
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])

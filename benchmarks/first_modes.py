@@ -33,11 +33,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.run import save_result  # noqa: E402
 
 CHILD = """
 import json, resource, sys, time
-from modalviewer.core.memory import prepare_compute_process
+try:
+    from modalviewer.core.memory import prepare_compute_process
+except ImportError:  # a baseline from before the memory modules were one
+    from modalviewer.processes.memory import prepare_compute_process
 prepare_compute_process()
 import numpy as np
 import modalviewer as mv
@@ -195,6 +197,8 @@ def main(argv=None) -> int:
             rows.append(measure(case, operator, args.k, args.first, baseline))
             print(json.dumps(rows[-1]), flush=True)
     data = {"k": args.k, "first": args.first, "baseline": args.baseline, "rows": rows}
+    from benchmarks.run import save_result  # imports the package; the children need not
+
     save_result("first_modes", data)
     print(table(data))
     return 0
