@@ -7,8 +7,13 @@ pytestmark = pytest.mark.gui
 
 
 def _settle(qtbot, window):
-    """Let the posted layout requests of the docks run."""
-    qtbot.wait(50)
+    """Run the docks' posted layout requests (those a layout posts while it runs too),
+    however long the event loop took to get to them on a loaded machine."""
+    from qtpy import QtCore, QtWidgets
+
+    for _ in range(4):
+        qtbot.wait(20)
+        QtWidgets.QApplication.sendPostedEvents(None, QtCore.QEvent.Type.LayoutRequest)
     window.repaint()
 
 
