@@ -24,6 +24,7 @@ copy GitHub shows) and draws the plots::
 
 from __future__ import annotations
 
+import importlib
 import json
 import re
 import sys
@@ -44,12 +45,16 @@ def load(name: str):
     return json.loads((RESULTS / f"{name}.json").read_text())
 
 
-def _benchmarks():
+def _benchmarks(name: str = "run"):
+    """The module ``benchmarks.<name>`` (its ``table`` makes that benchmark's table)."""
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
-    from benchmarks import run
+    return importlib.import_module(f"benchmarks.{name}")
 
-    return run
+
+def benchmark_table(name: str):
+    """The table of ``benchmarks.<name>``, made by its own ``table`` from its results."""
+    return lambda: _benchmarks(name).table(load(name))
 
 
 def spectra_table(rows: list[dict]) -> str:
@@ -364,46 +369,11 @@ def correspondence_table(data: dict) -> str:
     return "\n".join(lines)
 
 
-def first_modes_table(data: dict) -> str:
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from benchmarks import first_modes
-
-    return first_modes.table(data)
-
-
-def slicing_table(data: dict) -> str:
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from benchmarks import slicing
-
-    return slicing.table(data)
-
-
-def out_of_core_threads_table(data: dict) -> str:
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from benchmarks import out_of_core_threads
-
-    return out_of_core_threads.table(data)
-
-
-def readers_table(data: dict) -> str:
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from benchmarks import readers
-
-    return readers.table(data)
-
-
 TABLES = {
-    "readers": (["readers"], lambda: readers_table(load("readers"))),
-    "out-of-core-threads": (
-        ["out_of_core_threads"],
-        lambda: out_of_core_threads_table(load("out_of_core_threads")),
-    ),
-    "first-modes": (["first_modes"], lambda: first_modes_table(load("first_modes"))),
-    "slicing": (["slicing"], lambda: slicing_table(load("slicing"))),
+    "readers": (["readers"], benchmark_table("readers")),
+    "out-of-core-threads": (["out_of_core_threads"], benchmark_table("out_of_core_threads")),
+    "first-modes": (["first_modes"], benchmark_table("first_modes")),
+    "slicing": (["slicing"], benchmark_table("slicing")),
     "spectra": (["latest"], lambda: spectra_table(load("latest"))),
     "paper": (["latest"], lambda: paper_table(load("latest"))),
     "stages": (["latest"], lambda: stage_table(load("latest"))),
