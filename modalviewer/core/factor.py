@@ -23,7 +23,7 @@ import sys
 import tempfile
 import threading
 import weakref
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 
 import numpy as np
 import scipy.sparse as sp
@@ -317,12 +317,9 @@ class _Pardiso:
     def solve(self, b: np.ndarray) -> np.ndarray:
         one = b.ndim == 1
         B = np.asfortranarray(b.reshape(self.n, -1), dtype=self.dtype)
-        if self.out_of_core:
-            # out of core, PARDISO's parallel substitution reads the factor file many
-            # times slower than one thread does (benchmarks/out_of_core_threads.py)
-            with _one_mkl_thread(self._lib):
-                error, X = self._call(33, B)
-        else:
+        # out of core, PARDISO's parallel substitution reads the factor file many times
+        # slower than one thread does (benchmarks/out_of_core_threads.py)
+        with _one_mkl_thread(self._lib) if self.out_of_core else nullcontext():
             error, X = self._call(33, B)
         if error != 0:
             raise np.linalg.LinAlgError(f"PARDISO solve failed (error {error})")
