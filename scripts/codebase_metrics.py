@@ -45,18 +45,24 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def imported_names(path: Path, tree: ast.AST) -> list[str]:
+def imported_names(path: Path, tree: ast.AST, top_level_only: bool = False) -> list[str]:
+    """The absolute names ``path`` imports (``tree`` is its parse): modules, and
+    ``module.name`` for each name taken from one; relative imports resolved.  With
+    ``top_level_only``, only the imports run when the module loads."""
     module = module_name(path)
     package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
     found = []
-    for node in ast.walk(tree):
+    for node in tree.body if top_level_only else ast.walk(tree):
         if isinstance(node, ast.Import):
             found += [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package.split(".")
                 prefix = ".".join(base[: len(base) - node.level + 1])
-                name = f"{prefix}.{node.module}" if node.module else prefix
+                if node.module is None:  # from . import a, b
+                    found += [f"{prefix}.{alias.name}" for alias in node.names]
+                    continue
+                name = f"{prefix}.{node.module}"
             else:
                 name = node.module or ""
             found.append(name)
@@ -64,12 +70,13 @@ def imported_names(path: Path, tree: ast.AST) -> list[str]:
     return found
 
 
-def import_graph(trees: dict[Path, ast.AST]) -> dict[str, set[str]]:
+def import_graph(trees: dict[Path, ast.AST], top_level_only: bool = False) -> dict[str, set[str]]:
+    """Which of the package's modules each module imports (see :func:`imported_names`)."""
     modules = {module_name(p): p for p in trees}
     graph: dict[str, set[str]] = {}
     for module, path in modules.items():
         targets = set()
-        for name in imported_names(path, trees[path]):
+        for name in imported_names(path, trees[path], top_level_only):
             while name and name not in modules:  # "pkg.mod.Class" -> "pkg.mod"
                 name = name.rpartition(".")[0]
             if not name or name == module:

@@ -68,3 +68,16 @@ def installed_wheel(tmp_path_factory):
     (purelib / "outer_packages.pth").write_text("\n".join(sorted(here)) + "\n")
     _run(*pip, "--python", python, "install", "--quiet", "--no-deps", "--no-build-isolation", wheel)
     return wheel, python, work
+
+
+@pytest.fixture(scope="session")
+def codebase_metrics():
+    """``scripts/codebase_metrics.py`` as a module: how the package's sources, imports,
+    functions and docstrings are read, for the architecture and shape tests."""
+    import importlib.util
+
+    script = Path(__file__).resolve().parents[1] / "scripts" / "codebase_metrics.py"
+    spec = importlib.util.spec_from_file_location("codebase_metrics", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

@@ -4,25 +4,12 @@ lines, at most 10 docstring lines citing a measurement from a particular run.
 
 The line count of ``modalviewer/`` is printed by the script but not asserted here."""
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "codebase_metrics.py"
-
 
 @pytest.fixture(scope="module")
-def metrics():
-    spec = importlib.util.spec_from_file_location("codebase_metrics", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-@pytest.fixture(scope="module")
-def figures(metrics):
-    return metrics.measure()
+def figures(codebase_metrics):
+    return codebase_metrics.measure()
 
 
 def test_no_import_circle_even_through_imports_inside_functions(figures):
@@ -37,12 +24,13 @@ def test_no_module_over_800_lines(figures):
     assert figures["modules over 800 lines"] == []
 
 
-def test_docstrings_state_rules_not_runs(figures, metrics):
+def test_docstrings_state_rules_not_runs(figures, codebase_metrics):
     found = figures["docstring lines citing a measurement"]
-    assert len(found) <= metrics.LIMITS["docstring lines citing a measurement"], found
+    assert len(found) <= codebase_metrics.LIMITS["docstring lines citing a measurement"], found
 
 
-def test_the_measures_see_what_they_look_for(metrics):
+def test_the_measures_see_what_they_look_for(codebase_metrics):
+    metrics = codebase_metrics
     """Each measure finds its fault in a made-up graph or text (so the tests above can fail)."""
     assert metrics.import_circles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [
         ["a", "b", "c"]
