@@ -23,7 +23,6 @@ from ..core.operators import operator_info
 from ..core.signatures import SignatureTable
 from ..core.spectrum import Spectrum
 from ..repair import REPAIRS
-from ..spectra import cached_or_computed
 from .jobs import DONE, Job, JobQueue, RepairJob, SpectrumJob
 from .process import repair_in_process
 from .state import SpectrumKey, ViewerState
@@ -95,6 +94,15 @@ def estimated_seconds(
         best = min(sizes, key=lambda r: abs(np.log(r.n_vertices / n)))
         return best.seconds * (n / best.n_vertices) ** SIZE_EXPONENT
     return None
+
+
+def expected_seconds(key: SpectrumKey, mesh: Mesh, cache: SpectrumCache) -> float | None:
+    """:func:`estimated_seconds` of ``key`` on ``mesh`` from ``cache``'s records; None for
+    Coarse-to-fine (its decimation is not recorded) and where the spectrum is in the
+    cache already (nothing is solved)."""
+    if key.coarse or key.cached(mesh, cache):
+        return None
+    return estimated_seconds(cache.solves(), key.operator, mesh.n_vertices, key.k, mesh.hash)
 
 
 MEMORY_SHARE = 0.75
@@ -354,21 +362,10 @@ class ViewerModel:
                 self.jobs.cancel(job)
 
     def estimated_seconds(self, key: SpectrumKey) -> float | None:
-        """Seconds the computation of ``key`` on the loaded mesh is expected to take:
-        :func:`estimated_seconds` from this machine's solves recorded in the cache; None
-        where those do not tell, for Coarse-to-fine (its decimation is not recorded), and
-        where the spectrum is in the cache already (nothing is solved)."""
-        if self.state.mesh is None or key.coarse or self._cached(key):
+        """:func:`expected_seconds` of ``key`` on the loaded mesh (None without one)."""
+        if self.state.mesh is None:
             return None
-        mesh = self.state.compute_mesh(key)
-        return estimated_seconds(
-            self.cache.solves(), key.operator, mesh.n_vertices, key.k, mesh.hash
-        )
-
-    def _cached(self, key: SpectrumKey) -> bool:
-        """Whether the exact spectrum of ``key`` is in the disk cache."""
-        mesh = self.state.compute_mesh(key)
-        return self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file()
+        return expected_seconds(key, self.state.compute_mesh(key), self.cache)
 
     def _show_if_unchanged(self, operator: str, before) -> None:
         """Show ``operator``'s spectrum if the display has not changed since a request
@@ -394,19 +391,7 @@ class ViewerModel:
         needs_table = operator_info(key.operator).distance_kind is not None
 
         def work(progress, cancel):
-            spec = cached_or_computed(
-                mesh,
-                key.operator,
-                key.k,
-                key.bending,
-                key.membrane,
-                cache=cache,
-                progress=progress,
-                cancel=cancel,
-                on_modes=on_modes,
-                coarse=key.coarse,
-                child_process=True,
-            )
+            spec = key.spectrum(mesh, cache, progress, cancel, on_modes)
             table = None
             if needs_table and (~spec.zero_mode_mask()).any():
                 # built here, off the GUI thread (on big meshes it takes a moment)

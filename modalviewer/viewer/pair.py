@@ -37,7 +37,6 @@ from ..core.operators import (
 )
 from ..core.spectrum import Spectrum
 from ..core.validate import check_vertices
-from ..spectra import cached_or_computed
 from .color_scale import auto_spread
 from .jobs import CANCELLED, DONE, Job, JobQueue
 from .state import (
@@ -45,6 +44,7 @@ from .state import (
     DISTANCE_DISPLAYS,
     SpectrumKey,
     ViewerState,
+    unit_area,
 )
 
 SIDES = ("a", "b")
@@ -105,19 +105,6 @@ class _Side:
     @property
     def name(self) -> str:
         return self.path.name if self.path is not None else "mesh"
-
-    def compute_mesh(self, rescale: bool) -> Mesh:
-        if not rescale:
-            return self.mesh
-        if self.unit_mesh is None:
-            # the same arithmetic as ViewerState.compute_mesh (rescale_to_area's rounds
-            # differently in the last bit), so the main window's unit-area spectra and
-            # this pair's share their disk cache entries
-            m = self.mesh
-            self.unit_mesh = Mesh(
-                m.vertices * (1.0 / np.sqrt(m.total_area)), m.faces, m.report, m.file_map
-            )
-        return self.unit_mesh
 
 
 class PairState:
@@ -337,52 +324,35 @@ class PairState:
         return [job for job in jobs if not job.done]
 
     def estimated_seconds(self) -> float | None:
-        """Seconds the missing spectra of the current key are expected to take, from this
-        machine's recorded solves (:func:`.model.estimated_seconds`); None where nothing
-        is missing, one of them has no estimate or is in the cache, and for
-        Coarse-to-fine."""
-        from .model import estimated_seconds
+        """Seconds the missing spectra of the current key are expected to take
+        (:func:`.model.expected_seconds`); None where nothing is missing or one of them
+        has no estimate."""
+        from .model import expected_seconds
 
         key = self.key()
         missing = [side for side in SIDES if self.spectrum(side) is None]
-        if key.coarse or not missing:
-            return None
-        records, total = self.cache.solves(), 0.0
-        for side in missing:
-            mesh = self.sides[side].compute_mesh(key.rescale)
-            if self.cache.path(mesh, key.operator, key.k, key.bending, key.membrane).is_file():
-                return None
-            seconds = estimated_seconds(records, key.operator, mesh.n_vertices, key.k, mesh.hash)
-            if seconds is None:
-                return None
-            total += seconds
-        return total
+        seconds = [expected_seconds(key, self.compute_mesh(s, key), self.cache) for s in missing]
+        return None if not missing or None in seconds else sum(seconds)
 
     def cancel(self) -> None:
         """Cancel this pair's jobs (queued and running)."""
         for side in SIDES:
             self.jobs.cancel_all(owner=self.owner(side), reason="cancelled")
 
+    def compute_mesh(self, side: str, key: SpectrumKey) -> Mesh:
+        """The mesh the spectrum of ``side`` for ``key`` is computed on (unit area with
+        ``key.rescale``)."""
+        s = self.sides[side]
+        if key.rescale and s.unit_mesh is None:
+            s.unit_mesh = unit_area(s.mesh)
+        return s.unit_mesh if key.rescale else s.mesh
+
     def _work(self, side: str, key: SpectrumKey, on_modes=None):
-        mesh = self.sides[side].compute_mesh(key.rescale)
-        cache = self.cache
-
-        def work(progress, cancel):
-            spec = cached_or_computed(
-                mesh,
-                key.operator,
-                key.k,
-                key.bending,
-                key.membrane,
-                cache=cache,
-                progress=progress,
-                cancel=cancel,
-                on_modes=on_modes,
-                child_process=True,
-            )
-            return spec, None
-
-        return work
+        mesh, cache = self.compute_mesh(side, key), self.cache
+        return lambda progress, cancel: (
+            key.spectrum(mesh, cache, progress, cancel, on_modes),
+            None,
+        )
 
     def _modes_arrived(self, slot):
         """Where the modes of ``slot``'s spectrum go as they converge: the maps are made

@@ -35,6 +35,7 @@ from ..core.operators import (
     signature_kind,
 )
 from ..core.spectrum import Spectrum, on_solver_mesh
+from ..spectra import cached_or_computed
 from .derived import DerivedValues
 
 DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature", "field")
@@ -110,6 +111,27 @@ class SpectrumKey:
             extra.append("coarse-to-fine")
         tail = f" ({'; '.join(extra)})" if extra else ""
         return f"{info.label}, {self.k} modes{tail}"
+
+    def spectrum(self, mesh: Mesh, cache, progress, cancel, on_modes=None) -> Spectrum:
+        """This key's spectrum of ``mesh`` (already of unit area where ``rescale``):
+        :func:`~modalviewer.spectra.cached_or_computed`, large exact solves in a child
+        process."""
+        return cached_or_computed(
+            mesh, self.operator, self.k, self.bending, self.membrane, cache=cache,
+            progress=progress, cancel=cancel, on_modes=on_modes, coarse=self.coarse,
+            child_process=True,
+        )  # fmt: skip
+
+    def cached(self, mesh: Mesh, cache) -> bool:
+        """Whether the exact spectrum of ``mesh`` for this key is in ``cache``."""
+        return cache.path(mesh, self.operator, self.k, self.bending, self.membrane).is_file()
+
+
+def unit_area(mesh: Mesh) -> Mesh:
+    """``mesh`` scaled to unit area (the viewer's and the shape pair's arithmetic, so
+    their spectra share disk cache entries)."""
+    factor = 1.0 / np.sqrt(mesh.total_area)
+    return Mesh(mesh.vertices * factor, mesh.faces, report=mesh.report, file_map=mesh.file_map)
 
 
 @dataclass(frozen=True)
@@ -278,15 +300,7 @@ class ViewerState:
         if self.mesh is None:
             raise ValueError("no mesh is loaded")
         rescale = key.rescale if key is not None else self.compute_settings.rescale
-        if not rescale:
-            return self.mesh
-        factor = 1.0 / np.sqrt(self.mesh.total_area)
-        return Mesh(
-            self.mesh.vertices * factor,
-            self.mesh.faces,
-            report=self.mesh.report,
-            file_map=self.mesh.file_map,
-        )
+        return unit_area(self.mesh) if rescale else self.mesh
 
     # ---------------------------------------------------------- spectra
     def add_spectrum(self, key: SpectrumKey, spec: Spectrum, table=None) -> None:

@@ -322,7 +322,7 @@ def test_the_pair_estimates_the_time_of_its_missing_spectra(tmp_path, spot):
 
     pair = _pair(tmp_path, spot, _moved(spot), k=K)
     key = pair.key()
-    meshes = [pair.sides[side].compute_mesh(key.rescale) for side in ("a", "b")]
+    meshes = [pair.compute_mesh(side, key) for side in ("a", "b")]
     records = [
         SolveRecord(key.operator, mesh.hash, mesh.n_vertices, K, seconds)
         for mesh, seconds in zip(meshes, (3.0, 5.0), strict=True)
