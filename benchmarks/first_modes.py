@@ -16,8 +16,9 @@ in a fresh process with the compute process's memory settings:
   no hand-over;
 - ``few``: a separate ``--first``-mode solve by this code.
 
-The runs of one row alternate (handover, baseline, few) so that a drift of the machine's
-speed shows in all three.  Writes ``benchmarks/results/first_modes.json``.
+The runs of one row alternate (handover, baseline, few), ``--repeats`` rounds of them,
+so that a drift of the machine's speed shows in all three; each figure is the median of
+its rounds.  Writes ``benchmarks/results/first_modes.json``.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -65,8 +68,6 @@ print(json.dumps({"vertices": mesh.n_vertices, "seconds": seconds, "peak_mb": pe
 def case_mesh(path: str, scheme: str, level: int, zup: bool = False):
     """The mesh of a case (see the module's docstring): :func:`benchmarks.curved.case_mesh`
     (a bundled asset may be named without its ".obj"), turned so that z is up."""
-    import numpy as np
-
     import modalviewer as mv
     from benchmarks.curved import case_mesh as subdivided
 
@@ -131,28 +132,47 @@ def first_arrival(arrivals: list, first: int, column: int) -> float | None:
     return next((a[0] for a in arrivals if a[column] >= first), None)
 
 
-def measure(case, operator: str, k: int, first: int, baseline: Path) -> dict:
-    new = run_child(ROOT, case, operator, k, first, handover=True)
-    old = run_child(baseline, case, operator, k, first, handover=False)
-    few = run_child(ROOT, case, operator, first, first, handover=False)
+def measure(case, operator: str, k: int, first: int, baseline: Path, repeats: int) -> dict:
+    """One row: ``repeats`` rounds of (handover, baseline, few), each figure the median
+    of its rounds; the seconds of every round are kept too."""
+    rounds = []
+    for _ in range(repeats):
+        rounds.append(
+            (
+                run_child(ROOT, case, operator, k, first, handover=True),
+                run_child(baseline, case, operator, k, first, handover=False),
+                run_child(ROOT, case, operator, first, first, handover=False),
+            )
+        )
+    new, old, _ = rounds[0]
     differences = [
         abs(a - b) / abs(b)
         for a, b in zip(new["eigenvalues"], old["eigenvalues"], strict=True)
         if b > 0
     ]
+
+    def median(values) -> float:
+        return float(np.median(list(values)))
+
     return {
         "case": case_name(case),
         "operator": operator,
         "vertices": new["vertices"],
         "k": k,
         "first": first,
-        "seconds_first": first_arrival(new["arrivals"], first, 1),
-        "seconds_first_nonzero": first_arrival(new["arrivals"], first, 2),
-        "seconds_total": new["seconds"],
-        "seconds_baseline": old["seconds"],
-        "seconds_few": few["seconds"],
-        "peak_mb": new["peak_mb"],
-        "peak_mb_baseline": old["peak_mb"],
+        "repeats": repeats,
+        "seconds_first": median(first_arrival(n["arrivals"], first, 1) for n, _, _ in rounds),
+        "seconds_first_nonzero": median(
+            first_arrival(n["arrivals"], first, 2) for n, _, _ in rounds
+        ),
+        "seconds_total": median(n["seconds"] for n, _, _ in rounds),
+        "seconds_baseline": median(o["seconds"] for _, o, _ in rounds),
+        "seconds_few": median(f["seconds"] for _, _, f in rounds),
+        "seconds_total_runs": [n["seconds"] for n, _, _ in rounds],
+        "seconds_baseline_runs": [o["seconds"] for _, o, _ in rounds],
+        "total_over_baseline_runs": [n["seconds"] / o["seconds"] for n, o, _ in rounds],
+        "peak_mb": median(n["peak_mb"] for n, _, _ in rounds),
+        "peak_mb_baseline": median(o["peak_mb"] for _, o, _ in rounds),
         "handovers": len(new["arrivals"]),
         "largest_eigenvalue_difference": max(differences, default=0.0),
     }
@@ -189,12 +209,13 @@ def main(argv=None) -> int:
     parser.add_argument("-k", type=int, default=100)
     parser.add_argument("--first", type=int, default=10)
     parser.add_argument("--baseline", default="2420880", help="the commit to compare with")
+    parser.add_argument("--repeats", type=int, default=3, help="rounds per row (medians)")
     args = parser.parse_args(argv)
     baseline = baseline_tree(args.baseline)
     rows = []
     for case in args.cases:
         for operator in args.operators:
-            rows.append(measure(case, operator, args.k, args.first, baseline))
+            rows.append(measure(case, operator, args.k, args.first, baseline, args.repeats))
             print(json.dumps(rows[-1]), flush=True)
     data = {"k": args.k, "first": args.first, "baseline": args.baseline, "rows": rows}
     from benchmarks.run import save_result  # imports the package; the children need not

@@ -198,6 +198,14 @@ it, so that a cluster of (nearly) equal eigenvalues is handed over whole and the
 handed over span the same space as the final ones."""
 
 
+HANDOVER_GROWTH = 0.5
+"""Converged pairs are handed over once at least this share of those handed over so far
+(and at least one) are ready: each hand-over reads the whole basis, so handing over
+every pair as it converges would cost more than the final rotation of all k vectors.
+With it, k pairs come in about ``log(k) / log(1.5)`` hand-overs, the first ones one
+or two pairs at a time, while the basis is small."""
+
+
 def _same_cluster(theta: np.ndarray, i: int) -> bool:
     """Whether the Ritz values ``theta[i - 1]`` and ``theta[i]`` (descending) lie within
     :data:`CLUSTER_RTOL` of each other."""
@@ -276,7 +284,8 @@ def block_krylov_schur(
         in double, :func:`_basis_t_times`): ``tol`` >= :data:`.eigen.FLOAT32_BASIS_TOL`.
     on_converged : ``on_converged(theta, Y)`` with newly converged leading pairs, largest
         first, (m,) values and a new (N, m) array, in pieces of about
-        :data:`HANDOVER_COLUMNS`, a cluster (:data:`CLUSTER_RTOL`) whole.  With it,
+        :data:`HANDOVER_COLUMNS`, a cluster (:data:`CLUSTER_RTOL`) whole, once
+        :data:`HANDOVER_GROWTH` times as many as before are ready.  With it,
         pairs are checked before the basis has k columns too.
 
     Returns
@@ -330,7 +339,8 @@ def block_krylov_schur(
         report("solving", 0.05 + 0.85 * done / k)
         if on_converged is not None and done < k:
             ready = _whole_clusters(theta, done, handed, b)
-            handed = _hand_over(Q, j, theta, S, handed, ready, timer, on_converged)
+            if ready - handed >= max(1, HANDOVER_GROWTH * handed):
+                handed = _hand_over(Q, j, theta, S, handed, ready, timer, on_converged)
         if done == k:
             with timer("restarts"):
                 rotate_in_place(Q, j, S[:, :k])
@@ -371,9 +381,7 @@ def _hand_over(Q, j, theta, S, handed: int, ready: int, timer, on_converged) -> 
         while stop < ready and _same_cluster(theta, stop):
             stop += 1
         with timer("handover"):
-            Y_new = _basis_times(Q, j, S[:, handed:stop])
-        on_converged(theta[handed:stop].copy(), Y_new)
-        del Y_new
+            on_converged(theta[handed:stop].copy(), _basis_times(Q, j, S[:, handed:stop]))
         handed = stop
     return handed
 

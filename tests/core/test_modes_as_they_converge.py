@@ -65,6 +65,11 @@ def test_modes_handed_over_equal_the_final_ones(spot, operator):
     counts = [c.k for c in calls]
     assert len(calls) >= 3, counts  # modes arrive in several steps before the end
     assert counts == sorted(set(counts)) and counts[-1] == 40
+    # each hand-over reads the whole Krylov basis: after the first, each brings at least
+    # half as many pairs of the iteration as came before (krylov.HANDOVER_GROWTH)
+    nulls = final.null_space_dimension
+    for before, after in zip(counts[:-2], counts[1:-1], strict=True):
+        assert after - before >= 0.5 * (before - nulls), counts
     assert calls[-1] is final and final.is_complete
     nulls = final.null_space_dimension
     assert nulls == {"laplacian": 1, "modified_dirichlet": 0, "shells": 6}[operator]
