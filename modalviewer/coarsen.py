@@ -38,8 +38,7 @@ def decimated_copy(mesh: Mesh, fraction: float = COARSE_FRACTION) -> Mesh:
     slivers on flat regions, which make the shells Hessian numerically indefinite)."""
     import pyvista as pv
 
-    faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
-    poly = pv.PolyData(np.array(mesh.vertices), faces).decimate_pro(
+    poly = pv.PolyData.from_regular_faces(np.array(mesh.vertices), mesh.faces).decimate_pro(
         1.0 - fraction, preserve_topology=True
     )
     arrays = np.asarray(poly.points), np.asarray(poly.faces).reshape(-1, 4)[:, 1:]

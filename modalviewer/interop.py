@@ -101,8 +101,7 @@ def to_pyvista(mesh, spectrum: Spectrum | None = None, fields: dict | None = Non
 
     mesh = as_mesh(mesh)
     n = mesh.n_vertices
-    faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
-    poly = pv.PolyData(np.array(mesh.vertices), faces)
+    poly = pv.PolyData.from_regular_faces(np.array(mesh.vertices), mesh.faces)
     if spectrum is not None:
         if spectrum.n_vertices != n:
             raise ValueError(

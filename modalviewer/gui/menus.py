@@ -152,7 +152,7 @@ def _view_menu(win, m) -> None:
     _action(win, m, "&Reset camera", win.scene_view.reset_camera, "R")
     views = m.addMenu("Camera &presets")
     for i, (name, label) in enumerate(CAMERA_PRESETS):
-        slot = lambda _=False, n=name: win.scene_view.drawing.camera_preset(n)  # noqa: E731
+        slot = lambda _=False, n=name: win.scene_view.drawing.reset_camera(n)  # noqa: E731
         _action(win, views, label, slot, f"Alt+{i + 1}")
     _up_axis_menu(win, m)
     m.addSeparator()

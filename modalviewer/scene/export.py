@@ -105,7 +105,7 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
     """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply, one point
     per input vertex in its order (NaN at vertices no face uses); a solver mesh of
     another numbering also gets ``file_vertex``, each point's input vertex number."""
-    import pyvista as pv
+    from ..interop import to_pyvista
 
     path = Path(path)
     if path.suffix.lower() not in (".vtp", ".ply"):
@@ -116,10 +116,7 @@ def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Pa
         arrays["file_vertex"] = np.asarray(mesh.file_vertices)
     if path.suffix.lower() == ".ply":
         return atomic_write(path, lambda tmp: _write_ply(tmp, mesh, arrays))
-    faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
-    poly = pv.PolyData(np.array(mesh.vertices), faces)
-    for name, values in arrays.items():
-        poly.point_data[name] = values
+    poly = to_pyvista(mesh, fields=arrays)
     return atomic_write(path, lambda tmp: poly.save(tmp, binary=True))
 
 

@@ -16,21 +16,6 @@ ZERO_LINE_FRACTION = 0.003
 ZERO_LINE_LENGTH = 0.01
 
 
-def isoline_segments(
-    points: np.ndarray,
-    faces: np.ndarray,
-    values: np.ndarray,
-    levels,
-    displacement: np.ndarray | None = None,
-) -> pv.PolyData:
-    """Isolines of a piecewise-linear field as line segments, one per crossed triangle
-    and level (vectorised; VTK's contour filter is slower): points (n, 3), faces (m, 3),
-    values (n,), levels (L,), ``displacement`` (n, 3) interpolated onto the line points.
-    A vertex exactly at a level counts as above it, so each crossing gives one segment."""
-    seg, disp, _ = segments(points, faces, values, levels, displacement)
-    return line_polydata(seg, disp)
-
-
 def line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
     """PolyData of (s, 2, 3) segments, with (s, 2, 3) ``disp`` as point data."""
     poly = pv.PolyData()
@@ -46,9 +31,12 @@ def line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
 
 
 def segments(points, faces, values, levels, displacement=None, with_triangles=False):
-    """(segments (s, 2, 3), their displacement (s, 2, 3) or None, level of each (s,)),
-    and with ``with_triangles`` two more items: the triangle of each segment (s,) and the
-    mesh edges its two ends lie on (s, 2, 2), each edge as (smaller, larger) vertex."""
+    """Isolines of a piecewise-linear field as line segments, one per crossed triangle
+    and level (vectorised; VTK's contour filter is slower): (segments (s, 2, 3), their
+    ``displacement`` (s, 2, 3) or None, level of each (s,)), and with ``with_triangles``
+    two more items: the triangle of each segment (s,) and the mesh edges its two ends lie
+    on (s, 2, 2), each edge as (smaller, larger) vertex.  A vertex exactly at a level
+    counts as above it, so each crossing gives one segment."""
     levels = np.sort(np.asarray(levels, dtype=np.float64))
     # levels crossed by each triangle: those in (min, max] of its corner values
     level = np.searchsorted(levels, values, side="right").astype(np.int32)

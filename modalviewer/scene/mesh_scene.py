@@ -68,9 +68,8 @@ class MeshScene:
         self.plotter = plotter
         self.mesh = mesh
         self.normals = normals
-        faces = np.hstack([np.full((mesh.n_faces, 1), 3), mesh.faces]).ravel()
         self.rest_points = np.array(mesh.vertices)
-        self.surface = pv.PolyData(self.rest_points.copy(), faces)
+        self.surface = pv.PolyData.from_regular_faces(self.rest_points.copy(), mesh.faces)
         self.surface.point_data["field"] = np.zeros(mesh.n_vertices)
         self.surface.point_data["displacement"] = np.zeros((mesh.n_vertices, 3))
         self.surface.point_data["Normals"] = normals
@@ -315,10 +314,6 @@ class MeshScene:
         self._iso_rest = self._zero_rest = None
         self._overlay_changed()
 
-    @property
-    def n_isoline_points(self) -> int:
-        return 0 if self._iso_rest is None else len(self._iso_rest)
-
     # ------------------------------------------------------ legend, colour bar
     def set_legend(self, text: str | None) -> None:
         """Show ``text`` (lines separated by newlines) at the top left of the view, and in
@@ -507,8 +502,7 @@ class MeshScene:
         if self.ghost_actor is None:
             if not visible:
                 return
-            faces = np.hstack([np.full((self.mesh.n_faces, 1), 3), self.mesh.faces]).ravel()
-            rest = pv.PolyData(self.rest_points.copy(), faces)
+            rest = pv.PolyData.from_regular_faces(self.rest_points.copy(), self.mesh.faces)
             rest.point_data["Normals"] = self.normals
             rest.GetPointData().SetNormals(rest.GetPointData().GetArray("Normals"))
             rgba = np.zeros((self.mesh.n_vertices, 4), np.uint8)
@@ -569,13 +563,6 @@ class MeshScene:
         corners = self.mesh.faces[cell]
         d = np.linalg.norm(self.surface.points[corners] - hit, axis=1)
         return int(corners[np.argmin(d)])
-
-    def display_position(self, vertex: int) -> tuple[float, float, float]:
-        """(x, y, depth) display coordinates of a vertex (VTK origin: bottom left)."""
-        renderer = self.plotter.renderer
-        renderer.SetWorldPoint(*self.surface.points[vertex], 1.0)
-        renderer.WorldToDisplay()
-        return renderer.GetDisplayPoint()
 
     def show_marker(self, vertex: int | None) -> None:
         """The pick marker, a magenta sphere, at ``vertex`` (None: none).  No render."""

@@ -238,10 +238,11 @@ class StateScene:
             scene.set_colorbar(field.title, clim=field.clim)
 
     # ------------------------------------------------------------ camera
-    def reset_camera(self) -> None:
-        """The mesh's canonical view, fitted to the window (R)."""
+    def reset_camera(self, preset: str = "canonical") -> None:
+        """The mesh's canonical view fitted to the window (R), or a ``preset``: from a
+        side ("+x" ... "-z") or "isometric"."""
         if self.scene is not None:
-            self.scene.reset_camera()
+            self.scene.apply_camera_preset(preset)
             self.request_render()
 
     def _on_up_axis(self) -> None:
@@ -249,12 +250,6 @@ class StateScene:
         if self.scene is not None:
             self.scene.up_axis = self.state.derived.up_axis()
             self.reset_camera()
-
-    def camera_preset(self, name: str) -> None:
-        """View from a side ("+x" ... "-z"), "isometric" or "canonical"."""
-        if self.scene is not None:
-            self.scene.apply_camera_preset(name)
-            self.request_render()
 
     def _apply_camera(self) -> None:
         camera = self.state.camera

@@ -61,3 +61,17 @@ def answer_next_dialog(qtbot, monkeypatch):
 @pytest.fixture
 def spot_path():
     return ASSETS / "spot.obj"
+
+
+@pytest.fixture
+def display_position():
+    """``display_position(scene, vertex)``: (x, y, depth) display coordinates of a mesh
+    vertex as ``scene``'s renderer draws it (VTK origin: bottom left)."""
+
+    def position(scene, vertex: int) -> tuple[float, float, float]:
+        renderer = scene.plotter.renderer
+        renderer.SetWorldPoint(*scene.surface.points[vertex], 1.0)
+        renderer.WorldToDisplay()
+        return renderer.GetDisplayPoint()
+
+    return position

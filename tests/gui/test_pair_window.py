@@ -50,7 +50,7 @@ def _magenta(img):  # the marker (230, 26, 153), shaded
 
 
 def test_pick_on_a_shows_the_distance_and_best_match_on_b(
-    window, spot_path, moved_spot, tmp_path, qtbot
+    window, spot_path, moved_spot, tmp_path, qtbot, display_position
 ):
     window.open_mesh(spot_path)
     window.state.set_display(distance_kind="hks")  # the pair starts with the main's kind
@@ -101,7 +101,7 @@ def test_pick_on_a_shows_the_distance_and_best_match_on_b(
     assert _blue(left).sum() < 50
     assert _magenta(right).sum() > 30
     # the marker on B sits where the match projects
-    x, y, _ = pair.scenes["b"].display_position(w)
+    x, y, _ = display_position(pair.scenes["b"], w)
     h = right.shape[0]
     ys, xs = np.nonzero(_magenta(right))
     assert np.min(np.hypot(xs - x, ys - (h - 1 - y))) < 6

@@ -45,7 +45,7 @@ def test_mode_colours_and_isolines(window, spot_path):
     assert counts["blue"] > 2000, counts
     assert counts["orange"] > 2000, counts
     assert counts["black"] > 200, counts  # isolines
-    assert window.scene.n_isoline_points > 100
+    assert window.scene.iso_actor.GetVisibility() and window.scene.isolines.n_points > 100
     # symmetric range: white at zero
     lo, hi = window.scene.clim
     assert lo == pytest.approx(-hi)
@@ -111,7 +111,7 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     assert peak == pytest.approx(0.1 * window.mesh.bounding_box_diagonal, rel=1e-6)
 
 
-def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot):
+def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot, display_position):
     window.open_mesh(spot_path)
     window.compute("laplacian", k=20, wait=True)
     widget = window.viewport.widget
@@ -119,7 +119,7 @@ def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot):
     window.viewport.render_now()
     target = window.scene.vertex_at_display(widget.width() / 2, h / 2)
     assert target is not None
-    x, y, _ = window.scene.display_position(target)
+    x, y, _ = display_position(window.scene, target)
     qtbot.mouseClick(
         widget,
         QtCore.Qt.MouseButton.LeftButton,
@@ -485,13 +485,13 @@ def test_isolines_match_vtk_contour_filter():
     import pyvista as pv
 
     from modalviewer.core.primitives import icosphere
-    from modalviewer.scene.isolines import isoline_segments
+    from modalviewer.scene.isolines import line_polydata, segments
 
     mesh = icosphere(4)
     v, f = mesh.vertices, mesh.faces
     values = np.sin(3 * v[:, 0]) * np.cos(2 * v[:, 1]) + 0.5 * v[:, 2]
     levels = np.linspace(values.min(), values.max(), 14)[1:-1]
-    ours = isoline_segments(v, f, values, levels, displacement=2.0 * v)
+    ours = line_polydata(*segments(v, f, values, levels, displacement=2.0 * v)[:2])
     poly = pv.PolyData(v, np.hstack([np.full((len(f), 1), 3), f]).ravel())
     poly.point_data["field"] = values
     ref = poly.contour(isosurfaces=list(levels), scalars="field")
@@ -553,7 +553,7 @@ def test_an_idle_window_does_not_render(window, spot_path, qtbot):
     assert len(renders) == 0
     window.show_mode(4)  # a change does render
     window.viewport.render_now()
-    assert window.scene.n_isoline_points > 0
+    assert window.scene.iso_actor.GetVisibility() and window.scene.isolines.n_points > 0
 
 
 def test_a_narrow_view_keeps_the_whole_mesh_in_sight(window, spot_path, qtbot):
