@@ -59,11 +59,6 @@ def bent_pose(mesh: Mesh, angle_degrees: float = 40.0, at: float = 0.5, width: f
     return Mesh(out, mesh.faces)
 
 
-def fold_vertices(mesh: Mesh) -> np.ndarray:
-    """Indices of the plate's vertices on the fold line."""
-    return np.flatnonzero(np.abs(plate().vertices[:, 0] - FOLD_X) < 1e-12)
-
-
 def bumpy_plate(n: int = 80, seed: int = 3) -> Mesh:
     """Unit-square plate with a dozen smooth bumps and dents of varied size (Fig. 10)."""
     base = grid_plate(n, n)
@@ -127,14 +122,3 @@ def machined_part(cells: int = 4) -> Mesh:
     solid[6 * c : 8 * c, 1 * c : 3 * c, : 1 * c] = False  # through hole in the base
     solid[2 * c : 4 * c, 1 * c : 3 * c, 1 * c : 2 * c] = True  # boss on the base
     return voxel_surface(solid, 1.0 / c)
-
-
-def sharp_vertices(mesh: Mesh, angle_degrees: float = 30.0) -> np.ndarray:
-    """(n,) True at vertices on an edge whose dihedral angle exceeds ``angle_degrees``."""
-    from .shells import dihedral_angles, hinges
-
-    h = hinges(mesh)
-    theta = np.abs(dihedral_angles(mesh.vertices, h))
-    sharp = np.zeros(mesh.n_vertices, dtype=bool)
-    sharp[h[theta > np.radians(angle_degrees)][:, :2].ravel()] = True
-    return sharp

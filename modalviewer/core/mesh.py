@@ -1,16 +1,11 @@
-"""Triangle mesh container: validation and topology queries.
+"""The immutable triangle :class:`Mesh`: validation (never repair: that is
+:func:`.cleaning.repair_mesh`) and topology queries.
 
-A :class:`Mesh` holds ``vertices`` (n, 3) float64 and ``faces`` (m, 3) int64, is
-immutable, and its construction validates but never repairs (repairs:
-:func:`.cleaning.repair_mesh`, which keeps every input vertex in its place).
-
-One vertex numbering, the user's own: vertex i is row i of the arrays or the i-th vertex
-record of the file.  A vertex no face uses (:attr:`Mesh.unused`) has no value: NaN in
-every per-vertex result, an empty stiffness row and a zero mass, as in libigl; a merged
-duplicate (:attr:`Mesh.merged_into`) takes the values of the vertex it was merged into.
-The solvers work on :attr:`Mesh.solver_mesh`, the used vertices only, which carries the
-map back (:attr:`Mesh.file_to_mesh`, :meth:`Mesh.to_file_field`); results come back in
-the input's numbering.  :func:`remove_unused` gives a compact mesh and its map.
+One vertex numbering, the user's own (row i of the arrays, the i-th vertex of the file).
+A vertex no face uses (:attr:`Mesh.unused`) has no value: NaN in every per-vertex result,
+an empty stiffness row and a zero mass, as in libigl; a merged duplicate
+(:attr:`Mesh.merged_into`) takes the values of its vertex.  The solvers work on
+:attr:`Mesh.solver_mesh`, the used vertices only, which maps results back.
 """
 
 from __future__ import annotations
@@ -80,15 +75,10 @@ def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def checked_arrays(vertices, faces, polygons: bool = False):
-    """``(vertices (n, 3) float64, faces (m, 3) int64, note)`` of raw arrays, checked
-    before anything is done with them; never reshaped.
-
-    Faces are an (m, 3) array of integers or whole floats (a (3, m) array is refused:
-    ``faces.T`` is meant); with ``polygons`` an (m, p) array (p > 3) is fanned into
-    triangles from each first vertex and ``note`` says so.  Vertices are (n, 3) and
-    finite, face indices in 0..n-1.  A :class:`MeshError` naming what is wrong and how
-    to fix it otherwise.
-    """
+    """``(vertices (n, 3) float64, faces (m, 3) int64, note)`` of raw arrays, checked and
+    never reshaped (a (3, m) array is refused: ``faces.T`` is meant); with ``polygons``
+    (m, p > 3) faces are fanned into triangles and ``note`` says so.  A :class:`MeshError`
+    naming what is wrong and how to fix it otherwise."""
     try:
         v = np.array(vertices, dtype=np.float64)
         f = np.asarray(faces)
@@ -170,25 +160,10 @@ def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
 
 
 class Mesh:
-    """A validated triangle mesh.
-
-    Parameters
-    ----------
-    vertices : (n, 3) vertex positions (any length unit); converted to float64.
-    faces : (m, 3) vertex indices of each triangle; converted to int64.
-    report : what loading found and repaired (:class:`MeshReport`).
-    file_map : only for a solver mesh (:attr:`solver_mesh`): (n_file,), for each vertex
-        of the input its vertex in this mesh, or -1 where no face uses it
-        (:attr:`file_to_mesh`).  None: the mesh's numbering is the input's.
-    merged_into : (n,) for each vertex the vertex it was merged into (itself where none);
-        a merged vertex is used by no face and takes that vertex's values.
-
-    Raises
-    ------
-    MeshError
-        If there are no faces, coordinates are not finite, indices are out of
-        range, a face repeats a vertex or has zero area.
-    """
+    """A validated triangle mesh; a :class:`MeshError` for no faces, coordinates not
+    finite, indices out of range, or a face that repeats a vertex or has zero area.
+    ``file_map`` is only for a :attr:`solver_mesh` (:attr:`file_to_mesh`);
+    ``merged_into``: :attr:`merged_into`."""
 
     def __init__(
         self,
@@ -294,9 +269,7 @@ class Mesh:
     @cached_property
     def solver_mesh(self) -> Mesh:
         """The mesh the solvers work on: this one's vertices that faces use, in their
-        order (the mesh itself where all are used and none merged).  Its
-        :attr:`file_to_mesh`, :attr:`file_vertices` and :meth:`to_file_field` map to and
-        from this mesh's numbering (NaN at unused vertices)."""
+        order (the mesh itself where all are used and none merged), with the maps back."""
         if self._file_map is not None or (self._merged is None and self._in_face.all()):
             return self
         rep = np.flatnonzero(self._in_face)
@@ -309,14 +282,13 @@ class Mesh:
             file_map=compact[self.merged_into],
         )
         rep.setflags(write=False)
-        solver.__dict__["_first_file_vertex"] = rep  # the input's vertex of each
+        solver.__dict__["file_vertices"] = rep  # the input's vertex of each
         solver._input = self
         return solver
 
     @property
     def input_mesh(self) -> Mesh:
-        """For a :attr:`solver_mesh`, the mesh in the input's numbering it was made from;
-        for any other mesh the mesh itself."""
+        """The mesh a :attr:`solver_mesh` was made from; any other mesh itself."""
         return self._input if self._input is not None else self
 
     # --------------------------------------------------- the file's numbering
@@ -345,21 +317,17 @@ class Mesh:
         return self._file_map
 
     @cached_property
-    def _first_file_vertex(self) -> np.ndarray:
+    def file_vertices(self) -> np.ndarray:
+        """(n,) int64: each mesh vertex's index in the file (for merged duplicates the
+        first of them)."""
         fm = self._file_map
+        if fm is None:
+            return np.arange(self.n_vertices)
         out = np.full(self.n_vertices, len(fm), dtype=np.int64)
         used = np.flatnonzero(fm >= 0)
         np.minimum.at(out, fm[used], used)
         out.setflags(write=False)
         return out
-
-    @property
-    def file_vertices(self) -> np.ndarray:
-        """(n,) int64: each mesh vertex's index in the file (for merged duplicates the
-        first of them)."""
-        if self._file_map is None:
-            return np.arange(self.n_vertices)
-        return self._first_file_vertex
 
     def file_vertex(self, index: int) -> int:
         """The input's number of vertex ``index`` of a solver mesh (the vertex a face
@@ -370,7 +338,7 @@ class Mesh:
                 f"mesh vertex {index} does not exist (the mesh has "
                 f"{_plural(self.n_vertices, 'vertex')})"
             )
-        return index if self._file_map is None else int(self._first_file_vertex[index])
+        return int(self.file_vertices[index])
 
     def mesh_vertex(self, file_index: int) -> int:
         """The mesh vertex of vertex ``file_index`` of the file; a :class:`MeshError` if
@@ -412,10 +380,8 @@ class Mesh:
     def file_map_after(self, new_of_old: np.ndarray) -> np.ndarray | None:
         """The ``file_map`` of a mesh made from this one whose vertex ``new_of_old[i]``
         is this mesh's vertex i (-1 for vertices it does not keep)."""
-        new_of_old = np.asarray(new_of_old, dtype=np.int64)
         fm = self.file_to_mesh
-        out = np.where(fm >= 0, new_of_old[np.maximum(fm, 0)], -1)
-        return out
+        return np.where(fm >= 0, np.asarray(new_of_old)[np.maximum(fm, 0)], -1)
 
     @cached_property
     def hash(self) -> str:
@@ -489,12 +455,6 @@ class Mesh:
         """Number of parts whose faces are connected through shared edges: more than
         :attr:`n_components` where parts meet only at vertices (a part meeting the rest
         at a single vertex can rotate about it: three more zero modes of the shells)."""
-        return int(self.face_component_labels.max(initial=-1)) + 1
-
-    @cached_property
-    def face_component_labels(self) -> np.ndarray:
-        """(m,) label of each face's part, faces connected through shared edges (see
-        :attr:`n_face_components`)."""
         # faces joined through each edge's consecutive faces (int32 throughout: the
         # graph's arrays are the load's largest temporaries)
         F = self.n_faces
@@ -505,7 +465,7 @@ class Mesh:
         del order, shared
         graph = sp.csr_matrix((np.ones(len(a), dtype=np.float32), (a, b)), shape=(F, F))
         del a, b
-        return connected_components(graph, directed=False)[1]
+        return int(connected_components(graph, directed=False)[0])
 
     @cached_property
     def component_labels(self) -> np.ndarray:

@@ -22,6 +22,7 @@ from .cost import (
     factor_goes_out_of_core,
     float32_basis_saving_mb,
 )
+from .memory import memory_limit_mb
 
 __all__ = [
     "DEFAULT_K",
@@ -61,54 +62,40 @@ two ``normal`` rules need the vertex normals."""
 class OperatorInfo:
     """What the viewer and the library need to know about one operator.
 
-    name : key used in files, the API and the cache.
-    label : words for menus, legends and titles.
-    short_label : a few words for narrow places (comparison titles, plot legends).
-    unknowns_per_vertex : 3 for displacement fields, 1 for scalar fields.
-    distance_kind : the multi-scale distance this operator's spectrum defines, or None.
-    has_weights : whether the bending and membrane weights apply.
+    name : key used in files, the API and the cache; label : words for menus, legends
+    and titles; short_label : a few words for narrow places.
     assemble : the function that assembles K, or its ``"module:function"`` in
-        :mod:`modalviewer.core`, called as ``function(mesh)`` or, with weights,
-        ``function(mesh, bending, membrane)``.
-    null_space : the exactly known null vectors in words.
-    null_space_rule : how they are built, a key of :data:`NULL_SPACE_RULES`.
-    exact_growth : measured peak memory of the exact solve against mesh size
-        (:class:`.cost.GrowthLaw`), which the memory check predicts from.
-    factor_memory : the factor's size in core and out of core against mesh size
-        (:class:`.cost.FactorLaw`).
-    signature_word : the signature (and distance) its spectrum defines, in words
-        ("heat kernel"), or None.
-    assembles_mass : whether :attr:`assemble` returns (K, mass (n,)); otherwise the mass
-        is the lumped vertex area.
-    measured_as : the operator whose measured laws this one borrows, or None (its own
-        runs are in ``benchmarks/results/growth.json``).
+        :mod:`modalviewer.core`, called as ``function(mesh)`` or, with
+        ``has_weights``, ``function(mesh, bending, membrane)``; with ``assembles_mass``
+        it returns (K, mass (n,)), otherwise the mass is the lumped vertex area.
+    null_space : the exactly known null vectors in words; null_space_rule : how they are
+        built, a key of :data:`NULL_SPACE_RULES`.
+    exact_growth, factor_memory : the exact solve's measured peak memory and its factor's
+        size against mesh size (:class:`.cost.GrowthLaw`, :class:`.cost.FactorLaw`),
+        which the memory check predicts from; ``measured_as``: the operator whose laws
+        these are, where not its own (``benchmarks/results/growth.json``).
+    distance_kind, wave_distance_kind : the multi-scale (and wave kernel) distance its
+        spectrum defines, or None; signature_word : that signature in words.
     nonnegative_weights : whether its weights stay non-negative on any mesh (the viewer
         suggests it where the cotan weights go negative).
-    wave_distance_kind : the wave kernel distance the viewer and the CLI offer for its
-        spectrum (``"wks"`` for the Laplacian), or None.
     """
 
     name: str
     label: str
     short_label: str
-    unknowns_per_vertex: int
-    distance_kind: str | None
-    has_weights: bool
     assemble: str | Callable
     null_space: str
-    null_space_rule: str
     exact_growth: GrowthLaw
+    null_space_rule: str = "constants"
+    unknowns_per_vertex: int = 1
+    has_weights: bool = False
     factor_memory: FactorLaw | None = None
+    distance_kind: str | None = None
     signature_word: str | None = None
     wave_distance_kind: str | None = None
     assembles_mass: bool = False
     measured_as: str | None = None
     nonnegative_weights: bool = False
-
-    @property
-    def vector(self) -> bool:
-        """True for 3-vector (displacement) fields, False for scalar fields."""
-        return self.unknowns_per_vertex == 3
 
     def unknowns(self, n_vertices: int) -> int:
         return self.unknowns_per_vertex * int(n_vertices)
@@ -126,14 +113,14 @@ class OperatorInfo:
         Krylov basis (:func:`.cost.float32_basis_saving_mb`); None for either: as the
         solver decides against :func:`.memory.memory_limit_mb`."""
         peak = self._in_core_peak_mb(n_vertices, k)
-        if self._out_of_core(n_vertices, k, out_of_core):
-            factor = self.factor_memory
+        if out_of_core is None:
+            out_of_core = self.factor_out_of_core(n_vertices, k)
+        factor = self.factor_memory
+        if out_of_core and factor is not None:
             peak += FILL_MARGIN * (
                 factor.out_of_core_mb(n_vertices) - factor.in_core_mb(n_vertices)
             )
         if basis_float32 is None:
-            from .memory import memory_limit_mb
-
             limit_mb = memory_limit_mb()
             basis_float32 = limit_mb is not None and peak > limit_mb
         if basis_float32:
@@ -144,34 +131,20 @@ class OperatorInfo:
         self, n_vertices: int, k: int = DEFAULT_K, limit_mb: float | None = None
     ) -> bool:
         """Whether the exact solve of ``k`` modes on ``n_vertices`` is predicted to keep
-        its factor in a file: its in-core peak above ``limit_mb`` (None: this machine's
-        :func:`.memory.memory_limit_mb`), as the solver decides
-        (:func:`.cost.factor_goes_out_of_core`)."""
-        if limit_mb is None:
-            from .memory import memory_limit_mb
-
-            limit_mb = memory_limit_mb()
+        its factor in a file (:func:`.cost.factor_goes_out_of_core`; ``limit_mb`` None:
+        this machine's :func:`.memory.memory_limit_mb`)."""
+        limit_mb = memory_limit_mb() if limit_mb is None else limit_mb
         peak = self._in_core_peak_mb(n_vertices, k)
         return factor_goes_out_of_core(peak, self.factor_memory, n_vertices, limit_mb)
 
     def _in_core_peak_mb(self, n_vertices: int, k: int) -> float:
-        """The exact solve's predicted peak with its factor in core: the law with the
-        arrays that grow with k (:func:`.cost.exact_peak_mb`) and the factor at
-        :data:`.cost.FILL_MARGIN` times its law."""
+        """The predicted peak with the factor in core: the law with the arrays that grow
+        with k, and the factor at :data:`.cost.FILL_MARGIN` times its law (curved meshes
+        fill in more than the plates the law comes from)."""
         peak = exact_peak_mb(self.exact_growth, n_vertices, self.unknowns(n_vertices), k)
-        return peak + self._further_fill_mb(n_vertices)
-
-    def _further_fill_mb(self, n_vertices: int) -> float:
-        """What a factor in core fills in on a curved mesh beyond the plates' law
-        (:data:`.cost.FILL_MARGIN`)."""
-        if self.factor_memory is None:
-            return 0.0
-        return (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
-
-    def _out_of_core(self, n_vertices: int, k: int, out_of_core: bool | None) -> bool:
-        if out_of_core is None:
-            return self.factor_out_of_core(n_vertices, k)
-        return bool(out_of_core) and self.factor_memory is not None
+        if self.factor_memory is not None:
+            peak += (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
+        return peak
 
     @property
     def null_space_needs_normals(self) -> bool:
@@ -192,26 +165,13 @@ class OperatorInfo:
         return result, lumped_masses(mesh)
 
 
-# exact_growth: the memory fits of benchmarks/results/growth.json (bumpy plates of 100k to
-# 1M vertices, 100 modes), made by `python -m benchmarks.growth`; tests/core/test_cost.py
-# checks that they are those fits.
-_GROWTH: dict[str, GrowthLaw] = {
-    "laplacian": GrowthLaw(410.0, 0.864),
-    "modified_dirichlet": GrowthLaw(411.7, 0.864),
-    "shells": GrowthLaw(1549.9, 1.026),
-    "shells_normal": GrowthLaw(454.2, 0.893),
-}
-
-# factor_memory: the fits of benchmarks/results/factor_memory.json (PARDISO's analysis of
-# the bumpy plates of 100k to 1M vertices), made by `python -m benchmarks.factor_memory`;
+# exact_growth, factor_memory: the fits of benchmarks/results/growth.json and
+# factor_memory.json (bumpy plates of 100k to 1M vertices, 100 modes), made by
+# `python -m benchmarks.growth` and `python -m benchmarks.factor_memory`;
 # tests/core/test_cost.py checks that they are those fits.  Curved meshes fill in 1.1 to
-# 1.2 times more (spot Loop x3, hand Loop x2: the same file's curved rows).
-_FACTOR: dict[str, FactorLaw] = {
-    "laplacian": FactorLaw(60.0, 1.042, 106.8, 0.689),
-    "modified_dirichlet": FactorLaw(60.0, 1.042, 106.8, 0.689),
-    "shells": FactorLaw(855.7, 1.087, 519.8, 0.952),
-    "shells_normal": FactorLaw(110.9, 1.082, 125.8, 0.752),
-}
+# 1.2 times more (spot Loop x3, hand Loop x2: factor_memory.json's curved rows).
+_LAPLACIAN_GROWTH = GrowthLaw(410.0, 0.864)
+_SCALAR_FACTOR = FactorLaw(60.0, 1.042, 106.8, 0.689)
 
 OPERATOR_INFO: dict[str, OperatorInfo] = {
     info.name: info
@@ -220,14 +180,11 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             "laplacian",
             "Laplacian (cotan)",
             "Laplacian",
-            unknowns_per_vertex=1,
-            distance_kind="hks",
-            has_weights=False,
             assemble="laplacian:stiffness_matrix",
             null_space="constants",
-            null_space_rule="constants",
-            exact_growth=_GROWTH["laplacian"],
-            factor_memory=_FACTOR["laplacian"],
+            exact_growth=_LAPLACIAN_GROWTH,
+            factor_memory=_SCALAR_FACTOR,
+            distance_kind="hks",
             signature_word="heat kernel",
             wave_distance_kind="wks",
         ),
@@ -235,45 +192,39 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             "modified_dirichlet",
             "Modified Dirichlet energy E_D^N",
             "E_D^N",
-            unknowns_per_vertex=1,
-            distance_kind="feature",
-            has_weights=False,
             assemble="dirichlet:modified_dirichlet_matrix",
             null_space="constants of flat components",
             null_space_rule="normal translations",
-            exact_growth=_GROWTH["modified_dirichlet"],
-            factor_memory=_FACTOR["modified_dirichlet"],
+            exact_growth=GrowthLaw(411.7, 0.864),
+            factor_memory=_SCALAR_FACTOR,
+            distance_kind="feature",
             signature_word="feature",
         ),
         OperatorInfo(
             "shells",
             "Discrete Shells (3D vibrations)",
             "Shells 3D",
-            unknowns_per_vertex=3,
-            distance_kind="vibration",
-            has_weights=True,
             assemble="shells:shells_hessian",
             null_space="rigid motions",
             null_space_rule="rigid motions",
-            exact_growth=_GROWTH["shells"],
-            factor_memory=_FACTOR["shells"],
+            unknowns_per_vertex=3,
+            has_weights=True,
+            exact_growth=GrowthLaw(1549.9, 1.026),
+            factor_memory=FactorLaw(855.7, 1.087, 519.8, 0.952),
+            distance_kind="vibration",
             signature_word="vibration",
         ),
         OperatorInfo(
             "laplacian_robust",
             "Laplacian (robust, intrinsic Delaunay)",
             "Robust Laplacian",
-            unknowns_per_vertex=1,
-            distance_kind=None,
-            has_weights=False,
             assemble="robust:robust_laplacian_matrices",
+            assembles_mass=True,
             null_space="constants",
-            null_space_rule="constants",
             # the cotan Laplacian's laws: as many unknowns, a matrix of about the same
             # sparsity (the intrinsic flips replace edges, keeping their number)
-            exact_growth=_GROWTH["laplacian"],
-            factor_memory=_FACTOR["laplacian"],
-            assembles_mass=True,
+            exact_growth=_LAPLACIAN_GROWTH,
+            factor_memory=_SCALAR_FACTOR,
             measured_as="laplacian",
             nonnegative_weights=True,
         ),
@@ -281,14 +232,12 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             "shells_normal",
             "Discrete Shells, normal variations",
             "Shells normal",
-            unknowns_per_vertex=1,
-            distance_kind=None,
-            has_weights=True,
             assemble="shells:normal_shells_hessian",
             null_space="normal rigid motions of flat components",
             null_space_rule="normal rigid motions",
-            exact_growth=_GROWTH["shells_normal"],
-            factor_memory=_FACTOR["shells_normal"],
+            has_weights=True,
+            exact_growth=GrowthLaw(454.2, 0.893),
+            factor_memory=FactorLaw(110.9, 1.082, 125.8, 0.752),
         ),
     )
 }

@@ -99,7 +99,6 @@ def test_every_registry_entry_is_complete(name):
     info = OPERATOR_INFO[name]
     assert info.name == name
     assert info.unknowns_per_vertex in (1, 3)
-    assert info.vector == (info.unknowns_per_vertex == 3)
     assert info.null_space_rule in NULL_SPACE_RULES
     assert info.null_space
     assert info.distance_kind is None or info.distance_kind in DISTANCE_KINDS
