@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -74,68 +75,59 @@ def count_text(count: int, singular: str, plural: str) -> str:
     return f"{count} {singular if count == 1 else plural}"
 
 
-def _check_last_line(text: str, damage: _Damage, record: str) -> None:
-    """A text file whose last record has no line break may have been cut inside it."""
+def _check_last_line(text: str, damage: _Damage, record, first: int = 1) -> None:
+    """A text whose last record has no line break may have been cut inside it (``first``:
+    the file's number of the text's first line)."""
     stripped = text.rstrip(" \t")
     if stripped and not stripped.endswith(("\n", "\r")):
         last = stripped.splitlines()[-1].strip()
         if last and not last.startswith("#") and (record == "" or last.split()[0] in record):
             damage.note(
-                f"line {stripped.count(chr(10)) + 1}",
+                f"line {stripped.count(chr(10)) + first}",
                 f"the file ends inside the record '{last[:40]}' without a line break: "
                 "it may be cut there, and that record may be wrong",
             )
 
 
-def _fan(polygon: list[int]) -> list[tuple[int, int, int]]:
-    return [(polygon[0], polygon[i], polygon[i + 1]) for i in range(1, len(polygon) - 1)]
-
-
-def _check_indices(faces: list, n_vertices: int, damage: _Damage, place) -> list:
-    """Faces whose indices all exist; the others reported at ``place(i)``."""
-    kept = []
-    for i, face in enumerate(faces):
-        bad = [j for j in face if j < 0 or j >= n_vertices]
-        if bad:
+def _mesh_file(vertices, polygons: list, unplaced: list, damage: _Damage, place) -> MeshFile:
+    """The vertices (every record, in the file's order) and the polygons fanned into
+    triangles, less the faces with fewer than three corners or naming a vertex the file
+    does not have (each reported at ``place(i)``) and, with ``strict=False``, those using
+    one of the ``unplaced`` vertices, whose records were incomplete.  Those vertices stay,
+    used by no face, so that the vertices after them keep the file's numbers; they are
+    put outside the bounding box of the others, where no repair can take them for a
+    duplicate of a real vertex."""
+    vertices = np.array(vertices, dtype=np.float64).reshape(-1, 3)
+    n, kept = len(vertices), []
+    for i, face in enumerate(polygons):
+        bad = [j for j in face if j < 0 or j >= n]
+        if len(face) < 3:
+            damage(place(i), "the face has fewer than three corners")
+        elif bad:
             damage(
                 place(i),
                 f"the face names vertex {bad[0]} but the file has only "
-                f"{count_text(n_vertices, 'vertex', 'vertices')}"
-                " (numbered from 0)",
+                f"{count_text(n, 'vertex', 'vertices')} (numbered from 0)",
             )
-            continue
-        kept.append(face)
-    return kept
-
-
-def _without_unplaced(vertices: np.ndarray, polygons: list, unplaced: list, damage) -> list:
-    """The faces that use none of the ``unplaced`` vertices (whose records were
-    incomplete: ``strict=False`` only).  Those vertices stay, used by no face, so that the
-    vertices after them keep the file's numbers; they are put outside the bounding box of
-    the others, where no repair can take them for a duplicate of a real vertex."""
-    if not unplaced:
-        return polygons
-    placed = np.delete(vertices, unplaced, axis=0)
-    if len(placed):
-        low, high = placed.min(axis=0), placed.max(axis=0)
-        outside = high + (high - low).max() + 1.0
-    else:
-        outside = np.zeros(3)
-    vertices[unplaced] = outside + np.arange(len(unplaced))[:, None]
-    bad = np.zeros(len(vertices), dtype=bool)
-    bad[unplaced] = True
-    kept = [p for p in polygons if not bad[p].any()]
-    if len(kept) < len(polygons):
-        dropped = count_text(len(polygons) - len(kept), "face", "faces")
-        damage.note("faces", f"{dropped} using a vertex whose record was incomplete dropped")
-    return kept
-
-
-def _triangles(polygons: list) -> np.ndarray:
-    if polygons and all(len(p) == 3 for p in polygons):
-        return np.array(polygons, dtype=np.int64).reshape(-1, 3)
-    tris = [t for p in polygons for t in _fan(p)]
-    return np.array(tris, dtype=np.int64).reshape(-1, 3)
+        else:
+            kept.append(face)
+    if unplaced:
+        placed = np.delete(vertices, unplaced, axis=0)
+        if len(placed):
+            low, high = placed.min(axis=0), placed.max(axis=0)
+            outside = high + (high - low).max() + 1.0
+        else:
+            outside = np.zeros(3)
+        vertices[unplaced] = outside + np.arange(len(unplaced))[:, None]
+        used = np.zeros(n, dtype=bool)
+        used[unplaced] = True
+        whole = [p for p in kept if not used[p].any()]
+        if len(whole) < len(kept):
+            dropped = count_text(len(kept) - len(whole), "face", "faces")
+            damage.note("faces", f"{dropped} using a vertex whose record was incomplete dropped")
+        kept = whole
+    triangles = [(p[0], p[i], p[i + 1]) for p in kept for i in range(1, len(p) - 1)]  # fanned
+    return MeshFile(vertices, np.array(triangles, dtype=np.int64).reshape(-1, 3), damage.notes)
 
 
 def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
@@ -198,10 +190,25 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
             "such as an image, with the name of a mesh file?)"
         )
     text = data.decode("utf-8", "replace")
+    _check_last_line(text, damage, ("v", "f"))
     fast = _read_obj_fast(text)
-    if fast is not None:
-        _check_last_line(text, damage, ("v", "f"))
-        return MeshFile(fast[0], fast[1], damage.notes)
+    result = _obj_records(text, damage) if fast is None else MeshFile(*fast, damage.notes)
+    used = np.zeros(len(result.vertices), dtype=bool)
+    used[result.faces.ravel()] = True
+    unused = int((~used).sum())
+    # a file cut between two face records ends in a face record and leaves vertices no
+    # face uses; one that ends in a comment ("# End of File") or another record does not
+    tail = [line.strip() for line in text[-4096:].splitlines() if line.strip()]
+    if unused and len(result.faces) and tail[-1].startswith(("f ", "f\t")):
+        result.notes.append(
+            f"the file ends with a face record and {count_text(unused, 'vertex', 'vertices')} "
+            f"of it {'is' if unused == 1 else 'are'} used by no face: it may be truncated (a "
+            "file cut between two face records leaves such vertices)"
+        )
+    return result
+
+
+def _obj_records(text: str, damage: _Damage) -> MeshFile:
     vertices: list = []
     unplaced: list = []
     polygons: list = []
@@ -232,100 +239,35 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
             # OBJ numbers from 1; negative numbers count back from the last vertex read
             polygons.append([c - 1 if c > 0 else n + c for c in corners])
             face_lines.append(number)
-    polygons = _check_indices(polygons, len(vertices), damage, lambda i: f"line {face_lines[i]}")
-    _check_last_line(text, damage, ("v", "f"))
-    v = np.array(vertices, dtype=np.float64).reshape(-1, 3)
-    polygons = _without_unplaced(v, polygons, unplaced, damage)
-    return MeshFile(v, _triangles(polygons), damage.notes)
+    return _mesh_file(vertices, polygons, unplaced, damage, lambda i: f"line {face_lines[i]}")
 
 
 # --------------------------------------------------------------------------- OFF
 
 
-def _read_off_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
-    """Vertices and triangles of a well-formed OFF of triangles without comments or
-    colours (the counts met exactly); None for any other file, which the record-by-record
-    reader then reads and checks."""
-    if "#" in text:
-        return None
-    rows = [row for row in text.splitlines() if row.strip()]
-    head = rows[0].split() if rows else []
-    if not head or head[0] != "OFF":
-        return None
-    if len(head) == 1:
-        head, rows = rows[1].split() if len(rows) > 1 else [], rows[1:]
-    try:
-        n, m = int(head[0]), int(head[1])
-    except (ValueError, IndexError):
-        return None
-    if len(rows) != 1 + n + m:
-        return None
-    vertices = _numbers(rows[1 : 1 + n], 3, np.float64)
-    faces = None if vertices is None else _triangle_rows(rows[1 + n :], n)
-    return None if faces is None else (vertices, faces)
-
-
 def _read_off(path: Path, strict: bool) -> MeshFile:
-    damage = _Damage(path.name, strict)
-    text = path.read_bytes().decode("utf-8", "replace")
-    fast = _read_off_fast(text)
-    if fast is not None:
-        _check_last_line(text, damage, "")
-        return MeshFile(fast[0], fast[1], damage.notes)
-    lines = []
-    for number, line in enumerate(text.splitlines(), start=1):
-        words = line.split("#", 1)[0].split()
-        if words:
-            lines.append((number, words))
-    if not lines or not lines[0][1][0].upper().endswith("OFF"):
+    """An OFF file is read as an ASCII PLY of its vertex and face elements, after its
+    header: "OFF" and the counts, on one line or two, comments allowed."""
+    lines = path.read_bytes().decode("utf-8", "replace").splitlines(keepends=True)
+    head: list[str] = []
+    start = 0
+    while len(head) < 3 and start < len(lines):
+        head += lines[start].split("#", 1)[0].split()
+        start += 1
+    if not head or not head[0].upper().endswith("OFF"):
         raise MeshError(f"{path.name}: not an OFF file (the first line is not 'OFF')")
-    head = lines[0][1][1:]
-    rest = lines[1:]
-    if not head:
-        if not rest:
-            raise MeshError(f"{path.name}: the OFF file ends before its vertex and face counts")
-        head, rest = rest[0][1], rest[1:]
+    if len(head) < 3:
+        raise MeshError(f"{path.name}: the OFF file ends before its vertex and face counts")
     try:
-        n_vertices, n_faces = int(head[0]), int(head[1])
-    except (ValueError, IndexError):
+        n_vertices, n_faces = int(head[1]), int(head[2])
+    except ValueError:
         raise MeshError(f"{path.name}: the OFF counts line is not 'vertices faces edges'") from None
-    vertices, unplaced = [], []
-    for i in range(n_vertices):
-        if i >= len(rest):
-            damage.ends_early(f"vertex {i}", i, count_text(n_vertices, "vertex", "vertices"))
-            break
-        number, words = rest[i]
-        try:
-            xyz = [float(w) for w in words[:3]]
-        except ValueError:
-            xyz = []
-        if len(xyz) < 3:
-            damage(f"line {number} (vertex {i})", "the vertex record is incomplete")
-            unplaced.append(i)
-            xyz = [np.nan] * 3
-        vertices.append(xyz)
-    polygons, places = [], []
-    face_rows = rest[n_vertices:] if len(rest) > n_vertices else []
-    for i in range(n_faces):
-        if i >= len(face_rows):
-            damage.ends_early(f"face {i}", i, count_text(n_faces, "face", "faces"))
-            break
-        number, words = face_rows[i]
-        try:
-            count = int(words[0])
-            corners = [int(w) for w in words[1 : 1 + count]]
-        except ValueError:
-            count, corners = 0, []
-        if count < 3 or len(corners) < count:
-            damage(f"line {number} (face {i})", "the face record is incomplete")
-            continue
-        polygons.append(corners)
-        places.append(f"line {number} (face {i})")
-    polygons = _check_indices(polygons, len(vertices), damage, lambda i: places[i])
-    _check_last_line(text, damage, "")
-    v = np.array(vertices, dtype=np.float64).reshape(-1, 3)
-    polygons = _without_unplaced(v, polygons, unplaced, damage)
-    return MeshFile(v, _triangles(polygons), damage.notes)
+    elements = [
+        ("vertex", n_vertices, [(c, ["double"]) for c in "xyz"]),
+        ("face", n_faces, [("vertex_indices", ["list", "uchar", "int"])]),
+    ]
+    body = "".join(lines[start:])
+    return _read_ascii(path, elements, body, start + 1, _Damage(path.name, strict))
 
 
 # --------------------------------------------------------------------------- PLY
@@ -379,7 +321,7 @@ def _ply_header(path: Path, data: bytes):
     return fmt, elements, body
 
 
-def _ply_binary(name, count, props, body, offset, order, damage):
+def _ply_binary(body, order, damage, name, count, props, offset):
     """Rows of one binary element: a dict of columns; the offset after it; rows read."""
     if all(types[0] != "list" for _, types in props):
         dtype = np.dtype([(p, order + _PLY_TYPES[t[0]]) for p, t in props])
@@ -430,7 +372,7 @@ def _ply_binary(name, count, props, body, offset, order, damage):
     return columns, offset, count
 
 
-def _ply_ascii(name, count, props, lines, line_index, damage):
+def _ply_ascii(lines, damage, name, count, props, line_index):
     columns: dict = {p: [] for p, _ in props}
     for i in range(count):
         if line_index >= len(lines):
@@ -462,11 +404,11 @@ def _ply_ascii(name, count, props, lines, line_index, damage):
     return columns, line_index, count
 
 
-def _read_ply_ascii_fast(elements, body: bytes) -> tuple[np.ndarray, np.ndarray] | None:
-    """Vertices and triangles of a well-formed ASCII PLY of scalar vertex properties and
-    triangles only (the counts met exactly); None for any other file, which the
-    record-by-record reader then reads and checks."""
-    if [name for name, _, _ in elements] != ["vertex", "face"]:
+def _ascii_fast(elements, body: str) -> tuple[np.ndarray, np.ndarray] | None:
+    """Vertices and triangles of a well-formed ASCII body of scalar vertex properties and
+    triangles only, without comments (the counts met exactly), parsed by numpy in one
+    go; None for any other, which the record-by-record reader then reads and checks."""
+    if [name for name, _, _ in elements] != ["vertex", "face"] or "#" in body:
         return None
     (_, n, vertex_props), (_, m, face_props) = elements
     names = [prop for prop, _ in vertex_props]
@@ -474,7 +416,7 @@ def _read_ply_ascii_fast(elements, body: bytes) -> tuple[np.ndarray, np.ndarray]
         return None
     if len(face_props) != 1 or face_props[0][0] not in _FACE_LISTS:
         return None
-    rows = [row for row in body.decode("ascii", "replace").splitlines() if row.strip()]
+    rows = [row for row in body.splitlines() if row.strip()]
     if len(rows) != n + m:
         return None
     table = _numbers(rows[:n], len(names), np.float64)
@@ -484,30 +426,39 @@ def _read_ply_ascii_fast(elements, body: bytes) -> tuple[np.ndarray, np.ndarray]
     return np.ascontiguousarray(table[:, [names.index(c) for c in "xyz"]]), faces
 
 
+def _read_ascii(path: Path, elements, body: str, first: int, damage: _Damage) -> MeshFile:
+    """The elements of an ASCII PLY's or an OFF file's ``body``, whose first line is the
+    file's line ``first``."""
+    _check_last_line(body, damage, "", first)
+    fast = _ascii_fast(elements, body)
+    if fast is not None:
+        return MeshFile(*fast, damage.notes)
+    lines = []
+    for number, line in enumerate(body.splitlines(), start=first):
+        words = line.split("#", 1)[0].split()
+        if words:
+            lines.append((number, words))
+    return _read_elements(path, elements, partial(_ply_ascii, lines, damage), damage)
+
+
 def _read_ply(path: Path, strict: bool) -> MeshFile:
     damage = _Damage(path.name, strict)
     data = path.read_bytes()
     fmt, elements, body = _ply_header(path, data)
-    header_lines = data[: len(data) - len(body)].count(b"\n")
-    order = "<" if fmt == "binary_little_endian" else ">"
-    fast = _read_ply_ascii_fast(elements, body) if fmt == "ascii" else None
-    if fast is not None:
-        _check_last_line(body.decode("ascii", "replace"), damage, "")
-        return MeshFile(fast[0], fast[1], damage.notes)
     if fmt == "ascii":
-        lines = []
-        for number, line in enumerate(body.decode("ascii", "replace").splitlines()):
-            words = line.split()
-            if words:
-                lines.append((number + header_lines + 1, words))
-        _check_last_line(body.decode("ascii", "replace"), damage, "")
+        first = data[: len(data) - len(body)].count(b"\n") + 1
+        return _read_ascii(path, elements, body.decode("ascii", "replace"), first, damage)
+    order = "<" if fmt == "binary_little_endian" else ">"
+    return _read_elements(path, elements, partial(_ply_binary, body, order, damage), damage)
+
+
+def _read_elements(path: Path, elements, read, damage: _Damage) -> MeshFile:
+    """The mesh of a PLY's ``elements`` (name, count, properties), each read by
+    ``read(name, count, properties, position)`` -> (columns, position after, rows read)."""
     cursor = 0
     vertices, polygons, unplaced = None, [], []
     for name, count, props in elements:
-        if fmt == "ascii":
-            columns, cursor, rows = _ply_ascii(name, count, props, lines, cursor, damage)
-        else:
-            columns, cursor, rows = _ply_binary(name, count, props, body, cursor, order, damage)
+        columns, cursor, rows = read(name, count, props, cursor)
         if name == "vertex":
             missing = [c for c in "xyz" if c not in columns]
             if missing:
@@ -525,7 +476,7 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
                 strips = [np.asarray(s) for s in lists if s is not None]
                 polygons += [list(t) for s in strips for t in strips_to_triangles(s)]
             elif isinstance(lists, np.ndarray):
-                polygons = lists  # the fast path's (m, 3) array
+                polygons = lists  # the binary fast path's (m, 3) array
             else:
                 polygons += [list(p) for p in lists if p is not None]
         if rows < count:
@@ -535,20 +486,14 @@ def _read_ply(path: Path, strict: bool) -> MeshFile:
     n = len(vertices)
     if isinstance(polygons, np.ndarray):
         bad = np.flatnonzero(np.any((polygons < 0) | (polygons >= n), axis=1))
-        for i in bad[:1] if strict else bad:
+        for i in bad[:1] if damage.strict else bad:
             damage(
                 f"face {i}",
                 f"the face names vertex {polygons[i][(polygons[i] < 0) | (polygons[i] >= n)][0]}"
                 f" but the file has only {count_text(n, 'vertex', 'vertices')} (numbered from 0)",
             )
         return MeshFile(vertices, np.delete(polygons, bad, axis=0), damage.notes)
-    short = [i for i, p in enumerate(polygons) if len(p) < 3]
-    for i in short:
-        damage(f"face {i}", "the face has fewer than three corners")
-    polygons = [p for p in polygons if len(p) >= 3]
-    polygons = _check_indices(polygons, n, damage, lambda i: f"face {i}")
-    polygons = _without_unplaced(vertices, polygons, unplaced, damage)
-    return MeshFile(vertices, _triangles(polygons), damage.notes)
+    return _mesh_file(vertices, polygons, unplaced, damage, lambda i: f"face {i}")
 
 
 # --------------------------------------------------------------------------- STL
@@ -659,25 +604,4 @@ def read_mesh_file(path, strict: bool = True) -> MeshFile:
     ``strict=True`` at the first damaged or missing record, naming the file, the line or
     element and what is missing."""
     path = Path(path)
-    result = READERS[path.suffix.lower()](path, strict)
-    used = np.zeros(len(result.vertices), dtype=bool)
-    used[result.faces.ravel()] = True
-    unused = int((~used).sum())
-    if unused and len(result.faces) and path.suffix.lower() == ".obj" and _ends_in_face(path):
-        result.notes.append(
-            f"the file ends with a face record and {count_text(unused, 'vertex', 'vertices')} "
-            f"of it {'is' if unused == 1 else 'are'} used by no face: it may be truncated (a "
-            "file cut between two face records leaves such vertices)"
-        )
-    return result
-
-
-def _ends_in_face(path: Path) -> bool:
-    """Whether the last record of an OBJ file is a face ("f ..."): a file cut between two
-    face records ends so, one that ends in a comment (``# End of File``) or another
-    record does not."""
-    with open(path, "rb") as fh:
-        fh.seek(max(0, path.stat().st_size - 4096))
-        lines = [line.strip() for line in fh.read().splitlines()]
-    last = next((line for line in reversed(lines) if line), b"")
-    return last.startswith((b"f ", b"f\t"))
+    return READERS[path.suffix.lower()](path, strict)

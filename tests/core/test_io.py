@@ -39,7 +39,7 @@ def test_formats_round_trip(tmp_path, ext):
 
 @pytest.mark.parametrize(
     ("ext", "fast_path"),
-    [(".off", "_read_off_fast"), (".ply", "_read_ply_ascii_fast"), (".obj", "_read_obj_fast")],
+    [(".off", "_ascii_fast"), (".ply", "_ascii_fast"), (".obj", "_read_obj_fast")],
 )
 def test_the_fast_readers_read_what_the_record_readers_read(tmp_path, monkeypatch, ext, fast_path):
     """Well-formed text files go through numpy in one go; the arrays are those of the
