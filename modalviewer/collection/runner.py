@@ -29,7 +29,6 @@ from .store import (
     read_entry,
     rebuild_index,
     shape_dna,
-    status_failed,
     write_entry,
     write_error,
 )
@@ -181,14 +180,12 @@ def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
     for ``kind="wks"`` of log10(A W_E(v)) at energies of the default band."""
     from ..core.signatures import default_energies, default_times, signature, wks_sigma
 
+    scales = default_energies(spec) if kind == "wks" else default_times(spec)
+    picked = scales[np.linspace(0, len(scales) - 1, HISTOGRAM_SCALES).round().astype(int)]
     if kind == "wks":
-        energies = default_energies(spec)
-        picked = energies[np.linspace(0, len(energies) - 1, HISTOGRAM_SCALES).round().astype(int)]
-        _, w = signature(spec, kind="wks", energies=picked, sigma=wks_sigma(energies))
+        _, w = signature(spec, kind="wks", energies=picked, sigma=wks_sigma(scales))
         h = area * w
     else:
-        times = default_times(spec)
-        picked = times[np.linspace(0, len(times) - 1, HISTOGRAM_SCALES).round().astype(int)]
         _, s = signature(spec, times=picked)  # (n, S)
         z = np.exp(-np.outer(spec.eigenvalues[~spec.zero_mode_mask()], picked)).sum(axis=0)
         h = area * s / z
@@ -353,12 +350,12 @@ def run_batch(
     todo: list[tuple[str, Path, str | None]] = []
     for name, path in zip(names, paths, strict=True):
         status, known = _done(store, name, path, parameters, retry_failed)
-        if status == "done":
-            summary.skipped.append(name)
-            if status_failed(store, name):
-                summary.failed_before.append(name)
-        else:
+        if status == "todo":
             todo.append((name, path, known))
+        else:
+            summary.skipped.append(name)
+            if status == "failed":
+                summary.failed_before.append(name)
     total = len(paths)
     already = len(summary.skipped)
 
@@ -396,7 +393,8 @@ def run_batch(
 
 
 def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bool):
-    """("done", None) if ``name`` needs no work; else ("todo", the stored key or None)."""
+    """("done", None) if ``name`` has a current result, ("failed", None) if a current
+    recorded failure (not retried), else ("todo", the stored key or None)."""
     entry = read_entry(store / "meshes" / f"{name}.npz")
     try:
         stat = file_stat(path)
@@ -414,7 +412,7 @@ def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bo
         except (OSError, ValueError):
             record = {}
         if record.get("parameters") == parameters and record.get("stat") == stat:
-            return "done", None
+            return "failed", None
     return "todo", None
 
 

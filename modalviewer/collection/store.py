@@ -33,6 +33,10 @@ HISTOGRAM_SCALES = 8
 """How many of the standard scales (evenly among them) the histograms are taken at."""
 
 
+STORE_PARAMETERS = ("operator", "k", "bending", "membrane", "signatures")
+"""The parameters ``collection.json`` holds: one set per store."""
+
+
 class CollectionError(ValueError):
     """A store that cannot be read or written, or a mesh it does not hold."""
 
@@ -134,15 +138,8 @@ def prepare_store(store: Path, parameters: dict) -> None:
     (store / "meshes").mkdir(parents=True, exist_ok=True)
     (store / "errors").mkdir(exist_ok=True)
     header = store / "collection.json"
-    info = {
-        "format": STORE_FORMAT,
-        "version": STORE_VERSION,
-        "operator": parameters["operator"],
-        "k": parameters["k"],
-        "bending": parameters["bending"],
-        "membrane": parameters["membrane"],
-        "signatures": parameters["signatures"],
-    }
+    info = {"format": STORE_FORMAT, "version": STORE_VERSION}
+    info.update((key, parameters[key]) for key in STORE_PARAMETERS)
     if header.exists():
         try:
             old = json.loads(header.read_text(encoding="utf-8"))
@@ -160,13 +157,6 @@ def prepare_store(store: Path, parameters: dict) -> None:
                 "another store"
             )
     _write_json(header, info)
-
-
-def status_failed(store: Path, name: str) -> bool:
-    """Whether ``name`` is recorded as failed (and has no result)."""
-    return (store / "errors" / f"{name}.json").exists() and not (
-        store / "meshes" / f"{name}.npz"
-    ).exists()
 
 
 def shape_dna_distance(a: np.ndarray, b: np.ndarray) -> float:
@@ -346,30 +336,6 @@ class Collection:
                 return name
         return None
 
-    def query_dna(self, mesh=None, spectrum: Spectrum | None = None) -> tuple[np.ndarray, str]:
-        """(Shape-DNA, mesh hash) of ``mesh`` (a :class:`~.core.mesh.Mesh`): the stored one
-        if the store holds its geometry, else from ``spectrum`` (of the store's operator
-        with at least its k modes) or a spectrum computed with the store's parameters."""
-        name = self.name_of(mesh.hash)
-        if name is not None:
-            row = self.names.index(name)
-            return self.descriptors["shape_dna"][row], mesh.hash
-        if not self.spectrum_fits(spectrum):
-            from ..core.pipeline import compute_spectrum
-
-            spectrum = compute_spectrum(
-                mesh, self.operator, self.k, self.info["bending"], self.info["membrane"]
-            )
-        else:
-            k = self.k
-            spectrum = replace(
-                spectrum,
-                eigenvalues=spectrum.eigenvalues[:k],
-                modes=spectrum.modes[..., :k],
-                residuals=spectrum.residuals[:k],
-            )
-        return shape_dna(spectrum, mesh.total_area), mesh.hash
-
     def spectrum_fits(self, spectrum: Spectrum | None) -> bool:
         """Whether ``spectrum`` can stand for the store's: its operator and weights, at
         least its k modes."""
@@ -394,19 +360,31 @@ class Collection:
         (:func:`shape_dna_distance`), nearest first, as [(name, distance)], at most ``n``
         (all with None).  ``query`` is a stored name, a mesh file or a
         :class:`~.core.mesh.Mesh`; a stored mesh of the same geometry comes first (at
-        distance 0), before shapes at a distance 0 by rounding."""
+        distance 0), before shapes at a distance 0 by rounding.  A mesh the store does not
+        hold is ranked by ``spectrum`` where it fits (:meth:`spectrum_fits`), else by a
+        spectrum computed with the store's parameters."""
         from ..core.mesh import Mesh
 
+        table = self.descriptors["shape_dna"]
         if isinstance(query, str) and query in self:
-            dna = self.descriptors["shape_dna"][self.names.index(query)]
-            own = self.entry(query)["mesh_hash"]
+            stored = query
         else:
             if not isinstance(query, Mesh):
                 from ..io import load_mesh
 
                 query = load_mesh(query)
-            dna, own = self.query_dna(query, spectrum)
-        table = self.descriptors["shape_dna"]
+            stored = self.name_of(query.hash)
+        if stored is not None:
+            dna, own = table[self.names.index(stored)], self.entry(stored)["mesh_hash"]
+        else:
+            if not self.spectrum_fits(spectrum):
+                from ..core.pipeline import compute_spectrum
+
+                weights = self.info["bending"], self.info["membrane"]
+                spectrum = compute_spectrum(query, self.operator, self.k, *weights)
+            # its first k eigenvalues, as the store's spectra hold them
+            spectrum = replace(spectrum, eigenvalues=spectrum.eigenvalues[: self.k])
+            dna, own = shape_dna(spectrum, query.total_area), query.hash
         ranked = []
         for row, name in enumerate(self.names):
             same = self.entry(name).get("mesh_hash") == own
