@@ -1,7 +1,6 @@
-"""The memory of an exact spectrum computation: the exact solver's plan (the Krylov
-basis's size, the memory its factor may take, when the basis is kept in single
-precision) and the predictions from the mesh's size alone (the memory check that
-refuses what would not fit)."""
+"""The memory of an exact spectrum computation: the solver's plan (the Krylov basis's
+size, the factor's budget, a single-precision basis) and the predictions from the mesh's
+size alone (the memory check that refuses what would not fit)."""
 
 from __future__ import annotations
 
@@ -28,30 +27,19 @@ __all__ = [
 
 MB = 2**20
 
-GROWTH_MODES = 100
-"""The number of modes the growth laws' runs computed."""
+GROWTH_MODES = 100  # the number of modes the growth laws' runs computed
 
-LAWS_FROM_VERTICES = 100_000
-"""The growth laws are fitted to the runs from this many vertices on
-(``benchmarks.growth``); below it fixed costs dominate."""
-
-
+# The Krylov basis holds (1 + BASIS_EXTRA) times the working pairs: more converges in
+# fewer operator applications but costs memory and orthogonalisation time.  Where the
+# vectors beyond the working pairs would take more than BASIS_EXTRA_BYTES, at most
+# BASIS_EXTRA_MAX of them: there the basis is the largest array beside the factor and
+# they buy little speed ("Iteration" in docs/how-it-works.md).  At least
+# MIN_WORKING_PAIRS pairs: with fewer, clustered spectra (a mesh of many similar parts)
+# did not converge.
 BASIS_EXTRA = 0.6
-"""The Krylov basis holds (1 + BASIS_EXTRA) times the working number of pairs (fewer
-extra vectors for big solves: :data:`BASIS_EXTRA_MAX`): more converges in fewer operator
-applications but costs memory and orthogonalisation time (the basis sizes and the
-choice: "Iteration" in docs/how-it-works.md)."""
 BASIS_EXTRA_MAX = 112
 BASIS_EXTRA_BYTES = 900e6
-"""Where the basis's vectors beyond the working pairs would take more than
-BASIS_EXTRA_BYTES, it holds at most BASIS_EXTRA_MAX of them: there the basis is the
-largest array beside the factor, and the extra vectors buy little speed.  Smaller bases
-are left alone: there fewer extra vectors cost more time than the memory they save
-("Iteration" in docs/how-it-works.md)."""
 MIN_WORKING_PAIRS = 24
-"""The iteration works with at least this many pairs (where the space allows): with a
-basis of 20 columns for a few wanted pairs, clustered spectra (a mesh of many similar
-parts) did not converge in 60 restarts."""
 
 
 def krylov_sizes(k: int, n_free: int, block: int | None = None) -> tuple[int, int, int, int]:
@@ -69,20 +57,19 @@ def krylov_sizes(k: int, n_free: int, block: int | None = None) -> tuple[int, in
 
 
 def factor_budget_mb(limit_mb: float | None, n: int, basis_columns: int, block: int):
-    """The memory (MB) a factor may take so that the solve stays within ``limit_mb``:
-    what is left after this process's resident memory, the Krylov basis array and the
-    iteration's (N, block) temporaries (at most :data:`TEMPORARY_BLOCKS` of them,
-    the refinement's double blocks included); None if there is no limit."""
+    """The memory (MB) a factor may take so that the solve stays within ``limit_mb``
+    (None: no limit): what is left after this process's resident memory, the Krylov
+    basis and the iteration's :data:`TEMPORARY_BLOCKS` (N, block) temporaries."""
     if limit_mb is None:
         return None
     arrays = 8.0 * n * (basis_columns + TEMPORARY_BLOCKS * block) / 2**20
     return limit_mb - resident_mb() - arrays
 
 
+# (N, block) arrays alive beside the basis: the operator's scaled right-hand sides,
+# PARDISO's solution, the orthogonalisation's copy and its Cholesky-QR products; the
+# refinement's four (N, 2 block) ones
 TEMPORARY_BLOCKS = 8
-"""(N, block) arrays alive beside the basis during the iteration: the operator's
-scaled right-hand sides, PARDISO's solution, the orthogonalisation's copy and its
-Cholesky-QR products; the refinement's four (N, 2 block) ones."""
 
 
 def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
@@ -95,11 +82,10 @@ def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
 def basis_in_float32(
     limit_mb: float | None, n: int, basis_columns: int, out_columns: int, block: int
 ) -> bool:
-    """Whether the Krylov basis is stored in single precision: where resident memory (the
-    factor included) and a double-precision basis with the iteration's temporaries
-    exceed ``limit_mb`` and the single-precision buffer (:func:`float32_basis_mb`) is
-    smaller.  Double precision is kept wherever it fits: single precision limits the
-    tolerance to :data:`.eigen.FLOAT32_BASIS_TOL`."""
+    """Whether the Krylov basis is kept in single precision: only where the
+    double-precision one does not fit in ``limit_mb`` beside the factor and the
+    single-precision buffer is smaller (it limits the tolerance to
+    :data:`.eigen.FLOAT32_BASIS_TOL`)."""
     left_mb = factor_budget_mb(limit_mb, n, basis_columns, block)  # now: after the factor
     if left_mb is None or left_mb >= 0:
         return False
@@ -107,8 +93,7 @@ def basis_in_float32(
 
 
 def basis_columns(k: int, n_unknowns: int) -> int:
-    """Columns of the exact solver's Krylov basis array for ``k`` modes of ``n_unknowns``
-    (:func:`krylov_sizes`): with the modes, the arrays whose size grows with k."""
+    """Columns of the exact solver's Krylov basis array for ``k`` modes of ``n_unknowns``."""
     n = max(int(n_unknowns), 2)
     k = max(1, min(int(k), n))
     _, block, max_basis, _ = krylov_sizes(k, n)
@@ -129,10 +114,8 @@ def float32_basis_saving_mb(n_unknowns: int, k: int) -> float:
 def exact_peak_mb(law: GrowthLaw, n_vertices: int, n_unknowns: int, k: int) -> float:
     """Peak memory (MB) of an exact solve of ``k`` modes: the measured law at
     :data:`GROWTH_MODES` modes plus, per further mode, its columns of the Krylov basis
-    (:func:`basis_columns`) and of the modes, ``n_unknowns`` doubles each.  Every further
-    column is counted in full, more than the peak holds at once, so the prediction errs
-    on the side of refusing ("Memory check" in docs/performance.md); the factor's fill on
-    curved meshes is added by :meth:`.operators.OperatorInfo.predicted_peak_mb`."""
+    and of the modes in full, more than the peak holds at once, so the prediction errs
+    on the side of refusing ("Memory check" in docs/performance.md)."""
     n = max(int(n_unknowns), 1)
     k, k0 = min(int(k), n), min(GROWTH_MODES, n)
     columns = basis_columns(k, n) - basis_columns(k0, n) + (k - k0)
@@ -148,25 +131,20 @@ def power_of_size(at_100k: float, exponent: float, n_vertices: int) -> float:
 @dataclass(frozen=True)
 class GrowthLaw:
     """Peak memory of an exact solve of :data:`GROWTH_MODES` modes as a power of the mesh
-    size, measured on the reference machine (``benchmarks/growth.py``: bumpy plates of
-    100k to 1M vertices, each run in its own process; ``benchmarks/results/growth.json``
-    holds the runs)."""
+    size, measured on the reference machine (``benchmarks/results/growth.json``)."""
 
     peak_mb_at_100k: float
     memory_exponent: float
 
     def peak_mb(self, n_vertices: int) -> float:
-        """Predicted peak resident memory (MB) of the computing process, at
-        :data:`GROWTH_MODES` modes."""
         return power_of_size(self.peak_mb_at_100k, self.memory_exponent, n_vertices)
 
 
 @dataclass(frozen=True)
 class FactorLaw:
-    """Memory (MB) of the exact solver's factorisation as powers of the mesh size: kept
-    in core, and out of core (PARDISO's symbolic data and working buffer, the factor in
-    a file), from PARDISO's analysis of the bumpy plates of 100k to 1M vertices
-    (``benchmarks/factor_memory.py``, ``benchmarks/results/factor_memory.json``)."""
+    """Memory (MB) of the exact solver's factorisation as powers of the mesh size, in core
+    and out of core (PARDISO's symbolic data and working buffer, the factor in a file)
+    (``benchmarks/results/factor_memory.json``)."""
 
     in_core_mb_at_100k: float
     in_core_exponent: float
@@ -181,20 +159,18 @@ class FactorLaw:
 
 
 FILL_MARGIN = 1.26
-"""The memory check counts an exact solve's factor in core at this times its law
-(:class:`FactorLaw`): closed curved surfaces fill in more than the plates the laws come
-from.  It is the largest in-core factor of the curved meshes PARDISO analysed over the
-plates' law (``benchmarks/results/factor_memory.json``, "curved"; tests/core/test_cost.py
-checks it), so on the plates themselves the check errs on the side of refusing."""
+"""The memory check counts a factor in core at this times its law: the largest ratio of
+the curved meshes PARDISO analysed (closed curved surfaces fill in more than the plates
+the laws come from; ``factor_memory.json``'s curved rows, checked by
+tests/core/test_cost.py)."""
 
 
 def factor_goes_out_of_core(
     in_core_peak_mb: float, factor: FactorLaw | None, n_vertices: int, limit_mb: float | None
 ) -> bool:
     """Whether the exact solver will keep its factor in a file: the in-core peak above
-    the memory limit (:func:`.memory.memory_limit_mb`), out of core needing less, and
-    PARDISO (the only backend with that mode) there.  The rule of
-    :func:`factor_budget_mb`, on the predicted sizes."""
+    ``limit_mb``, out of core needing less, and PARDISO (the only backend with that mode)
+    there."""
     if factor is None or limit_mb is None or in_core_peak_mb <= limit_mb:
         return False
     if factor.out_of_core_mb(n_vertices) >= factor.in_core_mb(n_vertices):

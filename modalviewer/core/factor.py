@@ -1,16 +1,11 @@
 """Sparse symmetric positive definite factorisations: factor once, solve many right-hand sides.
 
-Backends, tried in this order by ``backend="auto"``: ``"pardiso"`` (Intel MKL PARDISO
-through ``ctypes``, x86_64: supernodal Cholesky with parallel METIS ordering and
-parallel solves, the fastest; "Spectra" in docs/performance.md), ``"cholmod"``
-(``cholespy``), ``"superlu"`` (``scipy.sparse.linalg.splu``, always available).
-
-Out of core: given ``memory_budget_mb``, PARDISO keeps its factor in memory only if its
-analysis says it fits; otherwise it writes the factor to a temporary folder
-(``iparm[59] = 2``), removed with the factor, and each solve reads it back: less memory,
-slower solves ("Memory of big exact solves" in docs/performance.md).  CHOLMOD and
-SuperLU ignore the budget.  Every backend raises :class:`numpy.linalg.LinAlgError` if
-the matrix is not positive definite.
+Backends, fastest first (``backend="auto"`` takes the first available): ``"pardiso"``
+(Intel MKL PARDISO through ``ctypes``: parallel METIS ordering and solves),
+``"cholmod"`` (``cholespy``), ``"superlu"`` (scipy, always there).  Given
+``memory_budget_mb``, PARDISO writes a factor that does not fit to a temporary folder
+(out of core: less memory, slower solves; "Memory of big exact solves" in
+docs/performance.md); the others ignore the budget.
 """
 
 from __future__ import annotations
@@ -78,22 +73,19 @@ def available_backends() -> list[str]:
     return names
 
 
+# The out-of-core working buffer: OUT_OF_CORE_MARGIN times PARDISO's stated minimum
+# (``iparm[15] + iparm[62]`` KB) plus OUT_OF_CORE_EXTRA_MB; with exactly the minimum the
+# factorisation can fail for lack of memory (error -2).
 OUT_OF_CORE_MARGIN = 1.1
 OUT_OF_CORE_EXTRA_MB = 64.0
-"""The out-of-core working buffer is OUT_OF_CORE_MARGIN times PARDISO's stated minimum
-(symbolic data plus its smallest buffer, ``iparm[15] + iparm[62]`` KB) plus this: with
-exactly the minimum the numerical factorisation can fail for lack of memory (error
--2)."""
 
+# PARDISO reads its out-of-core settings from the environment: one factorisation at a time
 _OOC_ENVIRONMENT = threading.Lock()
-"""PARDISO reads its out-of-core folder and buffer size from the environment when it
-factors: one factorisation at a time sets them."""
 
 
 @contextmanager
 def _out_of_core_environment(folder: str, buffer_mb: float):
-    """PARDISO's out-of-core settings in the environment while the block runs (one
-    block at a time), the previous values restored after it."""
+    """PARDISO's out-of-core settings in the environment while the block runs."""
     settings = {
         "MKL_PARDISO_OOC_PATH": folder,
         "MKL_PARDISO_OOC_MAX_CORE_SIZE": str(int(buffer_mb)),
@@ -116,26 +108,14 @@ FOLDER_PREFIX = "modalviewer-factor-"
 
 
 def factor_folder() -> str:
-    """Where out-of-core factors are written: ``MODALVIEWER_FACTOR_DIR`` if set, else the
-    system's temporary folder."""
+    """Where out-of-core factors go: ``MODALVIEWER_FACTOR_DIR``, else the temporary folder."""
     return os.environ.get("MODALVIEWER_FACTOR_DIR") or tempfile.gettempdir()
 
 
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OSError):
-        return True
-    return True
-
-
 def remove_stale_factor_folders(parent: str | None = None) -> list[str]:
-    """Remove the out-of-core factor folders in ``parent`` (default
-    :func:`factor_folder`) whose process has ended: a computation process that was
-    stopped (the viewer's Cancel ends it) cannot remove its own.  Each folder is named
-    ``modalviewer-factor-<pid>-...``.  Returns the removed paths."""
+    """Remove (and return) the factor folders ``modalviewer-factor-<pid>-...`` in
+    ``parent`` (default :func:`factor_folder`) whose process has ended: a stopped
+    computation process cannot remove its own."""
     parent = parent or factor_folder()
     removed = []
     try:
@@ -146,10 +126,16 @@ def remove_stale_factor_folders(parent: str | None = None) -> list[str]:
         if not name.startswith(FOLDER_PREFIX):
             continue
         pid_text = name[len(FOLDER_PREFIX) :].split("-", 1)[0]
-        if pid_text.isdigit() and not _pid_alive(int(pid_text)):
+        if not pid_text.isdigit():
+            continue
+        try:
+            os.kill(int(pid_text), 0)
+        except ProcessLookupError:  # ended (any other error: alive, or not ours to see)
             path = os.path.join(parent, name)
             shutil.rmtree(path, ignore_errors=True)
             removed.append(path)
+        except OSError:
+            pass
     return removed
 
 
@@ -259,10 +245,9 @@ class _Pardiso:
             raise np.linalg.LinAlgError(f"PARDISO factorisation failed (error {error})")
 
     def _factor_in_core_again(self) -> None:
-        """Drop a failed out-of-core factorisation and its folder: a fresh handle with
-        the in-core setting (the next call must be phase 12).  The failed handle is not
-        released (PARDISO's release of it can crash the process after error -2), so its
-        analysis's memory is left to the process's end."""
+        """Drop a failed out-of-core factorisation and its folder for a fresh in-core
+        handle (the next call must be phase 12); the failed one is not released
+        (PARDISO's release can crash after error -2): its memory waits for the exit."""
         self._pt = np.zeros(64, dtype=np.int64)
         self._iparm[59] = 0
         self.out_of_core = False
@@ -356,22 +341,9 @@ def factor_memory_mb(A: sp.spmatrix) -> tuple[float, float] | None:
 
 
 class SPDSolver:
-    """Factor a sparse symmetric positive definite matrix once, solve many times.
-
-    Parameters
-    ----------
-    A : (N, N) sparse symmetric positive definite matrix.
-    backend : "auto" | "pardiso" | "cholmod" | "superlu" (module docstring).
-    memory_budget_mb : the memory (MB) the factor may take; PARDISO writes a larger
-        factor to a file (out of core).  None: in core.
-
-    Attributes
-    ----------
-    out_of_core : True if the factor lives in a file.
-    factor_mb : the factor's in-core size (PARDISO's analysis; None for the others).
-
-    Raises :class:`numpy.linalg.LinAlgError` if A is not positive definite.
-    """
+    """Factor a sparse symmetric positive definite matrix once, solve many times; a
+    :class:`numpy.linalg.LinAlgError` if it is not positive definite.  ``out_of_core``:
+    whether the factor lives in a file; ``factor_mb``: its in-core size (PARDISO only)."""
 
     out_of_core = False
     factor_mb: float | None = None

@@ -1,19 +1,12 @@
-"""Memory: how much a computation may use, how much this process holds, and the C
-library's allocator settings for processes that compute.
-
-The exact solver keeps its working set within :func:`memory_limit_mb` (half this
-machine's memory, or ``MODALVIEWER_MEMORY_LIMIT_MB``), leaving room for the viewer, the
-desktop and the file cache that holds an out-of-core factor (:mod:`.factor`).
+"""Memory: how much a computation may use (:func:`memory_limit_mb`, leaving room for
+the viewer, the desktop and the file cache that holds an out-of-core factor), how much
+this process holds, and the allocator settings for processes that compute.
 
 A computation allocates and frees many arrays of hundreds of megabytes, and first
-touches of fresh pages cost more than much of the arithmetic.
-:func:`prepare_compute_process` makes them cheaper in a process that exists to compute:
-arrays up to :data:`HEAP_ARRAY_MAX_BYTES` are reused from the heap instead of going to
-the kernel and back (:func:`keep_freed_memory`; bigger ones would leave holes the next
-do not fit), numpy stops advising huge pages, whose compaction slows page faults
-(:func:`no_huge_page_advice`), and all threads share one malloc arena
-(:func:`one_malloc_arena`).  What each saves and costs: "Memory" in
-docs/how-it-works.md.
+touches of fresh pages cost more than much of the arithmetic:
+:func:`prepare_compute_process` reuses heap memory, stops numpy's huge-page advice
+(compaction slows page faults) and gives all threads one malloc arena ("Memory" in
+docs/how-it-works.md).
 """
 
 from __future__ import annotations
@@ -35,8 +28,7 @@ __all__ = [
     "prepare_compute_process",
 ]
 
-MEMORY_LIMIT_SHARE = 0.5
-"""The share of this machine's memory a computation plans to stay within."""
+MEMORY_LIMIT_SHARE = 0.5  # the share of this machine's memory a computation plans for
 
 MB = 2**20
 
@@ -82,8 +74,7 @@ def resident_mb() -> float:
 
 @functools.cache
 def glibc():
-    """The C library as a ``ctypes.CDLL`` on Linux (glibc's ``libc.so.6``), else None,
-    loaded once."""
+    """glibc's ``libc.so.6`` as a ``ctypes.CDLL`` on Linux, else None."""
     import sys
 
     if not sys.platform.startswith("linux"):
@@ -96,9 +87,8 @@ def glibc():
 
 def return_freed_memory() -> bool:
     """Give the memory this process has freed back to the system (glibc's
-    ``malloc_trim(0)``), called at each stage of :func:`.pipeline.compute_spectrum`: a
-    stage's freed heap pages are not always reusable by the next stage's arrays of other
-    sizes.  True where it ran (glibc), False elsewhere."""
+    ``malloc_trim(0)``; True where it ran): a stage's freed heap pages are not always
+    reusable by the next stage's arrays of other sizes."""
     trim = getattr(glibc(), "malloc_trim", None)
     if trim is None:
         return False
@@ -112,15 +102,14 @@ _M_TRIM_THRESHOLD = -1
 _M_MMAP_THRESHOLD = -3
 _M_ARENA_MAX = -8
 
+# Arrays up to this size come from the heap in a compute process, their memory reused
+# when freed; bigger ones are mapped (glibc's largest mmap threshold on 64-bit systems):
+# serving every array from the heap leaves holes the next do not fit.
 HEAP_ARRAY_MAX_BYTES = 32 * 2**20
-"""Arrays up to this size come from the heap in a compute process and their memory is
-reused when freed; bigger ones are mapped and unmapped (glibc's largest mmap threshold
-on 64-bit systems): serving every array from the heap raised the exact solves' peak."""
 
 
 def _mallopt():
-    """glibc's ``mallopt`` with its argument types set, or None where the C library is
-    not glibc."""
+    """glibc's ``mallopt`` with its argument types set, or None."""
     mallopt = getattr(glibc(), "mallopt", None)
     if mallopt is not None:
         mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
@@ -130,9 +119,7 @@ def _mallopt():
 
 def keep_freed_memory() -> bool:
     """Ask glibc to serve allocations up to :data:`HEAP_ARRAY_MAX_BYTES` from the heap
-    (``M_MMAP_THRESHOLD``) and keep freed heap memory (``M_TRIM_THRESHOLD`` at its
-    largest).  True if both took effect; False (and nothing changed) where the C library
-    is not glibc."""
+    and keep freed heap memory; True if both took effect."""
     mallopt = _mallopt()
     if mallopt is None:
         return False
@@ -142,17 +129,16 @@ def keep_freed_memory() -> bool:
 
 
 def one_malloc_arena() -> bool:
-    """Ask glibc to serve every thread from one arena (``mallopt(M_ARENA_MAX, 1)``), so
-    memory freed on one thread is reused by the next allocation on any other.  Takes
-    effect for threads that have not yet allocated: call it when the process starts.
-    True if it took effect; False where the C library is not glibc."""
+    """Ask glibc to serve every thread from one arena, so memory freed on one thread is
+    reused on any other (for threads that have not yet allocated: call it when the
+    process starts); True if it took effect."""
     mallopt = _mallopt()
     return mallopt is not None and bool(mallopt(_M_ARENA_MAX, 1))
 
 
 def no_huge_page_advice() -> bool:
-    """Stop numpy from advising huge pages for new arrays (what the environment variable
-    ``NUMPY_MADVISE_HUGEPAGE=0`` does at import).  True if the setting exists."""
+    """Stop numpy from advising huge pages for new arrays (``NUMPY_MADVISE_HUGEPAGE=0``
+    at run time); True if the setting exists."""
     import numpy as np
 
     core = getattr(np, "_core", None) or np.core
