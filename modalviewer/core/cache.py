@@ -31,9 +31,7 @@ __all__ = [
 
 log = logging.getLogger("modalviewer.cache")
 
-DEFAULT_LIMIT_MB = 2048
-"""Default size limit in megabytes: room for a dozen shells spectra of mid-sized meshes,
-or a few of large ones."""
+DEFAULT_LIMIT_MB = 2048  # a dozen shells spectra of mid-sized meshes, or a few large ones
 
 _STALE_PART_SECONDS = 3600.0  # a temporary file this old belongs to a killed writer
 
@@ -48,9 +46,8 @@ def default_cache_dir() -> Path:
 
 
 def default_cache_limit() -> int:
-    """The size limit in bytes: ``$MODALVIEWER_CACHE_MAX_MB`` megabytes (a number; 0 keeps
-    nothing), else :data:`DEFAULT_LIMIT_MB`.  A value that is not a number is ignored with
-    a warning."""
+    """The size limit in bytes: ``$MODALVIEWER_CACHE_MAX_MB`` megabytes (0 keeps nothing;
+    not a number: a warning), else :data:`DEFAULT_LIMIT_MB`."""
     env = os.environ.get("MODALVIEWER_CACHE_MAX_MB", "").strip()
     if env:
         try:
@@ -70,8 +67,7 @@ def default_cache_limit() -> int:
 
 @dataclass(frozen=True)
 class CacheEntry:
-    """One cached spectrum file: its path, size in bytes and last use (seconds since the
-    epoch)."""
+    """One cached spectrum file: its path, size in bytes and last use (epoch seconds)."""
 
     path: Path
     size: int
@@ -80,9 +76,8 @@ class CacheEntry:
 
 @dataclass(frozen=True)
 class SolveRecord:
-    """What a cached spectrum says of the solve that made it: its operator, the mesh
-    (hash and vertex count), the number of modes and the solve's seconds
-    (``parameters["seconds_total"]``)."""
+    """What a cached spectrum says of the solve that made it (``seconds``:
+    ``parameters["seconds_total"]``)."""
 
     operator: str
     mesh_hash: str
@@ -97,16 +92,10 @@ older solver are not served (2: exactly known null spaces deflated and counted).
 
 
 class SpectrumCache:
-    """Spectra stored as ``.npz`` files in ``directory``, at most ``max_bytes`` in all.
-
-    Parameters
-    ----------
-    directory : the cache folder; default :func:`default_cache_dir`.
-    max_bytes : the size limit; default :func:`default_cache_limit` (or
-        ``$MODALVIEWER_CACHE_MAX_MB``).  The least recently used entries are deleted
-        when the limit is exceeded; the entry just written or read is always kept, even
-        if it alone is larger.  0 stores nothing.
-    """
+    """Spectra stored as ``.npz`` files in ``directory`` (default
+    :func:`default_cache_dir`), at most ``max_bytes`` in all (default
+    :func:`default_cache_limit`; 0 stores nothing).  Beyond it the least recently used
+    entries are deleted, never the entry just written or read."""
 
     def __init__(self, directory: Path | None = None, max_bytes: int | None = None):
         self.directory = Path(directory) if directory else default_cache_dir()
@@ -115,21 +104,17 @@ class SpectrumCache:
         self.max_bytes = int(max_bytes) if max_bytes is not None else default_cache_limit()
         self._last_stamp = 0
 
-    # ---------------------------------------------------------------- keys
-    def key(
+    def path(
         self, mesh: Mesh, operator: OperatorLike, k: int, bending: float, membrane: float
-    ) -> str:
+    ) -> Path:
+        """The entry's file, named by a hash of the mesh and the parameters."""
         info = operator_info(operator)
         params = {"op": info.name, "k": int(k), "solver": SOLVER_VERSION}
         if info.has_weights:
             params.update(bending=float(bending), membrane=float(membrane))
         blob = mesh.hash + json.dumps(params, sort_keys=True)
-        return hashlib.sha256(blob.encode()).hexdigest()[:32]
+        return self.directory / f"{hashlib.sha256(blob.encode()).hexdigest()[:32]}.npz"
 
-    def path(self, *args) -> Path:
-        return self.directory / f"{self.key(*args)}.npz"
-
-    # ---------------------------------------------------------- inspection
     def entries(self) -> list[CacheEntry]:
         """The cached spectra, most recently used first."""
         out = []
@@ -160,22 +145,25 @@ class SpectrumCache:
                 freed += e.size
             except OSError:
                 pass
-        self._remove_stale_parts(max_age=_STALE_PART_SECONDS)
+        try:  # and temporary files of killed writers
+            parts = list(self.directory.glob("*.part"))
+        except OSError:
+            parts = []
+        for p in parts:
+            try:
+                if time.time() - p.stat().st_mtime > _STALE_PART_SECONDS:
+                    p.unlink()
+            except OSError:
+                pass
         return freed
 
     def solves(self) -> list[SolveRecord]:
-        """The solves this machine recorded in the cache, most recently used first: each
-        entry's operator, mesh, modes and ``seconds_total``, read from the file's
-        metadata and the header of its mass array (not its modes).  Entries that cannot
-        be read, or carry no time (coarse-to-fine, foreign files), are left out."""
-        records = []
-        for entry in self.entries():
-            record = _solve_record(entry.path)
-            if record is not None:
-                records.append(record)
-        return records
+        """The solves this machine recorded in the cache, most recently used first, read
+        from each file's metadata and mass array header (not its modes); entries that
+        cannot be read, or carry no time (coarse-to-fine, foreign files), left out."""
+        records = (_solve_record(entry.path) for entry in self.entries())
+        return [record for record in records if record is not None]
 
-    # ------------------------------------------------------------- use
     def get(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Spectrum | None:
         """The cached spectrum (its ``from_cache`` set), or None.  A hit counts as a use
         (for the eviction order); an entry that cannot be read is deleted with a warning."""
@@ -205,9 +193,8 @@ class SpectrumCache:
         return spec
 
     def writable_path(self, mesh, operator, k, bending=1.0, membrane=1.0) -> Path:
-        """Where a new entry should be written: the cache file, or a temporary file.
-
-        Makes room first, so that the limit holds once the entry is written."""
+        """Where a new entry should be written: the cache file (room made first, so that
+        the limit holds once it is written), or a temporary file."""
         try:
             self.directory.mkdir(parents=True, exist_ok=True)
             if os.access(self.directory, os.W_OK) and self.max_bytes > 0:
@@ -254,7 +241,6 @@ class SpectrumCache:
             log.info("cache over its limit: evicted %d least recently used", len(evicted))
         return evicted
 
-    # ------------------------------------------------------------ helpers
     def _touch(self, path: Path) -> None:
         now = max(time.time_ns(), self._last_stamp + 1)  # strictly increasing here
         self._last_stamp = now
@@ -272,19 +258,6 @@ class SpectrumCache:
             return True
         except OSError:
             return False
-
-    def _remove_stale_parts(self, max_age: float) -> None:
-        now = time.time()
-        try:
-            parts = list(self.directory.glob("*.part"))
-        except OSError:
-            return
-        for p in parts:
-            try:
-                if now - p.stat().st_mtime > max_age:
-                    p.unlink()
-            except OSError:
-                pass
 
 
 def _solve_record(path: Path) -> SolveRecord | None:

@@ -43,27 +43,21 @@ def make_folder_for(path: Path) -> Path:
     return folder
 
 
-def temp_beside(path: Path, suffix: str | None = None) -> Path:
-    """An empty temporary file in ``path``'s folder, with the umask's permissions.  A
+def atomic_write(path: Path, write, suffix: str | None = None) -> Path:
+    """Call ``write(tmp_path)`` on a temporary file beside ``path``, then rename it to
+    ``path``; on any failure the temporary file is removed and ``path`` is untouched.  A
     missing folder is a FileNotFoundError naming it (not the temporary file)."""
     path = Path(path)
     if not path.parent.is_dir():
         raise FileNotFoundError(f"the folder {path.parent} does not exist")
-    fd, tmp = tempfile.mkstemp(
+    fd, name = tempfile.mkstemp(
         prefix=f".{path.name}.", suffix=path.suffix if suffix is None else suffix, dir=path.parent
     )
+    tmp = Path(name)
     try:
         os.fchmod(fd, new_file_mode())
     finally:
         os.close(fd)
-    return Path(tmp)
-
-
-def atomic_write(path: Path, write, suffix: str | None = None) -> Path:
-    """Call ``write(tmp_path)`` on a temporary file beside ``path``, then rename it to
-    ``path``; on any failure the temporary file is removed and ``path`` is untouched."""
-    path = Path(path)
-    tmp = temp_beside(path, suffix)
     try:
         write(tmp)
         os.replace(tmp, path)

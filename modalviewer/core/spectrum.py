@@ -28,19 +28,13 @@ class SpectrumFileError(ValueError):
 class Spectrum:
     """Lowest eigenpairs of one operator on one mesh.
 
-    Attributes
-    ----------
     eigenvalues : (k,) ascending, units 1/time^2 for vibrations (frequency = sqrt).
-    modes : (n, k), or (n, 3, k) for ``"shells"``, one row per vertex in the input
-        numbering: NaN at the vertices no face uses, a merged duplicate's row that of
-        its vertex.  M-orthonormal (``Phi.T @ M @ Phi = I`` over the used rows, ``M`` the
-        lumped ``mass`` per component), so values scale with 1 / sqrt(area);
-        :meth:`euclidean_modes` gives unit-length columns.
-    operator : the operator's name (:attr:`operator_info`: its registry entry).
-    mass : (n,) lumped vertex masses (0 at vertices no face uses).
+    modes : (n, k), or (n, 3, k) for ``"shells"``, a row per vertex in the input
+        numbering (NaN where no face uses it, a merged duplicate's row that of its
+        vertex); M-orthonormal over the used rows (``M`` the lumped ``mass``), so values
+        scale with 1 / sqrt(area) (:meth:`euclidean_modes`: unit-length columns).
     residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
-    mesh_hash : SHA-256 of the mesh geometry the spectrum belongs to.
-    parameters : bending and membrane weights, solver information.
+    mesh_hash, parameters : SHA-256 of the mesh geometry; weights and solver information.
     from_cache : read from the spectrum cache rather than computed now (not saved).
     """
 
@@ -54,19 +48,15 @@ class Spectrum:
     from_cache: bool = field(default=False, compare=False)
 
     def __repr__(self) -> str:
-        """One line: operator, k, vertices, the modes' shape ((n, 3, k) for vector modes,
-        (n, k) for scalar ones) and the eigenvalue range (not the arrays)."""
         lam = self.eigenvalues
         span = f"{lam.min():.3g} .. {lam.max():.3g}" if lam.size else "none"
         return (
             f"Spectrum(operator={self.operator!r}, k={self.k}, n_vertices={self.n_vertices}, "
-            f"modes={tuple(self.modes.shape)}, "
-            f"eigenvalues={span})"
+            f"modes={tuple(self.modes.shape)}, eigenvalues={span})"
         )
 
     @property
     def operator_info(self) -> OperatorInfo:
-        """The operator object (:class:`.operators.OperatorInfo`) of :attr:`operator`."""
         return operator_info(self.operator)
 
     @property
@@ -139,17 +129,6 @@ class Spectrum:
         return modes**2
 
 
-def _atomic_write(path: Path, write) -> None:
-    """``write(fh)`` into a temporary file beside ``path``, then rename it (permissions of
-    the user's umask, see :mod:`.files`)."""
-
-    def to_file(tmp: Path) -> None:
-        with open(tmp, "wb") as fh:
-            write(fh)
-
-    atomic_write(Path(path), to_file, suffix=".part")
-
-
 def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
     """Write ``spec`` to ``path`` as ``.npz`` (atomically: a half-written file never
     replaces a good one), with its mesh hash and parameters; an OSError if it cannot
@@ -162,17 +141,18 @@ def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
         "parameters": spec.parameters,
     }
 
-    def write(fh):
-        np.savez(
-            fh,
-            eigenvalues=spec.eigenvalues,
-            modes=spec.modes,
-            mass=spec.mass,
-            residuals=spec.residuals,
-            meta=np.array(json.dumps(meta)),
-        )
+    def write(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:
+            np.savez(
+                fh,
+                eigenvalues=spec.eigenvalues,
+                modes=spec.modes,
+                mass=spec.mass,
+                residuals=spec.residuals,
+                meta=np.array(json.dumps(meta)),
+            )
 
-    _atomic_write(Path(path), write)
+    atomic_write(Path(path), write, suffix=".part")
 
 
 def load_spectrum(

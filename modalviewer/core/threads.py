@@ -11,11 +11,10 @@ OpenBLAS the call runs as it is; ``MODALVIEWER_SINGLE_BLAS_THREAD=0`` turns it o
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import os
 
-__all__ = ["blas_limit", "single_blas_thread"]
+__all__ = ["single_blas_thread"]
 
 _OPENBLAS = None  # threadpoolctl's controller of the loaded OpenBLAS libraries, or False
 
@@ -33,20 +32,15 @@ def _openblas():
     return _OPENBLAS
 
 
-def blas_limit():
-    """A context manager: OpenBLAS at one thread inside, as it was after it."""
-    found = _openblas()
-    if not found or os.environ.get("MODALVIEWER_SINGLE_BLAS_THREAD") == "0":
-        return contextlib.nullcontext()
-    return found.limit(limits=1)
-
-
 def single_blas_thread(fn):
-    """Decorator: ``fn`` runs inside :func:`blas_limit`."""
+    """Decorator: ``fn`` runs with OpenBLAS at one thread."""
 
     @functools.wraps(fn)
     def wrapper(*args, **kwargs):
-        with blas_limit():
+        found = _openblas()
+        if not found or os.environ.get("MODALVIEWER_SINGLE_BLAS_THREAD") == "0":
+            return fn(*args, **kwargs)
+        with found.limit(limits=1):
             return fn(*args, **kwargs)
 
     return wrapper
