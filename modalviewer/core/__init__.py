@@ -1,24 +1,10 @@
 """Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
 
+from . import components, cross
 from .cache import SpectrumCache
 from .cleaning import repair_mesh
-from .components import (
-    ComponentSpectrum,
-    compute_spectrum_per_component,
-    largest_component,
-    split_components,
-)
-from .cross import (
-    CrossTables,
-    Matches,
-    ScaleWarning,
-    best_match,
-    common_times,
-    cross_distance,
-    distance_ranks,
-    mutual_best_matches,
-    rescale_to_area,
-)
+from .components import *  # noqa: F403
+from .cross import *  # noqa: F403
 from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
 from .fmaps import FunctionalMap, correspondence_errors, functional_map
@@ -39,20 +25,9 @@ from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, sav
 from .truncation import k_for_truncation, truncation_error
 
 __all__ = [
-    "CrossTables",
-    "Matches",
-    "ScaleWarning",
-    "best_match",
-    "common_times",
-    "cross_distance",
-    "distance_ranks",
-    "mutual_best_matches",
-    "rescale_to_area",
+    *components.__all__,
+    *cross.__all__,
     "Cancelled",
-    "ComponentSpectrum",
-    "compute_spectrum_per_component",
-    "largest_component",
-    "split_components",
     "EigenError",
     "Mesh",
     "MeshError",

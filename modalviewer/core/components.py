@@ -2,10 +2,7 @@
 
 A mesh of c components has c constants (Laplacian) or 6 c rigid motions (shells) as
 exact zero modes, so k must exceed that before any vibration shows, and the components'
-modes are interleaved in one list.  :func:`largest_component` keeps the component of
-largest area (with a report of what was removed); :func:`compute_spectrum_per_component`
-computes k modes of each component on its own, largest first;
-:func:`split_components` gives the components themselves.
+modes are interleaved in one list: computing per component avoids both.
 """
 
 from __future__ import annotations
@@ -14,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .eigen import CancelFn, ProgressFn
+from .eigen import ProgressFn
 from .mesh import Mesh, MeshReport, _plural, shape_summary
 from .operators import DEFAULT_K, OperatorLike, operator_info
 from .pipeline import compute_spectrum
@@ -103,14 +100,9 @@ def _largest_report(mesh: Mesh, kept: Mesh, n_parts: int) -> MeshReport:
 
 @dataclass
 class ComponentSpectrum:
-    """The spectrum of one connected component.
-
-    Attributes
-    ----------
-    mesh : the component as a mesh of its own.
-    vertices : (n_c,) its vertex indices in the original mesh.
-    spectrum : k modes of the component (fewer if it has fewer unknowns), on ``mesh``.
-    """
+    """The spectrum (k modes, fewer if it has fewer unknowns) of one connected
+    component, on ``mesh``, the component as a mesh of its own whose vertex i is
+    ``vertices[i]`` of the original mesh."""
 
     mesh: Mesh
     vertices: np.ndarray
@@ -130,17 +122,15 @@ def compute_spectrum_per_component(
     mesh: Mesh,
     operator: OperatorLike,
     k: int = DEFAULT_K,
-    bending: float = 1.0,
-    membrane: float = 1.0,
     progress: ProgressFn | None = None,
-    cancel: CancelFn | None = None,
     min_vertices: int = 1,
+    **options,
 ) -> list[ComponentSpectrum]:
     """k modes of each connected component with at least ``min_vertices`` vertices,
-    largest area first (a ValueError if there is none).  The other arguments are
-    :func:`~modalviewer.core.pipeline.compute_spectrum`'s; k is capped at each
-    component's unknowns, and progress runs from 0 to 1 over all components, weighted by
-    their vertex counts."""
+    largest area first (a ValueError if there is none), each by
+    :func:`~modalviewer.core.pipeline.compute_spectrum` with ``options`` (``bending``,
+    ``membrane``, ``cancel``); k is capped at each component's unknowns, and progress
+    runs from 0 to 1 over all components, weighted by their vertex counts."""
     operator = operator_info(operator)
     k = check_count(k, "k")
     min_vertices = check_count(min_vertices, "min_vertices", 0)
@@ -156,9 +146,7 @@ def compute_spectrum_per_component(
             if progress is not None:
                 progress(stage, (base + weight * fraction) / total)
 
-        spec = compute_spectrum(
-            part, operator, k, bending, membrane, progress=part_progress, cancel=cancel
-        )
+        spec = compute_spectrum(part, operator, k, progress=part_progress, **options)
         out.append(ComponentSpectrum(part, vertices, spec))
         done += part.n_vertices
     return out

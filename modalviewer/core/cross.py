@@ -5,13 +5,11 @@ Eq. (31) with one signature from each mesh, each divided by its own mesh's
 
 ``delta(v, w) = sqrt( sum_i ((S^A_{t_i}(v) / Z^A(t_i) - S^B_{t_i}(w) / Z^B(t_i))^2 * dlogt) )``
 
-The common scales are the intersection of the two default ranges (CONVENTIONS.md), the
-scales both truncated spectra resolve; ranges that do not overlap are refused.  The
-meshes are used as given: signatures carry a factor ``1 / area`` (and the shells
+The common scales are the intersection of the two default ranges, the scales both
+truncated spectra resolve.  Signatures carry a factor ``1 / area`` (and the shells
 spectrum is not scale covariant at all), so compare meshes of the same area
 (:func:`rescale_to_area`); a :class:`ScaleWarning` says when the areas differ by more
-than :data:`AREA_TOLERANCE`.  Details and measurements: docs/library-guide.md,
-"Comparing two shapes".
+than :data:`AREA_TOLERANCE` ("Comparing two shapes" in docs/library-guide.md).
 """
 
 from __future__ import annotations
@@ -50,9 +48,7 @@ class ScaleWarning(UserWarning):
 
 
 def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
-    """A copy of ``mesh`` scaled about the origin to total area ``area`` (positive;
-    a ValueError otherwise); faces and the load report are kept.  Rescale both meshes
-    of a comparison to the same area."""
+    """A copy of ``mesh`` scaled about the origin to the positive total ``area``."""
     area = float(area)
     if not (np.isfinite(area) and area > 0):
         raise ValueError(f"the target area must be a positive number, got {area}")
@@ -67,8 +63,7 @@ def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
 
 
 def _source_row(table: SignatureTable, vertex: int) -> np.ndarray:
-    """The normalised signature of ``vertex``; a ValueError naming it if no face uses
-    it."""
+    """The normalised signature of ``vertex``; a ValueError if no face uses it."""
     row = table.table[check_vertex(vertex, table.table.shape[0])]
     if np.isnan(row).any():
         from .mesh import _unused_words
@@ -105,11 +100,9 @@ def common_times(
     samples: int = 100,
     kind: str = "heat",
 ) -> np.ndarray:
-    """Log-spaced scales shared by both spectra: ``t_range`` if given, else the
-    intersection of the two default ranges (see the module docstring); for
-    ``kind="wks"`` energies, the intersection of the default energy bands.  (samples,)
-    ascending, ``samples`` >= 2.  A ValueError if the default ranges do not overlap
-    (the meshes differ too much in size: :func:`rescale_to_area`, or pass ``t_range``)."""
+    """(samples,) log-spaced scales shared by both spectra: ``t_range`` if given, else
+    the intersection of the two default ranges (of energies for ``kind="wks"``); a
+    ValueError if those do not overlap (the meshes differ too much in size)."""
     samples = check_count(samples, "samples", 2)
     if t_range is None:
         ends = default_energies if kind == "wks" else default_times
@@ -127,15 +120,9 @@ def common_times(
 
 
 class CrossTables:
-    """The normalised signature tables of A and B at common scales, for repeated queries:
-    one (n, k) x (k, T) product per mesh to build, one matrix-vector product per query.
-
-    Attributes
-    ----------
-    times : (T,) the common scales (:func:`common_times`; with ``kind="wks"`` the common
-        energies, so the wave kernels have the same width on both).
-    a, b : :class:`SignatureTable` of each mesh at ``times``.
-    """
+    """The normalised signature tables ``a``, ``b`` of A and B at the common scales
+    ``times`` (:func:`common_times`; energies for ``kind="wks"``, so the wave kernels
+    have the same width on both), for repeated queries."""
 
     def __init__(
         self,
@@ -189,16 +176,9 @@ class CrossTables:
 
 @dataclass
 class Matches:
-    """Best matches of picked vertices of A on B, and back.
-
-    Attributes
-    ----------
-    vertices_a : (p,) the picked vertices of A.
-    matches_b : (p,) the vertex of B closest to each (smallest distance).
-    distances : (p,) that distance.
-    back_matches_a : (p,) the vertex of A closest to each ``matches_b``.
-    mutual : (p,) True where ``back_matches_a == vertices_a`` (a mutual best match).
-    """
+    """Best matches of picked vertices of A on B, and back: for each of ``vertices_a``
+    (p,), the closest vertex of B (``matches_b``) at ``distances``, the vertex of A
+    closest to that (``back_matches_a``) and whether it is the picked one (``mutual``)."""
 
     vertices_a: np.ndarray
     matches_b: np.ndarray
@@ -215,15 +195,10 @@ def cross_distance(
     samples: int = 100,
     include_zero: bool = False,
 ) -> np.ndarray:
-    """The distance of eq. (31) from vertex ``vertex`` of A to every vertex of B (module
-    docstring), each signature normalised by its own ``Z(t)``, on the meshes as given.
-
-    ``t_range``: the scales (default: :func:`common_times`), ``samples`` of them,
-    log-spaced; ``include_zero``: whether the signatures include the zero modes.
-    Returns (n_b,), NaN at the vertices no face uses.  A ValueError if the spectra are of
-    different operators (or shells spectra of different weights), or their default
-    scale ranges do not overlap.
-    """
+    """(n_b,) the distance of eq. (31) from vertex ``vertex`` of A to every vertex of B
+    (NaN where no face uses it) over ``samples`` log-spaced scales in ``t_range``
+    (default: :func:`common_times`).  A ValueError for spectra of different operators
+    or weights, or default scale ranges that do not overlap."""
     v = spec_a.check_source(check_vertex(vertex, spec_a.n_vertices))
     _check_pair(spec_a, spec_b)
     times = common_times(spec_a, spec_b, t_range, samples)

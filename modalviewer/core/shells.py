@@ -32,7 +32,6 @@ __all__ = [
     "shells_gradient",
     "shells_hessian",
     "normal_shells_hessian",
-    "normal_projection",
     "weighted_gradient_matrix",
 ]
 
@@ -218,27 +217,15 @@ def _gram(G: sp.csr_matrix) -> sp.csr_matrix:
 
 
 def shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
-    """The Hessian H of the Discrete Shells energy at rest (Lemma 1): (3n, 3n) CSR,
-    symmetric positive semi-definite, the rigid motions in its null space; dofs
-    ``3 * i + c``, mass ``kron(M, I3)``.  ``bending``, ``membrane``: the energies'
-    weights.  Bending scales like 1 / length^2 and membrane like 1 / length, so the
-    spectrum depends on the mesh's absolute size.  Assembled as ``G^T G`` of
-    :func:`weighted_gradient_matrix`."""
+    """The Hessian H of the Discrete Shells energy at rest (Lemma 1) as ``G^T G``: (3n, 3n)
+    CSR, symmetric positive semi-definite, the rigid motions in its null space, mass
+    ``kron(M, I3)``.  Bending scales like 1 / length^2 and membrane like 1 / length, so
+    the spectrum depends on the mesh's absolute size."""
     return _gram(weighted_gradient_matrix(mesh, bending, membrane))
 
 
-def normal_projection(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_matrix:
-    """P, (3n, n): column i holds the unit normal N_i in the rows of vertex i."""
-    n = mesh.n_vertices
-    normals = vertex_normals(mesh) if normals is None else normals
-    rows = np.arange(3 * n)
-    cols = np.repeat(np.arange(n), 3)
-    return sp.csr_matrix((normals.ravel(), (rows, cols)), shape=(3 * n, n))
-
-
 def normal_shells_hessian(mesh: Mesh, bending: float = 1.0, membrane: float = 1.0) -> sp.csr_matrix:
-    """``H_N = P^T H P``: the shells Hessian restricted to normal variations ``f N``, with P
-    of :func:`normal_projection` (assembled as ``(G P)^T (G P)``); (n, n) CSR, symmetric
-    positive semi-definite."""
-    G_N = weighted_gradient_matrix(mesh, bending, membrane, normals=vertex_normals(mesh))
-    return _gram(G_N)
+    """``H_N = P^T H P``: the shells Hessian restricted to normal variations ``f N`` (P
+    (3n, n) holding the unit vertex normals), assembled as ``(G P)^T (G P)``; (n, n) CSR,
+    symmetric positive semi-definite."""
+    return _gram(weighted_gradient_matrix(mesh, bending, membrane, normals=vertex_normals(mesh)))

@@ -52,24 +52,23 @@ def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
     return mask
 
 
+def _nonzero_eigenvalues(spec: Spectrum) -> np.ndarray:
+    return spec.eigenvalues[_used(spec, False)]
+
+
 def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False) -> np.ndarray:
-    """Log-spaced scales from ``4 ln 10 / lambda_max`` to ``4 ln 10 / lambda_min`` (the
-    largest and the smallest non-zero eigenvalue), ``samples`` of them, ascending; a
-    ValueError if the spectrum has no non-zero modes.  ``include_zero`` does not change
-    the range."""
+    """``samples`` log-spaced scales from ``4 ln 10`` over the largest to over the
+    smallest non-zero eigenvalue (``include_zero`` does not change the range)."""
     samples = check_count(samples, "samples", 2)
-    lam = spec.eigenvalues[~spec.zero_mode_mask()]
-    if lam.size == 0:
-        raise ValueError("the spectrum has no non-zero modes; compute more modes")
+    lam = _nonzero_eigenvalues(spec)
     t1 = 4.0 * np.log(10.0) / lam.max()
     t2 = 4.0 * np.log(10.0) / lam.min()
     return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
 
 
 def default_energies(spec: Spectrum, samples: int = 100) -> np.ndarray:
-    """Energies of the wave kernel signature: ``samples`` values log-spaced from the
-    smallest to the largest non-zero eigenvalue (Aubry et al.'s band); a ValueError
-    if the spectrum has fewer than two distinct non-zero eigenvalues."""
+    """``samples`` energies of the wave kernel signature, log-spaced from the smallest to
+    the largest non-zero eigenvalue (Aubry et al.'s band)."""
     samples = check_count(samples, "samples", 2)
     lam = _positive_eigenvalues(spec)
     return np.exp(np.linspace(np.log(lam.min()), np.log(lam.max()), samples))
@@ -77,8 +76,7 @@ def default_energies(spec: Spectrum, samples: int = 100) -> np.ndarray:
 
 def wks_sigma(energies: Sequence[float] | np.ndarray) -> float:
     """The wave kernel's width in log-energy: :data:`WKS_VARIANCE` times the spacing of
-    ``log(energies)`` (their range over ``len - 1``; for one energy, ``WKS_VARIANCE``
-    times 0.05)."""
+    ``log(energies)`` (for one energy, times 0.05)."""
     e = np.log(check_times(energies, "energies"))
     if e.size < 2 or e.max() == e.min():
         return WKS_VARIANCE * 0.05
@@ -86,9 +84,7 @@ def wks_sigma(energies: Sequence[float] | np.ndarray) -> float:
 
 
 def _positive_eigenvalues(spec: Spectrum) -> np.ndarray:
-    lam = spec.eigenvalues[~spec.zero_mode_mask()]
-    if lam.size == 0:
-        raise ValueError("the spectrum has no non-zero modes; compute more modes")
+    lam = _nonzero_eigenvalues(spec)
     if lam.min() <= 0:
         raise ValueError(
             f"the wave kernel signature needs positive eigenvalues; this spectrum has "
@@ -97,22 +93,6 @@ def _positive_eigenvalues(spec: Spectrum) -> np.ndarray:
     if lam.max() == lam.min():
         raise ValueError("the wave kernel signature needs two distinct non-zero eigenvalues")
     return lam
-
-
-def _wks_weights(spec: Spectrum, energies: np.ndarray, sigma: float) -> np.ndarray:
-    """(k', T) ``exp(-(log E - log lambda_j)^2 / (2 sigma^2))`` over the non-zero modes."""
-    lam = _positive_eigenvalues(spec)
-    gap = np.log(energies)[None, :] - np.log(lam)[:, None]
-    return np.exp(-(gap**2) / (2.0 * sigma**2))
-
-
-def _check_sigma(sigma, energies) -> float:
-    if sigma is None:
-        return wks_sigma(energies)
-    sigma = float(sigma)
-    if not (np.isfinite(sigma) and sigma > 0):
-        raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
-    return sigma
 
 
 def signature(
@@ -124,24 +104,11 @@ def signature(
     energies: float | Sequence[float] | np.ndarray | None = None,
     sigma: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The signature ``sum_j exp(-lambda_j t) |phi_j(v)|^2`` at every vertex (or at
-    ``vertices``) and scale (module docstring for the kinds).
-
-    Parameters
-    ----------
-    times : positive, finite scales (default: :func:`default_times`).
-    include_zero : whether the sum includes the zero modes (``kind="heat"`` only).
-    vertices : vertex indices (default: every vertex); vertices no face uses get NaN.
-    kind : ``"heat"``, or ``"wks"``: ``W_E(v)`` at ``energies`` (default
-        :func:`default_energies`) with width ``sigma`` in log-energy (default
-        :func:`wks_sigma`).
-
-    Returns
-    -------
-    (times (T,) or the energies; values (n, T) or (len(vertices), T)).  A TypeError,
-    ValueError or IndexError for scales not positive and finite or vertices not of the
-    mesh.
-    """
+    """``(times (T,), values (n, T))``: the signature at every vertex (or only the rows
+    of ``vertices``; NaN where no face uses one) and positive scale ``times`` (default
+    :func:`default_times`), with or without the zero modes.  ``kind="wks"``: ``W_E(v)``
+    at ``energies`` (default :func:`default_energies`) of width ``sigma`` in log-energy
+    (default :func:`wks_sigma`) instead (module docstring)."""
     if _check_kind(kind) == "wks":
         if times is not None or include_zero:
             raise ValueError(
@@ -149,10 +116,13 @@ def signature(
                 "(no times or include_zero)"
             )
         energies = default_energies(spec) if energies is None else check_times(energies, "energies")
-        sigma = _check_sigma(sigma, energies)
+        sigma = wks_sigma(energies) if sigma is None else float(sigma)
+        if not (np.isfinite(sigma) and sigma > 0):
+            raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
         if vertices is not None:
             vertices = check_vertices(vertices, spec.n_vertices, allow_empty=True)
-        weights = _wks_weights(spec, energies, sigma)
+        gap = np.log(energies)[None, :] - np.log(_positive_eigenvalues(spec))[:, None]
+        weights = np.exp(-(gap**2) / (2.0 * sigma**2))  # (k', T) over the non-zero modes
         squared = spec.squared_modes(vertices)[:, ~spec.zero_mode_mask()]
         return energies, (squared @ weights) / weights.sum(axis=0)
     if energies is not None or sigma is not None:
@@ -186,10 +156,10 @@ def normalised_signatures(
 
 
 class SignatureTable:
-    """Normalised signatures of all vertices, ready for fast distance queries: ``F =
-    S_t(v) / Z(t) * sqrt(dlogt)`` as (n, T), so ``delta(v, w) = |F[v] - F[w]|`` (with
-    ``kind="wks"``, ``W_E(v) sqrt(dlogE)`` over the energy range ``t_range``).  One
-    (n, k) x (k, T) product to build, O(n T) per query."""
+    """Normalised signatures of all vertices for fast distance queries: ``table`` (n, T)
+    ``F = S_t(v) / Z(t) * sqrt(dlogt)`` at the scales ``times``, so ``delta(v, w) =
+    |F[v] - F[w]|`` (``kind="wks"``: ``W_E(v) sqrt(dlogE)`` at energies).  ``t_range``
+    is the range asked for (None: the default range).  O(n T) per query."""
 
     def __init__(
         self,
@@ -201,11 +171,9 @@ class SignatureTable:
     ):
         samples = check_count(samples, "samples", 2)
         self.kind = _check_kind(kind)
-        """The signature kind, "heat" or "wks"."""
         if kind == "wks" and include_zero:
             raise ValueError("the wave kernel signature leaves the zero modes out")
         self.t_range = None if t_range is None else check_t_range(t_range)
-        """The scale range asked for (None: the default range, see :attr:`times`)."""
         if self.t_range is None:
             if kind == "wks":
                 times = default_energies(spec, samples)
@@ -215,12 +183,10 @@ class SignatureTable:
             t1, t2 = self.t_range
             times = np.exp(np.linspace(np.log(t1), np.log(t2), samples))
         self.times = times
-        """The scales (the energies for ``kind="wks"``), ascending."""
         self.table = normalised_signatures(spec, times, include_zero, kind=kind)
 
     @property
     def table(self) -> np.ndarray:
-        """(n, T) normalised signatures."""
         return self._table
 
     @table.setter
@@ -261,14 +227,10 @@ def multiscale_distance(
     include_zero: bool = False,
     kind: str = "heat",
 ) -> np.ndarray:
-    """The multi-scale distance ``delta_[t1,t2](vertex, w)`` of eq. (31) to every vertex w:
-    a Riemann sum over ``samples`` log-spaced scales in ``t_range`` (default
-    :func:`default_times`' range; for ``kind="wks"`` energies, :func:`default_energies`)
-    of signature differences normalised by ``Z(t) = sum_j exp(-lambda_j t)``.
-
-    Returns (n,): 0 at ``vertex``, NaN at the vertices no face uses.  A ValueError if the
-    spectrum has no non-zero modes, or no face uses ``vertex``.
-    """
+    """(n,) the multi-scale distance of eq. (31) from ``vertex`` to every vertex (NaN
+    where no face uses it): a Riemann sum over ``samples`` log-spaced scales in
+    ``t_range`` (default: :func:`default_times`' or, for ``kind="wks"``,
+    :func:`default_energies`' range) of signature differences normalised by ``Z(t)``."""
     vertex = spec.check_source(check_vertex(vertex, spec.n_vertices))
     table = SignatureTable(spec, t_range, samples, include_zero, kind=kind)
     return table.distance_from(vertex)
