@@ -52,13 +52,13 @@ def build_figures(out_dir, progress=print) -> list[Path]:
         state.style.shell_coloring = "deformed"
         state.style.ghost = True
         for membrane in (0.01, 100.0):
-            state.set_compute_settings(membrane=membrane)
+            state.compute_settings.membrane = membrane
             viewer.compute("shells", k=16)
             viewer.show_mode(8)
-            state.set_animation(amplitude=30)
+            state.animation.amplitude = 30
             save(f"fig4_vibration_membrane_{membrane:g}")
-        state.set_compute_settings(membrane=1.0)
-        state.set_animation(amplitude=40)
+        state.compute_settings.membrane = 1.0
+        state.animation.amplitude = 40
         # Figs. 5 and 7: vibration distance on spot, continuous and two threshold maps
         # (marking a tenth and a quarter of the surface)
         viewer.open_mesh(ASSETS / "spot.obj")
@@ -80,12 +80,12 @@ def build_figures(out_dir, progress=print) -> list[Path]:
         # Fig. 9: vibration distance from a fingertip, full mesh and coarse-to-fine
         for coarse in (False, True):
             viewer.open_mesh(ASSETS / "demo_hand.obj")
-            state.set_compute_settings(coarse=coarse)
+            state.compute_settings.coarse = coarse
             viewer.compute("shells", k=100)
             viewer.pick_vertex(landmarks["demo_hand"]["finger1"])
             viewer.show_distance("vibration", display="continuous")
             save(f"fig9_hand_vibration_distance_{'coarse_to_fine' if coarse else 'full'}")
-        state.set_compute_settings(coarse=False)
+        state.compute_settings.coarse = False
         # Fig. 8: feature signature on the machined part at three scales, and curvature
         viewer.open_mesh(ASSETS / "demo_machined_part.obj")
         viewer.compute("modified_dirichlet", k=100)

@@ -205,7 +205,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
     # =========================================================== settings
     def closeEvent(self, event):  # noqa: N802
-        self.state.set_animation(playing=False)
+        self.state.animation.playing = False
         if self.compare is not None:
             self.compare.close()
         self.viewer.jobs.shutdown(5.0)
@@ -376,7 +376,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.viewer.jobs.cancel_all()
 
     def toggle_animation(self) -> None:
-        self.state.set_animation(playing=not self.state.animation.playing)
+        self.state.animation.playing = not self.state.animation.playing
 
     def animation_frame(self, phase: float) -> float:
         """Move the surface to the given phase (radians); returns the app's time in s."""

@@ -57,19 +57,15 @@ def restore(win) -> None:
     st.style.colorbar = _flag(s, "view/colorbar", True)
     _restore_color_range(st, s)
     st.style.log_signature = _flag(s, "view/log_signature", False)
-    st.set_animation(
-        # the largest displacement of the deformed shape and of the animation
-        amplitude=int(s.value("view/mode_amplitude", 40)),
-        speed=int(s.value("view/speed", 30)),
-    )
-    operator = str(s.value("compute/operator", "modified_dirichlet"))
-    st.set_compute_settings(
-        operator=operator if operator in OPERATOR_INFO else "modified_dirichlet",
-        bending=float(s.value("compute/bending", 1.0)),
-        membrane=float(s.value("compute/membrane", 1.0)),
-        rescale=_flag(s, "compute/rescale", False),
-        coarse=_flag(s, "compute/coarse", False),
-    )
+    # the largest displacement of the deformed shape and of the animation
+    st.animation.amplitude = int(s.value("view/mode_amplitude", 40))
+    st.animation.speed = int(s.value("view/speed", 30))
+    c, operator = st.compute_settings, str(s.value("compute/operator", "modified_dirichlet"))
+    c.operator = operator if operator in OPERATOR_INFO else "modified_dirichlet"
+    c.bending = float(s.value("compute/bending", 1.0))
+    c.membrane = float(s.value("compute/membrane", 1.0))
+    c.rescale = _flag(s, "compute/rescale", False)
+    c.coarse = _flag(s, "compute/coarse", False)
     rebuild_recent(win)
 
 
@@ -185,7 +181,7 @@ def remember_up_axis(win, path, axis: str | None) -> None:
 def choose_up_axis(win, axis: str | None) -> None:
     """View > Up axis: set the state's up axis (the view turns to the canonical one for
     it) and remember it for the file shown."""
-    win.state.set_up_axis(axis)
+    win.state.up_axis = axis
     remember_up_axis(win, win.state.mesh_path, win.state.up_axis)
 
 
@@ -193,4 +189,4 @@ def restore_up_axis(win) -> None:
     """A newly loaded file gets the up axis chosen for it before, if any."""
     axis = remembered_up_axis(win, win.state.mesh_path)
     if axis is not None and win.state.mesh is not None:
-        win.state.set_up_axis(axis)
+        win.state.up_axis = axis

@@ -255,13 +255,13 @@ class Pictures:
 
         view = parse_view(view) if isinstance(view, str) else tuple(float(x) for x in view)
         if up is not None:
-            self.state.set_up_axis(up)
+            self.state.up_axis = up
         mesh = self.state.mesh
         if mesh is None:
             return None
         camera = view_camera(mesh.vertices, mesh.faces, view, up=self.state.derived.up_axis())
         data = {**camera.as_dict(), "fit": True}
-        self.state.set_camera(data)
+        self.state.camera = data
         return data
 
     def current_camera(self) -> dict | None:

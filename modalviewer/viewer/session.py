@@ -111,6 +111,14 @@ def _known(cls, values: dict) -> dict:
     return {k: v for k, v in (values or {}).items() if k in names}
 
 
+def _update(evented, values: dict | None, names=None) -> None:
+    """Set the fields of the evented dataclass ``evented`` that ``values`` has (of
+    ``names`` only, if given)."""
+    for name, value in _known(type(evented), values).items():
+        if names is None or name in names:
+            setattr(evented, name, value)
+
+
 def restore_session(model, path) -> Restored:
     """Open the session's mesh and restore its state in ``model`` (a ViewerModel): the
     spectra are requested (the cache answers at once, others are recomputed) and the
@@ -153,14 +161,15 @@ def restore_session(model, path) -> Restored:
     state.style.ghost = bool(style.get("ghost", True))
     limits = style.get("color_limits")
     state.set_color_range(str(style.get("color_range", "auto")), limits)
-    anim = data.get("animation") or {}
-    state.set_animation(**_known(type(state.animation), anim))
-    settings = ComputeSettings(**_known(ComputeSettings, data.get("compute_settings")))
-    state.set_compute_settings(**asdict(settings))
+    _update(state.animation, data.get("animation"))
+    _update(
+        state.compute_settings,
+        asdict(ComputeSettings(**_known(ComputeSettings, data.get("compute_settings")))),
+    )
     if data.get("t_range"):
         state.set_scale_range(tuple(data["t_range"]))
     try:
-        state.set_up_axis(data.get("up_axis"))
+        state.up_axis = data.get("up_axis")
     except ValueError as exc:
         out.notes.append(f"the up axis: {exc}")
     picked = data.get("picked")
@@ -180,15 +189,13 @@ def restore_session(model, path) -> Restored:
     display = Display(**_known(Display, saved_display))
     for raw in data.get("spectra") or []:
         key = SpectrumKey(**_known(SpectrumKey, raw))
-        saved = state.compute_settings
-        state.set_compute_settings(
-            bending=key.bending, membrane=key.membrane, rescale=key.rescale, coarse=key.coarse
-        )
+        saved = asdict(state.compute_settings)
+        _update(state.compute_settings, asdict(key), ("bending", "membrane", "rescale", "coarse"))
         try:
             out.jobs.append(model.request_spectrum(key.operator, key.k))
         except ValueError as exc:
             out.notes.append(f"{key.describe()}: {exc}")
-        state.set_compute_settings(**asdict(saved))
+        _update(state.compute_settings, saved)
     camera = data.get("camera")
 
     def apply_display(_job=None) -> None:
@@ -199,7 +206,7 @@ def restore_session(model, path) -> Restored:
         except ValueError as exc:
             out.notes.append(f"the saved display cannot be shown: {exc}")
         if camera:
-            state.set_camera(camera)
+            state.camera = camera
 
     if out.jobs:
         for job in out.jobs:

@@ -11,18 +11,23 @@ method changes only what it is given, except for the threshold rule
 Events (``state.events.<name>.connect(callback)``), emitted on the thread that changed
 the state: ``mesh()`` (new mesh or none; spectra, pick and display reset),
 ``spectra(operator)``, ``display()``, ``style()``, ``pick()``, ``compute_settings()``,
-``scale_range()``, ``animation()``, ``camera()`` (set through the state: a preset, a
-restored session), ``signature_curve()`` (the exact curve arrived) and ``up_axis()``.
+``scale_range()``, ``animation()``, ``camera(new, old)`` (set through the state: a
+preset, a restored session), ``signature_curve()`` (the exact curve arrived) and
+``up_axis(new, old)``.  ``style``, ``animation`` and ``compute_settings`` are evented
+dataclasses (``state.animation.speed = 50``), ``camera`` and ``up_axis`` evented fields
+of the state.
 """
 
 from __future__ import annotations
 
+import operator as op_
 from dataclasses import dataclass, replace
 from functools import cached_property
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
-from psygnal import Signal, SignalGroup, evented
+from psygnal import Signal, SignalGroup, SignalGroupDescriptor, evented
 
 from ..core.mesh import Mesh
 from ..core.operators import (
@@ -65,9 +70,11 @@ quarter of the surface, else robust; symmetric for modes)."""
 RENDER_STYLES = ("paper", "shaded")
 
 
-@dataclass(frozen=True)
+@evented
+@dataclass
 class ComputeSettings:
-    """What the next computation computes (the Compute panel's fields)."""
+    """What the next computation computes (the Compute panel's fields); setting a field
+    validates it and emits ``events.<field>`` (and the state's ``compute_settings``)."""
 
     operator: str = "modified_dirichlet"
     k: int = DEFAULT_K
@@ -75,6 +82,15 @@ class ComputeSettings:
     membrane: float = 1.0
     rescale: bool = False
     coarse: bool = False
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "operator":
+            operator_info(value)  # a ValueError naming the operators for an unknown one
+        elif name == "k":
+            value = int(value)
+            if value < 1:
+                raise ValueError("the number of modes must be at least 1")
+        super().__setattr__(name, value)
 
     def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
         op = operator or self.operator
@@ -181,6 +197,8 @@ def _scale(t) -> float | None:
 
 
 class ViewerEvents(SignalGroup):
+    """The state's events besides its fields' (``camera``, ``up_axis``)."""
+
     mesh = Signal()
     spectra = Signal(str)
     display = Signal()
@@ -189,8 +207,6 @@ class ViewerEvents(SignalGroup):
     compute_settings = Signal()
     scale_range = Signal()
     animation = Signal()
-    camera = Signal()
-    up_axis = Signal()
     signature_curve = Signal()
 
 
@@ -224,20 +240,61 @@ class Style:
         super().__setattr__(name, value)
 
 
+@evented
 @dataclass
 class Animation:
+    """The vibration's animation; setting a field clips it and emits ``events.<field>``
+    (and the state's ``animation``).  Only a mode plays (the state stops it otherwise)."""
+
     playing: bool = False
     # largest displacement of a mode, in percent of a quarter of the bounding-box diagonal
     # (40: a tenth of the diagonal), of the deformed shape and of the animation's peak
-    amplitude: int = 40
-    speed: int = 30  # tenths of a radian per second
+    amplitude: int = 40  # 0..100
+    speed: int = 30  # tenths of a radian per second, 1..100
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "playing":
+            value = bool(value)
+        elif name in ("amplitude", "speed"):
+            value = int(np.clip(value, 0 if name == "amplitude" else 1, 100))
+        super().__setattr__(name, value)
 
 
+@dataclass(eq=False)
 class ViewerState:
-    """The viewer's state; see the module docstring for its events."""
+    """The viewer's state; see the module docstring for its events.
 
-    def __init__(self) -> None:
-        self.events = ViewerEvents()
+    camera : set by a preset or a restored session, the scene applies it (position,
+        focal_point, view_up, parallel_scale; "fit": fitted to the shape); the scene also
+        stores the user's camera here before a session is saved.  Set again, an equal
+        camera is applied again.
+    up_axis : the chosen up axis ("+x" ... "-z"), or None (also given as "auto"):
+        automatic (detected where confident, else +Y;
+        :meth:`.derived.DerivedValues.up_axis` is the one in effect); the scene turns to
+        the canonical view for it.
+    """
+
+    events: ClassVar = SignalGroupDescriptor(
+        signal_group_class=ViewerEvents,
+        equality_operators={"camera": op_.is_},
+        # attributes named as events are not evented fields: their events are emitted
+        signal_aliases=dict.fromkeys(
+            ("mesh", "spectra", "display", "style", "compute_settings", "animation")
+        ),
+    )
+    camera: dict | None = None
+    up_axis: str | None = None
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "up_axis":
+            from .camera import AXES
+
+            value = None if value in (None, "auto") else str(value).lower()
+            if value is not None and value not in AXES:
+                raise ValueError(f"up axis must be auto or one of {', '.join(AXES)}")
+        super().__setattr__(name, value)
+
+    def __post_init__(self) -> None:
         self.mesh: Mesh | None = None
         self.mesh_path: Path | None = None
         self.mesh_repairs: list[str] = []  # repairs applied after loading, in order
@@ -250,20 +307,22 @@ class ViewerState:
         self.picked: int | None = None
         self.t_range: tuple[float, float] | None = None
         self.style = Style()
-        self.style.events.all.connect(self._style_changed)
+        self.style.events.all.connect(lambda: self.events.style.emit())
         self.animation = Animation()
-        self.camera: dict | None = None
-        self.up_axis: str | None = None
-        """The chosen up axis ("+x" ... "-z"), or None: automatic (detected where
-        confident, else +Y; :meth:`.derived.DerivedValues.up_axis` is the one in effect)."""
+        self.animation.events.all.connect(self._animation_changed)
+        self.compute_settings.events.all.connect(lambda: self.events.compute_settings.emit())
         self.threshold_map: tuple | str | None = None
         """The distance map (:meth:`.derived.DerivedValues.map_identity`) on which
         ``display.threshold`` and ``display.threshold_share`` were last matched; None
         before the first (it gets the share), :data:`NEXT_MAP` after a fraction was set
         while no threshold map was on screen (the next one keeps it)."""
 
-    def _style_changed(self) -> None:
-        self.events.style.emit()
+    def _animation_changed(self) -> None:
+        if self.animation.playing and self.display.kind != "mode":
+            with self.animation.events.blocked():
+                self.animation.playing = False  # only a mode plays
+        else:
+            self.events.animation.emit()
 
     @cached_property
     def derived(self) -> DerivedValues:
@@ -286,13 +345,13 @@ class ViewerState:
         self.fields.clear()
         self._latest.clear()
         self.computing.clear()
-        if mesh is not None:
-            self.compute_settings = replace(self.compute_settings, k=default_k(mesh.n_vertices))
         self.picked = None
-        self.animation.playing = False
         self.display = self.display.blank()
-        self.camera = None
-        self.up_axis = None
+        with self.events.blocked():  # the mesh event tells them all
+            if mesh is not None:
+                self.compute_settings.k = default_k(mesh.n_vertices)
+            self.animation.playing = False
+            self.camera = self.up_axis = None
         self.events.mesh.emit()
 
     def compute_mesh(self, key: SpectrumKey | None = None) -> Mesh:
@@ -372,19 +431,6 @@ class ViewerState:
         return (0, 0) if spec is None else (spec.k, spec.modes_requested)
 
     # --------------------------------------------------------- settings
-    def set_compute_settings(self, **changes) -> None:
-        """Change fields of :class:`ComputeSettings` (operator, k, bending, ...)."""
-        if "operator" in changes:
-            operator_info(changes["operator"])
-        if "k" in changes:
-            changes["k"] = int(changes["k"])
-            if changes["k"] < 1:
-                raise ValueError("the number of modes must be at least 1")
-        new = replace(self.compute_settings, **changes)
-        if new != self.compute_settings:
-            self.compute_settings = new
-            self.events.compute_settings.emit()
-
     def set_color_range(self, mode: str, limits: tuple[float, float] | None = None) -> None:
         """The colour range, one of :data:`COLOR_RANGES`; ``limits`` (low < high) sets
         :attr:`Style.color_limits` ("limits" needs them, given now or before)."""
@@ -404,18 +450,6 @@ class ViewerState:
                 self.style.color_range, self.style.color_limits = mode, limits
             self.events.style.emit()
 
-    def set_animation(self, **changes) -> None:
-        """playing (only a mode can play), amplitude (0..100), speed (1..100)."""
-        anim = self.animation
-        new = Animation(
-            playing=bool(changes.get("playing", anim.playing)) and self.display.kind == "mode",
-            amplitude=int(np.clip(changes.get("amplitude", anim.amplitude), 0, 100)),
-            speed=int(np.clip(changes.get("speed", anim.speed), 1, 100)),
-        )
-        if new != anim:
-            self.animation = new
-            self.events.animation.emit()
-
     def set_scale_range(self, t_range: tuple[float, float] | None) -> None:
         """The scale range (t1, t2) of signatures and distances; None for the default."""
         if t_range is not None:
@@ -429,25 +463,6 @@ class ViewerState:
             self.events.scale_range.emit()
             if self.display.kind in ("distance", "signature"):
                 self.events.display.emit()
-
-    def set_up_axis(self, axis: str | None) -> None:
-        """Choose the up axis ("+x", "-x", "+y", "-y", "+z", "-z"; None or "auto": the
-        detected one); the scene turns to the canonical view for it."""
-        from .camera import AXES
-
-        axis = None if axis in (None, "auto") else str(axis).lower()
-        if axis is not None and axis not in AXES:
-            raise ValueError(f"up axis must be auto or one of {', '.join(AXES)}")
-        if axis != self.up_axis:
-            self.up_axis = axis
-            self.events.up_axis.emit()
-
-    def set_camera(self, camera: dict | None) -> None:
-        """Set the camera (position, focal_point, view_up, parallel_scale); the scene
-        applies it.  The scene also stores the user's camera here before a session is
-        saved."""
-        self.camera = camera
-        self.events.camera.emit()
 
     # ---------------------------------------------------------- display
     def set_display(self, **changes) -> None:
@@ -489,9 +504,8 @@ class ViewerState:
             fraction_set="threshold" in changes,
             share_set="threshold_share" in changes,
         )
-        if new.kind != "mode" and self.animation.playing:
-            self.animation = replace(self.animation, playing=False)
-            self.events.animation.emit()
+        if new.kind != "mode":
+            self.animation.playing = False
         self.events.display.emit()
 
     def add_field(self, name: str, values) -> None:

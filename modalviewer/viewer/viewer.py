@@ -164,7 +164,10 @@ class Viewer(ViewerModel, Pictures):
             self.events.info.emit(
                 "Slivers fixed", f"{j.result.report}\n\nComputing {key.describe()} again..."
             )
-            self.state.set_compute_settings(operator=key.operator, k=key.k)
+            self.state.compute_settings.operator, self.state.compute_settings.k = (
+                key.operator,
+                key.k,
+            )
             job_ = self._request(key.operator, key.k, show=True)
             if job_ is not None:
                 retried.append(job_)
@@ -219,13 +222,10 @@ class Viewer(ViewerModel, Pictures):
             if wait:
                 raise ComputeError("Open a mesh first.")
             return None
-        changes = {}
         if operator is not None:
-            changes["operator"] = operator
+            self.state.compute_settings.operator = operator
         if k is not None:
-            changes["k"] = int(k)
-        if changes:
-            self.state.set_compute_settings(**changes)
+            self.state.compute_settings.k = k
         job = self._request(None, None, show=True)
         if job is None and wait:
             raise ComputeError(self.last_error or "the computation was refused")
@@ -584,7 +584,8 @@ class Viewer(ViewerModel, Pictures):
 
         camera = self.current_camera()
         if camera is not None:
-            self.state.camera = camera
+            with self.state.events.camera.blocked():  # what the picture shows already
+                self.state.camera = camera
         return save_session(self.state, path)
 
     def open_session(self, path, wait: bool = True) -> list[str]:

@@ -368,7 +368,8 @@ def test_compute_options_and_the_colour_bar_are_remembered(window, qtbot):
     file that still names the removed preview options starts without them."""
     from modalviewer.gui import MainWindow, window_settings
 
-    window.state.set_compute_settings(coarse=True, operator="laplacian")
+    window.state.compute_settings.coarse = True
+    window.state.compute_settings.operator = "laplacian"
     window.state.style.colorbar = False
     window.state.set_color_range("limits", (-0.5, 2.0))
     window.state.style.log_signature = True
@@ -537,7 +538,8 @@ def test_preferences_are_written_soon_after_they_change(window, qtbot):
     from modalviewer.gui import MainWindow
 
     window.remember_settings = True  # as on a desktop
-    window.state.set_compute_settings(operator="shells_normal", coarse=True)
+    window.state.compute_settings.operator = "shells_normal"
+    window.state.compute_settings.coarse = True
     qtbot.waitUntil(
         lambda: window.settings.value("compute/operator") == "shells_normal", timeout=3000
     )

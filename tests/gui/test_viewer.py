@@ -442,7 +442,7 @@ def test_coarse_to_fine_option(window):
 
     assets = Path(__file__).resolve().parents[2] / "assets"
     window.open_mesh(assets / "demo_hand.obj")
-    window.state.set_compute_settings(coarse=True)
+    window.state.compute_settings.coarse = True
     spec = window.compute("shells", k=60, wait=True)
     assert spec.n_vertices == window.mesh.n_vertices
     assert spec.parameters["coarse_vertices"] < 0.25 * window.mesh.n_vertices

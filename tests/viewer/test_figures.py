@@ -112,11 +112,11 @@ def test_an_mp4_has_the_frames_and_size_asked_for(spot, tmp_path):
 
 def test_the_default_animation_plays_one_period_at_the_windows_speed(spot):
     spot.show_mode(8, "shells")
-    spot.state.set_animation(speed=50)  # 5 rad/s: a period of 1.26 s
+    spot.state.animation.speed = 50  # 5 rad/s: a period of 1.26 s
     try:
         frames = spot.animation_images(fps=10, size=(64, 48))
     finally:
-        spot.state.set_animation(speed=30)
+        spot.state.animation.speed = 30
     assert len(frames) == round(2 * np.pi / 5.0 * 10)  # 13
 
 

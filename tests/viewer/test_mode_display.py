@@ -54,7 +54,7 @@ def test_the_amplitude_sets_the_largest_displacement(machined):
     scene = machined.renderer(SIZE).scene
     largest = np.linalg.norm(scene.surface.points - scene.rest_points, axis=1).max()
     assert largest == pytest.approx(0.1 * diagonal, rel=1e-6)  # the default: a tenth
-    state.set_animation(amplitude=20)
+    state.animation.amplitude = 20
     try:
         largest = np.linalg.norm(scene.surface.points - scene.rest_points, axis=1).max()
         assert largest == pytest.approx(0.05 * diagonal, rel=1e-6)
@@ -68,7 +68,7 @@ def test_the_amplitude_sets_the_largest_displacement(machined):
             * (np.linalg.norm(state.spectrum("shells").mode(8), axis=1).max()),
         )
     finally:
-        state.set_animation(amplitude=40)
+        state.animation.amplitude = 40
 
 
 def test_the_ghost_of_the_rest_shape_can_be_hidden(machined):
@@ -116,7 +116,7 @@ def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
     fought for the pixels, pale blotches showed on the parts a mode barely moves."""
     state = machined.state
     scene = machined.renderer(SIZE).scene
-    state.set_animation(amplitude=1)
+    state.animation.amplitude = 1
     try:
         state.style.ghost = True
         with_ghost = machined.image(size=SIZE).astype(int)
@@ -125,7 +125,7 @@ def test_the_ghost_lies_behind_where_the_surface_barely_moves(machined):
         without = machined.image(size=SIZE, fit=False).astype(int)
     finally:
         state.style.ghost = True
-        state.set_animation(amplitude=40)
+        state.animation.amplitude = 40
     changed = (np.abs(with_ghost - without).max(axis=2) > 8).mean()
     assert changed < 0.002, changed
 

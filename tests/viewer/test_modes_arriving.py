@@ -65,7 +65,7 @@ def test_a_script_looks_at_the_first_modes_while_the_others_converge(viewer, pau
     assert "the others follow as they converge" in wording.arrival_note(state, "shells")
     chosen = state.display
     camera = {"position": (3.0, 1.0, 2.0), "focal_point": (0.0, 0.0, 0.0), "view_up": (0, 1, 0)}
-    state.set_camera(camera)
+    state.camera = camera
     paused.set()
     assert viewer.wait_for_modes(120, "shells", timeout=300) == (120, 120)
     final = state.spectrum("shells")

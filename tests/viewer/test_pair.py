@@ -122,7 +122,7 @@ def test_rescale_makes_a_larger_copy_comparable(tmp_path, spot):
 def test_spectra_of_a_come_from_the_main_state_and_the_disk_cache(tmp_path, spot, monkeypatch):
     model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
     model.set_mesh(spot, ASSETS / "spot.obj")
-    model.state.set_compute_settings(rescale=True)
+    model.state.compute_settings.rescale = True
     model.jobs.wait(model.request_spectrum("laplacian", K), timeout=120)
     pair = PairState(
         model.jobs, model.cache, spot, _moved(spot), state_a=model.state, k=K, rescale=True

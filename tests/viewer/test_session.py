@@ -104,14 +104,14 @@ def test_a_session_keeps_the_chosen_up_axis(tmp_path):
     shutil.copy(ASSETS / "spot.obj", mesh_path)
     first = _model(tmp_path)
     first.open_mesh(mesh_path)
-    first.state.set_up_axis("+z")
+    first.state.up_axis = "+z"
     path = save_session(first.state, tmp_path / "up.json")
     assert json.loads(path.read_text())["up_axis"] == "+z"
     second = _model(tmp_path)
     restored = restore_session(second, path)
     assert restored.notes == [] and second.state.up_axis == "+z"
     # an automatic axis stays automatic; a damaged value is a note, not a failure
-    first.state.set_up_axis(None)
+    first.state.up_axis = None
     data = json.loads(save_session(first.state, tmp_path / "auto.json").read_text())
     assert data["up_axis"] is None
     data["up_axis"] = "sideways"
@@ -128,7 +128,9 @@ def test_a_session_naming_the_removed_preview_options_opens_without_them(tmp_pat
     shutil.copy(ASSETS / "spot.obj", mesh_path)
     first = _model(tmp_path)
     first.open_mesh(mesh_path)
-    first.state.set_compute_settings(operator="laplacian", k=25, coarse=True)
+    first.state.compute_settings.operator = "laplacian"
+    first.state.compute_settings.k = 25
+    first.state.compute_settings.coarse = True
     path = save_session(first.state, tmp_path / "old.json")
     data = json.loads(path.read_text())
     data["compute_settings"].update(preview=True, preview_only=True)

@@ -312,6 +312,44 @@ def test_the_style_fields_are_validated_when_set_and_say_so_once():
     viewer.close()
 
 
+def test_animation_settings_camera_and_up_axis_are_evented_fields(model):
+    state, seen = model.state, []
+    for name in ("animation", "compute_settings", "camera", "up_axis"):
+        getattr(state.events, name).connect(lambda *_, name=name: seen.append(name))
+    state.animation.amplitude = 250
+    state.animation.amplitude = 100  # the same after clipping: no event
+    state.animation.speed = 0
+    assert (state.animation.amplitude, state.animation.speed) == (100, 1)
+    state.animation.playing = True  # only a mode plays: stays still, says nothing
+    assert state.animation.playing is False and seen == ["animation", "animation"]
+    state.compute_settings.k = "12"
+    state.compute_settings.k = 12
+    assert state.compute_settings.k == 12 and seen[2:] == ["compute_settings"]
+    with pytest.raises(ValueError, match="at least 1"):
+        state.compute_settings.k = 0
+    with pytest.raises(ValueError, match="unknown operator"):
+        state.compute_settings.operator = "nonsense"
+    assert (state.compute_settings.k, state.compute_settings.operator) == (12, "modified_dirichlet")
+    state.up_axis = "+Z"
+    state.up_axis = "+z"
+    with pytest.raises(ValueError, match="up axis"):
+        state.up_axis = "up"
+    assert state.up_axis == "+z" and seen[3:] == ["up_axis"]
+    camera = {"position": [0, 0, 5], "focal_point": [0, 0, 0], "view_up": [0, 1, 0]}
+    state.camera = camera
+    state.camera = dict(camera)  # set again: applied again
+    assert seen[4:] == ["camera", "camera"]
+    model.jobs.wait(model.request_spectrum("laplacian", k=8))
+    state.show_mode(1, "laplacian")
+    state.animation.playing = True
+    assert state.animation.playing and seen[-1] == "animation"
+    state.set_display(kind="curvature")  # a picture that does not vibrate stops it
+    assert not state.animation.playing and seen[-1] == "animation"
+    del seen[:]
+    state.set_mesh(icosphere(1))  # the mesh event says it all
+    assert state.camera is None and state.up_axis is None and seen == []
+
+
 def test_a_new_spectrum_of_an_operator_replaces_its_other_keys(model):
     """Every k used to stay in memory (3.0 GB after 18 requests at 130k) and in saved
     sessions, with one of them shown."""
@@ -348,13 +386,13 @@ def test_a_coarse_to_fine_spectrum_is_marked_as_approximate(model):
     """Found under Xvfb: a coarse-to-fine result replaced the exact spectrum and was
     listed and drawn as a plain Laplacian spectrum (lambda_1 9.388 against 9.377)."""
     state = model.state
-    state.set_compute_settings(coarse=True)
+    state.compute_settings.coarse = True
     job = model.request_spectrum("laplacian", k=12, show=True)
     model.jobs.wait(job)
     assert state.is_coarse("laplacian") and wording.display_mark(state) == " (coarse-to-fine)"
     assert state.derived.field().title.endswith("(coarse-to-fine)")
     assert "(coarse-to-fine: approximate)" in wording.legend(state)
-    state.set_compute_settings(coarse=False)
+    state.compute_settings.coarse = False
     exact = model.request_spectrum("laplacian", k=12, show=True)
     model.jobs.wait(exact)
     assert not state.is_coarse("laplacian") and wording.display_mark(state) == ""

@@ -79,15 +79,15 @@ def test_the_canonical_view_of_a_z_up_cow_stands_it_upright():
     up = np.asarray(viewer.current_camera()["view_up"])
     assert up[2] > 0.9  # +Z at the top of the screen (the +Y default would lay it down)
     # choosing +Y turns to the canonical view for +Y, and R (reset) keeps it
-    viewer.state.set_up_axis("+y")
+    viewer.state.up_axis = "+y"
     assert np.asarray(viewer.current_camera()["view_up"])[1] > 0.9
     viewer.renderer().drawing.reset_camera()
     assert np.asarray(viewer.current_camera()["view_up"])[1] > 0.9
-    viewer.state.set_up_axis("auto")
+    viewer.state.up_axis = "auto"
     assert viewer.state.up_axis is None
     assert np.asarray(viewer.current_camera()["view_up"])[2] > 0.9
     with pytest.raises(ValueError, match="up axis"):
-        viewer.state.set_up_axis("up")
+        viewer.state.up_axis = "up"
     viewer.close()
 
 

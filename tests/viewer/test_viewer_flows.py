@@ -292,7 +292,7 @@ def test_a_script_picks_without_computing_the_default_kinds_spectrum(viewer, spo
     # pick_file_vertex then show_distance("hks") had started the 3D shells for the
     # default vibration distance as well
     viewer.open_mesh(spot_path)
-    viewer.state.set_compute_settings(k=12)
+    viewer.state.compute_settings.k = 12
     viewer.pick_file_vertex(123, show=False)
     assert viewer.picked == 123 and viewer.jobs.jobs == []
     viewer.show_distance("hks")

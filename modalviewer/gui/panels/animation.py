@@ -29,9 +29,10 @@ class AnimationPanel(QtWidgets.QWidget):
         # Speed and Play share a row: the Modes dock shows the whole panel at the
         # default window size, under the spectrum plot
         form.addRow("Speed", row((self.speed_slider, 1), self.play_button))
-        self.play_button.toggled.connect(lambda on: state.set_animation(playing=on))
-        self.amp_slider.valueChanged.connect(lambda v: state.set_animation(amplitude=v))
-        self.speed_slider.valueChanged.connect(lambda v: state.set_animation(speed=v))
+        anim = state.animation
+        self.play_button.toggled.connect(lambda on: setattr(anim, "playing", on))
+        self.amp_slider.valueChanged.connect(lambda v: setattr(anim, "amplitude", v))
+        self.speed_slider.valueChanged.connect(lambda v: setattr(anim, "speed", v))
         follow(state, self.update_from_state, "animation", "display", "mesh")
         self.update_from_state()
 

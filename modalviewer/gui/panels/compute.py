@@ -62,14 +62,15 @@ class ComputePanel(QtWidgets.QWidget):
         self.mesh_info = WrappingLabel("No mesh")
         form.addRow(self.mesh_info)
 
+        c = state.compute_settings
         self.operator_combo.currentIndexChanged.connect(
-            lambda _: state.set_compute_settings(operator=self.operator_combo.currentData())
+            lambda _: setattr(c, "operator", self.operator_combo.currentData())
         )
-        self.k_spin.valueChanged.connect(lambda v: state.set_compute_settings(k=v))
-        self.bending_spin.valueChanged.connect(lambda v: state.set_compute_settings(bending=v))
-        self.membrane_spin.valueChanged.connect(lambda v: state.set_compute_settings(membrane=v))
-        self.rescale_check.toggled.connect(lambda on: state.set_compute_settings(rescale=on))
-        self.coarse_check.toggled.connect(lambda on: state.set_compute_settings(coarse=on))
+        self.k_spin.valueChanged.connect(lambda v: setattr(c, "k", v))
+        self.bending_spin.valueChanged.connect(lambda v: setattr(c, "bending", v))
+        self.membrane_spin.valueChanged.connect(lambda v: setattr(c, "membrane", v))
+        self.rescale_check.toggled.connect(lambda on: setattr(c, "rescale", on))
+        self.coarse_check.toggled.connect(lambda on: setattr(c, "coarse", on))
         self.compute_button.clicked.connect(self.computeRequested)
         follow(state, self.update_from_state, "compute_settings", "mesh")
         self.update_from_state()
