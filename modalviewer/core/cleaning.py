@@ -25,8 +25,7 @@ __all__ = ["repair_mesh"]
 _LISTED = 10  # vertex numbers a report lists before "and N more"
 
 
-def _listing(items: list[str], total: int) -> str:
-    """'vertex 3' or 'vertices 3, 7 and 2 more'."""
+def _listing(items: list[str], total: int) -> str:  # 'vertex 3', 'vertices 3, 7 and 2 more'
     text = ", ".join(items)
     if total > len(items):
         text += f" and {total - len(items)} more"
@@ -36,13 +35,8 @@ def _listing(items: list[str], total: int) -> str:
 def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
     """Vertices within ``tol`` of each other merged into the first of them: (vertices,
     faces, how many merged, each file vertex's new index, each new vertex's file
-    index).  Only vertices that faces use are merged: a vertex no face uses stays apart
-    (it is left without a value later), so a merged vertex is never named by the number
-    of one no face uses."""
-    if tol > 0:
-        key = np.round(v / tol).astype(np.int64)
-    else:
-        key = v
+    index).  Only vertices that faces use are merged: one no face uses stays apart."""
+    key = np.round(v / tol).astype(np.int64) if tol > 0 else v
     in_face = np.zeros(len(v), dtype=bool)
     in_face[f.ravel()] = True
     key = np.column_stack([key, np.where(in_face, -1, np.arange(len(v)))])
@@ -96,9 +90,8 @@ def _collapsible(p: int, q: int, v, f, topo, min_area: float) -> bool:
 
 def _flippable(t: int, a: int, b: int, x: int, v, f, topo, min_area: float):
     """(face across edge ab, its third vertex d) if the zero-area face t = (a, b, x) and
-    that face can trade their edge ab for xd: the surface stays a manifold (no edge xd
-    yet, consistent orientation) and both new faces (a, d, x), (d, b, x) have area and
-    face the way the old neighbour did; else None."""
+    that face can trade their edge ab for xd, keeping a manifold with both new faces of
+    area facing the way the old neighbour did; else None."""
     fi, fp, ni, nptr, on_boundary, adj = topo
     around_a = fi[fp[a] : fp[a + 1]]
     across = [int(g) for g in around_a if g != t and b in f[g]]
@@ -119,24 +112,15 @@ def _flippable(t: int, a: int, b: int, x: int, v, f, topo, min_area: float):
 
 
 def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max_rounds=100):
-    """Collapse an edge, the shortest where possible, of every face of area at most
-    ``min_area``.
+    """Remove every face of area at most ``min_area`` without opening holes, in rounds
+    of non-adjacent changes until none is left or none can be made: flip its longest
+    edge where the apex lies a tenth to nine tenths along it (a remesh's T-junction: no
+    vertex moves); else merge the apex into the nearer end of that edge, or collapse its
+    other edges, shortest first, where the surface stays a manifold and no face turns
+    over (:func:`_collapsible`); a face whose longest edge is on the boundary is removed.
 
-    A zero-area face's apex (the corner opposite its longest edge) is merged into the
-    nearer end of that edge, which removes the faces on the edge, so a closed surface
-    stays closed.  A collapse is done only if the surface stays a manifold (the two
-    vertices share no neighbour but the corners opposite their edge; an inside edge does
-    not join two boundary vertices) and no face around the moved vertex turns over;
-    otherwise the face's other edges are tried, shortest first.  An apex from a tenth to
-    nine tenths along the longest edge (a remesh's T-junction) is handled by flipping
-    that edge instead, where the result is a manifold with two faces of area: no vertex
-    moves.  A face whose longest edge is on the boundary is removed: the boundary then
-    runs through its apex, so no hole opens.  Rounds of non-adjacent edges go on until no
-    zero-area face is left or none can be collapsed.
-
-    Returns (faces, number of flipped edges, number of collapsed edges, faces removed
-    along the boundary, largest move, faces still of zero area, (n,) vertex each vertex
-    was merged into: itself where none).
+    Returns (faces, flipped edges, collapsed edges, faces removed along the boundary,
+    largest move, faces still of zero area, (n,) vertex each vertex was merged into).
     """
     n = len(v)
     f = f.copy()
@@ -208,9 +192,8 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
 
 
 def _topology(f: np.ndarray, n: int):
-    """(fi, fp, ni, nptr, on_boundary, adj) of the faces f on n vertices: vertex -> faces
-    (CSR indices and pointers), vertex -> neighbours, the boundary vertices and the
-    (n, n) matrix whose entry counts the faces on an edge."""
+    """(fi, fp, ni, nptr, on_boundary, adj): vertex -> faces and vertex -> neighbours
+    (CSR indices and pointers), the boundary vertices and the faces per edge (n, n)."""
     m = len(f)
     vf = sp.csr_matrix(
         (np.ones(3 * m, dtype=np.int8), (f.ravel(), np.repeat(np.arange(m), 3))),
@@ -317,21 +300,12 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
 
 
 def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-10):
-    """Repair raw arrays into a valid :class:`Mesh` and report what was done.
-
-    Steps: check finiteness and index range (errors, not repairs), merge vertices closer
-    than ``merge_tolerance`` times the bounding-box diagonal, drop faces that repeat a
-    vertex, collapse or flip faces of (near) zero area (:func:`_collapse_zero_area_faces`),
-    drop duplicate faces, make the orientation consistent per component where possible.
-    Only the faces change: vertex i is row i of ``vertices``; merged vertices take the
-    values of the one they were merged into (:attr:`Mesh.merged_into`), vertices no face
-    uses are :attr:`Mesh.unused`, and the report names vertices by their numbers from 0.
-
-    Returns
-    -------
-    Mesh
-        With ``mesh.report`` describing every change.
-    """
+    """A valid :class:`Mesh` of raw arrays, ``mesh.report`` saying every change: vertices
+    closer than ``merge_tolerance`` times the bounding-box diagonal merged, faces that
+    repeat a vertex or another face dropped, faces of zero area flipped or collapsed
+    (:func:`_collapse_zero_area_faces`), the orientation made consistent per component
+    where possible.  Only the faces change: vertex i stays row i of ``vertices`` (merged
+    ones take their vertex's values, :attr:`Mesh.merged_into`)."""
     report = MeshReport(source=source)
     v, f, split = checked_arrays(vertices, faces, polygons=True)
     if split:
@@ -403,8 +377,7 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
 
 
 def _repair_zero_area(v, f, file_map, min_area: float, diag: float, report: MeshReport):
-    """Flip, collapse or remove the faces of area at most ``min_area``
-    (:func:`_collapse_zero_area_faces`), saying so in ``report``: (faces, file_map with
+    """:func:`_collapse_zero_area_faces`, saying so in ``report``: (faces, file_map with
     the collapsed vertices merged)."""
     f, n_flipped, n_collapsed, dropped, largest, left, merged_into = _collapse_zero_area_faces(
         v, f, min_area
