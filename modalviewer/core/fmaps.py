@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .signatures import default_energies, default_times, signature
+from .cross import common_times
+from .signatures import signature
 from .spectrum import Spectrum
 from .validate import check_count
 
@@ -33,15 +34,9 @@ DESCRIPTORS = ("wks", "hks")
 
 @dataclass
 class FunctionalMap:
-    """The result of :func:`functional_map`.
-
-    Attributes
-    ----------
-    C : (k, k) the functional map from A's modes to B's (after ZoomOut: of its final size).
-    point_map : (n_b,) for each vertex of B the index of its vertex of A (-1 where B's
-        vertex is used by no face).
-    k : the size of C.
-    """
+    """The result of :func:`functional_map`: ``C`` (k, k) the functional map from A's
+    modes to B's (after ZoomOut: of its final size), ``point_map`` (n_b,) each vertex of
+    B's vertex of A (-1 where no face uses B's vertex)."""
 
     C: np.ndarray
     point_map: np.ndarray
@@ -60,19 +55,6 @@ def _scalar_basis(spec: Spectrum, k: int, which: str) -> tuple[np.ndarray, np.nd
     return spec.modes[:, :k], used
 
 
-def _band(spec_a: Spectrum, spec_b: Spectrum, kind: str, samples: int) -> np.ndarray:
-    """Energies (wks) or scales (hks) in both spectra's default ranges."""
-    ends = default_energies if kind == "wks" else default_times
-    a, b = ends(spec_a, 2), ends(spec_b, 2)
-    lo, hi = max(a[0], b[0]), min(a[-1], b[-1])
-    if not lo < hi:
-        raise ValueError(
-            "the two spectra's signature ranges do not overlap: the shapes differ too much "
-            "in size (rescale both to the same area, mv.rescale_to_area)"
-        )
-    return np.exp(np.linspace(np.log(lo), np.log(hi), samples))
-
-
 def _descriptors(spec_a, spec_b, descriptors, samples: int):
     if isinstance(descriptors, str):
         if descriptors not in DESCRIPTORS:
@@ -80,7 +62,8 @@ def _descriptors(spec_a, spec_b, descriptors, samples: int):
                 f"unknown descriptors {descriptors!r}; choose 'wks', 'hks' or pass a pair of "
                 "arrays (n_a, d), (n_b, d)"
             )
-        scales = _band(spec_a, spec_b, descriptors, samples)
+        kind = "wks" if descriptors == "wks" else "heat"
+        scales = common_times(spec_a, spec_b, samples=samples, kind=kind)
         if descriptors == "wks":
             return (
                 signature(spec_a, kind="wks", energies=scales)[1],
@@ -156,24 +139,15 @@ def functional_map(
     zoomout_step: int = 1,
 ) -> FunctionalMap:
     """The functional map from A to B in their first ``k`` modes, and the point map of
-    B's vertices to A's (module docstring).
+    B's vertices to A's (module docstring), for spectra of one scalar operator on two
+    shapes of about the same area.
 
-    Parameters
-    ----------
-    spec_a, spec_b : spectra of one scalar operator on two shapes of about the same area,
-        at least ``k`` (and ``zoomout``) modes each.
-    descriptors : "wks" (wave kernel signatures at ``samples`` shared energies), "hks"
-        (heat-type signatures at shared scales), or your own per-vertex arrays
-        ((n_a, d), (n_b, d)).
-    k : the size of the map from the descriptors.
-    mu : the weight of the commutativity with the eigenvalues; the wave kernel
-        descriptors need about 1 (pyFM's 1e-3 leaves C far from diagonal), the heat
-        kernel's hardly depend on it.
-    zoomout : refine by ZoomOut up to this many modes (C then (zoomout, zoomout)),
-        ``zoomout_step`` modes per step (1 as in the paper).
-
-    A ValueError for vector modes, too few modes, unknown descriptors, descriptor arrays
-    of the wrong shape, or shapes whose signature ranges do not overlap.
+    ``descriptors``: "wks" (wave kernel signatures at ``samples`` shared energies),
+    "hks" (heat-type signatures at shared scales), or per-vertex arrays ((n_a, d),
+    (n_b, d)).  ``mu``: the weight of the commutativity with the eigenvalues; the wave
+    kernel descriptors need about 1 (pyFM's 1e-3 leaves C far from diagonal), the heat
+    kernel's hardly depend on it.  ``zoomout``: refine by ZoomOut up to this many modes,
+    ``zoomout_step`` per step (1 as in the paper).
     """
     k = check_count(k, "k", 1)
     final = k if zoomout is None else check_count(zoomout, "zoomout", k)

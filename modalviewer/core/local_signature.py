@@ -114,32 +114,16 @@ def local_signature(
     max_steps: int = 2000,
     spectrum: Spectrum | None = None,
 ) -> np.ndarray:
-    """The signature at ``vertices`` and scales ``times``, summed over all modes.
+    """(len(vertices), T) the signature at ``vertices`` and scales ``times`` summed over
+    all modes: ``signature(compute_spectrum(mesh, operator, k=all), times, include_zero,
+    vertices)[1]`` with no truncation error and no eigenvectors (Lemma 2).
 
-    The same quantity as ``signature(compute_spectrum(mesh, operator, k=all), times,
-    include_zero, vertices)[1]``, with no truncation error and no eigenvectors (Lemma 2).
-
-    Parameters
-    ----------
-    mesh : the surface.
-    operator : an operator's name or :class:`.operators.OperatorInfo`.
-    vertices : int or sequence of vertex indices (0-based).
-    times : (T,) positive scales.
-    include_zero : add the zero modes (constants, rigid motions) as ``signature`` does.
-    bending, membrane : Discrete Shells weights.
-    rtol : relative accuracy at which each scale's value is accepted.
-    max_steps : Lanczos steps allowed per unknown; the cost grows with
-        ``sqrt(max(times) * lambda_max)``.
-    spectrum : an exact spectrum of the same mesh and operator: its modes are summed
-        directly and the quadrature adds only the modes above its largest eigenvalue,
-        so large scales cost a few steps (without one, scales far above
-        ``4 ln 10 / lambda_1`` on fine meshes can need thousands).
-
-    Returns
-    -------
-    (len(vertices), T); a single vertex gives (1, T).  A TypeError, IndexError or
-    ValueError for bad vertex indices or scales (:mod:`.validate`); a RuntimeError if a
-    scale has not settled to ``rtol`` within ``max_steps`` Lanczos steps.
+    Each scale's value is accepted at relative accuracy ``rtol``; a RuntimeError if it
+    has not settled within ``max_steps`` Lanczos steps per unknown.  With ``spectrum``,
+    an exact spectrum of the same mesh and operator, its modes are summed directly and
+    the quadrature adds only the modes above them, so large scales cost a few steps
+    (without one, scales far above ``4 ln 10 / lambda_1`` on fine meshes can need
+    thousands).
     """
     operator = operator_info(operator)
     vertices = check_vertices(vertices, mesh.n_vertices)
@@ -147,18 +131,10 @@ def local_signature(
     if solver is not mesh:  # unused or merged vertices: on the vertices faces use
         from .spectrum import on_solver_mesh
 
-        return local_signature(
-            solver,
-            operator,
-            [solver.mesh_vertex(v) for v in vertices],  # an unused vertex: its name
-            times,
-            include_zero=include_zero,
-            spectrum=None if spectrum is None else on_solver_mesh(spectrum, solver),
-            bending=bending,
-            membrane=membrane,
-            rtol=rtol,
-            max_steps=max_steps,
-        )
+        picks = [solver.mesh_vertex(v) for v in vertices]  # an unused vertex: its name
+        spectrum = None if spectrum is None else on_solver_mesh(spectrum, solver)
+        args = (include_zero, bending, membrane, rtol, max_steps, spectrum)
+        return local_signature(solver, operator, picks, times, *args)
     times = check_times(times)
     K, mass = operator_matrices(mesh, operator, bending, membrane)
     per_vertex = operator.unknowns_per_vertex

@@ -1,18 +1,13 @@
 """The exactly known null spaces of the operators, per connected component.
 
 Each energy is a sum over the connected components, so its null space is the direct sum
-of theirs.  Known exactly, per component: ``laplacian`` the constant; ``shells`` the
-six rigid motions (every term of the energy is invariant under them);
-``modified_dirichlet`` the constant on a *flat* component only (``f_i N_i`` constant);
-``shells_normal`` the three affine functions of the plane on a flat component only
-(``f_i N_i`` a rigid motion).  Each rule lives in the registry
-(:attr:`.operators.OperatorInfo.null_space_rule`).  Other null vectors (pieces of a
-shells component meeting at one vertex) are not deflated; the eigensolver finds them
-like any other mode.
-
-Every candidate is checked on the assembled matrix against :data:`NULL_RTOL` before it
-is used (a nearly flat component's constant fails for E_D^N); the accepted vectors are
-Mass-orthonormal, ``Z^T Mass Z = I``.
+of theirs.  Known exactly, per component (the registry's
+:attr:`.operators.OperatorInfo.null_space_rule`): the constant (Laplacian), the six
+rigid motions (shells), and on a *flat* component only the constant (E_D^N: ``f_i N_i``
+constant) or the three affine functions of the plane (normal shells: ``f_i N_i`` a rigid
+motion).  Other null vectors (shells pieces meeting at one vertex) are found by the
+eigensolver like any other mode.  Every candidate is checked on the assembled matrix
+against :data:`NULL_RTOL` (a nearly flat component's constant fails for E_D^N).
 """
 
 from __future__ import annotations
@@ -35,17 +30,9 @@ null vectors reach 1e-16 to 1e-14 (rounding in the assembly and the product)."""
 
 @dataclass(frozen=True)
 class NullSpace:
-    """Mass-orthonormal exact null vectors of one operator on one mesh.
-
-    Attributes
-    ----------
-    vectors : (N, d) sparse CSC matrix, N unknowns (3n for ``"shells"``, dof 3i+c),
-        ``vectors.T @ diag(mass) @ vectors = I`` and ``K @ vectors = 0`` to rounding.
-        Each column lives on one component; columns are ordered by component.
-    operator : the operator.
-    n_components : connected components of the mesh.
-    per_component : (n_components,) null vectors found on each component.
-    """
+    """Exact null vectors of one operator on one mesh: ``vectors`` (N, d) sparse CSC,
+    ``vectors.T @ diag(mass) @ vectors = I`` and ``K @ vectors = 0`` to rounding, each
+    column on one component, ordered by component; ``per_component`` counts them."""
 
     vectors: sp.csc_matrix
     operator: OperatorInfo
@@ -69,11 +56,9 @@ class NullSpace:
             where = f"{counts[0]} per component"
         else:
             where = f"on {len(with_null)} of the {c} components"
-        first = (
-            "the first mode is an exact zero mode"
-            if d == 1
-            else (f"the first {d} modes are exact zero modes")
-        )
+        first = f"the first {d} modes are exact zero modes"
+        if d == 1:
+            first = "the first mode is an exact zero mode"
         return f"{comps}: {first} ({kind}, {where}), computed directly, not by iteration."
 
 
@@ -144,15 +129,9 @@ def null_space(
     mass: np.ndarray,
     normals: np.ndarray | None = None,
 ) -> NullSpace:
-    """The exactly known null vectors of ``operator`` on ``mesh`` (see the module text).
-
-    Parameters
-    ----------
-    K, mass : the operator's matrix and diagonal mass (``assembly.operator_matrices``);
-        every candidate is checked against K.
-    normals : the vertex normals the operator was built with (E_D^N, normal shells);
-        default: the area-weighted ones the operators use.
-    """
+    """The exactly known null vectors of ``operator`` on ``mesh``, checked against its
+    matrix ``K`` (mass: its diagonal mass); ``normals``: the vertex normals it was built
+    with (default: the area-weighted ones the operators use)."""
     info = operator_info(operator)  # a ValueError naming the known operators
     mass = np.asarray(mass, dtype=np.float64)
     if info.null_space_needs_normals and normals is None:
