@@ -183,32 +183,23 @@ def plot(
     modes=None,
     grid=None,
 ):
-    """The viewer's picture of ``mesh`` rendered off screen, as a :class:`Picture`; with
-    ``interactive``, an :class:`InteractivePicture` to turn in the notebook (the
-    ``notebook`` extra; without it a :class:`Picture` and a warning saying how to
-    install it); with ``animate``, the mode vibrating as a looping GIF
-    (:class:`~modalviewer.scene.animation.Animation`).
+    """The viewer's picture of ``mesh`` (anything :func:`~modalviewer.as_mesh` takes, or
+    a file) rendered off screen at ``size``, as a :class:`Picture`, also written to
+    ``screenshot`` if given: mode ``mode`` of ``spectrum`` (default its first non-zero
+    one); or per-vertex ``field`` values (an (n,) array in ``mesh``'s numbering, NaN
+    allowed at ``mesh.unused``, a ``(name, values)`` pair or a dict's first item; signed
+    values in the modes' colours, others white to red); or the ``kind`` distance map
+    ("vibration", "feature", "hks", "wks"; default the distance of ``spectrum``'s
+    operator, or "vibration") from ``vertex`` (the input's numbering), from ``spectrum``
+    where it is the kind's, else from ``k`` modes computed and cached as in the viewer.
 
-    Parameters
-    ----------
-    mesh : anything :func:`~modalviewer.as_mesh` takes (a file path too).
-    spectrum, mode : show mode ``mode`` of ``spectrum`` (default its first non-zero one).
-    field : per-vertex values to colour by instead: an (n,) array in ``mesh``'s
-        numbering (NaN allowed at ``mesh.unused``), a ``(name, values)`` pair or a dict
-        (its first item); signed values in the modes' diverging colours, others white
-        to red.
-    vertex, kind : the ``kind`` distance map ("vibration", "feature", "hks", "wks") from
-        ``vertex`` (the input's numbering); by default the distance of ``spectrum``'s
-        operator, or "vibration".  A spectrum of the kind's operator is used if given,
-        otherwise ``k`` modes are computed (cached on disk as in the viewer).
-    screenshot : also write the PNG there (the page, .html, for an interactive one).
-    size : (width, height) in pixels.
-    interactive : a page with the 3D scene instead of an image.
-    modes, grid : several modes of ``spectrum`` side by side with one camera and colour
-        bar (``grid`` (columns, rows), default rows of up to 4; ``size`` per panel).
-    animate, frames, fps : one period of the mode vibrating in ``frames`` frames
-        (default: the window's speed) at ``fps``; ``screenshot`` then names a .gif (or
-        .mp4 where imageio-ffmpeg is installed).
+    ``interactive``: an :class:`InteractivePicture` to turn in the notebook (the
+    ``notebook`` extra; without it a :class:`Picture` and a warning saying how to install
+    it).  ``modes``: those modes side by side, one camera and colour bar (``grid``
+    (columns, rows), default rows of up to 4; ``size`` per panel).  ``animate``: the mode
+    vibrating, one period in ``frames`` frames (default: the window's speed) at ``fps``,
+    as an :class:`~modalviewer.scene.animation.Animation` (a looping GIF; ``screenshot``
+    then names a .gif, or a .mp4 where imageio-ffmpeg is installed).
     """
     if isinstance(mesh, (str, Path)):
         from .io import load_mesh

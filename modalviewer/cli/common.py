@@ -80,15 +80,24 @@ MODE_INDEX = whole(0)
 WEIGHT = number()
 
 
-def size(text: str) -> tuple[int, int]:
-    """An argparse type: WIDTHxHEIGHT in pixels, each 16 to 8192."""
-    try:
-        w, h = (int(x) for x in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"size must look like 1024x768, got {text!r}") from None
-    if not (16 <= w <= 8192 and 16 <= h <= 8192):
-        raise argparse.ArgumentTypeError("width and height must be between 16 and 8192")
-    return w, h
+def two_numbers(what: str, example: str, least: int, most: float = np.inf):
+    """An argparse type: two whole numbers written like ``example`` ("1024x768"), each
+    in [least, most]."""
+
+    def parse(text: str) -> tuple[int, int]:
+        try:
+            a, b = (int(x) for x in text.lower().split("x"))
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{what} looks like {example}, got {text!r}") from None
+        if not (least <= min(a, b) and max(a, b) <= most):
+            bounds = f"at least {least}" if most == np.inf else f"{least} to {most:g}"
+            raise argparse.ArgumentTypeError(f"both numbers of {what} must be {bounds}")
+        return a, b
+
+    return parse
+
+
+size = two_numbers("a size", "1024x768", 16, 8192)  # WIDTHxHEIGHT in pixels
 
 
 def mode_list(text: str) -> list[int]:

@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from ..core.operators import DEFAULT_K, OPERATOR_NAMES
@@ -20,21 +19,12 @@ from .common import (
     png_text,
     refuse_other_picture_suffix,
     size,
+    two_numbers,
     viewer_of,
     warnings_printed,
     whole,
     wrote,
 )
-
-
-def _grid(text: str) -> tuple[int, int]:
-    try:
-        columns, rows = (int(x) for x in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"a grid looks like 4x2, got {text!r}") from None
-    if columns < 1 or rows < 1:
-        raise argparse.ArgumentTypeError("a grid has at least one column and one row")
-    return columns, rows
 
 
 def add_parsers(sub) -> None:
@@ -51,7 +41,7 @@ def add_parsers(sub) -> None:
     )
     r.add_argument(
         "--grid",
-        type=_grid,
+        type=two_numbers("a grid", "4x2", 1),
         help="with --modes: COLUMNSxROWS of the panels (default: rows of up to 4)",
     )
     r.add_argument("-k", type=COUNT, help=f"number of modes (default: the viewer's, {DEFAULT_K})")

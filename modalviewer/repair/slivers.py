@@ -40,7 +40,7 @@ class SliverReport(MeshReport):
     slivers_after: int = 0
     worst_quality_before: float = math.nan
     worst_quality_after: float = math.nan
-    max_vertex_shift: float = 0.0  # largest move of a vertex (see fix_slivers)
+    max_vertex_shift: float = 0.0  # largest move of a kept vertex (remeshed: off the input)
     max_deviation: float = 0.0  # Hausdorff distance between the surfaces, at the vertices
     method: str = ""
     seconds: float = 0.0
@@ -132,8 +132,8 @@ def _hausdorff(ms, sampled_id: int, target_id: int, n_samples: int) -> float:
 
 
 def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
-    """A copy of ``mesh`` without needle and cap triangles, made by edge flips and
-    collapses; ``result.report`` is a :class:`SliverReport`.
+    """A copy of ``mesh`` without needle and cap triangles; ``result.report`` is a
+    :class:`SliverReport`, its distances relative to the bounding-box diagonal.
 
     Three repairs are tried in turn and the first is returned whose result keeps the
     input's topology (boundary and non-manifold edges, components, Euler characteristic,
@@ -141,31 +141,13 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     MeshLab's T-vertex removal by flips then collapses; by collapses alone; isotropic
     remeshing of the slivers and the faces around them.  MeshLab's collapses do not
     check the link condition (one bad collapse can make an edge non-manifold); the
-    remeshing does, more slowly.
-
-    Parameters
-    ----------
-    mesh : the mesh to repair (not changed).
-    min_quality : the quality every triangle should have afterwards.  MeshLab's
-        criterion is applied as ``L / height >= sqrt(3) / min_quality`` (L the longest
-        edge), so the triangles left have quality above about ``min_quality`` and the
-        ones treated are below ``1.33 * min_quality``.
-    progress : optional ``progress(stage, fraction)``, called before each repair tried
-        and before the measurements.
-
-    Returns
-    -------
-    Mesh
-        Where nothing was changed, the input's vertices and numbering; else MeshLab's
-        own vertex numbering (the report says so).
-        ``report.max_vertex_shift`` (largest move of a kept vertex, or after remeshing
-        distance from the input surface) and ``report.max_deviation`` (Hausdorff
-        distance at the vertices) are relative to the bounding-box diagonal.
-
-    Raises
-    ------
-    MeshError
-        If ``pymeshlab`` is not installed, or no repair keeps the topology.
+    remeshing does, more slowly.  MeshLab's criterion ``L / height >= sqrt(3) /
+    min_quality`` (L the longest edge) leaves triangles of quality above about
+    ``min_quality`` and treats those below ``1.33 * min_quality``.  Where nothing was
+    changed the result has the input's vertices and numbering, else MeshLab's (the
+    report says so).  ``progress(stage, fraction)`` is called before each repair tried
+    and before the measurements.  MeshError if ``pymeshlab`` is not installed or no
+    repair keeps the topology.
     """
     if not 0.0 < min_quality < 1.0:
         raise ValueError(f"min_quality must be between 0 and 1, got {min_quality}")

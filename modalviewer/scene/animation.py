@@ -75,15 +75,6 @@ def check_size(path, size) -> None:
         raise ValueError(f"an MP4's width and height must be even, got {size[0]}x{size[1]}")
 
 
-def gif_bytes(images: list[np.ndarray], fps: float) -> bytes:
-    """``images`` (RGB uint8, equal sizes) as a looping GIF playing at ``fps``."""
-    import io
-
-    out = io.BytesIO()
-    _write_gif(out, images, fps)
-    return out.getvalue()
-
-
 def _write_gif(target, images, fps) -> None:
     from PIL import Image
 
@@ -131,9 +122,13 @@ class Animation:
     imageio-ffmpeg are installed)."""
 
     def __init__(self, frames: list[np.ndarray], fps: float = DEFAULT_FPS):
+        import io
+
         self.frames = frames
         self.fps = float(fps)
-        self.data = gif_bytes(frames, fps)
+        out = io.BytesIO()
+        _write_gif(out, frames, fps)
+        self.data = out.getvalue()
 
     @property
     def size(self) -> tuple[int, int]:
@@ -148,9 +143,6 @@ class Animation:
 
     def save(self, path) -> Path:
         """Write the animation to ``path`` (.gif or .mp4), atomically; returns the path."""
-        path = animation_path(path)
-        if path.suffix.lower() == ".gif":
-            return atomic_write(path, lambda tmp: Path(tmp).write_bytes(self.data))
         return write_animation(path, self.frames, self.fps)
 
     def __repr__(self) -> str:

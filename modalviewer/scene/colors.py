@@ -20,25 +20,14 @@ def lookup_table(colors: list[np.ndarray], n: int = 256) -> pv.LookupTable:
     anchors = np.linspace(0.0, 1.0, len(colors))
     x = np.linspace(0.0, 1.0, n)
     rgb = np.column_stack([np.interp(x, anchors, [c[i] for c in colors]) for i in range(3)])
-    lut = pv.LookupTable()
-    lut.SetNumberOfTableValues(n)
-    for i, (r, g, b) in enumerate(rgb):
-        lut.SetTableValue(i, float(r), float(g), float(b), 1.0)
-    lut.Build()
-    return lut
+    return _table(rgb)
 
 
-def _threshold_table(n: int = 2048) -> pv.LookupTable:
-    """The threshold maps' table: blue (similar) below its middle, white above.  Fine
-    (2048 entries), so the step of :meth:`MeshScene.show_threshold`, which looks colours up
-    after interpolation along the surface, falls within 1/2048 of the range from the
-    threshold."""
-    table = np.empty((n, 4))
-    table[:, :3] = WHITE
-    table[: n // 2, :3] = SIMILAR_BLUE
-    table[:, 3] = 1.0
+def _table(rgb: np.ndarray) -> pv.LookupTable:
+    """A lookup table of the (n, 3) colours ``rgb`` in [0, 1], opaque."""
+    table = np.column_stack([rgb, np.ones(len(rgb))])
     lut = pv.LookupTable()
-    lut.SetNumberOfTableValues(n)
+    lut.SetNumberOfTableValues(len(rgb))
     lut.SetTable(numpy_to_vtk((255 * table).round().astype(np.uint8), deep=True))
     return lut
 
@@ -62,4 +51,7 @@ COLORMAPS = {  # colours from the low to the high end of each colour map
 }
 DIVERGING = lookup_table([ORANGE, WHITE, BLUE])  # negative -> zero -> positive
 SEQUENTIAL = lookup_table([WHITE, RED])  # similar -> dissimilar
-THRESHOLD = _threshold_table()  # closer than threshold -> blue
+# closer than the threshold -> blue: 2048 entries, so that the step of
+# MeshScene.show_threshold, which looks colours up after interpolation along the surface,
+# falls within 1/2048 of the range from the threshold
+THRESHOLD = _table(np.where(np.arange(2048)[:, None] < 1024, SIMILAR_BLUE, WHITE))

@@ -171,7 +171,8 @@ class MeshScene:
         """Colour the surface by ``values`` (n,).
 
         kind: "diverging" (symmetric about zero, orange/white/blue), "sequential"
-        (white to red), "threshold" (values 0/1: blue/white) or "plain".
+        (white to red), "threshold" (blue below the middle of ``clim``, default (0, 1),
+        white above: :meth:`show_threshold`) or "plain".
         clim: the colour range; ``clipped`` (low, high): values lie beyond that end.
         isolines: number of isolines (the zero level bold for diverging fields).
         displacement: (n, 3) shape of the animation, carried along by the isolines.
@@ -198,7 +199,7 @@ class MeshScene:
             clim = (0.0, hi) if clim is None else clim
             self._mapper.lookup_table = SEQUENTIAL
         elif kind == "threshold":
-            clim = (0.0, 1.0)
+            clim = clim or (0.0, 1.0)
             self._mapper.lookup_table = THRESHOLD
         else:
             clim = clim or (float(values.min()), float(values.max()) or 1.0)
@@ -279,17 +280,8 @@ class MeshScene:
         the table steps at the middle of the scalar range, which :meth:`set_threshold`
         centres on the threshold, so the step lies exactly on it however small."""
         values = np.asarray(distances, dtype=np.float64)
-        self.surface.point_data["field"] = values
-        self.scale = None
-        hi = float(np.max(values)) or 1.0
-        self.clim = (0.0, hi)
-        self.clipped = (False, False)
-        self._mapper.lookup_table = THRESHOLD
+        self.show_field(values, "threshold", clim=(0.0, float(np.max(values)) or 1.0), name=name)
         self._mapper.SetInterpolateScalarsBeforeMapping(True)
-        self._mapper.ScalarVisibilityOn()
-        self.kind = "threshold"
-        self.field_name = name
-        self.set_isolines(values, 0, False)
         self.set_threshold(threshold)
 
     def set_threshold(self, threshold: float) -> None:
