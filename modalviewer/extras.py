@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 
-__all__ = ["EXTRA_OF", "MissingExtraError", "extra_needed", "install_command"]
+__all__ = ["EXTRA_OF", "MissingExtraError", "extra_needed"]
 
 EXTRA_OF = {
     "pyvista": "viewer",
@@ -39,11 +39,6 @@ class MissingExtraError(ModuleNotFoundError):
     """An optional package is missing; the message names the extra that installs it."""
 
 
-def install_command(module: str) -> str:
-    """``pip install "modalviewer[<extra>]"`` for an optional ``module``."""
-    return f'pip install "modalviewer[{EXTRA_OF[module.split(".")[0]]}]"'
-
-
 @contextmanager
 def extra_needed(what: str):
     """Run the block; an optional package it fails to import becomes a
@@ -58,5 +53,7 @@ def extra_needed(what: str):
         if top not in EXTRA_OF:
             raise
         raise MissingExtraError(
-            f"{what} needs {top}, which is not installed: {install_command(top)}", name=top
+            f"{what} needs {top}, which is not installed: "
+            f'pip install "modalviewer[{EXTRA_OF[top]}]"',
+            name=top,
         ) from None

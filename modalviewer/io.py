@@ -23,13 +23,6 @@ __all__ = ["load_mesh", "read_file", "SUPPORTED_EXTENSIONS"]
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 
 
-def _read_vtk(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    with extra_needed(f"reading {path.suffix.lower()} files"):
-        import pyvista as pv
-
-    return pyvista_arrays(pv.read(str(path)))
-
-
 def pyvista_arrays(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """(vertices, triangles, notes) of a pyvista data set: its outer surface where it is
     not a ``PolyData``, polygons triangulated by pyvista (the notes say both)."""
@@ -54,9 +47,8 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
     damage notes of a mesh file; ``strict`` as in :func:`load_mesh`."""
     path = Path(path)
     ext = path.suffix.lower()
-    if ext not in SUPPORTED_EXTENSIONS and ext in _meshio_extensions():
-        return _read_meshio(path)
-    if ext not in SUPPORTED_EXTENSIONS:
+    by_meshio = ext not in SUPPORTED_EXTENSIONS and ext in _meshio_extensions()
+    if ext not in SUPPORTED_EXTENSIONS and not by_meshio:
         raise MeshError(
             f"{path.name}: unsupported file type '{ext or '(none)'}'; "
             f"open one of {', '.join(SUPPORTED_EXTENSIONS)}"
@@ -65,22 +57,35 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
         raise MeshError(f"{path}: no such file")
     if path.stat().st_size == 0:
         raise MeshError(f"{path.name}: the file is empty")
+    kind = "mesh" if by_meshio else ext[1:].upper()
     try:
-        if ext in (".vtk", ".vtp"):
-            vertices, faces, notes = _read_vtk(path)
+        if by_meshio:
+            import meshio
+
+            vertices, faces, notes = meshio_arrays(meshio.read(path))
+        elif ext in (".vtk", ".vtp"):
+            with extra_needed(f"reading {ext} files"):
+                import pyvista as pv
+
+            vertices, faces, notes = pyvista_arrays(pv.read(str(path)))
         else:
             found = read_mesh_file(path, strict=strict)
             vertices, faces, notes = found.vertices, found.faces, found.notes
     except (MeshError, MissingExtraError):
         raise
-    except Exception:  # a parser may raise anything on a file of another type
+    except (Exception, SystemExit) as exc:  # a parser may raise anything (meshio even exit)
+        said = (
+            f" (meshio: {exc})"
+            if by_meshio and str(exc) and not isinstance(exc, SystemExit)
+            else ""
+        )
         raise MeshError(
-            f"{path.name}: could not be read as a {ext[1:].upper()} file; "
+            f"{path.name}: could not be read as a {kind} file{said}; "
             "the file may be damaged, truncated or of another type"
         ) from None
     if len(vertices) == 0:
         raise MeshError(
-            f"{path.name}: no vertices found in this {ext[1:].upper()} file; "
+            f"{path.name}: no vertices found in this {kind} file; "
             "the file may be damaged, truncated or of another type"
         )
     return vertices, faces, notes
@@ -135,25 +140,6 @@ def meshio_arrays(m) -> tuple[np.ndarray, np.ndarray, list[str]]:
     if points.ndim == 2 and points.shape[1] == 2:  # a planar mesh: z = 0
         points = np.column_stack([points, np.zeros(len(points))])
     return points, faces.astype(np.int64), notes
-
-
-def _read_meshio(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    import meshio
-
-    if not path.is_file():
-        raise MeshError(f"{path}: no such file")
-    try:
-        data = meshio.read(path)
-    except (Exception, SystemExit) as exc:  # meshio may even exit on an unreadable file
-        detail = f" ({exc})" if str(exc) and not isinstance(exc, SystemExit) else ""
-        raise MeshError(
-            f"{path.name}: meshio could not read it{detail}; the file may be damaged, "
-            "truncated or of another type"
-        ) from None
-    vertices, faces, notes = meshio_arrays(data)
-    if len(vertices) == 0:
-        raise MeshError(f"{path.name}: no vertices found in this file")
-    return vertices, faces, notes
 
 
 def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:

@@ -257,15 +257,11 @@ def _interactive(viewer, size) -> InteractivePicture:
 
 @extra_needed("mv.view (the desktop viewer)")
 def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: bool = True):
-    """Open the desktop viewer on in-memory data; returns the window (``.viewer`` its
-    :class:`~modalviewer.viewer.Viewer`).
-
-    ``mesh_or_arrays``: anything :func:`~modalviewer.as_mesh` accepts, or a file.
-    ``spectrum`` is added to the viewer (its first non-zero mode shown); ``fields`` (name
-    -> per-vertex array) become the viewer's fields, the first shown.  ``block=False``
-    returns at once (a notebook with ``%gui qt``, or a script running the Qt loop);
-    otherwise when the window closes.
-    """
+    """Open the desktop viewer on anything :func:`~modalviewer.as_mesh` accepts, or a
+    file; returns the window (``.viewer`` its :class:`~modalviewer.viewer.Viewer`) when
+    it closes, or at once with ``block=False`` (a notebook with ``%gui qt``, a script
+    running the Qt loop).  ``spectrum`` is shown from its first non-zero mode; ``fields``
+    (name -> per-vertex array) become the viewer's fields, the first shown."""
     if isinstance(mesh_or_arrays, (str, Path)):
         from .io import load_mesh
 
@@ -305,14 +301,10 @@ def add_to_plotter(
 ):
     """Add ``mesh`` coloured as the viewer colours it to ``plotter`` (a
     ``pyvista.Plotter``); returns the :class:`~modalviewer.scene.mesh_scene.MeshScene`
-    holding its actors.
-
-    ``values_or_spectrum``: per-vertex values (n,) (signed: diverging colours, else
-    white to red) or a :class:`Spectrum`: its mode ``mode`` (default the first non-zero
-    one; vector modes by their normal component) or, with ``vertex``, the multiscale
-    distance from it.  In ``mesh``'s numbering; the surface drawn is its vertices faces
-    use.  ``isolines``: their number (0: none); ``name``: the colour bar's title.
-    """
+    holding its actors (the vertices faces use).  ``values_or_spectrum``: per-vertex
+    values in ``mesh``'s numbering (signed: diverging colours, else white to red), or a
+    :class:`Spectrum`: its mode ``mode`` (default the first non-zero one; vector modes by
+    their normal component) or, with ``vertex``, the multiscale distance from it."""
     from .core.laplacian import vertex_normals
     from .core.signatures import multiscale_distance
     from .core.spectrum import on_solver_mesh

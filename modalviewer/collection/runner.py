@@ -323,22 +323,18 @@ def run_batch(
     log: Callable[[str], None] | None = None,
 ) -> BatchSummary:
     """Compute every mesh of ``sources`` (see :func:`find_meshes`) into ``store``, one task
-    per mesh.
-
-    Where it runs: ``client`` (a ``dask.distributed.Client``); else the scheduler at
-    ``scheduler`` (``"tcp://host:8786"``); else a local cluster of ``workers``
-    single-threaded processes; ``workers=0``: one mesh after another here, without Dask.
-    Each task asks for its :func:`memory_estimate` of the resource ``memory``, which local
-    workers offer as their ``memory_limit`` (default: the machine's memory over the
-    workers) and a scheduler's workers if they declare it (``--resources
-    memory=BYTES``), so two big meshes do not start together on a worker that cannot hold
-    both.  Meshes whose stored key is current are skipped, and recorded failures unless
-    ``retry_failed``; results are written as they arrive, failures recorded in
-    ``errors/``, and the index rebuilt at the end (also when interrupted).  A store holds
-    one set of parameters: others raise CollectionError if it holds results.
+    per mesh, on ``client`` (a ``dask.distributed.Client``), else the ``scheduler``
+    (``"tcp://host:8786"``), else a local cluster of ``workers`` single-threaded
+    processes (0: one mesh after another here, without Dask).  Each task asks for its
+    :func:`memory_estimate` of the resource ``memory``, which local workers offer as their
+    ``memory_limit`` (default: the machine's memory over the workers) and a scheduler's
+    if they declare it (``--resources memory=BYTES``), so that two big meshes do not
+    start together on a worker that cannot hold both.  Meshes whose stored key is
+    current are skipped, and recorded failures unless ``retry_failed``; results are
+    written as they arrive, and the index rebuilt at the end (also when interrupted).  A
+    store holds one set of parameters: others raise CollectionError if it holds results.
     ``progress(done, total, failed, seconds, already)`` is called after each mesh;
-    ``log(text)`` gets notes.
-    """
+    ``log(text)`` gets notes."""
     store = Path(store)
     parameters = _parameters(operator, k, signatures, bending, membrane)
     paths = find_meshes(sources)

@@ -36,8 +36,8 @@ def caption(img: np.ndarray, text: str) -> np.ndarray:
     return np.vstack([rgb, img])
 
 
-def comparison_images(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -> list:
-    """One captioned image per view of ``comparison`` (``camera``: a
+def comparison_image(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -> np.ndarray:
+    """The views of ``comparison`` side by side, each captioned (``camera``: a
     :class:`~modalviewer.viewer.camera.Camera`, default the mesh's canonical view)."""
     state = comparison.state
     images = []
@@ -52,12 +52,7 @@ def comparison_images(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -
             images.append(caption(grab(plotter, scene, scale=scale), view.title))
         finally:
             plotter.close()
-    return images
-
-
-def comparison_image(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -> np.ndarray:
-    """The views of ``comparison`` side by side (see :func:`comparison_images`)."""
-    return side_by_side(comparison_images(comparison, size, camera, scale), gap=4 * scale)
+    return side_by_side(images, gap=4 * scale)
 
 
 def save_comparison(comparison, path, size=VIEW_SIZE, camera=None, scale: int = 1) -> Path:

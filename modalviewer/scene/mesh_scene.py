@@ -168,17 +168,13 @@ class MeshScene:
         clipped: tuple[bool, bool] = (False, False),
         scale: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
-        """Colour the surface by ``values`` (n,).
-
-        kind: "diverging" (symmetric about zero, orange/white/blue), "sequential"
-        (white to red), "threshold" (blue below the middle of ``clim``, default (0, 1),
-        white above: :meth:`show_threshold`) or "plain".
-        clim: the colour range; ``clipped`` (low, high): values lie beyond that end.
-        isolines: number of isolines (the zero level bold for diverging fields).
-        displacement: (n, 3) shape of the animation, carried along by the isolines.
-        scale: (knot values, knot positions) of a spread scale: a sequential field is
-        coloured by ``np.interp(values, *scale)``, the colour bar keeps the values.
-        """
+        """Colour the surface by ``values`` (n,) of ``kind`` "diverging" (symmetric
+        about zero, orange/white/blue), "sequential" (white to red), "threshold" (blue
+        below the middle of ``clim``: :meth:`show_threshold`) or "plain"; ``clipped``
+        (low, high): values lie beyond that end of ``clim``; the zero isoline is bold on a
+        diverging field; the isolines carry ``displacement`` (the animation's shape); a
+        sequential field with a spread ``scale`` (knot values, knot positions) is
+        coloured by ``np.interp(values, *scale)``, its colour bar keeping the values."""
         values = np.array(values, dtype=np.float64)  # the animation rewrites the copy drawn
         self.scale = None
         if scale is not None and kind == "sequential":

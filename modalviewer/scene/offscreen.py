@@ -5,8 +5,6 @@ pyvista plotter (EGL where there is no display, no Qt), for exports without a wi
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from .platform import prepare_offscreen
 from .view import StateScene
 
@@ -97,19 +95,6 @@ class OffscreenRenderer:
         from .export import grab
 
         return grab(self.plotter, self.scene, scale, transparent, colorbar=colorbar, marker=marker)
-
-    def screenshot(
-        self,
-        path,
-        scale: int = 1,
-        transparent: bool = False,
-        colorbar: bool | None = None,
-        marker: bool = True,
-    ) -> Path:
-        """Write the picture to a PNG (atomically); returns its path."""
-        from .export import save_png
-
-        return save_png(path, self.image(scale, transparent, colorbar, marker))
 
     def close(self) -> None:
         self.drawing.close()

@@ -14,6 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..viewer import wording
+from ..viewer.camera import Camera
 from ..viewer.derived import Field
 from ..viewer.state import ViewerState
 from .mesh_scene import MeshScene, add_actor
@@ -255,19 +256,13 @@ class StateScene:
         camera = self.state.camera
         if camera is None or self.scene is None:
             return
-        from ..viewer.camera import Camera
-
         self.scene.set_camera(Camera.from_dict(camera), fit=bool(camera.get("fit", False)))
         self.request_render()
 
     def current_camera(self) -> dict:
         """The camera as plain data (for sessions)."""
         cam = self.plotter.camera
-        return {
-            "position": [float(x) for x in cam.position],
-            "focal_point": [float(x) for x in cam.focal_point],
-            "view_up": [float(x) for x in cam.up],
-        }
+        return Camera(cam.position, cam.focal_point, cam.up).as_dict()
 
     # --------------------------------------------------------- animation
     def _on_animation(self) -> None:
