@@ -107,7 +107,7 @@ class Comparison:
             title=f"{item_label(item)} mode {j}",
         )
         lam = "0 (zero mode)" if spec.zero_mode_mask()[j] else f"{spec.eigenvalues[j]:.5g}"
-        mark = approximation_mark(self.state, item)
+        mark = approximation_mark(spec, self.state.is_coarse(item))
         return ComparisonView(item, f"{item_label(item)}{mark}: mode {j}, lambda = {lam}", field)
 
     def _distance_views(self) -> list[ComparisonView]:
@@ -131,7 +131,8 @@ class Comparison:
                 )
                 views.append(ComparisonView(item, f"{item_label(item)}: {need}", marker=vertex))
                 continue
-            mark = approximation_mark(state, operator_for_distance(item))
+            op = operator_for_distance(item)
+            mark = approximation_mark(state.spectrum(op), state.is_coarse(op))
             if display.distance_display == "threshold":
                 if share is None:
                     thr = display.threshold * float(d.max())

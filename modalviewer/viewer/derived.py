@@ -498,7 +498,7 @@ class DerivedValues:
             return None
         d, isolines = state.display, state.style.isolines
         plain = Field(np.zeros(state.mesh.n_vertices), "plain")
-        mark, legend = wording.display_mark(state), wording.legend(state, self)
+        mark, legend = wording.display_mark(state), wording.legend(state)
         if d.kind == "mode":
             spec = state.spectrum(d.operator)
             if spec is None:

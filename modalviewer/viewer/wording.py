@@ -1,7 +1,7 @@
 """The viewer's words: legends, the status line, notes and marks, and how a job ended
-(no Qt, no VTK).  Functions read a :class:`~.state.ViewerState` and, for numbers
-computed from it, its :class:`~.derived.DerivedValues`; nothing here changes or caches
-anything.
+(no Qt, no VTK).  Marks and notes take the values they name (a spectrum, counts); the
+legend and the status line read a :class:`~.state.ViewerState` and its
+:class:`~.derived.DerivedValues`.  Nothing here changes or caches anything.
 """
 
 from __future__ import annotations
@@ -33,22 +33,22 @@ def percent_text(fraction: float) -> str:
     return f"{value:.0f}\u00a0%" if value >= 10 else f"{value:.2g}\u00a0%"
 
 
-def arrival_text(state, operator: str | None) -> str:
-    """ "first 20 of 100 modes" while the spectrum of ``operator`` is still arriving (its
-    modes are handed over as they converge), else ""."""
-    ready, asked = state.modes_ready(operator)
-    return f"first {ready} of {asked} modes" if ready < asked else ""
-
-
-def arrival_note(state, operator: str | None) -> str:
-    """A sentence on a spectrum still arriving ("12 of 100 modes ready; the others follow
-    as they converge."), or on one whose computation stopped before its last modes; ""
-    for a whole spectrum."""
-    ready, asked = state.modes_ready(operator)
-    if ready >= asked:
+def arrival_text(spec: Spectrum | None) -> str:
+    """ "first 20 of 100 modes" while ``spec``'s modes are still arriving (handed over as
+    they converge), else ""."""
+    if spec is None or spec.k >= spec.modes_requested:
         return ""
-    key = state.spectrum_key(operator)
-    if key in state.computing:
+    return f"first {spec.k} of {spec.modes_requested} modes"
+
+
+def arrival_note(spec: Spectrum | None, computing: bool) -> str:
+    """A sentence on a spectrum still arriving (``computing``: "12 of 100 modes ready;
+    the others follow as they converge."), or on one whose computation stopped before
+    its last modes; "" for a whole spectrum."""
+    if not arrival_text(spec):
+        return ""
+    ready, asked = spec.k, spec.modes_requested
+    if computing:
         return f"{ready} of {asked} modes ready; the others follow as they converge."
     return (
         f"Only {ready} of {asked} modes: the computation stopped before the others "
@@ -56,31 +56,35 @@ def arrival_note(state, operator: str | None) -> str:
     )
 
 
-def approximation_mark(state, operator: str | None) -> str:
+def approximation_mark(spec: Spectrum | None, coarse: bool) -> str:
     """ " (coarse-to-fine)", " (first 20 of 100 modes)" or "": what titles and lists add
-    to the spectrum shown for ``operator`` when it is an approximation or incomplete."""
-    marks = ["coarse-to-fine"] if state.is_coarse(operator) else []
-    arriving = arrival_text(state, operator)
-    if arriving:
-        marks.append(arriving)
+    to a spectrum that is an approximation (``coarse``) or incomplete."""
+    marks = [m for m in ("coarse-to-fine" if coarse else "", arrival_text(spec)) if m]
     return f" ({'; '.join(marks)})" if marks else ""
 
 
 def display_mark(state) -> str:
     """:func:`approximation_mark` of the spectrum the picture is made of."""
-    return approximation_mark(state, state.display_operator())
+    op = state.display_operator()
+    return approximation_mark(state.spectrum(op), state.is_coarse(op))
 
 
-def approximation_note(state, operator: str | None) -> str:
+def approximation_note(spec: Spectrum | None, coarse: bool) -> str:
     """ " (coarse-to-fine spectrum)", " (from the first 20 of 100 modes)" or "" for
-    what is made of the spectrum shown for ``operator`` (a map, a signature)."""
-    if state.spectrum(operator) is None:
-        return ""
-    notes = ["coarse-to-fine spectrum"] if state.is_coarse(operator) else []
-    arriving = arrival_text(state, operator)
-    if arriving:
-        notes.append(f"from the {arriving}")
+    what is made of ``spec`` (a map, a signature)."""
+    arriving = arrival_text(spec)
+    notes = [
+        "coarse-to-fine spectrum" if coarse else "",
+        f"from the {arriving}" if arriving else "",
+    ]
+    notes = [n for n in notes if n and spec is not None]
     return f" ({'; '.join(notes)})" if notes else ""
+
+
+def _approximation_note(state, kind: str) -> str:
+    """:func:`approximation_note` of the spectrum distance ``kind`` is made of."""
+    op = operator_for_distance(kind)
+    return approximation_note(state.spectrum(op), state.is_coarse(op))
 
 
 def missing_distance_reason(state, kind: str) -> str:
@@ -93,10 +97,9 @@ def missing_distance_reason(state, kind: str) -> str:
     return "the spectrum has no non-zero modes; compute more modes"
 
 
-def legend(state, derived=None) -> str:
+def legend(state) -> str:
     """One or two lines naming what the surface shows, with its numbers."""
-    derived = derived if derived is not None else state.derived
-    d = state.display
+    derived, d = state.derived, state.display
     if state.mesh is None or d.kind == "none":
         return ""
     if d.kind == "mode":
@@ -128,7 +131,7 @@ def legend(state, derived=None) -> str:
         if dist is None:
             return f"{name}: {missing_distance_reason(state, d.distance_kind)}"
         source = f"from vertex {state.picked_file_vertex}"
-        source += approximation_note(state, operator_for_distance(d.distance_kind))
+        source += _approximation_note(state, d.distance_kind)
         if d.distance_display == "threshold":
             thr = derived.threshold_value(dist)
             share = 100.0 * derived.surface_share(dist, thr)
@@ -145,10 +148,11 @@ def legend(state, derived=None) -> str:
         word = distance_word(d.distance_kind).capitalize()
         at = "E" if derived.wave() else "t"
         text = f"{word} signature at {at} = {derived.signature_time():.3g}"
-        text += approximation_note(state, operator_for_distance(d.distance_kind))
+        text += _approximation_note(state, d.distance_kind)
         if state.style.log_signature:
             text += ", log10(S / smallest S)"
-        note = truncation_note(state, derived)
+        spec = state.spectrum(operator_for_distance(d.distance_kind))
+        note = truncation_note(derived.truncation(), spec.k)
         return f"{text}\n{note}" if note else text
     if d.kind == "curvature":
         return "Curvature sqrt(k1^2 + k2^2), white 0 to red"
@@ -194,29 +198,27 @@ def negative_weights_note(state) -> str:
     )
 
 
-def truncation_note(state, derived=None) -> str:
-    """The share of the signature shown that truncation misses, with its k and the k
-    that would bring it below :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`,
-    when its estimate exceeds that level; else ""."""
+def truncation_note(truncation: tuple[float, int] | None, k: int) -> str:
+    """The share of a signature of ``k`` modes that truncation misses and the k that
+    would bring it below :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`
+    (``truncation``: :meth:`.derived.DerivedValues.truncation`), when that share exceeds
+    the level; else ""."""
     from ..core.truncation import TRUNCATION_LEVEL
 
-    derived = derived if derived is not None else state.derived
-    found = derived.truncation()
-    if found is None or found[0] <= TRUNCATION_LEVEL:
+    if truncation is None or truncation[0] <= TRUNCATION_LEVEL:
         return ""
-    error, k = found
-    spec = state.spectrum(operator_for_distance(state.display.distance_kind))
+    error, needed = truncation
     return (
         f"truncation: about {percent_text(error)} of the signature is missing (k = "
-        f"{spec.k}; k = {k} for < {percent_text(TRUNCATION_LEVEL)})"
+        f"{k}; k = {needed} for < {percent_text(TRUNCATION_LEVEL)})"
     )
 
 
-def summary(state, derived=None) -> str:
+def summary(state) -> str:
     """The status line: the current display's live numbers, on one line."""
     if state.mesh is None:
         return "Open a mesh to begin (File > Open, Ctrl+O)."
-    text = legend(state, derived).replace("\n", "; ")
+    text = legend(state).replace("\n", "; ")
     if not text:
         m = state.mesh
         text = f"{_plural(m.n_vertices, 'vertex')}, {_plural(m.n_faces, 'face')}"

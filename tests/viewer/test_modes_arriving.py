@@ -62,7 +62,9 @@ def test_a_script_looks_at_the_first_modes_while_the_others_converge(viewer, pau
     assert viewer.modes_ready("shells") == (ready, 120)  # the solve waits
     # the legend says what the map is made of, the Modes panel's note what follows
     assert f"from the first {ready} of 120 modes" in wording.legend(state)
-    assert "the others follow as they converge" in wording.arrival_note(state, "shells")
+    assert "the others follow as they converge" in wording.arrival_note(
+        state.spectrum("shells"), state.spectrum_key("shells") in state.computing
+    )
     chosen = state.display
     camera = {"position": (3.0, 1.0, 2.0), "focal_point": (0.0, 0.0, 0.0), "view_up": (0, 1, 0)}
     state.camera = camera
@@ -79,7 +81,12 @@ def test_a_script_looks_at_the_first_modes_while_the_others_converge(viewer, pau
     marked = state.derived.surface_share(dist, state.derived.threshold_value(dist))
     assert marked == pytest.approx(0.05, abs=0.01)
     assert "of 120 modes" not in wording.legend(state)
-    assert wording.arrival_note(state, "shells") == ""
+    assert (
+        wording.arrival_note(
+            state.spectrum("shells"), state.spectrum_key("shells") in state.computing
+        )
+        == ""
+    )
 
 
 def test_modes_relayed_by_a_child_process_equal_the_result(tmp_path):
@@ -119,7 +126,9 @@ def test_cancelling_mid_way_keeps_the_modes_shown_and_caches_nothing(tmp_path, m
     state = viewer.state
     spec = state.spectrum("shells")
     assert spec is not None and not spec.is_complete  # what had arrived stays on screen
-    assert "stopped before the others" in wording.arrival_note(state, "shells")
+    assert "stopped before the others" in wording.arrival_note(
+        state.spectrum("shells"), state.spectrum_key("shells") in state.computing
+    )
     mesh = state.compute_mesh()
     assert not cache.path(mesh, "shells", 200, 1.0, 1.0).is_file()
     assert cache.get(mesh, "shells", 200, 1.0, 1.0) is None

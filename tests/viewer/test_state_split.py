@@ -139,14 +139,16 @@ def test_the_wording_functions_give_the_legends_they_gave_as_state_methods(tmp_p
     model.jobs.wait(model.request_spectrum("laplacian", k=30))
     state.show_mode(5, "laplacian")
     mode_text = "Laplacian (cotan), mode 5: lambda = 10.75\nblue +, white 0, orange -"
-    assert wording.legend(state, model.state.derived) == mode_text
+    assert wording.legend(state) == mode_text
     # the picture's legend also names the colour range
     assert model.state.derived.field().legend == mode_text + "\nrange: the largest |value|"
     assert wording.summary(state) == mode_text.replace("\n", "; ")
     state.set_pick(100)
     state.set_display(kind="distance", distance_kind="hks", distance_display="threshold")
     threshold_text = "blue: heat kernel distance < 0.0621, 10.0 % of the surface\nfrom vertex 100"
-    assert wording.legend(state, model.state.derived) == threshold_text
+    assert wording.legend(state) == threshold_text
     assert model.state.derived.field().legend == threshold_text
     assert wording.display_mark(state) == ""
-    assert wording.approximation_note(state, "laplacian") == ""
+    assert (
+        wording.approximation_note(state.spectrum("laplacian"), state.is_coarse("laplacian")) == ""
+    )

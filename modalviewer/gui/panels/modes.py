@@ -115,7 +115,8 @@ class ModesPanel(QtWidgets.QWidget):
         with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
             self.spectrum_combo.clear()
             for name in computed:
-                info, mark = OPERATOR_INFO[name], approximation_mark(state, name)
+                info = OPERATOR_INFO[name]
+                mark = approximation_mark(state.spectrum(name), state.is_coarse(name))
                 # marked: the short name, so the mark is not cut off in a narrow panel
                 self.spectrum_combo.addItem((info.short_label if mark else info.label) + mark, name)
                 index = self.spectrum_combo.count() - 1
@@ -157,11 +158,11 @@ class ModesPanel(QtWidgets.QWidget):
                 "to this mesh; eigenvalues and modes approximate (untick Coarse-to-fine and "
                 "Compute for the exact spectrum)."
             )
-        arriving = arrival_note(state, op)
+        arriving = arrival_note(spec, state.spectrum_key(op) in state.computing)
         if arriving:
             text += f"\n{arriving}"
         self.eigen_label.setText(text)
-        approximate = approximation_mark(state, op)
+        approximate = approximation_mark(spec, state.is_coarse(op))
         # marked: the short name (as in the spectrum list), so the title keeps to one line
         info = OPERATOR_INFO[op]
         self.spectrum_plot.set_data(
