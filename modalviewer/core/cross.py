@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .mesh import Mesh
+from .mesh import Mesh, _unused_words
 from .signatures import SignatureTable, default_energies, default_times, normalised_signatures
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_vertex, check_vertices
@@ -66,8 +66,6 @@ def _source_row(table: SignatureTable, vertex: int) -> np.ndarray:
     """The normalised signature of ``vertex``; a ValueError if no face uses it."""
     row = table.table[check_vertex(vertex, table.table.shape[0])]
     if np.isnan(row).any():
-        from .mesh import _unused_words
-
         raise ValueError(_unused_words(int(vertex)))
     return row
 

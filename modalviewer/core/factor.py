@@ -11,6 +11,7 @@ docs/performance.md); the others ignore the budget.
 from __future__ import annotations
 
 import ctypes
+import functools
 import glob
 import os
 import shutil
@@ -32,18 +33,11 @@ __all__ = [
     "remove_stale_factor_folders",
 ]
 
-_MKL = None
 
-
+@functools.cache
 def _load_mkl():
     """The MKL runtime library shipped by the ``mkl`` wheel, or None."""
-    global _MKL
-    if _MKL is not None:
-        return _MKL or None
-    candidates = []
-    env = os.environ.get("MODALVIEWER_MKL_RT")
-    if env:
-        candidates.append(env)
+    candidates = [os.environ["MODALVIEWER_MKL_RT"]] if os.environ.get("MODALVIEWER_MKL_RT") else []
     for prefix in dict.fromkeys([sys.prefix, sys.base_prefix]):
         candidates += sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")), key=len)
     for path in candidates:
@@ -52,9 +46,7 @@ def _load_mkl():
             lib.pardiso.restype = None
         except (OSError, AttributeError):
             continue
-        _MKL = lib
         return lib
-    _MKL = False
     return None
 
 

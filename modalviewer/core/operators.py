@@ -1,11 +1,9 @@
 """The one list of operators modalviewer computes spectra of, and what each one is.
 
-Every per-operator fact lives in its :class:`OperatorInfo` in :data:`OPERATOR_INFO`;
-other modules ask the registry instead of comparing names, so a new operator is one
-more entry and its assembly function.  Public functions accept a name or an
-:class:`OperatorInfo` (:data:`OperatorLike`), resolve it once with
-:func:`operator_info` and pass the object on.  This module imports nothing of the
-package: assembly functions are named ``"module:function"`` and imported when used.
+Every per-operator fact lives in its :class:`OperatorInfo` in :data:`OPERATOR_INFO`, so
+a new operator is one more entry and its assembly function (named ``"module:function"``
+and imported when used).  Public functions accept a name or an :class:`OperatorInfo`
+(:data:`OperatorLike`), resolve it once with :func:`operator_info` and pass it on.
 """
 
 from __future__ import annotations
@@ -39,8 +37,7 @@ __all__ = [
     "signature_kind",
 ]
 
-DEFAULT_K = 100
-"""The number of modes computed where none is given (the paper's figures use 100)."""
+DEFAULT_K = 100  # the number of modes computed where none is given (as in the paper's figures)
 
 
 def default_k(n_vertices: int) -> int:
@@ -257,8 +254,8 @@ OperatorLike = str | OperatorInfo
 
 
 def operator_info(operator: OperatorLike) -> OperatorInfo:
-    """The operator object of ``operator``: the registry entry of a name, an
-    :class:`OperatorInfo` as it is; a ValueError naming the known operators otherwise."""
+    """The registry entry of a name (an :class:`OperatorInfo` as it is); a ValueError
+    naming the known operators otherwise."""
     if isinstance(operator, OperatorInfo):
         return operator
     try:
@@ -285,8 +282,7 @@ def signature_kind(kind: str) -> str:
 
 
 def distance_word(kind: str) -> str:
-    """Distance ``kind`` in lower-case words ("heat kernel" for ``"hks"``, "wave
-    kernel" for ``"wks"``)."""
+    """Distance ``kind`` in lower-case words ("heat kernel" for ``"hks"``)."""
     if signature_kind(kind) == "wks":
         return "wave kernel"
     word = operator_info(operator_for_distance(kind)).signature_word

@@ -23,9 +23,8 @@ __all__ = [
 
 
 def csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
-    """Rows ``start:stop`` of a CSR matrix as a matrix sharing its arrays (no copy): set
-    on an empty matrix, because scipy's constructor prunes (copies) any view smaller than
-    half its base array, which would copy all of K at every :func:`row_halves` product."""
+    """Rows ``start:stop`` of a CSR matrix sharing its arrays, set on an empty matrix:
+    scipy's constructor copies any view smaller than half its base array."""
     p = K.indptr
     a, b = int(p[start]), int(p[stop])
     rows = sp.csr_matrix((stop - start, K.shape[1]), dtype=K.dtype)
@@ -45,11 +44,9 @@ def row_halves(K: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
 
 
 def threaded_product(K, X, out: np.ndarray | None = None):
-    """K @ X for a CSR matrix K and a dense array or sparse matrix X, the two row halves
-    of K on two threads (scipy's products release the GIL and run on one core;
-    splitting rows keeps X whole and contiguous).  Sparse X gives a CSR result.  For
-    dense X the product can be written into ``out`` (C-contiguous, not overlapping X),
-    which saves fresh memory."""
+    """K @ X for a CSR matrix K and a dense array or sparse matrix X (a CSR result), the
+    two row halves of K on two threads; dense X's product can be written into ``out``
+    (C-contiguous, not overlapping X), which saves fresh memory."""
     K = sp.csr_matrix(K)
     if sp.issparse(X):
         X = sp.csr_matrix(X)
@@ -88,9 +85,8 @@ def threaded_product(K, X, out: np.ndarray | None = None):
 
 
 def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice, np.ndarray]]:
-    """``(cols, K @ Y[:, cols])`` for consecutive blocks of ``width`` columns, each a
-    :func:`threaded_product` (sparse K; other K plain products): passes over ``K Y``
-    with (N, width) temporaries instead of an (N, k) one."""
+    """``(cols, K @ Y[:, cols])`` for consecutive blocks of ``width`` columns: passes over
+    ``K Y`` with (N, width) temporaries instead of an (N, k) one."""
     if sp.issparse(K):
         K = sp.csr_matrix(K)
     for start in range(0, Y.shape[1], width):

@@ -22,11 +22,9 @@ __all__ = ["robust_laplacian_matrices", "negative_cotan_weights"]
 
 
 def robust_laplacian_matrices(mesh: Mesh) -> tuple[sp.csr_matrix, np.ndarray]:
-    """(L, m): the intrinsic Delaunay stiffness matrix (symmetric positive semi-definite,
-    non-positive off the diagonal) and the (n,) lumped masses of
-    ``robust_laplacian.mesh_laplacian`` (default mollification), the eigenproblem being
-    ``L phi = lambda diag(m) phi``.  A :class:`MissingExtraError` without the
-    ``robust-laplacian`` package (``pip install "modalviewer[robust]"``)."""
+    """(L, m): the intrinsic Delaunay stiffness matrix and the (n,) lumped masses of
+    ``robust_laplacian.mesh_laplacian`` (default mollification); a
+    :class:`MissingExtraError` without ``pip install "modalviewer[robust]"``."""
     with extra_needed("the operator laplacian_robust"):
         import robust_laplacian
     L, M = robust_laplacian.mesh_laplacian(
@@ -43,18 +41,11 @@ def negative_cotan_weights(mesh: Mesh) -> int:
     """The number of edges whose cotan weight ``(cot alpha + cot beta) / 2`` is negative
     beyond round-off (1e-12 of the largest), counted without assembling the matrix and
     kept per mesh object, so the window counts while reading and asks again for free."""
-    count = _COUNTS.get(mesh)
-    if count is None:
-        count = _COUNTS[mesh] = _count_negative(mesh)
-    return count
-
-
-def _count_negative(mesh: Mesh) -> int:
-    if len(mesh.faces) == 0:
-        return 0
+    if mesh in _COUNTS:
+        return _COUNTS[mesh]
     cots = face_cotangents(mesh)
     # face_edges[:, k] runs from corner k to k + 1: the angle opposite it is at k + 2
     opposite = cots[:, [2, 0, 1]]
     w = 0.5 * np.bincount(mesh.face_edges.ravel(), opposite.ravel(), minlength=len(mesh.edges))
-    scale = float(np.abs(w).max())
-    return int(np.count_nonzero(w < -1e-12 * scale))
+    _COUNTS[mesh] = int(np.count_nonzero(w < -1e-12 * float(np.abs(w).max())))
+    return _COUNTS[mesh]

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .mesh import _unused_words
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_times, check_vertex, check_vertices
 
@@ -200,8 +201,6 @@ class SignatureTable:
         cancels recomputed directly, so d(v, v) = 0 exactly."""
         row = self.table[check_vertex(vertex, self.table.shape[0])]
         if np.isnan(row).any():
-            from .mesh import _unused_words
-
             raise ValueError(_unused_words(vertex))
         return self.distance_to(row)
 

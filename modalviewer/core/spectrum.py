@@ -11,7 +11,7 @@ import numpy as np
 
 from .eigen import zero_modes
 from .files import atomic_write
-from .mesh import Mesh
+from .mesh import Mesh, _unused_words
 from .operators import OPERATOR_INFO, OPERATOR_NAMES, OperatorInfo, operator_info
 
 __all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
@@ -115,8 +115,6 @@ class Spectrum:
         """``vertex`` if it has values (a face uses it, or it was merged into a vertex a
         face uses); a ValueError naming it otherwise."""
         if np.isnan(self.modes[vertex]).any():
-            from .mesh import _unused_words
-
             raise ValueError(_unused_words(vertex))
         return vertex
 

@@ -7,10 +7,8 @@ depends on the eigenvalues alone.  The missing eigenvalues are extrapolated by a
 law ``lambda_j ~ j^p`` (Weyl's law: ``p = 1`` for a surface's Laplacian) fitted on the
 upper half of the computed non-zero ones, its exponent lowered by ``SAFETY_EXPONENT``;
 the tail is bounded by its integral (incomplete gamma function) and doubled
-(``SAFETY_FACTOR``).  An upper-bound-style estimate, not a proof
-(``tests/core/test_truncation.py`` compares it with meshes whose every mode is known),
-of the whole surface's share; at one vertex
-:func:`~.local_signature.local_signature` gives the exact value.
+(``SAFETY_FACTOR``): an upper-bound-style estimate of the whole surface's share, not a
+proof; at one vertex :func:`~.local_signature.local_signature` gives the exact value.
 """
 
 from __future__ import annotations
@@ -64,10 +62,8 @@ def _tail(lam_k: float, k: int, p: float, first: float, last: float, times) -> n
 
 
 def truncation_error(spec: Spectrum, times: float | Sequence[float] | np.ndarray) -> np.ndarray:
-    """(T,) estimated share (0..1) of the signature at each scale that the modes beyond
-    the spectrum's largest eigenvalue hold (zero modes left out, as signatures do by
-    default) at the positive scales ``times``; see the module docstring.  0 where the
-    spectrum has every mode."""
+    """(T,) estimated share (0..1) of the signature (zero modes left out) at each of the
+    positive scales ``times`` that the modes beyond the spectrum's hold."""
     lam, p, total = _law(spec)
     times = np.atleast_1d(np.asarray(times, dtype=np.float64))
     k = lam.size
@@ -80,11 +76,9 @@ def truncation_error(spec: Spectrum, times: float | Sequence[float] | np.ndarray
 
 
 def k_for_truncation(spec: Spectrum, t: float, level: float = TRUNCATION_LEVEL) -> int:
-    """The number of modes (zero modes included) whose estimated truncation error at
-    scale ``t`` is at most ``level``, by the same extrapolation as
-    :func:`truncation_error`; the spectrum's own k if it is already below, at most the
-    mesh's number of unknowns.  ``level``: the largest share of the signature allowed
-    to be missing, in (0, 1)."""
+    """The number of modes (zero modes included, at least the spectrum's own k, at most
+    the mesh's unknowns) whose estimated truncation error (:func:`truncation_error`) at
+    scale ``t`` is at most ``level``."""
     lam, p, total = _law(spec)
     k = lam.size
     zeros = spec.k - k
