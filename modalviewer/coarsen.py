@@ -1,11 +1,6 @@
 """Coarse-to-fine (paper Section 7, Fig. 9): the spectrum of a decimated copy, carried
-to the mesh.
-
-The share of vertices kept (:data:`COARSE_FRACTION`), the decimation
-(:func:`decimated_copy`), the transfer (:func:`transfer_spectrum`) and both
-(:func:`coarse_to_fine_spectrum`).  Outside :mod:`modalviewer.core` (numpy and scipy
-only) because the decimation is VTK's, through pyvista, imported when a copy is made.
-"""
+to the mesh.  Outside :mod:`modalviewer.core` (numpy and scipy only) because the
+decimation is VTK's, through pyvista, imported when a copy is made."""
 
 from __future__ import annotations
 

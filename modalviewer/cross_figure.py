@@ -1,11 +1,6 @@
-"""Images of a distance between two shapes, rendered by the viewer's own scene.
-
-Panels side by side in one PNG: mesh A with the picked vertex, then mesh B coloured by
-a distance from it (as the viewer's distance display) with its best match marked, each
-drawn off screen by :class:`~modalviewer.scene.mesh_scene.MeshScene` and captioned.
-Used by ``modalviewer distance A --to B -o fig.png`` and
-``scripts/hand_correspondence.py``.
-"""
+"""Images of a distance between two shapes (``modalviewer distance A --to B -o``): mesh
+A with the picked vertex beside mesh B coloured by the distance from it, each panel
+drawn off screen by the viewer's :class:`~modalviewer.scene.mesh_scene.MeshScene`."""
 
 from __future__ import annotations
 

@@ -1,9 +1,5 @@
-"""Cache or compute: how the viewer, the shape pair and the command line get a spectrum.
-
-:func:`cached_or_computed` serves a spectrum from the disk cache
-(:class:`.core.cache.SpectrumCache`) or computes it and stores it there, so every part
-of the package asks for a spectrum the same way and shares the same cache entries.
-"""
+"""Cache or compute: how the viewer, the shape pair and the command line get a spectrum,
+so that they share the same cache entries."""
 
 from __future__ import annotations
 

@@ -1,10 +1,6 @@
-"""Shape collections: the spectra, signatures and global descriptors of a whole dataset.
-
-:func:`run_batch` (:mod:`.runner`) computes one spectrum per mesh (and, if asked, its
-signatures and descriptors) on a Dask cluster or one mesh after another in this process,
-into a store (:mod:`.store`, its format); :func:`open_collection` reads it (numpy only);
-:meth:`Collection.similar` ranks it by spectral distance to a shape.
-"""
+"""Shape collections: the spectra, signatures and global descriptors of a whole dataset,
+computed by :func:`run_batch` (:mod:`.runner`) into a store (:mod:`.store`) that
+:func:`open_collection` reads with numpy alone."""
 
 from .runner import BatchSummary, find_meshes, mesh_names, process_mesh, run_batch
 from .store import (

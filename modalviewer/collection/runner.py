@@ -461,10 +461,9 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
             )
         futures = {}
         for name, path, known in todo:
-            extra = {}
-            if capacity is not None:
-                need = memory_estimate(vertex_count_hint(path), parameters)
-                extra["resources"] = {"memory": min(need, capacity)}
+            need = (
+                None if capacity is None else memory_estimate(vertex_count_hint(path), parameters)
+            )
             future = client.submit(
                 process_mesh,
                 str(path),
@@ -472,7 +471,7 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
                 known,
                 pure=False,
                 key=f"modalviewer-mesh-{name}-{os.urandom(4).hex()}",
-                **extra,
+                resources=None if need is None else {"memory": min(need, capacity)},
             )
             futures[future] = (name, path)
         for future in distributed.as_completed(futures):

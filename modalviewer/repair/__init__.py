@@ -67,8 +67,6 @@ def repair_unavailable(name: str) -> str | None:
 def apply_repair(name: str, mesh: Mesh, progress=None) -> Mesh:
     """Repair ``name`` applied to ``mesh`` (a new Mesh whose report says what changed)."""
     if name == "fix_slivers":
-        from .slivers import fix_slivers
-
         return fix_slivers(mesh, progress=progress)
     if name == "largest_component":
         from ..core.components import largest_component

@@ -46,15 +46,14 @@ class SliverReport(MeshReport):
     seconds: float = 0.0
 
 
-def _topology(mesh: Mesh) -> tuple:
-    n_edges = len(mesh.edges)
-    return (
-        mesh.n_boundary_edges,
-        mesh.n_nonmanifold_edges,
-        mesh.n_components,
-        mesh.n_vertices - n_edges + mesh.n_faces,  # Euler characteristic
-        mesh.is_consistently_oriented,
-    )
+def _topology(mesh: Mesh) -> dict:
+    return {
+        "boundary edges": mesh.n_boundary_edges,
+        "non-manifold edges": mesh.n_nonmanifold_edges,
+        "components": mesh.n_components,
+        "Euler characteristic": mesh.n_vertices - len(mesh.edges) + mesh.n_faces,
+        "consistent orientation": mesh.is_consistently_oriented,
+    }
 
 
 _METHODS = {
@@ -225,15 +224,6 @@ def _unchanged(mesh: Mesh, report: SliverReport, started: float) -> Mesh:
     return out
 
 
-_TOPOLOGY_WORDS = (
-    "boundary edges",
-    "non-manifold edges",
-    "components",
-    "Euler characteristic",
-    "consistent orientation",
-)
-
-
 def _first_repair(mesh: Mesh, report: SliverReport, min_quality: float, progress):
     """(repaired mesh, method, vertex tags, MeshSet) of the first of :data:`_METHODS`
     whose result keeps the topology and has fewer triangles below ``min_quality``; a
@@ -256,11 +246,7 @@ def _first_repair(mesh: Mesh, report: SliverReport, min_quality: float, progress
             continue
         after = _topology(candidate)
         if after != before:
-            changes = [
-                f"{n} {x} -> {y}"
-                for n, x, y in zip(_TOPOLOGY_WORDS, before, after, strict=True)
-                if x != y
-            ]
+            changes = [f"{n} {before[n]} -> {after[n]}" for n in before if before[n] != after[n]]
             refused.append(f"{method}: {', '.join(changes)}")
             continue
         if (candidate.face_quality < min_quality).sum() >= report.below_min_quality_before:

@@ -1,10 +1,6 @@
 """Animations of a vibration mode written to a file: GIF through Pillow, MP4 through
-imageio and its ffmpeg plugin (the ``video`` extra), each written atomically.  No Qt.
-
-The frames are drawn by :meth:`.view.StateScene.animation_frame`, as the window's clock
-draws them: the surface at ``sin(phase)`` of the amplitude, a signed mode's colours
-changing sign with it, the rest shape's ghost behind a 3D mode, legend and colour bar.
-"""
+imageio and its ffmpeg plugin (the ``video`` extra), each written atomically; the
+frames are drawn as the window draws them (:meth:`.view.StateScene.animation_frame`)."""
 
 from __future__ import annotations
 
