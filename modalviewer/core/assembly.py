@@ -10,8 +10,6 @@ import numpy as np
 from .mesh import Mesh
 from .operators import OperatorLike, operator_info
 
-__all__ = ["operator_matrices"]
-
 
 def operator_matrices(
     mesh: Mesh, operator: OperatorLike, bending: float = 1.0, membrane: float = 1.0

@@ -21,14 +21,6 @@ from .mesh import Mesh
 from .operators import OperatorLike, operator_info
 from .spectrum import Spectrum, load_spectrum, save_spectrum
 
-__all__ = [
-    "CacheEntry",
-    "SolveRecord",
-    "SpectrumCache",
-    "default_cache_dir",
-    "default_cache_limit",
-]
-
 log = logging.getLogger("modalviewer.cache")
 
 DEFAULT_LIMIT_MB = 2048  # a dozen shells spectra of mid-sized meshes, or a few large ones

@@ -19,9 +19,6 @@ from .mesh import (
     shape_summary,
 )
 
-__all__ = ["repair_mesh"]
-
-
 _LISTED = 10  # vertex numbers a report lists before "and N more"
 
 

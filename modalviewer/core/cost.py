@@ -10,21 +10,6 @@ import numpy as np
 
 from .memory import resident_mb
 
-__all__ = [
-    "FILL_MARGIN",
-    "FactorLaw",
-    "GrowthLaw",
-    "basis_columns",
-    "basis_in_float32",
-    "factor_budget_mb",
-    "float32_basis_mb",
-    "krylov_sizes",
-    "exact_peak_mb",
-    "factor_goes_out_of_core",
-    "float32_basis_saving_mb",
-    "power_of_size",
-]
-
 MB = 2**20
 
 GROWTH_MODES = 100  # the number of modes the growth laws' runs computed

@@ -7,8 +7,6 @@ import numpy as np
 from .laplacian import lumped_masses, stiffness_matrix
 from .mesh import Mesh
 
-__all__ = ["total_curvature"]
-
 
 def total_curvature(mesh: Mesh) -> np.ndarray:
     """(n,) sqrt(k1^2 + k2^2) = sqrt(4 H^2 - 2 K), units 1/length: H from the cotan

@@ -12,9 +12,6 @@ from .cleaning import repair_mesh
 from .mesh import Mesh
 from .primitives import grid_plate
 
-__all__ = ["plate", "folded_plate", "bumpy_plate", "voxel_surface", "double_torus",
-           "machined_part", "bent_pose"]  # fmt: skip
-
 PLATE_N = (48, 24)  # grid cells of the Fig. 1 plate, 2 x 1
 FOLD_X = 1.0  # the fold runs along the grid line x = 1
 

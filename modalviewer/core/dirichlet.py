@@ -8,8 +8,6 @@ import scipy.sparse as sp
 from .laplacian import stiffness_matrix, vertex_normals
 from .mesh import Mesh, MeshError
 
-__all__ = ["modified_dirichlet_matrix"]
-
 
 def modified_dirichlet_matrix(mesh: Mesh, normals: np.ndarray | None = None) -> sp.csr_matrix:
     """The matrix A of the modified Dirichlet energy E_D^N, ``A_ij = <N_i, N_j> S_ij`` (so

@@ -25,14 +25,6 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = [
-    "SPDSolver",
-    "available_backends",
-    "factor_folder",
-    "factor_memory_mb",
-    "remove_stale_factor_folders",
-]
-
 
 @functools.cache
 def _load_mkl():

@@ -26,8 +26,6 @@ from .signatures import signature
 from .spectrum import Spectrum
 from .validate import check_count
 
-__all__ = ["FunctionalMap", "functional_map", "correspondence_errors", "DESCRIPTORS"]
-
 DESCRIPTORS = ("wks", "hks")
 """The descriptors :func:`functional_map` computes itself."""
 

@@ -11,8 +11,6 @@ import scipy.sparse as sp
 
 from .mesh import Mesh
 
-__all__ = ["stiffness_matrix", "mass_matrix", "vertex_normals", "face_cotangents"]
-
 
 def face_cotangents(mesh: Mesh) -> np.ndarray:
     """(m, 3) cotangent of the interior angle at corner k of each face."""

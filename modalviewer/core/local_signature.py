@@ -26,8 +26,6 @@ from .operators import OperatorLike, operator_info
 from .spectrum import Spectrum
 from .validate import check_times, check_vertices
 
-__all__ = ["local_signature"]
-
 
 class _ShiftedInverse:
     """``B = (A + sigma I)^-1 = M^1/2 (K + sigma M)^-1 M^1/2``, from one factorisation."""

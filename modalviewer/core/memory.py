@@ -15,19 +15,6 @@ import ctypes
 import functools
 import os
 
-__all__ = [
-    "MEMORY_LIMIT_SHARE",
-    "memory_limit_mb",
-    "physical_memory_mb",
-    "glibc",
-    "resident_mb",
-    "return_freed_memory",
-    "keep_freed_memory",
-    "no_huge_page_advice",
-    "one_malloc_arena",
-    "prepare_compute_process",
-]
-
 MEMORY_LIMIT_SHARE = 0.5  # the share of this machine's memory a computation plans for
 
 MB = 2**20

@@ -18,8 +18,6 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-__all__ = ["Mesh", "MeshError", "MeshReport", "remove_unused", "triangle_quality"]
-
 
 class MeshError(ValueError):
     """Raised for input that cannot be a triangle surface, with a message for a user."""

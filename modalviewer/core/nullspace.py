@@ -21,8 +21,6 @@ from .laplacian import vertex_normals
 from .mesh import Mesh
 from .operators import OperatorInfo, OperatorLike, operator_info
 
-__all__ = ["NullSpace", "null_space", "NULL_RTOL"]
-
 NULL_RTOL = 1e-10
 """A candidate null vector z is accepted if ``|K z| <= NULL_RTOL * | |K| |z| |``: exact
 null vectors reach 1e-16 to 1e-14 (rounding in the assembly and the product)."""

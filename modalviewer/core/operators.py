@@ -22,21 +22,6 @@ from .cost import (
 )
 from .memory import memory_limit_mb
 
-__all__ = [
-    "DEFAULT_K",
-    "default_k",
-    "OperatorInfo",
-    "OperatorLike",
-    "OPERATOR_INFO",
-    "OPERATOR_NAMES",
-    "DISTANCE_KINDS",
-    "NULL_SPACE_RULES",
-    "distance_word",
-    "operator_info",
-    "operator_for_distance",
-    "signature_kind",
-]
-
 DEFAULT_K = 100  # the number of modes computed where none is given (as in the paper's figures)
 
 

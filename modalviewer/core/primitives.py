@@ -6,8 +6,6 @@ import numpy as np
 
 from .mesh import Mesh
 
-__all__ = ["add_slivers", "grid_plate", "icosphere", "torus"]
-
 
 def grid_plate(nx: int = 10, ny: int = 10, width: float = 1.0, height: float = 1.0) -> Mesh:
     """Flat rectangle [0, width] x [0, height] in z = 0 with (nx+1)(ny+1) vertices, each

@@ -13,14 +13,6 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse import _sparsetools
 
-__all__ = [
-    "column_block_products",
-    "row_halves",
-    "threaded_product",
-    "csr_rows",
-    "transform_columns_in_place",
-]
-
 
 def csr_rows(K: sp.csr_matrix, start: int, stop: int) -> sp.csr_matrix:
     """Rows ``start:stop`` of a CSR matrix sharing its arrays, set on an empty matrix:

@@ -18,8 +18,6 @@ from ..extras import extra_needed
 from .laplacian import face_cotangents
 from .mesh import Mesh
 
-__all__ = ["robust_laplacian_matrices", "negative_cotan_weights"]
-
 
 def robust_laplacian_matrices(mesh: Mesh) -> tuple[sp.csr_matrix, np.ndarray]:
     """(L, m): the intrinsic Delaunay stiffness matrix and the (n,) lumped masses of

@@ -20,21 +20,6 @@ from .laplacian import vertex_normals
 from .mesh import Mesh, MeshError
 from .products import threaded_product
 
-__all__ = [
-    "hinges",
-    "dihedral_angles",
-    "dihedral_angle_gradients",
-    "edge_lengths",
-    "edge_length_gradients",
-    "triangle_areas",
-    "triangle_area_gradients",
-    "shells_energy",
-    "shells_gradient",
-    "shells_hessian",
-    "normal_shells_hessian",
-    "weighted_gradient_matrix",
-]
-
 
 # ----------------------------------------------------------------- topology
 def hinges(mesh: Mesh) -> np.ndarray:

@@ -19,17 +19,6 @@ from .mesh import _unused_words
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_times, check_vertex, check_vertices
 
-__all__ = [
-    "default_times",
-    "default_energies",
-    "wks_sigma",
-    "signature",
-    "multiscale_distance",
-    "SignatureTable",
-    "SIGNATURE_KINDS",
-    "WKS_VARIANCE",
-]
-
 SIGNATURE_KINDS: dict[str, str] = {
     "heat": "sum_j exp(-lambda_j t) |phi_j(v)|^2 over scales t",
     "wks": "the wave kernel signature over energies E (Aubry et al. 2011)",

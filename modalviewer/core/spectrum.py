@@ -14,8 +14,6 @@ from .files import atomic_write
 from .mesh import Mesh, _unused_words
 from .operators import OPERATOR_INFO, OPERATOR_NAMES, OperatorInfo, operator_info
 
-__all__ = ["Spectrum", "save_spectrum", "load_spectrum", "SpectrumFileError", "OPERATORS"]
-
 OPERATORS = OPERATOR_NAMES
 FORMAT_VERSION = 1
 

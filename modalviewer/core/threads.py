@@ -14,8 +14,6 @@ from __future__ import annotations
 import functools
 import os
 
-__all__ = ["single_blas_thread"]
-
 _OPENBLAS = None  # threadpoolctl's controller of the loaded OpenBLAS libraries, or False
 
 

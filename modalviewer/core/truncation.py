@@ -20,8 +20,6 @@ import scipy.special as ss
 
 from .spectrum import Spectrum
 
-__all__ = ["truncation_error", "k_for_truncation", "TRUNCATION_LEVEL"]
-
 TRUNCATION_LEVEL = 0.05
 """The estimated truncation error above which the viewer warns and suggests a k."""
 SAFETY_FACTOR = 2.0

@@ -14,8 +14,6 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["check_count", "check_vertex", "check_vertices", "check_times", "check_t_range"]
-
 
 def _shown(value: object) -> str:
     """``value`` as the message shows it: numpy scalars as Python ones, long reprs cut."""
