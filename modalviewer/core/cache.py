@@ -13,9 +13,13 @@ import hashlib
 import json
 import logging
 import os
+import tempfile
 import time
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from .mesh import Mesh
 from .operators import OperatorLike, operator_info
@@ -194,8 +198,6 @@ class SpectrumCache:
                 return self.path(mesh, operator, k, bending, membrane)
         except OSError:
             pass
-        import tempfile
-
         return Path(tempfile.mkdtemp(prefix="modalviewer-")) / "spectrum.npz"
 
     def put(self, mesh, spec: Spectrum, k, bending=1.0, membrane=1.0) -> Path | None:
@@ -244,9 +246,7 @@ class SpectrumCache:
     @staticmethod
     def _unlink(path: Path) -> bool:
         try:
-            path.unlink()
-            return True
-        except FileNotFoundError:
+            path.unlink(missing_ok=True)
             return True
         except OSError:
             return False
@@ -254,10 +254,6 @@ class SpectrumCache:
 
 def _solve_record(path: Path) -> SolveRecord | None:
     """The :class:`SolveRecord` of one cache file, or None."""
-    import zipfile
-
-    import numpy as np
-
     try:
         with zipfile.ZipFile(path) as archive:
             with archive.open("meta.npy") as fh:

@@ -314,11 +314,9 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     n_file = len(v)
     v_input = v
     v, f, merged, file_map, rep = _merge_duplicate_vertices(v, f, merge_tolerance * diag)
-    if merged:
-        first = np.full(len(v), n_file, dtype=np.int64)
-        np.minimum.at(first, file_map, np.arange(n_file))
-        dup = np.flatnonzero(first[file_map] != np.arange(n_file))
-        pairs = [f"{int(i)} into {int(first[file_map[i]])}" for i in dup[:_LISTED]]
+    if merged:  # rep: each merged group's first vertex
+        dup = np.flatnonzero(rep[file_map] != np.arange(n_file))
+        pairs = [f"{int(i)} into {int(rep[file_map[i]])}" for i in dup[:_LISTED]]
         report.add(
             f"Merged {_plural(merged, 'duplicate vertex')} ("
             + _listing(pairs, len(dup))

@@ -221,11 +221,10 @@ class _Pardiso:
                 # core it may still fit, and the caller must not read this as indefinite
                 self._factor_in_core_again()
                 error, _ = self._call(12, dummy)
-        if error == -4:
-            self.release()
-            raise np.linalg.LinAlgError("matrix is not positive definite")
         if error != 0:
             self.release()
+            if error == -4:
+                raise np.linalg.LinAlgError("matrix is not positive definite")
             raise np.linalg.LinAlgError(f"PARDISO factorisation failed (error {error})")
 
     def _factor_in_core_again(self) -> None:
@@ -297,8 +296,7 @@ class _Pardiso:
     def release(self) -> None:
         if self._alive:
             self._alive = False
-            dummy = np.zeros((self.n, 1), dtype=self.dtype, order="F")
-            self._call(-1, dummy)
+            self._call(-1, np.zeros((self.n, 1), dtype=self.dtype, order="F"))
         if self._folder is not None:
             self._remove_folder()
             self._folder = None
@@ -311,10 +309,8 @@ class _Pardiso:
 
 
 def factor_memory_mb(A: sp.spmatrix) -> tuple[float, float] | None:
-    """(in core, out of core): the memory (MB) PARDISO's factorisation of the symmetric
-    positive definite A needs kept in memory and kept in a file (its working buffer
-    and symbolic data, as :class:`SPDSolver` would ask for), from its analysis alone
-    (no numerical factorisation); None without PARDISO."""
+    """(in core, out of core): the memory (MB) PARDISO's factorisation of A needs, from
+    its analysis alone (no numerical factorisation); None without PARDISO."""
     if "pardiso" not in available_backends():
         return None
     analysis = _Pardiso(sp.csr_matrix(A), _load_mkl(), factorise=False)

@@ -59,9 +59,8 @@ def _unused_words(index: int) -> str:
 
 
 def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(m,) shape quality ``4 sqrt(3) area / (l0^2 + l1^2 + l2^2)`` of each triangle: 1
-    equilateral, 0 degenerate, about 2 h / L for a needle or cap of longest edge L and
-    height h onto it."""
+    """(m,) quality ``4 sqrt(3) area / (l0^2 + l1^2 + l2^2)`` of each triangle: 1
+    equilateral, about 2 h / L for a needle or cap of longest edge L and height h."""
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces)
     e0 = v[f[:, 1]] - v[f[:, 0]]
@@ -243,9 +242,8 @@ class Mesh:
     # ------------------------------------------------------- the input numbering
     @property
     def merged_into(self) -> np.ndarray:
-        """(n,) int64: for each vertex the vertex it was merged into (a duplicate, or
-        the end of a collapsed zero-area face), itself where none; a merged vertex takes
-        that vertex's values."""
+        """(n,) int64: each vertex's vertex it was merged into (a duplicate, or the end of
+        a collapsed zero-area face), whose values it takes; itself where none."""
         return np.arange(self.n_vertices) if self._merged is None else self._merged
 
     @cached_property
@@ -257,9 +255,8 @@ class Mesh:
 
     @cached_property
     def unused(self) -> np.ndarray:
-        """(u,) int64, ascending: the vertices without a value, which no face uses and
-        which are not merged into one that a face uses.  Their per-vertex results are
-        NaN; asking for distances from one is an error naming it."""
+        """(u,) int64, ascending: the vertices without a value (NaN results), which no face
+        uses and which are not merged into one that a face uses."""
         out = np.flatnonzero(~self._in_face[self.merged_into])
         out.setflags(write=False)
         return out
@@ -340,8 +337,7 @@ class Mesh:
 
     def mesh_vertex(self, file_index: int) -> int:
         """The mesh vertex of vertex ``file_index`` of the file; a :class:`MeshError` if
-        the file has no such vertex or no face uses it (distances and modes are
-        undefined there)."""
+        the file has no such vertex or no face uses it."""
         file_index = int(file_index)
         n = self.n_file_vertices
         if not 0 <= file_index < n:
@@ -376,8 +372,7 @@ class Mesh:
         return out
 
     def file_map_after(self, new_of_old: np.ndarray) -> np.ndarray | None:
-        """The ``file_map`` of a mesh made from this one whose vertex ``new_of_old[i]``
-        is this mesh's vertex i (-1 for vertices it does not keep)."""
+        """The ``file_map`` of a mesh whose vertex ``new_of_old[i]`` is this one's i."""
         fm = self.file_to_mesh
         return np.where(fm >= 0, np.asarray(new_of_old)[np.maximum(fm, 0)], -1)
 
@@ -467,9 +462,8 @@ class Mesh:
 
     @cached_property
     def component_labels(self) -> np.ndarray:
-        """(n,) connected-component label of each vertex, 0 to :attr:`n_components` - 1
-        in the order of their first vertices; -1 for :attr:`unused` vertices (a merged
-        vertex has the label of the one it was merged into)."""
+        """(n,) connected-component label of each vertex, in the order of their first
+        vertices; -1 for :attr:`unused` vertices, a merged one's that of its vertex."""
         e = self.edges
         n = self.n_vertices
         adj = sp.coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
@@ -550,8 +544,7 @@ def _unique_index_rows(rows: np.ndarray, **kwargs):
 
 def shape_summary(mesh: Mesh) -> str:
     """The report's first sentence: vertices, faces, components, boundary, non-manifold
-    edges, and parts joined to the rest only at vertices (each can turn about its
-    vertex: three zero modes more for the 3D shells than its component's six)."""
+    edges, and parts joined to the rest only at vertices."""
     unused = len(mesh.unused)
     summary = (
         f"{_plural(mesh.n_vertices, 'vertex')}"
@@ -576,10 +569,8 @@ def shape_summary(mesh: Mesh) -> str:
 
 
 def remove_unused(mesh: Mesh) -> tuple[Mesh, np.ndarray]:
-    """A compact copy of ``mesh``, its vertices that faces use in their order, and the
-    map back: ``(compact, kept)``, vertex i of ``compact`` being vertex ``kept[i]``
-    (ascending int64) of ``mesh``, so values in ``mesh``'s numbering are
-    ``values[kept]`` in ``compact``'s."""
+    """``(compact, kept)``: a copy of ``mesh`` of its vertices that faces use, vertex i
+    being ``mesh``'s vertex ``kept[i]`` (ascending), so ``values[kept]`` moves values."""
     solver = mesh.solver_mesh
     kept = np.array(solver.file_vertices if solver is not mesh else np.arange(mesh.n_vertices))
     compact = Mesh(solver.vertices, solver.faces, report=mesh.report)
