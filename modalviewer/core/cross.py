@@ -151,24 +151,19 @@ class CrossTables:
     ) -> Matches:
         """See :func:`mutual_best_matches`."""
         va = check_vertices(vertices_a, self.a.table.shape[0], "vertices_a")
-        vb = (
-            None
-            if vertices_b is None
-            else check_vertices(vertices_b, self.b.table.shape[0], "vertices_b")
-        )
-        matches_b = np.empty(len(va), np.int64)
-        distances = np.empty(len(va))
-        back = np.empty(len(va), np.int64)
-        for i, v in enumerate(va):
+        vb, among_a = None, None  # the searches run over every vertex, or over the picks
+        if vertices_b is not None:
+            vb, among_a = check_vertices(vertices_b, self.b.table.shape[0], "vertices_b"), va
+
+        def nearest(d: np.ndarray, among: np.ndarray | None) -> int:
+            return int(np.nanargmin(d)) if among is None else int(among[np.nanargmin(d[among])])
+
+        rows = []
+        for v in va:
             d = self.a_to_b(v)
-            w = int(np.nanargmin(d)) if vb is None else int(vb[np.nanargmin(d[vb])])
-            matches_b[i], distances[i] = w, d[w]
-            d_back = self.b_to_a(w)
-            back[i] = (
-                int(np.nanargmin(d_back))
-                if vertices_b is None
-                else int(va[np.nanargmin(d_back[va])])
-            )
+            w = nearest(d, vb)
+            rows.append((w, d[w], nearest(self.b_to_a(w), among_a)))
+        matches_b, distances, back = (np.array(column) for column in zip(*rows, strict=True))
         return Matches(va, matches_b, distances, back, back == va)
 
 

@@ -137,12 +137,9 @@ def normalised_signatures(
     times = np.asarray(times, dtype=np.float64)
     dlogt = (np.log(times[-1]) - np.log(times[0])) / (len(times) - 1)
     if _check_kind(kind) == "wks":
-        _, values = signature(spec, kind="wks", energies=times, vertices=vertices)
-        return values * np.sqrt(dlogt)
-    mask = _used(spec, include_zero)
-    weights = np.exp(-np.outer(spec.eigenvalues[mask], times))  # (k, T)
-    z = weights.sum(axis=0)  # (T,)
-    return (spec.squared_modes(vertices)[:, mask] @ (weights / z)) * np.sqrt(dlogt)
+        return signature(spec, kind="wks", energies=times, vertices=vertices)[1] * np.sqrt(dlogt)
+    z = np.exp(-np.outer(spec.eigenvalues[_used(spec, include_zero)], times)).sum(axis=0)
+    return signature(spec, times, include_zero, vertices)[1] / z * np.sqrt(dlogt)
 
 
 class SignatureTable:
