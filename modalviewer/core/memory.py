@@ -95,50 +95,27 @@ _M_ARENA_MAX = -8
 HEAP_ARRAY_MAX_BYTES = 32 * 2**20
 
 
-def _mallopt():
-    """glibc's ``mallopt`` with its argument types set, or None."""
+def prepare_compute_process() -> bool:
+    """The allocator settings for a process that exists to compute (its memory goes back
+    to the system when it ends); True if all took effect.  glibc serves arrays up to
+    :data:`HEAP_ARRAY_MAX_BYTES` from the heap, keeps freed heap memory and serves every
+    thread from one arena, so memory freed on one thread is reused on any other (for
+    threads that have not yet allocated: call it when the process starts); numpy stops
+    advising huge pages for new arrays (``NUMPY_MADVISE_HUGEPAGE=0`` at run time)."""
+    import numpy as np
+
     mallopt = getattr(glibc(), "mallopt", None)
+    settings = [
+        (_M_MMAP_THRESHOLD, HEAP_ARRAY_MAX_BYTES),
+        (_M_TRIM_THRESHOLD, 2**31 - 1),
+        (_M_ARENA_MAX, 1),
+    ]
     if mallopt is not None:
         mallopt.argtypes = [ctypes.c_int, ctypes.c_int]
         mallopt.restype = ctypes.c_int
-    return mallopt
-
-
-def keep_freed_memory() -> bool:
-    """Ask glibc to serve allocations up to :data:`HEAP_ARRAY_MAX_BYTES` from the heap
-    and keep freed heap memory; True if both took effect."""
-    mallopt = _mallopt()
-    if mallopt is None:
-        return False
-    return bool(mallopt(_M_MMAP_THRESHOLD, HEAP_ARRAY_MAX_BYTES)) and bool(
-        mallopt(_M_TRIM_THRESHOLD, 2**31 - 1)
-    )
-
-
-def one_malloc_arena() -> bool:
-    """Ask glibc to serve every thread from one arena, so memory freed on one thread is
-    reused on any other (for threads that have not yet allocated: call it when the
-    process starts); True if it took effect."""
-    mallopt = _mallopt()
-    return mallopt is not None and bool(mallopt(_M_ARENA_MAX, 1))
-
-
-def no_huge_page_advice() -> bool:
-    """Stop numpy from advising huge pages for new arrays (``NUMPY_MADVISE_HUGEPAGE=0``
-    at run time); True if the setting exists."""
-    import numpy as np
-
+    took = [mallopt is not None and bool(mallopt(*setting)) for setting in settings]
     core = getattr(np, "_core", None) or np.core
     setter = getattr(core.multiarray, "_set_madvise_hugepage", None)
-    if setter is None:
-        return False
-    setter(False)
-    return True
-
-
-def prepare_compute_process() -> bool:
-    """The three allocator settings for a process that exists to compute (memory goes
-    back to the system when it ends, not before); True if all took effect."""
-    kept = keep_freed_memory()
-    shared = one_malloc_arena()
-    return no_huge_page_advice() and kept and shared
+    if setter is not None:
+        setter(False)
+    return all(took) and setter is not None
