@@ -154,14 +154,7 @@ def principal_axes(vertices, faces=None) -> tuple[np.ndarray, np.ndarray]:
         # exact second moment of a uniform triangle: (sum_i x_i x_i^T + s s^T) / 12 with
         # s = x0 + x1 + x2, taken about the surface's mean
         a, b, c = x0 - mean, x1 - mean, x2 - mean
-        s = a + b + c
-        second = (
-            np.einsum("i,ij,ik->jk", w, a, a)
-            + np.einsum("i,ij,ik->jk", w, b, b)
-            + np.einsum("i,ij,ik->jk", w, c, c)
-            + np.einsum("i,ij,ik->jk", w, s, s)
-        ) / 12.0
-        cov = second
+        cov = sum(np.einsum("i,ij,ik->jk", w, x, x) for x in (a, b, c, a + b + c)) / 12.0
     values, vectors = np.linalg.eigh(cov)
     order = np.argsort(values)[::-1]
     return values[order], vectors[:, order].T
@@ -523,9 +516,3 @@ def canonical_camera(mesh, up=None) -> dict:
     (position, focal_point, view_up)."""
     return canonical_view(mesh.vertices, mesh.faces, up=up).as_dict()
 
-
-def preset_camera(mesh, name: str, up=None) -> dict:
-    """:func:`preset_view` ("+x" ... "-z", "isometric"; "canonical" too) as a dict."""
-    if name == "canonical":
-        return canonical_camera(mesh, up)
-    return preset_view(mesh.vertices, name, up=up).as_dict()

@@ -9,6 +9,7 @@ around it estimate a request's time and memory.
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from dataclasses import replace
 from pathlib import Path
 
@@ -37,18 +38,12 @@ def copy_vertices(n_vertices: int) -> int:
     return round(COARSE_FRACTION * n_vertices)
 
 
-def solved_vertices(key: SpectrumKey, n_vertices: int) -> int:
-    """Vertices the computation of ``key`` solves on: the mesh's, or with Coarse-to-fine
-    its decimated copy's."""
-    return copy_vertices(n_vertices) if key.coarse else n_vertices
-
-
 def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
     """Bytes the exact computation of ``key`` on ``n_vertices`` is predicted to need at
     its peak (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`;
     Coarse-to-fine solves on its decimated copy)."""
-    info = operator_info(key.operator)
-    return info.predicted_peak_mb(solved_vertices(key, n_vertices), key.k) * 2**20
+    solved = copy_vertices(n_vertices) if key.coarse else n_vertices
+    return operator_info(key.operator).predicted_peak_mb(solved, key.k) * 2**20
 
 
 ESTIMATE_RANGE = 2.0
@@ -113,15 +108,8 @@ before they start."""
 def largest_k_that_fits(key: SpectrumKey, n_vertices: int, available: int) -> int:
     """The most modes of ``key``'s operator (its other settings kept) whose expected memory
     stays within :data:`MEMORY_SHARE` of ``available`` bytes; 0 if not even one does."""
-    limit = MEMORY_SHARE * available
-    lo, hi = 0, max(1, key.k)
-    while lo < hi:  # the memory estimate grows with k
-        mid = (lo + hi + 1) // 2
-        if memory_needed(replace(key, k=mid), n_vertices) <= limit:
-            lo = mid
-        else:
-            hi = mid - 1
-    return lo
+    ks, limit = range(1, max(1, key.k) + 1), MEMORY_SHARE * available  # memory grows with k
+    return bisect_right(ks, limit, key=lambda k: memory_needed(replace(key, k=k), n_vertices))
 
 
 COARSE_WORDS = "with Coarse-to-fine (a decimated copy)"
@@ -149,29 +137,21 @@ def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = C
     return text[0].upper() + text[1:] + "."
 
 
-def _share_words(available: int) -> str:
-    """The memory a computation may take, in words: that share of ``available`` in GiB,
-    the share named, and the machine's total."""
-    share = {0.75: "three quarters", 0.5: "half"}.get(MEMORY_SHARE, f"{MEMORY_SHARE:.0%}")
-    return (
-        f"the {MEMORY_SHARE * available / 2**30:.1f} GiB a computation may take ({share} of "
-        f"this machine's {available / 2**30:.1f} GiB)"
-    )
-
-
 def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS) -> str | None:
     """A message if computing ``key`` on ``n_vertices`` would need more than
     :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
     The viewer's refusals and ``modalviewer compute`` say the same."""
     needed = memory_needed(key, n_vertices)
     available = (physical_memory_mb() or 0.0) * 2**20  # bytes; 0 if unknown
-    if available and needed > MEMORY_SHARE * available:
-        return (
-            f"{operator_info(key.operator).label} with {key.k} modes on "
-            f"{n_vertices} vertices needs about {needed / 2**30:.1f} GiB of memory, "
-            f"more than {_share_words(available)}. " + what_fits(key, n_vertices, available, coarse)
-        )
-    return None
+    if not available or needed <= MEMORY_SHARE * available:
+        return None
+    share = {0.75: "three quarters", 0.5: "half"}.get(MEMORY_SHARE, f"{MEMORY_SHARE:.0%}")
+    return (
+        f"{operator_info(key.operator).label} with {key.k} modes on {n_vertices} vertices "
+        f"needs about {needed / 2**30:.1f} GiB of memory, more than the "
+        f"{MEMORY_SHARE * available / 2**30:.1f} GiB a computation may take ({share} of this "
+        f"machine's {available / 2**30:.1f} GiB). " + what_fits(key, n_vertices, available, coarse)
+    )
 
 
 class ViewerModel:

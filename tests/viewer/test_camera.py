@@ -5,9 +5,9 @@ import pytest
 
 from modalviewer.core.primitives import grid_plate
 from modalviewer.viewer.camera import (
+    Camera,
     canonical_camera,
     canonical_view,
-    preset_camera,
     preset_view,
     principal_axes,
 )
@@ -136,9 +136,9 @@ def test_isometric_preset_and_dict_form():
     assert np.allclose(cam.direction, np.ones(3) / np.sqrt(3))
     assert np.dot(cam.up, cam.direction) == pytest.approx(0.0, abs=1e-12)
     assert cam.up[1] > 0.8
-    d = preset_camera(plate, "canonical")
+    d = canonical_camera(plate)
     assert set(d) == {"position", "focal_point", "view_up"}
-    assert d == canonical_camera(plate)
+    assert Camera.from_dict(d) == canonical_view(plate.vertices, plate.faces)
     with pytest.raises(ValueError, match="unknown camera preset"):
         preset_view(plate.vertices, "top")
     with pytest.raises(ValueError, match="unknown up axis"):
