@@ -515,4 +515,3 @@ def canonical_camera(mesh, up=None) -> dict:
     """:func:`canonical_view` of a :class:`~modalviewer.core.mesh.Mesh` as a dict
     (position, focal_point, view_up)."""
     return canonical_view(mesh.vertices, mesh.faces, up=up).as_dict()
-

@@ -296,9 +296,5 @@ class Pictures:
         if not hasattr(comparison, "views"):
             comparison = self.comparison(comparison)
         cam = self.current_camera()
-        camera = None
-        if cam is not None:
-            camera = Camera(
-                tuple(cam["position"]), tuple(cam["focal_point"]), tuple(cam["view_up"])
-            )
+        camera = Camera.from_dict(cam) if cam is not None else None
         return save_comparison(comparison, path, size or VIEW_SIZE, camera, scale)

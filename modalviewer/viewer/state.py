@@ -2,20 +2,18 @@
 
 :class:`ViewerState` (``viewer.state``) is the single source of truth: the scene, the
 panels, the status bar and the plots observe its events and redraw from it.  Fields that
-only need validating are evented (:class:`Style`: ``state.style.isolines = 8``); changes
-that do more go through methods (``set_display``, ``set_pick``, ...).  Values computed
-from it live in :attr:`ViewerState.derived`, the words shown in :mod:`.wording`.  A
-method changes only what it is given, except for the threshold rule
-(:meth:`ViewerState._match_threshold`).
+only need validating are evented: the dataclasses ``style``, ``animation`` and
+``compute_settings`` (``state.animation.speed = 50``) and the state's ``camera`` and
+``up_axis``; changes that do more go through methods (``set_display``, ``set_pick``,
+...), which change only what they are given, except for the threshold rule
+(:meth:`ViewerState._match_threshold`).  Values computed from it live in
+:attr:`ViewerState.derived`, the words shown in :mod:`.wording`.
 
 Events (``state.events.<name>.connect(callback)``), emitted on the thread that changed
 the state: ``mesh()`` (new mesh or none; spectra, pick and display reset),
 ``spectra(operator)``, ``display()``, ``style()``, ``pick()``, ``compute_settings()``,
-``scale_range()``, ``animation()``, ``camera(new, old)`` (set through the state: a
-preset, a restored session), ``signature_curve()`` (the exact curve arrived) and
-``up_axis(new, old)``.  ``style``, ``animation`` and ``compute_settings`` are evented
-dataclasses (``state.animation.speed = 50``), ``camera`` and ``up_axis`` evented fields
-of the state.
+``scale_range()``, ``animation()``, ``camera(new, old)`` (a preset, a restored session),
+``signature_curve()`` (the exact curve arrived) and ``up_axis(new, old)``.
 """
 
 from __future__ import annotations
@@ -93,16 +91,12 @@ class ComputeSettings:
         super().__setattr__(name, value)
 
     def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
+        """The key of ``operator``'s spectrum (default: these settings'), of ``k`` modes
+        (default: these settings'); weights only for an operator that has them."""
         op = operator or self.operator
-        weights = operator_info(op).has_weights
-        return SpectrumKey(
-            operator=op,
-            k=int(k if k is not None else self.k),
-            bending=float(self.bending) if weights else 1.0,
-            membrane=float(self.membrane) if weights else 1.0,
-            rescale=bool(self.rescale),
-            coarse=bool(self.coarse),
-        )
+        weights = (self.bending, self.membrane) if operator_info(op).has_weights else (1, 1)
+        k = int(k if k is not None else self.k)
+        return SpectrumKey(op, k, *map(float, weights), bool(self.rescale), bool(self.coarse))
 
 
 @dataclass(frozen=True)

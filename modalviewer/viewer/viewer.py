@@ -632,19 +632,17 @@ class Viewer(ViewerModel, Pictures):
                 if job.status != DONE:
                     raise ComputeError(job.error or job.status)
             return jobs
-        pending = {job.id for job in jobs}
+        called = []
 
-        def ready(j: Job) -> None:
-            pending.discard(j.id)
-            if j.status != DONE:
-                pending.clear()
-            elif not pending and all(x.status == DONE for x in jobs) and then is not None:
+        def ready(_job=None) -> None:  # once, when the last job is in (never if one failed)
+            if then is not None and not called and all(j.status == DONE for j in jobs):
+                called.append(True)
                 then()
 
-        if not jobs and then is not None:
-            then()
         for job in jobs:
             job.then(ready)
+        if not jobs:
+            ready()
         return jobs
 
     def comparison(self, items: list[str], wait: bool = True):
