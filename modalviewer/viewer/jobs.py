@@ -112,19 +112,10 @@ class SpectrumJob(Job):
         super().__init__(fn, key, description, owner)
         self.spectrum_key = spectrum_key
 
-    @property
-    def spectrum(self):
-        """The spectrum once the job is done, else None."""
-        return self.result[0] if self.status == DONE and self.result else None
-
 
 class RepairJob(Job):
-    """A job applying the repair ``repair`` (a name of ``modalviewer.repair.REPAIRS``)
-    to a mesh; its result is the repaired Mesh."""
-
-    def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable, repair: str):
-        super().__init__(fn, key, description, owner)
-        self.repair = repair
+    """A job applying a repair of ``modalviewer.repair.REPAIRS`` to a mesh; its result is
+    the repaired Mesh."""
 
 
 class LatestModes:

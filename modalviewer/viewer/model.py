@@ -198,7 +198,6 @@ class ViewerModel:
                 ("repair", mesh.hash, name),
                 REPAIRS[name],
                 mesh.hash,
-                repair=name,
             )
         )
 
