@@ -1,9 +1,7 @@
 """On-disk cache of computed spectra, keyed by mesh hash, operator and parameters.
 
-A folder of ``.npz`` files, one per spectrum, at most ``max_bytes`` in all: the least
-recently used go first, a file's modification time being its last use (:meth:`SpectrumCache.get`
-touches it; files are written atomically).  Every entry is checked when read (zip
-checksums, format, shapes, finite values, mesh hash); a damaged or foreign one is
+A folder of ``.npz`` files, one per spectrum, the least recently used (by modification
+time) going first.  Every entry is checked when read; a damaged or foreign one is
 deleted with a warning in the ``modalviewer.cache`` log and counts as a miss.
 """
 

@@ -26,6 +26,16 @@ __all__ = [
 ]
 
 
+def _by_area(mesh: Mesh) -> tuple[np.ndarray, list[int]]:
+    """Each face's component label, and the components largest area first (then most
+    vertices, then lowest label)."""
+    labels = mesh.component_labels
+    face_label = labels[mesh.faces[:, 0]]
+    areas = np.bincount(face_label, weights=mesh.face_areas, minlength=mesh.n_components)
+    sizes = np.bincount(labels, minlength=mesh.n_components)
+    return face_label, sorted(range(mesh.n_components), key=lambda c: (-areas[c], -sizes[c], c))
+
+
 def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
     """The connected components, largest area first: (mesh, vertices) per component,
     row i of the component's arrays being vertex ``vertices[i]`` of ``mesh`` (ascending:
@@ -36,14 +46,10 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
             (Mesh(part.vertices, part.faces), solver.file_vertices[vertices])
             for part, vertices in split_components(solver)
         ]
-    labels = mesh.component_labels
-    face_label = labels[mesh.faces[:, 0]]
-    areas = np.bincount(face_label, weights=mesh.face_areas, minlength=mesh.n_components)
-    sizes = np.bincount(labels, minlength=mesh.n_components)
-    order = sorted(range(mesh.n_components), key=lambda c: (-areas[c], -sizes[c], c))
+    face_label, order = _by_area(mesh)
     out = []
     for c in order:
-        vertices = np.flatnonzero(labels == c)
+        vertices = np.flatnonzero(mesh.component_labels == c)
         remap = np.full(mesh.n_vertices, -1, dtype=np.int64)
         remap[vertices] = np.arange(len(vertices))
         faces = remap[mesh.faces[face_label == c]]
@@ -59,15 +65,8 @@ def largest_component(mesh: Mesh) -> Mesh:
     used by no face (:attr:`~modalviewer.core.mesh.Mesh.unused`)."""
     if not mesh.renumbered:  # the input's numbering: the other components' faces go
         solver = mesh.solver_mesh
-        labels = solver.component_labels[solver.faces[:, 0]]
-        if solver.n_components == 1:
-            keep = np.ones(mesh.n_faces, dtype=bool)
-        else:
-            area = np.bincount(labels, weights=solver.face_areas, minlength=solver.n_components)
-            size = np.bincount(solver.component_labels, minlength=solver.n_components)
-            largest = min(range(solver.n_components), key=lambda c: (-area[c], -size[c], c))
-            keep = labels == largest
-        kept = Mesh(mesh.vertices, mesh.faces[keep], merged_into=mesh.merged_into)
+        face_label, order = _by_area(solver)
+        kept = Mesh(mesh.vertices, mesh.faces[face_label == order[0]], merged_into=mesh.merged_into)
         report = _largest_report(mesh, kept, solver.n_components)
         return Mesh(kept.vertices, kept.faces, report=report, merged_into=kept.merged_into)
     parts = split_components(mesh)

@@ -1,7 +1,5 @@
 """Writing files atomically (a temporary file beside the target, then a rename) with the
-permissions of the user's umask: ``tempfile.mkstemp`` creates mode 0600 and a rename
-keeps it, so :func:`atomic_write` gives the temporary file what ``open(path, "w")``
-would (0666 minus the umask) before renaming it.
+permissions ``open(path, "w")`` would give (``tempfile.mkstemp``'s are 0600).
 """
 
 from __future__ import annotations

@@ -60,13 +60,6 @@ class NullSpace:
         return f"{comps}: {first} ({kind}, {where}), computed directly, not by iteration."
 
 
-def _component_vertices(mesh: Mesh) -> list[np.ndarray]:
-    labels = mesh.component_labels
-    order = np.argsort(labels, kind="stable")
-    bounds = np.searchsorted(labels[order], np.arange(labels.max() + 2))
-    return [order[bounds[c] : bounds[c + 1]] for c in range(len(bounds) - 1)]
-
-
 def _rigid_fields(x: np.ndarray, m: np.ndarray) -> np.ndarray:
     """(p, 3, 6) velocities of 3 translations and 3 rotations about the centre of mass."""
     c = (m[:, None] * x).sum(axis=0) / m.sum()
@@ -95,7 +88,10 @@ def _candidates(mesh: Mesh, info: OperatorInfo, mass: np.ndarray, normals):
     """Per component: (rows of the unknowns, Mass-orthonormal dense candidate columns)."""
     x = mesh.vertices
     rule, per_vertex = info.null_space_rule, info.unknowns_per_vertex
-    for verts in _component_vertices(mesh):
+    labels = mesh.component_labels
+    order = np.argsort(labels, kind="stable")
+    bounds = np.searchsorted(labels[order], np.arange(labels.max() + 2))
+    for verts in (order[bounds[c] : bounds[c + 1]] for c in range(len(bounds) - 1)):
         m = mass[per_vertex * verts]
         if rule == "constants":
             yield verts, _mass_orthonormal(np.ones((len(verts), 1)), m)

@@ -44,22 +44,14 @@ two ``normal`` rules need the vertex normals."""
 class OperatorInfo:
     """What the viewer and the library need to know about one operator.
 
-    name : key used in files, the API and the cache; label : words for menus, legends
-    and titles; short_label : a few words for narrow places.
-    assemble : the function that assembles K, or its ``"module:function"`` in
-        :mod:`modalviewer.core`, called as ``function(mesh)`` or, with
-        ``has_weights``, ``function(mesh, bending, membrane)``; with ``assembles_mass``
-        it returns (K, mass (n,)), otherwise the mass is the lumped vertex area.
-    null_space : the exactly known null vectors in words; null_space_rule : how they are
-        built, a key of :data:`NULL_SPACE_RULES`.
-    exact_growth, factor_memory : the exact solve's measured peak memory and its factor's
-        size against mesh size (:class:`.cost.GrowthLaw`, :class:`.cost.FactorLaw`),
-        which the memory check predicts from; ``measured_as``: the operator whose laws
-        these are, where not its own (``benchmarks/results/growth.json``).
-    distance_kind, wave_distance_kind : the multi-scale (and wave kernel) distance its
-        spectrum defines, or None; signature_word : that signature in words.
-    nonnegative_weights : whether its weights stay non-negative on any mesh (the viewer
-        suggests it where the cotan weights go negative).
+    ``name`` keys files, the API and the cache; ``assemble`` is the function that
+    assembles K (or its ``"module:function"`` in :mod:`modalviewer.core`), called with
+    the bending and membrane weights where ``has_weights``, returning the mass too where
+    ``assembles_mass`` (else the lumped vertex areas); ``null_space_rule`` is a key of
+    :data:`NULL_SPACE_RULES`; ``exact_growth`` and ``factor_memory`` are the measured
+    laws the memory check predicts from (``measured_as``: the operator whose laws they
+    are, where not its own); ``nonnegative_weights``: its weights stay non-negative on
+    any mesh (the viewer suggests it where the cotan weights go negative).
     """
 
     name: str

@@ -1,10 +1,9 @@
 """The robust Laplacian: the intrinsic Delaunay Laplacian of the tufted cover (Sharp and
 Crane, SGP 2020), from the optional ``robust-laplacian`` package.
 
-Obtuse and sliver triangles make cotan weights negative, which breaks the maximum
-principle and can make signatures oscillate; the intrinsic Delaunay weights are
-non-negative, and the tufted cover accepts non-manifold meshes.  The viewer suggests it
-where :func:`negative_cotan_weights` finds negative weights.
+Obtuse and sliver triangles make cotan weights negative (signatures can oscillate); the
+intrinsic Delaunay weights are non-negative, and the tufted cover accepts non-manifold
+meshes.
 """
 
 from __future__ import annotations

@@ -1,12 +1,8 @@
-"""OpenBLAS at one thread during an eigensolve, set at run time.
-
-MKL PARDISO and numpy's OpenBLAS take turns on the same cores hundreds of times per
-eigensolve, and OpenBLAS threads left spinning after each call slow PARDISO's down.
-``OPENBLAS_THREAD_TIMEOUT`` (set by ``import modalviewer``) is read only when OpenBLAS
-loads, too late if numpy was imported first; :func:`single_blas_thread` works whatever
-the import order, limiting OpenBLAS to one thread through threadpoolctl for the
-decorated call (``benchmarks/import_order.py`` measures it).  Without threadpoolctl or
-OpenBLAS the call runs as it is; ``MODALVIEWER_SINGLE_BLAS_THREAD=0`` turns it off.
+"""OpenBLAS at one thread during an eigensolve, set at run time through threadpoolctl:
+OpenBLAS threads left spinning after each call slow MKL PARDISO's down, and
+``OPENBLAS_THREAD_TIMEOUT`` (set by ``import modalviewer``) comes too late if numpy was
+imported first (``benchmarks/import_order.py``).  ``MODALVIEWER_SINGLE_BLAS_THREAD=0``
+turns it off.
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """Checks of the arguments at the public API's edge: counts, vertex indices, scales.
 
 One place for the rules, so that every function rejects the same inputs with the same
-words (the parameter's name and the value given): counts (``k``, ``samples``) are
-integers, not bools, floats or strings, and at least a minimum; vertex indices are
-integers in ``0..n-1`` (no negative indices counted from the end); scales (``times``,
-``t_range``) are positive and finite.  Wrong types raise TypeError, wrong values
-ValueError, indices out of range IndexError.
+words: counts are integers (not bools) of at least a minimum, vertex indices integers
+in ``0..n-1`` (no negative ones), scales positive and finite.  Wrong types raise
+TypeError, wrong values ValueError, indices out of range IndexError.
 """
 
 from __future__ import annotations
