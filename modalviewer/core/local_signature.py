@@ -14,6 +14,8 @@ exactly known null vectors (:mod:`.nullspace`), which commutes with ``A``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -23,24 +25,13 @@ from .factor import SPDSolver
 from .mesh import Mesh
 from .nullspace import null_space
 from .operators import OperatorLike, operator_info
-from .spectrum import Spectrum
+from .spectrum import Spectrum, on_solver_mesh
 from .validate import check_times, check_vertices
 
 
-class _ShiftedInverse:
-    """``B = (A + sigma I)^-1 = M^1/2 (K + sigma M)^-1 M^1/2``, from one factorisation."""
-
-    def __init__(self, K, mass: np.ndarray, sigma: float):
-        self.sigma = sigma
-        self.sqrt_mass = np.sqrt(mass)
-        self.solver = SPDSolver(sp.csr_matrix(K + sigma * sp.diags(mass)))
-
-    def __matmul__(self, v: np.ndarray) -> np.ndarray:
-        return self.sqrt_mass * self.solver.solve(self.sqrt_mass * v)
-
-
 def _quadrature(
-    B: _ShiftedInverse,
+    B: Callable[[np.ndarray], np.ndarray],
+    sigma: float,
     b: np.ndarray,
     times: np.ndarray,
     rtol: float,
@@ -64,7 +55,7 @@ def _quadrature(
     settled = 0
     next_check = 8  # checks grow apart with the step count: the rule costs O(m^2) each
     for step in range(1, max_steps + 1):
-        w = B @ q
+        w = B(q)
         alpha = float(q @ w)
         w -= alpha * q
         if betas:
@@ -76,7 +67,7 @@ def _quadrature(
             next_check = step + max(8, step // 8)
             theta, s = sla.eigh_tridiagonal(np.array(alphas), np.array(betas))
             weights = s[0] ** 2
-            x = 1.0 / np.maximum(theta, np.finfo(float).tiny) - B.sigma
+            x = 1.0 / np.maximum(theta, np.finfo(float).tiny) - sigma
             values = beta0**2 * (np.exp(-np.outer(times, np.maximum(x, 0.0))) @ weights)
             if breakdown:  # an invariant subspace: the rule is exact
                 return values
@@ -127,8 +118,6 @@ def local_signature(
     vertices = check_vertices(vertices, mesh.n_vertices)
     solver = mesh.solver_mesh
     if solver is not mesh:  # unused or merged vertices: on the vertices faces use
-        from .spectrum import on_solver_mesh
-
         picks = [solver.mesh_vertex(v) for v in vertices]  # an unused vertex: its name
         spectrum = None if spectrum is None else on_solver_mesh(spectrum, solver)
         args = (include_zero, bending, membrane, rtol, max_steps, spectrum)
@@ -136,8 +125,15 @@ def local_signature(
     times = check_times(times)
     K, mass = operator_matrices(mesh, operator, bending, membrane)
     per_vertex = operator.unknowns_per_vertex
-    # the shift: the scales' geometric mean's rate, where exp(-t x) varies the most
-    B = _ShiftedInverse(K, mass, 1.0 / float(np.sqrt(times.min() * times.max())))
+    # B = (A + sigma I)^-1 = M^1/2 (K + sigma M)^-1 M^1/2 from one factorisation, sigma
+    # the scales' geometric mean's rate, where exp(-t x) varies the most
+    sigma = 1.0 / float(np.sqrt(times.min() * times.max()))
+    shifted = SPDSolver(sp.csr_matrix(K + sigma * sp.diags(mass)))
+    root = np.sqrt(mass)
+
+    def B(v: np.ndarray) -> np.ndarray:
+        return root * shifted.solve(root * v)
+
     T = len(times)
     known = np.zeros((len(vertices), per_vertex, T))
     if spectrum is not None:
@@ -165,6 +161,6 @@ def local_signature(
             if Y is not None:
                 b -= Y @ Y[r]
             scaled_known = known[i, alpha] * mass[r]
-            tail = _quadrature(B, b, times, rtol, max_steps, scaled_known)
+            tail = _quadrature(B, sigma, b, times, rtol, max_steps, scaled_known)
             out[i] += known[i, alpha] + tail / mass[r]
     return out

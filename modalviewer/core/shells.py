@@ -29,7 +29,6 @@ def hinges(mesh: Mesh) -> np.ndarray:
     if problem:
         raise MeshError("Discrete Shells cannot run: " + problem)
     f = mesh.faces
-    m = len(f)
     edge_of_halfedge = mesh.face_edges.ravel()  # half-edge 3t+k: f[t,k] -> f[t,k+1]
     interior = np.flatnonzero(mesh.edge_face_counts == 2)
     order = np.argsort(edge_of_halfedge, kind="stable")
@@ -42,7 +41,7 @@ def hinges(mesh: Mesh) -> np.ndarray:
     x1 = f[t1, (k1 + 1) % 3]
     x2 = f[t1, (k1 + 2) % 3]
     x3 = f[t2, (k2 + 2) % 3]
-    assert m == 0 or np.all(f[t2, k2] == x1)
+    assert np.all(f[t2, k2] == x1)
     return np.stack([x0, x1, x2, x3], axis=1)
 
 
@@ -152,11 +151,7 @@ def shells_gradient(mesh: Mesh, x, bending: float = 1.0, membrane: float = 1.0) 
     grad = np.zeros((mesh.n_vertices, 3))
     for stencil, f, df, w in _terms(mesh, bending, membrane):
         coef = w * (f(x, stencil) - f(mesh.vertices, stencil))
-        contrib = coef[:, None, None] * df(x, stencil)
-        for c in range(3):
-            grad[:, c] += np.bincount(
-                stencil.ravel(), contrib[:, :, c].ravel(), minlength=mesh.n_vertices
-            )
+        np.add.at(grad, stencil.ravel(), (coef[:, None, None] * df(x, stencil)).reshape(-1, 3))
     return grad.ravel()
 
 
@@ -171,26 +166,19 @@ def weighted_gradient_matrix(
     (Lemma 1).  Columns: the 3n vertex-major dofs, or with ``normals`` (n, 3) the n
     normal variations, which gives ``H_N = G_N^T G_N`` without the 3n Hessian."""
     _check_weights(bending, membrane)
-    x = mesh.vertices
-    n = mesh.n_vertices
+    n = mesh.n_vertices if normals is not None else 3 * mesh.n_vertices
     blocks = []
     for stencil, _, df, w in _terms(mesh, bending, membrane):
         e, L = stencil.shape
-        g = df(x, stencil) * np.sqrt(w)[:, None, None]  # (e, L, 3)
+        g = df(mesh.vertices, stencil) * np.sqrt(w)[:, None, None]  # (e, L, 3)
         if normals is None:
             cols = (3 * stencil[:, :, None] + np.arange(3)).reshape(e, 3 * L)
             vals = g.reshape(e, 3 * L)
         else:
             cols = stencil
             vals = np.einsum("elc,elc->el", g, normals[stencil])
-        width = cols.shape[1]
-        indptr = np.arange(0, e * width + 1, width, dtype=np.int64)
-        blocks.append(
-            sp.csr_matrix(
-                (vals.ravel(), cols.ravel(), indptr),
-                shape=(e, n if normals is not None else 3 * n),
-            )
-        )
+        indptr = np.arange(0, vals.size + 1, cols.shape[1], dtype=np.int64)
+        blocks.append(sp.csr_matrix((vals.ravel(), cols.ravel(), indptr), shape=(e, n)))
     return sp.vstack(blocks, format="csr")
 
 

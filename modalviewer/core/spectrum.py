@@ -16,6 +16,7 @@ from .operators import OPERATOR_INFO, OPERATOR_NAMES, OperatorInfo, operator_inf
 
 OPERATORS = OPERATOR_NAMES
 FORMAT_VERSION = 1
+_ARRAYS = ("eigenvalues", "modes", "mass", "residuals")  # a spectrum file's arrays
 
 
 class SpectrumFileError(ValueError):
@@ -139,14 +140,8 @@ def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as fh:
-            np.savez(
-                fh,
-                eigenvalues=spec.eigenvalues,
-                modes=spec.modes,
-                mass=spec.mass,
-                residuals=spec.residuals,
-                meta=np.array(json.dumps(meta)),
-            )
+            arrays = {name: getattr(spec, name) for name in _ARRAYS}
+            np.savez(fh, **arrays, meta=np.array(json.dumps(meta)))
 
     atomic_write(Path(path), write, suffix=".part")
 
@@ -175,12 +170,10 @@ def load_spectrum(
     try:
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
+            arrays = {name: np.array(data[name], dtype=np.float64) for name in _ARRAYS}
             spec = Spectrum(
-                eigenvalues=np.array(data["eigenvalues"], dtype=np.float64),
-                modes=np.array(data["modes"], dtype=np.float64),
+                **arrays,
                 operator=meta["operator"],
-                mass=np.array(data["mass"], dtype=np.float64),
-                residuals=np.array(data["residuals"], dtype=np.float64),
                 mesh_hash=meta.get("mesh_hash", ""),
                 parameters=meta.get("parameters", {}),
             )
@@ -209,10 +202,8 @@ def load_spectrum(
 
 
 def in_input_numbering(spec: Spectrum, mesh: Mesh) -> Spectrum:
-    """``spec``, computed on ``mesh.solver_mesh``, in ``mesh``'s numbering: a row per
-    vertex of ``mesh``, NaN modes and zero mass at its unused vertices, a merged
-    vertex's modes those of the vertex it was merged into (and mass 0: no face uses it).
-    ``spec`` itself where the solver mesh is ``mesh``."""
+    """``spec``, computed on ``mesh.solver_mesh``, in ``mesh``'s numbering: NaN modes and
+    zero mass at unused vertices, a merged vertex's modes those of its vertex (mass 0)."""
     solver = mesh.solver_mesh
     if solver is mesh:
         return spec
@@ -228,10 +219,9 @@ def in_input_numbering(spec: Spectrum, mesh: Mesh) -> Spectrum:
 
 
 class GrowingSpectrum:
-    """The modes of a spectrum as they arrive, lowest first, gathered in one array for
-    all k of them: :meth:`so_far` is a :class:`Spectrum` of those in (its modes a view of
-    the array, not written again; its residuals NaN, not computed until the spectrum is
-    whole)."""
+    """The modes of a spectrum as they arrive, lowest first, in one array for all k:
+    :meth:`so_far` is a :class:`Spectrum` of those in (its modes a view of the array; its
+    residuals NaN until the spectrum is whole)."""
 
     def __init__(self, k: int) -> None:
         self.k = int(k)
@@ -263,9 +253,8 @@ class GrowingSpectrum:
 
 
 def on_solver_mesh(spec: Spectrum, mesh: Mesh) -> Spectrum:
-    """``spec`` of ``mesh.input_mesh`` (one row per input vertex) on ``mesh``, a solver
-    mesh (:attr:`.mesh.Mesh.solver_mesh`); ``spec`` itself where it is in that numbering
-    already."""
+    """``spec`` of ``mesh.input_mesh`` (one row per input vertex) on ``mesh``, its solver
+    mesh; ``spec`` itself where it is in that numbering already."""
     if mesh.input_mesh is mesh or spec.n_vertices == mesh.n_vertices:
         return spec
     if spec.mesh_hash and spec.mesh_hash != mesh.input_mesh.hash:
