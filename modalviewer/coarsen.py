@@ -15,13 +15,6 @@ from .core.operators import OperatorLike, operator_info
 from .core.pipeline import compute_spectrum
 from .core.spectrum import Spectrum
 
-__all__ = [
-    "COARSE_FRACTION",
-    "decimated_copy",
-    "transfer_spectrum",
-    "coarse_to_fine_spectrum",
-]
-
 COARSE_FRACTION = 0.2
 """Share of the vertices the coarse-to-fine copy keeps (:func:`decimated_copy`'s
 default; the viewer's cost estimates use it too)."""

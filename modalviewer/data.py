@@ -11,8 +11,6 @@ import sys
 import sysconfig
 from pathlib import Path
 
-__all__ = ["asset_path", "assets_dir"]
-
 _MARKER = "spot.obj"  # the default mesh, present in every copy of the assets
 
 

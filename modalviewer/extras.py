@@ -10,8 +10,6 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 
-__all__ = ["EXTRA_OF", "MissingExtraError", "extra_needed"]
-
 EXTRA_OF = {
     "pyvista": "viewer",
     "vtk": "viewer",

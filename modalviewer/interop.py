@@ -17,8 +17,6 @@ from .core.spectrum import Spectrum
 from .extras import extra_needed
 from .io import mesh_from_arrays, meshio_arrays, pyvista_arrays
 
-__all__ = ["as_mesh", "operator_matrices", "to_pyvista", "arrays_of"]
-
 
 def _module(obj) -> str:
     return type(obj).__module__.split(".")[0]

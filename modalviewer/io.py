@@ -18,8 +18,6 @@ from .core.mesh import Mesh, MeshError, MeshReport, shape_summary
 from .extras import MissingExtraError, extra_needed
 from .readers import count_text, read_mesh_file
 
-__all__ = ["load_mesh", "read_file", "SUPPORTED_EXTENSIONS"]
-
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 
 

@@ -18,8 +18,6 @@ from .core.spectrum import Spectrum
 from .extras import extra_needed
 from .interop import as_mesh
 
-__all__ = ["Picture", "InteractivePicture", "plot", "view", "add_to_plotter"]
-
 DEFAULT_PLOT_SIZE = (800, 600)
 
 

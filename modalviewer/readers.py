@@ -24,8 +24,6 @@ import numpy as np
 
 from .core.mesh import MeshError
 
-__all__ = ["DamagedFileError", "MeshFile", "read_mesh_file", "strips_to_triangles", "READERS"]
-
 
 class DamagedFileError(MeshError):
     """A file of its format, damaged or truncated: ``load_mesh(path, strict=False)``

@@ -121,10 +121,8 @@ def distance(args) -> int:
         viewer.add_spectrum(spec)
         viewer.state.set_display(distance_kind=args.kind)
         viewer.pick_vertex(args.vertex)
-        if marked is None:
-            viewer.show_distance(args.kind, display="continuous")
-        else:
-            viewer.show_distance(args.kind, display="threshold", threshold=marked[0])
+        display = "continuous" if marked is None else "threshold"
+        viewer.show_distance(args.kind, display, threshold=None if marked is None else marked[0])
         viewer.set_view(args.view, up=args.up)
         written = viewer.export_screenshot(args.output, size=args.size)
         viewer.close()

@@ -17,8 +17,6 @@ import numpy as np
 
 from ..core.mesh import Mesh, MeshError, MeshReport, _plural
 
-__all__ = ["SliverReport", "fix_slivers"]
-
 SLIVER_QUALITY = 1e-3
 """Quality below which a triangle is counted as a sliver in reports."""
 

@@ -31,10 +31,9 @@ def grab(
     if scene is None:
         scene = getattr(plotter, "_modalviewer_scene", None)
     overlay = scene.overlay(legend=legend, colorbar=colorbar) if scene is not None else None
-    # the scene's own 2D actors are replaced by the overlay drawn at the export's scale
-    hidden = [a for a in scene.overlay_actors() if a.GetVisibility()] if scene else []
-    if scene is not None and not marker and scene.marker_actor is not None:
-        hidden += [scene.marker_actor] if scene.marker_actor.GetVisibility() else []
+    # the scene's own overlay is replaced by the overlay drawn at the export's scale
+    hidden = [] if scene is None else [scene.overlay_actor, None if marker else scene.marker_actor]
+    hidden = [actor for actor in hidden if actor is not None and actor.GetVisibility()]
     for actor in hidden:
         actor.SetVisibility(False)
     try:

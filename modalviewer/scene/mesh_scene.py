@@ -393,10 +393,6 @@ class MeshScene:
         image.GetPointData().SetScalars(scalars)
         actor.GetMapper().SetInputData(image)
 
-    def overlay_actors(self) -> list:
-        """The scene's 2D actors (legend, colour bar) that exports replace by the overlay."""
-        return [self.overlay_actor] if self.overlay_actor is not None else []
-
     # ----------------------------------------------------------------- camera
     def canonical_camera(self) -> cameras.Camera:
         """The canonical first view of this mesh (see ``modalviewer.viewer.camera``),
@@ -574,8 +570,8 @@ class MeshScene:
     def remove(self) -> None:
         for name in ("surface", "iso_actor", "zero_actor", "marker", "back_marker", "ghost"):
             self.plotter.remove_actor(name, render=False)
-        for actor in self.overlay_actors():
-            self.plotter.renderer.RemoveViewProp(actor)
+        if self.overlay_actor is not None:
+            self.plotter.renderer.RemoveViewProp(self.overlay_actor)
         if self._overlay_observer is not None:
             self.plotter.renderer.RemoveObserver(self._overlay_observer)
         self.overlay_actor = self._overlay_observer = None
