@@ -8,8 +8,6 @@ never change it.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 from qtpy import QtWidgets
 
@@ -17,14 +15,16 @@ from ..scene.comparison import caption
 from ..scene.mesh_scene import MeshScene
 from ..scene.view import draw_field, label_field
 from ..viewer.comparison import Comparison, item_label
-from .viewport import grab_views, make_viewport, save_views
-from .window_keys import dispatch_key, install_keys
+from .viewport import grab_views, make_viewport
+from .views_window import ViewsWindow
 
 
-class CompareWindow(QtWidgets.QWidget):
+class CompareWindow(ViewsWindow):
     """Two or three linked views of ``items`` (operators or distance kinds).  Operator
     views share the comparison's mode index, starting at the first non-zero mode; Left /
     Right step it, Esc and Ctrl+W close the window."""
+
+    EXPORT = ("compare.png", "Export the comparison")
 
     def __init__(self, main, items: list[str], force_offscreen: bool | None = None):
         super().__init__()
@@ -57,43 +57,20 @@ class CompareWindow(QtWidgets.QWidget):
             self.titles.append(title)
         for event in self._followed():  # also a spectrum replaced (another k, weights)
             event.connect(self.refresh)
-        self._keys = install_keys(
-            self,
+        self.install_keys(
             [
                 ("Escape", self.close),
                 ("Ctrl+W", self.close),
                 ("Right", lambda: self.comparison.step(+1)),
                 ("Left", lambda: self.comparison.step(-1)),
-                ("Ctrl+E", self.export_dialog),
-            ],
+            ]
         )
         self.resize(420 * len(items), 480)
-
-    @property
-    def mode_index(self) -> int:
-        return self.comparison.mode_index
-
-    def keyPressEvent(self, event):  # noqa: N802
-        """Esc and Ctrl+W close; Left / Right step the mode of operator views."""
-        if not dispatch_key(self._keys, event):
-            super().keyPressEvent(event)
 
     def _followed(self) -> tuple:
         """The events the views are redrawn on."""
         events = self.state.events
         return events.pick, events.display, events.style, events.spectra, self.comparison.changed
-
-    def render_all(self) -> None:
-        for viewport in self.viewports:
-            viewport.request_render()
-
-    def show_mode(self, index: int) -> None:
-        """Mode ``index`` of each operator (those without a spectrum stay grey)."""
-        self.comparison.show_mode(index)
-
-    def show_distance(self) -> None:
-        """Each kind's distance from the main window's picked vertex."""
-        self.refresh()
 
     def refresh(self) -> None:
         """Draw what the comparison's views show now."""
@@ -112,25 +89,15 @@ class CompareWindow(QtWidgets.QWidget):
         written above it."""
         images = grab_views(self.viewports, self.scenes, scale, transparent)
         self.render_all()
-        return [caption(image, t.text()) for image, t in zip(images, self.titles, strict=True)]
+        return [caption(image, t) for image, t in zip(images, self.captions(), strict=True)]
 
-    def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
-        """The views side by side, each with its title and colour bar (or a threshold
-        map's legend), in one PNG (written atomically)."""
-        titles = [title.text() for title in self.titles]
-        return save_views(path, self.viewports, self.scenes, scale, transparent, titles)
-
-    def export_dialog(self) -> None:
-        """Ctrl+E: the export dialog (file, size multiplier, transparent background)."""
-        from .file_dialogs import window_screenshot_dialog
-
-        window_screenshot_dialog(self, "compare.png", "Export the comparison")
+    def captions(self) -> list[str]:
+        return [title.text() for title in self.titles]
 
     def closeEvent(self, event):  # noqa: N802
         for followed in self._followed():
             followed.disconnect(self.refresh)
-        for viewport in self.viewports:
-            viewport.close_plotter()
+        self.close_views()
         if self.main.compare is self:
             self.main.compare = None
         super().closeEvent(event)

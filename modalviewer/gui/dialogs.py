@@ -44,6 +44,8 @@ def ask_action(parent, title: str, text: str, action: str) -> bool:
     return box.clickedButton() is chosen
 
 
+NO_MESH_A = "Open a mesh first: it becomes mesh A of the pair."
+
 DAMAGED_WORDS = "the file is damaged or truncated"
 """How ``window.last_error`` ends for a file refused as damaged (:func:`offer_open_anyway`):
 a run without a display tells from it that ``--partial`` would open the file."""
@@ -53,7 +55,7 @@ def offer_open_anyway(window, path, error: Exception) -> bool:
     """Name the damage of a file that did not load (status bar, ``window.last_error``)
     and ask whether to load its whole records; True for "Open anyway" (the default)."""
     message = file_message(path, str(error)).split("; the file is damaged")[0]
-    window.last_error = f"{message}; {DAMAGED_WORDS}"
+    window.viewer.last_error = f"{message}; {DAMAGED_WORDS}"
     window.statusBar().showMessage(message, 10000)
     return ask_action(
         window,

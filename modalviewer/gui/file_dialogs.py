@@ -11,7 +11,7 @@ from qtpy import QtWidgets
 from ..core.operators import operator_info
 from ..core.spectrum import in_input_numbering, save_spectrum
 from ..io import SUPPORTED_EXTENSIONS
-from .dialogs import AnimationDialog, ScreenshotDialog, ask
+from .dialogs import NO_MESH_A, AnimationDialog, ScreenshotDialog, ask
 from .paths import ASSETS, SCREENSHOTS
 
 
@@ -54,14 +54,28 @@ def _save(win, what: str, write, say=None, **remember) -> Path | None:
     return out
 
 
-def open_mesh_dialog(win) -> None:
-    start = str(win.settings.value("files/last_dir", str(ASSETS)))
+def _mesh_file(win, title: str, start) -> str:
+    """A mesh file chosen by the user ("" if none), starting in the last folder opened."""
+    start = str(win.settings.value("files/last_dir", str(start)))
     patterns = " ".join(f"*{e}" for e in SUPPORTED_EXTENSIONS)
-    path, _ = QtWidgets.QFileDialog.getOpenFileName(
-        win, "Open mesh", start, f"Meshes ({patterns});;All files (*)"
-    )
+    filters = f"Meshes ({patterns});;All files (*)"
+    return QtWidgets.QFileDialog.getOpenFileName(win, title, start, filters)[0]
+
+
+def open_mesh_dialog(win) -> None:
+    path = _mesh_file(win, "Open mesh", ASSETS)
     if path:
         win.open_mesh(path)
+
+
+def open_second_mesh_dialog(win) -> None:
+    """File > Open second mesh...: choose mesh B of the shape pair."""
+    if win.state.mesh is None:
+        win.show_error(NO_MESH_A)
+        return
+    path = _mesh_file(win, "Open second mesh (B)", Path.cwd())
+    if path:
+        win.open_second_mesh(path, wait=False)
 
 
 def _saved_size(win, key: str, default) -> tuple[int, int]:
@@ -134,11 +148,6 @@ def window_screenshot_dialog(window, name: str, title: str) -> None:
     say = status.setText if status is not None else lambda t: win.statusBar().showMessage(t, 8000)
     write = lambda: window.export_screenshot(path, scale, transparent)  # noqa: E731
     _save(win, "screenshot", write, say, screenshot_dir=str(Path(path).parent))
-
-
-def pair_screenshot_dialog(pair_window) -> None:
-    """Export a shape pair window (:func:`window_screenshot_dialog`)."""
-    window_screenshot_dialog(pair_window, "pair.png", "Export the pair")
 
 
 def field_dialog(win) -> None:

@@ -14,6 +14,8 @@ import os
 import time
 from concurrent.futures import TimeoutError as FutureTimeout
 from contextlib import contextmanager
+from functools import partial
+from operator import attrgetter
 from pathlib import Path
 
 from qtpy import QtCore, QtGui, QtWidgets
@@ -22,7 +24,7 @@ from ..core.cache import SpectrumCache
 from ..core.mesh import Mesh, MeshError
 from ..core.operators import OPERATOR_INFO
 from ..readers import DamagedFileError
-from ..viewer.jobs import QUEUED, Job
+from ..viewer.jobs import Job
 from ..viewer.state import SpectrumKey
 from ..viewer.viewer import ComputeError, Viewer
 from ..viewer.wording import seconds_text
@@ -57,18 +59,36 @@ FROM_VIEWER = frozenset(
     "compute cancel_computation set_mesh show_mode step_mode show_distance distance_map "
     "set_threshold show_signature show_curvature export_screenshot current_field "
     "export_field fix_slivers_and_retry clear_cache save_session spectra picked "
-    "last_distance sliver_failure".split()
+    "last_distance sliver_failure last_error".split()
 )
 """What the window passes on to its :class:`~modalviewer.viewer.Viewer` unchanged, so a
 script drives the window as it drives a viewer."""
+
+REPORTED = frozenset({"pick_file_vertex", "pick_vertex", "repair_mesh"})
+"""The viewer's methods the window passes on with a bad argument's ValueError shown to
+the user instead of raised."""
+
+VIEWS = {
+    "mesh": "state.mesh",
+    "scene": "scene_view.scene",
+    "display": "state.display.kind",
+    "frame_times": "scene_view.frame_times",
+    "running_job": "viewer.jobs.running",
+    "busy": "viewer.jobs.busy",
+    "cancel_all": "viewer.jobs.cancel_all",
+    "animation_frame": "scene_view.drawing.animation_frame",
+}
+"""Read-only values (and two methods) of the window's parts, by name."""
 
 
 @contextmanager
 def _shortcuts_off(window):
     """Disable ``window``'s actions and shortcuts that have a key for the duration, then
-    give each back the state it had: keys pressed meanwhile are dropped, all of them."""
+    give each back the state it had: keys pressed meanwhile are dropped, all of them.
+    Dialogs keep theirs (Esc cancels the reading; a closed one may be deleted meanwhile)."""
     keyed = [a for a in window.findChildren(QtGui.QAction) if not a.shortcut().isEmpty()]
-    keyed += window.findChildren(QtGui.QShortcut)
+    shortcuts = window.findChildren(QtGui.QShortcut)
+    keyed += [s for s in shortcuts if not isinstance(s.parent(), QtWidgets.QDialog)]
     enabled = [item.isEnabled() for item in keyed]
     for item in keyed:
         item.setEnabled(False)
@@ -81,12 +101,6 @@ def _shortcuts_off(window):
 
 class MainWindow(QtWidgets.QMainWindow):
     """The modalviewer main window, showing ``viewer`` (a new :class:`Viewer` if None)."""
-
-    STATUS_LINE_WIDTH = StatusBarWidgets.STATUS_LINE_WIDTH
-    STATUS_LINE_WIDTH_BESIDE_MESSAGE = StatusBarWidgets.STATUS_LINE_WIDTH_BESIDE_MESSAGE
-
-    meshLoaded = QtCore.Signal(str)
-    spectrumReady = QtCore.Signal(str)
 
     def __init__(
         self,
@@ -131,8 +145,7 @@ class MainWindow(QtWidgets.QMainWindow):
         self.jobs_panel = JobsPanel(self.viewer.jobs, self.state)
         self.modes_panel = ModesPanel(self.state)
         self.animation_panel = AnimationPanel(self.state)
-        self.distances_panel = DistancesPanel(self.state, computing=self.viewer.computing)
-        self.viewer.jobs.events.changed.connect(self._tell_distances_panel)
+        self.distances_panel = DistancesPanel(self.state)
         self.distances_panel.showDistanceRequested.connect(lambda: self.show_distance())
         self.distances_panel.showSignatureRequested.connect(
             lambda: self.show_signature(self.state.display.signature_sample)
@@ -146,7 +159,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.cancel_button = self.status_widgets.cancel_button
 
         self.state.events.mesh.connect(self._on_mesh)
-        self.state.events.spectra.connect(self.spectrumReady.emit)
         messages = self.viewer.events
         messages.status.connect(lambda text, msec: self.statusBar().showMessage(text, msec))
         messages.error.connect(self._show_error_box)
@@ -173,10 +185,6 @@ class MainWindow(QtWidgets.QMainWindow):
     def _show_error_box(self, title: str, message: str) -> None:
         self.statusBar().showMessage(message, 10000)
         self._open_box(QtWidgets.QMessageBox.Icon.Warning, title, message)
-
-    def show_info(self, message: str, title: str = "modalviewer") -> None:
-        """A non-blocking information dialog (and the status bar)."""
-        self._show_info_box(title, message)
 
     def _show_info_box(self, title: str, message: str) -> None:
         log.info("%s", message)
@@ -347,17 +355,28 @@ class MainWindow(QtWidgets.QMainWindow):
     def _on_mesh(self) -> None:
         if self.compare is not None:
             self.compare.close()
-        mesh, path = self.state.mesh, self.state.mesh_path
+        path = self.state.mesh_path
         name = path.name if path else "mesh"
-        self.setWindowTitle(f"modalviewer - {name}" if mesh is not None else "modalviewer")
-        self.meshLoaded.emit(str(path) if path else "")
+        self.setWindowTitle(f"modalviewer - {name}" if self.state.mesh else "modalviewer")
 
     # ================================================ scripting (the Viewer)
     def __getattr__(self, name: str):
-        """The viewer's scripting methods and read-only values (:data:`FROM_VIEWER`)."""
+        """The viewer's scripting methods and values (:data:`FROM_VIEWER`,
+        :data:`REPORTED`) and the parts' values (:data:`VIEWS`)."""
         if name in FROM_VIEWER:
             return getattr(self.viewer, name)
+        if name in REPORTED:
+            return partial(self._reporting, getattr(self.viewer, name))
+        if name in VIEWS:
+            return attrgetter(VIEWS[name])(self)
         raise AttributeError(f"'MainWindow' object has no attribute {name!r}")
+
+    def _reporting(self, method, *args, **kwargs):
+        try:
+            return method(*args, **kwargs)
+        except ValueError as exc:
+            self.show_error(str(exc))
+            return None
 
     def wait_for(self, job: Job) -> Job:
         """Run the event loop until ``job`` (and only it) has ended."""
@@ -372,27 +391,8 @@ class MainWindow(QtWidgets.QMainWindow):
             self._waits.remove(loop)
         return job
 
-    def cancel_all(self) -> None:
-        self.viewer.jobs.cancel_all()
-
     def toggle_animation(self) -> None:
         self.state.animation.playing = not self.state.animation.playing
-
-    def animation_frame(self, phase: float) -> float:
-        """Move the surface to the given phase (radians); returns the app's time in s."""
-        return self.scene_view.drawing.animation_frame(phase)
-
-    def pick_file_vertex(self, number: int) -> None:
-        try:
-            self.viewer.pick_file_vertex(number)
-        except ValueError as exc:
-            self.show_error(str(exc))
-
-    def pick_vertex(self, index: int, show: bool = True) -> None:
-        try:
-            self.viewer.pick_vertex(index, show)
-        except ValueError as exc:
-            self.show_error(str(exc))
 
     def _on_view_clicked(self, x: float, y: float) -> None:
         scene = self.scene
@@ -444,14 +444,6 @@ class MainWindow(QtWidgets.QMainWindow):
         self.compare.refresh()
         return self.compare
 
-    # ============================================================ repairs
-    def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
-        try:
-            return self.viewer.repair_mesh(name, wait)
-        except ValueError as exc:
-            self.show_error(str(exc))
-            return None
-
     def _offer_sliver_fix(self, key: SpectrumKey, message: str) -> None:
         """A failure on sliver triangles, with a "Fix slivers and retry" button (the
         default)."""
@@ -479,48 +471,9 @@ class MainWindow(QtWidgets.QMainWindow):
         if self.state.mesh_path is not None and self.remember_settings:
             window_settings.remember_file(self, Path(self.state.mesh_path).resolve())
         if notes:  # in a box of their own: the status bar's line is soon another's
-            self.show_info("\n".join(notes), "Session restored with changes")
+            self._show_info_box("Session restored with changes", "\n".join(notes))
         return notes
-
-    # ==================================================== read-only views
-    @property
-    def mesh(self) -> Mesh | None:
-        return self.state.mesh
-
-    @property
-    def scene(self):
-        return self.scene_view.scene
 
     @property
     def current_operator(self) -> str | None:
         return self.state.current_operator()
-
-    @property
-    def display(self) -> str:
-        return self.state.display.kind
-
-    def _tell_distances_panel(self, job: Job) -> None:
-        """A job queued or ended: the Distances panel says whether a map waits for a
-        spectrum (progress alone changes nothing there)."""
-        if job.done or job.status == QUEUED:
-            self.distances_panel.update_from_state()
-
-    @property
-    def last_error(self) -> str | None:
-        return self.viewer.last_error
-
-    @last_error.setter
-    def last_error(self, message: str | None) -> None:
-        self.viewer.last_error = message
-
-    @property
-    def frame_times(self) -> list[float]:
-        return self.scene_view.frame_times
-
-    @property
-    def running_job(self) -> Job | None:
-        return self.viewer.jobs.running
-
-    @property
-    def busy(self) -> bool:
-        return self.viewer.jobs.busy

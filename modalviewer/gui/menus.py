@@ -10,7 +10,6 @@ from qtpy import QtCore, QtGui, QtWidgets
 from ..repair import REPAIRS
 from . import file_dialogs
 from .collection_dialog import open_collection_dialog
-from .pair_window import open_second_mesh_dialog
 
 
 def _action(win, menu, text, slot, shortcut=None, tip=None) -> QtGui.QAction:
@@ -81,7 +80,7 @@ def _file_menu(win, m) -> None:
     _action(win, m, "&Open mesh...", lambda: d.open_mesh_dialog(win), "Ctrl+O")
     win.recent_menu = m.addMenu("Open &recent")
     for text, slot, key, tip in (
-        ("Open &second mesh (shape pair)...", open_second_mesh_dialog, "Ctrl+Shift+B", PAIR_TIP),
+        ("Open &second mesh (shape pair)...", d.open_second_mesh_dialog, "Ctrl+Shift+B", PAIR_TIP),
         ("Open co&llection...", open_collection_dialog, None, COLLECTION_TIP),
         _SEPARATOR,
         ("Open s&ession...", d.open_session_dialog, "Ctrl+Shift+O", None),

@@ -12,7 +12,6 @@ from __future__ import annotations
 import logging
 from pathlib import Path
 
-import numpy as np
 from qtpy import QtCore, QtWidgets
 
 from ..core.mesh import Mesh
@@ -22,9 +21,10 @@ from ..viewer.camera import Camera, CameraLink
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from ..viewer.wording import seconds_text
-from .panels.common import quiet, row, select_data, slider, spin_box
-from .viewport import make_viewport, save_views
-from .window_keys import dispatch_key, install_keys
+from .dialogs import NO_MESH_A
+from .panels.common import add_items, bind, row, show_values, slider, spin_box
+from .viewport import make_viewport
+from .views_window import ViewsWindow
 
 log = logging.getLogger("modalviewer")
 
@@ -55,8 +55,10 @@ class PairError(RuntimeError):
     """A scripted pair action failed; the message is for users."""
 
 
-class PairWindow(QtWidgets.QWidget):
+class PairWindow(ViewsWindow):
     """Two views, A (left) and B (right); see the module docstring."""
+
+    EXPORT = ("pair.png", "Export the pair")
 
     def __init__(self, main, mesh_b: Mesh, path_b=None, k: int | None = None, force_offscreen=None):
         super().__init__(main, QtCore.Qt.WindowType.Window)
@@ -65,7 +67,7 @@ class PairWindow(QtWidgets.QWidget):
         self.main = main
         state_a = main.state
         if state_a.mesh is None:
-            raise PairError("Open a mesh first (it becomes mesh A).")
+            raise PairError(NO_MESH_A)
         self.pair = main.viewer.pair(mesh_b, k=k, wait=False, path=path_b)
         self._closed = False
         self._syncing = False
@@ -86,18 +88,10 @@ class PairWindow(QtWidgets.QWidget):
     # ================================================================ UI
     def _build(self, force_offscreen) -> None:
         p = self.pair
-        self.kind_combo = _tip(QtWidgets.QComboBox(), KIND_TIP)
-        for kind, label in DISTANCE_KINDS.items():
-            self.kind_combo.addItem(label, kind)
-        self.kind_combo.currentIndexChanged.connect(
-            lambda: p.set_kind(self.kind_combo.currentData())
-        )
-        self.display_combo = QtWidgets.QComboBox()
-        self.display_combo.addItem("Continuous", "continuous")
-        self.display_combo.addItem("Threshold", "threshold")
-        self.display_combo.currentIndexChanged.connect(
-            lambda: p.set_display(self.display_combo.currentData())
-        )
+        kinds = ((label, kind) for kind, label in DISTANCE_KINDS.items())
+        self.kind_combo = _tip(add_items(QtWidgets.QComboBox(), kinds), KIND_TIP)
+        displays = (("Continuous", "continuous"), ("Threshold", "threshold"))
+        self.display_combo = add_items(QtWidgets.QComboBox(), displays)
         self.share_slider = slider(1, 500, SHARE_TIP)  # tenths of a percent of the other's area
         self.share_slider.valueChanged.connect(lambda v: p.set_display("threshold", v / 1000))
         self.share_label = QtWidgets.QLabel()
@@ -108,11 +102,17 @@ class PairWindow(QtWidgets.QWidget):
         self.rescale_check = _tip(
             QtWidgets.QCheckBox("Rescale both to the same area before computing"), RESCALE_TIP
         )
-        self.rescale_check.toggled.connect(p.set_rescale)
         self.link_check = _tip(QtWidgets.QCheckBox("Linked cameras"), LINK_TIP)
-        self.link_check.toggled.connect(p.set_linked)
+        self.controls = {  # the pair's field -> (its widget, its setter)
+            "kind": (self.kind_combo, p.set_kind),
+            "distance_display": (self.display_combo, p.set_display),
+            "rescale": (self.rescale_check, p.set_rescale),
+            "linked": (self.link_check, p.set_linked),
+        }
+        for widget, setter in self.controls.values():
+            bind(widget, setter)
         export = _tip(QtWidgets.QPushButton("Export..."), "Both views side by side in one PNG")
-        export.clicked.connect(self._export_dialog)
+        export.clicked.connect(self.export_dialog)
         layout = QtWidgets.QVBoxLayout(self)
         controls = (self.kind_combo, self.display_combo, self.share_slider, self.share_label)
         layout.addLayout(row("Distance", *controls, self.k_spin, 1, export))
@@ -143,20 +143,16 @@ class PairWindow(QtWidgets.QWidget):
         layout.addLayout(row((self.status, 1), self.progress, self.cancel_button))
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
-        keys = [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]
-        self._keys = install_keys(self, [*keys, ("Ctrl+E", self._export_dialog)])
+        self.install_keys(
+            [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]
+        )
         self._sync_controls()
 
     def _sync_controls(self) -> None:
         p = self.pair
-        with quiet(self.kind_combo, self.display_combo, self.share_slider, self.k_spin):
-            select_data(self.kind_combo, p.kind)
-            select_data(self.display_combo, p.distance_display)
-            self.share_slider.setValue(int(round(1000 * p.share)))
-            self.k_spin.setValue(p.k)
-        with quiet(self.rescale_check, self.link_check):
-            self.rescale_check.setChecked(p.rescale)
-            self.link_check.setChecked(p.linked)
+        shown = [(widget, getattr(p, name)) for name, (widget, _) in self.controls.items()]
+        numbers = [(self.share_slider, int(round(1000 * p.share))), (self.k_spin, p.k)]
+        show_values(shown + numbers)
         self.share_slider.setEnabled(p.distance_display == "threshold")
 
     # ============================================================ meshes
@@ -189,22 +185,16 @@ class PairWindow(QtWidgets.QWidget):
             return
         self.pair.set_mesh("a", mesh, self.main.state.mesh_path)
 
-    def open_b(self, path) -> bool:
-        """Replace mesh B by the mesh file ``path``; False (after a message) if it failed."""
-        mesh = self.main.read_mesh_file(path)
-        if mesh is None:
-            return False
-        self.pair.set_mesh("b", mesh, Path(path))
-        return True
-
     def dragEnterEvent(self, event):  # noqa: N802
         if event.mimeData().hasUrls():
             event.acceptProposedAction()
 
     def dropEvent(self, event):  # noqa: N802
+        """A file dropped on the window replaces mesh B."""
         urls = event.mimeData().urls()
-        if urls:
-            self.open_b(urls[0].toLocalFile())
+        mesh = self.main.read_mesh_file(urls[0].toLocalFile()) if urls else None
+        if mesh is not None:
+            self.pair.set_mesh("b", mesh, Path(urls[0].toLocalFile()))
 
     # =========================================================== drawing
     def redraw(self) -> None:
@@ -283,8 +273,7 @@ class PairWindow(QtWidgets.QWidget):
         if self._closed:
             return
         self.status.setText(text)
-        if hasattr(self.main, "show_error"):
-            self.main.show_error(text, "Shape pair")
+        self.main.show_error(text, "Shape pair")
 
     def _on_jobs(self, _job=None) -> None:
         if self._closed:
@@ -357,10 +346,8 @@ class PairWindow(QtWidgets.QWidget):
         """A's canonical view; B seen from the same direction, about its own centre and
         at its own size (meshes in one frame, like a shape and its deformed copy, then
         show the same side); linked cameras are linked anew."""
-        ma, mb = self.pair.drawn_mesh("a"), self.pair.drawn_mesh("b")
         self.scenes["a"].reset_camera()
-        factor = mb.bounding_box_diagonal / (ma.bounding_box_diagonal or 1.0)
-        self._link = CameraLink(np.eye(3), factor, _bbox_centre(ma), _bbox_centre(mb))
+        self._link = CameraLink.facing(*(self.pair.drawn_mesh(side) for side in SIDES))
         self._copy_camera("a", "b")
         self._on_linked(self.pair.linked)
 
@@ -369,10 +356,6 @@ class PairWindow(QtWidgets.QWidget):
         if self.scenes["a"] is not None and self.scenes["b"] is not None:
             self._start_views()
         self.render_all()
-
-    def render_all(self) -> None:
-        for viewport in self.viewports.values():
-            viewport.request_render()
 
     # ====================================================== interaction
     def _on_click(self, side: str, x: float, y: float) -> None:
@@ -412,17 +395,6 @@ class PairWindow(QtWidgets.QWidget):
             raise PairError(str(exc)) from None
         QtWidgets.QApplication.processEvents()
 
-    # =========================================================== export
-    def export_screenshot(self, path, scale: int = 1, transparent: bool = False) -> Path:
-        """Both views side by side, with their legends, in one PNG written atomically."""
-        views = [self.viewports[s] for s in SIDES]
-        return save_views(path, views, [self.scenes[s] for s in SIDES], scale, transparent)
-
-    def _export_dialog(self) -> None:
-        from .file_dialogs import pair_screenshot_dialog
-
-        pair_screenshot_dialog(self)
-
     # ============================================================ close
     def _escape(self) -> None:
         """Esc cancels this window's computations if any run (as in the main window),
@@ -431,11 +403,6 @@ class PairWindow(QtWidgets.QWidget):
             self.pair.cancel()
         else:
             self.close()
-
-    def keyPressEvent(self, event):  # noqa: N802
-        """Esc cancels or closes, Ctrl+W closes, R resets the cameras."""
-        if not dispatch_key(self._keys, event):
-            super().keyPressEvent(event)
 
     def eventFilter(self, obj, event):  # noqa: N802
         if obj is self.main and event.type() == QtCore.QEvent.Type.Close:
@@ -449,16 +416,10 @@ class PairWindow(QtWidgets.QWidget):
             self.main.viewer.jobs.events.changed.disconnect(self._on_jobs)
             self.main.state.events.mesh.disconnect(self._on_main_mesh)
             self.main.removeEventFilter(self)
-            for viewport in self.viewports.values():
-                viewport.close_plotter()
+            self.close_views()
             if getattr(self.main, "pair_window", None) is self:
                 self.main.pair_window = None
         super().closeEvent(event)
-
-
-def _bbox_centre(mesh: Mesh) -> np.ndarray:
-    v = mesh.vertices
-    return 0.5 * (v.min(axis=0) + v.max(axis=0))
 
 
 def _camera(vtk_camera) -> Camera:
@@ -470,11 +431,8 @@ def open_pair_window(main, path, wait: bool = True, k: int | None = None) -> Pai
     closed).  With ``wait`` the call returns once both spectra are in (PairError if one
     fails); None (after a message) if there is no mesh A or ``path`` cannot be read."""
     if main.state.mesh is None:
-        main.show_error("Open a mesh first: it becomes mesh A of the pair.")
-        if wait:
-            raise PairError("Open a mesh first: it becomes mesh A of the pair.")
-        return None
-    mesh = main.read_mesh_file(path)
+        main.show_error(NO_MESH_A)
+    mesh = main.read_mesh_file(path) if main.state.mesh is not None else None
     if mesh is None:
         if wait:
             raise PairError(main.last_error or f"cannot open {path}")
@@ -491,20 +449,4 @@ def open_pair_window(main, path, wait: bool = True, k: int | None = None) -> Pai
     return window
 
 
-def open_second_mesh_dialog(main) -> None:
-    """File > Open second mesh...: choose mesh B."""
-    from ..io import SUPPORTED_EXTENSIONS
-
-    if main.state.mesh is None:
-        main.show_error("Open a mesh first: it becomes mesh A of the pair.")
-        return
-    start = str(main.settings.value("files/last_dir", str(Path.cwd())))
-    patterns = " ".join(f"*{e}" for e in SUPPORTED_EXTENSIONS)
-    path, _ = QtWidgets.QFileDialog.getOpenFileName(
-        main, "Open second mesh (B)", start, f"Meshes ({patterns});;All files (*)"
-    )
-    if path:
-        open_pair_window(main, path, wait=False)
-
-
-__all__ = ["PairError", "PairWindow", "open_pair_window", "open_second_mesh_dialog"]
+__all__ = ["PairError", "PairWindow", "open_pair_window"]

@@ -1,17 +1,39 @@
 """What the main window remembers between desktop runs (QSettings): layout, view and
-compute preferences, recent files.  Off-screen runs (tests, ``make run`` without a
-display) neither read the layout nor write anything."""
+compute preferences, recent files, the up axis chosen per file.  Off-screen runs
+(tests, ``make run`` without a display) neither read the layout nor write anything."""
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
 
 from qtpy import QtCore, QtGui
 
 from ..core.operators import OPERATOR_INFO
+from ..viewer.camera import AXES
 from ..viewer.state import COLOR_RANGES, RENDER_STYLES, SHELL_COLORINGS
 from .docks import fit_modes_dock
+
+PREFERENCES = (
+    # (key, part of the state, its field, default, type or the values allowed)
+    ("view/isolines", "style", "isolines", 12, int),
+    ("view/shell_color", "style", "shell_coloring", "deformed", SHELL_COLORINGS),
+    ("view/ghost", "style", "ghost", True, bool),
+    ("view/style", "style", "render", "paper", RENDER_STYLES),
+    ("view/colorbar", "style", "colorbar", True, bool),
+    ("view/log_signature", "style", "log_signature", False, bool),
+    # the largest displacement of the deformed shape and of the animation
+    ("view/mode_amplitude", "animation", "amplitude", 40, int),
+    ("view/speed", "animation", "speed", 30, int),
+    ("compute/operator", "compute_settings", "operator", "modified_dirichlet", OPERATOR_INFO),
+    ("compute/bending", "compute_settings", "bending", 1.0, float),
+    ("compute/membrane", "compute_settings", "membrane", 1.0, float),
+    ("compute/rescale", "compute_settings", "rescale", False, bool),
+    ("compute/coarse", "compute_settings", "coarse", False, bool),
+)
+"""The preferences remembered; a value not allowed gives the default (an option offered
+no longer, a damaged file), never an error at start-up."""
 
 
 def settings() -> QtCore.QSettings:
@@ -26,13 +48,18 @@ def headless() -> bool:
     return QtGui.QGuiApplication.platformName() in ("offscreen", "minimal")
 
 
-def _flag(settings, key: str, default: bool) -> bool:
-    """A remembered on/off setting (stored as "true" / "false")."""
-    return str(settings.value(key, _flag_text(default))).lower() == "true"
+def _text(value):
+    """A value as stored: on/off as "true" / "false"."""
+    return ("true" if value else "false") if isinstance(value, bool) else value
 
 
-def _flag_text(on: bool) -> str:
-    return "true" if on else "false"
+def _read(s, key: str, default, kind):
+    value = s.value(key, _text(default))
+    if kind is bool:
+        return str(value).lower() == "true"
+    if isinstance(kind, type):
+        return kind(value)
+    return str(value) if str(value) in kind else default
 
 
 def restore(win) -> None:
@@ -48,24 +75,9 @@ def restore(win) -> None:
     else:  # once the window is laid out
         QtCore.QTimer.singleShot(0, win, lambda: fit_modes_dock(win))
     st = win.state
-    st.style.isolines = int(s.value("view/isolines", 12))
-    coloring = str(s.value("view/shell_color", "deformed"))  # a former "auto": deformed
-    st.style.shell_coloring = coloring if coloring in SHELL_COLORINGS else "deformed"
-    st.style.ghost = _flag(s, "view/ghost", True)
-    style = str(s.value("view/style", "paper"))
-    st.style.render = style if style in RENDER_STYLES else "paper"
-    st.style.colorbar = _flag(s, "view/colorbar", True)
+    for key, part, field, default, kind in PREFERENCES:
+        setattr(getattr(st, part), field, _read(s, key, default, kind))
     _restore_color_range(st, s)
-    st.style.log_signature = _flag(s, "view/log_signature", False)
-    # the largest displacement of the deformed shape and of the animation
-    st.animation.amplitude = int(s.value("view/mode_amplitude", 40))
-    st.animation.speed = int(s.value("view/speed", 30))
-    c, operator = st.compute_settings, str(s.value("compute/operator", "modified_dirichlet"))
-    c.operator = operator if operator in OPERATOR_INFO else "modified_dirichlet"
-    c.bending = float(s.value("compute/bending", 1.0))
-    c.membrane = float(s.value("compute/membrane", 1.0))
-    c.rescale = _flag(s, "compute/rescale", False)
-    c.coarse = _flag(s, "compute/coarse", False)
     rebuild_recent(win)
 
 
@@ -93,23 +105,11 @@ def save(win) -> None:
     s, st = win.settings, win.state
     s.setValue("window/geometry", win.saveGeometry())
     s.setValue("window/state", win.saveState())
-    s.setValue("view/isolines", st.style.isolines)
-    s.setValue("view/mode_amplitude", st.animation.amplitude)
-    s.setValue("view/speed", st.animation.speed)
-    s.setValue("view/shell_color", st.style.shell_coloring)
-    s.setValue("view/style", st.style.render)
-    s.setValue("view/colorbar", _flag_text(st.style.colorbar))
-    s.setValue("view/ghost", _flag_text(st.style.ghost))
+    for key, part, field, _default, _kind in PREFERENCES:
+        s.setValue(key, _text(getattr(getattr(st, part), field)))
     s.setValue("view/color_range", st.style.color_range)
     limits = st.style.color_limits
     s.setValue("view/color_limits", "" if limits is None else f"{limits[0]!r} {limits[1]!r}")
-    s.setValue("view/log_signature", _flag_text(st.style.log_signature))
-    c = st.compute_settings
-    s.setValue("compute/operator", c.operator)
-    s.setValue("compute/bending", c.bending)
-    s.setValue("compute/membrane", c.membrane)
-    s.setValue("compute/rescale", _flag_text(c.rescale))
-    s.setValue("compute/coarse", _flag_text(c.coarse))
     for removed in ("compute/preview", "compute/preview_only"):  # options no longer offered
         s.remove(removed)
     s.sync()
@@ -145,8 +145,6 @@ UP_AXES_KEPT = 200  # files whose up axis is remembered (the most recently chose
 
 
 def _up_axes(win) -> dict[str, str]:
-    import json
-
     try:
         value = json.loads(str(win.settings.value(UP_AXES_KEY, "{}")))
     except ValueError:
@@ -154,39 +152,26 @@ def _up_axes(win) -> dict[str, str]:
     return {str(k): str(v) for k, v in value.items()} if isinstance(value, dict) else {}
 
 
-def remembered_up_axis(win, path) -> str | None:
-    """The up axis chosen for the file ``path`` (View > Up axis), or None: automatic."""
-    from ..viewer.camera import AXES
-
-    if path is None or not win.remember_settings:
-        return None
-    axis = _up_axes(win).get(str(Path(path).resolve()))
-    return axis if axis in AXES else None
-
-
-def remember_up_axis(win, path, axis: str | None) -> None:
-    """Remember ``axis`` (None: automatic, forgotten) for the file ``path``."""
-    import json
-
+def choose_up_axis(win, axis: str | None) -> None:
+    """View > Up axis: set the state's up axis (the view turns to the canonical one for
+    it) and remember it (None: automatic, forgotten) for the file shown."""
+    win.state.up_axis = axis
+    path = win.state.mesh_path
     if path is None or not win.remember_settings:
         return
     key = str(Path(path).resolve())
     axes = {k: v for k, v in _up_axes(win).items() if k != key}
-    if axis is not None:
-        axes[key] = axis
+    if win.state.up_axis is not None:
+        axes[key] = win.state.up_axis
     kept = dict(list(axes.items())[-UP_AXES_KEPT:])
     win.settings.setValue(UP_AXES_KEY, json.dumps(kept))
 
 
-def choose_up_axis(win, axis: str | None) -> None:
-    """View > Up axis: set the state's up axis (the view turns to the canonical one for
-    it) and remember it for the file shown."""
-    win.state.up_axis = axis
-    remember_up_axis(win, win.state.mesh_path, win.state.up_axis)
-
-
 def restore_up_axis(win) -> None:
     """A newly loaded file gets the up axis chosen for it before, if any."""
-    axis = remembered_up_axis(win, win.state.mesh_path)
-    if axis is not None and win.state.mesh is not None:
+    path = win.state.mesh_path
+    if path is None or win.state.mesh is None or not win.remember_settings:
+        return
+    axis = _up_axes(win).get(str(Path(path).resolve()))
+    if axis in AXES:
         win.state.up_axis = axis

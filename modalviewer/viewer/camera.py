@@ -84,6 +84,14 @@ class CameraLink:
         (fa, da), (fb, db) = _frame(a), _frame(b)
         return cls(fb @ fa.T, db / da, np.asarray(a.focal_point), np.asarray(b.focal_point))
 
+    @classmethod
+    def facing(cls, a, b) -> CameraLink:
+        """The link that shows mesh ``b`` from the direction ``a`` is seen from, about
+        its own bounding box centre and at its own size."""
+        centre_a, centre_b = ((m.vertices.min(0) + m.vertices.max(0)) / 2 for m in (a, b))
+        scale = b.bounding_box_diagonal / (a.bounding_box_diagonal or 1.0)
+        return cls(np.eye(3), scale, centre_a, centre_b)
+
     def carry(self, camera: Camera, from_a: bool = True) -> tuple[Camera, float]:
         """``camera`` of A carried to B (or of B to A), and the factor its size (a
         parallel projection's scale) is multiplied by."""

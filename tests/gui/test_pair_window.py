@@ -187,7 +187,7 @@ def test_pair_export_dialog_offers_size_and_transparency(
         return dialogs.QtWidgets.QDialog.DialogCode.Accepted
 
     monkeypatch.setattr(dialogs.ScreenshotDialog, "exec", accept)
-    pair._export_dialog()
+    pair.export_dialog()
     assert seen["start"] == str(spot_path.resolve().parent / "pair.png")
     assert not seen["colorbar_shown"]
     out = tmp_path / "pair2x.png"

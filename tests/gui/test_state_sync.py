@@ -58,7 +58,7 @@ def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
     qtbot.waitUntil(lambda: window.compare is not None, timeout=120000)
     assert window.state.display == before
     compare = window.compare
-    assert compare.mode_index == 1  # the first non-zero mode, not the constant mode 0
+    assert compare.comparison.mode_index == 1  # the first non-zero mode, not the constant mode 0
     assert "mode 1," in compare.titles[0].text()
     field = np.array(compare.scenes[0].surface.point_data["field"])
     assert np.ptp(field) > 0  # not one solid colour
@@ -79,7 +79,7 @@ def test_3_compare_asks_before_computing_and_never_changes_the_main_window(
     qtbot.waitExposed(compare)
     view = compare.viewports[0].widget
     qtbot.keyClick(view, QtCore.Qt.Key.Key_Right)
-    assert compare.mode_index == 2
+    assert compare.comparison.mode_index == 2
     import os
 
     old = os.umask(0o022)
@@ -517,6 +517,8 @@ def test_choosing_the_spectrum_on_screen_again_keeps_its_mode(window, spot_path)
 def test_the_status_line_gives_room_to_a_message(window, spot_path, qtbot):
     """Found under Xvfb: "Computing Discrete Shells (3D vibrations), 100 modes; no pr..."
     was cut off by the status line beside it."""
+    from modalviewer.gui.status_bar import StatusBarWidgets
+
     window.resize(1600, 1000)
     window.open_mesh(spot_path)
     window.compute("laplacian", k=20, wait=True)
@@ -525,11 +527,11 @@ def test_the_status_line_gives_room_to_a_message(window, spot_path, qtbot):
     message = "Computing Discrete Shells (3D vibrations), 100 modes; " + "x" * 60
     bar.showMessage(message)
     qtbot.wait(50)
-    assert line.width() <= window.STATUS_LINE_WIDTH_BESIDE_MESSAGE
+    assert line.width() <= StatusBarWidgets.STATUS_LINE_WIDTH_BESIDE_MESSAGE
     assert bar.toolTip() == message
     bar.clearMessage()
     qtbot.wait(50)
-    assert line.maximumWidth() == window.STATUS_LINE_WIDTH
+    assert line.maximumWidth() == StatusBarWidgets.STATUS_LINE_WIDTH
 
 
 def test_preferences_are_written_soon_after_they_change(window, qtbot):

@@ -343,7 +343,7 @@ def test_linked_comparison_of_three_operators(window, spot_path, tmp_path, qtbot
     compare = window.open_comparison(["laplacian", "modified_dirichlet", "shells_normal"])
     cameras = {id(vp.plotter.renderer.GetActiveCamera()) for vp in compare.viewports}
     assert len(cameras) == 1  # one shared camera
-    compare.show_mode(7)
+    compare.comparison.show_mode(7)
     for op, scene in zip(compare.items, compare.scenes, strict=True):
         np.testing.assert_allclose(
             scene.surface.point_data["field"], window.spectra[op].mode(7), rtol=0, atol=0

@@ -5,7 +5,7 @@ from __future__ import annotations
 from qtpy import QtWidgets
 
 from ...viewer.state import ViewerState
-from .common import follow, quiet, row, slider
+from .common import bind, follow, row, show_values, slider
 
 
 class AnimationPanel(QtWidgets.QWidget):
@@ -29,18 +29,18 @@ class AnimationPanel(QtWidgets.QWidget):
         # Speed and Play share a row: the Modes dock shows the whole panel at the
         # default window size, under the spectrum plot
         form.addRow("Speed", row((self.speed_slider, 1), self.play_button))
-        anim = state.animation
-        self.play_button.toggled.connect(lambda on: setattr(anim, "playing", on))
-        self.amp_slider.valueChanged.connect(lambda v: setattr(anim, "amplitude", v))
-        self.speed_slider.valueChanged.connect(lambda v: setattr(anim, "speed", v))
+        self.fields = {
+            "playing": self.play_button,
+            "amplitude": self.amp_slider,
+            "speed": self.speed_slider,
+        }
+        for name, widget in self.fields.items():
+            bind(widget, lambda value, n=name: setattr(state.animation, n, value))
         follow(state, self.update_from_state, "animation", "display", "mesh")
         self.update_from_state()
 
     def update_from_state(self) -> None:
         anim = self.state.animation
-        with quiet(self.play_button, self.amp_slider, self.speed_slider):
-            self.play_button.setChecked(anim.playing)
-            self.amp_slider.setValue(anim.amplitude)
-            self.speed_slider.setValue(anim.speed)
+        show_values((widget, getattr(anim, name)) for name, widget in self.fields.items())
         self.play_button.setText("Pause" if anim.playing else "Play")
         self.play_button.setEnabled(self.state.display.kind == "mode")

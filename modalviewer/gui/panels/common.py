@@ -22,6 +22,15 @@ def combo() -> QtWidgets.QComboBox:
     return box
 
 
+def add_items(box: QtWidgets.QComboBox, items) -> QtWidgets.QComboBox:
+    """``box`` with the items (label, data) or (label, data, tooltip) added."""
+    for label, data, *tip in items:
+        box.addItem(label, data)
+        if tip:
+            box.setItemData(box.count() - 1, tip[0], QtCore.Qt.ItemDataRole.ToolTipRole)
+    return box
+
+
 def describe(box: QtWidgets.QComboBox, text: str) -> None:
     """What ``box`` is for, shown in its tooltip below its current item's whole text."""
     box.setProperty("purpose", text)
@@ -107,6 +116,32 @@ def follow(state, slot, *names: str) -> None:
     """Call ``slot`` on each of ``state``'s events ``names`` ("display", "mesh", ...)."""
     for name in names:
         getattr(state.events, name).connect(slot)
+
+
+def bind(widget, setter) -> None:
+    """Call ``setter(value)`` with ``widget``'s new value (a combo box's item data, a
+    check box's or checkable button's state, a spin box's or slider's number) when the
+    user changes it."""
+    if isinstance(widget, QtWidgets.QComboBox):
+        widget.currentIndexChanged.connect(lambda _index: setter(widget.currentData()))
+    elif isinstance(widget, QtWidgets.QAbstractButton):
+        widget.toggled.connect(setter)
+    else:
+        widget.valueChanged.connect(setter)
+
+
+def show_values(pairs) -> None:
+    """Set each widget of ``pairs`` (widget, value) to its value, its signals blocked
+    (the state it shows is not set back)."""
+    pairs = list(pairs)
+    with quiet(*(widget for widget, _ in pairs)):
+        for widget, value in pairs:
+            if isinstance(widget, QtWidgets.QComboBox):
+                select_data(widget, value)
+            elif isinstance(widget, QtWidgets.QAbstractButton):
+                widget.setChecked(value)
+            else:
+                widget.setValue(value)
 
 
 def select_data(box: QtWidgets.QComboBox, data) -> None:

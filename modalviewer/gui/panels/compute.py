@@ -7,7 +7,7 @@ from qtpy import QtCore, QtWidgets
 from ...core.operators import OPERATOR_INFO
 from ...viewer import wording
 from ...viewer.state import ViewerState
-from .common import WrappingLabel, combo, follow, quiet, select_data
+from .common import WrappingLabel, bind, combo, follow, show_values
 
 K_MAX = 1_000_000
 """The Modes k box's maximum: no limit a mesh could reach before the memory check."""
@@ -62,36 +62,23 @@ class ComputePanel(QtWidgets.QWidget):
         self.mesh_info = WrappingLabel("No mesh")
         form.addRow(self.mesh_info)
 
-        c = state.compute_settings
-        self.operator_combo.currentIndexChanged.connect(
-            lambda _: setattr(c, "operator", self.operator_combo.currentData())
-        )
-        self.k_spin.valueChanged.connect(lambda v: setattr(c, "k", v))
-        self.bending_spin.valueChanged.connect(lambda v: setattr(c, "bending", v))
-        self.membrane_spin.valueChanged.connect(lambda v: setattr(c, "membrane", v))
-        self.rescale_check.toggled.connect(lambda on: setattr(c, "rescale", on))
-        self.coarse_check.toggled.connect(lambda on: setattr(c, "coarse", on))
+        self.fields = {  # compute settings field -> its widget
+            "operator": self.operator_combo,
+            "k": self.k_spin,
+            "bending": self.bending_spin,
+            "membrane": self.membrane_spin,
+            "rescale": self.rescale_check,
+            "coarse": self.coarse_check,
+        }
+        for name, widget in self.fields.items():
+            bind(widget, lambda value, n=name: setattr(state.compute_settings, n, value))
         self.compute_button.clicked.connect(self.computeRequested)
         follow(state, self.update_from_state, "compute_settings", "mesh")
         self.update_from_state()
 
     def update_from_state(self) -> None:
         s = self.state.compute_settings
-        widgets = (
-            self.operator_combo,
-            self.k_spin,
-            self.bending_spin,
-            self.membrane_spin,
-            self.rescale_check,
-            self.coarse_check,
-        )
-        with quiet(*widgets):
-            select_data(self.operator_combo, s.operator)
-            self.k_spin.setValue(s.k)
-            self.bending_spin.setValue(s.bending)
-            self.membrane_spin.setValue(s.membrane)
-            self.rescale_check.setChecked(s.rescale)
-            self.coarse_check.setChecked(s.coarse)
+        show_values((widget, getattr(s, name)) for name, widget in self.fields.items())
         weights = OPERATOR_INFO[s.operator].has_weights
         self.bending_spin.setEnabled(weights)
         self.membrane_spin.setEnabled(weights)

@@ -12,7 +12,7 @@ from ...core.operators import (
 )
 from ...viewer.state import ViewerState
 from ..plots import LinePlot
-from .common import WrappingLabel, combo, follow, quiet, row, select_data, slider
+from .common import WrappingLabel, add_items, bind, combo, follow, quiet, row, show_values, slider
 
 SLIDER_STEPS = 1000
 
@@ -28,18 +28,18 @@ class DistancesPanel(QtWidgets.QWidget):
     showSignatureRequested = QtCore.Signal()
     exactCurveRequested = QtCore.Signal()
 
-    def __init__(self, state: ViewerState, parent=None, computing=None):
+    def __init__(self, state: ViewerState, parent=None):
         super().__init__(parent)
         self.state = state
-        # computing(operator): whether its spectrum is on its way (the window's jobs)
-        self.computing = computing or (lambda _operator: False)
         form = QtWidgets.QFormLayout(self)
-        self.kind_combo = combo()
-        for key, label in DISTANCE_KINDS.items():
-            self.kind_combo.addItem(label, key)
-        self.display_combo = combo()
-        self.display_combo.addItem("Continuous (white to red)", "continuous")
-        self.display_combo.addItem("Threshold (blue = similar)", "threshold")
+        self.kind_combo = add_items(combo(), ((v, k) for k, v in DISTANCE_KINDS.items()))
+        self.display_combo = add_items(
+            combo(),
+            (
+                ("Continuous (white to red)", "continuous"),
+                ("Threshold (blue = similar)", "threshold"),
+            ),
+        )
         self.threshold_slider = slider(1, SLIDER_STEPS, "Threshold of the blue (similar) region")
         self.by_share_check = QtWidgets.QCheckBox("Slider by share of surface")
         self.by_share_check.setChecked(True)
@@ -87,16 +87,16 @@ class DistancesPanel(QtWidgets.QWidget):
         self.kind_combo.currentIndexChanged.connect(self._on_kind)
         self.display_combo.currentIndexChanged.connect(self._on_display)
         self.threshold_slider.valueChanged.connect(self._on_slider)
-        self.by_share_check.toggled.connect(lambda on: self.state.set_display(keep_share=bool(on)))
+        bind(self.by_share_check, lambda on: self.state.set_display(keep_share=on))
         self.t1_edit.editingFinished.connect(self._on_range)
         self.t2_edit.editingFinished.connect(self._on_range)
         self.distance_button.clicked.connect(self.showDistanceRequested)
         self.scale_slider.valueChanged.connect(self._on_scale)
         self.scale_edit.editingFinished.connect(self._on_scale_typed)
-        self.log_check.toggled.connect(
-            lambda on: setattr(self.state.style, "log_signature", bool(on))
+        bind(self.log_check, lambda on: setattr(self.state.style, "log_signature", on))
+        state.events.style.connect(
+            lambda: show_values([(self.log_check, self.state.style.log_signature)])
         )
-        state.events.style.connect(self._update_log_check)
         state.events.signature_curve.connect(self._update_signature_plot)
         follow(state, self.update_from_state, "display", "pick", "spectra", "mesh", "scale_range")
         self.update_from_state()
@@ -147,16 +147,16 @@ class DistancesPanel(QtWidgets.QWidget):
                 "field then takes its default)."
             )
             return
-        t1 = typed[0] if typed[0] is not None else defaults[0]
-        t2 = typed[1] if typed[1] is not None else defaults[1]
-        if not 0 < t1 < t2:
+        t1, t2 = (t if t is not None else d for t, d in zip(typed, defaults or typed, strict=True))
+        try:
+            self.state.set_scale_range((t1, t2))
+        except ValueError:
             self.range_label.setText(
                 f"t1 must be above 0 and below t2 (t1 = {t1:.4g}, t2 = {t2:.4g}); the "
                 "range in use is kept."
             )
             return
         self.range_label.setText("")
-        self.state.set_scale_range((t1, t2))
 
     def _on_scale(self, value: int) -> None:
         self.state.set_display(signature_sample=value)
@@ -178,39 +178,33 @@ class DistancesPanel(QtWidgets.QWidget):
             signature_time=t,
         )
 
-    def _update_log_check(self) -> None:
-        with quiet(self.log_check):
-            self.log_check.setChecked(self.state.style.log_signature)
-
     # ------------------------------------------------------------ output
     def update_from_state(self, *_args) -> None:
         state = self.state
         d = state.display
-        with quiet(
-            self.kind_combo,
-            self.display_combo,
-            self.threshold_slider,
-            self.scale_slider,
-            self.by_share_check,
-        ):
-            self.by_share_check.setChecked(d.keep_share)
-            select_data(self.kind_combo, d.distance_kind)
-            select_data(self.display_combo, d.distance_display)
-            self.scale_slider.setValue(d.signature_sample)
-            dist = state.derived.distance_map()
-            fraction = d.threshold if dist is None else state.derived.map_fraction(dist)
-            if dist is not None and self.by_share_check.isChecked():
-                position = state.derived.surface_share(dist, fraction * float(dist.max()))
-            else:
-                position = fraction
-            self.threshold_slider.setValue(max(1, int(round(position * SLIDER_STEPS))))
+        dist = state.derived.distance_map()
+        fraction = d.threshold if dist is None else state.derived.map_fraction(dist)
+        if dist is not None and d.keep_share:
+            position = state.derived.surface_share(dist, fraction * float(dist.max()))
+        else:
+            position = fraction
+        show_values(
+            (
+                (self.by_share_check, d.keep_share),
+                (self.kind_combo, d.distance_kind),
+                (self.display_combo, d.distance_display),
+                (self.scale_slider, d.signature_sample),
+                (self.threshold_slider, max(1, int(round(position * SLIDER_STEPS)))),
+            )
+        )
         self.threshold_slider.setEnabled(d.distance_display == "threshold")
         if dist is not None:
             thr = fraction * float(dist.max())
             share = 100.0 * state.derived.surface_share(dist, thr)
             self.threshold_label.setText(f"< {thr:.4g} ({share:.1f} % of surface)")
         elif state.picked is not None:
-            if self.computing(operator_for_distance(d.distance_kind)):
+            operator = operator_for_distance(d.distance_kind)
+            if any(key.operator == operator for key in state.computing):
                 self.threshold_label.setText("The map follows when its spectrum is computed")
             else:
                 self.threshold_label.setText("Show distance (D) computes the spectrum it needs")

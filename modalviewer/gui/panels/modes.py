@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from qtpy import QtCore, QtWidgets
+from qtpy import QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
@@ -11,12 +11,15 @@ from ...viewer.wording import approximation_mark, arrival_note
 from ..plots import LinePlot
 from .common import (
     WrappingLabel,
+    add_items,
+    bind,
     combo,
     describe,
     follow,
     quiet,
     row,
     select_data,
+    show_values,
     slider,
     spin_box,
 )
@@ -41,26 +44,24 @@ class ModesPanel(QtWidgets.QWidget):
         self.spectrum_plot = LinePlot("Spectrum", "mode index", "\u03bb")
         lay.addWidget(self.spectrum_plot)
         form = QtWidgets.QFormLayout()
-        self.color_combo = combo()
-        for label, data, tip in (
+        self.color_combo = add_items(
+            combo(),
             (
-                "Deformed shape",
-                "deformed",
-                "The surface displaced by the mode (Amplitude), coloured by the mode's "
-                "|Phi| per vertex (Mass-normalised, whatever the Amplitude); the rest "
-                "shape as a grey ghost (G)",
+                (
+                    "Deformed shape",
+                    "deformed",
+                    "The surface displaced by the mode (Amplitude), coloured by the mode's "
+                    "|Phi| per vertex (Mass-normalised, whatever the Amplitude); the rest "
+                    "shape as a grey ghost (G)",
+                ),
+                (
+                    "Normal component on rest shape",
+                    "normal",
+                    "The displacement along smoothed normals, signed, on the rest shape",
+                ),
+                ("Magnitude on rest shape", "magnitude", "|displacement| on the rest shape"),
             ),
-            (
-                "Normal component on rest shape",
-                "normal",
-                "The displacement along smoothed normals, signed, on the rest shape",
-            ),
-            ("Magnitude on rest shape", "magnitude", "|displacement| on the rest shape"),
-        ):
-            self.color_combo.addItem(label, data)
-            self.color_combo.setItemData(
-                self.color_combo.count() - 1, tip, QtCore.Qt.ItemDataRole.ToolTipRole
-            )
+        )
         describe(self.color_combo, "How 3D vibration modes are shown")
         self.iso_spin = spin_box(0, 60, tip="Number of isolines (0: none)")
         form.addRow("Show 3D modes as", self.color_combo)
@@ -71,10 +72,9 @@ class ModesPanel(QtWidgets.QWidget):
         self.mode_slider.valueChanged.connect(self._on_mode_input)
         self.mode_spin.valueChanged.connect(self._on_mode_input)
         self.spectrum_plot.sampleClicked.connect(self._on_mode_input)
-        self.color_combo.currentIndexChanged.connect(
-            lambda _: setattr(state.style, "shell_coloring", self.color_combo.currentData())
-        )
-        self.iso_spin.valueChanged.connect(lambda n: setattr(state.style, "isolines", n))
+        self.style_fields = {"shell_coloring": self.color_combo, "isolines": self.iso_spin}
+        for name, widget in self.style_fields.items():
+            bind(widget, lambda value, n=name: setattr(state.style, n, value))
         follow(state, self.update_from_state, "display", "spectra", "mesh")
         state.events.style.connect(self._update_style)
         self.update_from_state()
@@ -118,11 +118,8 @@ class ModesPanel(QtWidgets.QWidget):
                 info = OPERATOR_INFO[name]
                 mark = approximation_mark(state.spectrum(name), state.is_coarse(name))
                 # marked: the short name, so the mark is not cut off in a narrow panel
-                self.spectrum_combo.addItem((info.short_label if mark else info.label) + mark, name)
-                index = self.spectrum_combo.count() - 1
-                self.spectrum_combo.setItemData(
-                    index, info.label + mark, QtCore.Qt.ItemDataRole.ToolTipRole
-                )
+                label = (info.short_label if mark else info.label) + mark
+                add_items(self.spectrum_combo, [(label, name, info.label + mark)])
             if op is not None:
                 select_data(self.spectrum_combo, op)
             spec = state.spectrum(op)
@@ -173,9 +170,8 @@ class ModesPanel(QtWidgets.QWidget):
         )
 
     def _update_style(self) -> None:
-        with quiet(self.color_combo, self.iso_spin):
-            select_data(self.color_combo, self.state.style.shell_coloring)
-            self.iso_spin.setValue(self.state.style.isolines)
+        style = self.state.style
+        show_values((w, getattr(style, name)) for name, w in self.style_fields.items())
 
 
 def _what_is_shown(state: ViewerState) -> str:
