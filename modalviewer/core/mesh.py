@@ -524,22 +524,16 @@ def _unique_index_rows(rows: np.ndarray, **kwargs):
     """``np.unique(rows, axis=0, **kwargs)`` for non-negative integer rows, through one
     int64 key per row: a 1-D sort, much faster than numpy's row-wise unique."""
     rows = np.asarray(rows, dtype=np.int64)
-    if rows.size == 0:
-        return np.unique(rows, axis=0, **kwargs)
-    base = int(rows.max()) + 1
-    if base ** rows.shape[1] >= 2**62:
+    base = int(rows.max(initial=0)) + 1
+    if rows.size == 0 or base ** rows.shape[1] >= 2**62:
         return np.unique(rows, axis=0, **kwargs)
     key = np.zeros(len(rows), dtype=np.int64)
     for c in range(rows.shape[1]):
         key = key * base + rows[:, c]
-    out = np.unique(key, **kwargs)
-    keys = out[0] if isinstance(out, tuple) else out
-    decoded = np.empty((len(keys), rows.shape[1]), dtype=np.int64)
-    rest = keys.copy()
-    for c in range(rows.shape[1] - 1, -1, -1):
-        decoded[:, c] = rest % base
-        rest //= base
-    return (decoded, *out[1:]) if isinstance(out, tuple) else decoded
+    with_index = kwargs.pop("return_index", False)
+    _, first, *rest = np.unique(key, return_index=True, **kwargs)  # unique rows: rows[first]
+    out = (rows[first], first, *rest) if with_index else (rows[first], *rest)
+    return out if len(out) > 1 else out[0]
 
 
 def shape_summary(mesh: Mesh) -> str:
