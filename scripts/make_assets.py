@@ -110,7 +110,7 @@ def main() -> int:
             raise SystemExit(f"{name} is not a clean surface")
         write_obj(ASSETS / f"{name}.obj", mesh)
         print(f"{name}: {mesh.n_vertices} vertices, {mesh.n_faces} faces, "
-              f"{mesh.n_components} component(s), closed={mesh.is_closed}")  # fmt: skip
+              f"{mesh.n_components} component(s), closed={mesh.n_boundary_edges == 0}")  # fmt: skip
     (ASSETS / "demo_landmarks.json").write_text(json.dumps(landmarks, indent=1) + "\n")
     return 0
 

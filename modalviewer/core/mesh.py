@@ -499,10 +499,6 @@ class Mesh:
         _, counts = _unique_index_rows(he, return_counts=True)
         return bool(counts.max() == 1)
 
-    @property
-    def is_closed(self) -> bool:
-        return self.n_boundary_edges == 0
-
     def shell_problem(self) -> str | None:
         """Why the Discrete Shells and E_D^N operators cannot run here, or None."""
         if not self.is_edge_manifold:

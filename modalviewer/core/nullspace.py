@@ -128,7 +128,7 @@ def null_space(
     with (default: the area-weighted ones the operators use)."""
     info = operator_info(operator)  # a ValueError naming the known operators
     mass = np.asarray(mass, dtype=np.float64)
-    if info.null_space_needs_normals and normals is None:
+    if info.null_space_rule.startswith("normal") and normals is None:  # E_D^N, normal shells
         normals = vertex_normals(mesh)
     rows, cols, vals = [], [], []
     component = []

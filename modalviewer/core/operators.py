@@ -120,10 +120,6 @@ class OperatorInfo:
             peak += (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
         return peak
 
-    @property
-    def null_space_needs_normals(self) -> bool:
-        return self.null_space_rule.startswith("normal")
-
     def matrices(self, mesh, bending: float = 1.0, membrane: float = 1.0):
         """(K, mass (n,) per vertex) on ``mesh``: the function :attr:`assemble`, and the
         lumped vertex areas unless it returns a mass of its own (:attr:`assembles_mass`)."""

@@ -52,7 +52,7 @@ def test_loader_flips_zero_area_caps_and_a_closed_mesh_stays_closed(tmp_path):
     assert _zero_area_count(v, f) == 10
     mesh = mv.load_mesh(_write_obj(tmp_path / "caps.obj", v, f))
     text = str(mesh.report)
-    assert mesh.is_closed and mesh.n_boundary_edges == 0  # 30 boundary edges when deleted
+    assert mesh.n_boundary_edges == 0  # 30 boundary edges when deleted
     assert euler(mesh) == 2 and mesh.n_components == 1 and mesh.is_consistently_oriented
     assert "Flipped the longest edge of 10 degenerate (zero-area) faces" in text
     assert "no vertex moved" in text
@@ -68,7 +68,7 @@ def test_loader_collapses_zero_area_caps_near_a_corner(tmp_path):
     v, f = add_slivers(sphere, needles=0, caps=10, eps=0.0, at=0.02)
     mesh = mv.load_mesh(_write_obj(tmp_path / "caps.obj", v, f))
     text = str(mesh.report)
-    assert mesh.is_closed and euler(mesh) == 2 and mesh.is_consistently_oriented
+    assert mesh.n_boundary_edges == 0 and euler(mesh) == 2 and mesh.is_consistently_oriented
     assert "Collapsed 10 degenerate (zero-area) faces" in text and "no holes" in text
     # each cap's apex was only used by the split face: the sphere comes back exactly
     # (the apexes keep their numbers, merged into the vertex they were collapsed onto)
@@ -114,7 +114,7 @@ def slivered_sphere():
 
 def test_fix_slivers_removes_needles_and_caps_and_keeps_the_surface(slivered_sphere):
     sphere, bad = slivered_sphere
-    assert bad.is_closed and (bad.face_quality < 1e-3).sum() == 60
+    assert bad.n_boundary_edges == 0 and (bad.face_quality < 1e-3).sum() == 60
     stages = []
     fixed = mv.fix_slivers(bad, progress=lambda stage, x: stages.append((stage, x)))
     assert stages[0][1] == 0.0 and stages[-1] == ("done", 1.0)
@@ -122,7 +122,7 @@ def test_fix_slivers_removes_needles_and_caps_and_keeps_the_surface(slivered_sph
     r = fixed.report
     assert isinstance(r, mv.SliverReport)
     # topology: still one closed sphere
-    assert fixed.is_closed and euler(fixed) == 2 and fixed.n_components == 1
+    assert fixed.n_boundary_edges == 0 and euler(fixed) == 2 and fixed.n_components == 1
     assert fixed.is_edge_manifold and fixed.is_consistently_oriented
     # quality: from 1e-8 to a healthy mesh (the icosphere's own worst is 0.86)
     assert bad.face_quality.min() < 2e-8
@@ -191,7 +191,7 @@ def test_fix_slivers_falls_back_to_local_remeshing(slivered_sphere, monkeypatch)
     fixed = mv.fix_slivers(bad)
     r = fixed.report
     assert "remeshing" in r.method and "remeshing" in str(r)
-    assert fixed.is_closed and euler(fixed) == 2 and fixed.is_consistently_oriented
+    assert fixed.n_boundary_edges == 0 and euler(fixed) == 2 and fixed.is_consistently_oriented
     assert r.slivers_after == 0 and r.worst_quality_after > 0.03
     # the rest of the sphere is untouched, and the new vertices lie on the old surface
     assert r.triangles_changed < bad.n_faces / 2
