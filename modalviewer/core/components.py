@@ -47,6 +47,7 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
             for part, vertices in split_components(solver)
         ]
     face_label, order = _by_area(mesh)
+    fm = mesh.file_to_mesh  # each part's file_map: its vertex of each file vertex
     out = []
     for c in order:
         vertices = np.flatnonzero(mesh.component_labels == c)
@@ -54,7 +55,14 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
         remap[vertices] = np.arange(len(vertices))
         faces = remap[mesh.faces[face_label == c]]
         out.append(
-            (Mesh(mesh.vertices[vertices], faces, file_map=mesh.file_map_after(remap)), vertices)
+            (
+                Mesh(
+                    mesh.vertices[vertices],
+                    faces,
+                    file_map=np.where(fm >= 0, remap[np.maximum(fm, 0)], -1),
+                ),
+                vertices,
+            )
         )
     return out
 

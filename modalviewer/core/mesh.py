@@ -120,21 +120,6 @@ def checked_arrays(vertices, faces, polygons: bool = False):
                 "holds triangles (as_mesh and repair_mesh split polygons into triangles)"
             )
     f = f.astype(np.int64)
-    _check_finite_and_indices(v, f)
-    note = ""
-    if f.shape[1] > 3:
-        p = f.shape[1]
-        kind = "quad" if p == 4 else f"polygon of {p} vertices"
-        note = (
-            f"Split {_plural(len(f), kind)} into {_plural(len(f) * (p - 2), 'triangle')} "
-            "(fanned from each one's first vertex)."
-        )
-        f = np.stack([f[:, [0, i, i + 1]] for i in range(1, p - 1)], axis=1).reshape(-1, 3)
-    return v, f, note
-
-
-def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
-    """Raise MeshError for NaN/Inf coordinates or face indices outside 0..n-1."""
     bad = ~np.isfinite(v).all(axis=1)
     if bad.any():
         raise MeshError(
@@ -154,6 +139,16 @@ def _check_finite_and_indices(v: np.ndarray, f: np.ndarray) -> None:
             f"(the mesh has {_plural(n, 'vertex')}); faces and vertices do not belong "
             f"together ({cause})"
         )
+    note = ""
+    if f.shape[1] > 3:
+        p = f.shape[1]
+        kind = "quad" if p == 4 else f"polygon of {p} vertices"
+        note = (
+            f"Split {_plural(len(f), kind)} into {_plural(len(f) * (p - 2), 'triangle')} "
+            "(fanned from each one's first vertex)."
+        )
+        f = np.stack([f[:, [0, i, i + 1]] for i in range(1, p - 1)], axis=1).reshape(-1, 3)
+    return v, f, note
 
 
 class Mesh:
@@ -370,11 +365,6 @@ class Mesh:
         used = fm >= 0
         out[used] = a[fm[used]]
         return out
-
-    def file_map_after(self, new_of_old: np.ndarray) -> np.ndarray | None:
-        """The ``file_map`` of a mesh whose vertex ``new_of_old[i]`` is this one's i."""
-        fm = self.file_to_mesh
-        return np.where(fm >= 0, np.asarray(new_of_old)[np.maximum(fm, 0)], -1)
 
     @cached_property
     def hash(self) -> str:

@@ -10,20 +10,17 @@ from __future__ import annotations
 import functools
 import os
 
-_OPENBLAS = None  # threadpoolctl's controller of the loaded OpenBLAS libraries, or False
 
-
+@functools.cache
 def _openblas():
-    global _OPENBLAS
-    if _OPENBLAS is None:
-        try:
-            from threadpoolctl import ThreadpoolController
+    """threadpoolctl's controller of the loaded OpenBLAS libraries, or None."""
+    try:
+        from threadpoolctl import ThreadpoolController
 
-            found = ThreadpoolController().select(internal_api="openblas")
-            _OPENBLAS = found if found.lib_controllers else False
-        except Exception:  # threadpoolctl missing or failing on this platform
-            _OPENBLAS = False
-    return _OPENBLAS
+        found = ThreadpoolController().select(internal_api="openblas")
+        return found if found.lib_controllers else None
+    except Exception:  # threadpoolctl missing or failing on this platform
+        return None
 
 
 def single_blas_thread(fn):
