@@ -85,10 +85,7 @@ def voxel_surface(solid: np.ndarray, size: float = 1.0) -> Mesh:
         for direction in (1, -1):
             neighbour = np.roll(solid, -direction, axis=axis)
             cells = np.argwhere(solid & ~neighbour)
-            offset = np.zeros(3, dtype=int)
-            if direction == 1:
-                offset[axis] = 1
-            quad = corners[axis] + offset
+            quad = corners[axis] + (direction == 1) * np.eye(3, dtype=int)[axis]
             if direction == -1:
                 quad = quad[::-1]  # reversed winding: normal along -axis
             quads.append(cells[:, None, :] + quad[None, :, :])

@@ -13,6 +13,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import glob
+import importlib.util
 import os
 import shutil
 import sys
@@ -47,11 +48,7 @@ def available_backends() -> list[str]:
     names = []
     if os.environ.get("MODALVIEWER_NO_PARDISO") != "1" and _load_mkl() is not None:
         names.append("pardiso")
-    try:
-        import cholespy  # noqa: F401
-    except ImportError:  # pragma: no cover - depends on the environment
-        pass
-    else:
+    if importlib.util.find_spec("cholespy") is not None:
         names.append("cholmod")
     names.append("superlu")
     return names
@@ -125,9 +122,8 @@ def remove_stale_factor_folders(parent: str | None = None) -> list[str]:
 
 def has_vertex_blocks(A: sp.csr_matrix, size: int = 3) -> bool:
     """Whether A's rows come in groups of ``size`` with one sparsity pattern each (the
-    3D shells' vertex blocks): in nearly all of a few hundred groups spread over the
-    matrix the rows have the same columns (an entry that cancels to an exact zero drops
-    out of a few; a scalar operator's neighbouring rows almost never agree)."""
+    3D shells' vertex blocks) in nearly all of a few hundred groups spread over it (an
+    entry that cancels to an exact zero drops out of a few)."""
     n = A.shape[0]
     if n % size or n < size:
         return False

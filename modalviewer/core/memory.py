@@ -14,6 +14,7 @@ from __future__ import annotations
 import ctypes
 import functools
 import os
+import sys
 
 MEMORY_LIMIT_SHARE = 0.5  # the share of this machine's memory a computation plans for
 
@@ -62,8 +63,6 @@ def resident_mb() -> float:
 @functools.cache
 def glibc():
     """glibc's ``libc.so.6`` as a ``ctypes.CDLL`` on Linux, else None."""
-    import sys
-
     if not sys.platform.startswith("linux"):
         return None
     try:
@@ -85,10 +84,6 @@ def return_freed_memory() -> bool:
     return True
 
 
-_M_TRIM_THRESHOLD = -1
-_M_MMAP_THRESHOLD = -3
-_M_ARENA_MAX = -8
-
 # Arrays up to this size come from the heap in a compute process, their memory reused
 # when freed; bigger ones are mapped (glibc's largest mmap threshold on 64-bit systems):
 # serving every array from the heap leaves holes the next do not fit.
@@ -106,9 +101,9 @@ def prepare_compute_process() -> bool:
 
     mallopt = getattr(glibc(), "mallopt", None)
     settings = [
-        (_M_MMAP_THRESHOLD, HEAP_ARRAY_MAX_BYTES),
-        (_M_TRIM_THRESHOLD, 2**31 - 1),
-        (_M_ARENA_MAX, 1),
+        (-3, HEAP_ARRAY_MAX_BYTES),  # M_MMAP_THRESHOLD
+        (-1, 2**31 - 1),  # M_TRIM_THRESHOLD: keep all freed memory
+        (-8, 1),  # M_ARENA_MAX
     ]
     if mallopt is not None:
         mallopt.argtypes = [ctypes.c_int, ctypes.c_int]

@@ -187,14 +187,12 @@ class Mesh:
             )
         self.report = report if report is not None else MeshReport()
         self._file_map = None
+        n = len(v)
         if file_map is not None:
             fm = np.array(file_map, dtype=np.int64, copy=True).reshape(-1)
-            n = len(v)
             if fm.size and (fm.min() < -1 or fm.max() >= n):
                 raise MeshError("file_map refers to vertices the mesh does not have")
-            hit = np.zeros(n, dtype=bool)
-            hit[fm[fm >= 0]] = True
-            if not hit.all():
+            if not np.isin(np.arange(n), fm).all():
                 raise MeshError("file_map leaves a mesh vertex without a vertex of the file")
             if not (len(fm) == n and np.array_equal(fm, np.arange(n))):
                 fm.setflags(write=False)
@@ -202,7 +200,6 @@ class Mesh:
         self._merged = None
         if merged_into is not None:
             mi = np.array(merged_into, dtype=np.int64).reshape(-1)
-            n = len(v)
             if mi.shape != (n,) or (n and (mi.min() < 0 or mi.max() >= n)):
                 raise MeshError(f"merged_into must hold one vertex index per vertex ({n})")
             if np.any(mi[mi] != mi):

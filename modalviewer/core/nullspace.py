@@ -66,9 +66,7 @@ def _rigid_fields(x: np.ndarray, m: np.ndarray) -> np.ndarray:
     r = x - c
     fields = np.zeros((len(x), 3, 6))
     fields[:, [0, 1, 2], [0, 1, 2]] = 1.0
-    for a in range(3):
-        axis = np.zeros(3)
-        axis[a] = 1.0
+    for a, axis in enumerate(np.eye(3)):
         fields[:, :, 3 + a] = np.cross(axis, r)
     return fields
 

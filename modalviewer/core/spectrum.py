@@ -72,20 +72,17 @@ class Spectrum:
 
     @property
     def modes_requested(self) -> int:
-        """How many modes the computation gives: more than :attr:`k` while the modes are
-        handed over as they converge (``compute_spectrum(..., on_modes=...)``)."""
+        """How many modes the computation gives: more than :attr:`k` while they arrive."""
         return int(self.parameters.get("modes_requested", self.k))
 
     @property
     def is_complete(self) -> bool:
-        """False for the first modes of a computation still running (see
-        :attr:`modes_requested`)."""
+        """False for the first modes of a computation still running."""
         return self.k >= self.modes_requested
 
     @property
     def null_space_dimension(self) -> int:
-        """How many of the first modes are deflated exact null vectors (constants per
-        component, rigid motions per component, ...; :mod:`.nullspace`)."""
+        """How many of the first modes are deflated exact null vectors (:mod:`.nullspace`)."""
         return int(self.parameters.get("null_space_dimension", 0))
 
     def zero_mode_mask(self) -> np.ndarray:
