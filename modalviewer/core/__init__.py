@@ -5,10 +5,9 @@ from .cache import SpectrumCache
 from .cleaning import repair_mesh
 from .components import *  # noqa: F403
 from .cross import *  # noqa: F403
-from .dirichlet import modified_dirichlet_matrix
 from .eigen import Cancelled, EigenError
 from .fmaps import FunctionalMap, correspondence_errors, functional_map
-from .laplacian import mass_matrix, stiffness_matrix, vertex_normals
+from .laplacian import mass_matrix, modified_dirichlet_matrix, stiffness_matrix, vertex_normals
 from .local_signature import local_signature
 from .mesh import Mesh, MeshError, MeshReport, remove_unused
 from .pipeline import ZeroModesWarning, compute_spectrum

@@ -162,7 +162,7 @@ OPERATOR_INFO: dict[str, OperatorInfo] = {
             "modified_dirichlet",
             "Modified Dirichlet energy E_D^N",
             "E_D^N",
-            assemble="dirichlet:modified_dirichlet_matrix",
+            assemble="laplacian:modified_dirichlet_matrix",
             null_space="constants of flat components",
             null_space_rule="normal translations",
             exact_growth=GrowthLaw(411.7, 0.864),

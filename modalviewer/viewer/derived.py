@@ -15,8 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.curvature import total_curvature
-from ..core.laplacian import lumped_masses, vertex_normals
+from ..core.laplacian import lumped_masses, total_curvature, vertex_normals
 from ..core.operators import (
     DISTANCE_KINDS,
     operator_for_distance,
