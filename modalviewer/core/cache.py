@@ -86,10 +86,8 @@ older solver are not served (2: exactly known null spaces deflated and counted).
 
 
 class SpectrumCache:
-    """Spectra stored as ``.npz`` files in ``directory`` (default
-    :func:`default_cache_dir`), at most ``max_bytes`` in all (default
-    :func:`default_cache_limit`; 0 stores nothing).  Beyond it the least recently used
-    entries are deleted, never the entry just written or read."""
+    """Spectra as ``.npz`` files in ``directory``, at most ``max_bytes`` in all (0 stores
+    nothing): beyond it the least recently used go, never the one just written or read."""
 
     def __init__(self, directory: Path | None = None, max_bytes: int | None = None):
         self.directory = Path(directory) if directory else default_cache_dir()

@@ -141,13 +141,12 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
         order = np.argsort(lengths[rows, shortest], kind="stable")
 
         topo = _topology(f, n)
-        adj = topo[5]
 
         # A zero-area face along the boundary (its longest edge on no other face) is
         # removed: the boundary then runs through its apex, along the same line.
         lo = np.argmax(lengths, axis=1)
         u, w = zf[rows, lo], zf[rows, (lo + 1) % 3]
-        along_boundary = np.asarray(adj[u, w]).ravel() == 1
+        along_boundary = np.asarray(topo[5][u, w]).ravel() == 1  # faces on the edge
         drop = np.zeros(len(f), dtype=bool)
         drop[zero[along_boundary]] = True
 
@@ -299,10 +298,9 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
 def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-10):
     """A valid :class:`Mesh` of raw arrays, ``mesh.report`` saying every change: vertices
     closer than ``merge_tolerance`` times the bounding-box diagonal merged, faces that
-    repeat a vertex or another face dropped, faces of zero area flipped or collapsed
-    (:func:`_collapse_zero_area_faces`), the orientation made consistent per component
-    where possible.  Only the faces change: vertex i stays row i of ``vertices`` (merged
-    ones take their vertex's values, :attr:`Mesh.merged_into`)."""
+    repeat a vertex or another face dropped, faces of zero area flipped or collapsed,
+    the orientation made consistent where possible.  Only the faces change: vertex i
+    stays row i of ``vertices``."""
     report = MeshReport(source=source)
     v, f, split = checked_arrays(vertices, faces, polygons=True)
     if split:

@@ -34,12 +34,10 @@ def folded_plate(angle_degrees: float = 90.0) -> Mesh:
 
 
 def bent_pose(mesh: Mesh, angle_degrees: float = 40.0, at: float = 0.5, width: float = 0.4) -> Mesh:
-    """A second pose of ``mesh``, vertex for vertex (the ground truth of a correspondence
-    is the identity): the part beyond ``at`` of the bounding box's longest extent turned
-    by ``angle_degrees`` about an axis across it, the turn growing smoothly (a smoothstep)
-    over ``width`` of that extent, so only that band is strained, the more the farther
-    from the axis.  The axis runs along the box's middle extent, through the band's middle
-    and the box's centre, so a flat shape bends as a sheet does (nearly isometrically)."""
+    """A second pose of ``mesh``, vertex for vertex (a correspondence's ground truth is the
+    identity): the part beyond ``at`` of the bounding box's longest extent turned by
+    ``angle_degrees`` about an axis along its middle extent, the turn growing smoothly over
+    ``width`` of that extent, so a flat shape bends as a sheet does (nearly isometrically)."""
     v = np.array(mesh.vertices)
     lo, hi = v.min(axis=0), v.max(axis=0)
     extent = hi - lo

@@ -19,6 +19,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from .cross import common_times
@@ -49,8 +51,7 @@ def _scalar_basis(spec: Spectrum, k: int, which: str) -> tuple[np.ndarray, np.nd
         )
     if spec.k < k:
         raise ValueError(f"spectrum {which} has {spec.k} modes; k={k} needs at least {k}")
-    used = spec.mass > 0
-    return spec.modes[:, :k], used
+    return spec.modes[:, :k], spec.mass > 0  # the rows of vertices faces use
 
 
 def _descriptors(spec_a, spec_b, descriptors, samples: int):
@@ -62,11 +63,8 @@ def _descriptors(spec_a, spec_b, descriptors, samples: int):
             )
         kind = "wks" if descriptors == "wks" else "heat"
         scales = common_times(spec_a, spec_b, samples=samples, kind=kind)
-        if descriptors == "wks":
-            return (
-                signature(spec_a, kind="wks", energies=scales)[1],
-                signature(spec_b, kind="wks", energies=scales)[1],
-            )
+        if kind == "wks":
+            return tuple(signature(s, kind="wks", energies=scales)[1] for s in (spec_a, spec_b))
         return signature(spec_a, scales)[1], signature(spec_b, scales)[1]
     fa, fb = (np.asarray(f, dtype=np.float64) for f in descriptors)
     if fa.ndim == 1:
@@ -174,9 +172,6 @@ def correspondence_errors(
     y of B, the distance on A between ``point_map[y]`` and ``truth[y]`` (default: y, two
     poses of one mesh) along A's edges (Dijkstra, a little above the geodesic distance),
     over sqrt(area of A): (ceil(n_b / every),), NaN where y has no image."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import dijkstra
-
     point_map = np.asarray(point_map, dtype=np.int64)
     truth = np.arange(len(point_map)) if truth is None else np.asarray(truth, dtype=np.int64)
     ys = np.arange(0, len(point_map), check_count(every, "every", 1))

@@ -91,12 +91,10 @@ HEAP_ARRAY_MAX_BYTES = 32 * 2**20
 
 
 def prepare_compute_process() -> bool:
-    """The allocator settings for a process that exists to compute (its memory goes back
-    to the system when it ends); True if all took effect.  glibc serves arrays up to
-    :data:`HEAP_ARRAY_MAX_BYTES` from the heap, keeps freed heap memory and serves every
-    thread from one arena, so memory freed on one thread is reused on any other (for
-    threads that have not yet allocated: call it when the process starts); numpy stops
-    advising huge pages for new arrays (``NUMPY_MADVISE_HUGEPAGE=0`` at run time)."""
+    """The allocator settings for a process that exists to compute, called when it starts
+    (True if all took effect): glibc serves arrays up to :data:`HEAP_ARRAY_MAX_BYTES` from
+    the heap, keeps freed heap memory and serves every thread from one arena (memory freed
+    on one thread is reused on any other); numpy stops advising huge pages."""
     import numpy as np
 
     mallopt = getattr(glibc(), "mallopt", None)

@@ -89,10 +89,9 @@ def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[s
 
 def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384, lead: int = 0) -> np.ndarray:
     """``Y A`` for a C-contiguous (N, w) Y and a (w, m) A, m <= w (an int m: Y's first m
-    columns), written over Y's memory (Y is left meaningless): a C-contiguous (N, m)
-    array on Y's buffer, or with ``lead`` > 0 (N, lead + m), the first ``lead`` columns
-    left for the caller.  Row chunk by chunk, so only a chunk of the product is alive;
-    row i ends at (i + 1)(lead + m) <= (i + 1) w, so writes never reach unread rows."""
+    columns), written over Y's buffer (Y is left meaningless) as (N, lead + m), the first
+    ``lead`` columns left for the caller; chunk by chunk, and row i ends at
+    (i + 1)(lead + m) <= (i + 1) w, so writes never reach unread rows."""
     n, w = Y.shape
     m = A if isinstance(A, int) else A.shape[1]
     width = lead + m

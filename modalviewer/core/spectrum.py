@@ -153,12 +153,11 @@ def load_spectrum(
     is not a readable, consistent and finite spectrum file or belongs to another mesh; a
     TypeError if ``mesh`` is not a Mesh (pass a hash as ``mesh_hash=``) or both are given."""
     if mesh is not None:
-        if isinstance(mesh, (str, bytes)):
-            raise TypeError(
-                "mesh must be a Mesh; to check against a hash string pass mesh_hash=..."
-            )
         if not isinstance(mesh, Mesh):
-            raise TypeError(f"mesh must be a Mesh, got {type(mesh).__name__}")
+            hint = f", got {type(mesh).__name__}"
+            if isinstance(mesh, (str, bytes)):
+                hint = "; to check against a hash string pass mesh_hash=..."
+            raise TypeError("mesh must be a Mesh" + hint)
         if mesh_hash is not None:
             raise TypeError("pass mesh or mesh_hash, not both")
         mesh_hash = mesh.hash
