@@ -136,10 +136,8 @@ class OperatorInfo:
 
 
 # exact_growth, factor_memory: the fits of benchmarks/results/growth.json and
-# factor_memory.json (bumpy plates of 100k to 1M vertices, 100 modes), made by
-# `python -m benchmarks.growth` and `python -m benchmarks.factor_memory`;
-# tests/core/test_cost.py checks that they are those fits.  Curved meshes fill in 1.1 to
-# 1.2 times more (spot Loop x3, hand Loop x2: factor_memory.json's curved rows).
+# factor_memory.json (python -m benchmarks.growth, benchmarks.factor_memory: bumpy plates
+# of 100k to 1M vertices, 100 modes), checked by tests/core/test_cost.py.
 _LAPLACIAN_GROWTH = GrowthLaw(410.0, 0.864)
 _SCALAR_FACTOR = FactorLaw(60.0, 1.042, 106.8, 0.689)
 

@@ -161,14 +161,13 @@ class SignatureTable:
         if kind == "wks" and include_zero:
             raise ValueError("the wave kernel signature leaves the zero modes out")
         self.t_range = None if t_range is None else check_t_range(t_range)
-        if self.t_range is None:
-            if kind == "wks":
-                times = default_energies(spec, samples)
-            else:
-                times = default_times(spec, samples, include_zero)
-        else:
+        if self.t_range is not None:
             t1, t2 = self.t_range
             times = np.exp(np.linspace(np.log(t1), np.log(t2), samples))
+        elif kind == "wks":
+            times = default_energies(spec, samples)
+        else:
+            times = default_times(spec, samples, include_zero)
         self.times = times
         self.table = normalised_signatures(spec, times, include_zero, kind=kind)
 

@@ -37,12 +37,11 @@ def _law(spec: Spectrum) -> tuple[np.ndarray, float, int]:
     per = 3 if spec.is_vector else 1
     unknowns = spec.n_vertices * per - int(zero.sum())
     k = lam.size
-    if k >= 4:
-        j = np.arange(1, k + 1)
+    fitted = 1.0  # Weyl's law where there are too few eigenvalues to fit
+    if k >= 4:  # fitted on the upper half
         h = k // 2
-        fitted = float(np.polyfit(np.log(j[h:]), np.log(np.maximum(lam[h:], 1e-300)), 1)[0])
-    else:
-        fitted = 1.0
+        j = np.arange(h + 1, k + 1)
+        fitted = float(np.polyfit(np.log(j), np.log(np.maximum(lam[h:], 1e-300)), 1)[0])
     p = float(np.clip(SAFETY_EXPONENT * fitted, MIN_EXPONENT, MAX_EXPONENT))
     return lam, p, max(unknowns, k)
 
