@@ -101,10 +101,10 @@ def _show(main, collection, mesh, spectrum) -> CollectionDialog | None:
     try:
         rows = nearest_rows(collection, mesh, spectrum)
     except (ValueError, RuntimeError, MemoryError) as exc:
-        QtWidgets.QApplication.restoreOverrideCursor()
         main.show_error(f"Cannot rank the collection: {exc}", "Open collection")
         return None
-    QtWidgets.QApplication.restoreOverrideCursor()
+    finally:
+        QtWidgets.QApplication.restoreOverrideCursor()
     dialog = CollectionDialog(main, collection, rows)
     main.collection_dialog = dialog
     dialog.show()

@@ -8,14 +8,12 @@ never change it.
 
 from __future__ import annotations
 
-import numpy as np
 from qtpy import QtWidgets
 
-from ..scene.comparison import caption
 from ..scene.mesh_scene import MeshScene
 from ..scene.view import draw_field, label_field
 from ..viewer.comparison import Comparison, item_label
-from .viewport import grab_views, make_viewport
+from .viewport import make_viewport
 from .views_window import ViewsWindow
 
 
@@ -32,7 +30,6 @@ class CompareWindow(ViewsWindow):
         self.state = main.state
         self.comparison = Comparison(self.state, items)
         self.items = self.comparison.items
-        self.distances = self.comparison.distances
         self.setWindowTitle("modalviewer - " + self.comparison.title)
         layout = QtWidgets.QHBoxLayout(self)
         self.viewports, self.scenes, self.titles = [], [], []
@@ -50,8 +47,7 @@ class CompareWindow(ViewsWindow):
                 camera.DeepCopy(main.plotter.renderer.GetActiveCamera())
             else:
                 viewport.plotter.renderer.SetActiveCamera(camera)
-            if hasattr(viewport, "cameraChanged"):
-                viewport.cameraChanged.connect(self.render_all)
+            viewport.cameraChanged.connect(self.render_all)
             self.viewports.append(viewport)
             self.scenes.append(scene)
             self.titles.append(title)
@@ -77,19 +73,12 @@ class CompareWindow(ViewsWindow):
         views = self.comparison.views()
         for view, scene, title in zip(views, self.scenes, self.titles, strict=True):
             title.setText(view.title)
-            if self.distances:
+            if self.comparison.distances:
                 scene.show_marker(view.marker)
-            if view.field is not None or self.distances:
+            if view.field is not None or self.comparison.distances:
                 draw_field(scene, view.field)
                 label_field(scene, view.field)
         self.render_all()
-
-    def grab_images(self, scale: int = 1, transparent: bool = False) -> list[np.ndarray]:
-        """Each view as on screen at ``scale``, its colour bar drawn on and its title
-        written above it."""
-        images = grab_views(self.viewports, self.scenes, scale, transparent)
-        self.render_all()
-        return [caption(image, t) for image, t in zip(images, self.captions(), strict=True)]
 
     def captions(self) -> list[str]:
         return [title.text() for title in self.titles]

@@ -16,32 +16,22 @@ def file_message(path, message: str) -> str:
     return message if name in message else f"{name}: {message}"
 
 
-def ask(parent, title: str, question: str, default_yes: bool = False) -> bool:
+def ask(parent, title: str, question: str, default_yes: bool = False, action=None) -> bool:
     """A yes/no question (default No; ``default_yes`` where Yes is the action the user
-    asked for).  With MODALVIEWER_NO_DIALOGS set (tests, scripts) the answer is
+    asked for), or with ``action`` a warning with that button (the default) and Cancel.
+    With MODALVIEWER_NO_DIALOGS set (tests, scripts) the answer is
     MODALVIEWER_ASSUME_YES, so nothing starts without being asked for."""
     if os.environ.get("MODALVIEWER_NO_DIALOGS"):
         return bool(os.environ.get("MODALVIEWER_ASSUME_YES"))
+    icon = QtWidgets.QMessageBox.Icon.Warning if action else QtWidgets.QMessageBox.Icon.Question
+    box = QtWidgets.QMessageBox(icon, title, question, parent=parent)
     buttons = QtWidgets.QMessageBox.StandardButton
-    default = buttons.Yes if default_yes else buttons.No
-    answer = QtWidgets.QMessageBox.question(
-        parent, title, question, buttons.Yes | buttons.No, default
-    )
-    return answer == buttons.Yes
-
-
-def ask_action(parent, title: str, text: str, action: str) -> bool:
-    """A question with the button ``action`` (the default: what the user asked for) and
-    Cancel; True if ``action`` was chosen.  With MODALVIEWER_NO_DIALOGS set the answer
-    is MODALVIEWER_ASSUME_YES, as for :func:`ask`."""
-    if os.environ.get("MODALVIEWER_NO_DIALOGS"):
-        return bool(os.environ.get("MODALVIEWER_ASSUME_YES"))
-    box = QtWidgets.QMessageBox(QtWidgets.QMessageBox.Icon.Warning, title, text, parent=parent)
-    chosen = box.addButton(action, QtWidgets.QMessageBox.ButtonRole.AcceptRole)
-    box.addButton(QtWidgets.QMessageBox.StandardButton.Cancel)
-    box.setDefaultButton(chosen)
+    role = QtWidgets.QMessageBox.ButtonRole.AcceptRole
+    yes = box.addButton(action, role) if action else box.addButton(buttons.Yes)
+    no = box.addButton(buttons.Cancel if action else buttons.No)
+    box.setDefaultButton(yes if action or default_yes else no)
     box.exec()
-    return box.clickedButton() is chosen
+    return box.clickedButton() is yes
 
 
 NO_MESH_A = "Open a mesh first: it becomes mesh A of the pair."
@@ -57,12 +47,12 @@ def offer_open_anyway(window, path, error: Exception) -> bool:
     message = file_message(path, str(error)).split("; the file is damaged")[0]
     window.viewer.last_error = f"{message}; {DAMAGED_WORDS}"
     window.statusBar().showMessage(message, 10000)
-    return ask_action(
+    return ask(
         window,
         "Damaged file",
         f"{message}.\n\nThe file is damaged or truncated. Open anyway loads the "
         "records that are whole and reports what was dropped.",
-        "Open anyway",
+        action="Open anyway",
     )
 
 
@@ -78,14 +68,11 @@ class _ExportDialog(QtWidgets.QDialog):
     :meth:`_finish` is called, Save and Cancel."""
 
     def __init__(self, parent, title: str, path: Path, filters: str):
-        super().__init__(parent)
-        self.setWindowTitle(title)
+        super().__init__(parent, windowTitle=title)
         self.filters = filters
         self.form = QtWidgets.QFormLayout(self)
-        self.path_edit = QtWidgets.QLineEdit(str(path))
-        self.path_edit.setMinimumWidth(420)
-        browse = QtWidgets.QPushButton("...")
-        browse.clicked.connect(self._browse)
+        self.path_edit = QtWidgets.QLineEdit(str(path), minimumWidth=420)
+        browse = QtWidgets.QPushButton("...", clicked=self._browse)
         self.form.addRow("File", row(self.path_edit, browse))
 
     def _finish(self) -> None:
@@ -120,11 +107,12 @@ class ScreenshotDialog(_ExportDialog):
             self.width_box, self.height_box = _size_boxes(form, size)
         self.scale = spin_box(1, 8)
         self.transparent = QtWidgets.QCheckBox("Transparent background")
-        self.colorbar = QtWidgets.QCheckBox("Colour bar and legend")
-        self.colorbar.setChecked(colorbar)
-        self.marker = QtWidgets.QCheckBox("Pick marker")
-        self.marker.setChecked(bool(marker))
-        self.marker.setToolTip("The picked vertex's marker (shown on distance maps by default)")
+        self.colorbar = QtWidgets.QCheckBox("Colour bar and legend", checked=colorbar)
+        self.marker = QtWidgets.QCheckBox(
+            "Pick marker",
+            checked=bool(marker),
+            toolTip="The picked vertex's marker (shown on distance maps by default)",
+        )
         form.addRow("Size multiplier", self.scale)
         form.addRow(self.transparent)
         form.addRow(self.colorbar)

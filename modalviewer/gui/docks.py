@@ -60,13 +60,12 @@ def fit_modes_dock(win) -> None:
 def add_dock(win, title: str, widget: QtWidgets.QWidget, area) -> QtWidgets.QDockWidget:
     """A dock titled ``title`` holding ``widget`` in a vertical scroll area, wide enough
     for the widget's contents (no sideways scrolling; labels wrap)."""
-    dock = QtWidgets.QDockWidget(title, win)
-    dock.setMaximumWidth(DOCK_WIDTH)
-    dock.setObjectName(title.replace(" ", "_"))
-    scroll = QtWidgets.QScrollArea()
-    scroll.setWidgetResizable(True)
+    dock = QtWidgets.QDockWidget(
+        title, win, maximumWidth=DOCK_WIDTH, objectName=title.replace(" ", "_")
+    )
+    off = QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff
+    scroll = QtWidgets.QScrollArea(widgetResizable=True, horizontalScrollBarPolicy=off)
     scroll.setWidget(widget)
-    scroll.setHorizontalScrollBarPolicy(QtCore.Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
     needed = widget.minimumSizeHint().width() + scroll.verticalScrollBar().sizeHint().width()
     scroll.setMinimumWidth(min(DOCK_WIDTH, needed + 4))
     dock.setWidget(scroll)

@@ -9,7 +9,7 @@ from pathlib import Path
 from qtpy import QtWidgets
 
 from ..core.operators import operator_info
-from ..core.spectrum import in_input_numbering, save_spectrum
+from ..core.spectrum import save_spectrum
 from ..io import SUPPORTED_EXTENSIONS
 from .dialogs import NO_MESH_A, AnimationDialog, ScreenshotDialog, ask
 from .paths import ASSETS, SCREENSHOTS
@@ -163,19 +163,8 @@ def field_dialog(win) -> None:
         _save(win, "field", lambda: win.export_field(path))
 
 
-def spectrum_to_export(state):
-    """The spectrum File > Export spectrum writes: the one the picture on screen is made
-    of (a mode's operator, a distance's), else the viewer's current one; in the input
-    mesh's numbering (one row per vertex of the file)."""
-    for operator in (state.display_operator(), state.current_operator()):
-        spec = state.spectrum(operator) if operator is not None else None
-        if spec is not None:
-            return in_input_numbering(spec, state.mesh.input_mesh)
-    return None
-
-
 def spectrum_dialog(win) -> None:
-    spec = spectrum_to_export(win.state)
+    spec = win.viewer.spectrum_shown()
     if spec is None:
         win.show_error("Compute a spectrum first.")
         return

@@ -34,8 +34,12 @@ from .compare import CompareWindow
 from .dialogs import ask, file_message, offer_open_anyway
 from .docks import build_docks
 from .pair_window import PairWindow, open_pair_window
-from .panels import AnimationPanel, ComputePanel, DistancesPanel, JobsPanel, ModesPanel
+from .panels.animation import AnimationPanel
 from .panels.common import follow
+from .panels.compute import ComputePanel
+from .panels.distances import DistancesPanel
+from .panels.jobs import JobsPanel
+from .panels.modes import ModesPanel
 from .qt_dispatch import QtDispatcher
 from .scene_view import SceneView
 from .status_bar import StatusBarWidgets
@@ -69,6 +73,10 @@ REPORTED = frozenset({"pick_file_vertex", "pick_vertex", "repair_mesh"})
 the user instead of raised."""
 
 VIEWS = {
+    "cache": "viewer.cache",
+    "plotter": "viewport.plotter",
+    "status_line": "status_widgets.status_line",
+    "cancel_button": "status_widgets.cancel_button",
     "mesh": "state.mesh",
     "scene": "scene_view.scene",
     "display": "state.display.kind",
@@ -78,7 +86,7 @@ VIEWS = {
     "cancel_all": "viewer.jobs.cancel_all",
     "animation_frame": "scene_view.drawing.animation_frame",
 }
-"""Read-only values (and two methods) of the window's parts, by name."""
+"""Parts of the window's parts, by name: read-only values and two methods."""
 
 
 @contextmanager
@@ -124,15 +132,13 @@ class MainWindow(QtWidgets.QMainWindow):
         self._waits: list[QtCore.QEventLoop] = []
         self.viewer.use_event_loop(self.dispatcher, self.wait_for)
         self.state = self.viewer.state
-        self.cache = self.viewer.cache
         self.message_box: QtWidgets.QMessageBox | None = None  # the last one opened
         self.compare: CompareWindow | None = None
 
         self.viewport = make_viewport(self, force_offscreen)
-        self.plotter = self.viewport.plotter
         # a usable 3D view however narrow the window: the docks keep the widths their
         # contents need, so without it a 700-pixel window left the view 45 pixels wide
-        self.viewport.widget.setMinimumSize(MIN_VIEW_SIZE[0], MIN_VIEW_SIZE[1])
+        self.viewport.widget.setMinimumSize(*MIN_VIEW_SIZE)
         self.setCentralWidget(self.viewport.widget)
         self.viewport.widget.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
         self.viewport.widget.installEventFilter(self)
@@ -153,10 +159,10 @@ class MainWindow(QtWidgets.QMainWindow):
         self.distances_panel.exactCurveRequested.connect(self.viewer.request_exact_curve)
         build_docks(self)
         menus.build_menus(self)
-        self.status_widgets = StatusBarWidgets(self.statusBar(), self.state, self.viewer.jobs)
-        self.status_widgets.cancel_button.clicked.connect(self.cancel_computation)
-        self.status_line = self.status_widgets.status_line
-        self.cancel_button = self.status_widgets.cancel_button
+        jobs = self.viewer.jobs
+        self.status_widgets = StatusBarWidgets(
+            self.statusBar(), self.state, jobs, self.cancel_computation
+        )
 
         self.state.events.mesh.connect(self._on_mesh)
         messages = self.viewer.events
@@ -166,9 +172,7 @@ class MainWindow(QtWidgets.QMainWindow):
         messages.sliver_failure.connect(self._offer_sliver_fix)
         window_settings.restore(self)
         # preferences are written a second after they change, not only on a clean quit
-        self._settings_timer = QtCore.QTimer(self)
-        self._settings_timer.setSingleShot(True)
-        self._settings_timer.setInterval(1000)
+        self._settings_timer = QtCore.QTimer(self, singleShot=True, interval=1000)
         self._settings_timer.timeout.connect(lambda: window_settings.save(self))
         save_soon = lambda *_: self._settings_timer.start()  # noqa: E731
         follow(self.state, save_soon, "compute_settings", "style", "animation")
@@ -228,14 +232,12 @@ class MainWindow(QtWidgets.QMainWindow):
         """Arrow keys step modes and Space plays only while the 3D view has the focus,
         so they never steal a key from a focused slider, spin box or button."""
         if obj is self.viewport.widget and event.type() == QtCore.QEvent.Type.KeyPress:
-            key = event.key()
-            if key in (QtCore.Qt.Key.Key_Right, QtCore.Qt.Key.Key_Up):
-                self.step_mode(+1)
+            key = QtCore.Qt.Key
+            step = {key.Key_Right: +1, key.Key_Up: +1, key.Key_Left: -1, key.Key_Down: -1}
+            if event.key() in step:
+                self.step_mode(step[event.key()])
                 return True
-            if key in (QtCore.Qt.Key.Key_Left, QtCore.Qt.Key.Key_Down):
-                self.step_mode(-1)
-                return True
-            if key == QtCore.Qt.Key.Key_Space:
+            if event.key() == key.Key_Space:
                 self.toggle_animation()
                 return True
         return super().eventFilter(obj, event)
@@ -252,8 +254,7 @@ class MainWindow(QtWidgets.QMainWindow):
         if not urls:
             return
         path = urls[0].toLocalFile()
-        x = event.position().x() if hasattr(event, "position") else event.pos().x()
-        if self.state.mesh is not None and x > self.width() / 2:
+        if self.state.mesh is not None and event.position().x() > self.width() / 2:
             self.open_second_mesh(path, wait=False)
         else:  # after the drop has ended: reading runs an event loop of its own
             QtCore.QTimer.singleShot(0, lambda: self.open_mesh(path))
@@ -329,8 +330,8 @@ class MainWindow(QtWidgets.QMainWindow):
         except OSError:
             size = ""
         dialog = QtWidgets.QProgressDialog(f"Opening {path.name}{size}...", "Cancel", 0, 0, self)
-        dialog.setWindowTitle("Opening mesh")
         dialog.setWindowModality(QtCore.Qt.WindowModality.WindowModal)
+        dialog.setWindowTitle("Opening mesh")
         loop = QtCore.QEventLoop()
 
         def tick():  # shown by hand: QProgressDialog's own delay restarts at each value
@@ -339,8 +340,7 @@ class MainWindow(QtWidgets.QMainWindow):
             elif not dialog.isVisible() and time.monotonic() - started >= READING_DIALOG_S:
                 dialog.show()
 
-        timer = QtCore.QTimer()
-        timer.setInterval(50)
+        timer = QtCore.QTimer(interval=50)
         timer.timeout.connect(tick)
         dialog.canceled.connect(loop.quit)
         timer.start()

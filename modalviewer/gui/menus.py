@@ -222,10 +222,9 @@ def about(win) -> None:
 
 
 def controls(win) -> None:
-    box = QtWidgets.QMessageBox(win)
-    box.setWindowTitle("Controls")
-    box.setTextFormat(QtCore.Qt.TextFormat.RichText)
-    box.setText("<pre>" + html.escape(CONTROLS) + "</pre>")  # one item per line, no wrapping
+    rich = QtCore.Qt.TextFormat.RichText  # one item per line, no wrapping
+    text = "<pre>" + html.escape(CONTROLS) + "</pre>"
+    box = QtWidgets.QMessageBox(win, windowTitle="Controls", textFormat=rich, text=text)
     box.exec()
 
 

@@ -9,7 +9,6 @@ own display and pick are never changed.
 
 from __future__ import annotations
 
-import logging
 from pathlib import Path
 
 from qtpy import QtCore, QtWidgets
@@ -18,15 +17,15 @@ from ..core.mesh import Mesh
 from ..core.operators import DISTANCE_KINDS, operator_info
 from ..scene.mesh_scene import MeshScene
 from ..viewer.camera import Camera, CameraLink
+from ..viewer.jobs import RUNNING
 from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from ..viewer.wording import seconds_text
 from .dialogs import NO_MESH_A
-from .panels.common import add_items, bind, row, show_values, slider, spin_box
+from .panels.common import add_items, bind, row, show_values, slider, spin_box, tip
+from .status_bar import JobProgress
 from .viewport import make_viewport
 from .views_window import ViewsWindow
-
-log = logging.getLogger("modalviewer")
 
 RESCALE_TIP = (
     "Scale both meshes to unit area before their spectra are computed (the distances are "
@@ -36,19 +35,12 @@ RESCALE_TIP = (
     "scale by different powers of the size), so a larger copy vibrates differently, not "
     "just slower. Untick only for meshes known to share one scale."
 )
-
-
 KIND_TIP = (
     "The signature compared: vibration (Discrete Shells), feature (E_D^N), heat kernel or "
     "wave kernel (Laplacian)"
 )
 SHARE_TIP = "Threshold: the share of the other mesh's area shown blue (the most similar points)"
 LINK_TIP = "Turning or zooming one view turns the other the same way (each about its centre)"
-
-
-def _tip(widget, text: str):
-    widget.setToolTip(text)
-    return widget
 
 
 class PairError(RuntimeError):
@@ -89,20 +81,19 @@ class PairWindow(ViewsWindow):
     def _build(self, force_offscreen) -> None:
         p = self.pair
         kinds = ((label, kind) for kind, label in DISTANCE_KINDS.items())
-        self.kind_combo = _tip(add_items(QtWidgets.QComboBox(), kinds), KIND_TIP)
+        self.kind_combo = tip(add_items(QtWidgets.QComboBox(), kinds), KIND_TIP)
         displays = (("Continuous", "continuous"), ("Threshold", "threshold"))
         self.display_combo = add_items(QtWidgets.QComboBox(), displays)
         self.share_slider = slider(1, 500, SHARE_TIP)  # tenths of a percent of the other's area
         self.share_slider.valueChanged.connect(lambda v: p.set_display("threshold", v / 1000))
-        self.share_label = QtWidgets.QLabel()
-        self.share_label.setMinimumWidth(150)
+        self.share_label = QtWidgets.QLabel(minimumWidth=150)
         self.k_spin = spin_box(2, 1000, tip="Modes computed on each mesh (the same on both)")
         self.k_spin.setPrefix("k = ")
         self.k_spin.editingFinished.connect(lambda: p.set_k(self.k_spin.value()))
-        self.rescale_check = _tip(
+        self.rescale_check = tip(
             QtWidgets.QCheckBox("Rescale both to the same area before computing"), RESCALE_TIP
         )
-        self.link_check = _tip(QtWidgets.QCheckBox("Linked cameras"), LINK_TIP)
+        self.link_check = tip(QtWidgets.QCheckBox("Linked cameras"), LINK_TIP)
         self.controls = {  # the pair's field -> (its widget, its setter)
             "kind": (self.kind_combo, p.set_kind),
             "distance_display": (self.display_combo, p.set_display),
@@ -111,7 +102,7 @@ class PairWindow(ViewsWindow):
         }
         for widget, setter in self.controls.values():
             bind(widget, setter)
-        export = _tip(QtWidgets.QPushButton("Export..."), "Both views side by side in one PNG")
+        export = tip(QtWidgets.QPushButton("Export..."), "Both views side by side in one PNG")
         export.clicked.connect(self.export_dialog)
         layout = QtWidgets.QVBoxLayout(self)
         controls = (self.kind_combo, self.display_combo, self.share_slider, self.share_label)
@@ -124,23 +115,15 @@ class PairWindow(ViewsWindow):
             self.titles[side] = QtWidgets.QLabel()
             viewport = self.viewports[side] = make_viewport(self, force_offscreen)
             viewport.clicked.connect(lambda x, y, s=side: self._on_click(s, x, y))
-            if hasattr(viewport, "cameraChanged"):
-                viewport.cameraChanged.connect(lambda s=side: self._on_camera(s))
+            viewport.cameraChanged.connect(lambda s=side: self._on_camera(s))
             column.addWidget(self.titles[side])
             column.addWidget(viewport.widget, 1)
             views.addLayout(column, 1)
         layout.addLayout(views, 1)
-        self.status = QtWidgets.QLabel()
-        self.status.setWordWrap(True)
-        self.progress = QtWidgets.QProgressBar()
-        self.progress.setRange(0, 1000)
-        self.progress.setMinimumWidth(240)  # room for "Discrete Shells ... of B"
-        self.progress.setMaximumWidth(320)
-        self.cancel_button = _tip(QtWidgets.QPushButton("Cancel"), "Cancel this window's work")
-        self.cancel_button.clicked.connect(p.cancel)
-        for widget in (self.progress, self.cancel_button):
-            widget.hide()
-        layout.addLayout(row((self.status, 1), self.progress, self.cancel_button))
+        self.status = QtWidgets.QLabel(wordWrap=True)
+        self.job_progress = JobProgress((240, 320), "Cancel this window's work", p.cancel)
+        self.progress = self.job_progress.bar
+        layout.addLayout(row((self.status, 1), self.progress, self.job_progress.cancel_button))
         self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
         self.install_keys(
@@ -279,30 +262,7 @@ class PairWindow(ViewsWindow):
         if self._closed:
             return
         pending = self.pair.pending()
-        running = next((j for j in pending if j.status == "running"), None)
-        self.progress.setVisible(bool(pending))
-        self.cancel_button.setVisible(bool(pending))
-        if running is not None:
-            self.progress.setValue(int(1000 * running.fraction))
-            more = f" (+{len(pending) - 1} queued)" if len(pending) > 1 else ""
-            self.progress.setFormat(
-                self._fitted(running.description, f": {running.stage} %p %{more}")
-            )
-        elif pending:
-            self.progress.setValue(0)
-            self.progress.setFormat(self._fitted(f"waiting: {pending[0].description}", ""))
-        if pending:  # the whole text where the bar shows it shortened
-            self.progress.setToolTip(pending[0].description)
-
-    def _fitted(self, head: str, tail: str) -> str:
-        """``head`` + ``tail`` as the progress bar's format, ``head`` (the computation's
-        name) shortened with an ellipsis so that the text fits inside the bar: the
-        stage and percentage in ``tail`` always show ("%p" is the bar's percentage)."""
-        metrics = self.progress.fontMetrics()
-        room = self.progress.width() - 2 * metrics.horizontalAdvance("M")  # frame, margins
-        tail_width = metrics.horizontalAdvance(tail.replace("%p", "100"))
-        elide = QtCore.Qt.TextElideMode.ElideRight
-        return metrics.elidedText(head, elide, max(0, room - tail_width)) + tail
+        self.job_progress.show_jobs(sorted(pending, key=lambda job: job.status != RUNNING))
 
     # ========================================================== cameras
     def _on_linked(self, on: bool) -> None:

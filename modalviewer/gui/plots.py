@@ -46,15 +46,9 @@ class LinePlot(QtWidgets.QWidget):
         self.second_label = ""
         self.setMinimumHeight(140)
 
-    def set_data(
-        self, x, y, highlight=None, logx=False, markers=True, title=None, zero_mask=None
-    ) -> None:
-        """``zero_mask`` (len(y),) bool: samples plotted and labelled as exactly 0 (a
-        spectrum's zero modes, whose computed eigenvalues are round-off)."""
+    def set_data(self, x, y, highlight=None, logx=False, markers=True, title=None) -> None:
         self.x = np.asarray(x, dtype=float)
         self.y = np.asarray(y, dtype=float)
-        if zero_mask is not None and self.y.size:
-            self.y = np.where(np.asarray(zero_mask, dtype=bool), 0.0, self.y)
         self.highlight = highlight
         self.logx = logx
         self.markers = markers

@@ -22,8 +22,7 @@ class SceneView(QtCore.QObject):
         self._phase = 0.0
         self._last_tick: float | None = None
         self.frame_times: list[float] = []
-        self.timer = QtCore.QTimer(self)
-        self.timer.setInterval(16)
+        self.timer = QtCore.QTimer(self, interval=16)
         self.timer.timeout.connect(self._animate_step)
         self.drawing = StateScene(
             state, self.plotter, viewport.request_render, on_animation=self._on_animation

@@ -1,11 +1,86 @@
-"""The main window's status bar: the status line (what is shown), the progress bar of
-the running computation and its Cancel button."""
+"""The main window's status bar: the status line (what is shown, always in sync with the
+state), the progress bar of the running computation and its Cancel button."""
 
 from __future__ import annotations
 
-from qtpy import QtWidgets
+from qtpy import QtCore, QtGui, QtWidgets
 
-from .panels import StatusLine
+from ..viewer.jobs import RUNNING
+from ..viewer.wording import summary
+from .panels.common import follow, tip
+
+
+class StatusLine(QtWidgets.QLabel):
+    """A permanent status-bar label showing :func:`~modalviewer.viewer.wording.summary`."""
+
+    def __init__(self, state, parent=None):
+        super().__init__(parent)
+        self.state = state
+        # framed, so a temporary message to its left ("Computing ...") does not read as
+        # the start of the same line
+        self.setFrameShape(QtWidgets.QFrame.Shape.StyledPanel)
+        follow(state, self.update_from_state, "display", "pick", "spectra", "mesh", "style")
+        self.update_from_state()
+
+    def update_from_state(self, *_args) -> None:
+        text = summary(self.state)
+        self.setText(text)
+        self.setToolTip(text)
+
+    def minimumSizeHint(self) -> QtCore.QSize:  # noqa: N802 (Qt override)
+        # narrower than its text: the text is elided (paintEvent), whole in the tooltip
+        hint = super().minimumSizeHint()
+        return QtCore.QSize(min(hint.width(), 160), hint.height())
+
+    def paintEvent(self, event) -> None:  # noqa: N802
+        """The text elided with "..." where the label is narrower than it (the status bar
+        shares its width with messages), instead of cut off mid-word."""
+        painter = QtGui.QPainter(self)
+        self.drawFrame(painter)
+        rect = self.contentsRect().adjusted(self.margin() + 3, 0, -self.margin() - 3, 0)
+        text = self.fontMetrics().elidedText(
+            self.text(), QtCore.Qt.TextElideMode.ElideRight, max(rect.width(), 0)
+        )
+        painter.drawText(rect, int(self.alignment()), text)
+        painter.end()
+
+
+class JobProgress:
+    """A progress bar and its Cancel button showing jobs (hidden without any), the
+    running one first: [its name:] its stage, percentage and how many wait; what comes
+    before the percentage is shortened with an ellipsis where the bar is too narrow."""
+
+    def __init__(self, width: tuple[int, int], cancel_tip: str, cancel, named: bool = True):
+        self.named = named
+        self.bar = QtWidgets.QProgressBar(
+            maximum=1000, minimumWidth=width[0], maximumWidth=width[1]
+        )
+        self.cancel_button = tip(QtWidgets.QPushButton("Cancel"), cancel_tip)
+        self.cancel_button.clicked.connect(cancel)
+        self.show_jobs([])
+
+    def show_jobs(self, jobs) -> None:
+        for widget in (self.bar, self.cancel_button):
+            widget.setVisible(bool(jobs))
+        if not jobs:
+            return
+        job, more = jobs[0], f" (+{len(jobs) - 1} queued)" if len(jobs) > 1 else ""
+        self.bar.setValue(int(1000 * job.fraction) if job.status == RUNNING else 0)
+        if job.status != RUNNING:
+            self.bar.setFormat(self._fitted(f"waiting: {job.description}", ""))
+        elif self.named:
+            self.bar.setFormat(self._fitted(job.description, f": {job.stage} %p %{more}"))
+        else:  # as in the Computations list
+            self.bar.setFormat(self._fitted(job.stage, f" %p %{more}"))
+        self.bar.setToolTip(f"{job.description}: {job.stage}")  # the whole text
+
+    def _fitted(self, head: str, tail: str) -> str:
+        """``head`` elided to fit + ``tail`` ("%p" is the bar's percentage)."""
+        metrics = self.bar.fontMetrics()
+        room = self.bar.width() - 2 * metrics.horizontalAdvance("M")  # frame, margins
+        tail_width = metrics.horizontalAdvance(tail.replace("%p", "100"))
+        elide = QtCore.Qt.TextElideMode.ElideRight
+        return metrics.elidedText(head, elide, max(0, room - tail_width)) + tail
 
 
 class StatusBarWidgets:
@@ -15,24 +90,17 @@ class StatusBarWidgets:
     """Widest the status line gets; :data:`STATUS_LINE_WIDTH_BESIDE_MESSAGE` while a
     temporary message is shown, which needs the room more (what is computing and why)."""
     STATUS_LINE_WIDTH_BESIDE_MESSAGE = 300
-    STAGE_CHARS = 30
-    """Characters of the running stage the progress bar shows (longer ones are cut, whole
-    in its tooltip and in the Computations list)."""
 
-    def __init__(self, bar: QtWidgets.QStatusBar, state, jobs):
+    def __init__(self, bar: QtWidgets.QStatusBar, state, jobs, cancel):
         self.bar = bar
         self.jobs = jobs
         self.status_line = StatusLine(state)
         self.status_line.setMaximumWidth(self.STATUS_LINE_WIDTH)
         bar.addPermanentWidget(self.status_line)
-        self.progress = QtWidgets.QProgressBar()
-        self.progress.setFixedWidth(260)
-        self.progress.setRange(0, 1000)
-        self.progress.hide()
-        self.cancel_button = QtWidgets.QPushButton("Cancel")
-        self.cancel_button.setToolTip("Cancel the running computation (Esc)")
-        self.cancel_button.hide()
-        bar.addPermanentWidget(self.progress)
+        cancel_tip = "Cancel the running computation (Esc)"
+        self.progress = JobProgress((260, 260), cancel_tip, cancel, named=False)
+        self.cancel_button = self.progress.cancel_button
+        bar.addPermanentWidget(self.progress.bar)
         bar.addPermanentWidget(self.cancel_button)
         # the message shares the bar with the status line: while one is shown the status
         # line (elided, whole in its tooltip) gives it room; whole message on hover
@@ -47,14 +115,5 @@ class StatusBarWidgets:
 
     def _on_job_changed(self, _job) -> None:
         running = self.jobs.running
-        self.progress.setVisible(running is not None)
-        self.cancel_button.setVisible(running is not None)
-        if running is not None:
-            self.progress.setValue(int(1000 * running.fraction))
-            queued = len(self.jobs.jobs) - 1
-            more = f" (+{queued} queued)" if queued else ""
-            stage = running.stage
-            if len(stage) > self.STAGE_CHARS:
-                stage = stage[: self.STAGE_CHARS - 1] + "…"
-            self.progress.setFormat(f"{stage} %p %{more}")  # as in the Computations list
-            self.progress.setToolTip(f"{running.description}: {running.stage}")
+        others = [job for job in self.jobs.jobs if job is not running]
+        self.progress.show_jobs([running, *others] if running is not None else [])

@@ -34,9 +34,8 @@ class OffscreenViewport(QtWidgets.QWidget):
     cameraChanged = QtCore.Signal()
 
     def __init__(self, parent=None):
-        super().__init__(parent)
-        self.setMinimumSize(200, 150)
-        self.setFocusPolicy(QtCore.Qt.FocusPolicy.StrongFocus)
+        strong = QtCore.Qt.FocusPolicy.StrongFocus
+        super().__init__(parent, minimumSize=QtCore.QSize(200, 150), focusPolicy=strong)
         # notebook=False: in a Jupyter kernel pyvista would show through its notebook
         # backend (trame, or an ImportError without it) instead of rendering here
         self.plotter = pv.Plotter(off_screen=True, notebook=False, window_size=(640, 480))

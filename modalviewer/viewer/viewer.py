@@ -186,6 +186,13 @@ class Viewer(ViewerModel, Pictures):
         """The latest spectrum of each computed operator."""
         return {op: self._public(self.state.spectrum(op)) for op in self.state.operators_computed()}
 
+    def spectrum_shown(self) -> Spectrum | None:
+        """The spectrum the picture on screen is made of (a mode's operator, a distance's),
+        else the current one: what File > Export spectrum writes."""
+        operators = (self.state.display_operator(), self.state.current_operator())
+        shown = [self.state.spectrum(op) for op in operators if op is not None]
+        return self._public(next((spec for spec in shown if spec is not None), None))
+
     def add_spectrum(self, spectrum: Spectrum) -> None:
         """Put a spectrum computed elsewhere (``modalviewer.compute_spectrum``, a file)
         into the viewer, as the spectrum of its operator and k under the current compute

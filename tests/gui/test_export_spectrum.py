@@ -1,10 +1,10 @@
-"""File > Export spectrum writes the spectrum the picture on screen is made of."""
+"""File > Export spectrum writes the spectrum the picture on screen is made of
+(``Viewer.spectrum_shown``)."""
 
 from pathlib import Path
 
 from modalviewer.core.cache import SpectrumCache
-from modalviewer.gui.file_dialogs import spectrum_to_export
-from modalviewer.viewer import ViewerModel
+from modalviewer.viewer import Viewer
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
@@ -12,19 +12,19 @@ ASSETS = Path(__file__).resolve().parents[2] / "assets"
 def test_the_exported_spectrum_is_the_one_on_screen(tmp_path):
     # with a vibration distance on screen and the Laplacian computed after it (as the
     # distance comparison does), the export took the Laplacian
-    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    model = Viewer(cache=SpectrumCache(tmp_path / "cache"))
     model.open_mesh(ASSETS / "demo_plate.obj")
     state = model.state
     model.jobs.wait(model.request_spectrum("shells", k=12, show=True))
     state.show_mode(8)
-    assert spectrum_to_export(state).operator == "shells"
+    assert model.spectrum_shown().operator == "shells"
     state.set_display(kind="distance", distance_kind="vibration")
     model.jobs.wait(model.request_spectrum("laplacian", k=12, show=False))
-    assert spectrum_to_export(state).operator == "shells"
+    assert model.spectrum_shown().operator == "shells"
     state.set_display(distance_kind="hks")
-    assert spectrum_to_export(state).operator == "laplacian"
+    assert model.spectrum_shown().operator == "laplacian"
     state.show_mode(3, "laplacian")
-    assert spectrum_to_export(state).operator == "laplacian"
+    assert model.spectrum_shown().operator == "laplacian"
 
 
 def test_the_exported_spectrum_has_a_row_per_vertex_of_the_file(tmp_path):
@@ -37,10 +37,10 @@ def test_the_exported_spectrum_has_a_row_per_vertex_of_the_file(tmp_path):
     path = tmp_path / "padded.obj"
     rows = [f"v {x:.17g} {y:.17g} {z:.17g}" for x, y, z in v]
     path.write_text("\n".join(rows + [f"f {a + 2} {b + 2} {c + 2}" for a, b, c in plate.faces]))
-    model = ViewerModel(cache=SpectrumCache(tmp_path / "cache"))
+    model = Viewer(cache=SpectrumCache(tmp_path / "cache"))
     mesh = model.open_mesh(path)
     model.jobs.wait(model.request_spectrum("laplacian", k=8, show=True))
-    spec = spectrum_to_export(model.state)
+    spec = model.spectrum_shown()
     mv.save_spectrum(spec, tmp_path / "s.npz")
     back = mv.load_spectrum(tmp_path / "s.npz", mesh=mesh)  # the file's mesh, as loaded
     assert back.n_vertices == len(v) and np.isnan(back.modes[0]).all()

@@ -7,6 +7,7 @@ import pytest
 from PIL import Image
 from qtpy import QtCore, QtWidgets
 
+from modalviewer.gui.viewport import grab_views
 from modalviewer.scene.export import grab
 from modalviewer.scene.framing import overlay_boxes
 from modalviewer.scene.offscreen import OffscreenRenderer
@@ -159,7 +160,7 @@ def test_a_compare_windows_export_has_a_colour_bar_per_continuous_view(
         x += w + 4
     # a threshold map: each view's two-swatch legend (the blue swatch) instead
     window.viewer.show_distance("vibration", display="threshold", share=0.2)
-    images = compare.grab_images()
+    images = grab_views(compare.viewports, compare.scenes)
     for image in images:
         bottom = image[-80:].astype(int)
         blue = (bottom[..., 2] - bottom[..., 0] > 80).sum()

@@ -6,6 +6,7 @@ from PIL import Image
 from qtpy import QtCore
 
 from modalviewer.core.primitives import icosphere
+from modalviewer.gui.viewport import grab_views
 
 pytestmark = pytest.mark.gui
 
@@ -348,9 +349,9 @@ def test_linked_comparison_of_three_operators(window, spot_path, tmp_path, qtbot
         np.testing.assert_allclose(
             scene.surface.point_data["field"], window.spectra[op].mode(7), rtol=0, atol=0
         )
-    images = compare.grab_images()
+    images = grab_views(compare.viewports, compare.scenes)
     compare.viewports[0].plotter.camera.Azimuth(180)  # the shared camera: all views turn
-    behind = compare.grab_images()
+    behind = grab_views(compare.viewports, compare.scenes)
     compare.viewports[0].plotter.camera.Azimuth(180)
     for img, back in zip(images, behind, strict=True):
         counts, counts_back = _classify(img), _classify(back)

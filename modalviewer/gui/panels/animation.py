@@ -15,9 +15,9 @@ class AnimationPanel(QtWidgets.QWidget):
         super().__init__(parent)
         self.state = state
         form = QtWidgets.QFormLayout(self)
-        self.play_button = QtWidgets.QPushButton("Play")
-        self.play_button.setCheckable(True)
-        self.play_button.setToolTip("Animate the mode (Space)")
+        self.play_button = QtWidgets.QPushButton(
+            "Play", checkable=True, toolTip="Animate the mode (Space)"
+        )
         self.amp_slider = slider(
             0,
             100,

@@ -77,12 +77,16 @@ class WrappingLabel(QtWidgets.QLabel):
         self.setMinimumHeight(needed if needed > 0 else kept)
 
 
+def tip(widget, text: str):
+    """``widget`` with the tooltip ``text``."""
+    widget.setToolTip(text)
+    return widget
+
+
 def slider(low: int, high: int, tip: str = "") -> QtWidgets.QSlider:
     """A horizontal slider over ``low`` .. ``high`` with the tooltip ``tip``."""
-    widget = QtWidgets.QSlider(QtCore.Qt.Orientation.Horizontal)
-    widget.setRange(low, high)
-    widget.setToolTip(tip)
-    return widget
+    horizontal = QtCore.Qt.Orientation.Horizontal
+    return QtWidgets.QSlider(horizontal, minimum=low, maximum=high, toolTip=tip)
 
 
 def spin_box(low, high, value=None, tip: str = "", suffix: str = "") -> QtWidgets.QSpinBox:

@@ -7,7 +7,7 @@ from qtpy import QtCore, QtWidgets
 from ...core.operators import OPERATOR_INFO
 from ...viewer import wording
 from ...viewer.state import ViewerState
-from .common import WrappingLabel, bind, combo, follow, show_values
+from .common import WrappingLabel, add_items, bind, combo, follow, show_values, spin_box, tip
 
 K_MAX = 1_000_000
 """The Modes k box's maximum: no limit a mesh could reach before the memory check."""
@@ -22,36 +22,35 @@ class ComputePanel(QtWidgets.QWidget):
         super().__init__(parent)
         self.state = state
         form = QtWidgets.QFormLayout(self)
-        self.operator_combo = combo()
-        for info in OPERATOR_INFO.values():
-            self.operator_combo.addItem(info.label, info.name)
-        self.k_spin = QtWidgets.QSpinBox()
+        operators = ((info.label, info.name) for info in OPERATOR_INFO.values())
+        self.operator_combo = add_items(combo(), operators)
         # no cap of its own: a mesh has as many modes as unknowns (a request for more
         # gets them all and says so), and the memory check refuses what would not fit,
         # saying what would (a capped box drops typed digits beyond its cap unsaid)
-        self.k_spin.setRange(1, K_MAX)
-        self.k_spin.setToolTip(
-            "Number of modes (lowest eigenpairs) to compute. A mesh has as many as it has "
-            "unknowns (vertices, three per vertex for the 3D shells); a request that "
-            "would not fit in memory is refused with what would."
+        self.k_spin = spin_box(
+            1,
+            K_MAX,
+            tip="Number of modes (lowest eigenpairs) to compute. A mesh has as many as it "
+            "has unknowns (vertices, three per vertex for the 3D shells); a request that "
+            "would not fit in memory is refused with what would.",
         )
-        self.bending_spin = QtWidgets.QDoubleSpinBox()
-        self.membrane_spin = QtWidgets.QDoubleSpinBox()
-        for spin in (self.bending_spin, self.membrane_spin):
-            spin.setDecimals(4)
-            spin.setRange(0.0, 1e6)
-        self.rescale_check = QtWidgets.QCheckBox("Rescale to unit area (default: off)")
-        self.rescale_check.setToolTip(
+        self.bending_spin, self.membrane_spin = (
+            QtWidgets.QDoubleSpinBox(decimals=4, maximum=1e6) for _ in range(2)
+        )
+        self.rescale_check = tip(
+            QtWidgets.QCheckBox("Rescale to unit area (default: off)"),
             "Compute on a copy scaled to total area 1. The shells spectrum depends on the "
-            "absolute size; rescaling makes meshes of different sizes comparable."
+            "absolute size; rescaling makes meshes of different sizes comparable.",
         )
-        self.coarse_check = QtWidgets.QCheckBox("Coarse-to-fine (default: off)")
-        self.coarse_check.setToolTip(
+        self.coarse_check = tip(
+            QtWidgets.QCheckBox("Coarse-to-fine (default: off)"),
             "Compute on a copy decimated to about a fifth of the vertices and carry the modes "
-            "to this mesh by nearest vertex (paper Section 7): much faster on big meshes."
+            "to this mesh by nearest vertex (paper Section 7): much faster on big meshes.",
         )
-        self.compute_button = QtWidgets.QPushButton("Compute spectrum")
-        self.compute_button.setToolTip("Compute the selected operator's spectrum (Ctrl+R)")
+        self.compute_button = tip(
+            QtWidgets.QPushButton("Compute spectrum"),
+            "Compute the selected operator's spectrum (Ctrl+R)",
+        )
         form.addRow("Operator", self.operator_combo)
         form.addRow("Modes k", self.k_spin)
         form.addRow("Bending weight", self.bending_spin)

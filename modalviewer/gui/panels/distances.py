@@ -10,9 +10,20 @@ from ...core.operators import (
     operator_for_distance,
     signature_kind,
 )
-from ...viewer.state import ViewerState
+from ...viewer.state import DISTANCE_DISPLAYS, ViewerState
 from ..plots import LinePlot
-from .common import WrappingLabel, add_items, bind, combo, follow, quiet, row, show_values, slider
+from .common import (
+    WrappingLabel,
+    add_items,
+    bind,
+    combo,
+    follow,
+    quiet,
+    row,
+    show_values,
+    slider,
+    tip,
+)
 
 SLIDER_STEPS = 1000
 
@@ -33,20 +44,15 @@ class DistancesPanel(QtWidgets.QWidget):
         self.state = state
         form = QtWidgets.QFormLayout(self)
         self.kind_combo = add_items(combo(), ((v, k) for k, v in DISTANCE_KINDS.items()))
-        self.display_combo = add_items(
-            combo(),
-            (
-                ("Continuous (white to red)", "continuous"),
-                ("Threshold (blue = similar)", "threshold"),
-            ),
-        )
+        displays = ("Continuous (white to red)", "Threshold (blue = similar)")
+        self.display_combo = add_items(combo(), zip(displays, DISTANCE_DISPLAYS, strict=True))
         self.threshold_slider = slider(1, SLIDER_STEPS, "Threshold of the blue (similar) region")
-        self.by_share_check = QtWidgets.QCheckBox("Slider by share of surface")
-        self.by_share_check.setChecked(True)
-        self.by_share_check.setToolTip(
+        self.by_share_check = tip(
+            QtWidgets.QCheckBox("Slider by share of surface"),
             "On: the slider moves through the share of the surface marked similar. "
-            "Off: linear in the fraction of the largest distance."
+            "Off: linear in the fraction of the largest distance.",
         )
+        self.by_share_check.setChecked(True)
         self.threshold_label = WrappingLabel("-")
         self.threshold_slider.setSingleStep(5)  # 0.5 % of the surface per arrow key
         self.threshold_slider.setPageStep(50)
@@ -56,8 +62,9 @@ class DistancesPanel(QtWidgets.QWidget):
             edit.setPlaceholderText("default")
             edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
         self.pick_label = WrappingLabel("Click the surface to pick a vertex.")
-        self.distance_button = QtWidgets.QPushButton("Show distance")
-        self.distance_button.setToolTip("Distance from the picked vertex (D)")
+        self.distance_button = tip(
+            QtWidgets.QPushButton("Show distance"), "Distance from the picked vertex (D)"
+        )
         form.addRow("Kind", self.kind_combo)
         form.addRow("Display", self.display_combo)
         form.addRow("Threshold", self.threshold_slider)
@@ -71,21 +78,21 @@ class DistancesPanel(QtWidgets.QWidget):
         form.addRow(self.distance_button)
         self.scale_slider = slider(0, 99, "Show the signature at this scale")
         form.addRow("Signature at scale", self.scale_slider)
-        self.scale_edit = QtWidgets.QLineEdit()
-        self.scale_edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
-        self.scale_edit.setToolTip(
+        self.scale_edit = tip(
+            QtWidgets.QLineEdit(),
             "Type a scale t: the signature is summed at t itself (the slider shows the "
-            "nearest sample)"
+            "nearest sample)",
         )
-        self.log_check = QtWidgets.QCheckBox("Log colours")
-        self.log_check.setToolTip("Colour the signature by log10(S / smallest S)")
+        self.scale_edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
+        log_tip = "Colour the signature by log10(S / smallest S)"
+        self.log_check = tip(QtWidgets.QCheckBox("Log colours"), log_tip)
         self.scale_row = row((self.scale_edit, 1), self.log_check)
         form.addRow("t", self.scale_row)
         self.signature_plot = LinePlot("Signature of the picked vertex", "t (log)", "S_t")
         form.addRow(self.signature_plot)
 
         self.kind_combo.currentIndexChanged.connect(self._on_kind)
-        self.display_combo.currentIndexChanged.connect(self._on_display)
+        bind(self.display_combo, lambda display: state.set_display(distance_display=display))
         self.threshold_slider.valueChanged.connect(self._on_slider)
         bind(self.by_share_check, lambda on: self.state.set_display(keep_share=on))
         self.t1_edit.editingFinished.connect(self._on_range)
@@ -115,9 +122,6 @@ class DistancesPanel(QtWidgets.QWidget):
             self.showDistanceRequested.emit()
         elif self.state.display.kind == "signature":
             self.showSignatureRequested.emit()
-
-    def _on_display(self, _index: int) -> None:
-        self.state.set_display(distance_display=self.display_combo.currentData())
 
     def _on_slider(self, value: int) -> None:
         position = value / SLIDER_STEPS
