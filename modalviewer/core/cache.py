@@ -70,8 +70,7 @@ class CacheEntry:
 
 @dataclass(frozen=True)
 class SolveRecord:
-    """What a cached spectrum says of the solve that made it (``seconds``:
-    ``parameters["seconds_total"]``)."""
+    """What a cached spectrum says of the solve that made it (``parameters``' seconds)."""
 
     operator: str
     mesh_hash: str

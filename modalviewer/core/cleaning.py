@@ -272,7 +272,6 @@ def _orient_faces(f: np.ndarray) -> tuple[np.ndarray, int, bool]:
         if seen[seed]:
             continue
         seen[seed] = True
-        patch[seed] = seed
         queue = deque([seed])
         while queue:
             t = queue.popleft()

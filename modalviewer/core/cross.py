@@ -5,11 +5,9 @@ Eq. (31) with one signature from each mesh, each divided by its own mesh's
 
 ``delta(v, w) = sqrt( sum_i ((S^A_{t_i}(v) / Z^A(t_i) - S^B_{t_i}(w) / Z^B(t_i))^2 * dlogt) )``
 
-The common scales are the intersection of the two default ranges, the scales both
-truncated spectra resolve.  Signatures carry a factor ``1 / area`` (and the shells
-spectrum is not scale covariant at all), so compare meshes of the same area
-(:func:`rescale_to_area`); a :class:`ScaleWarning` says when the areas differ by more
-than :data:`AREA_TOLERANCE` ("Comparing two shapes" in docs/library-guide.md).
+The common scales are those both truncated spectra resolve.  Signatures carry a factor
+``1 / area`` (the shells spectrum is not even scale covariant), so compare meshes of the
+same area (:func:`rescale_to_area`); a :class:`ScaleWarning` says when they differ.
 """
 
 from __future__ import annotations

@@ -98,8 +98,7 @@ def double_torus(cells: int = 4) -> Mesh:
     """A 7 x 4 x 1 slab with two square holes, ``cells`` voxels per unit length: genus two,
     flat faces bounded by sharp edges (Fig. 3)."""
     c = cells
-    solid = np.zeros((7 * c, 4 * c, 1 * c), dtype=bool)
-    solid[:, :, :] = True
+    solid = np.ones((7 * c, 4 * c, 1 * c), dtype=bool)
     solid[1 * c : 3 * c, 1 * c : 3 * c, :] = False
     solid[4 * c : 6 * c, 1 * c : 3 * c, :] = False
     return voxel_surface(solid, 1.0 / c)

@@ -94,9 +94,8 @@ def factor_folder() -> str:
 
 
 def remove_stale_factor_folders(parent: str | None = None) -> list[str]:
-    """Remove (and return) the factor folders ``modalviewer-factor-<pid>-...`` in
-    ``parent`` (default :func:`factor_folder`) whose process has ended: a stopped
-    computation process cannot remove its own."""
+    """Remove (and return) the factor folders in ``parent`` whose process has ended: a
+    stopped computation process cannot remove its own."""
     parent = parent or factor_folder()
     removed = []
     try:
@@ -104,10 +103,8 @@ def remove_stale_factor_folders(parent: str | None = None) -> list[str]:
     except OSError:
         return removed
     for name in names:
-        if not name.startswith(FOLDER_PREFIX):
-            continue
         pid_text = name[len(FOLDER_PREFIX) :].split("-", 1)[0]
-        if not pid_text.isdigit():
+        if not name.startswith(FOLDER_PREFIX) or not pid_text.isdigit():
             continue
         try:
             os.kill(int(pid_text), 0)

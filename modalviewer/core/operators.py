@@ -246,8 +246,7 @@ def operator_for_distance(kind: str) -> str:
 
 
 def signature_kind(kind: str) -> str:
-    """The signature (:data:`.signatures.SIGNATURE_KINDS`) distance ``kind`` is made of:
-    "wks" for a wave kernel distance, "heat" for the others."""
+    """The signature kind distance ``kind`` is made of: "wks" or "heat"."""
     info = operator_info(operator_for_distance(kind))
     return "wks" if kind == info.wave_distance_kind else "heat"
 

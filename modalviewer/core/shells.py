@@ -113,8 +113,6 @@ def _terms(mesh: Mesh, bending: float, membrane: float):
     rest = mesh.vertices
     hinge = hinges(mesh)
     edges = mesh.edges
-    faces = mesh.faces
-    areas = mesh.face_areas
     if bending:
         # combined area A_e of the two triangles of each hinge
         a_e = triangle_areas(rest, hinge[:, [0, 1, 2]]) + triangle_areas(rest, hinge[:, [1, 0, 3]])
@@ -122,7 +120,7 @@ def _terms(mesh: Mesh, bending: float, membrane: float):
         yield hinge, dihedral_angles, dihedral_angle_gradients, bending * 3.0 * len_e**2 / a_e
     if membrane:
         yield edges, edge_lengths, edge_length_gradients, membrane / edge_lengths(rest, edges)
-        yield faces, triangle_areas, triangle_area_gradients, membrane / areas
+        yield mesh.faces, triangle_areas, triangle_area_gradients, membrane / mesh.face_areas
 
 
 def _check_weights(bending: float, membrane: float) -> None:

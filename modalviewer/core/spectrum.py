@@ -25,16 +25,11 @@ class SpectrumFileError(ValueError):
 
 @dataclass
 class Spectrum:
-    """Lowest eigenpairs of one operator on one mesh.
-
-    eigenvalues : (k,) ascending, units 1/time^2 for vibrations (frequency = sqrt).
-    modes : (n, k), or (n, 3, k) for ``"shells"``, a row per vertex in the input
-        numbering (NaN where no face uses it, a merged duplicate's row that of its
-        vertex); M-orthonormal over the used rows (``M`` the lumped ``mass``), so values
-        scale with 1 / sqrt(area) (:meth:`euclidean_modes`: unit-length columns).
-    residuals : (k,) relative residuals |K u - lambda M u| / |lambda M u|.
-    mesh_hash, parameters : SHA-256 of the mesh geometry; weights and solver information.
-    from_cache : read from the spectrum cache rather than computed now (not saved).
+    """Lowest eigenpairs of one operator on one mesh: ``eigenvalues`` (k,) ascending;
+    ``modes`` (n, k), or (n, 3, k) for ``"shells"``, a row per vertex in the input
+    numbering (NaN where no face uses it), M-orthonormal over the used rows (``M`` the
+    lumped ``mass``), so values scale with 1 / sqrt(area); ``residuals`` (k,) relative,
+    |K u - lambda M u| / |lambda M u|; ``from_cache``: read from the cache (not saved).
     """
 
     eigenvalues: np.ndarray
@@ -86,8 +81,7 @@ class Spectrum:
         return int(self.parameters.get("null_space_dimension", 0))
 
     def zero_mode_mask(self) -> np.ndarray:
-        """(k,) True for the zero modes: the deflated null vectors and the eigenvalues
-        :func:`.eigen.zero_modes` counts as zero (the rule the residual check used)."""
+        """(k,) True for the zero modes (the rule of :func:`.eigen.zero_modes`)."""
         return zero_modes(
             self.eigenvalues,
             float(self.parameters.get("zero_mode_scale", 0.0)),
@@ -108,15 +102,13 @@ class Spectrum:
         return (flat / np.where(norms > 0, norms, 1.0)).reshape(self.modes.shape)
 
     def check_source(self, vertex: int) -> int:
-        """``vertex`` if it has values (a face uses it, or it was merged into a vertex a
-        face uses); a ValueError naming it otherwise."""
+        """``vertex`` if it has values (a face uses it or its vertex), else a ValueError."""
         if np.isnan(self.modes[vertex]).any():
             raise ValueError(_unused_words(vertex))
         return vertex
 
     def squared_modes(self, vertices=None) -> np.ndarray:
-        """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes); only the rows of
-        ``vertices`` (a sequence of indices) if given."""
+        """(n, k) |phi_j(v)|^2 (summed over xyz for vector modes), or only ``vertices``' rows."""
         modes = self.modes if vertices is None else self.modes[np.asarray(vertices, dtype=int)]
         if self.is_vector:
             return np.einsum("ick,ick->ik", modes, modes)
@@ -215,9 +207,8 @@ def in_input_numbering(spec: Spectrum, mesh: Mesh) -> Spectrum:
 
 
 class GrowingSpectrum:
-    """The modes of a spectrum as they arrive, lowest first, in one array for all k:
-    :meth:`so_far` is a :class:`Spectrum` of those in (its modes a view of the array; its
-    residuals NaN until the spectrum is whole)."""
+    """The modes of a spectrum as they arrive, lowest first, in one array for all k;
+    :meth:`so_far` views them as a :class:`Spectrum` (residuals NaN until it is whole)."""
 
     def __init__(self, k: int) -> None:
         self.k = int(k)
