@@ -63,8 +63,7 @@ def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _collapsible(p: int, q: int, v, f, topo, min_area: float) -> bool:
     """Whether merging vertex p into q keeps the surface a manifold and turns no face
-    around p upside down (``topo``: vertex-face and vertex-vertex CSR arrays, boundary
-    vertices, face counts per edge)."""
+    around p upside down (``topo``: :func:`_topology`)."""
     fi, fp, ni, nptr, on_boundary, adj = topo
     around_p = fi[fp[p] : fp[p + 1]]
     with_q = (f[around_p] == q).any(axis=1)

@@ -58,9 +58,8 @@ TEMPORARY_BLOCKS = 8
 
 
 def float32_basis_mb(n: int, basis_columns: int, out_columns: int) -> float:
-    """Memory (MB) of the buffer that holds a single-precision Krylov basis of
-    ``basis_columns`` columns and, after it, the ``out_columns`` double-precision
-    modes in the same memory (:func:`.eigen._widen_in_place`)."""
+    """Memory (MB) of the buffer that holds a single-precision Krylov basis and, after
+    it, the ``out_columns`` double-precision modes (:func:`.eigen._widen_in_place`)."""
     return max(8.0 * n * out_columns, 4.0 * n * basis_columns) / 2**20
 
 

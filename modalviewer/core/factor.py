@@ -231,8 +231,7 @@ class _Pardiso:
         self._folder = None
 
     def _out_of_core_folder(self) -> str | None:
-        """A new folder for the factor file, or None (the factor stays in core) where
-        the file would not fit on the disk with a gigabyte to spare."""
+        """A new folder for the factor file, or None where it would not fit on the disk."""
         parent = factor_folder()
         remove_stale_factor_folders(parent)
         try:

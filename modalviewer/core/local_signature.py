@@ -3,13 +3,12 @@
 The signature over *all* modes, ``S_t(v) = sum_j exp(-lambda_j t) |phi_j(v)|^2``, is
 the diagonal of the kernel of the linearised gradient flow (eq. 26): summed over the
 unknowns ``r`` of vertex ``v`` (three for the 3D shells),
-``S_t(v) = sum_r e_r^T M^-1/2 exp(-t M^-1/2 K M^-1/2) M^-1/2 e_r``.  Each quadratic form
-is evaluated by Lanczos quadrature (Golub and Meurant) on the shifted inverse of
-``A = M^-1/2 K M^-1/2`` (van den Eshof and Hochbruck): one factorisation of
-``K + sigma M``, then Lanczos steps from ``e_r`` give the Gauss rule for every ``t`` at
-once, until every scale has settled; the steps needed do not grow with the stiffest
-mode.  Zero modes are left out by starting from ``P e_r``, ``P`` projecting out the
-exactly known null vectors (:mod:`.nullspace`), which commutes with ``A``.
+``S_t(v) = sum_r e_r^T M^-1/2 exp(-t M^-1/2 K M^-1/2) M^-1/2 e_r``, each quadratic form
+by Lanczos quadrature (Golub and Meurant) on the shifted inverse of ``A = M^-1/2 K M^-1/2``
+(van den Eshof and Hochbruck): one factorisation of ``K + sigma M``, then Lanczos steps
+from ``e_r`` give the Gauss rule for every ``t`` at once.  Zero modes are left out by
+starting from ``P e_r``, ``P`` projecting out the known null vectors (:mod:`.nullspace`),
+which commutes with ``A``.
 """
 
 from __future__ import annotations
