@@ -53,7 +53,7 @@ def main() -> int:
     app.processEvents()
     print(f"open both meshes and the window: {time.perf_counter() - started:.1f} s")
     # seen from the palm side, so the bent fingertip shows; B follows A (linked)
-    pair.pair.set_linked(False)
+    pair.pair.linked = False
     for side in ("a", "b"):
         plotter = pair.viewports[side].plotter
         plotter.view_xy()
@@ -61,11 +61,11 @@ def main() -> int:
         plotter.camera.Elevation(35.0)
         plotter.camera.OrthogonalizeViewUp()
         plotter.reset_camera()
-    pair.pair.set_linked(True)
+    pair.pair.linked = True
     pair.pair.set_display("threshold", share=args.share)
     for kind in ("vibration", "hks"):
         t = time.perf_counter()
-        pair.pair.set_kind(kind)
+        pair.pair.kind = kind
         pair.wait()
         print(f"{kind}: spectra of both meshes {time.perf_counter() - t:.1f} s")
         t = time.perf_counter()

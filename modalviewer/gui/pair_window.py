@@ -89,19 +89,19 @@ class PairWindow(ViewsWindow):
         self.share_label = QtWidgets.QLabel(minimumWidth=150)
         self.k_spin = spin_box(2, 1000, tip="Modes computed on each mesh (the same on both)")
         self.k_spin.setPrefix("k = ")
-        self.k_spin.editingFinished.connect(lambda: p.set_k(self.k_spin.value()))
+        self.k_spin.editingFinished.connect(lambda: setattr(p, "k", self.k_spin.value()))
         self.rescale_check = tip(
             QtWidgets.QCheckBox("Rescale both to the same area before computing"), RESCALE_TIP
         )
         self.link_check = tip(QtWidgets.QCheckBox("Linked cameras"), LINK_TIP)
-        self.controls = {  # the pair's field -> (its widget, its setter)
-            "kind": (self.kind_combo, p.set_kind),
-            "distance_display": (self.display_combo, p.set_display),
-            "rescale": (self.rescale_check, p.set_rescale),
-            "linked": (self.link_check, p.set_linked),
+        self.controls = {  # the pair's field -> its widget
+            "kind": self.kind_combo,
+            "distance_display": self.display_combo,
+            "rescale": self.rescale_check,
+            "linked": self.link_check,
         }
-        for widget, setter in self.controls.values():
-            bind(widget, setter)
+        for name, widget in self.controls.items():
+            bind(widget, lambda value, n=name: setattr(p, n, value))
         export = tip(QtWidgets.QPushButton("Export..."), "Both views side by side in one PNG")
         export.clicked.connect(self.export_dialog)
         layout = QtWidgets.QVBoxLayout(self)
@@ -133,7 +133,7 @@ class PairWindow(ViewsWindow):
 
     def _sync_controls(self) -> None:
         p = self.pair
-        shown = [(widget, getattr(p, name)) for name, (widget, _) in self.controls.items()]
+        shown = [(widget, getattr(p, name)) for name, widget in self.controls.items()]
         numbers = [(self.share_slider, int(round(1000 * p.share))), (self.k_spin, p.k)]
         show_values(shown + numbers)
         self.share_slider.setEnabled(p.distance_display == "threshold")
@@ -266,7 +266,7 @@ class PairWindow(ViewsWindow):
 
     # ========================================================== cameras
     def _on_linked(self, on: bool) -> None:
-        """Linked cameras (``pair.set_linked``): the two views keep the relative viewpoint
+        """Linked cameras (``pair.linked``): the two views keep the relative viewpoint
         they have when the link is made (after opening or R: the same direction, each
         about its own mesh's centre), so turning, zooming or panning one view does the
         same to the other.  Free cameras: turn B by hand to line it up with A (a rotated

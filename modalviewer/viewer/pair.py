@@ -8,8 +8,10 @@ pick.  Its spectra go through the main window's :class:`~.jobs.JobQueue` and the
 cache, reusing a spectrum of A the main window already holds.  Distances are
 :class:`~modalviewer.core.cross.CrossTables` queries.  The window draws
 :meth:`PairState.view` of each side and observes ``events``: ``meshes()`` (A or B
-replaced: spectra and pick dropped), ``spectra()``, ``display()`` and ``message(str)``
-(something the user should read).
+replaced: spectra and pick dropped), ``spectra()``, ``display()`` (also after a setting
+changed: ``kind``, ``k``, ``rescale``, ``distance_display``, ``share``, evented fields,
+each with its own event too), ``linked(on)`` and ``message(str)`` (something the user
+should read).
 
 Vertices and distances are in the input's numbering (NaN at vertices no face uses);
 only :class:`PairView` numbers the vertices of :meth:`PairState.drawn_mesh`.
@@ -18,11 +20,12 @@ only :class:`PairView` numbers the vertices of :meth:`PairState.drawn_mesh`.
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
-from psygnal import Signal, SignalGroup
+from psygnal import Signal, SignalGroup, SignalGroupDescriptor
 
 from ..core.cache import SpectrumCache
 from ..core.cross import CrossTables, Matches, ScaleWarning
@@ -92,7 +95,6 @@ class PairEvents(SignalGroup):
     spectra = Signal()
     display = Signal()
     message = Signal(str)
-    linked = Signal(bool)  # the cameras were linked or freed
 
 
 class _Side:
@@ -107,6 +109,7 @@ class _Side:
         return self.path.name if self.path is not None else "mesh"
 
 
+@dataclass(eq=False)
 class PairState:
     """Mesh A and mesh B, their spectra, the pick and the display; see the module docstring.
 
@@ -115,39 +118,55 @@ class PairState:
     ``k``: modes per spectrum on both meshes (default:
     :func:`~modalviewer.core.operators.default_k`).
     ``weights``: the Discrete Shells (bending, membrane) weights.
+    ``share``: of the other mesh's area, marked by the threshold display.
+    ``linked``: the two views' cameras move together (keeping their relative viewpoint).
     """
 
-    def __init__(
-        self,
-        jobs: JobQueue,
-        cache: SpectrumCache,
-        mesh_a: Mesh,
-        mesh_b: Mesh,
-        path_a=None,
-        path_b=None,
-        state_a: ViewerState | None = None,
-        k: int | None = None,
-        weights: tuple[float, float] = (1.0, 1.0),
-        kind: str = "hks",
-        rescale: bool = True,
-    ) -> None:
-        self.events = PairEvents()
-        self.jobs = jobs
-        self.cache = cache
-        self.state_a = state_a
+    events: ClassVar = SignalGroupDescriptor(
+        signal_group_class=PairEvents,
+        signal_aliases=dict.fromkeys(("jobs", "cache", "state_a", "weights")),
+    )
+    jobs: JobQueue
+    cache: SpectrumCache
+    mesh_a: InitVar[Mesh]
+    mesh_b: InitVar[Mesh]
+    path_a: InitVar[object] = None
+    path_b: InitVar[object] = None
+    state_a: ViewerState | None = None
+    k: int | None = None
+    weights: tuple[float, float] = (1.0, 1.0)
+    kind: str = "hks"
+    rescale: bool = True
+    distance_display: str = "continuous"
+    share: float = DEFAULT_THRESHOLD_SHARE
+    linked: bool = True
+
+    def __setattr__(self, name: str, value) -> None:
+        if name == "kind" and value not in DISTANCE_KINDS:
+            raise ValueError(f"distance kind must be one of {', '.join(DISTANCE_KINDS)}")
+        if name == "distance_display" and value not in DISTANCE_DISPLAYS:
+            raise ValueError(f"display must be one of {DISTANCE_DISPLAYS}")
+        if name == "k" and value is not None:
+            value = int(value)
+            if value < 1:
+                raise ValueError("the number of modes must be at least 1")
+        elif name == "share":
+            if not np.isfinite(value := float(value)):
+                raise ValueError("the share must be a number between 0 and 1")
+            value = float(np.clip(value, 0.0, 1.0))
+        elif name in ("rescale", "linked"):
+            value = bool(value)
+        elif name == "weights":
+            value = (float(value[0]), float(value[1]))
+        super().__setattr__(name, value)
+
+    def __post_init__(self, mesh_a: Mesh, mesh_b: Mesh, path_a, path_b) -> None:
         self.sides = {"a": _Side(mesh_a, path_a), "b": _Side(mesh_b, path_b)}
-        if kind not in DISTANCE_KINDS:
-            raise ValueError(f"distance kind must be one of {tuple(DISTANCE_KINDS)}")
-        self.kind = kind
-        self.k = int(k) if k is not None else self._default_k()
-        if self.k < 1:
-            raise ValueError("the number of modes must be at least 1")
-        self.weights = (float(weights[0]), float(weights[1]))
-        self.rescale = bool(rescale)
-        self.distance_display = "continuous"
-        self.share = DEFAULT_THRESHOLD_SHARE  # of the other mesh's area, threshold display
+        if self.k is None:
+            self.k = min(default_k(self.sides[s].mesh.n_vertices) for s in SIDES)
+        for name in ("kind", "k", "rescale", "distance_display", "share"):
+            getattr(self.events, name).connect(lambda: self.events.display.emit())
         self._pick: tuple[str, int] | None = None  # (side, vertex of the drawn mesh)
-        self.linked = True  # the two views' cameras move together
         self.note = ""  # a warning about the current pair (scale), shown in legends
         self._spectra: dict[tuple[str, str, SpectrumKey], Spectrum] = {}
         self._pending: dict[tuple[str, str, SpectrumKey], Job] = {}
@@ -156,12 +175,6 @@ class PairState:
         self._distance: tuple | None = None  # (tables id, pick, distances)
         self._back: tuple | None = None  # (tables id, side, best match, back match)
         self._scale: tuple | None = None  # (distances, their spread colour scale)
-
-    def set_linked(self, on: bool) -> None:
-        """Link the two views' cameras (they keep their relative viewpoint) or free them."""
-        if bool(on) != self.linked:
-            self.linked = bool(on)
-            self.events.linked.emit(self.linked)
 
     # ----------------------------------------------------------- meshes
     def mesh(self, side: str) -> Mesh:
@@ -189,9 +202,6 @@ class PairState:
         self.events.meshes.emit()
         self.events.display.emit()
 
-    def _default_k(self) -> int:
-        return min(default_k(self.sides[s].mesh.n_vertices) for s in SIDES)
-
     def owner(self, side: str) -> tuple:
         """The owner of this pair's jobs for ``side`` (cancelling them leaves others')."""
         return ("pair", id(self), side, self.sides[side].mesh.hash)
@@ -207,42 +217,12 @@ class PairState:
         bending, membrane = self.weights if weights else (1.0, 1.0)
         return SpectrumKey(self.operator, self.k, bending, membrane, rescale=self.rescale)
 
-    def set_kind(self, kind: str) -> None:
-        if kind not in DISTANCE_KINDS:
-            raise ValueError(f"distance kind must be one of {', '.join(DISTANCE_KINDS)}")
-        if kind != self.kind:
-            self.kind = kind
-            self.events.display.emit()
-
-    def set_k(self, k: int) -> None:
-        k = int(k)
-        if k < 1:
-            raise ValueError("the number of modes must be at least 1")
-        if k != self.k:
-            self.k = k
-            self.events.display.emit()
-
-    def set_rescale(self, on: bool) -> None:
-        if bool(on) != self.rescale:
-            self.rescale = bool(on)
-            self.events.display.emit()
-
     def set_display(self, display: str, share: float | None = None) -> None:
-        """``display``: "continuous" or "threshold"; ``share``: the part (0..1) of the
-        other mesh's surface area the threshold marks blue."""
-        if display not in DISTANCE_DISPLAYS:
-            raise ValueError(f"display must be one of {DISTANCE_DISPLAYS}")
-        changed = display != self.distance_display
+        """Set ``distance_display`` ("continuous" or "threshold") and, if given,
+        ``share``."""
         self.distance_display = display
         if share is not None:
-            share = float(share)
-            if not np.isfinite(share):
-                raise ValueError("the share must be a number between 0 and 1")
-            share = float(np.clip(share, 0.0, 1.0))
-            changed |= share != self.share
             self.share = share
-        if changed:
-            self.events.display.emit()
 
     @property
     def picked(self) -> tuple[str, int] | None:

@@ -111,7 +111,7 @@ def test_rescale_makes_a_larger_copy_comparable(tmp_path, spot):
     d = pair.distance_on("b")
     assert "areas differ" in pair.note and "areas differ" in pair.view("b").legend
     assert d[700] > 0.3 * d.max()  # unscaled: the copy is far everywhere
-    pair.set_rescale(True)
+    pair.rescale = True
     assert pair.distance_on("b") is None  # unit-area spectra are not in yet
     _wait(pair)
     d = pair.distance_on("b")
@@ -156,9 +156,18 @@ def test_bad_input_gets_clear_errors(tmp_path, spot):
     with pytest.raises(ValueError, match="side must be"):
         pair.pick("c", 1)
     with pytest.raises(ValueError, match="distance kind"):
-        pair.set_kind("curvature")
+        pair.kind = "curvature"
     with pytest.raises(ValueError, match="at least 1"):
-        pair.set_k(0)
+        pair.k = 0
+    with pytest.raises(ValueError, match="between 0 and 1"):
+        pair.share = float("nan")
+    seen = []
+    pair.events.display.connect(lambda: seen.append("display"))
+    pair.events.linked.connect(seen.append)
+    pair.share = 2.0  # clipped to the whole area
+    pair.share = 1.0  # no change: no event
+    pair.kind, pair.k, pair.linked = "wks", "12", False
+    assert (pair.share, pair.k, seen) == (1.0, 12, ["display", "display", "display", False])
 
 
 def test_replacing_a_mesh_cancels_its_jobs_and_drops_the_pick(tmp_path, spot):
@@ -259,7 +268,7 @@ def test_the_wave_kernel_distance_between_shapes_is_its_own(tmp_path, spot):
     _wait(pair)
     pair.pick("a", 700)
     heat = pair.distance_on("b").copy()
-    pair.set_kind("wks")
+    pair.kind = "wks"
     _wait(pair)
     wave = pair.distance_on("b")
     spec_a, spec_b = pair.spectrum("a"), pair.spectrum("b")

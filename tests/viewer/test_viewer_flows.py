@@ -236,7 +236,7 @@ def test_a_shape_pair_without_a_window(viewer, tmp_path):
     assert side == "b"
     # the vertex itself or one mirrored by the shape's symmetry: as far from the x axis
     assert abs(b.vertices[match, 2]) == pytest.approx(abs(b.vertices[5, 2]), abs=0.05)
-    pair.set_linked(False)
+    pair.linked = False
     assert not pair.linked
 
 
