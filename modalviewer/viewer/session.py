@@ -20,6 +20,8 @@ from .jobs import Job
 from .state import ComputeSettings, Display, SpectrumKey, ViewerState
 
 FORMAT = "modalviewer-session"
+STYLE = ("isolines", "shell_coloring", "colorbar", "render", "ghost")
+COLOR_RANGE = ("color_range", "color_limits")  # set together (ViewerState.set_color_range)
 VERSION = 2  # 2: "picked" is the file's vertex number (1: the loaded mesh's index)
 
 
@@ -63,15 +65,7 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
         "display": asdict(state.display),
         "picked": state.picked_file_vertex,  # the file's number
         "t_range": list(state.t_range) if state.t_range else None,
-        "style": {
-            "isolines": state.style.isolines,
-            "shell_coloring": state.style.shell_coloring,
-            "colorbar": state.style.colorbar,
-            "render": state.style.render,
-            "ghost": state.style.ghost,
-            "color_range": state.style.color_range,
-            "color_limits": list(state.style.color_limits) if state.style.color_limits else None,
-        },
+        "style": {name: getattr(state.style, name) for name in (*STYLE, *COLOR_RANGE)},
         "animation": {"amplitude": state.animation.amplitude, "speed": state.animation.speed},
         "camera": state.camera,
         "up_axis": state.up_axis,  # None: the detected one
@@ -153,14 +147,9 @@ def restore_session(model, path) -> Restored:
             f"{mesh_path.name} changed on disk since the session was saved: spectra are "
             "recomputed and the pick may point elsewhere"
         )
-    style = data.get("style") or {}
-    state.style.isolines = int(style.get("isolines", state.style.isolines))
-    state.style.shell_coloring = str(style.get("shell_coloring", state.style.shell_coloring))
-    state.style.colorbar = bool(style.get("colorbar", True))
-    state.style.render = str(style.get("render", "paper"))
-    state.style.ghost = bool(style.get("ghost", True))
-    limits = style.get("color_limits")
-    state.set_color_range(str(style.get("color_range", "auto")), limits)
+    style = {"colorbar": True, "render": "paper", "ghost": True, **(data.get("style") or {})}
+    _update(state.style, style, STYLE)
+    state.set_color_range(str(style.get("color_range", "auto")), style.get("color_limits"))
     _update(state.animation, data.get("animation"))
     _update(
         state.compute_settings,

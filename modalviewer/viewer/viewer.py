@@ -164,10 +164,8 @@ class Viewer(ViewerModel, Pictures):
             self.events.info.emit(
                 "Slivers fixed", f"{j.result.report}\n\nComputing {key.describe()} again..."
             )
-            self.state.compute_settings.operator, self.state.compute_settings.k = (
-                key.operator,
-                key.k,
-            )
+            settings = self.state.compute_settings  # the Compute panel shows what is retried
+            settings.operator, settings.k = key.operator, key.k
             job_ = self._request(key.operator, key.k, show=True)
             if job_ is not None:
                 retried.append(job_)
