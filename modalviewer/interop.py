@@ -18,15 +18,11 @@ from .extras import extra_needed
 from .io import mesh_from_arrays, meshio_arrays, pyvista_arrays
 
 
-def _module(obj) -> str:
-    return type(obj).__module__.split(".")[0]
-
-
 def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """(vertices, triangles, notes) of any object :func:`as_mesh` accepts."""
     if isinstance(obj, Mesh):
         return obj.vertices, obj.faces, []
-    module = _module(obj)
+    module = type(obj).__module__.split(".")[0]  # recognised without importing the library
     if module == "trimesh":
         return np.asarray(obj.vertices, np.float64), np.asarray(obj.faces, np.int64), []
     if module == "pyvista" or module == "vtkmodules":
