@@ -4,6 +4,7 @@ the window's scripting method (``open_mesh``, ``export_screenshot``, ``save_sess
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from qtpy import QtWidgets
@@ -18,19 +19,12 @@ from .paths import ASSETS, SCREENSHOTS
 def _mesh_folder(win) -> Path:
     """Where files about the open mesh go by default: its folder if writable, else the
     screenshots folder of a source checkout, else the home folder."""
-    import os
-
     path = win.state.mesh_path
     if path is not None and os.access(Path(path).resolve().parent, os.W_OK):
         return Path(path).resolve().parent
     if os.access(SCREENSHOTS, os.W_OK):
         return SCREENSHOTS
     return Path.home()
-
-
-def _mesh_stem(win) -> str:
-    path = win.state.mesh_path
-    return Path(path).stem if path is not None else "mesh"
 
 
 def _picture_folder(win) -> str:
@@ -203,7 +197,7 @@ def save_session_dialog(win) -> None:
     path, _ = QtWidgets.QFileDialog.getSaveFileName(
         win,
         "Save session",
-        str(_mesh_folder(win) / f"{_mesh_stem(win)}.session.json"),
+        str(_mesh_folder(win) / f"{Path(win.state.mesh_path or 'mesh').stem}.session.json"),
         "Session (*.json)",
     )
     if path:

@@ -329,24 +329,20 @@ class MainWindow(QtWidgets.QMainWindow):
             size = f" ({path.stat().st_size / 2**20:.0f} MB)"
         except OSError:
             size = ""
-        dialog = QtWidgets.QProgressDialog(f"Opening {path.name}{size}...", "Cancel", 0, 0, self)
+        dialog = QtWidgets.QProgressDialog(
+            f"Opening {path.name}{size}...", "Cancel", 0, 0, self, windowTitle="Opening mesh"
+        )
         dialog.setWindowModality(QtCore.Qt.WindowModality.WindowModal)
-        dialog.setWindowTitle("Opening mesh")
         loop = QtCore.QEventLoop()
-
-        def tick():  # shown by hand: QProgressDialog's own delay restarts at each value
-            if future.done() or dialog.wasCanceled():
-                loop.quit()
-            elif not dialog.isVisible() and time.monotonic() - started >= READING_DIALOG_S:
-                dialog.show()
-
-        timer = QtCore.QTimer(interval=50)
-        timer.timeout.connect(tick)
+        future.add_done_callback(lambda _future: self.dispatcher(loop.quit))
         dialog.canceled.connect(loop.quit)
-        timer.start()
+        # shown by hand: QProgressDialog's own delay restarts at each value
+        wait_ms = int(1000 * (READING_DIALOG_S - (time.monotonic() - started)))
+        QtCore.QTimer.singleShot(
+            max(wait_ms, 0), dialog, lambda: loop.isRunning() and dialog.show()
+        )
         with _shortcuts_off(self):
             loop.exec()
-        timer.stop()
         cancelled = not future.done()
         dialog.reset()
         dialog.deleteLater()
@@ -404,7 +400,8 @@ class MainWindow(QtWidgets.QMainWindow):
     def open_second_mesh(self, path, wait: bool = True, k: int | None = None) -> PairWindow:
         """Open ``path`` as mesh B beside this window's mesh A in a shape pair window: a
         click on one mesh shows the distance between shapes on the other.  With ``wait``
-        the call returns once both spectra are in (``k`` modes each, default 100)."""
+        the call returns once both spectra are in (``k`` modes each, by default
+        :func:`~modalviewer.core.operators.default_k` of the smaller mesh)."""
         return open_pair_window(self, path, wait=wait, k=k)
 
     # ========================================================= comparison

@@ -13,12 +13,8 @@ from .collection_dialog import open_collection_dialog
 
 
 def _action(win, menu, text, slot, shortcut=None, tip=None) -> QtGui.QAction:
-    action = QtGui.QAction(text, win)
-    if shortcut:
-        action.setShortcut(QtGui.QKeySequence(shortcut))
-    if tip:
-        action.setStatusTip(tip)
-    action.triggered.connect(slot)
+    key = QtGui.QKeySequence(shortcut or "")
+    action = QtGui.QAction(text, win, shortcut=key, statusTip=tip or "", triggered=slot)
     menu.addAction(action)
     return action
 
@@ -121,8 +117,19 @@ AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 CAMERA_PRESETS = (*((a, f"From {a.upper()}") for a in AXES), ("isometric", "Isometric"))
 
 
-def _follow_style(win, action, field: str, on_value):
-    return lambda: action.setChecked(getattr(win.state.style, field) == on_value)
+def _radio(win, menu, items, choose, current, event) -> dict:
+    """Checkable items (value, label) of ``menu`` calling ``choose(value)``, one checked
+    at a time: the one of ``current()``, now and on ``event``; returns value -> action."""
+    group = QtGui.QActionGroup(menu)
+    actions = {}
+    for value, label in items:
+        actions[value] = _action(win, menu, label, lambda _=False, v=value: choose(v))
+        actions[value].setCheckable(True)
+        group.addAction(actions[value])
+    follow = lambda *_: actions[current()].setChecked(True)  # noqa: E731
+    follow()
+    event.connect(follow)
+    return actions
 
 
 def _view_menu(win, m) -> None:
@@ -140,11 +147,21 @@ def _view_menu(win, m) -> None:
         slot = lambda on, f=field, v=values: setattr(win.state.style, f, v[bool(on)])  # noqa: E731
         action = _action(win, m, text, slot, key)
         action.setCheckable(True)
-        follow = _follow_style(win, action, field, on_value)
+
+        def follow(a=action, f=field, v=on_value) -> None:
+            a.setChecked(getattr(win.state.style, f) == v)
+
         follow()
         win.state.events.style.connect(follow)
         setattr(win, attribute, action)
-    build_color_range_menu(win, m.addMenu("Colour &range"))
+    win.color_range_actions = _radio(
+        win,
+        m.addMenu("Colour &range"),
+        COLOR_RANGE_ITEMS,
+        lambda rule: ask_color_limits(win) if rule == "limits" else win.state.set_color_range(rule),
+        lambda: win.state.style.color_range,
+        win.state.events.style,
+    )
     panels = m.addMenu("&Panels")
     for dock in win.findChildren(QtWidgets.QDockWidget):
         panels.addAction(dock.toggleViewAction())  # a closed panel comes back from here
@@ -167,29 +184,6 @@ COLOR_RANGE_ITEMS = (
     ("spread", "Spread by &area: each tenth of the colours a tenth of the surface"),
     ("limits", "Typed &limits..."),
 )
-
-
-def build_color_range_menu(win, menu) -> None:
-    """The colour range as radio items following ``state.style.color_range``; "Typed
-    limits..." asks for low and high."""
-    group = QtGui.QActionGroup(menu)
-    actions = {}
-    for rule, label in COLOR_RANGE_ITEMS:
-        if rule == "limits":
-            slot = lambda _=False: ask_color_limits(win)  # noqa: E731
-        else:
-            slot = lambda _=False, r=rule: win.state.set_color_range(r)  # noqa: E731
-        action = _action(win, menu, label, slot)
-        action.setCheckable(True)
-        group.addAction(action)
-        actions[rule] = action
-
-    def follow() -> None:
-        actions[win.state.style.color_range].setChecked(True)
-
-    follow()
-    win.state.events.style.connect(follow)
-    win.color_range_actions = actions
 
 
 def ask_color_limits(win) -> None:
@@ -264,28 +258,23 @@ def _up_axis_menu(win, menu) -> None:
     remembered per file; R returns to the canonical view for it."""
     from . import window_settings
 
+    choose = lambda axis: window_settings.choose_up_axis(win, axis)  # noqa: E731
+    items = ((None, "&Automatic"), *((a, a.upper()) for a in AXES))
+    state = win.state
     up = menu.addMenu("&Up axis")
-    group = QtGui.QActionGroup(win)
-    win.up_axis_actions = {}
-    for axis, label in ((None, "&Automatic"), *((a, a.upper()) for a in AXES)):
-        action = up.addAction(label)
-        action.setCheckable(True)
-        group.addAction(action)
-        action.triggered.connect(lambda _=False, a=axis: window_settings.choose_up_axis(win, a))
-        win.up_axis_actions[axis] = action
+    actions = _radio(win, up, items, choose, lambda: state.up_axis, state.events.up_axis)
+    win.up_axis_actions = actions
 
     def update() -> None:
-        state = win.state
         detected = state.derived.up_axis() if state.mesh is not None else None
-        automatic = win.up_axis_actions[None]
         shown = state.up_axis is None and detected
-        automatic.setText(f"&Automatic ({detected.upper()})" if shown else "&Automatic")
-        win.up_axis_actions[state.up_axis].setChecked(True)
+        actions[None].setText(f"&Automatic ({detected.upper()})" if shown else "&Automatic")
+        actions[state.up_axis].setChecked(True)
 
     def on_mesh() -> None:
         window_settings.restore_up_axis(win)
         update()
 
-    win.state.events.mesh.connect(on_mesh)
-    win.state.events.up_axis.connect(update)
+    state.events.mesh.connect(on_mesh)
+    state.events.up_axis.connect(update)
     update()
