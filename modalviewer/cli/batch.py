@@ -86,9 +86,8 @@ def batch(args) -> int:
 
     from ..collection.runner import import_distributed, run_batch
 
-    workers = args.workers  # -k, --workers and --memory-limit checked by the parser
-    if workers is None:
-        workers = os.cpu_count() or 1
+    # -k, --workers and --memory-limit are checked by the parser; default: one per core
+    workers = (os.cpu_count() or 1) if args.workers is None else args.workers
     if workers > 0 or args.scheduler:
         try:
             import_distributed()

@@ -297,12 +297,16 @@ def viewer_of(mesh, path):
     return viewer
 
 
-def png_text(path) -> str:
-    """The image written, as "PNG WxH" (a window has a smallest size)."""
+def picture_text(path) -> str:
+    """The picture or animation written: "PNG WxH" (a window has a smallest size), "GIF
+    WxH, N frames" or "MP4"."""
+    if Path(path).suffix.lower() == ".mp4":
+        return "MP4"
     from PIL import Image
 
     with Image.open(path) as image:
-        return f"PNG {image.width}x{image.height}"
+        frames = f", {image.n_frames} frames" if image.format == "GIF" else ""
+        return f"{image.format} {image.width}x{image.height}{frames}"
 
 
 def wrote(path, what: str) -> None:

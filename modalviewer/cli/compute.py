@@ -55,9 +55,7 @@ def compute(args) -> int:
     mv.save_spectrum(spec, args.output)
     wrote(args.output, f"spectrum, {spec.k} {args.operator} modes")
     if spec.k < args.k:
-        from ..core.operators import operator_info
-
-        unknowns = operator_info(args.operator).unknowns(mesh.n_vertices)
+        unknowns = spec.operator_info.unknowns(mesh.n_vertices)
         whole = f": all the mesh has ({unknowns} unknowns)" if spec.k >= unknowns else ""
         print(f"asked for {args.k} modes, {spec.k} came{whole}")
     print(

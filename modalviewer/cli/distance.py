@@ -24,7 +24,7 @@ from .common import (
     load,
     make_output_folders,
     number,
-    png_text,
+    picture_text,
     progress_bar,
     refuse_other_picture_suffix,
     size,
@@ -126,7 +126,7 @@ def distance(args) -> int:
         viewer.set_view(args.view, up=args.up)
         written = viewer.export_screenshot(args.output, size=args.size)
         viewer.close()
-        wrote(written, f"{png_text(written)}, {args.kind} distance map")
+        wrote(written, f"{picture_text(written)}, {args.kind} distance map")
     order = np.argsort(d)[1:6]
     print(
         f"{args.kind} distance from vertex {args.vertex}: max {d.max():.6g}; nearest "
@@ -260,7 +260,7 @@ def _distance_to(args, mesh_a) -> int:
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))
         wrote(
             args.output,
-            f"{png_text(args.output)}, vertex {args.vertex} of A, {args.kind} distance on B",
+            f"{picture_text(args.output)}, vertex {args.vertex} of A, {args.kind} distance on B",
         )
     order = np.argsort(d, kind="stable")[:5]
     print(

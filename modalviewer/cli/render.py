@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from ..core.operators import DEFAULT_K, OPERATOR_NAMES
 from ..viewer.state import SHELL_COLORINGS
 from .common import (
@@ -16,7 +14,7 @@ from .common import (
     load,
     make_output_folders,
     mode_list,
-    png_text,
+    picture_text,
     refuse_other_picture_suffix,
     size,
     two_numbers,
@@ -148,7 +146,7 @@ def render(args) -> int:
         viewer.close()
         shown = ", ".join(f"{j}: {spec.eigenvalues[j]:.6g}" for j in args.modes)
         print(f"modes of {args.operator}: lambda {shown}")
-        wrote(written, f"{png_text(written)}, {len(args.modes)} modes")
+        wrote(written, f"{picture_text(written)}, {len(args.modes)} modes")
         return 0
     if args.animate:
         written = viewer.export_animation(
@@ -160,20 +158,8 @@ def render(args) -> int:
         )
     viewer.close()
     print(f"mode {args.mode} of {args.operator}: lambda = {spec.eigenvalues[args.mode]:.6g}")
-    wrote(written, f"{_picture_text(written)}, mode {args.mode}")
+    wrote(written, f"{picture_text(written)}, mode {args.mode}")
     return 0
-
-
-def _picture_text(path) -> str:
-    """The picture or animation written: "PNG WxH", "GIF WxH, N frames" or "MP4"."""
-    if Path(path).suffix.lower() == ".mp4":
-        return "MP4"
-    if Path(path).suffix.lower() == ".gif":
-        from PIL import Image
-
-        with Image.open(path) as image:
-            return f"GIF {image.width}x{image.height}, {image.n_frames} frames"
-    return png_text(path)
 
 
 def figures(args) -> int:

@@ -30,13 +30,12 @@ def line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
     return poly
 
 
-def segments(points, faces, values, levels, displacement=None, with_triangles=False):
+def segments(points, faces, values, levels, displacement=None):
     """Isolines of a piecewise-linear field as line segments, one per crossed triangle
-    and level (vectorised; VTK's contour filter is slower): (segments (s, 2, 3), their
-    ``displacement`` (s, 2, 3) or None, level of each (s,)), and with ``with_triangles``
-    two more items: the triangle of each segment (s,) and the mesh edges its two ends lie
-    on (s, 2, 2), each edge as (smaller, larger) vertex.  A vertex exactly at a level
-    counts as above it, so each crossing gives one segment."""
+    and level (vectorised; VTK's contour filter is slower): segments (s, 2, 3), their
+    ``displacement`` (s, 2, 3) or None, the level of each (s,), its triangle (s,) and the
+    mesh edges its two ends lie on (s, 2, 2), each edge as (smaller, larger) vertex.  A
+    vertex exactly at a level counts as above it, so each crossing gives one segment."""
     levels = np.sort(np.asarray(levels, dtype=np.float64))
     # levels crossed by each triangle: those in (min, max] of its corner values
     level = np.searchsorted(levels, values, side="right").astype(np.int32)
@@ -46,9 +45,8 @@ def segments(points, faces, values, levels, displacement=None, with_triangles=Fa
     tri = np.flatnonzero(hi > lo)
     if tri.size == 0:
         empty = np.zeros((0, 2, 3))
-        out = (empty, (empty if displacement is not None else None), np.zeros(0))
-        none = (np.zeros(0, dtype=np.int64), np.zeros((0, 2, 2), dtype=np.int64))
-        return (*out, *none) if with_triangles else out
+        disp = None if displacement is None else empty
+        return empty, disp, np.zeros(0), np.zeros(0, np.int64), np.zeros((0, 2, 2), np.int64)
     counts = hi[tri] - lo[tri]
     tri_rep = np.repeat(tri, counts)
     first = np.repeat(lo[tri], counts)
@@ -70,8 +68,6 @@ def segments(points, faces, values, levels, displacement=None, with_triangles=Fa
     disp = None
     if displacement is not None:
         disp = displacement[va] * (1 - t) + displacement[vb] * t
-    if not with_triangles:
-        return seg, disp, c
     edges = np.stack([np.minimum(va, vb), np.maximum(va, vb)], axis=-1)  # (s, 2, 2)
     return seg, disp, c, tri_rep, edges
 

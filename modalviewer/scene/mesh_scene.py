@@ -150,10 +150,8 @@ class MeshScene:
             self.plotter.add_light(pv.Light(light_type="headlight", intensity=1.0))
         else:
             self.plotter.enable_lightkit()
-        prop = self.surface_actor.prop
-        prop.ambient = params["ambient"]
-        prop.diffuse = params["diffuse"]
-        prop.specular = params["specular"]
+        for term in ("ambient", "diffuse", "specular"):
+            setattr(self.surface_actor.prop, term, params[term])
         self.style = style
 
     # ----------------------------------------------------------------- fields
@@ -227,7 +225,6 @@ class MeshScene:
             values,
             everything,
             self.surface.point_data["displacement"],
-            with_triangles=True,
         )
         zero = level == 0.0 if want_zero else np.zeros(len(level), dtype=bool)
         if want_zero:
