@@ -7,7 +7,7 @@ The meshes are the bumpy plate (:func:`modalviewer.core.demo_shapes.bumpy_plate`
 n x n grids: 10k, 32k, 102k, 336k and 1M vertices by default.  Every (size, operator)
 runs in a fresh process with the computation processes' memory settings, so
 its peak resident memory is its own; mesh construction is not timed, assembly is.  A run
-the memory check refuses (:func:`modalviewer.viewer.model.memory_refusal`: more than
+the memory check refuses (:func:`modalviewer.core.memory.memory_refusal`: more than
 three quarters of this machine's memory expected) is recorded as refused with the
 estimate, not started.  Growth exponents are least-squares fits of log(seconds) and
 log(peak MB) against log(vertices) over the sizes from 100k on (below that, fixed costs
@@ -57,10 +57,10 @@ def _one(grid: int, operator: str, k: int) -> dict:
 
 
 def _refusal(grid: int, operator: str, k: int) -> str | None:
-    from modalviewer.viewer.model import memory_refusal
-    from modalviewer.viewer.state import SpectrumKey
+    from modalviewer.core.memory import memory_refusal
+    from modalviewer.core.operators import operator_info
 
-    return memory_refusal(SpectrumKey(operator, k), grid * grid)
+    return memory_refusal(operator_info(operator), k, grid * grid)
 
 
 def fit_growth(rows: list[dict], value: str) -> tuple[float, float] | None:

@@ -301,9 +301,9 @@ def test_compute_refuses_what_does_not_fit_and_says_what_would(tmp_path, monkeyp
     """As in the viewer: an exact computation expected to need more than its share of the
     machine's memory is refused before it starts, with the most modes that fit."""
     from modalviewer import cli
-    from modalviewer.viewer import model
+    from modalviewer.core import memory
 
-    monkeypatch.setattr(model, "physical_memory_mb", lambda: 64.0)  # 64 MiB
+    monkeypatch.setattr(memory, "physical_memory_mb", lambda: 64.0)  # 64 MiB
     code = cli.main(
         [
             "compute",

@@ -95,11 +95,13 @@ def _counting_modes(progress, k: int):
 def _refuse_if_too_large(mesh, operator: str, k: int) -> None:
     """The viewer's memory check before an exact computation starts: a ValueError saying
     what would fit where it would need more than its share of this machine's memory."""
-    from ..viewer.model import memory_refusal
-    from ..viewer.state import ComputeSettings
+    from ..coarsen import COARSE_FRACTION
+    from ..core.memory import memory_refusal
+    from ..core.operators import operator_info
 
+    n = mesh.n_vertices
     refusal = memory_refusal(
-        ComputeSettings().key(operator, k), mesh.n_vertices, coarse="on a decimated copy"
+        operator_info(operator), k, n, round(COARSE_FRACTION * n), "on a decimated copy"
     )
     if refusal:
         raise ValueError(refusal)

@@ -15,6 +15,7 @@ import ctypes
 import functools
 import os
 import sys
+from bisect import bisect_right
 
 MEMORY_LIMIT_SHARE = 0.5  # the share of this machine's memory a computation plans for
 
@@ -112,3 +113,64 @@ def prepare_compute_process() -> bool:
     if setter is not None:
         setter(False)
     return all(took) and setter is not None
+
+
+MEMORY_SHARE = 0.75
+"""Computations expected to need more than this share of the physical memory are refused
+before they start."""
+
+
+def memory_needed(operator, k: int, n_vertices: int) -> float:
+    """Bytes an exact solve of ``k`` modes of ``operator`` (an
+    :class:`~.operators.OperatorInfo`) on ``n_vertices`` is predicted to need at its peak."""
+    return operator.predicted_peak_mb(n_vertices, k) * MB
+
+
+def largest_k_that_fits(operator, k: int, n_vertices: int, available: float) -> int:
+    """The most modes, up to ``k``, whose expected memory stays within
+    :data:`MEMORY_SHARE` of ``available`` bytes; 0 if not even one does."""
+    ks, limit = range(1, max(1, k) + 1), MEMORY_SHARE * available  # memory grows with k
+    return bisect_right(ks, limit, key=lambda j: memory_needed(operator, j, n_vertices))
+
+
+def what_fits(
+    operator, k: int, n_vertices: int, available: float, copy_vertices=None, coarse: str = ""
+) -> str:
+    """What would fit instead: fewer modes, ``k`` modes solved on a decimated copy of
+    ``copy_vertices`` (named ``coarse``; only where the copy has ``k`` modes: as many
+    modes as unknowns), or neither."""
+    options = []
+    fewer = largest_k_that_fits(operator, k, n_vertices, available)
+    if fewer >= 1:
+        options.append(f"at most {fewer} modes fit")
+    if (
+        copy_vertices is not None
+        and k <= operator.unknowns(copy_vertices)
+        and memory_needed(operator, k, copy_vertices) <= MEMORY_SHARE * available
+    ):
+        options.append(f"{k} modes {coarse} fit")
+    if not options:
+        return "Not even one mode fits: use a coarser mesh or a machine with more memory."
+    text = "; ".join(options)
+    return text[0].upper() + text[1:] + "."
+
+
+def memory_refusal(
+    operator, k: int, n_vertices: int, copy_vertices=None, coarse: str = ""
+) -> str | None:
+    """A message if an exact solve of ``k`` modes of ``operator`` on ``n_vertices`` would
+    need more than :data:`MEMORY_SHARE` of this machine's memory, saying what would fit
+    (:func:`what_fits`); else None.  The viewer's refusals and ``modalviewer compute``
+    say the same."""
+    needed = memory_needed(operator, k, n_vertices)
+    available = (physical_memory_mb() or 0.0) * MB  # bytes; 0 if unknown
+    if not available or needed <= MEMORY_SHARE * available:
+        return None
+    share = {0.75: "three quarters", 0.5: "half"}.get(MEMORY_SHARE, f"{MEMORY_SHARE:.0%}")
+    return (
+        f"{operator.label} with {k} modes on {n_vertices} vertices "
+        f"needs about {needed / 2**30:.1f} GiB of memory, more than the "
+        f"{MEMORY_SHARE * available / 2**30:.1f} GiB a computation may take ({share} of this "
+        f"machine's {available / 2**30:.1f} GiB). "
+        + what_fits(operator, k, n_vertices, available, copy_vertices, coarse)
+    )

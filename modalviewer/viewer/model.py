@@ -4,13 +4,11 @@
 :class:`~.jobs.Job` whose result, and before it the modes as they converge, land in the
 state if the mesh it was computed for is still loaded.  A job changes the display only if
 asked (``show=True``) and the display has not changed since the request.  The functions
-around it estimate a request's time and memory.
+around it estimate a request's time.
 """
 
 from __future__ import annotations
 
-from bisect import bisect_right
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +16,7 @@ import numpy as np
 from ..coarsen import COARSE_FRACTION
 from ..core.cache import SolveRecord, SpectrumCache
 from ..core.eigen import Cancelled
-from ..core.memory import physical_memory_mb
+from ..core.memory import memory_refusal
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
 from ..core.signatures import SignatureTable
@@ -31,19 +29,6 @@ from .state import SpectrumKey, ViewerState
 
 class ComputeRefused(ValueError):
     """A computation was refused before it started; the message says why and what to do."""
-
-
-def copy_vertices(n_vertices: int) -> int:
-    """Vertices of the decimated copy Coarse-to-fine solves on (:data:`COARSE_FRACTION`)."""
-    return round(COARSE_FRACTION * n_vertices)
-
-
-def memory_needed(key: SpectrumKey, n_vertices: int) -> float:
-    """Bytes the exact computation of ``key`` on ``n_vertices`` is predicted to need at
-    its peak (:meth:`~modalviewer.core.operators.OperatorInfo.predicted_peak_mb`;
-    Coarse-to-fine solves on its decimated copy)."""
-    solved = copy_vertices(n_vertices) if key.coarse else n_vertices
-    return operator_info(key.operator).predicted_peak_mb(solved, key.k) * 2**20
 
 
 ESTIMATE_RANGE = 2.0
@@ -98,60 +83,6 @@ def expected_seconds(key: SpectrumKey, mesh: Mesh, cache: SpectrumCache) -> floa
     if key.coarse or key.cached(mesh, cache):
         return None
     return estimated_seconds(cache.solves(), key.operator, mesh.n_vertices, key.k, mesh.hash)
-
-
-MEMORY_SHARE = 0.75
-"""Computations expected to need more than this share of the physical memory are refused
-before they start."""
-
-
-def largest_k_that_fits(key: SpectrumKey, n_vertices: int, available: int) -> int:
-    """The most modes of ``key``'s operator (its other settings kept) whose expected memory
-    stays within :data:`MEMORY_SHARE` of ``available`` bytes; 0 if not even one does."""
-    ks, limit = range(1, max(1, key.k) + 1), MEMORY_SHARE * available  # memory grows with k
-    return bisect_right(ks, limit, key=lambda k: memory_needed(replace(key, k=k), n_vertices))
-
-
-COARSE_WORDS = "with Coarse-to-fine (a decimated copy)"
-"""How :func:`what_fits` names Coarse-to-fine (the viewer's option)."""
-
-
-def what_fits(key: SpectrumKey, n_vertices: int, available: int, coarse: str = COARSE_WORDS) -> str:
-    """What would fit instead of ``key``: fewer modes, Coarse-to-fine (named ``coarse``;
-    only where it gives ``key.k`` modes: the decimated copy has as many modes as
-    unknowns), or neither."""
-    k = largest_k_that_fits(key, n_vertices, available)
-    copy_modes = operator_info(key.operator).unknowns(copy_vertices(n_vertices))
-    coarse_needs = memory_needed(replace(key, coarse=True), n_vertices)
-    coarse_fits = (
-        not key.coarse and key.k <= copy_modes and coarse_needs <= MEMORY_SHARE * available
-    )
-    options = []
-    if k >= 1:
-        options.append(f"at most {k} modes fit")
-    if coarse_fits:
-        options.append(f"{key.k} modes {coarse} fit")
-    if not options:
-        return "Not even one mode fits: use a coarser mesh or a machine with more memory."
-    text = "; ".join(options)
-    return text[0].upper() + text[1:] + "."
-
-
-def memory_refusal(key: SpectrumKey, n_vertices: int, coarse: str = COARSE_WORDS) -> str | None:
-    """A message if computing ``key`` on ``n_vertices`` would need more than
-    :data:`MEMORY_SHARE` of this machine's memory, saying what would fit; else None.
-    The viewer's refusals and ``modalviewer compute`` say the same."""
-    needed = memory_needed(key, n_vertices)
-    available = (physical_memory_mb() or 0.0) * 2**20  # bytes; 0 if unknown
-    if not available or needed <= MEMORY_SHARE * available:
-        return None
-    share = {0.75: "three quarters", 0.5: "half"}.get(MEMORY_SHARE, f"{MEMORY_SHARE:.0%}")
-    return (
-        f"{operator_info(key.operator).label} with {key.k} modes on {n_vertices} vertices "
-        f"needs about {needed / 2**30:.1f} GiB of memory, more than the "
-        f"{MEMORY_SHARE * available / 2**30:.1f} GiB a computation may take ({share} of this "
-        f"machine's {available / 2**30:.1f} GiB). " + what_fits(key, n_vertices, available, coarse)
-    )
 
 
 class ViewerModel:
@@ -238,8 +169,13 @@ class ViewerModel:
 
     # ------------------------------------------------------------ spectra
     def refusal(self, key: SpectrumKey) -> str | None:
-        """:func:`memory_refusal` of ``key`` on the loaded mesh."""
-        return memory_refusal(key, self.state.mesh.n_vertices)
+        """:func:`~.core.memory.memory_refusal` of ``key`` on the loaded mesh
+        (Coarse-to-fine solves on its decimated copy)."""
+        info, n = operator_info(key.operator), self.state.mesh.n_vertices
+        copy = round(COARSE_FRACTION * n)
+        if key.coarse:
+            return memory_refusal(info, key.k, copy)
+        return memory_refusal(info, key.k, n, copy, "with Coarse-to-fine (a decimated copy)")
 
     def request_spectrum(
         self, operator: str | None = None, k: int | None = None, show: bool = False

@@ -455,25 +455,28 @@ def test_the_status_line_says_what_is_computing_before_any_spectrum(model):
 def test_a_refusal_says_what_would_fit(monkeypatch):
     """A request too large for the machine names the most modes that fit (checked
     against the estimate itself) and whether Coarse-to-fine fits."""
+    from modalviewer.core import memory
+    from modalviewer.core.operators import operator_info
     from modalviewer.core.primitives import icosphere
     from modalviewer.viewer import model as model_module
 
     m = model_module.ViewerModel()
     m.set_mesh(icosphere(4))
     key = m.state.compute_settings.key("shells", 300)
-    n = m.state.mesh.n_vertices
-    from dataclasses import replace
+    n, shells = m.state.mesh.n_vertices, operator_info("shells")
 
     # memory for about 150 of the 300 modes asked for
-    needed = model_module.memory_needed(replace(key, k=150), n)
-    available = int(needed / model_module.MEMORY_SHARE)
-    monkeypatch.setattr(model_module, "physical_memory_mb", lambda: available / 2**20)
+    needed = memory.memory_needed(shells, 150, n)
+    available = int(needed / memory.MEMORY_SHARE)
+    # the solver's choices (out of core, float32 basis) stay those of this machine
+    monkeypatch.setenv("MODALVIEWER_MEMORY_LIMIT_MB", str(memory.memory_limit_mb()))
+    monkeypatch.setattr(memory, "physical_memory_mb", lambda: available / 2**20)
     message = m.refusal(key)
-    k = model_module.largest_k_that_fits(key, n, available)
+    k = memory.largest_k_that_fits(shells, 300, n, available)
     assert 1 <= k < 300 and f"at most {k} modes fit" in message.lower()
-    limit = model_module.MEMORY_SHARE * available
-    assert model_module.memory_needed(replace(key, k=k), n) <= limit
-    assert model_module.memory_needed(replace(key, k=k + 1), n) > limit
+    limit = memory.MEMORY_SHARE * available
+    assert memory.memory_needed(shells, k, n) <= limit
+    assert memory.memory_needed(shells, k + 1, n) > limit
     assert "Coarse-to-fine" in message
     # it names the limit it applies, not only the machine's memory (above which a
     # refused request's need can lie)
@@ -481,7 +484,7 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
         f"more than the {limit / 2**30:.1f} GiB a computation may take (three quarters of "
         f"this machine's {available / 2**30:.1f} GiB)" in message
     ), message
-    monkeypatch.setattr(model_module, "physical_memory_mb", lambda: 1024 / 2**20)
+    monkeypatch.setattr(memory, "physical_memory_mb", lambda: 1024 / 2**20)
     assert "Not even one mode fits" in m.refusal(key)
 
 
@@ -489,32 +492,33 @@ def test_a_refusal_offers_no_option_that_cannot_give_the_modes_asked_for(monkeyp
     """More modes than the decimated copy has unknowns: Coarse-to-fine is not offered (a
     refusal of a million shells modes on a 46k mesh
     said "1000000 modes with Coarse-to-fine (a decimated copy) fit")."""
-    from dataclasses import replace
-
     from modalviewer.coarsen import COARSE_FRACTION
+    from modalviewer.core import memory
+    from modalviewer.core.operators import operator_info
     from modalviewer.core.primitives import icosphere
     from modalviewer.viewer import model as model_module
 
     m = model_module.ViewerModel()
     m.set_mesh(icosphere(4))  # 2562 vertices; the copy 512, 1536 shells unknowns
-    n = m.state.mesh.n_vertices
-    copy_modes = 3 * round(COARSE_FRACTION * n)
-    too_many = m.state.compute_settings.key("shells", copy_modes + 1)
+    n, shells = m.state.mesh.n_vertices, operator_info("shells")
+    copy = round(COARSE_FRACTION * n)
+    too_many = 3 * copy + 1
     # enough memory for the copy's solve and for 300 modes, not for the request
     available = int(
         max(
-            model_module.memory_needed(replace(too_many, coarse=True), n),
-            model_module.memory_needed(replace(too_many, k=300), n),
+            memory.memory_needed(shells, too_many, copy),
+            memory.memory_needed(shells, 300, n),
         )
-        / model_module.MEMORY_SHARE
+        / memory.MEMORY_SHARE
     )
-    assert model_module.memory_needed(too_many, n) > model_module.MEMORY_SHARE * available
-    monkeypatch.setattr(model_module, "physical_memory_mb", lambda: available / 2**20)
-    message = m.refusal(too_many)
+    assert memory.memory_needed(shells, too_many, n) > memory.MEMORY_SHARE * available
+    monkeypatch.setenv("MODALVIEWER_MEMORY_LIMIT_MB", str(memory.memory_limit_mb()))
+    monkeypatch.setattr(memory, "physical_memory_mb", lambda: available / 2**20)
+    message = m.refusal(m.state.compute_settings.key("shells", too_many))
     assert "Coarse-to-fine" not in message, message
     assert "modes fit" in message
-    fewer = replace(too_many, k=copy_modes)  # as many as the copy has: offered
-    assert "Coarse-to-fine" in model_module.what_fits(fewer, n, available)
+    fewer = too_many - 1  # as many as the copy has: offered
+    assert "Coarse-to-fine" in memory.what_fits(shells, fewer, n, available, copy, "Coarse-to-fine")
 
 
 def test_a_share_marks_its_boundary_vertex_whatever_the_rounding(model):
