@@ -101,7 +101,7 @@ def test_plot_picks_the_input_vertex(case):
             f"Heat kernel distance from vertex {pick}"
         )
         np.testing.assert_allclose(
-            viewer.last_distance, mv.multiscale_distance(spec, pick), rtol=1e-9, equal_nan=True
+            viewer.distance_map(), mv.multiscale_distance(spec, pick), rtol=1e-9, equal_nan=True
         )
     finally:
         viewer.close()

@@ -63,12 +63,12 @@ FROM_VIEWER = frozenset(
     "compute cancel_computation set_mesh show_mode step_mode show_distance distance_map "
     "set_threshold show_signature show_curvature export_screenshot current_field "
     "export_field fix_slivers_and_retry clear_cache save_session spectra picked "
-    "last_distance sliver_failure last_error".split()
+    "sliver_failure last_error".split()
 )
 """What the window passes on to its :class:`~modalviewer.viewer.Viewer` unchanged, so a
 script drives the window as it drives a viewer."""
 
-REPORTED = frozenset({"pick_file_vertex", "pick_vertex", "repair_mesh"})
+REPORTED = frozenset({"pick_vertex", "repair_mesh"})
 """The viewer's methods the window passes on with a bad argument's ValueError shown to
 the user instead of raised."""
 

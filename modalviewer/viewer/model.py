@@ -1,10 +1,8 @@
 """The viewer's model: its state, the jobs that fill it, and the spectrum cache (no Qt).
 
-:class:`ViewerModel` (the :class:`~.viewer.Viewer` is one) turns a request into a
-:class:`~.jobs.Job` whose result, and before it the modes as they converge, land in the
-state if the mesh it was computed for is still loaded.  A job changes the display only if
-asked (``show=True``) and the display has not changed since the request.  The functions
-around it estimate a request's time.
+A request becomes a :class:`~.jobs.Job` whose modes land in the state, as they converge,
+while the mesh they were computed for is still loaded; a job changes the display only if
+asked (``show=True``) and the display has not changed since the request.
 """
 
 from __future__ import annotations
@@ -46,15 +44,11 @@ def estimated_seconds(
     records: list[SolveRecord], operator: str, n_vertices: int, k: int, mesh_hash: str = ""
 ) -> float | None:
     """Seconds an exact solve of ``k`` modes of ``operator`` on a mesh of ``n_vertices``
-    (hash ``mesh_hash``) is expected to take, from this machine's recorded solves
-    (``records``, most recent first: :meth:`.core.cache.SpectrumCache.solves`), or None.
-
-    From the same operator's records: the same mesh and k (the most recent); else the
-    same mesh at the nearest k0 within a factor :data:`ESTIMATE_RANGE`, times
-    ``(k / k0) ** MODES_EXPONENT``; else the same k on the mesh nearest in size n0
-    within that factor, times ``(n / n0) ** SIZE_EXPONENT``; else None.  One scaling at
-    a time and only that near: the time's growth with size and k depends on the operator
-    and the shape, so anything further would guess."""
+    (hash ``mesh_hash``) is expected to take, from this machine's ``records`` (most recent
+    first), or None: the same mesh and k; else the same mesh at the nearest k0 within
+    :data:`ESTIMATE_RANGE`, scaled by ``(k / k0) ** MODES_EXPONENT``; else the same k on
+    the mesh nearest in size n0 within it, scaled by ``(n / n0) ** SIZE_EXPONENT``.  One
+    scaling, only that near: the growth depends on the operator and the shape."""
     same = [r for r in records if r.operator == operator]
     n, k = max(int(n_vertices), 1), max(int(k), 1)
 
@@ -77,18 +71,16 @@ def estimated_seconds(
 
 
 def expected_seconds(key: SpectrumKey, mesh: Mesh, cache: SpectrumCache) -> float | None:
-    """:func:`estimated_seconds` of ``key`` on ``mesh`` from ``cache``'s records; None for
-    Coarse-to-fine (its decimation is not recorded) and where the spectrum is in the
-    cache already (nothing is solved)."""
+    """:func:`estimated_seconds` of ``key`` on ``mesh``; None for Coarse-to-fine (not
+    recorded) and for a cached spectrum (nothing is solved)."""
     if key.coarse or key.cached(mesh, cache):
         return None
     return estimated_seconds(cache.solves(), key.operator, mesh.n_vertices, key.k, mesh.hash)
 
 
 class ViewerModel:
-    """The state, the job queue and the spectrum cache, and the requests that fill the
-    state (no messages for the user: :class:`.viewer.Viewer`, which is this model, adds
-    them and the scripting API)."""
+    """The state, the job queue, the spectrum cache and the requests that fill the state
+    (:class:`.viewer.Viewer` adds messages and the scripting API)."""
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None):
         self.state = ViewerState()
@@ -114,9 +106,8 @@ class ViewerModel:
         self.state.set_mesh(mesh, path, repairs)
 
     def repair(self, name: str) -> Job:
-        """A job applying repair ``name`` (see ``REPAIRS``) to the loaded mesh, in a child
-        process (see :mod:`.process`); when it ends the repaired mesh replaces it (its
-        report says what changed)."""
+        """A job applying repair ``name`` (``REPAIRS``) in a child process; the repaired
+        mesh replaces the loaded one."""
         state = self.state
         if state.mesh is None:
             raise ComputeRefused("Open a mesh first.")
@@ -139,28 +130,10 @@ class ViewerModel:
         return job.then(replace_mesh)
 
     def open_mesh(self, path, strict: bool = True) -> Mesh:
-        """Load a mesh file (OBJ, PLY, OFF or STL) and show it.
-
-        Parameters
-        ----------
-        path : the file.
-        strict : with False, a damaged or truncated file loads its whole records and the
-            mesh's report says what was dropped.
-
-        Returns
-        -------
-        Mesh
-            The loaded (and repaired) mesh.
-
-        Raises
-        ------
-        modalviewer.readers.DamagedFileError
-            For a damaged or truncated file with ``strict=True``.
-        MeshError
-            For other unusable meshes.
-        OSError
-            If the file cannot be read.
-        """
+        """Load a mesh file (OBJ, PLY, OFF or STL), show it and return it.  A damaged or
+        truncated file raises :class:`modalviewer.readers.DamagedFileError` with
+        ``strict``, else loads its whole records (the report says what was dropped);
+        MeshError for other unusable meshes, OSError if the file cannot be read."""
         from ..io import load_mesh
 
         mesh = load_mesh(Path(path), strict=strict)
@@ -180,10 +153,10 @@ class ViewerModel:
     def request_spectrum(
         self, operator: str | None = None, k: int | None = None, show: bool = False
     ) -> SpectrumJob:
-        """A job computing (or loading from the cache) ``operator``'s spectrum, with the
-        compute settings for what is not given; one that has ended if the spectrum is in
-        the state.  ``show``: display its first non-zero mode when it arrives, unless the
-        display changed meanwhile.  ComputeRefused if too large for this machine."""
+        """A job computing (or loading from the cache) ``operator``'s spectrum, the compute
+        settings for what is not given (an ended one if the state has it); ``show``: show
+        its first non-zero mode when it arrives, unless the display changed meanwhile.
+        ComputeRefused if too large for this machine."""
         state = self.state
         if state.mesh is None:
             raise ComputeRefused("Open a mesh first.")
@@ -220,10 +193,9 @@ class ViewerModel:
         return job
 
     def _modes_arrived(self, key: SpectrumKey, show_from):
-        """Where the modes of ``key`` go as they converge (on the owner's thread): into
-        the state, if the mesh is still the one they were computed for.  ``show_from``:
-        the display at a ``show`` request; the first modes are shown if it has not
-        changed since, as a finished spectrum would be."""
+        """Where the modes of ``key`` go as they converge: into the state while its mesh is
+        loaded; the first are shown if the display is still ``show_from`` (a ``show``
+        request's)."""
         owner = self.state.mesh.hash
         wanted = [show_from]
 
@@ -244,8 +216,8 @@ class ViewerModel:
         return deliver
 
     def _answered(self, key: SpectrumKey, show: bool) -> SpectrumJob:
-        """An ended job holding ``key``'s spectrum already in the state; with ``show`` its
-        first mode is shown unless that operator is on screen (the mode or map stays)."""
+        """An ended job holding ``key``'s spectrum from the state; with ``show`` its first
+        mode is shown unless that operator is on screen already."""
         state = self.state
         spec = state.spectra[key]
         job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
@@ -255,8 +227,7 @@ class ViewerModel:
         return job
 
     def computing(self, operator: str) -> bool:
-        """Whether a spectrum of ``operator`` for the loaded mesh is queued or being
-        computed (a map waiting for it will follow)."""
+        """Whether a spectrum of ``operator`` is queued or being computed."""
         return any(
             isinstance(job, SpectrumJob)
             and not job.done
@@ -283,9 +254,8 @@ class ViewerModel:
         return expected_seconds(key, self.state.compute_mesh(key), self.cache)
 
     def _show_if_unchanged(self, operator: str, before) -> None:
-        """Show ``operator``'s spectrum if the display has not changed since a request
-        (``before``): at the mode shown then if it was one of the same operator's (a new
-        k keeps the user's place; the last mode if there are fewer now), else at its
+        """Show ``operator``'s spectrum if the display is still ``before``: at the mode
+        shown then if of this operator (a new k keeps the user's place), else at its
         first non-zero mode."""
         if self.state.display not in (before, before.blank()):
             return
@@ -298,8 +268,7 @@ class ViewerModel:
         self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
 
     def _work(self, key: SpectrumKey, on_modes=None):
-        """The function a job runs for ``key``: cache or compute (``on_modes`` gets the
-        modes as they converge), signature table."""
+        """The function a job runs for ``key``: the spectrum, then its signature table."""
         mesh = self.state.compute_mesh(key)
         cache = self.cache
         t_range = self.state.t_range
@@ -319,12 +288,11 @@ class ViewerModel:
         return work
 
     def request_exact_curve(self, wait: bool = False) -> Job | None:
-        """Sum the picked vertex's signature curve over all modes
-        (:func:`~modalviewer.core.local_signature.local_signature` with the spectrum
-        shown) as a job in the queue; the result is
+        """A job summing the picked vertex's signature curve over all modes
+        (:func:`~modalviewer.core.local_signature.local_signature`); the result is
         :meth:`.derived.DerivedValues.exact_curve`, announced by
-        ``state.events.signature_curve``.  None if there is no curve, its spectrum is
-        coarse-to-fine, or the exact curve is already in."""
+        ``state.events.signature_curve``.  None without a curve, for a coarse-to-fine
+        spectrum, or if it is in already."""
         from ..core.local_signature import local_signature
 
         state, derived = self.state, self.state.derived

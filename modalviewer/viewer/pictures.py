@@ -1,10 +1,7 @@
-"""The Viewer's pictures: what the surface shows as values, PNG screenshots, animations,
-mode grids and comparisons, drawn by :mod:`modalviewer.scene` (loaded on the first
-picture, so the rest of the viewer needs no VTK).  A part of :class:`.viewer.Viewer`.
-
-Without a window the pictures come from an off-screen renderer of the state; a window
-attaches its own view (:meth:`Pictures.attach_picture`), and screenshots without a size
-are taken from it as on screen.
+"""The Viewer's pictures: the field shown, PNG screenshots, animations, mode grids and
+comparisons, drawn by :mod:`modalviewer.scene` (loaded on the first picture, so the rest
+of the viewer needs no VTK): off screen, or from a window's view
+(:meth:`Pictures.attach_picture`).
 """
 
 from __future__ import annotations
@@ -21,17 +18,16 @@ class Pictures:
     ``_picture`` and ``_renderer``)."""
 
     def attach_picture(self, source) -> None:
-        """Exports and sessions take their picture and camera from ``source`` (a window's
-        view: ``source.plotter``, ``source.scene``, ``source.current_camera()``) instead
-        of an off-screen renderer; None detaches it."""
+        """Take pictures and camera from ``source`` (a window's view: ``plotter``,
+        ``scene``, ``current_camera()``) instead of off screen; None detaches it."""
         self._picture = source
         if source is not None and self._renderer is not None:
             self._renderer.close()
             self._renderer = None
 
     def current_field(self) -> tuple[str, np.ndarray] | None:
-        """(name, per-vertex values) of what the surface shows, or None without a mesh.
-        Without a field (a fresh mesh) the values are zeros."""
+        """(name, per-vertex values) of what the surface shows (zeros for the plain
+        surface), or None without a mesh."""
         if self.state.mesh is None:
             return None
         field = self.state.derived.field()
@@ -55,8 +51,7 @@ class Pictures:
 
     @extra_needed("the viewer's pictures")
     def renderer(self, size=None):
-        """The off-screen renderer drawing this viewer (made on first use; ``size``
-        (width, height) in pixels, default 1024x768)."""
+        """The off-screen renderer, made on first use (``size`` default 1024x768)."""
         from ..scene.offscreen import DEFAULT_SIZE, OffscreenRenderer
 
         if self._renderer is None:
@@ -76,29 +71,12 @@ class Pictures:
         marker: bool | None = None,
         fit: bool = True,
     ) -> Path:
-        """Save the picture as PNG (atomically).
-
-        With a window attached and no ``size``, its view as on screen; otherwise the same
-        scene drawn off screen, the camera fitted so the whole (deformed) shape lies in
-        the frame, clear of the legend and the colour bar.
-
-        Parameters
-        ----------
-        path : the PNG to write.
-        scale : magnification: the PNG is ``scale`` times the picture's width and height.
-        transparent : a transparent background.
-        colorbar : with the colour bar and legend (None: as the state says).
-        size : (width, height) in pixels before ``scale``; without a window 1024 x 768
-            by default (a size given to one call does not carry over).
-        marker : with the pick marker (None: on distance maps only).
-        fit : fit the camera to the shape (off screen); False keeps the camera (pictures
-            of several displays from one camera).
-
-        Returns
-        -------
-        pathlib.Path
-            The file written.
-        """
+        """Save the picture as PNG (atomically); returns the path.  With a window and no
+        ``size``, its view as on screen; otherwise drawn off screen at ``size`` (default
+        1024 x 768, not carried over), with ``fit`` the camera fitted to the whole
+        (deformed) shape clear of the legend.  ``scale`` multiplies the pixels;
+        ``colorbar`` None and ``marker`` None: as the state says, the marker on distance
+        maps only."""
         from ..scene.export import png_path, save_png
 
         path = png_path(path)  # a wrong name is refused before any drawing
@@ -134,17 +112,15 @@ class Pictures:
                 renderer.close()
 
     def marker_shown(self, marker: bool | None = None) -> bool:
-        """Whether a picture shows the pick marker: ``marker`` where given, else on
-        distance maps only (a mode's picture is the same whatever vertex was picked)."""
+        """``marker`` where given, else True on distance maps only (a mode's picture does
+        not depend on the pick)."""
         if marker is not None:
             return bool(marker)
         return self.state.display.kind == "distance"
 
     def _offscreen_at(self, size):
-        """(an off-screen renderer of the state at ``size``, whether it is a temporary
-        one to close): this viewer's own without a window; with a window a new one,
-        looking from the window's camera.  A size does not carry over from an earlier
-        call, as :meth:`renderer`'s does."""
+        """(renderer at ``size``, whether to close it): this viewer's own, or with a
+        window a temporary one from the window's camera."""
         from ..scene.offscreen import DEFAULT_SIZE, OffscreenRenderer
 
         if self._picture is None:
@@ -158,12 +134,9 @@ class Pictures:
     def animation_images(
         self, frames: int | None = None, fps: float | None = None, size=None, marker=None
     ) -> list[np.ndarray]:
-        """The frames of one period of the mode shown vibrating, as the window animates
-        it (RGB uint8 arrays, ``size`` (width, height), default 640 x 480): ``frames``
-        frames (default: as many as play one period at ``fps`` at the window's speed),
-        the camera from the picture's direction fitted to the whole motion, legend and
-        colour bar drawn on; the pick marker only if ``marker``.  ValueError when no
-        mode is shown."""
+        """One period of the mode shown vibrating, as RGB uint8 frames (``size`` default
+        640 x 480; ``frames`` default: one period at ``fps`` at the window's speed), the
+        camera fitted to the whole motion.  ValueError when no mode is shown."""
         from ..scene.animation import ANIMATION_SIZE, DEFAULT_FPS, frame_phases, period_frames
         from ..scene.offscreen import OffscreenRenderer
 
@@ -202,10 +175,8 @@ class Pictures:
         size=None,
         marker: bool | None = None,
     ) -> Path:
-        """Write one period of the mode shown, vibrating as the window shows it, to a GIF
-        or (where imageio and imageio-ffmpeg are installed) an MP4, atomically; it loops
-        without a jump.  ``frames``, ``fps``, ``size`` and ``marker`` as in
-        :meth:`animation_images` (``fps`` default 25).  Returns the path written."""
+        """Write :meth:`animation_images` to a GIF or (with imageio-ffmpeg) an MP4,
+        atomically, looping without a jump (``fps`` default 25); returns the path."""
         from ..scene.animation import (
             ANIMATION_SIZE,
             DEFAULT_FPS,
@@ -220,11 +191,9 @@ class Pictures:
         return write_animation(path, images, DEFAULT_FPS if fps is None else fps)
 
     def mode_grid(self, modes, operator: str | None = None, grid=None, size=None) -> np.ndarray:
-        """Modes ``modes`` of ``operator`` (default: the one shown) side by side in one
-        picture (RGB uint8): panels of ``size`` (width, height) pixels (default 400 x
-        340) in a ``grid`` (columns, rows; default rows of up to 4), one camera fitted to
-        all, each captioned with its mode number and eigenvalue, one colour bar for the
-        range they share (see :func:`modalviewer.scene.grid.mode_grid`)."""
+        """Modes ``modes`` of ``operator`` (default: the one shown) side by side, one
+        picture (RGB uint8) of panels of ``size`` (default 400 x 340) in a ``grid``
+        (columns, rows; default rows of up to 4): :func:`modalviewer.scene.grid.mode_grid`."""
         from ..scene.grid import GRID_PANEL, mode_grid
 
         return mode_grid(self, modes, operator, grid, size or GRID_PANEL)
@@ -239,18 +208,16 @@ class Pictures:
         return save_png(path, self.mode_grid(modes, operator, grid, size))
 
     def animation_frame(self, phase: float, size=None) -> float:
-        """Move the picture's surface to ``phase`` (radians) of the vibration shown (a
-        still of the animation, kept until the display changes); returns the time this
-        took in s."""
+        """Show the vibration at ``phase`` (radians) until the display changes; returns
+        the seconds taken."""
         source = self._picture or self.renderer(size)
         drawing = getattr(source, "drawing", source)
         return drawing.animation_frame(phase)
 
     def set_view(self, view="canonical", up=None) -> dict | None:
-        """Turn the camera to ``view``: "canonical", a preset ("+x" ... "-z",
-        "isometric"/"iso") or (azimuth, elevation) in degrees about the up axis (also as
-        "AZ,EL"); ``up`` ("auto", "+x" ... "-z") chooses the up axis first.  Returns
-        the camera set (position, focal_point, view_up), None without a mesh."""
+        """Turn the camera to ``view``: "canonical", a preset ("+x" ... "-z", "iso") or
+        (azimuth, elevation) in degrees about the up axis (or "AZ,EL"), after choosing
+        the ``up`` axis if given.  Returns the camera set, None without a mesh."""
         from .camera import parse_view, view_camera
 
         view = parse_view(view) if isinstance(view, str) else tuple(float(x) for x in view)
@@ -274,22 +241,8 @@ class Pictures:
 
     @extra_needed("Viewer.export_comparison")
     def export_comparison(self, comparison, path, size=None, scale: int = 1) -> Path:
-        """Write the views of ``comparison`` side by side to a PNG, seen from the camera of
-        this viewer's picture.
-
-        Parameters
-        ----------
-        comparison : a :meth:`comparison`, or its items (two or three operators or
-            distance kinds; their missing spectra are computed first).
-        path : the PNG to write.
-        size : (width, height) of each view in pixels.
-        scale : magnification: each view is ``scale`` times ``size``.
-
-        Returns
-        -------
-        pathlib.Path
-            The file written.
-        """
+        """Write the views of ``comparison`` (a :meth:`comparison` or its items) side by
+        side to a PNG from this viewer's camera, each ``scale`` times ``size``."""
         from ..scene.comparison import VIEW_SIZE, save_comparison
         from .camera import Camera
 

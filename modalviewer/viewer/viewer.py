@@ -1,18 +1,14 @@
 """The Viewer: everything the modalviewer window does, scripted without a window (no Qt).
 
-A :class:`Viewer` is the viewer's model (:class:`~.model.ViewerModel`: the evented
-state, the job queue and the spectrum cache) with the scripting API, messages for the
-user and pictures (:class:`~.pictures.Pictures`).  Scripts, notebooks, the command line
-and the windows all drive the same object (docs/viewer-guide.md shows a script); a
-window only wires widgets to it: what a click does, the matching method here does.
-
-Messages are events: ``viewer.events.status(text, milliseconds)``, ``error(title,
-text)``, ``info(title, text)`` and ``sliver_failure(key, text)`` (a computation failed
-on slivers; :meth:`Viewer.fix_slivers_and_retry` may help).  Without a window nothing
-listens, and scripts get return values and exceptions.  Without a window, jobs run in
-worker threads and their results are handed back while a ``wait`` call waits
-(:class:`~.jobs.ManualDispatcher`); a window installs its event loop instead
-(:meth:`Viewer.use_event_loop`).
+A :class:`Viewer` is the model (:class:`~.model.ViewerModel`: evented state, job queue,
+spectrum cache) with the scripting API, messages and pictures (:class:`~.pictures.Pictures`).
+Scripts, notebooks, the command line and the windows drive the same object; a window
+only wires widgets to it.  Messages are events: ``viewer.events.status(text,
+milliseconds)``, ``error(title, text)``, ``info(title, text)`` and ``sliver_failure(key,
+text)``; without a window nothing listens and scripts get return values and exceptions,
+and worker results are handed back while a ``wait`` call waits
+(:class:`~.jobs.ManualDispatcher`; a window installs its event loop,
+:meth:`Viewer.use_event_loop`).
 """
 
 from __future__ import annotations
@@ -54,13 +50,9 @@ class ViewerMessages(SignalGroup):
 
 
 class Viewer(ViewerModel, Pictures):
-    """The viewer without a window; see the module docstring.
-
-    cache : where spectra are kept on disk (default: ``$MODALVIEWER_CACHE`` or the
-        user's cache folder).
-    dispatch, waiter : how results of worker threads reach this thread and how a
-        ``wait`` waits; the defaults suit scripts (see :meth:`use_event_loop`).
-    """
+    """The viewer without a window.  ``cache``: where spectra are kept on disk (default:
+    ``$MODALVIEWER_CACHE`` or the user's cache folder); ``dispatch``, ``waiter``: see
+    :meth:`use_event_loop` (the defaults suit scripts)."""
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None, waiter=None):
         super().__init__(cache=cache, dispatch=dispatch or ManualDispatcher())
@@ -107,8 +99,7 @@ class Viewer(ViewerModel, Pictures):
         return self.state.mesh.input_mesh if self.state.mesh is not None else None
 
     def _public(self, spec: Spectrum | None) -> Spectrum | None:
-        """``spec`` of the loaded mesh in the input's numbering (one row per vertex of
-        :attr:`mesh`)."""
+        """``spec`` in the input's numbering (one row per vertex of :attr:`mesh`)."""
         if spec is None or self.state.mesh is None:
             return spec
         return in_input_numbering(spec, self.state.mesh.input_mesh)
@@ -118,9 +109,9 @@ class Viewer(ViewerModel, Pictures):
             self._status(str(self.state.mesh.report), 15000)
 
     def repair_mesh(self, name: str, wait: bool = True) -> Mesh | None:
-        """Apply repair ``name`` ("fix_slivers", "largest_component") to the loaded mesh in
-        the background; the repaired mesh replaces it (its report says what changed).
-        With ``wait`` returns the repaired mesh (ComputeError if the repair failed)."""
+        """Apply repair ``name`` ("fix_slivers", "largest_component") in the background;
+        the repaired mesh replaces the loaded one.  With ``wait`` returns it (ComputeError
+        if the repair failed)."""
         job = self.repair(name)
         job.then(self._on_repaired)
         if not wait:
@@ -137,10 +128,9 @@ class Viewer(ViewerModel, Pictures):
             self.report_error(f"{job.description} failed: {job.error}", "Repair failed")
 
     def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
-        """Fix the loaded mesh's slivers (as Mesh > Fix slivers), report it and request
-        again the spectrum ``key`` (default: the last one whose factorisation failed on
-        slivers).  Returns the repair job (None if none started: without pymeshlab the
-        error says how to install it); with ``wait`` waits and returns the spectrum."""
+        """Fix the mesh's slivers and request again the spectrum ``key`` (default: the
+        last one whose factorisation failed on slivers).  Returns the repair job (None if
+        none started, e.g. without pymeshlab); with ``wait`` returns the spectrum."""
         key = key or self.sliver_failure
         if key is None:
             self._status("No computation failed on sliver triangles.", 5000)
@@ -185,43 +175,25 @@ class Viewer(ViewerModel, Pictures):
         return {op: self._public(self.state.spectrum(op)) for op in self.state.operators_computed()}
 
     def spectrum_shown(self) -> Spectrum | None:
-        """The spectrum the picture on screen is made of (a mode's operator, a distance's),
-        else the current one: what File > Export spectrum writes."""
+        """The spectrum the picture is made of, else the current one (File > Export spectrum)."""
         operators = (self.state.display_operator(), self.state.current_operator())
         shown = [self.state.spectrum(op) for op in operators if op is not None]
         return self._public(next((spec for spec in shown if spec is not None), None))
 
     def add_spectrum(self, spectrum: Spectrum) -> None:
-        """Put a spectrum computed elsewhere (``modalviewer.compute_spectrum``, a file)
-        into the viewer, as the spectrum of its operator and k under the current compute
-        settings; it must belong to the loaded mesh."""
+        """Put a spectrum of the loaded mesh computed elsewhere into the viewer, under the
+        current compute settings' key for its operator and k."""
         key = self.state.compute_settings.key(spectrum.operator, spectrum.k)
         self.state.add_spectrum(key, spectrum)
 
     def compute(
         self, operator: str | None = None, k: int | None = None, wait: bool = True, then=None
     ) -> Spectrum | None:
-        """Compute a spectrum in the background (cached on disk) and show its first non-zero
-        mode when it arrives (unless the display changed meanwhile).
-
-        Parameters
-        ----------
-        operator : an operator's name (default: the compute settings').
-        k : the number of modes (default: the compute settings').
-        wait : return once the spectrum is in.
-        then : called with the spectrum when it arrives.
-
-        Returns
-        -------
-        Spectrum or None
-            With ``wait=True`` this request's spectrum; otherwise None.
-
-        Raises
-        ------
-        ComputeError
-            With ``wait=True``, if no mesh is open, or the computation failed, was
-            cancelled or was too large to start.
-        """
+        """Compute a spectrum in the background (cached on disk) and show its first
+        non-zero mode when it arrives (unless the display changed meanwhile).
+        ``operator`` and ``k`` default to the compute settings'; ``then`` is called with
+        the spectrum.  With ``wait`` returns it, and raises ComputeError if no mesh is
+        open or the computation failed, was cancelled or was too large to start."""
         if self.state.mesh is None:
             self.report_error("Open a mesh first.")
             if wait:
@@ -237,8 +209,7 @@ class Viewer(ViewerModel, Pictures):
         return self._finish(job, wait, then)
 
     def _request(self, operator, k=None, show: bool = False) -> SpectrumJob | None:
-        """:meth:`~.model.ViewerModel.request_spectrum`, said on the status line; None (with
-        an error message) if it is too large to start."""
+        """:meth:`request_spectrum`, said on the status line; None if refused (reported)."""
         try:
             job = self.request_spectrum(operator, k, show=show)
         except ComputeRefused as exc:
@@ -255,9 +226,8 @@ class Viewer(ViewerModel, Pictures):
 
     def modes_ready(self, operator: str | None = None) -> tuple[int, int]:
         """(modes in, modes asked for) of ``operator``'s spectrum (default: the current
-        operator's): ``(12, 100)`` while a computation has handed over its first 12 of
-        100 modes, ``(100, 100)`` when all are in, ``(0, 0)`` with none.  In a script
-        (no event loop) it first takes in what the computation has handed over."""
+        one), e.g. ``(12, 100)`` while modes arrive; in a script it first takes in what
+        the computation has handed over."""
         if isinstance(self.jobs.dispatch, ManualDispatcher):
             self.jobs.dispatch.process()
         return self.state.modes_ready(operator or self.state.current_operator())
@@ -265,10 +235,9 @@ class Viewer(ViewerModel, Pictures):
     def wait_for_modes(
         self, count: int, operator: str | None = None, timeout: float | None = None
     ) -> tuple[int, int]:
-        """Wait until at least ``count`` modes of ``operator``'s spectrum are in (or all
-        it will have, or its computation ended); returns :meth:`modes_ready`.  Default
-        operator: the last one asked for.  With
-        ``compute(..., wait=False)``: look at the first modes while the others converge."""
+        """Wait until ``count`` modes of ``operator``'s spectrum (default: the last asked
+        for) are in, or its computation ended; returns :meth:`modes_ready`.  After
+        ``compute(..., wait=False)``: the first modes, while the others converge."""
         if not isinstance(self.jobs.dispatch, ManualDispatcher):
             raise RuntimeError(
                 "wait_for_modes is for scripts; in a window the modes arrive through the "
@@ -297,10 +266,8 @@ class Viewer(ViewerModel, Pictures):
         return self._public(job.result[0])
 
     def long_wait_note(self, job: SpectrumJob) -> str:
-        """ "this will take about ..." for a request expected to take long with nothing on
-        screen meanwhile (the estimate from this machine's own earlier solves,
-        :meth:`.model.ViewerModel.estimated_seconds`); "" otherwise, and where there is
-        no estimate."""
+        """ "this will take about ..." for a request expected (from this machine's solves)
+        to take longer than :data:`LONG_WAIT_SECONDS`; else ""."""
         if job.done:
             return ""
         seconds = self.estimated_seconds(job.spectrum_key)
@@ -311,8 +278,7 @@ class Viewer(ViewerModel, Pictures):
         return f"this will take about {about} (Esc cancels{faster})"
 
     def cancel_computation(self) -> None:
-        """Cancel the running computation; other queued requests keep their turn (the
-        message says how many)."""
+        """Cancel the running computation; other queued requests keep their turn."""
         if self.jobs.running is None:
             self._status("No computation running.", 3000)
             return
@@ -379,8 +345,7 @@ class Viewer(ViewerModel, Pictures):
 
     # =============================================================== modes
     def show_mode(self, index: int, operator: str | None = None) -> None:
-        """Colour the surface by mode ``index`` of ``operator`` (default: the spectrum
-        shown or last shown)."""
+        """Show mode ``index`` of ``operator`` (default: the current spectrum's)."""
         op = operator or self.state.current_operator()
         if op is None or self.state.spectrum(op) is None:
             return
@@ -408,16 +373,10 @@ class Viewer(ViewerModel, Pictures):
         """The picked vertex (the input's number, as :attr:`mesh` numbers it), or None."""
         return self.state.picked_file_vertex
 
-    def pick_file_vertex(self, number: int, show: bool = True) -> None:
-        """The same as :meth:`pick_vertex`: the viewer has one numbering, the input's."""
-        self.pick_vertex(number, show)
-
     def pick_vertex(self, index: int, show: bool = True) -> None:
-        """Pick vertex ``index`` of :attr:`mesh` (the input's numbering, as ``modalviewer
-        distance --vertex`` takes it; a ValueError for one no face uses): the marker and,
-        with ``show``, the distance map of the display's kind, its spectrum computed if
-        missing.  ``show=False`` spares a script that shows another kind next a spectrum
-        it does not need."""
+        """Pick vertex ``index`` of :attr:`mesh` (the input's numbering; ValueError for
+        one no face uses) and, with ``show``, show the distance map of the display's kind
+        (computing its spectrum if missing)."""
         if self.state.mesh is None:
             return
         self.state.set_pick_file_vertex(index)
@@ -431,28 +390,13 @@ class Viewer(ViewerModel, Pictures):
         share: float | None = None,
         threshold: float | None = None,
     ) -> np.ndarray | None:
-        """The distance map from the picked vertex, shown on the surface; a missing
-        spectrum is computed in the background and the map appears when it is ready
-        (unless the display changed meanwhile).
-
-        Parameters
-        ----------
-        kind : ``"vibration"``, ``"feature"`` or ``"hks"`` (default: the display's).
-        display : ``"continuous"`` (white to red) or ``"threshold"`` (blue where similar).
-        share : a threshold map marking this share (0..1] of the surface's area similar.
-        threshold : a threshold map at this absolute distance (marks distance <= it).
-
-        Returns
-        -------
-        ndarray, shape (n,) or None
-            The distance to every vertex; None until it is ready (or without a pick).
-
-        Raises
-        ------
-        ValueError
-            For both ``share`` and ``threshold``, a share outside (0, 1], a negative
-            threshold or an unknown kind.
-        """
+        """Show the distance map of ``kind`` (default: the display's) from the picked
+        vertex; a missing spectrum is computed and the map appears when it is ready
+        (unless the display changed meanwhile).  ``display``: "continuous" or
+        "threshold"; ``share`` (0..1] of the area, or an absolute ``threshold``
+        distance, for a threshold map.  Returns the (n,) distances, None until ready or
+        without a pick.  ValueError for both share and threshold, a share outside (0, 1],
+        a negative threshold or an unknown kind."""
         if share is not None and threshold is not None:
             raise ValueError("give either share (of the area) or threshold (a distance)")
         if share is not None and not 0.0 < float(share) <= 1.0:
@@ -498,8 +442,7 @@ class Viewer(ViewerModel, Pictures):
         return self._show_map(share, threshold)
 
     def _show_map(self, share: float | None, threshold: float | None) -> np.ndarray | None:
-        """Show the distance map of the display's kind, at ``share`` of the area or at the
-        absolute distance ``threshold`` if given."""
+        """Show the display kind's distance map, at ``share`` or ``threshold`` if given."""
         changes: dict = {"kind": "distance"}
         d = self.state.derived.distance_map()
         if threshold is not None and d is not None:
@@ -509,16 +452,10 @@ class Viewer(ViewerModel, Pictures):
         self.state.set_display(**changes)
         return self.state.derived.distance_map()
 
-    def distance_map(self, kind: str) -> np.ndarray | None:
-        """Distance of ``kind`` from the picked vertex (one value per vertex of
-        :attr:`mesh`, NaN where no face uses one), or None if its spectrum is missing."""
+    def distance_map(self, kind: str | None = None) -> np.ndarray | None:
+        """Distance of ``kind`` (default: the display's) from the picked vertex, per vertex
+        of :attr:`mesh` (NaN where no face uses one); None if its spectrum is missing."""
         return self._input_field(self.state.derived.distance_map(kind))
-
-    @property
-    def last_distance(self) -> np.ndarray | None:
-        if self.state.display.kind != "distance":
-            return None
-        return self._input_field(self.state.derived.distance_map())
 
     def _input_field(self, values: np.ndarray | None) -> np.ndarray | None:
         """Per-vertex ``values`` of the solver's mesh in the input's numbering."""
@@ -527,15 +464,13 @@ class Viewer(ViewerModel, Pictures):
         return self.state.mesh.to_file_field(values)
 
     def set_threshold(self, fraction: float) -> float:
-        """Move the threshold (a fraction of the largest distance); returns the time the
-        viewer took, in s."""
+        """Move the threshold (a fraction of the largest distance); returns the seconds taken."""
         started = time.perf_counter()
         self.state.set_display(threshold=float(fraction))
         return time.perf_counter() - started
 
     def show_signature(self, sample: int) -> None:
-        """Colour by the signature at scale sample ``sample`` of the distance kind's
-        spectrum."""
+        """Colour by the signature at scale sample ``sample`` of the distance kind."""
         operator = operator_for_distance(self.state.display.distance_kind)
         if not self.state.derived.has_signatures(operator):
             self._status(
@@ -547,8 +482,7 @@ class Viewer(ViewerModel, Pictures):
         self.state.set_display(kind="signature", signature_sample=int(sample))
 
     def show_signature_at(self, t: float) -> None:
-        """Colour by the signature at the scale ``t`` itself (any positive scale; the
-        signature is summed at ``t``, not at the nearest sample)."""
+        """Colour by the signature summed at scale ``t`` itself (not the nearest sample)."""
         operator = operator_for_distance(self.state.display.distance_kind)
         if not self.state.derived.has_signatures(operator):
             self.show_signature(0)  # says what to compute
@@ -561,10 +495,9 @@ class Viewer(ViewerModel, Pictures):
         )
 
     def show_field(self, name: str, values=None) -> None:
-        """Colour the surface by a per-vertex field of your own: ``values`` ((n,), one
-        per vertex of the loaded mesh) kept as the field ``name`` (see
-        :meth:`~.state.ViewerState.add_field`), or, without ``values``, a field given
-        before.  Signed values get the modes' colours, others white to red."""
+        """Colour by your own per-vertex field ``name``: ``values`` (n,) kept as it
+        (:meth:`~.state.ViewerState.add_field`), or one given before.  Signed values get
+        the modes' colours, others white to red."""
         if values is not None:
             self.state.add_field(name, values)
         self.state.set_display(kind="field", field=str(name))
@@ -594,9 +527,8 @@ class Viewer(ViewerModel, Pictures):
         return save_session(self.state, path)
 
     def open_session(self, path, wait: bool = True) -> list[str]:
-        """Restore a session; returns the notes on what could not be restored as saved.
-        With ``wait`` the call returns once every spectrum is loaded or recomputed.
-        Raises SessionError, MeshError or OSError for a file that cannot be restored."""
+        """Restore a session (with ``wait``, its spectra too); returns notes on what could
+        not be restored as saved.  SessionError, MeshError or OSError for a bad file."""
         from .session import restore_session
 
         restored = restore_session(self, path)
@@ -609,23 +541,21 @@ class Viewer(ViewerModel, Pictures):
 
     # ========================================================== comparison
     def missing_for(self, items: list[str]) -> list[str]:
-        """The operators whose spectra a comparison of ``items`` (operators or distance
-        kinds) needs and the state does not have."""
+        """The operators a comparison of ``items`` needs whose spectra are missing."""
         needed = [operator_for_distance(i) if i in DISTANCE_KINDS else i for i in items]
         return [op for op in dict.fromkeys(needed) if self.state.spectrum(op) is None]
 
     def comparison_cost(self, operators: list[str]) -> float | None:
-        """Seconds the spectra of ``operators`` are expected to take on this mesh (from
-        this machine's earlier solves, :meth:`.model.ViewerModel.estimated_seconds`);
-        None where one of them has no estimate."""
+        """Seconds the spectra of ``operators`` are expected to take; None if one has no
+        estimate."""
         settings = self.state.compute_settings
         seconds = [self.estimated_seconds(settings.key(op)) for op in operators]
         return None if any(s is None for s in seconds) else sum(seconds)
 
     def prepare_comparison(self, items: list[str], wait: bool = True, then=None):
-        """Request the spectra a comparison of ``items`` needs; with ``wait`` return once
-        they are in (ComputeError if one failed), else call ``then()`` when they are.
-        Returns the jobs (None if a request was refused)."""
+        """Request the spectra a comparison of ``items`` needs; with ``wait`` return the
+        jobs once they are in (ComputeError if one failed), else call ``then()`` then.
+        None if a request was refused."""
         jobs = [self._request(op, None, show=False) for op in self.missing_for(items)]
         if any(job is None for job in jobs):
             if wait:
@@ -651,9 +581,8 @@ class Viewer(ViewerModel, Pictures):
         return jobs
 
     def comparison(self, items: list[str], wait: bool = True):
-        """A :class:`~.comparison.Comparison` of two or three operators or distance
-        kinds on the loaded mesh; missing spectra are computed first (with ``wait``; the
-        display of this viewer is not changed)."""
+        """A :class:`~.comparison.Comparison` of two or three operators or distance kinds;
+        missing spectra are computed first (the display is not changed)."""
         from .comparison import Comparison
 
         if self.state.mesh is None:
@@ -664,30 +593,13 @@ class Viewer(ViewerModel, Pictures):
 
     # ========================================================== shape pair
     def pair(self, mesh_b, k: int | None = None, wait: bool = True, strict: bool = True, path=None):
-        """Distances between two shapes: this viewer's mesh as A and ``mesh_b`` as B.
-
-        Use the result with ``pair.pick("a", v)``, ``pair.distance_on("b")`` and
-        ``pair.best_match()``, all in the input's numbering; the distance kind and the
-        Discrete Shells weights are this viewer's.
-
-        Parameters
-        ----------
-        mesh_b : Mesh B (:class:`Mesh`), or its file.
-        k : modes per spectrum (default: :func:`~modalviewer.core.operators.default_k`).
-        wait : return once the spectra of both meshes are in.
-        strict : as for :meth:`open_mesh`, for a file.
-        path : the file a given Mesh was read from (its name labels B).
-
-        Returns
-        -------
-        PairState
-            The two meshes, their spectra and the pick.
-
-        Raises
-        ------
-        ComputeError
-            If no mesh is open, or (with ``wait``) a spectrum could not be computed.
-        """
+        """A :class:`~.pair.PairState`: this viewer's mesh as A, ``mesh_b`` (a Mesh or its
+        file; ``path`` names a given Mesh's file) as B, with this viewer's distance kind
+        and Discrete Shells weights; use ``pair.pick("a", v)``, ``pair.distance_on("b")``
+        and ``pair.best_match()`` (the input's numbering).  ``k`` modes per spectrum
+        (default: :func:`~modalviewer.core.operators.default_k`); ``strict`` as for
+        :meth:`open_mesh`.  ComputeError if no mesh is open, or (with ``wait``, which
+        waits for both spectra) a spectrum could not be computed."""
         from ..io import load_mesh
         from .pair import PairState
 
@@ -716,8 +628,7 @@ class Viewer(ViewerModel, Pictures):
         return pair
 
     def wait_for_pair(self, pair) -> None:
-        """Request the spectra ``pair``'s distance kind needs and wait for them
-        (ComputeError with the reason if one could not be computed)."""
+        """Request and wait for ``pair``'s spectra (ComputeError if one failed)."""
         for job in pair.request():
             self.wait_for(job)
             if job.status != DONE:

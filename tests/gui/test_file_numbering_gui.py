@@ -20,10 +20,10 @@ def test_the_window_picks_and_exports_in_file_numbers(window, tmp_path):
     path.write_text(head + "\n".join(rows) + "\n")
     window.open_mesh(path)
     window.compute("laplacian", k=20, wait=True)
-    window.pick_file_vertex(41)
+    window.pick_vertex(41)
     assert window.picked == 41 and window.state.picked_file_vertex == 41
     assert window.distances_panel.pick_label.text().startswith("Picked vertex 41 at")
-    window.pick_file_vertex(n + 1)  # used by no face: a message, the pick stays
+    window.pick_vertex(n + 1)  # used by no face: a message, the pick stays
     assert window.picked == 41
     window.show_distance("hks")
     out = window.export_field(tmp_path / "f.vtp")

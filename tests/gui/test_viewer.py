@@ -129,7 +129,7 @@ def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot, displa
     assert window.picked == target
     # the vibration distance needs the shells spectrum: computed in the worker
     qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
-    d = window.last_distance
+    d = window.distance_map()
     assert d.shape == (window.mesh.n_vertices,) and d[target] == 0.0 and d.max() > 0
     img = window.viewport.render_now()
     assert _classify(img)["red"] > 500
@@ -449,7 +449,7 @@ def test_coarse_to_fine_option(window):
     assert spec.parameters["coarse_vertices"] < 0.25 * window.mesh.n_vertices
     tip = json.loads((assets / "demo_landmarks.json").read_text())["demo_hand"]["finger1"]
     window.pick_vertex(tip)
-    coarse_d = window.last_distance
+    coarse_d = window.distance_map()
     full = mv.compute_spectrum(window.mesh, "shells", k=60)
     full_d = mv.multiscale_distance(full, tip)
     assert np.corrcoef(coarse_d, full_d)[0, 1] > 0.85

@@ -168,7 +168,7 @@ def test_messages_instead_of_dialogs(viewer, spot_path):
     assert statuses[-1].startswith("Laplacian (cotan), 10 modes in ")
     assert "largest relative residual" in statuses[-1]
     assert viewer.clear_cache() > 0
-    viewer.pick_file_vertex(5)
+    viewer.pick_vertex(5)
     assert viewer.picked == viewer.mesh.mesh_vertex(5)
     with pytest.raises(ValueError):
         viewer.show_distance(share=1.5)
@@ -289,11 +289,11 @@ def test_a_job_keeps_what_the_status_line_said_of_it(viewer, spot_path):
 
 
 def test_a_script_picks_without_computing_the_default_kinds_spectrum(viewer, spot_path):
-    # pick_file_vertex then show_distance("hks") had started the 3D shells for the
+    # pick_vertex then show_distance("hks") had started the 3D shells for the
     # default vibration distance as well
     viewer.open_mesh(spot_path)
     viewer.state.compute_settings.k = 12
-    viewer.pick_file_vertex(123, show=False)
+    viewer.pick_vertex(123, show=False)
     assert viewer.picked == 123 and viewer.jobs.jobs == []
     viewer.show_distance("hks")
     operators = [job.spectrum_key.operator for job in viewer.jobs.jobs]
