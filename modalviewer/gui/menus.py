@@ -165,7 +165,7 @@ def _view_menu(win, m) -> None:
     panels = m.addMenu("&Panels")
     for dock in win.findChildren(QtWidgets.QDockWidget):
         panels.addAction(dock.toggleViewAction())  # a closed panel comes back from here
-    _action(win, m, "&Reset camera", win.scene_view.reset_camera, "R")
+    _action(win, m, "&Reset camera", lambda: win.scene_view.drawing.reset_camera(), "R")
     views = m.addMenu("Camera &presets")
     for i, (name, label) in enumerate(CAMERA_PRESETS):
         slot = lambda _=False, n=name: win.scene_view.drawing.reset_camera(n)  # noqa: E731

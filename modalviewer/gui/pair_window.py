@@ -22,7 +22,7 @@ from ..viewer.pair import SIDES, PairView
 from ..viewer.viewer import LONG_WAIT_SECONDS, ComputeError
 from ..viewer.wording import seconds_text
 from .dialogs import NO_MESH_A
-from .panels.common import add_items, bind, row, show_values, slider, spin_box, tip
+from .panels.common import add_items, bind, row, show_values, slider, spin_box
 from .status_bar import JobProgress
 from .viewport import make_viewport
 from .views_window import ViewsWindow
@@ -81,7 +81,7 @@ class PairWindow(ViewsWindow):
     def _build(self, force_offscreen) -> None:
         p = self.pair
         kinds = ((label, kind) for kind, label in DISTANCE_KINDS.items())
-        self.kind_combo = tip(add_items(QtWidgets.QComboBox(), kinds), KIND_TIP)
+        self.kind_combo = add_items(QtWidgets.QComboBox(toolTip=KIND_TIP), kinds)
         displays = (("Continuous", "continuous"), ("Threshold", "threshold"))
         self.display_combo = add_items(QtWidgets.QComboBox(), displays)
         self.share_slider = slider(1, 500, SHARE_TIP)  # tenths of a percent of the other's area
@@ -90,10 +90,9 @@ class PairWindow(ViewsWindow):
         self.k_spin = spin_box(2, 1000, tip="Modes computed on each mesh (the same on both)")
         self.k_spin.setPrefix("k = ")
         self.k_spin.editingFinished.connect(lambda: setattr(p, "k", self.k_spin.value()))
-        self.rescale_check = tip(
-            QtWidgets.QCheckBox("Rescale both to the same area before computing"), RESCALE_TIP
-        )
-        self.link_check = tip(QtWidgets.QCheckBox("Linked cameras"), LINK_TIP)
+        rescale = "Rescale both to the same area before computing"
+        self.rescale_check = QtWidgets.QCheckBox(rescale, toolTip=RESCALE_TIP)
+        self.link_check = QtWidgets.QCheckBox("Linked cameras", toolTip=LINK_TIP)
         self.controls = {  # the pair's field -> its widget
             "kind": self.kind_combo,
             "distance_display": self.display_combo,
@@ -102,8 +101,8 @@ class PairWindow(ViewsWindow):
         }
         for name, widget in self.controls.items():
             bind(widget, lambda value, n=name: setattr(p, n, value))
-        export = tip(QtWidgets.QPushButton("Export..."), "Both views side by side in one PNG")
-        export.clicked.connect(self.export_dialog)
+        export_tip = "Both views side by side in one PNG"
+        export = QtWidgets.QPushButton("Export...", toolTip=export_tip, clicked=self.export_dialog)
         layout = QtWidgets.QVBoxLayout(self)
         controls = (self.kind_combo, self.display_combo, self.share_slider, self.share_label)
         layout.addLayout(row("Distance", *controls, self.k_spin, 1, export))

@@ -35,16 +35,9 @@ class LinePlot(QtWidgets.QWidget):
     sampleClicked = QtCore.Signal(int)
 
     def __init__(self, title: str = "", xlabel: str = "", ylabel: str = "", parent=None):
-        super().__init__(parent)
+        super().__init__(parent, minimumHeight=140)
         self.title, self.xlabel, self.ylabel = title, xlabel, ylabel
-        self.x = np.zeros(0)
-        self.y = np.zeros(0)
-        self.highlight: int | None = None
-        self.logx = False
-        self.markers = True
-        self.second: np.ndarray | None = None  # a second curve over the same x (dashed)
-        self.second_label = ""
-        self.setMinimumHeight(140)
+        self.set_data([], [])
 
     def set_data(self, x, y, highlight=None, logx=False, markers=True, title=None) -> None:
         self.x = np.asarray(x, dtype=float)

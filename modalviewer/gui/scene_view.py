@@ -33,10 +33,6 @@ class SceneView(QtCore.QObject):
     def scene(self):
         return self.drawing.scene
 
-    def reset_camera(self) -> None:
-        """The mesh's canonical view, fitted to the window (R)."""
-        self.drawing.reset_camera()
-
     def _restart_phase(self) -> None:
         self._phase = 0.0
 

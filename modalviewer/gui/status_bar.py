@@ -7,7 +7,7 @@ from qtpy import QtCore, QtGui, QtWidgets
 
 from ..viewer.jobs import RUNNING
 from ..viewer.wording import summary
-from .panels.common import follow, tip
+from .panels.common import follow
 
 
 class StatusLine(QtWidgets.QLabel):
@@ -55,8 +55,7 @@ class JobProgress:
         self.bar = QtWidgets.QProgressBar(
             maximum=1000, minimumWidth=width[0], maximumWidth=width[1]
         )
-        self.cancel_button = tip(QtWidgets.QPushButton("Cancel"), cancel_tip)
-        self.cancel_button.clicked.connect(cancel)
+        self.cancel_button = QtWidgets.QPushButton("Cancel", toolTip=cancel_tip, clicked=cancel)
         self.show_jobs([])
 
     def show_jobs(self, jobs) -> None:

@@ -43,7 +43,7 @@ def test_the_up_axis_menu_turns_the_view_and_is_remembered_per_file(qtbot, z_up_
     assert first.state.up_axis == "+y" and actions["+y"].isChecked()
     assert _up(first)[1] > 0.9
     first.plotter.camera.Azimuth(70)
-    first.scene_view.reset_camera()  # R: the canonical view for the chosen axis
+    first.scene_view.drawing.reset_camera()  # R: the canonical view for the chosen axis
     assert _up(first)[1] > 0.9
     first.open_mesh(ASSETS / "demo_plate.obj")  # another file: automatic
     assert first.state.up_axis is None and actions[None].isChecked()

@@ -574,7 +574,7 @@ def test_a_narrow_view_keeps_the_whole_mesh_in_sight(window, spot_path, qtbot):
 
     window.viewport.widget.setFixedSize(600, 400)
     qtbot.wait(50)
-    window.scene_view.reset_camera()  # fitted in a wide view
+    window.scene_view.drawing.reset_camera()  # fitted in a wide view
     cols, w, h = surface_columns()
     assert (w, h) == (600, 400)
     assert cols.size > 0 and cols.min() > 2 and cols.max() < w - 3

@@ -11,11 +11,8 @@ def combo() -> QtWidgets.QComboBox:
     """A combo box as wide as 14 characters, not as its longest item (a dock has a
     340-pixel limit; a wider combo would cut off its right edge), its current item's
     whole text in its tooltip."""
-    box = QtWidgets.QComboBox()
-    box.setSizeAdjustPolicy(
-        QtWidgets.QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon
-    )
-    box.setMinimumContentsLength(14)
+    policy = QtWidgets.QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon
+    box = QtWidgets.QComboBox(sizeAdjustPolicy=policy, minimumContentsLength=14)
     # the box shows the start of a long item ("Discrete Shells, normal v..."); the
     # tooltip names it whole, above what the box is for (see describe)
     box.currentTextChanged.connect(lambda _text: _refresh_tooltip(box))
@@ -77,12 +74,6 @@ class WrappingLabel(QtWidgets.QLabel):
         self.setMinimumHeight(needed if needed > 0 else kept)
 
 
-def tip(widget, text: str):
-    """``widget`` with the tooltip ``text``."""
-    widget.setToolTip(text)
-    return widget
-
-
 def slider(low: int, high: int, tip: str = "") -> QtWidgets.QSlider:
     """A horizontal slider over ``low`` .. ``high`` with the tooltip ``tip``."""
     horizontal = QtCore.Qt.Orientation.Horizontal
@@ -91,12 +82,9 @@ def slider(low: int, high: int, tip: str = "") -> QtWidgets.QSlider:
 
 def spin_box(low, high, value=None, tip: str = "", suffix: str = "") -> QtWidgets.QSpinBox:
     """A whole-number box over ``low`` .. ``high`` set to ``value`` (if given)."""
-    box = QtWidgets.QSpinBox()
-    box.setRange(low, high)
+    box = QtWidgets.QSpinBox(minimum=low, maximum=high, toolTip=tip, suffix=suffix)
     if value is not None:
         box.setValue(int(value))
-    box.setToolTip(tip)
-    box.setSuffix(suffix)
     return box
 
 

@@ -7,7 +7,7 @@ from qtpy import QtCore, QtWidgets
 from ...core.operators import OPERATOR_INFO
 from ...viewer import wording
 from ...viewer.state import ViewerState
-from .common import WrappingLabel, add_items, bind, combo, follow, show_values, spin_box, tip
+from .common import WrappingLabel, add_items, bind, combo, follow, show_values, spin_box
 
 K_MAX = 1_000_000
 """The Modes k box's maximum: no limit a mesh could reach before the memory check."""
@@ -37,20 +37,19 @@ class ComputePanel(QtWidgets.QWidget):
         self.bending_spin, self.membrane_spin = (
             QtWidgets.QDoubleSpinBox(decimals=4, maximum=1e6) for _ in range(2)
         )
-        self.rescale_check = tip(
-            QtWidgets.QCheckBox("Rescale to unit area (default: off)"),
-            "Compute on a copy scaled to total area 1. The shells spectrum depends on the "
-            "absolute size; rescaling makes meshes of different sizes comparable.",
+        self.rescale_check = QtWidgets.QCheckBox(
+            "Rescale to unit area (default: off)",
+            toolTip="Compute on a copy scaled to total area 1. The shells spectrum depends on "
+            "the absolute size; rescaling makes meshes of different sizes comparable.",
         )
-        self.coarse_check = tip(
-            QtWidgets.QCheckBox("Coarse-to-fine (default: off)"),
-            "Compute on a copy decimated to about a fifth of the vertices and carry the modes "
-            "to this mesh by nearest vertex (paper Section 7): much faster on big meshes.",
+        self.coarse_check = QtWidgets.QCheckBox(
+            "Coarse-to-fine (default: off)",
+            toolTip="Compute on a copy decimated to about a fifth of the vertices and carry "
+            "the modes to this mesh by nearest vertex (paper Section 7): much faster on big "
+            "meshes.",
         )
-        self.compute_button = tip(
-            QtWidgets.QPushButton("Compute spectrum"),
-            "Compute the selected operator's spectrum (Ctrl+R)",
-        )
+        compute_tip = "Compute the selected operator's spectrum (Ctrl+R)"
+        self.compute_button = QtWidgets.QPushButton("Compute spectrum", toolTip=compute_tip)
         form.addRow("Operator", self.operator_combo)
         form.addRow("Modes k", self.k_spin)
         form.addRow("Bending weight", self.bending_spin)

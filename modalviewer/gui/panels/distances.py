@@ -22,7 +22,6 @@ from .common import (
     row,
     show_values,
     slider,
-    tip,
 )
 
 SLIDER_STEPS = 1000
@@ -47,12 +46,12 @@ class DistancesPanel(QtWidgets.QWidget):
         displays = ("Continuous (white to red)", "Threshold (blue = similar)")
         self.display_combo = add_items(combo(), zip(displays, DISTANCE_DISPLAYS, strict=True))
         self.threshold_slider = slider(1, SLIDER_STEPS, "Threshold of the blue (similar) region")
-        self.by_share_check = tip(
-            QtWidgets.QCheckBox("Slider by share of surface"),
-            "On: the slider moves through the share of the surface marked similar. "
+        self.by_share_check = QtWidgets.QCheckBox(
+            "Slider by share of surface",
+            checked=True,
+            toolTip="On: the slider moves through the share of the surface marked similar. "
             "Off: linear in the fraction of the largest distance.",
         )
-        self.by_share_check.setChecked(True)
         self.threshold_label = WrappingLabel("-")
         self.threshold_slider.setSingleStep(5)  # 0.5 % of the surface per arrow key
         self.threshold_slider.setPageStep(50)
@@ -62,8 +61,8 @@ class DistancesPanel(QtWidgets.QWidget):
             edit.setPlaceholderText("default")
             edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
         self.pick_label = WrappingLabel("Click the surface to pick a vertex.")
-        self.distance_button = tip(
-            QtWidgets.QPushButton("Show distance"), "Distance from the picked vertex (D)"
+        self.distance_button = QtWidgets.QPushButton(
+            "Show distance", toolTip="Distance from the picked vertex (D)"
         )
         form.addRow("Kind", self.kind_combo)
         form.addRow("Display", self.display_combo)
@@ -78,14 +77,13 @@ class DistancesPanel(QtWidgets.QWidget):
         form.addRow(self.distance_button)
         self.scale_slider = slider(0, 99, "Show the signature at this scale")
         form.addRow("Signature at scale", self.scale_slider)
-        self.scale_edit = tip(
-            QtWidgets.QLineEdit(),
-            "Type a scale t: the signature is summed at t itself (the slider shows the "
-            "nearest sample)",
+        self.scale_edit = QtWidgets.QLineEdit(
+            toolTip="Type a scale t: the signature is summed at t itself (the slider shows "
+            "the nearest sample)"
         )
         self.scale_edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
         log_tip = "Colour the signature by log10(S / smallest S)"
-        self.log_check = tip(QtWidgets.QCheckBox("Log colours"), log_tip)
+        self.log_check = QtWidgets.QCheckBox("Log colours", toolTip=log_tip)
         self.scale_row = row((self.scale_edit, 1), self.log_check)
         form.addRow("t", self.scale_row)
         self.signature_plot = LinePlot("Signature of the picked vertex", "t (log)", "S_t")
