@@ -456,11 +456,11 @@ def test_coarse_to_fine_option(window):
 
 
 def test_too_large_computation_is_refused_up_front(window, spot_path, monkeypatch):
+    from modalviewer.core import memory
     from modalviewer.gui import main_window
-    from modalviewer.viewer import model
 
     window.open_mesh(spot_path)
-    monkeypatch.setattr(model, "physical_memory_mb", lambda: 64.0)  # 64 MiB
+    monkeypatch.setattr(memory, "physical_memory_mb", lambda: 64.0)  # 64 MiB
     with pytest.raises(main_window.ComputeError, match="GiB of memory"):
         window.compute("shells", k=300, wait=True)
     assert "Coarse-to-fine" in window.last_error and not window.busy
