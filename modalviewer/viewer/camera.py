@@ -69,9 +69,8 @@ class Camera:
 
 @dataclass(frozen=True)
 class CameraLink:
-    """The similarity ``x_B = focal_b + scale * rotation @ (x_A - focal_a)`` that carries
-    the camera of one view (A) to another's (B): two views of two meshes that turn,
-    zoom and pan together, each about its own mesh."""
+    """The similarity ``x_B = focal_b + scale * rotation @ (x_A - focal_a)`` carrying view
+    A's camera to view B's: two views that turn, zoom and pan together."""
 
     rotation: np.ndarray
     scale: float
@@ -86,15 +85,13 @@ class CameraLink:
 
     @classmethod
     def facing(cls, a, b) -> CameraLink:
-        """The link that shows mesh ``b`` from the direction ``a`` is seen from, about
-        its own bounding box centre and at its own size."""
+        """The link showing mesh ``b`` as mesh ``a`` is seen, about its own centre and size."""
         centre_a, centre_b = ((m.vertices.min(0) + m.vertices.max(0)) / 2 for m in (a, b))
         scale = b.bounding_box_diagonal / (a.bounding_box_diagonal or 1.0)
         return cls(np.eye(3), scale, centre_a, centre_b)
 
     def carry(self, camera: Camera, from_a: bool = True) -> tuple[Camera, float]:
-        """``camera`` of A carried to B (or of B to A), and the factor its size (a
-        parallel projection's scale) is multiplied by."""
+        """``camera`` carried A to B (or B to A), and the factor its parallel scale takes."""
         rot, s, src, dst = self.rotation, self.scale, self.focal_a, self.focal_b
         if not from_a:
             rot, s, src, dst = rot.T, 1.0 / s, dst, src
@@ -144,9 +141,8 @@ def _bounds(vertices) -> tuple[np.ndarray, float]:
 
 
 def principal_axes(vertices, faces=None) -> tuple[np.ndarray, np.ndarray]:
-    """(variances (3,) descending, axes (3, 3) with the axes as rows) of the surface: the
-    area-weighted second moments of the triangles (each triangle's own spread included),
-    or of the vertices without faces."""
+    """(variances (3,) descending, axes as rows (3, 3)): the area-weighted second moments
+    of the triangles, or of the vertices without faces."""
     v = np.asarray(vertices, dtype=np.float64)
     if faces is None or len(faces) == 0:
         c = v - v.mean(axis=0)
@@ -195,9 +191,7 @@ def _rotate(v: np.ndarray, axis: np.ndarray, degrees: float) -> np.ndarray:
 
 
 def look_from(vertices, direction, up) -> Camera:
-    """A camera looking at the mesh's bounding-box centre from ``direction`` (pointing from
-    the centre to the camera), far enough to see the bounding sphere, with ``up`` made
-    orthogonal to the direction."""
+    """A camera at ``direction`` from the bounding-box centre, seeing the bounding sphere."""
     centre, radius = _bounds(vertices)
     d = _unit(direction)
     u = np.asarray(up, dtype=np.float64)
@@ -208,9 +202,8 @@ def look_from(vertices, direction, up) -> Camera:
 
 
 def silhouette_area(points, cell: float, directions) -> np.ndarray:
-    """(d,) area of the silhouette of ``points`` seen along each unit direction (d, 3),
-    estimated by the square cells of side ``cell`` that the projected points fall into
-    (:func:`_surface_points` gives points dense enough for its cell)."""
+    """(d,) silhouette area of ``points`` along each direction (d, 3): the square cells of
+    side ``cell`` the projected points fall into."""
     v = np.asarray(points, dtype=np.float64)
     v = v - v.mean(axis=0)
     out = np.zeros(len(directions))
@@ -229,9 +222,8 @@ def silhouette_area(points, cell: float, directions) -> np.ndarray:
 
 
 def _surface_points(vertices, faces, samples: int = 40000) -> tuple[np.ndarray, float]:
-    """(points, cell): ``samples`` points spread uniformly over the surface (a fixed
-    seed, so a mesh always gets the same view) and a cell side at which a surface seen
-    face-on leaves no cell empty, whatever the size of its triangles."""
+    """(points, cell): uniform points on the surface (a fixed seed: a mesh always gets the
+    same view) and a cell side a surface seen face-on leaves no cell of empty."""
     v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
     x0, x1, x2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     area = 0.5 * np.linalg.norm(np.cross(x1 - x0, x2 - x0), axis=1)
@@ -275,8 +267,8 @@ def _largest_silhouette(vertices, faces, up_vec: np.ndarray) -> np.ndarray:
 
 
 def sharp_edges(vertices, faces) -> tuple[np.ndarray, np.ndarray] | None:
-    """The sharp edges of a CAD-like surface (see the module docstring): ((s, 3) edge
-    vectors, (s, 2, 3) the unit normals of their two faces); None for other surfaces."""
+    """((s, 3) edge vectors, (s, 2, 3) their faces' unit normals) of the sharp edges of a
+    CAD-like surface; None for other surfaces."""
     v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
     normals = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
     normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
@@ -298,24 +290,12 @@ def sharp_edges(vertices, faces) -> tuple[np.ndarray, np.ndarray] | None:
     return vectors[sharp], pair[sharp]
 
 
-def crease_visibility(edges: tuple[np.ndarray, np.ndarray], direction) -> float:
-    """How well the sharp ``edges`` (:func:`sharp_edges`) show from unit ``direction``
-    (toward the camera): their length, each weighted by the cosine between the view and
-    the less visible of its two faces (0 where one is turned away), since a crease shows
-    as the meeting of two faces both seen."""
-    vectors, normals = edges
-    seen = np.clip((normals @ _unit(direction)).min(axis=1), 0.0, None)
-    return float(np.linalg.norm(vectors, axis=1) @ seen)
-
-
 def canonical_view(
     vertices, faces=None, up=None, azimuth: float | None = None, elevation: float | None = None
 ) -> Camera:
-    """The canonical first view of a mesh (see the module docstring).  ``up``: an axis
-    name ("+y", "z", ...) or a vector; ``azimuth``/``elevation`` in degrees turn the
-    camera about the up axis and toward it from the straight front view (default
-    :data:`DEFAULT_TURN`, or for a CAD-like part the turn of :data:`CAD_TURNS` that shows
-    its sharp edges best)."""
+    """The canonical first view (module docstring); ``up`` an axis name or a vector;
+    ``azimuth``/``elevation`` (degrees) turn from the front view (default
+    :data:`DEFAULT_TURN`, for a CAD-like part the best of :data:`CAD_TURNS`)."""
     up_vec = _up_vector(up)
     view = _largest_silhouette(vertices, faces, up_vec)
     if abs(view @ up_vec) > np.cos(np.radians(30.0)):
@@ -338,14 +318,17 @@ def canonical_view(
         el = DEFAULT_TURN[1] if elevation is None else elevation
         direction = _turned(view, screen_up, az, el)
     else:
+        # the turn showing the creases best: their lengths weighted by the cosine of the
+        # less visible face (a crease shows where both faces are seen)
+        lengths, normals = np.linalg.norm(edges[0], axis=1), edges[1]
         turns = [_turned(view, screen_up, a, e) for a, e in CAD_TURNS]
-        direction = max(turns, key=lambda d: crease_visibility(edges, d))
+        direction = max(turns, key=lambda d: lengths @ np.clip((normals @ d).min(1), 0, None))
     return look_from(vertices, direction, screen_up)
 
 
 def _turned(view, screen_up, azimuth: float, elevation: float) -> np.ndarray:
-    """``view`` turned by ``azimuth`` about ``screen_up`` toward the front (+Z, then +X:
-    of the two turns the one facing it more), then by ``elevation`` toward up."""
+    """``view`` turned by ``azimuth`` about ``screen_up`` toward the front, then by
+    ``elevation`` toward up."""
     turns = [_rotate(view, screen_up, a) for a in (azimuth, -azimuth)]
     direction = max(turns, key=lambda d: float(d @ _TURN_TOWARD))
     right = _unit(np.cross(screen_up, direction))
@@ -353,11 +336,10 @@ def _turned(view, screen_up, azimuth: float, elevation: float) -> np.ndarray:
 
 
 def preset_view(vertices, name: str, up=None) -> Camera:
-    """The view from one side: "+x" puts the camera on the +X side looking toward -X, and
-    so on; "isometric" looks from the (+1, +1, +1) corner of the up-axis frame.  The
-    screen's up is the up axis, or for views along it the next axis (Z after Y, X after
-    Z, Y after X), negated for the view from the positive side (a top view with +Y up has
-    -Z at the top of the screen, so +Z is toward the viewer)."""
+    """The view from one side ("+x": the camera on the +X side), or "isometric" from the
+    (+1, +1, +1) corner of the up-axis frame.  Screen up is the up axis; along it the
+    next axis (Z after Y), negated from the positive side (a top view with +Y up has +Z
+    toward the viewer)."""
     up_vec = _up_vector(up)
     key = name.lower()
     if key == "isometric":
@@ -391,8 +373,7 @@ BASE_SPAN = 0.5  # share of the horizontal extents a base must span
 
 
 def _supports(v: np.ndarray, f: np.ndarray, axis: int) -> int:
-    """The number of separate pieces (connected by the mesh's edges) of the surface in
-    the bottom ``SUPPORT_SLICE`` of its extent along ``axis``: the feet it stands on."""
+    """The connected pieces in the bottom ``SUPPORT_SLICE`` along ``axis``: its feet."""
     import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components
 
@@ -408,9 +389,8 @@ def _supports(v: np.ndarray, f: np.ndarray, axis: int) -> int:
 
 
 def _flat_base(v: np.ndarray, f: np.ndarray, axis: int) -> float:
-    """The share of the surface's area lying flat (normal along ``axis``) in the bottom
-    ``BASE_SLICE`` of its extent along ``axis``: a base it stands on; 0 unless the base
-    spans at least ``BASE_SPAN`` of the extent along both other axes."""
+    """The share of the area lying flat in the bottom ``BASE_SLICE`` along ``axis`` (a
+    base); 0 unless it spans ``BASE_SPAN`` of the other two extents."""
     x0, x1, x2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     n = np.cross(x1 - x0, x2 - x0)
     area = np.linalg.norm(n, axis=1)
@@ -435,13 +415,10 @@ def _has_boundary(f: np.ndarray) -> bool:
 
 
 def detect_up(vertices, faces=None) -> str | None:
-    """ "+z" when the mesh clearly stands on the XY plane (a Z-up file), else None (no
-    claim: the default +Y applies).  Conservative: a mesh thin along z (a plate, less
-    than ``FLAT_ASPECT`` of its largest extent) or standing on three or more feet along
-    y makes no claim; otherwise +Z is claimed when the bottom of the extent along z is
-    three or more separate pieces (feet, legs), or, for a closed surface, when a flat
-    base at the bottom along z spanning half its width and depth holds at least
-    ``BASE_SHARE`` of the area and such a base along y less than a quarter of that."""
+    """ "+z" when the mesh clearly stands on the XY plane, else None (+Y applies).  No
+    claim for a plate (thinner than ``FLAT_ASPECT`` along z) or three feet along y; +Z
+    for three feet along z, or (a closed surface) a flat base along z holding
+    ``BASE_SHARE`` of the area with a base along y under a quarter of that."""
     if faces is None or len(faces) == 0:
         return None
     v = np.asarray(vertices, dtype=np.float64)
@@ -471,9 +448,8 @@ def up_axis_of(vertices, faces=None, chosen: str | None = None) -> str:
 
 
 def orbit_view(vertices, azimuth: float, elevation: float, up=None) -> Camera:
-    """The camera at ``azimuth`` degrees about the up axis and ``elevation`` degrees
-    toward it, both from the front: the axis after the up axis (+Z for +Y up, +X for +Z
-    up, +Y for +X up; negated with the up axis).  Azimuth 90 looks from the right."""
+    """The camera at ``azimuth`` degrees about the up axis and ``elevation`` toward it,
+    from the front: the axis after the up axis (+Z for +Y up).  Azimuth 90: the right."""
     up_vec = _up_vector(up)
     k = int(np.argmax(np.abs(up_vec)))
     front = np.zeros(3)
@@ -520,6 +496,5 @@ def view_camera(vertices, faces, view, up=None) -> Camera:
 
 
 def canonical_camera(mesh, up=None) -> dict:
-    """:func:`canonical_view` of a :class:`~modalviewer.core.mesh.Mesh` as a dict
-    (position, focal_point, view_up)."""
+    """:func:`canonical_view` of ``mesh`` as :meth:`Camera.as_dict`."""
     return canonical_view(mesh.vertices, mesh.faces, up=up).as_dict()

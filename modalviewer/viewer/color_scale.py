@@ -1,28 +1,19 @@
 """Colour scales that spread a field's values over the colours by area (no Qt, no VTK).
 
-A distance from a vertex is small on most of a shape, so linear colours paint most of
-the surface alike.  The "spread" scale maps a value to the share of the area at or below
-it (an area-weighted rank), so each tenth of the colours covers about a tenth of the
-surface; the colour bar keeps the true values at its ticks.
+A distance from a vertex is small on most of a shape, so linear colours paint most of it
+alike; the "spread" scale maps a value to the share of the area at or below it, so each
+tenth of the colours covers about a tenth of the surface.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-ROBUST_PERCENTILE = 99.0
-"""The robust colour range ends at this area-weighted percentile of |value|."""
-
-SPREAD_SHARE = 0.25
-"""The automatic colour range spreads a one-signed field when a tenth of the linear
-scale would cover more than this share of the surface's area."""
-
+ROBUST_PERCENTILE = 99.0  # the robust range's end: this area-weighted percentile of |value|
+SPREAD_SHARE = 0.25  # "auto" spreads where a tenth of the linear scale covers more area
 TENTHS = 10
-KNOTS = 64
-"""Pieces of the piecewise-linear map from value to colour position."""
-
-TICKS = (0.0, 0.25, 0.5, 0.75, 1.0)
-"""Positions on the colour bar labelled with their values on a spread scale."""
+KNOTS = 64  # pieces of the piecewise-linear map from value to colour position
+TICKS = (0.0, 0.25, 0.5, 0.75, 1.0)  # colour bar positions labelled on a spread scale
 
 
 def crowded_share(values: np.ndarray, weights: np.ndarray, clim: tuple[float, float]) -> float:
@@ -38,10 +29,9 @@ def crowded_share(values: np.ndarray, weights: np.ndarray, clim: tuple[float, fl
 
 
 def spread_knots(values: np.ndarray, weights: np.ndarray, n: int = KNOTS):
-    """(knot values, knot positions): the area-weighted quantiles of ``values`` at
-    positions 0, 1/n, ..., 1, as a strictly increasing piecewise-linear map from value
-    to colour position (``np.interp(x, *knots)``).  Values shared by more than a 1/n
-    of the area (a flat region) keep one knot, at the lowest of their positions."""
+    """(knot values, knot positions): the area-weighted quantiles of ``values`` at 0,
+    1/n, ..., 1, a strictly increasing map to colour position (``np.interp(x, *knots)``);
+    a value covering more than 1/n of the area keeps one knot, its lowest position."""
     values = np.asarray(values, dtype=np.float64)
     order = np.argsort(values, kind="stable")
     cumulative = np.cumsum(np.asarray(weights, dtype=np.float64)[order])
@@ -66,9 +56,8 @@ def tick_values(knots) -> list[tuple[float, float]]:
 
 
 def auto_spread(values: np.ndarray, weights: np.ndarray):
-    """The spread scale's knots for a one-signed ``values`` of which a tenth of the
-    linear range 0 .. largest would cover more than :data:`SPREAD_SHARE` of the weight,
-    else None (linear colours read well)."""
+    """The spread knots of non-negative ``values`` crowded into a tenth of the linear
+    range (more than :data:`SPREAD_SHARE` of the weight), else None."""
     values = np.asarray(values, dtype=np.float64)
     if values.size == 0 or values.min() < 0:
         return None
@@ -78,8 +67,7 @@ def auto_spread(values: np.ndarray, weights: np.ndarray):
 
 
 def robust_limit(values: np.ndarray, weights: np.ndarray, percent: float = ROBUST_PERCENTILE):
-    """The ``percent`` area-weighted percentile of |values|: the smallest |value| that at
-    least ``percent`` % of the total weight lies at or below."""
+    """The ``percent`` weighted percentile of |values|."""
     a = np.abs(np.asarray(values, dtype=np.float64))
     order = np.argsort(a, kind="stable")
     cumulative = np.cumsum(np.asarray(weights, dtype=np.float64)[order])

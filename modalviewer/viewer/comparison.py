@@ -1,10 +1,6 @@
 """Side-by-side comparison of two or three operators (the paper's Fig. 1) or distance
-kinds (Figs. 6, 7) on the loaded mesh, without Qt or VTK.
-
-A :class:`Comparison` reads the viewer's state and never changes it (it keeps only its
-mode index); :meth:`Comparison.views` gives each view's :class:`~.derived.Field` and
-title, drawn by the compare window or
-:func:`modalviewer.scene.comparison.comparison_image` off screen.
+kinds (Figs. 6, 7) on the loaded mesh (no Qt, no VTK).  A :class:`Comparison` reads the
+viewer's state and never changes it; :meth:`Comparison.views` gives each view's field.
 """
 
 from __future__ import annotations
@@ -29,8 +25,7 @@ def item_label(item: str) -> str:
 
 @dataclass
 class ComparisonView:
-    """What one view of a comparison shows: ``field`` (None: the plain surface, with
-    ``title`` saying why), the marker at ``marker`` (a mesh vertex) or none."""
+    """One view: ``field`` (None: the plain surface, ``title`` says why) and ``marker``."""
 
     item: str
     title: str
@@ -39,10 +34,9 @@ class ComparisonView:
 
 
 class Comparison:
-    """Two or three ``items``, all operators or all distance kinds, on ``state``'s mesh:
-    operator views show one mode index (from the first operator's first non-zero mode),
-    distance views the threshold map from the pick marking the share the main display's
-    map marks.  ``changed`` is emitted when the mode index changes."""
+    """Two or three ``items``, all operators or all distance kinds: operator views show
+    one mode index, distance views the threshold map marking the main display's share.
+    ``changed`` is emitted when the mode index changes."""
 
     changed = Signal()
 
@@ -66,8 +60,8 @@ class Comparison:
 
     @property
     def mode_index(self) -> int:
-        """The mode index the operator views show: the first non-zero mode of the first
-        operator until it is changed (fixed once that spectrum is in)."""
+        """The operator views' mode index: the first operator's first non-zero mode until
+        changed."""
         if self._mode_index is None:
             if self.state.spectrum(self.items[0]) is None:
                 return 0

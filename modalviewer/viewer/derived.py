@@ -1,12 +1,10 @@
 """Values computed from the viewer's state and kept until it changes (no Qt, no VTK).
 
-:class:`DerivedValues` (``state.derived``) caches everything computed from the state:
-normals, the deformed mode's scale, colour ranges, curvature, vertex areas, signature
-tables, the pick's distance map, and :meth:`DerivedValues.field`, the picture the scene
-draws.  Every value remembers what it was computed from (mesh, spectrum object, pick,
-scale range) and is recomputed when that changed, so no reader gets a stale value
-whatever order the event callbacks run in; the state's ``mesh``, ``spectra`` and
-``scale_range`` events release what nothing shows any more.
+:class:`DerivedValues` (``state.derived``): normals, colour ranges, curvature, areas,
+signature tables, the pick's distance map and :meth:`DerivedValues.field`, the picture
+the scene draws.  Each value remembers what it was computed from (mesh, spectrum object,
+pick, scale range) and is recomputed when that changed, so no reader gets a stale value
+whatever order the event callbacks run in; the state's events release the rest.
 """
 
 from __future__ import annotations
@@ -34,42 +32,27 @@ from . import wording
 from .color_scale import robust_limit
 from .mode_scalar import smoothed_normals, vector_mode_scalar
 
-TIE_TOLERANCE = 1e-7
-"""Distances within this share of the largest of a threshold chosen by share are
-marked with it (:meth:`DerivedValues.threshold_for_share`)."""
+TIE_TOLERANCE = 1e-7  # distances this close (share of the largest) are marked together
 
 
 @dataclass
 class Field:
-    """A per-vertex picture derived from the state, ready for the scene to draw.
-
-    colormap : "diverging" (blue / white / orange), "sequential" (white to red),
-        "threshold" (blue = similar) or "plain" (the grey surface).
-    threshold : for "threshold": values (the distances) up to it are blue.
-    displacement : (n, 3) the mode's shape, its largest vector of length 1.
-    deformation : the surface is drawn at rest + deformation * displacement (0: the rest
-        shape); the animation replaces it.
-    ghost : draw the rest shape faint behind the displaced surface.
-    clim : the colour range; ``clipped`` (low, high): values lie beyond that end (marked
-        on the colour bar); ``color_range`` the range's rule.
-    scale : None (linear colours) or (knot values, knot positions), the piecewise-linear
-        map of a "spread" range to colour positions (:mod:`.color_scale`).
-    """
+    """A per-vertex picture derived from the state, ready for the scene to draw."""
 
     values: np.ndarray
-    colormap: str
+    colormap: str  # "diverging", "sequential" (white to red), "threshold", "plain"
     isolines: int = 0
-    displacement: np.ndarray | None = None
+    displacement: np.ndarray | None = None  # (n, 3) the mode's shape, largest length 1
     clim: tuple[float, float] | None = None
     title: str = ""
     legend: str = ""
     share_similar: float | None = None
-    threshold: float | None = None
-    deformation: float = 0.0
-    ghost: bool = False
-    clipped: tuple[bool, bool] = (False, False)
-    color_range: str = ""
-    scale: tuple[np.ndarray, np.ndarray] | None = None
+    threshold: float | None = None  # "threshold": values up to it are blue
+    deformation: float = 0.0  # drawn at rest + deformation * displacement
+    ghost: bool = False  # the rest shape faint behind the displaced surface
+    clipped: tuple[bool, bool] = (False, False)  # values beyond clim's (low, high)
+    color_range: str = ""  # the range's rule
+    scale: tuple[np.ndarray, np.ndarray] | None = None  # a spread range's knots
 
 
 class DerivedValues:
@@ -136,22 +119,20 @@ class DerivedValues:
         return self._mesh_value("smooth_normals", smoothed_normals)
 
     def vector_coloring(self) -> str:
-        """The scalar colouring 3D modes: "normal" (component) or "magnitude" (also of
-        the deformed shape)."""
+        """How 3D modes are coloured: "normal" (component) or "magnitude"."""
         coloring = self.state.style.shell_coloring
         return "magnitude" if coloring == "deformed" else coloring
 
     def amplitude_length(self) -> float:
-        """The largest displacement of a mode drawn displaced (deformed or animated):
-        ``animation.amplitude`` percent of a quarter of the bounding-box diagonal."""
+        """A displaced mode's largest displacement: ``animation.amplitude`` % of a quarter
+        of the bounding-box diagonal."""
         mesh = self.state.mesh
         if mesh is None:
             return 0.0
         return self.state.animation.amplitude / 100.0 * 0.25 * mesh.bounding_box_diagonal
 
     def deformation(self) -> float:
-        """The scale a still picture displaces the surface by: :meth:`amplitude_length`
-        for a 3D mode shown "deformed", else 0 (the rest shape)."""
+        """:meth:`amplitude_length` for a 3D mode shown "deformed", else 0."""
         state = self.state
         d = state.display
         if d.kind != "mode" or state.style.shell_coloring != "deformed":
@@ -160,11 +141,10 @@ class DerivedValues:
         return self.amplitude_length() if spec is not None and spec.is_vector else 0.0
 
     def color_range(self, values: np.ndarray, colormap: str) -> tuple[tuple, tuple, str]:
-        """(clim, clipped (low, high), rule) of ``values`` drawn with ``colormap``
-        ("diverging": symmetric about 0; else from 0) under ``style.color_range``; the
-        rule is the one applied ("auto" resolved: symmetric for modes; robust for other
-        fields, or "spread" for a one-signed field of which a tenth of the robust linear
-        scale would cover more than :data:`.color_scale.SPREAD_SHARE` of the surface)."""
+        """(clim, clipped (low, high), rule applied) of ``values`` drawn with ``colormap``
+        under ``style.color_range``; "auto" is symmetric for modes, else robust, or
+        "spread" where a tenth of the robust scale would cover more than
+        :data:`.color_scale.SPREAD_SHARE` of the surface."""
         from .color_scale import SPREAD_SHARE, crowded_share
 
         style, values = self.state.style, np.asarray(values, dtype=np.float64)
@@ -201,8 +181,7 @@ class DerivedValues:
         return (float(lo), float(hi)), clipped, rule
 
     def scaled(self, field: Field) -> Field:
-        """``field`` with its colour range (:meth:`color_range`) and, on a spread range,
-        its scale's knots; the compare windows' fields too."""
+        """``field`` with its colour range and, on a spread range, its knots."""
         from .color_scale import spread_knots
 
         field.clim, field.clipped, field.color_range = self.color_range(
@@ -224,27 +203,23 @@ class DerivedValues:
         return self._mesh_value("curvature", total_curvature)
 
     def negative_cotan_weights(self) -> int:
-        """The number of edges of the mesh whose cotan weight is negative
-        (:func:`~modalviewer.core.robust.negative_cotan_weights`)."""
+        """:func:`~modalviewer.core.robust.negative_cotan_weights` of the mesh."""
         from ..core.robust import negative_cotan_weights
 
         return negative_cotan_weights(self.state.mesh)
 
     def vertex_areas(self) -> np.ndarray:
-        """(n,) lumped vertex areas: shares "of the surface" are shares of its area, not
-        of its vertices, which differ on a mesh of uneven density."""
+        """(n,) lumped vertex areas: shares "of the surface" are of its area, not vertices."""
         return self._mesh_value("vertex_areas", lumped_masses)
 
     # ----------------------------------------------------- signatures
     def has_signatures(self, operator: str) -> bool:
-        """Whether ``operator``'s spectrum exists and has non-zero modes (signatures
-        leave zero modes out)."""
+        """Whether ``operator``'s spectrum has non-zero modes (signatures omit zero modes)."""
         spec = self.state.spectrum(operator)
         return spec is not None and not spec.zero_mode_mask().all()
 
     def table(self, operator: str, kind: str = "heat") -> SignatureTable:
-        """The signature table of ``operator``'s spectrum over the current scale range,
-        of signature ``kind`` ("heat", or "wks": the range is then of energies)."""
+        """The ``kind`` ("heat" or "wks") signature table of ``operator`` over the scale range."""
         spec = self.state.spectrum(operator)
         if spec is None:
             raise ValueError(f"no spectrum of {operator!r} has been computed")
@@ -262,13 +237,11 @@ class DerivedValues:
         return self.table(operator_for_distance(kind), signature_kind(kind))
 
     def wave(self) -> bool:
-        """Whether the display's distance kind is a wave kernel's (its scales are
-        energies)."""
+        """Whether the display's distance kind is a wave kernel's (scales are energies)."""
         return signature_kind(self.state.display.distance_kind) == "wks"
 
     def signature_time(self) -> float:
-        """The scale t the signature display is shown at: the typed one
-        (``display.signature_time``), or the scale of ``display.signature_sample``."""
+        """The signature display's scale: the typed one, or the sample's."""
         display = self.state.display
         if display.signature_time is not None:
             return float(display.signature_time)
@@ -276,15 +249,13 @@ class DerivedValues:
         return float(table.times[int(np.clip(display.signature_sample, 0, len(table.times) - 1))])
 
     def nearest_sample(self, t: float) -> int:
-        """The index of the table's scale nearest to ``t`` (in log scale): where the
-        slider stands for a typed scale."""
+        """The table's scale nearest to ``t`` in log (the slider's place for a typed t)."""
         table = self.kind_table()
         return int(np.argmin(np.abs(np.log(table.times) - np.log(float(t)))))
 
     def signature_values(self, operator: str, t: float, kind: str = "heat") -> np.ndarray:
-        """(n,) the signature of ``operator`` at scale ``t`` (of ``kind`` "wks": at
-        energy ``t``, the width that of the table's energies), or with
-        ``style.log_signature`` its log10 over its smallest value (0 at the smallest)."""
+        """(n,) the signature of ``operator`` at scale (or "wks" energy) ``t``; with
+        ``style.log_signature`` its log10 over its smallest value."""
         spec = self.state.spectrum(operator)
         if kind == "wks":
             sigma = wks_sigma(self.table(operator, kind).times)
@@ -299,11 +270,9 @@ class DerivedValues:
         return values
 
     def truncation(self, operator: str | None = None, t: float | None = None):
-        """(estimated truncation error (0..1), k suggested for below
-        :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`) of the signature of
-        ``operator`` (the display's) at scale ``t`` (the one shown); see
-        :mod:`modalviewer.core.truncation`.  None without signatures, and for the wave
-        kernel's (the estimate is the heat kernel's)."""
+        """(estimated truncation error, k suggested) of ``operator``'s signature at ``t``
+        (defaults: the display's; :mod:`modalviewer.core.truncation`).  None without
+        signatures, and for the wave kernel (the estimate is the heat kernel's)."""
         from ..core.truncation import TRUNCATION_LEVEL, k_for_truncation, truncation_error
 
         if operator is None:
@@ -326,9 +295,8 @@ class DerivedValues:
 
     # ------------------------------------------- the picked vertex's curve
     def curve_key(self) -> tuple | None:
-        """What the picked vertex's signature curve is made of (operator, spectrum id,
-        vertex, scale range), or None without one (also for the wave kernel's signature,
-        whose curve is not summed over all modes)."""
+        """(operator, spectrum id, vertex, scale range) of the picked vertex's curve; None
+        without one and for the wave kernel (not summed over all modes)."""
         state = self.state
         operator = operator_for_distance(state.display.distance_kind)
         if state.picked is None or not self.has_signatures(operator) or self.wave():
@@ -336,9 +304,8 @@ class DerivedValues:
         return (operator, id(state.spectrum(operator)), state.picked, state.t_range)
 
     def curve(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """(scales, values): the picked vertex's signature at the scales of the display
-        kind's table (energies for the wave kernel), from the modes in; None without a
-        pick or signatures."""
+        """(scales, values) of the picked vertex's signature at the display kind's table's
+        scales; None without a pick or signatures."""
         state = self.state
         operator = operator_for_distance(state.display.distance_kind)
         if state.picked is None or not self.has_signatures(operator):
@@ -352,17 +319,15 @@ class DerivedValues:
         return times, values[0]
 
     def curve_truncation(self) -> float | None:
-        """The estimated truncation error of the picked vertex's curve at its smallest
-        scale (where it is largest), or None without a curve."""
+        """The curve's truncation error at its smallest scale (the largest), or None."""
         key = self.curve_key()
         if key is None:
             return None
         return self.truncation(key[0], float(self.table(key[0]).times[0]))[0]
 
     def exact_curve(self) -> np.ndarray | None:
-        """(T,) the picked vertex's signature over the table's scales summed over all
-        modes (:func:`~modalviewer.core.local_signature.local_signature`), once a job has
-        computed it (:meth:`.viewer.Viewer.request_exact_curve`), else None."""
+        """(T,) the curve summed over all modes, once
+        :meth:`.model.ViewerModel.request_exact_curve` has computed it, else None."""
         key = self.curve_key()
         if key is None or self._exact_curve is None or self._exact_curve[0] != key:
             return None
@@ -373,8 +338,7 @@ class DerivedValues:
         self._exact_curve = (key, np.asarray(times), np.asarray(values))
 
     def up_axis(self) -> str:
-        """The up axis in effect: the chosen one (``state.up_axis``), else the one
-        detected on the mesh where confident (:func:`.camera.detect_up`), else +Y."""
+        """The chosen up axis, else :func:`.camera.detect_up`'s, else +Y."""
         from .camera import DEFAULT_UP, detect_up
 
         if self.state.up_axis is not None:
@@ -385,8 +349,7 @@ class DerivedValues:
         return detected or DEFAULT_UP
 
     def default_range(self) -> tuple[float, float] | None:
-        """The default scales (energies for the wave kernel) of the display kind's
-        spectrum, what an empty range field stands for; None before it is in."""
+        """The display kind's default scale range (an empty field's); None without it."""
         spec = self.state.spectrum(operator_for_distance(self.state.display.distance_kind))
         if spec is None:
             return None
@@ -400,8 +363,7 @@ class DerivedValues:
 
     # ------------------------------------------------------ distances
     def distance_map(self, kind: str | None = None) -> np.ndarray | None:
-        """Distance of ``kind`` (the display's by default) from the picked vertex, or
-        None if a spectrum is missing."""
+        """Distance of ``kind`` (default: the display's) from the pick, or None."""
         state = self.state
         kind = kind or state.display.distance_kind
         spec = state.spectrum(operator_for_distance(kind))
@@ -415,8 +377,7 @@ class DerivedValues:
         return d
 
     def map_identity(self) -> tuple | None:
-        """What the display's distance map is made of (kind, vertex, scale range, spectrum
-        object id), or None without one."""
+        """(kind, vertex, scale range, spectrum id) of the display's map, or None."""
         state = self.state
         spec = state.spectrum(operator_for_distance(state.display.distance_kind))
         if spec is None or state.picked is None:
@@ -431,9 +392,8 @@ class DerivedValues:
         return self.state.display.threshold * float(d.max())
 
     def map_fraction(self, d: np.ndarray) -> float:
-        """The fraction of the largest distance a threshold map of ``d`` uses: the
-        display's, or, with ``keep_share`` while the map is not drawn as a threshold map
-        (the state matches the fraction only then), the one marking the kept share."""
+        """The threshold fraction for ``d``: the display's, or with ``keep_share`` while no
+        threshold map is drawn (the state matches it only then), the kept share's."""
         display = self.state.display
         if display.keep_share and display.distance_display != "threshold":
             return self.threshold_for_share(display.threshold_share, d)
@@ -445,17 +405,15 @@ class DerivedValues:
         return float(areas[d <= value].sum() / areas.sum())
 
     def marked_share(self) -> float | None:
-        """The share (0..1) of the surface the threshold map on screen marks similar, or
-        None without one."""
+        """The share of the surface the threshold map on screen marks, or None."""
         d = self.distance_map()
         if self.state.display.distance_display != "threshold" or d is None:
             return None
         return self.surface_share(d, self.threshold_value(d))
 
     def threshold_for_share(self, share: float, d: np.ndarray | None = None) -> float:
-        """The threshold fraction that marks ``share`` (0..1) of the surface similar (or
-        a little more, where distances equal to :data:`TIE_TOLERANCE` of the largest
-        straddle it: all of them are marked)."""
+        """The fraction marking ``share`` of the surface (a little more where distances
+        equal to :data:`TIE_TOLERANCE` straddle it: all are marked)."""
         d = self.distance_map() if d is None else d
         if d is None or d.max() <= 0:
             return float(share)
@@ -477,7 +435,7 @@ class DerivedValues:
 
     # -------------------------------------------------------- pictures
     def mode_fields(self, spec: Spectrum, j: int) -> tuple[np.ndarray, np.ndarray]:
-        """(scalar to colour (n,), displacement (n, 3) scaled to a peak of 1) of mode j."""
+        """(scalar (n,), displacement (n, 3) of peak 1) of mode j."""
         phi = spec.mode(j)
         if spec.is_vector:
             coloring = self.vector_coloring()

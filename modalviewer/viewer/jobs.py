@@ -1,12 +1,10 @@
 """Computations as job objects: each its own progress, cancel, result or error (no Qt).
 
-One job runs at a time (a spectrum computation already uses every core), the others
-wait first in, first out; a request with the ``key`` of a queued or running job joins
-it.  Only :meth:`Job.cancel` cancels (the user, or the viewer when the job's mesh is
-replaced), and a cancelled or failed job says so to whoever waits for it.  The job's
-function runs in a worker thread; every state change is handed to ``dispatch`` (Qt's
-event loop, or :class:`ManualDispatcher` in scripts), so ``events`` are always emitted
-on the owner's thread.
+One job runs at a time (a spectrum computation already uses every core), the others wait
+first in, first out; a request with the ``key`` of a queued or running job joins it.  A
+job's function runs in a worker thread; every state change is handed to ``dispatch``
+(Qt's event loop, or :class:`ManualDispatcher` in scripts), so ``events`` are emitted on
+the owner's thread.
 """
 
 from __future__ import annotations
@@ -26,22 +24,16 @@ from .process import ChildError
 
 _ids = itertools.count(1)
 
+# failures whose message says it all: their jobs keep no traceback for the log
 EXPECTED_FAILURES: tuple[type[Exception], ...] = (MeshError, EigenError, ChildError)
-"""Failures whose message is for the user (a mesh the operator cannot run on, a solve
-that did not converge, a child process's reported error): their jobs keep no traceback,
-so the log says what failed without one."""
-
-PROGRESS_INTERVAL = 0.05
-"""Seconds between two progress reports of the same stage (each crosses threads)."""
+PROGRESS_INTERVAL = 0.05  # seconds between reports of one stage (each crosses threads)
 
 QUEUED, RUNNING, DONE, FAILED, CANCELLED = "queued", "running", "done", "failed", "cancelled"
 
 
 class Job:
-    """One computation: ``fn(progress, cancel)`` returns the result.  Set on the owner's
-    thread: ``status``, ``stage``, ``fraction``, ``result``, ``error`` (for users),
-    ``details`` (a traceback for the log), ``seconds`` and ``said`` (what the status line
-    said of the job, whole, for the Computations panel)."""
+    """One computation: ``fn(progress, cancel)`` returns the result.  ``error`` is for
+    users, ``details`` a traceback for the log, ``said`` what the status line said of it."""
 
     def __init__(self, fn: Callable, key: Hashable, description: str, owner: Hashable = None):
         self.id = next(_ids)
@@ -84,8 +76,7 @@ class Job:
         return self
 
     def then(self, callback: Callable[[Job], None]) -> Job:
-        """Call ``callback(job)`` on the owner's thread once the job has ended (at once
-        if it has)."""
+        """Call ``callback(job)`` on the owner's thread once the job has ended (or now)."""
         if self.done:
             callback(self)
         else:
@@ -98,8 +89,7 @@ class Job:
 
 
 class SpectrumJob(Job):
-    """A job computing (or loading) the spectrum ``spectrum_key`` of the loaded mesh; its
-    result is ``(Spectrum, SignatureTable or None)``."""
+    """A job computing the spectrum ``spectrum_key``; result ``(Spectrum, table or None)``."""
 
     def __init__(
         self,
@@ -114,16 +104,13 @@ class SpectrumJob(Job):
 
 
 class RepairJob(Job):
-    """A job applying a repair of ``modalviewer.repair.REPAIRS`` to a mesh; its result is
-    the repaired Mesh."""
+    """A job repairing a mesh (``modalviewer.repair.REPAIRS``); result the repaired Mesh."""
 
 
 class LatestModes:
-    """``on_modes`` of a spectrum computation, called in the worker thread: keeps the
-    latest spectrum so far and dispatches one ``deliver(spectrum)`` at a time to the
-    owner's thread, so a slow redraw skips steps rather than queueing them.  The
-    finished spectrum is the job's result, not delivered; nothing is delivered once
-    ``job`` was cancelled or has ended."""
+    """``on_modes`` of a spectrum computation (worker thread): keeps the latest spectrum
+    and dispatches one ``deliver(spectrum)`` at a time, so a slow redraw skips steps
+    rather than queueing them; nothing once ``job`` was cancelled or has ended."""
 
     def __init__(self, dispatch: Callable[[Callable[[], None]], None], deliver) -> None:
         self.dispatch, self.deliver = dispatch, deliver
@@ -194,8 +181,7 @@ class JobQueue:
         return self.add(Job(fn, key, description, owner))
 
     def add(self, job: Job) -> Job:
-        """Queue ``job``; an identical queued or running request (same ``key``) is
-        returned instead, and ``job`` is dropped."""
+        """Queue ``job``, or return a queued or running one of the same ``key``."""
         for queued in self.jobs:
             if queued.key == job.key and not queued.cancel_requested:
                 return queued
@@ -207,10 +193,8 @@ class JobQueue:
     def add_spectrum(
         self, make_work, key: Hashable, description: str, owner: Hashable, spectrum_key, deliver
     ) -> SpectrumJob:
-        """Queue a :class:`SpectrumJob` (see :meth:`add`) running ``make_work(on_modes)``:
-        the modes its solve hands to ``on_modes`` as they converge reach
-        ``deliver(spectrum)`` on the owner's thread (:class:`LatestModes`).  The viewer's
-        and the shape pair's requests both go through here."""
+        """Queue a :class:`SpectrumJob` running ``make_work(on_modes)``; the modes handed
+        to ``on_modes`` reach ``deliver(spectrum)`` on the owner's thread."""
         arrivals = LatestModes(self.dispatch, deliver)
         job = self.add(SpectrumJob(make_work(arrivals), key, description, owner, spectrum_key))
         arrivals.job = job
@@ -323,10 +307,8 @@ class JobQueue:
             self._start_next()
 
     def _end(self, job: Job, status: str, error: str | None) -> None:
-        """Mark ``job`` ended, tell the observers, then run its own callbacks.  An
-        observer that raises does not keep the callbacks from running (a wait on the
-        job would never end) nor, in ``_finish``, the next job from starting; its error
-        is raised afterwards."""
+        """Mark ``job`` ended, tell the observers, then run its callbacks even if an
+        observer raised (a wait would never end; the error is raised afterwards)."""
         if job.done:
             return
         job.status, job.error = status, error

@@ -1,14 +1,8 @@
 """The scalar that colours a mode: the mode itself for scalar operators; for 3D vibration
-modes (Discrete Shells) its magnitude or its normal component.
-
-The normal component is taken against *smoothed* vertex normals (area-weighted normals
-diffused by one implicit heat step of ``NORMAL_SMOOTHING`` mean edge lengths): plain
-normals jump across a sharp edge within one ring of triangles and make jagged isolines;
-the component stays signed, so the zero line shows where the surface does not move
-along its normal.  The magnitude |Phi| is as smooth as the mode's components even where
-the normal turns by 90 degrees.  How smooth each is: the viewer guide, "How the
-pictures are drawn".  The viewer draws 3D modes as the deformed shape by default
-(:meth:`.derived.DerivedValues.deformation`); these colourings are the options.
+modes its magnitude or its normal component against *smoothed* normals (plain normals
+jump across a sharp edge and make jagged isolines; the component stays signed, so its
+zero line shows where the surface does not move along its normal).  The viewer guide,
+"How the pictures are drawn", compares them.
 """
 
 from __future__ import annotations
@@ -30,9 +24,8 @@ def mean_edge_length(mesh: Mesh) -> float:
 
 
 def smoothed_normals(mesh: Mesh, radius: float | None = None) -> np.ndarray:
-    """(n, 3) unit vertex normals after one implicit heat step (M + r^2 S) N' = M N of the
-    area-weighted normals N; ``radius`` r defaults to ``NORMAL_SMOOTHING`` mean edge
-    lengths.  Vertices whose diffused normal vanishes keep their plain normal."""
+    """(n, 3) unit normals after one implicit heat step (M + r^2 S) N' = M N (``radius``
+    r default: ``NORMAL_SMOOTHING`` mean edge lengths); a vanishing one stays plain."""
     normals = vertex_normals(mesh)
     r = NORMAL_SMOOTHING * mean_edge_length(mesh) if radius is None else float(radius)
     if r <= 0:
@@ -50,8 +43,7 @@ def smoothed_normals(mesh: Mesh, radius: float | None = None) -> np.ndarray:
 
 
 def vector_mode_scalar(phi: np.ndarray, normals: np.ndarray, coloring: str = "normal"):
-    """The scalar colouring a 3D mode ``phi`` (n, 3): "normal" -> phi . normals (pass
-    :func:`smoothed_normals`), "magnitude" -> |phi|."""
+    """A 3D mode ``phi`` (n, 3) as a scalar: "normal" (phi . normals) or "magnitude"."""
     phi = np.asarray(phi, dtype=np.float64)
     if coloring == "normal":
         return np.einsum("ij,ij->i", phi, normals)
@@ -61,7 +53,6 @@ def vector_mode_scalar(phi: np.ndarray, normals: np.ndarray, coloring: str = "no
 
 
 def mode_scalar(spec, j: int, normals: np.ndarray, coloring: str = "normal") -> np.ndarray:
-    """The scalar colouring mode ``j`` of spectrum ``spec``: the mode for scalar operators,
-    :func:`vector_mode_scalar` for 3D modes (``normals`` from :func:`smoothed_normals`)."""
+    """Mode ``j`` of ``spec`` as a scalar (:func:`vector_mode_scalar` for 3D modes)."""
     phi = spec.mode(j)
     return vector_mode_scalar(phi, normals, coloring) if spec.is_vector else np.asarray(phi)

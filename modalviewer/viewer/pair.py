@@ -1,20 +1,15 @@
 """Two meshes side by side: a pick on one, the distance between shapes on the other (no Qt).
 
-:class:`PairState` holds meshes A and B, the distance kind and how it is shown
-(continuous, or a threshold as a share of the other mesh's area), whether both are
-rescaled to unit area before their spectra are computed (signatures carry a factor
-1/area and the shells spectrum is not scale covariant: :mod:`.core.cross`), and the
-pick.  Its spectra go through the main window's :class:`~.jobs.JobQueue` and the disk
-cache, reusing a spectrum of A the main window already holds.  Distances are
-:class:`~modalviewer.core.cross.CrossTables` queries.  The window draws
-:meth:`PairState.view` of each side and observes ``events``: ``meshes()`` (A or B
-replaced: spectra and pick dropped), ``spectra()``, ``display()`` (also after a setting
-changed: ``kind``, ``k``, ``rescale``, ``distance_display``, ``share``, evented fields,
-each with its own event too), ``linked(on)`` and ``message(str)`` (something the user
-should read).
-
-Vertices and distances are in the input's numbering (NaN at vertices no face uses);
-only :class:`PairView` numbers the vertices of :meth:`PairState.drawn_mesh`.
+:class:`PairState` holds meshes A and B, the distance kind and its display, whether both
+are rescaled to unit area first (signatures carry a factor 1/area and the shells
+spectrum is not scale covariant: :mod:`.core.cross`), and the pick.  Its spectra go
+through the main window's :class:`~.jobs.JobQueue` and the disk cache, reusing the main
+window's spectrum of A; distances are :class:`~modalviewer.core.cross.CrossTables`
+queries.  The window draws :meth:`PairState.view` of each side and observes ``events``:
+``meshes()``, ``spectra()``, ``display()`` (also after any setting changed; each
+evented field has its own event too), ``linked(on)`` and ``message(str)``.  Vertices
+and distances are in the input's numbering; only :class:`PairView` numbers those of
+:meth:`PairState.drawn_mesh`.
 """
 
 from __future__ import annotations
@@ -65,29 +60,17 @@ def _check_side(side: str) -> None:
 
 @dataclass
 class PairView:
-    """What one side of the pair draws, on :meth:`PairState.drawn_mesh` (its numbering).
+    """What one side of the pair draws, on :meth:`PairState.drawn_mesh` (its numbering)."""
 
-    values : (n,) distances from the pick on the other side, or None (the plain surface).
-    colormap : "sequential" (white 0 to red), "threshold" (blue below ``threshold``) or
-        "plain".
-    marker : the picked vertex (picked side) or the best match (other side).
-    back_marker : on the picked side, the best match back when the match is not mutual;
-        else None.
-    legend : the lines drawn at the top left of the view and in exports.
-    colorbar_title, colorbar_labels : the colour bar (labels for a threshold's swatches).
-    scale : the knots of a colour scale spread by area (:func:`.color_scale.auto_spread`),
-        or None for linear colours.
-    """
-
-    values: np.ndarray | None
-    colormap: str
+    values: np.ndarray | None  # distances from the pick on the other side
+    colormap: str  # "sequential", "threshold" (blue below threshold) or "plain"
     threshold: float | None
-    marker: int | None
-    back_marker: int | None
+    marker: int | None  # the pick (picked side) or the best match (other side)
+    back_marker: int | None  # the best match back, when not mutual
     legend: str
     colorbar_title: str | None = None
-    colorbar_labels: list[str] | None = None
-    scale: np.ndarray | None = None
+    colorbar_labels: list[str] | None = None  # a threshold's swatches
+    scale: np.ndarray | None = None  # knots spread by area (color_scale.auto_spread)
 
 
 class PairEvents(SignalGroup):
@@ -111,16 +94,11 @@ class _Side:
 
 @dataclass(eq=False)
 class PairState:
-    """Mesh A and mesh B, their spectra, the pick and the display; see the module docstring.
-
-    ``jobs`` and ``cache``: the queue and disk cache the spectra go through.
-    ``state_a``: a viewer state whose spectra of mesh A may be reused (the main window's).
-    ``k``: modes per spectrum on both meshes (default:
-    :func:`~modalviewer.core.operators.default_k`).
-    ``weights``: the Discrete Shells (bending, membrane) weights.
-    ``share``: of the other mesh's area, marked by the threshold display.
-    ``linked``: the two views' cameras move together (keeping their relative viewpoint).
-    """
+    """Meshes A and B, their spectra, the pick and the display (module docstring).
+    ``state_a``: a viewer state whose spectra of A are reused; ``k``: modes per spectrum
+    (default: :func:`~modalviewer.core.operators.default_k`); ``weights``: Discrete
+    Shells (bending, membrane); ``share``: of the other mesh's area, marked by the
+    threshold display; ``linked``: the two cameras move together."""
 
     events: ClassVar = SignalGroupDescriptor(
         signal_group_class=PairEvents,
@@ -183,8 +161,7 @@ class PairState:
         return self.sides[side].mesh.input_mesh
 
     def drawn_mesh(self, side: str) -> Mesh:
-        """The surface the window draws of ``side``: the vertices faces use (the
-        numbering of :class:`PairView`; its ``file_vertex`` gives the input's)."""
+        """The surface drawn of ``side``: the vertices faces use (:class:`PairView`'s)."""
         _check_side(side)
         return self.sides[side].mesh
 
@@ -193,7 +170,7 @@ class PairState:
         return self.sides[side].name
 
     def set_mesh(self, side: str, mesh: Mesh, path=None) -> None:
-        """Replace mesh ``side``: its pending jobs are cancelled and the pick dropped."""
+        """Replace mesh ``side``, cancelling its jobs and dropping the pick."""
         _check_side(side)
         self.jobs.cancel_all(owner=self.owner(side), reason="superseded: another mesh")
         self.sides[side] = _Side(mesh, path)
@@ -203,7 +180,7 @@ class PairState:
         self.events.display.emit()
 
     def owner(self, side: str) -> tuple:
-        """The owner of this pair's jobs for ``side`` (cancelling them leaves others')."""
+        """The owner of this pair's jobs for ``side``."""
         return ("pair", id(self), side, self.sides[side].mesh.hash)
 
     # ---------------------------------------------------------- settings
@@ -212,14 +189,13 @@ class PairState:
         return operator_for_distance(self.kind)
 
     def key(self) -> SpectrumKey:
-        """The spectrum both meshes need for the current kind, k, weights and scaling."""
+        """The spectrum key both meshes need now."""
         weights = operator_info(self.operator).has_weights
         bending, membrane = self.weights if weights else (1.0, 1.0)
         return SpectrumKey(self.operator, self.k, bending, membrane, rescale=self.rescale)
 
     def set_display(self, display: str, share: float | None = None) -> None:
-        """Set ``distance_display`` ("continuous" or "threshold") and, if given,
-        ``share``."""
+        """Set ``distance_display`` and, if given, ``share``."""
         self.distance_display = display
         if share is not None:
             self.share = share
@@ -233,8 +209,7 @@ class PairState:
         return side, self.sides[side].mesh.file_vertex(v)
 
     def pick(self, side: str, vertex: int | None) -> None:
-        """Pick vertex ``vertex`` of mesh ``side`` (None clears the pick); a ValueError
-        for a vertex the mesh does not have or no face uses."""
+        """Pick ``vertex`` of mesh ``side`` (None clears it); ValueError for one no face uses."""
         _check_side(side)
         new = None
         if vertex is not None:
@@ -250,7 +225,7 @@ class PairState:
 
     # ----------------------------------------------------------- spectra
     def spectrum(self, side: str, key: SpectrumKey | None = None) -> Spectrum | None:
-        """The spectrum of mesh ``side`` for ``key`` (default: the current one), if in."""
+        """The spectrum of ``side`` for ``key`` (default: the current one), if in."""
         _check_side(side)
         key = key or self.key()
         mesh = self.sides[side].mesh
@@ -268,7 +243,7 @@ class PairState:
         return [job for job in self._pending.values() if not job.done]
 
     def failure(self) -> str | None:
-        """Why a spectrum the current display needs could not be computed, if it failed."""
+        """Why a spectrum the display needs failed, if one did."""
         key = self.key()
         for side in SIDES:
             error = self._failed.get((side, self.sides[side].mesh.hash, key))
@@ -277,8 +252,8 @@ class PairState:
         return None
 
     def request(self) -> list[Job]:
-        """Jobs for the spectra the current kind needs that are not in yet (computed or
-        read from the disk cache in the background); the list of those still pending."""
+        """Request the spectra the current key needs that are not in; returns the jobs
+        still pending."""
         key = self.key()
         jobs = []
         for side in SIDES:
@@ -304,9 +279,8 @@ class PairState:
         return [job for job in jobs if not job.done]
 
     def estimated_seconds(self) -> float | None:
-        """Seconds the missing spectra of the current key are expected to take
-        (:func:`.model.expected_seconds`); None where nothing is missing or one of them
-        has no estimate."""
+        """Seconds the missing spectra are expected to take; None if none is missing or
+        one has no estimate."""
         from .model import expected_seconds
 
         key = self.key()
@@ -320,8 +294,7 @@ class PairState:
             self.jobs.cancel_all(owner=self.owner(side), reason="cancelled")
 
     def compute_mesh(self, side: str, key: SpectrumKey) -> Mesh:
-        """The mesh the spectrum of ``side`` for ``key`` is computed on (unit area with
-        ``key.rescale``)."""
+        """The mesh ``side``'s spectrum for ``key`` is computed on (unit area with rescale)."""
         s = self.sides[side]
         if key.rescale and s.unit_mesh is None:
             s.unit_mesh = unit_area(s.mesh)
@@ -335,8 +308,7 @@ class PairState:
         )
 
     def _modes_arrived(self, slot):
-        """Where the modes of ``slot``'s spectrum go as they converge: the maps are made
-        of them (their legends say so) until the whole spectrum is in."""
+        """Where the modes of ``slot``'s spectrum go as they converge (the maps use them)."""
 
         def deliver(spec: Spectrum) -> None:
             side, mesh_hash, key = slot
@@ -350,8 +322,7 @@ class PairState:
         return deliver
 
     def arrival_note(self) -> str:
-        """ "from the first 20 of 100 modes of B" while a side's spectrum is arriving (or
-        its computation stopped before its last modes), else ""."""
+        """ "from the first 20 of 100 modes of B" while a spectrum is incomplete, else ""."""
         parts = []
         for side in SIDES:
             spec = self.spectrum(side)
@@ -387,8 +358,8 @@ class PairState:
 
     # --------------------------------------------------------- distances
     def _cross_tables(self) -> CrossTables | None:
-        """Both signature tables at the common scales (drawn meshes' numbering), or None
-        if a spectrum is missing or the pair cannot be compared (``note`` says why)."""
+        """Both signature tables at common scales, or None (``note`` says why if they
+        cannot be compared)."""
         sa, sb = self.spectrum("a"), self.spectrum("b")
         if sa is None or sb is None:
             return None
@@ -427,7 +398,7 @@ class PairState:
         return self._distance[1]
 
     def _spread(self, side: str, d: np.ndarray):
-        """:func:`auto_spread` of the distances ``d`` on ``side``, kept while they are."""
+        """:func:`auto_spread` of ``d`` on ``side``, kept while ``d`` is."""
         if self._scale is None or self._scale[0] is not d:
             self._scale = (d, auto_spread(d, self.sides[side].masses))
         return self._scale[1]
@@ -447,9 +418,8 @@ class PairState:
         return side, w, float(d[w]), self._back[1]
 
     def distance_on(self, side: str) -> np.ndarray | None:
-        """(n,) distance from the picked vertex (on the other side) to every vertex of
-        ``side`` (NaN where no face uses it); None if nothing is picked there, or the
-        spectra are not in."""
+        """(n,) distance from the pick on the other side to every vertex of ``side`` (NaN
+        where no face uses it); None without a pick there or the spectra."""
         _check_side(side)
         d = self._drawn_distance(side)
         return None if d is None else self.sides[side].mesh.to_file_field(d)
@@ -463,16 +433,15 @@ class PairState:
         return side, self.sides[side].mesh.file_vertex(w), distance
 
     def back_match(self) -> int | None:
-        """The vertex of the picked mesh closest to the best match (the pick itself when
-        the match is mutual)."""
+        """The picked mesh's vertex closest to the best match (the pick when mutual)."""
         match = self._drawn_matches()
         if match is None:
             return None
         return self.sides[other(match[0])].mesh.file_vertex(match[3])
 
     def mutual_best_matches(self, vertices_a, vertices_b=None) -> Matches | None:
-        """:meth:`CrossTables.mutual_best_matches` of vertices of A (on vertices of B, if
-        given); None if the spectra are not in."""
+        """:meth:`CrossTables.mutual_best_matches` of vertices of A (among vertices of B);
+        None if the spectra are not in."""
         tables = self._cross_tables()
         if tables is None:
             return None
@@ -485,9 +454,8 @@ class PairState:
         return Matches(picked, mesh_b.file_vertices[m.matches_b], m.distances, back, m.mutual)
 
     def threshold(self, side: str) -> tuple[float, float] | None:
-        """(distance, share of the area) of the threshold display on ``side``: the
-        smallest distance whose sub-level set ``d <= t`` covers ``share`` of the mesh's
-        area, and the part of the area that set really covers (>= share)."""
+        """(t, share covered) of the threshold on ``side``: the smallest t whose set
+        ``d <= t`` covers ``share`` of the area, and the share it covers."""
         d = self._drawn_distance(side)
         if d is None:
             return None
@@ -573,8 +541,7 @@ class PairState:
 
 
 def _drawn_vertices(mesh: Mesh, vertices, name: str) -> np.ndarray:
-    """The drawn mesh's vertices of input vertices ``vertices`` (a ValueError naming one
-    no face uses)."""
+    """The drawn mesh's vertices of input ``vertices`` (ValueError for one no face uses)."""
     checked = check_vertices(vertices, mesh.n_file_vertices, f"vertices of {name}")
     try:
         return np.array([mesh.mesh_vertex(v) for v in checked], dtype=np.int64)

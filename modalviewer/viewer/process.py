@@ -1,10 +1,9 @@
-"""Work in a child process, with progress relayed and cancel at once.
+"""Work in a child process, with progress relayed (JSON lines on stdout) and cancel at once.
 
-Spectra: sparse factorisations hold the GIL, so a computation in a thread would stall
-the viewer's event loop; a child keeps it free and is killed to cancel.  Mesh repairs:
-MeshLab run in a thread of a process that later runs MKL's solver corrupts the heap
-(abort at exit: "malloc_consolidate(): unaligned fastbin chunk"); a child cannot, and
-can be cancelled.  A child reports JSON lines on stdout (:mod:`modalviewer.processes.job_main`).
+Sparse factorisations hold the GIL, so a computation in a thread would stall the event
+loop; a child keeps it free and is killed to cancel.  MeshLab run in a thread of a
+process that later runs MKL's solver corrupts the heap (abort at exit:
+"malloc_consolidate(): unaligned fastbin chunk"); a child cannot.
 """
 
 from __future__ import annotations
@@ -28,8 +27,7 @@ from ..core.spectrum import GrowingSpectrum, load_spectrum
 
 
 class ChildError(RuntimeError):
-    """A failure a child process reported in words (its own traceback, if any, stayed in
-    the child): a message for the user, not a fault of this process."""
+    """A failure a child reported in words: a message for the user, not a fault here."""
 
 
 def _run_child(argv: list[str], progress, cancel, what: str, on_modes=None) -> None:
@@ -109,11 +107,9 @@ def compute_in_process(
     cancel,
     on_modes=None,
 ):
-    """Run ``modalviewer.processes.job_main`` in a child Python; returns the Spectrum read back
-    from ``out_path``; the child's error message is raised as RuntimeError.
-    ``on_modes(spectrum_so_far)``: as :func:`modalviewer.compute_spectrum`'s, the modes
-    the child's solve has converged so far (relayed through files), called in this
-    thread; the finished spectrum is returned, not passed to it."""
+    """Run ``modalviewer.processes.job_main`` in a child; returns the Spectrum it wrote to
+    ``out_path`` (its error raised).  ``on_modes`` as :func:`modalviewer.compute_spectrum`'s,
+    relayed through files and called in this thread."""
     params = {
         "operator": operator,
         "k": int(k),
@@ -137,9 +133,7 @@ def compute_in_process(
 
 
 class _ModesReceived:
-    """Reads the files of modes a child relays (``processes.job_main``), gathers them in
-    a :class:`~modalviewer.core.spectrum.GrowingSpectrum` and calls ``on_modes`` with a
-    Spectrum of all received so far."""
+    """Gathers the mode files a child relays and calls ``on_modes`` with all so far."""
 
     def __init__(self, mesh_hash: str, operator: str, on_modes) -> None:
         self.mesh_hash, self.operator, self.on_modes = mesh_hash, operator, on_modes
@@ -157,8 +151,7 @@ class _ModesReceived:
 
 
 def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
-    """Repair ``name`` (see :data:`modalviewer.repair.REPAIRS`) of ``mesh`` in a
-    child Python; returns the repaired Mesh with its report."""
+    """Repair ``name`` (:data:`modalviewer.repair.REPAIRS`) of ``mesh`` in a child."""
     job_path, out_path = _temp_path(".pickle"), _temp_path(".pickle")
     try:
         source = mesh.input_mesh  # repaired in the input's numbering

@@ -1,11 +1,8 @@
 """Sessions: the viewer state to and from a versioned JSON file (no Qt).
 
-A session stores the mesh file (path and geometry hash), the spectra by their keys (the
-arrays come back from the cache, or are recomputed) and what is displayed, so restoring
-it draws the same picture.  A mesh whose file changed is opened with a note; what no
-longer fits (a pick beyond the new mesh) is dropped with a note.  ``picked`` is the
-file's vertex number (version 2, :attr:`modalviewer.core.mesh.Mesh.file_to_mesh`);
-version 1 files, which stored the mesh's compact index, are read as such.
+A session stores the mesh file (path and hash), the spectra's keys (the arrays come
+back from the cache, or are recomputed) and the display, so restoring it draws the same
+picture; a changed mesh file, or what no longer fits, gets a note.
 """
 
 from __future__ import annotations
@@ -38,8 +35,8 @@ class Restored:
 
 
 def session_dict(state: ViewerState, base: Path | None = None) -> dict:
-    """The state as plain data.  ``base``: the folder mesh paths are stored relative to
-    (as well as absolute), so a session moved with its mesh still finds it."""
+    """The state as plain data; mesh paths also relative to ``base``, so a session moved
+    with its mesh still finds it."""
     if state.mesh is None:
         raise ValueError("no mesh is loaded: nothing to save")
     path = Path(state.mesh_path).resolve() if state.mesh_path else None
@@ -106,17 +103,15 @@ def _known(cls, values: dict) -> dict:
 
 
 def _update(evented, values: dict | None, names=None) -> None:
-    """Set the fields of the evented dataclass ``evented`` that ``values`` has (of
-    ``names`` only, if given)."""
+    """Set the fields of ``evented`` that ``values`` has (of ``names`` only, if given)."""
     for name, value in _known(type(evented), values).items():
         if names is None or name in names:
             setattr(evented, name, value)
 
 
 def restore_session(model, path) -> Restored:
-    """Open the session's mesh and restore its state in ``model`` (a ViewerModel): the
-    spectra are requested (the cache answers at once, others are recomputed) and the
-    returned jobs end when they are in; the display is set once all it needs arrived."""
+    """Open the session's mesh and restore its state in ``model``: the spectra are
+    requested (the returned jobs) and the display is set once they are in."""
     path = Path(path)
     data = read_session(path)
     out = Restored()

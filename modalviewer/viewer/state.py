@@ -1,13 +1,11 @@
 """The viewer's state: what is loaded, computed, displayed and picked (no Qt, no VTK).
 
-:class:`ViewerState` (``viewer.state``) is the single source of truth: the scene, the
-panels, the status bar and the plots observe its events and redraw from it.  Fields that
-only need validating are evented: the dataclasses ``style``, ``animation`` and
-``compute_settings`` (``state.animation.speed = 50``) and the state's ``camera`` and
-``up_axis``; changes that do more go through methods (``set_display``, ``set_pick``,
-...), which change only what they are given, except for the threshold rule
-(:meth:`ViewerState._match_threshold`).  Values computed from it live in
-:attr:`ViewerState.derived`, the words shown in :mod:`.wording`.
+:class:`ViewerState` is the single source of truth the scene, panels and plots redraw
+from.  Fields that only need validating are evented (``style``, ``animation`` and
+``compute_settings``: ``state.animation.speed = 50``; ``camera``, ``up_axis``); changes
+that do more go through methods (``set_display``, ``set_pick``, ...), which change only
+what they are given, except for the threshold rule (:meth:`ViewerState._match_threshold`).
+Values computed from it: :attr:`ViewerState.derived`; its words: :mod:`.wording`.
 
 Events (``state.events.<name>.connect(callback)``), emitted on the thread that changed
 the state: ``mesh()`` (new mesh or none; spectra, pick and display reset),
@@ -50,8 +48,7 @@ DEFAULT_THRESHOLD_FRACTION = 0.2
 """A threshold as a fraction of the largest distance, where none was set and no share
 applies (a map drawn without ``keep_share``)."""
 NEXT_MAP = "next map"
-""":attr:`ViewerState.threshold_map` after a fraction was set with no threshold map on
-screen: the next threshold map keeps the fraction (and measures its share)."""
+""":attr:`ViewerState.threshold_map` when the next threshold map keeps a fraction set."""
 SHELL_COLORINGS = ("deformed", "normal", "magnitude")
 """How a 3D vibration mode is shown: "deformed" (the surface displaced by the mode at the
 amplitude, coloured by the displacement magnitude), "normal" (its normal component
@@ -71,8 +68,7 @@ RENDER_STYLES = ("paper", "shaded")
 @evented
 @dataclass
 class ComputeSettings:
-    """What the next computation computes (the Compute panel's fields); setting a field
-    validates it and emits ``events.<field>`` (and the state's ``compute_settings``)."""
+    """What the next computation computes (the Compute panel); fields validated, evented."""
 
     operator: str = "modified_dirichlet"
     k: int = DEFAULT_K
@@ -91,8 +87,7 @@ class ComputeSettings:
         super().__setattr__(name, value)
 
     def key(self, operator: str | None = None, k: int | None = None) -> SpectrumKey:
-        """The key of ``operator``'s spectrum (default: these settings'), of ``k`` modes
-        (default: these settings'); weights only for an operator that has them."""
+        """The key of ``operator``'s spectrum of ``k`` modes (defaults: these settings')."""
         op = operator or self.operator
         weights = (self.bending, self.membrane) if operator_info(op).has_weights else (1, 1)
         k = int(k if k is not None else self.k)
@@ -123,9 +118,8 @@ class SpectrumKey:
         return f"{info.label}, {self.k} modes{tail}"
 
     def spectrum(self, mesh: Mesh, cache, progress, cancel, on_modes=None) -> Spectrum:
-        """This key's spectrum of ``mesh`` (already of unit area where ``rescale``):
-        :func:`~modalviewer.spectra.cached_or_computed`, large exact solves in a child
-        process."""
+        """:func:`~modalviewer.spectra.cached_or_computed` of ``mesh`` (of unit area
+        already where ``rescale``), large exact solves in a child process."""
         return cached_or_computed(
             mesh, self.operator, self.k, self.bending, self.membrane, cache=cache,
             progress=progress, cancel=cancel, on_modes=on_modes, coarse=self.coarse,
@@ -146,34 +140,19 @@ def unit_area(mesh: Mesh) -> Mesh:
 
 @dataclass(frozen=True)
 class Display:
-    """What the surface shows.
+    """What the surface shows."""
 
-    kind : "none" | "mode" | "distance" | "signature" | "curvature" | "field".
-    operator : the spectrum a mode belongs to.
-    mode : index of the mode shown.
-    distance_kind : "vibration" | "feature" | "hks" | "wks" (also picks the signature's
-        spectrum and kind).
-    distance_display : "continuous" | "threshold".
-    threshold : threshold as a fraction of the largest distance (0..1].
-    threshold_share : the share (0..1) of the surface's area the threshold map marks.
-    keep_share : a new threshold map keeps ``threshold_share`` rather than the fraction
-        (:meth:`ViewerState._match_threshold`).
-    signature_sample : index of the scale a signature is shown at (0..99).
-    signature_time : a scale t typed for the signature, or None: the sample's scale.
-    field : the name of the field shown with kind "field" (:attr:`ViewerState.fields`).
-    """
-
-    kind: str = "none"
-    operator: str | None = None
+    kind: str = "none"  # one of DISPLAY_KINDS
+    operator: str | None = None  # a mode's spectrum
     mode: int = 0
-    distance_kind: str = "vibration"
-    distance_display: str = "continuous"
-    threshold: float = DEFAULT_THRESHOLD_FRACTION
-    threshold_share: float = DEFAULT_THRESHOLD_SHARE
-    keep_share: bool = True
-    signature_sample: int = 50
-    signature_time: float | None = None
-    field: str | None = None
+    distance_kind: str = "vibration"  # also the signature's spectrum and kind
+    distance_display: str = "continuous"  # or "threshold"
+    threshold: float = DEFAULT_THRESHOLD_FRACTION  # of the largest distance, (0..1]
+    threshold_share: float = DEFAULT_THRESHOLD_SHARE  # of the area the threshold marks
+    keep_share: bool = True  # a new threshold map keeps the share, not the fraction
+    signature_sample: int = 50  # the signature's scale sample, 0..99
+    signature_time: float | None = None  # a typed scale t, else the sample's
+    field: str | None = None  # the field shown with kind "field"
 
     def blank(self) -> Display:
         """This display as a newly loaded mesh shows it: nothing, other choices kept."""
@@ -207,9 +186,8 @@ class ViewerEvents(SignalGroup):
 @evented
 @dataclass
 class Style:
-    """How the picture is drawn; setting a field validates it and emits
-    ``style.events.<field>`` (and the state's ``style`` event) if it changed.  The colour
-    range and its limits are set together by :meth:`ViewerState.set_color_range`."""
+    """How the picture is drawn; fields validated, evented.  The colour range and its
+    limits are set together by :meth:`ViewerState.set_color_range`."""
 
     isolines: int = 12  # clipped to 0..60
     shell_coloring: str = "deformed"  # 3D modes: one of SHELL_COLORINGS ("auto": deformed)
@@ -237,8 +215,7 @@ class Style:
 @evented
 @dataclass
 class Animation:
-    """The vibration's animation; setting a field clips it and emits ``events.<field>``
-    (and the state's ``animation``).  Only a mode plays (the state stops it otherwise)."""
+    """The vibration's animation; fields clipped, evented.  Only a mode plays."""
 
     playing: bool = False
     # largest displacement of a mode, in percent of a quarter of the bounding-box diagonal
@@ -256,17 +233,10 @@ class Animation:
 
 @dataclass(eq=False)
 class ViewerState:
-    """The viewer's state; see the module docstring for its events.
-
-    camera : set by a preset or a restored session, the scene applies it (position,
-        focal_point, view_up, parallel_scale; "fit": fitted to the shape); the scene also
-        stores the user's camera here before a session is saved.  Set again, an equal
-        camera is applied again.
-    up_axis : the chosen up axis ("+x" ... "-z"), or None (also given as "auto"):
-        automatic (detected where confident, else +Y;
-        :meth:`.derived.DerivedValues.up_axis` is the one in effect); the scene turns to
-        the canonical view for it.
-    """
+    """The viewer's state (events: the module docstring).  ``camera``: set by a preset or
+    a session, the scene applies it (an equal one again too; "fit": fitted to the
+    shape).  ``up_axis``: "+x" ... "-z", or None ("auto": detected where confident, else
+    +Y; :meth:`.derived.DerivedValues.up_axis`)."""
 
     events: ClassVar = SignalGroupDescriptor(
         signal_group_class=ViewerEvents,
@@ -305,11 +275,9 @@ class ViewerState:
         self.animation = Animation()
         self.animation.events.all.connect(self._animation_changed)
         self.compute_settings.events.all.connect(lambda: self.events.compute_settings.emit())
+        # the map (DerivedValues.map_identity) threshold and share were last matched on;
+        # None before the first, NEXT_MAP when the next one keeps a fraction set
         self.threshold_map: tuple | str | None = None
-        """The distance map (:meth:`.derived.DerivedValues.map_identity`) on which
-        ``display.threshold`` and ``display.threshold_share`` were last matched; None
-        before the first (it gets the share), :data:`NEXT_MAP` after a fraction was set
-        while no threshold map was on screen (the next one keeps it)."""
 
     def _animation_changed(self) -> None:
         if self.animation.playing and self.display.kind != "mode":
@@ -320,18 +288,15 @@ class ViewerState:
 
     @cached_property
     def derived(self) -> DerivedValues:
-        """The values computed from this state (:class:`~.derived.DerivedValues`),
-        created on first use."""
+        """The values computed from this state, created on first use."""
         return DerivedValues(self)
 
     # ------------------------------------------------------------- mesh
     def set_mesh(
         self, mesh: Mesh | None, path: Path | str | None = None, repairs: list[str] | None = None
     ) -> None:
-        """Load ``mesh`` (read from ``path``, then given ``repairs``): spectra, pick and
-        display of the previous mesh are dropped.  The state holds ``mesh.solver_mesh``
-        (the vertices faces use); its map gives the input's numbers, which is what is
-        shown and saved."""
+        """Load ``mesh`` (read from ``path``, then given ``repairs``), dropping the previous
+        mesh's spectra, pick and display; the state holds ``mesh.solver_mesh``."""
         self.mesh = mesh.solver_mesh if mesh is not None else None
         self.mesh_repairs = list(repairs or [])
         self.mesh_path = Path(path) if path is not None else None
@@ -357,12 +322,10 @@ class ViewerState:
 
     # ---------------------------------------------------------- spectra
     def add_spectrum(self, key: SpectrumKey, spec: Spectrum, table=None) -> None:
-        """Store a computed spectrum (and its signature table, if already built) as the
-        one shown for its operator; the operator's spectra of other keys are dropped
-        (nothing shows them, and exact ones come back from the cache).  The first modes
-        of a running computation (``spec.is_complete`` False) are stored the same way but
-        never replace a complete spectrum of ``key``, nor one on screen with more modes,
-        and reset nothing the user chose."""
+        """Store a spectrum (and its signature table) as its operator's, dropping the
+        operator's other keys (exact ones come back from the cache).  First modes of a
+        running computation never replace a complete spectrum of ``key`` nor one on
+        screen with more modes, and reset nothing the user chose."""
         if self.mesh is not None:
             spec = on_solver_mesh(spec, self.mesh)  # one of the input's numbering
         if self.mesh is None or spec.n_vertices != self.mesh.n_vertices:
@@ -389,8 +352,7 @@ class ViewerState:
                 self.events.display.emit()
 
     def set_computing(self, key: SpectrumKey, computing: bool) -> None:
-        """Whether the spectrum of ``key`` is being computed or waits its turn: the status
-        line says so while no spectrum is on screen."""
+        """Mark the spectrum of ``key`` as computed or queued (or not)."""
         if computing == (key in self.computing):
             return
         if computing:
@@ -413,21 +375,19 @@ class ViewerState:
         return [op for op in OPERATOR_INFO if op in self._latest]
 
     def has_spectrum(self, key: SpectrumKey) -> bool:
-        """Whether the whole spectrum of ``key`` is in (its first modes, while it is
-        computed, do not count)."""
+        """Whether the whole spectrum of ``key`` is in (first modes do not count)."""
         spec = self.spectra.get(key)
         return spec is not None and spec.is_complete
 
     def modes_ready(self, operator: str | None) -> tuple[int, int]:
-        """(modes in, modes asked for) of ``operator``'s spectrum: (12, 100) while the
-        first 12 of 100 have arrived, (100, 100) when all have, (0, 0) with none."""
+        """(modes in, modes asked for) of ``operator``'s spectrum; (0, 0) with none."""
         spec = self.spectrum(operator)
         return (0, 0) if spec is None else (spec.k, spec.modes_requested)
 
     # --------------------------------------------------------- settings
     def set_color_range(self, mode: str, limits: tuple[float, float] | None = None) -> None:
-        """The colour range, one of :data:`COLOR_RANGES`; ``limits`` (low < high) sets
-        :attr:`Style.color_limits` ("limits" needs them, given now or before)."""
+        """The colour range (:data:`COLOR_RANGES`) and, if given, its ``limits`` (low <
+        high; "limits" needs them, now or before)."""
         if mode not in COLOR_RANGES:
             raise ValueError(f"colour range must be one of {COLOR_RANGES}")
         if limits is not None:
@@ -503,9 +463,8 @@ class ViewerState:
         self.events.display.emit()
 
     def add_field(self, name: str, values) -> None:
-        """Keep the per-vertex ``values`` ((n,), finite) as the field ``name``, shown with
-        ``set_display(kind="field", field=name)``; a field of that name is replaced (and
-        redrawn if it is on screen).  The fields belong to the mesh: a new mesh drops them."""
+        """Keep finite per-vertex ``values`` as the field ``name`` (replacing one of that
+        name) for ``set_display(kind="field", field=name)``; a new mesh drops them."""
         if self.mesh is None:
             raise ValueError("no mesh is loaded")
         name = str(name)
@@ -549,15 +508,13 @@ class ViewerState:
 
     @property
     def picked_file_vertex(self) -> int | None:
-        """The picked vertex's number in the file (what the viewer shows and sessions
-        store); :attr:`picked` is the mesh's (compact) index the computations use."""
+        """The picked vertex's number in the file; :attr:`picked` is the solver mesh's."""
         if self.picked is None or self.mesh is None:
             return None
         return self.mesh.file_vertex(self.picked)
 
     def set_pick_file_vertex(self, file_index: int | None) -> None:
-        """Pick vertex ``file_index`` of the file (MeshError, a ValueError, for one no
-        face uses or the file does not have)."""
+        """Pick vertex ``file_index`` of the file (a ValueError for one no face uses)."""
         if file_index is not None:
             if self.mesh is None:
                 raise ValueError("no mesh is loaded")
@@ -565,8 +522,7 @@ class ViewerState:
         self.set_pick(file_index)
 
     def set_pick(self, vertex: int | None) -> None:
-        """Pick mesh vertex ``vertex`` (the mesh's index, as a click finds it; see
-        :meth:`set_pick_file_vertex` for the file's numbers)."""
+        """Pick vertex ``vertex`` of the solver mesh (as a click finds it)."""
         if vertex is not None:
             if self.mesh is None:
                 raise ValueError("no mesh is loaded")
@@ -590,23 +546,17 @@ class ViewerState:
         return None
 
     def is_coarse(self, operator: str | None) -> bool:
-        """True if the spectrum shown for ``operator`` was computed coarse-to-fine (on a
-        decimated copy, carried to this mesh: approximate)."""
+        """Whether ``operator``'s spectrum was computed coarse-to-fine (approximate)."""
         key = self._latest.get(operator) if operator else None
         return key is not None and key.coarse and key in self.spectra
 
     def _match_threshold(self, fraction_set: bool = False, share_set: bool = False) -> None:
         """The threshold rule: match ``display.threshold`` (a fraction of the largest
-        distance) and ``display.threshold_share`` (the share of the surface's area it
-        marks) on the threshold map on screen.
-
-        The distances are so skewed that one fraction marks most of the surface from one
-        vertex and little from another, so with ``keep_share`` a map not matched yet
-        (another vertex, kind, scale range or spectrum) gets the fraction that marks
-        ``threshold_share``.  A fraction the caller set (``fraction_set``, also before its
-        map is on screen), or any fraction without ``keep_share``, sets the share instead;
-        a share the caller set (``share_set``) sets the fraction.  The only place a setter
-        changes display fields it was not given; emits nothing."""
+        distance) and ``threshold_share`` (of the area) on the threshold map on screen.
+        Distances are so skewed that one fraction marks most of the surface from one
+        vertex and little from another, so with ``keep_share`` a new map gets the
+        fraction marking the share; a fraction set (``fraction_set``), or any without
+        ``keep_share``, sets the share; a share set sets the fraction.  Emits nothing."""
         d = self.display
         on_screen = d.kind == "distance" and d.distance_display == "threshold"
         dist = self.derived.distance_map() if on_screen else None  # none for other pictures

@@ -1,7 +1,6 @@
 """The viewer's words: legends, the status line, notes and marks, and how a job ended
-(no Qt, no VTK).  Marks and notes take the values they name (a spectrum, counts); the
-legend and the status line read a :class:`~.state.ViewerState` and its
-:class:`~.derived.DerivedValues`.  Nothing here changes or caches anything.
+(no Qt, no VTK).  Marks and notes take the values they name; the legend and the status
+line read the state and its derived values.  Nothing here changes or caches anything.
 """
 
 from __future__ import annotations
@@ -23,10 +22,9 @@ from .jobs import CANCELLED, DONE, Job, SpectrumJob
 
 
 def percent_text(fraction: float) -> str:
-    """A relative error as a short percentage: two significant digits below ten per
-    cent, whole per cents from there, and "less than a hundredth of a per cent" below
-    that, where the digits would only show how converged a mode is, not its error.  A no-break
-    space keeps number and sign together in a wrapped legend."""
+    """A relative error as a short percentage: two significant digits below 10 %, whole
+    per cents above, "< 0.01 %" below (more digits would show convergence, not error);
+    no-break spaces keep number and sign together in a wrapped legend."""
     value = 100.0 * float(fraction)
     if 0 < value < 0.01:
         return "<\u00a00.01\u00a0%"
@@ -34,17 +32,15 @@ def percent_text(fraction: float) -> str:
 
 
 def arrival_text(spec: Spectrum | None) -> str:
-    """ "first 20 of 100 modes" while ``spec``'s modes are still arriving (handed over as
-    they converge), else ""."""
+    """ "first 20 of 100 modes" while ``spec``'s modes are still arriving, else ""."""
     if spec is None or spec.k >= spec.modes_requested:
         return ""
     return f"first {spec.k} of {spec.modes_requested} modes"
 
 
 def arrival_note(spec: Spectrum | None, computing: bool) -> str:
-    """A sentence on a spectrum still arriving (``computing``: "12 of 100 modes ready;
-    the others follow as they converge."), or on one whose computation stopped before
-    its last modes; "" for a whole spectrum."""
+    """A sentence on a spectrum still arriving (``computing``) or stopped before its last
+    modes; "" for a whole spectrum."""
     if not arrival_text(spec):
         return ""
     ready, asked = spec.k, spec.modes_requested
@@ -57,8 +53,8 @@ def arrival_note(spec: Spectrum | None, computing: bool) -> str:
 
 
 def approximation_mark(spec: Spectrum | None, coarse: bool) -> str:
-    """ " (coarse-to-fine)", " (first 20 of 100 modes)" or "": what titles and lists add
-    to a spectrum that is an approximation (``coarse``) or incomplete."""
+    """ " (coarse-to-fine)", " (first 20 of 100 modes)" or "": the titles' mark of an
+    approximate (``coarse``) or incomplete spectrum."""
     marks = [m for m in ("coarse-to-fine" if coarse else "", arrival_text(spec)) if m]
     return f" ({'; '.join(marks)})" if marks else ""
 
@@ -70,8 +66,8 @@ def display_mark(state) -> str:
 
 
 def approximation_note(spec: Spectrum | None, coarse: bool) -> str:
-    """ " (coarse-to-fine spectrum)", " (from the first 20 of 100 modes)" or "" for
-    what is made of ``spec`` (a map, a signature)."""
+    """ " (coarse-to-fine spectrum)", " (from the first 20 of 100 modes)" or "" for a map
+    or signature made of ``spec``."""
     arriving = arrival_text(spec)
     notes = [
         "coarse-to-fine spectrum" if coarse else "",
@@ -165,8 +161,7 @@ def legend(state) -> str:
 
 
 def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool]) -> str:
-    """The legend's line naming the colour range ``rule`` ("symmetric", "robust",
-    "limits") of ``clim`` and the clipped ends."""
+    """The legend's line naming the colour range ``rule`` and the clipped ends."""
     lo, hi = clim
     if rule == "spread":
         return "colours spread by area: each tenth of the bar covers a tenth of the surface"
@@ -183,9 +178,8 @@ def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool])
 
 
 def negative_weights_note(state) -> str:
-    """ "This mesh has 46 negative cotan weights: try the Laplacian (robust, intrinsic
-    Delaunay)." where the mesh has edges whose cotan weight is negative and the registry
-    has an operator whose weights never are; else ""."""
+    """Advice to use the operator whose weights are never negative, where the mesh has
+    negative cotan weights; else ""."""
     robust = next((info for info in OPERATOR_INFO.values() if info.nonnegative_weights), None)
     if state.mesh is None or robust is None:
         return ""
@@ -199,10 +193,8 @@ def negative_weights_note(state) -> str:
 
 
 def truncation_note(truncation: tuple[float, int] | None, k: int) -> str:
-    """The share of a signature of ``k`` modes that truncation misses and the k that
-    would bring it below :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`
-    (``truncation``: :meth:`.derived.DerivedValues.truncation`), when that share exceeds
-    the level; else ""."""
+    """The share of a signature of ``k`` modes truncation misses and the k bringing it
+    below :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`, when above it; else ""."""
     from ..core.truncation import TRUNCATION_LEVEL
 
     if truncation is None or truncation[0] <= TRUNCATION_LEVEL:
@@ -241,19 +233,15 @@ def worst_residual(spec: Spectrum) -> float:
     return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
 
 
+# what the status line and ``modalviewer compute`` say of a solve that saved memory
 OUT_OF_CORE_WORDS = "factor kept on disk"
-"""What a spectrum whose solve kept its factor out of core says of it (the status line
-and ``modalviewer compute``)."""
-
 FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
-"""What a spectrum whose solve kept its Krylov basis in single precision says of it."""
 
 
 def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
-    """How a finished spectrum job's status line starts: the description and the solve's
-    stored time (``parameters["seconds_total"]``, so a solve and its reopening report the
-    same number), and for a cache hit also the time reading took, so it does not read
-    like a fresh solve; the job's own time where the spectrum has none."""
+    """A finished spectrum job's status line: the description and the solve's stored
+    time (a solve and its reopening say the same), for a cache hit the reading time as
+    well, so it does not read like a fresh solve."""
     fewer = fewer_modes_text(job, spec)
     solved = spec.parameters.get("seconds_total")
     if not isinstance(solved, (int, float)) or "transferred_from" in spec.parameters:
@@ -265,9 +253,8 @@ def finished_text(job: SpectrumJob, spec: Spectrum) -> str:
 
 
 def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:
-    """``" (only 126: all the mesh has)"`` where the spectrum holds fewer modes than the
-    job asked for (a mesh has as many modes as unknowns), else ``""``: the description
-    names the number asked for."""
+    """``" (only 126: all the mesh has)"`` where the spectrum has fewer modes than asked
+    for, else ``""``."""
     if spec.k >= job.spectrum_key.k:
         return ""
     unknowns = operator_info(spec.operator).unknowns(spec.n_vertices)
@@ -276,9 +263,7 @@ def fewer_modes_text(job: SpectrumJob, spec: Spectrum) -> str:
 
 
 def ended_text(job: Job) -> str:
-    """How ``job`` ended, in a line: its description with its run time
-    (:func:`finished_text` for a spectrum), "<description>: cancelled" (or why it was
-    given up) or "<description>: failed"."""
+    """How ``job`` ended, in a line: done with its time, cancelled (or why) or failed."""
     if job.status == DONE:
         if isinstance(job, SpectrumJob) and job.result:
             return finished_text(job, job.result[0])
@@ -289,10 +274,8 @@ def ended_text(job: Job) -> str:
 
 
 def memory_text(spec: Spectrum) -> str:
-    """``"; ... (memory limit)"`` with :data:`OUT_OF_CORE_WORDS` where the exact solve
-    kept its factor out of core (the reason it took longer) and
-    :data:`FLOAT32_BASIS_WORDS` where it kept its basis in single precision (the reason
-    its residuals are about 1e-7), else ``""``."""
+    """``"; ... (memory limit)"`` naming a factor out of core (why it took longer) and a
+    single-precision basis (why residuals are about 1e-7), else ``""``."""
     said = [
         words
         for words, key in ((OUT_OF_CORE_WORDS, "factor_out_of_core"),
@@ -303,10 +286,9 @@ def memory_text(spec: Spectrum) -> str:
 
 
 def residual_text(spec: Spectrum) -> str:
-    """'largest relative residual 1.3e-05' and, where that is above what well-shaped
-    meshes reach, the mode's rounding floor: the residual that rounding the mode to
-    double precision alone causes on this mesh (an estimate: no solver goes much below
-    it)."""
+    """'largest relative residual 1.3e-05' and, where it is high, the mode's rounding
+    floor: the residual rounding the mode to double precision alone causes (an
+    estimate: no solver goes much below it)."""
     worst = worst_residual(spec)
     text = f"largest relative residual {worst:.1e}"
     floor = float(spec.parameters.get("worst_residual_rounding_floor", 0.0))
