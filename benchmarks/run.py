@@ -34,12 +34,12 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import modalviewer as mv  # noqa: E402
+from modalviewer.core.assembly import operator_matrices  # noqa: E402
 from modalviewer.core.demo_shapes import bumpy_plate  # noqa: E402
 from modalviewer.core.eigen import solve_lowest  # noqa: E402
 from modalviewer.core.memory import prepare_compute_process  # noqa: E402
 from modalviewer.core.nullspace import null_space  # noqa: E402
 from modalviewer.core.operators import operator_info  # noqa: E402
-from modalviewer.core.pipeline import operator_matrices  # noqa: E402
 
 
 def make_mesh(size: str) -> mv.Mesh:

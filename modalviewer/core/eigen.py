@@ -40,21 +40,6 @@ from .memory import memory_limit_mb as default_memory_limit_mb
 from .products import column_block_products, threaded_product, transform_columns_in_place
 from .threads import single_blas_thread
 
-__all__ = [
-    "Cancelled",
-    "EigenError",
-    "EigenResult",
-    "SPDSolver",
-    "solve_lowest",
-    "relative_residuals",
-    "zero_modes",
-    "typical_eigenvalue",
-    "zero_mode_size",
-    "rounding_floors",
-    "progress_reporter",
-    "ZERO_MODE_RTOL",
-]
-
 ZERO_MODE_RTOL = 1e-8
 """Eigenvalues below this times the largest computed one count as zero modes."""
 ZERO_NOISE_RTOL = 1e-12

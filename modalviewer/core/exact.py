@@ -19,8 +19,6 @@ from .mesh import Mesh
 from .nullspace import NullSpace, null_space
 from .operators import OperatorInfo
 
-__all__ = ["ExactPairs", "ModeSink", "exact_pairs"]
-
 
 class ModeSink(Protocol):
     """Receives the pairs of :func:`exact_pairs` as they converge."""

@@ -13,8 +13,6 @@ from contextlib import contextmanager
 import numpy as np
 import scipy.linalg as la
 
-__all__ = ["EigenError", "NotConverged", "StageTimer", "block_krylov_schur"]
-
 ProgressFn = Callable[[str, float], None]
 ConvergedFn = Callable[[np.ndarray, np.ndarray], None]
 """``on_converged(values, vectors)``: newly converged pairs, handed over in order."""

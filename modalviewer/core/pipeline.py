@@ -8,7 +8,6 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .assembly import operator_matrices
 from .eigen import CancelFn, EigenError, ProgressFn, progress_reporter, rounding_floors
 from .exact import exact_pairs
 from .memory import return_freed_memory
@@ -16,15 +15,6 @@ from .mesh import Mesh
 from .operators import DEFAULT_K, OperatorInfo, OperatorLike, operator_info
 from .spectrum import GrowingSpectrum, Spectrum, in_input_numbering
 from .validate import check_count
-
-__all__ = [
-    "compute_spectrum",
-    "operator_matrices",
-    "sliver_report",
-    "RESIDUAL_LIMIT",
-    "ZeroModesWarning",
-]
-
 
 FLOOR_FACTOR = 10.0
 """Residuals above RESIDUAL_LIMIT are accepted up to this times their rounding floor:

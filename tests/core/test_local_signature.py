@@ -6,8 +6,8 @@ import pytest
 import scipy.linalg as sla
 
 import modalviewer as mv
+from modalviewer.core.assembly import operator_matrices
 from modalviewer.core.nullspace import null_space
-from modalviewer.core.pipeline import operator_matrices
 from modalviewer.core.primitives import grid_plate, icosphere, torus
 
 MESHES = {
