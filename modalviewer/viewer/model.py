@@ -178,19 +178,14 @@ class ViewerModel:
         state.set_computing(key, True)
         owner = state.mesh.hash
 
-        def computing_ended(_j: Job) -> None:
-            if self.state.mesh is not None and self.state.mesh.hash == owner:
-                self.state.set_computing(key, False)
+        def ended(j: Job) -> None:
+            if self.state.mesh is None or self.state.mesh.hash != owner:
+                return
+            self.state.set_computing(key, False)
+            if show and j.status == DONE and key in self.state.spectra:
+                self._show_if_unchanged(key.operator, display_at_request)
 
-        job.then(computing_ended)
-        if show:
-
-            def show_when_done(j: Job) -> None:
-                if j.status == DONE and key in self.state.spectra:
-                    self._show_if_unchanged(key.operator, display_at_request)
-
-            job.then(show_when_done)
-        return job
+        return job.then(ended)
 
     def _modes_arrived(self, key: SpectrumKey, show_from):
         """Where the modes of ``key`` go as they converge: into the state while its mesh is

@@ -271,7 +271,7 @@ class PairState:
                     f"{key.describe()} of {side.upper()} ({s.name})",
                     self.owner(side),
                     key,
-                    self._modes_arrived(slot),
+                    lambda spec, slot=slot: self._on_job(slot, None, spec),
                 )
                 self._pending[slot] = job
                 job.then(lambda j, slot=slot: self._on_job(slot, j))
@@ -307,20 +307,6 @@ class PairState:
             None,
         )
 
-    def _modes_arrived(self, slot):
-        """Where the modes of ``slot``'s spectrum go as they converge (the maps use them)."""
-
-        def deliver(spec: Spectrum) -> None:
-            side, mesh_hash, key = slot
-            if mesh_hash != self.sides[side].mesh.hash:
-                return
-            self._spectra[slot] = spec
-            self.events.spectra.emit()
-            if key == self.key():
-                self.events.display.emit()
-
-        return deliver
-
     def arrival_note(self) -> str:
         """ "from the first 20 of 100 modes of B" while a spectrum is incomplete, else ""."""
         parts = []
@@ -332,21 +318,20 @@ class PairState:
                 )
         return f"from {' and '.join(parts)}" if parts else ""
 
-    def _on_job(self, slot, job: Job) -> None:
-        self._pending.pop(slot, None)
+    def _on_job(self, slot, job: Job | None, spec: Spectrum | None = None) -> None:
+        """``slot``'s ended ``job``, or without one its first modes ``spec`` (the maps are
+        made of them until the whole spectrum is in), while its mesh is loaded."""
         side, mesh_hash, key = slot
+        if job is not None:
+            self._pending.pop(slot, None)
         if mesh_hash != self.sides[side].mesh.hash:
             return
-        if job.status == DONE:
-            self._spectra[slot] = job.result[0]
+        if job is None or job.status == DONE:
+            self._spectra[slot] = spec if job is None else job.result[0]
             self.events.spectra.emit()
-            if key == self.key():
-                self.events.display.emit()
         elif job.status == CANCELLED:
             # not a failure: the legend says so, and the next request computes again
             self._failed[slot] = "cancelled; pick again to compute"
-            if key == self.key():
-                self.events.display.emit()
         else:
             self._failed[slot] = f"failed: {job.error or 'unknown error'}"
             if key == self.key():
@@ -354,7 +339,8 @@ class PairState:
                     f"The {key.describe()} of {side.upper()} ({self.name(side)}) could not "
                     f"be computed: {job.error}"
                 )
-                self.events.display.emit()
+        if key == self.key():
+            self.events.display.emit()
 
     # --------------------------------------------------------- distances
     def _cross_tables(self) -> CrossTables | None:
