@@ -17,7 +17,7 @@ import pytest
 import modalviewer as mv
 from modalviewer import collection as coll
 from modalviewer.collection import runner
-from modalviewer.core import primitives
+from modalviewer.core import pipeline, primitives
 
 distributed = pytest.importorskip("distributed")
 
@@ -149,13 +149,13 @@ def test_a_broken_file_is_recorded_not_fatal(store):
 
 def test_resume_recomputes_nothing(store, sources, client, monkeypatch):
     calls = []
-    compute = runner._compute
+    compute = pipeline.compute_spectrum
 
     def counted(*args):
         calls.append(args[1])
         return compute(*args)
 
-    monkeypatch.setattr(runner, "_compute", counted)
+    monkeypatch.setattr(pipeline, "compute_spectrum", counted)
     params = dict(operator="laplacian", k=K, signatures=["vibration", "hks"], client=client)
     summary = coll.run_batch([sources], store, **params)
     assert calls == [] and summary.computed == [] and len(summary.skipped) == 7
@@ -257,7 +257,7 @@ def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
 
     running, most = [0], [0]
     lock = threading.Lock()
-    compute = runner._compute
+    compute = pipeline.compute_spectrum
 
     def counted(*args):
         with lock:
@@ -270,7 +270,7 @@ def test_tasks_ask_for_their_memory_estimate(sources, tmp_path, monkeypatch):
             with lock:
                 running[0] -= 1
 
-    monkeypatch.setattr(runner, "_compute", counted)
+    monkeypatch.setattr(pipeline, "compute_spectrum", counted)
     mesh = mv.load_mesh(sources / "torus.obj")
     assert runner.vertex_count_hint(sources / "torus.obj") == mesh.n_vertices
     need = runner.memory_estimate(mesh.n_vertices, runner._parameters("laplacian", K, [], 1, 1))

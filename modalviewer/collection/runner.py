@@ -27,6 +27,7 @@ from .store import (
     file_stat,
     prepare_store,
     read_entry,
+    read_json,
     rebuild_index,
     shape_dna,
     write_entry,
@@ -196,14 +197,6 @@ def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
     )
 
 
-def _compute(mesh, operator: str, parameters: dict) -> Spectrum:
-    from ..core.pipeline import compute_spectrum
-
-    return compute_spectrum(
-        mesh, operator, parameters["k"], parameters["bending"], parameters["membrane"]
-    )
-
-
 def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> dict:
     """The task of one mesh: read it, compute its spectra, signatures and descriptors.
     Returns ``{"status": "computed", "arrays": {...}, "entry": {...}}``, ``{"status":
@@ -211,6 +204,7 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
     "..."}``: errors are results, so one bad file does not stop the batch."""
     import warnings
 
+    from ..core.pipeline import compute_spectrum
     from ..core.signatures import signature
     from ..io import load_mesh
 
@@ -225,8 +219,9 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
         spectra: dict[str, Spectrum] = {}
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
+            weights = parameters["bending"], parameters["membrane"]
             for op in _operators(parameters):
-                spectra[op] = _compute(mesh, op, parameters)
+                spectra[op] = compute_spectrum(mesh, op, parameters["k"], *weights)
             main = spectra[parameters["operator"]]
             for op, spec in spectra.items():
                 prefix = "" if op == parameters["operator"] else f"{op}."
@@ -287,10 +282,6 @@ class BatchSummary:
     """The skipped meshes that failed in an earlier run (``retry_failed`` retries them)."""
     seconds: float = 0.0
     interrupted: bool = False
-
-    @property
-    def total(self) -> int:
-        return len(self.computed) + len(self.skipped) + len(self.failed)
 
     def text(self) -> str:
         rate = len(self.computed) / self.seconds * 60.0 if self.seconds > 0 else 0.0
@@ -358,7 +349,8 @@ def run_batch(
     def report() -> None:
         if progress is not None:
             elapsed = time.perf_counter() - start
-            progress(summary.total, total, len(summary.failed), elapsed, already)
+            done = len(summary.computed) + len(summary.skipped) + len(summary.failed)
+            progress(done, total, len(summary.failed), elapsed, already)
 
     def take(name: str, path: Path, result: dict) -> None:
         if result["status"] == "computed":
@@ -392,21 +384,15 @@ def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bo
     """("done", None) if ``name`` has a current result, ("failed", None) if a current
     recorded failure (not retried), else ("todo", the stored key or None)."""
     entry = read_entry(store / "meshes" / f"{name}.npz")
-    try:
-        stat = file_stat(path)
-    except OSError:
-        stat = None
+    stat = file_stat(path)
     if entry is not None:
         same = entry.get("parameters") == parameters and entry.get("source") == str(path.resolve())
         if same and entry.get("stat") == stat:
             return "done", None
         return "todo", entry.get("key") if entry.get("parameters") == parameters else None
     error = store / "errors" / f"{name}.json"
-    if error.exists() and not retry_failed:
-        try:
-            record = json.loads(error.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            record = {}
+    if not retry_failed:
+        record = read_json(error) or {}
         if record.get("parameters") == parameters and record.get("stat") == stat:
             return "failed", None
     return "todo", None

@@ -1,15 +1,11 @@
 """The store of a shape collection: its files, and :class:`Collection` reading them and
 ranking them by spectral distance to a shape (:meth:`Collection.similar`).
 
-A folder: ``collection.json`` (format, operator, k, signatures), ``meshes/NAME.npz`` per
-mesh (written atomically), ``errors/NAME.json`` per failure and ``index.json``, a
-summary rebuilt from those.  One file per mesh, so that workers finish independently, a
-killed run loses only what was in flight and numpy alone reads it.  A mesh file is a
-spectrum file (:func:`~.core.spectrum.save_spectrum`) plus ``entry`` (JSON: source,
-size, date, ``mesh_hash``, parameters, ``key``, area, vertex count), ``shape_dna``,
-``sig.KIND.times`` (T,) and ``sig.KIND.values`` (n, T), ``hist.KIND`` (S, B) over
-:data:`HISTOGRAM_EDGES`, and ``OP.eigenvalues``, ``OP.modes``, ... for a signature
-whose operator is not the store's.
+A folder of ``collection.json``, ``meshes/NAME.npz`` per mesh (a spectrum file with the
+entry, Shape-DNA, signatures and histograms), ``errors/NAME.json`` per failure and
+``index.json`` rebuilt from those; one file per mesh, so that workers finish
+independently, a killed run loses only what was in flight and numpy alone reads it.  The
+arrays are listed in the library guide (docs/library-guide.md, "Shape collections").
 """
 
 from __future__ import annotations
@@ -47,9 +43,21 @@ def entry_key(mesh_hash: str, parameters: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
-def file_stat(path: Path) -> list[int]:
-    st = Path(path).stat()
+def file_stat(path: Path) -> list[int] | None:
+    """[size, modification time in ns] of a file, None if it cannot be read."""
+    try:
+        st = Path(path).stat()
+    except OSError:
+        return None
     return [int(st.st_size), int(st.st_mtime_ns)]
+
+
+def read_json(path: Path) -> dict | None:
+    """The JSON object of a file, None if it is missing or unreadable."""
+    try:
+        return json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
 
 
 def shape_dna(spec: Spectrum, area: float) -> np.ndarray:
@@ -77,16 +85,12 @@ def write_entry(store: Path, name: str, result: dict) -> None:
 
 
 def write_error(store: Path, name: str, source: Path, parameters: dict, error: str) -> None:
-    try:
-        stat = file_stat(source)
-    except OSError:
-        stat = None
     _write_json(
         store / "errors" / f"{name}.json",
         {
             "name": name,
             "source": str(Path(source).resolve()),
-            "stat": stat,
+            "stat": file_stat(source),
             "parameters": parameters,
             "error": error,
         },
@@ -118,9 +122,8 @@ def _scan(store: Path) -> dict:
         entry["file_stat"] = file_stat(path)
         entries[path.stem] = entry
     for path in sorted((store / "errors").glob("*.json")):
-        try:
-            record = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+        record = read_json(path)
+        if record is None:
             continue
         errors[path.stem] = {"source": record.get("source"), "error": record.get("error")}
     return {"format": STORE_FORMAT + "-index", "entries": entries, "errors": errors}
@@ -141,10 +144,7 @@ def prepare_store(store: Path, parameters: dict) -> None:
     info = {"format": STORE_FORMAT, "version": STORE_VERSION}
     info.update((key, parameters[key]) for key in STORE_PARAMETERS)
     if header.exists():
-        try:
-            old = json.loads(header.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            old = {}
+        old = read_json(header) or {}
         if old.get("format") != STORE_FORMAT:
             raise CollectionError(f"{store} is not a modalviewer collection")
         if old == info:
@@ -196,10 +196,7 @@ class Collection:
     def _index(self) -> dict:
         """The index file if it matches the files, else one rebuilt from them (written
         back if the store is writable)."""
-        try:
-            index = json.loads((self.path / "index.json").read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            index = None
+        index = read_json(self.path / "index.json")
         if index is not None and self._current(index):
             return index
         try:
