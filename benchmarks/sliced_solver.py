@@ -27,10 +27,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from modalviewer.core import krylov
-from modalviewer.core.cost import krylov_sizes
 from modalviewer.core.eigen import _rayleigh_ritz_in_place, solve_lowest
 from modalviewer.core.factor import _load_mkl, _Pardiso
 from modalviewer.core.krylov import StageTimer, block_krylov_schur
+from modalviewer.core.memory import krylov_sizes
 
 BELOW_SHARE = 0.25
 """Share of a band's pairs expected below the previous band's top (the overlap)."""

@@ -6,11 +6,11 @@ shift-invert: the largest ``theta = 1 / (lambda - shift)`` of
 positive definite even when K is singular.  The factorisation is :mod:`.factor`'s; the
 iteration is block Krylov-Schur (:func:`.krylov.block_krylov_schur`), so one pass over
 the factor serves a block of right-hand sides, with a few more pairs than wanted
-(:func:`.cost.krylov_sizes`).  A block step of inverse iteration and a Rayleigh-Ritz
+(:func:`.memory.krylov_sizes`).  A block step of inverse iteration and a Rayleigh-Ritz
 step with K give Mass-orthonormal modes and residuals
 ``|K x - lambda M x| / |lambda M x|`` near 1e-10 on well-shaped meshes.  Within the
 memory limit (:mod:`.memory`) the factor goes out of core where it would not fit beside
-the Krylov basis (:func:`.cost.factor_budget_mb`), and the modes are written over the
+the Krylov basis (:func:`.memory.factor_budget_mb`), and the modes are written over the
 basis.  Every run is deterministic (fixed start block) and reports its residuals;
 docs/how-it-works.md, "How the eigenproblems are solved", gives the reasons.
 """
@@ -24,7 +24,6 @@ import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
 
-from .cost import basis_in_float32, factor_budget_mb, float32_basis_mb, krylov_sizes
 from .factor import SPDSolver
 from .krylov import (
     ConvergedFn,
@@ -36,6 +35,7 @@ from .krylov import (
     cholqr_in_place,
     rotate_in_place,
 )
+from .memory import basis_in_float32, factor_budget_mb, float32_basis_mb, krylov_sizes
 from .memory import memory_limit_mb as default_memory_limit_mb
 from .products import column_block_products, threaded_product, transform_columns_in_place
 from .threads import single_blas_thread
@@ -92,7 +92,7 @@ class EigenResult:
     basis_float32: bool = False
     """True if the Krylov basis was stored in single precision because even with the
     factor out of core a double-precision basis would not fit the memory limit
-    (:func:`.cost.basis_in_float32`)."""
+    (:func:`.memory.basis_in_float32`)."""
 
 
 def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
@@ -214,7 +214,7 @@ def solve_lowest(
         returns them again nor misses any.  With d >= k no factorisation is made.
     memory_limit_mb : the memory (MB) the solve plans to stay within (None:
         :func:`.memory.memory_limit_mb`); beyond it the factor goes out of core, and
-        then the basis to single precision (:func:`.cost.basis_in_float32`).
+        then the basis to single precision (:func:`.memory.basis_in_float32`).
     on_modes : called as ``on_modes(eigenvalues, vectors)`` with pairs as they
         converge, lowest first: (m,) eigenvalues and a new (N, m) array of
         Mass-orthonormal vectors, the null vectors first, equal to the result's to the
@@ -513,7 +513,7 @@ def _shift_invert(
     complement (dimension ``n_free``) of the deflated null vectors that ``project``
     removes: (eigenvalues, (N, w) array whose first k columns are the Mass-orthonormal
     modes, shift, backend name, operator columns).  The factor and basis keep within
-    ``limit_mb`` (:func:`.cost.factor_budget_mb`, :func:`.cost.basis_in_float32`; with
+    ``limit_mb`` (:func:`.memory.factor_budget_mb`, :func:`.memory.basis_in_float32`; with
     a single-precision basis w is exactly ``out_columns``); ``solver_info`` receives
     "factor_mb", "out_of_core" and "basis_float32"; ``on_converged`` the pairs of K as
     they converge."""

@@ -12,15 +12,15 @@ import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from .cost import (
+from .memory import (
     FILL_MARGIN,
     FactorLaw,
     GrowthLaw,
     exact_peak_mb,
     factor_goes_out_of_core,
     float32_basis_saving_mb,
+    memory_limit_mb,
 )
-from .memory import memory_limit_mb
 
 DEFAULT_K = 100  # the number of modes computed where none is given (as in the paper's figures)
 
@@ -82,9 +82,9 @@ class OperatorInfo:
         basis_float32: bool | None = None,
     ) -> float:
         """Predicted peak memory (MB) of an exact solve of ``k`` modes on ``n_vertices``
-        (:func:`.cost.exact_peak_mb` with :data:`.cost.FILL_MARGIN` on the factor).
+        (:func:`.memory.exact_peak_mb` with :data:`.memory.FILL_MARGIN` on the factor).
         ``out_of_core``: the factor kept in a file; ``basis_float32``: a single-precision
-        Krylov basis (:func:`.cost.float32_basis_saving_mb`); None for either: as the
+        Krylov basis (:func:`.memory.float32_basis_saving_mb`); None for either: as the
         solver decides against :func:`.memory.memory_limit_mb`."""
         peak = self._in_core_peak_mb(n_vertices, k)
         if out_of_core is None:
@@ -105,7 +105,7 @@ class OperatorInfo:
         self, n_vertices: int, k: int = DEFAULT_K, limit_mb: float | None = None
     ) -> bool:
         """Whether the exact solve of ``k`` modes on ``n_vertices`` is predicted to keep
-        its factor in a file (:func:`.cost.factor_goes_out_of_core`; ``limit_mb`` None:
+        its factor in a file (:func:`.memory.factor_goes_out_of_core`; ``limit_mb`` None:
         this machine's :func:`.memory.memory_limit_mb`)."""
         limit_mb = memory_limit_mb() if limit_mb is None else limit_mb
         peak = self._in_core_peak_mb(n_vertices, k)
@@ -113,7 +113,7 @@ class OperatorInfo:
 
     def _in_core_peak_mb(self, n_vertices: int, k: int) -> float:
         """The predicted peak with the factor in core: the law with the arrays that grow
-        with k, and the factor at :data:`.cost.FILL_MARGIN` times its law (curved meshes
+        with k, and the factor at :data:`.memory.FILL_MARGIN` times its law (curved meshes
         fill in more than the plates the law comes from)."""
         peak = exact_peak_mb(self.exact_growth, n_vertices, self.unknowns(n_vertices), k)
         if self.factor_memory is not None:

@@ -8,7 +8,7 @@ import pytest
 
 from benchmarks.growth import _fits
 from benchmarks.memory import relative_differences
-from modalviewer.core.cost import FILL_MARGIN, GrowthLaw
+from modalviewer.core.memory import FILL_MARGIN, GrowthLaw
 from modalviewer.core.operators import OPERATOR_INFO, operator_info
 
 RESULTS = Path(__file__).resolve().parents[2] / "benchmarks" / "results" / "growth.json"
@@ -101,7 +101,7 @@ def test_the_fill_margin_covers_the_curved_factors_measured():
 def test_more_modes_need_their_basis_and_mode_columns_and_no_more():
     """Between two mode counts the prediction differs by exactly the Krylov basis
     columns (the solver's own sizes) and the mode columns of N doubles each."""
-    from modalviewer.core.cost import BASIS_EXTRA_MAX, basis_columns, krylov_sizes
+    from modalviewer.core.memory import BASIS_EXTRA_MAX, basis_columns, krylov_sizes
 
     info = operator_info("shells")
     n_vertices = 200_000
@@ -127,7 +127,7 @@ def test_every_operators_factor_law_is_the_fit_of_the_measured_analyses():
     benchmarks/results/factor_memory.json, and they reproduce the plates they were fitted
     to within 15 %."""
     from benchmarks.factor_memory import fits
-    from modalviewer.core.cost import FactorLaw
+    from modalviewer.core.memory import FactorLaw
 
     data = json.loads(FACTOR_MEMORY.read_text())
     for fit in fits(data["plates"]):
@@ -215,8 +215,12 @@ def test_the_memory_check_predicts_the_factor_out_of_core_where_it_would_not_fit
 
 
 def test_a_single_precision_basis_is_predicted_as_its_buffer_and_chosen_over_the_limit():
-    from modalviewer.core.cost import float32_basis_mb, float32_basis_saving_mb, krylov_sizes
-    from modalviewer.core.memory import memory_limit_mb
+    from modalviewer.core.memory import (
+        float32_basis_mb,
+        float32_basis_saving_mb,
+        krylov_sizes,
+        memory_limit_mb,
+    )
 
     info = operator_info("shells")
     n_vertices, k = 1_002_001, 300

@@ -329,7 +329,7 @@ def test_a_basis_that_does_not_fit_is_kept_in_single_precision(monkeypatch):
 
 
 def test_the_basis_is_single_precision_only_where_double_does_not_fit():
-    from modalviewer.core.cost import basis_in_float32, float32_basis_mb
+    from modalviewer.core.memory import basis_in_float32, float32_basis_mb
 
     n, width, out, block = 3_000_000, 464, 300, 16
     assert not basis_in_float32(None, n, width, out, block)
