@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
+from modalviewer.core.assembly import operator_matrices
 from modalviewer.core.eigen import solve_lowest
-from modalviewer.core.pipeline import operator_matrices
 from modalviewer.core.primitives import grid_plate, icosphere
 
 
@@ -153,9 +153,9 @@ def test_operator_columns_count_the_failed_attempt_before_a_retry():
     from pathlib import Path
 
     import modalviewer as mv
+    from modalviewer.core.assembly import operator_matrices
     from modalviewer.core.eigen import solve_lowest
     from modalviewer.core.nullspace import null_space
-    from modalviewer.core.pipeline import operator_matrices
 
     mesh = mv.load_mesh(Path(__file__).resolve().parents[2] / "assets" / "demo_folded_plate.obj")
     K, mass = operator_matrices(mesh, "laplacian")

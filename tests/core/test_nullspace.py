@@ -8,6 +8,7 @@ import pytest
 import scipy.linalg as la
 
 import modalviewer as mv
+from modalviewer.core.assembly import operator_matrices
 from modalviewer.core.eigen import (
     EigenError,
     relative_residuals,
@@ -17,7 +18,7 @@ from modalviewer.core.eigen import (
 )
 from modalviewer.core.krylov import block_krylov_schur
 from modalviewer.core.nullspace import null_space
-from modalviewer.core.pipeline import ZeroModesWarning, operator_matrices
+from modalviewer.core.pipeline import ZeroModesWarning
 from modalviewer.core.primitives import grid_plate, icosphere, torus
 
 

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
-from modalviewer.core.pipeline import FLOOR_FACTOR, WELL_SHAPED_RESIDUAL, operator_matrices
+from modalviewer.core.assembly import operator_matrices
+from modalviewer.core.pipeline import FLOOR_FACTOR, WELL_SHAPED_RESIDUAL
 from modalviewer.core.primitives import icosphere
 from modalviewer.viewer.wording import residual_text
 

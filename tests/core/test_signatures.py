@@ -5,7 +5,7 @@ import pytest
 import scipy.linalg as la
 
 import modalviewer as mv
-from modalviewer.core.pipeline import operator_matrices
+from modalviewer.core.assembly import operator_matrices
 from modalviewer.core.primitives import icosphere
 
 

@@ -6,10 +6,10 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 import modalviewer as mv
+from modalviewer.core.assembly import operator_matrices
 from modalviewer.core.eigen import DENSE_LIMIT, EigenError, solve_lowest
 from modalviewer.core.factor import SPDSolver, available_backends
 from modalviewer.core.krylov import block_krylov_schur
-from modalviewer.core.pipeline import operator_matrices
 from modalviewer.core.primitives import grid_plate
 
 

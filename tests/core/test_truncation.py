@@ -6,8 +6,8 @@ import pytest
 import scipy.linalg as sla
 
 import modalviewer as mv
+from modalviewer.core.assembly import operator_matrices
 from modalviewer.core.nullspace import null_space
-from modalviewer.core.pipeline import operator_matrices
 from modalviewer.core.primitives import icosphere, torus
 from modalviewer.core.signatures import default_times
 from modalviewer.core.truncation import k_for_truncation, truncation_error
