@@ -95,25 +95,21 @@ def batch(args) -> int:
             raise Unavailable(str(exc)) from None
     # Dask's own log lines (a cancelled task on Ctrl+C, ...) would break the progress line
     logging.getLogger("distributed").setLevel(logging.ERROR)
-    progress = _MeshProgress()
-    try:
-        summary = run_batch(
-            args.sources,
-            args.output,
-            args.operator,
-            args.k,
-            args.signatures,
-            args.bending,
-            args.membrane,
-            workers=workers,
-            scheduler=args.scheduler,
-            memory_limit=None if args.memory_limit is None else int(args.memory_limit * 2**30),
-            retry_failed=args.retry_failed,
-            progress=progress,
-            log=lambda text: tqdm.write(f"modalviewer: note: {text}", sys.stderr),
-        )
-    finally:
-        progress.close()  # the line ends, also where the batch stopped short
+    summary = run_batch(
+        args.sources,
+        args.output,
+        args.operator,
+        args.k,
+        args.signatures,
+        args.bending,
+        args.membrane,
+        workers=workers,
+        scheduler=args.scheduler,
+        memory_limit=None if args.memory_limit is None else int(args.memory_limit * 2**30),
+        retry_failed=args.retry_failed,
+        progress=True,
+        log=lambda text: tqdm.write(f"modalviewer: note: {text}", sys.stderr),
+    )
     print(f"{args.output}: {summary.text()}")  # the summary first, then its details
     for name, error in summary.failed.items():
         print(f"failed: {name}: {error}")
@@ -123,37 +119,6 @@ def batch(args) -> int:
         sys.stderr.write("modalviewer: interrupted (the store holds every finished mesh)\n")
         return 130
     return 1 if summary.failed else 0
-
-
-class _MeshProgress:
-    """``run_batch``'s ``progress(done, total, failed, elapsed, already)`` as a tqdm bar on
-    stderr: the meshes done of all, the failures, the rate of this run's meshes (not the
-    ``already`` done before it) and the time left."""
-
-    def __init__(self):
-        self.bar = None
-
-    def __call__(self, done: int, total: int, failed: int, elapsed: float, already: int = 0):
-        from tqdm import tqdm
-
-        if self.bar is None:
-            self.bar = tqdm(
-                total=total,
-                initial=already,
-                file=sys.stderr,
-                unit="mesh",
-                ascii=".#",
-                smoothing=0,
-                bar_format="[{bar:30}] {n_fmt}/{total_fmt} meshes{postfix}, {rate_fmt}, "
-                "{remaining} left",
-            )
-        if failed:
-            self.bar.set_postfix_str(f"{failed} failed", refresh=False)
-        self.bar.update(done - self.bar.n)
-
-    def close(self) -> None:
-        if self.bar is not None:
-            self.bar.close()
 
 
 def similar(args) -> int:

@@ -8,6 +8,7 @@ import glob
 import json
 import logging
 import os
+import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -310,7 +311,7 @@ def run_batch(
     client=None,
     memory_limit: int | None = None,
     retry_failed: bool = False,
-    progress: Callable[..., None] | None = None,
+    progress: bool = False,
     log: Callable[[str], None] | None = None,
 ) -> BatchSummary:
     """Compute every mesh of ``sources`` (see :func:`find_meshes`) into ``store``, one task
@@ -324,8 +325,10 @@ def run_batch(
     current are skipped, and recorded failures unless ``retry_failed``; results are
     written as they arrive, and the index rebuilt at the end (also when interrupted).  A
     store holds one set of parameters: others raise CollectionError if it holds results.
-    ``progress(done, total, failed, seconds, already)`` is called after each mesh;
-    ``log(text)`` gets notes."""
+    ``progress``: a tqdm bar on stderr (meshes done of all, failures, this run's rate and
+    the time left); ``log(text)`` gets notes."""
+    from tqdm import tqdm
+
     store = Path(store)
     parameters = _parameters(operator, k, signatures, bending, membrane)
     paths = find_meshes(sources)
@@ -343,14 +346,16 @@ def run_batch(
             summary.skipped.append(name)
             if status == "failed":
                 summary.failed_before.append(name)
-    total = len(paths)
-    already = len(summary.skipped)
-
-    def report() -> None:
-        if progress is not None:
-            elapsed = time.perf_counter() - start
-            done = len(summary.computed) + len(summary.skipped) + len(summary.failed)
-            progress(done, total, len(summary.failed), elapsed, already)
+    bar = tqdm(
+        total=len(paths),
+        initial=len(summary.skipped),  # the rate is this run's
+        disable=not progress,
+        file=sys.stderr,
+        unit="mesh",
+        ascii=".#",
+        smoothing=0,
+        bar_format="[{bar:30}] {n_fmt}/{total_fmt} meshes{postfix}, {rate_fmt}, {remaining} left",
+    )
 
     def take(name: str, path: Path, result: dict) -> None:
         if result["status"] == "computed":
@@ -361,9 +366,9 @@ def run_batch(
         else:
             write_error(store, name, path, parameters, result["error"])
             summary.failed[name] = result["error"]
-        report()
+            bar.set_postfix_str(f"{len(summary.failed)} failed", refresh=False)
+        bar.update()
 
-    report()
     try:
         if not todo:
             pass
@@ -375,6 +380,7 @@ def run_batch(
     except KeyboardInterrupt:
         summary.interrupted = True
     finally:
+        bar.close()  # the line ends, also where the batch stopped short
         summary.seconds = time.perf_counter() - start
         rebuild_index(store)
     return summary
