@@ -10,7 +10,7 @@ import os as _os
 # MKL PARDISO and numpy's OpenBLAS take turns on the same cores hundreds of times per
 # eigensolve, and threads left spinning after each call slow the other down; these make
 # them sleep soon after each call.  Set before numpy loads OpenBLAS (an explicit setting
-# wins); when numpy came first, core/threads.py limits OpenBLAS at run time instead.
+# wins); when numpy came first, core/products.py limits OpenBLAS at run time instead.
 _os.environ.setdefault("KMP_BLOCKTIME", "0")
 _os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 

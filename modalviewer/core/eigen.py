@@ -37,8 +37,12 @@ from .krylov import (
 )
 from .memory import basis_in_float32, factor_budget_mb, float32_basis_mb, krylov_sizes
 from .memory import memory_limit_mb as default_memory_limit_mb
-from .products import column_block_products, threaded_product, transform_columns_in_place
-from .threads import single_blas_thread
+from .products import (
+    column_block_products,
+    single_blas_thread,
+    threaded_product,
+    transform_columns_in_place,
+)
 
 ZERO_MODE_RTOL = 1e-8
 """Eigenvalues below this times the largest computed one count as zero modes."""

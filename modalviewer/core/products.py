@@ -1,11 +1,20 @@
-"""Sparse products on the machine's two cores, and passes over (N, k) arrays in blocks.
+"""Sparse products on the machine's two cores, passes over (N, k) arrays in blocks, and
+OpenBLAS at one thread during an eigensolve.
 
 scipy's sparse products release the GIL but run on one core; splitting the rows of the
 left factor over two threads halves their time on two cores.
+
+:func:`single_blas_thread` sets OpenBLAS to one thread at run time through
+threadpoolctl: OpenBLAS threads left spinning after each call slow MKL PARDISO's down,
+and ``OPENBLAS_THREAD_TIMEOUT`` (set by ``import modalviewer``) comes too late if numpy
+was imported first (``benchmarks/import_order.py``).
+``MODALVIEWER_SINGLE_BLAS_THREAD=0`` turns it off.
 """
 
 from __future__ import annotations
 
+import functools
+import os
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 
@@ -102,3 +111,29 @@ def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384, lead: int =
         rows = slice(start, min(start + chunk, n))
         out[rows, lead:] = Y[rows, :m].copy() if isinstance(A, int) else Y[rows] @ A
     return out
+
+
+@functools.cache
+def _openblas():
+    """threadpoolctl's controller of the loaded OpenBLAS libraries, or None."""
+    try:
+        from threadpoolctl import ThreadpoolController
+
+        found = ThreadpoolController().select(internal_api="openblas")
+        return found if found.lib_controllers else None
+    except Exception:  # threadpoolctl missing or failing on this platform
+        return None
+
+
+def single_blas_thread(fn):
+    """Decorator: ``fn`` runs with OpenBLAS at one thread."""
+
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        found = _openblas()
+        if not found or os.environ.get("MODALVIEWER_SINGLE_BLAS_THREAD") == "0":
+            return fn(*args, **kwargs)
+        with found.limit(limits=1):
+            return fn(*args, **kwargs)
+
+    return wrapper
