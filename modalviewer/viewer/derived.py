@@ -60,51 +60,39 @@ class DerivedValues:
 
     def __init__(self, state) -> None:
         self.state = state
-        self._mesh = None  # the mesh the per-mesh values below belong to
-        self._per_mesh: dict[str, object] = {}
-        # (operator, signature kind) -> (spectrum, t_range, table)
-        self._tables: dict[tuple[str, str], tuple[Spectrum, tuple | None, SignatureTable]] = {}
-        # ((kind, vertex, t_range), spectrum, distances) of the last distance map
-        self._distance: tuple | None = None
-        self._truncation: dict = {}  # (spectrum id, t) -> (spectrum, (error, k))
-        self._exact_curve: tuple | None = None  # (curve_key(), times, values)
-        state.events.mesh.connect(self._drop_all)
+        self._kept: dict = {}  # name -> (inputs, value): see _value
+        state.events.mesh.connect(lambda: self._kept.clear())
         state.events.spectra.connect(self._drop_stale_spectra)
-        state.events.scale_range.connect(self._drop_distances)
 
     # ---------------------------------------------------------- caches
-    def _drop_all(self) -> None:
-        self._mesh = None
-        self._per_mesh = {}
-        self._tables = {}
-        self._distance = None
-        self._truncation = {}
-        self._exact_curve = None
+    def _value(self, name, inputs: tuple, compute=None):
+        """The value kept as ``name`` if computed from ``inputs`` (the same objects, or
+        equal plain values), else ``compute()`` kept (None without ``compute``)."""
+        kept, plain = self._kept.get(name), (str, int, float, tuple)
+        if kept is not None and len(kept[0]) == len(inputs):
+            same = zip(kept[0], inputs, strict=True)
+            if all(a is b or (isinstance(a, plain) and a == b) for a, b in same):
+                return kept[1]
+        if compute is None:
+            return None
+        self._kept[name] = (inputs, value := compute())
+        return value
 
     def _drop_stale_spectra(self, operator: str = "") -> None:
-        for key, (spec, _, _) in list(self._tables.items()):
-            if spec is not self.state.spectrum(key[0]):
-                del self._tables[key]
-        if self._distance is not None and not any(
-            self._distance[1] is spec for spec in self.state.spectra.values()
-        ):
-            self._distance = None
-
-    def _drop_distances(self) -> None:
-        self._distance = None
+        """Release the values made of spectra the state no longer holds."""
+        held = list(self.state.spectra.values())
+        for name, (inputs, _) in list(self._kept.items()):
+            if any(isinstance(x, Spectrum) and all(x is not s for s in held) for x in inputs):
+                del self._kept[name]
 
     def _mesh_value(self, name: str, compute):
         """The per-mesh value ``name``, computed by ``compute(mesh)`` once per mesh."""
         mesh = self.state.mesh
-        if mesh is not self._mesh:
-            self._mesh, self._per_mesh = mesh, {}
-        if name not in self._per_mesh:
-            self._per_mesh[name] = compute(mesh)
-        return self._per_mesh[name]
+        return self._value(name, (mesh,), lambda: compute(mesh))
 
     def keep_table(self, spec: Spectrum, table: SignatureTable) -> None:
         """Keep ``table``, built with ``spec`` (over ``table.t_range``), for reuse."""
-        self._tables[spec.operator, table.kind] = (spec, table.t_range, table)
+        self._kept["table", spec.operator, table.kind] = ((spec, table.t_range), table)
 
     # ------------------------------------------------------- per mesh
     @property
@@ -224,12 +212,11 @@ class DerivedValues:
         if spec is None:
             raise ValueError(f"no spectrum of {operator!r} has been computed")
         t_range = self.state.t_range
-        kept = self._tables.get((operator, kind))
-        if kept is not None and kept[0] is spec and kept[1] == t_range:
-            return kept[2]
-        table = SignatureTable(spec, t_range=t_range, kind=kind)
-        self._tables[operator, kind] = (spec, t_range, table)
-        return table
+        return self._value(
+            ("table", operator, kind),
+            (spec, t_range),
+            lambda: SignatureTable(spec, t_range=t_range, kind=kind),
+        )
 
     def kind_table(self, kind: str | None = None) -> SignatureTable:
         """The signature table distance ``kind`` (the display's by default) uses."""
@@ -283,15 +270,12 @@ class DerivedValues:
             return None
         spec = self.state.spectrum(operator)
         t = self.signature_time() if t is None else float(t)
-        key = (id(spec), t)
-        kept = self._truncation.get(key)
-        if kept is None or kept[0] is not spec:
+
+        def estimate():
             error = float(truncation_error(spec, [t])[0])
-            k = k_for_truncation(spec, t) if error > TRUNCATION_LEVEL else spec.k
-            if len(self._truncation) > 16:
-                self._truncation = {}
-            kept = self._truncation[key] = (spec, (error, k))
-        return kept[1]
+            return error, k_for_truncation(spec, t) if error > TRUNCATION_LEVEL else spec.k
+
+        return self._value(("truncation", operator, t), (spec,), estimate)
 
     # ------------------------------------------- the picked vertex's curve
     def curve_key(self) -> tuple | None:
@@ -329,13 +313,11 @@ class DerivedValues:
         """(T,) the curve summed over all modes, once
         :meth:`.model.ViewerModel.request_exact_curve` has computed it, else None."""
         key = self.curve_key()
-        if key is None or self._exact_curve is None or self._exact_curve[0] != key:
-            return None
-        return self._exact_curve[2]
+        return None if key is None else self._value("exact curve", (key,))
 
-    def keep_exact_curve(self, key: tuple, times: np.ndarray, values: np.ndarray) -> None:
+    def keep_exact_curve(self, key: tuple, values: np.ndarray) -> None:
         """Keep the exact curve computed for ``key`` (:meth:`curve_key`)."""
-        self._exact_curve = (key, np.asarray(times), np.asarray(values))
+        self._kept["exact curve"] = ((key,), np.asarray(values))
 
     def up_axis(self) -> str:
         """The chosen up axis, else :func:`.camera.detect_up`'s, else +Y."""
@@ -369,12 +351,10 @@ class DerivedValues:
         spec = state.spectrum(operator_for_distance(kind))
         if state.picked is None or spec is None or spec.zero_mode_mask().all():
             return None
-        key = (kind, state.picked, state.t_range)
-        if self._distance is not None and self._distance[0] == key and self._distance[1] is spec:
-            return self._distance[2]
-        d = self.kind_table(kind).distance_from(state.picked)
-        self._distance = (key, spec, d)
-        return d
+        inputs = (kind, state.picked, state.t_range, spec)
+        return self._value(
+            "distance", inputs, lambda: self.kind_table(kind).distance_from(inputs[1])
+        )
 
     def map_identity(self) -> tuple | None:
         """(kind, vertex, scale range, spectrum id) of the display's map, or None."""

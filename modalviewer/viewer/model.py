@@ -231,17 +231,6 @@ class ViewerModel:
             for job in self.jobs.jobs
         )
 
-    def cancel_running(self) -> None:
-        """Cancel the running job and the other jobs of the same spectrum request."""
-        running = self.jobs.running
-        if running is None:
-            return
-        key = running.spectrum_key if isinstance(running, SpectrumJob) else None
-        for job in list(self.jobs.jobs):
-            same = key is not None and isinstance(job, SpectrumJob) and job.spectrum_key == key
-            if job is running or same:
-                self.jobs.cancel(job)
-
     def estimated_seconds(self, key: SpectrumKey) -> float | None:
         """:func:`expected_seconds` of ``key`` on the loaded mesh (None without one)."""
         if self.state.mesh is None:
@@ -321,7 +310,7 @@ class ViewerModel:
 
         def arrived(j: Job) -> None:
             if j.status == DONE:
-                derived.keep_exact_curve(key, times, j.result)
+                derived.keep_exact_curve(key, j.result)
                 state.events.signature_curve.emit()
 
         job.then(arrived)

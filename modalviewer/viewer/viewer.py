@@ -278,11 +278,16 @@ class Viewer(ViewerModel, Pictures):
         return f"this will take about {about} (Esc cancels{faster})"
 
     def cancel_computation(self) -> None:
-        """Cancel the running computation; other queued requests keep their turn."""
-        if self.jobs.running is None:
+        """Cancel the running computation (and the other jobs of its spectrum); other
+        queued requests keep their turn."""
+        running = self.jobs.running
+        if running is None:
             self._status("No computation running.", 3000)
             return
-        self.cancel_running()
+        key = running.spectrum_key if isinstance(running, SpectrumJob) else None
+        for job in list(self.jobs.jobs):
+            if job is running or (isinstance(job, SpectrumJob) and job.spectrum_key == key):
+                self.jobs.cancel(job)
         left = {
             job.spectrum_key if isinstance(job, SpectrumJob) else job.key
             for job in self.jobs.jobs
