@@ -22,6 +22,7 @@ from ..core.spectrum import Spectrum
 from .store import (
     HISTOGRAM_EDGES,
     HISTOGRAM_SCALES,
+    SPECTRUM_ARRAYS,
     STORE_FORMAT,
     STORE_VERSION,
     entry_key,
@@ -226,7 +227,7 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
             main = spectra[parameters["operator"]]
             for op, spec in spectra.items():
                 prefix = "" if op == parameters["operator"] else f"{op}."
-                for part in ("eigenvalues", "modes", "mass", "residuals"):
+                for part in SPECTRUM_ARRAYS:
                     arrays[prefix + part] = getattr(spec, part)
                 if prefix:
                     arrays[prefix + "parameters"] = np.array(json.dumps(spec.parameters))

@@ -29,6 +29,8 @@ HISTOGRAM_SCALES = 8
 """How many of the standard scales (evenly among them) the histograms are taken at."""
 
 
+SPECTRUM_ARRAYS = ("eigenvalues", "modes", "mass", "residuals")
+"""A spectrum's arrays; a second operator's are stored as ``OP.eigenvalues``, ..."""
 STORE_PARAMETERS = ("operator", "k", "bending", "membrane", "signatures")
 """The parameters ``collection.json`` holds: one set per store."""
 
@@ -271,11 +273,8 @@ class Collection:
             if f"{operator}.eigenvalues" not in data:
                 raise CollectionError(f"{name} has no {operator} spectrum")
             return Spectrum(
-                eigenvalues=np.array(data[f"{operator}.eigenvalues"]),
-                modes=np.array(data[f"{operator}.modes"]),
+                **{part: np.array(data[f"{operator}.{part}"]) for part in SPECTRUM_ARRAYS},
                 operator=operator,
-                mass=np.array(data[f"{operator}.mass"]),
-                residuals=np.array(data[f"{operator}.residuals"]),
                 mesh_hash=self.entry(name)["mesh_hash"],
                 parameters=json.loads(str(data[f"{operator}.parameters"])),
             )
@@ -301,29 +300,25 @@ class Collection:
         return self._descriptors
 
     def _read_descriptors(self) -> dict[str, np.ndarray]:
-        names = self.names
-        dna, hists = [], {}
-        for row, name in enumerate(names):
+        names, kinds = self.names, self.info.get("signatures", [])
+        dna, hists = [], {kind: [] for kind in kinds}  # a store's meshes share its kinds
+        for name in names:
             with np.load(self.file(name), allow_pickle=False) as data:
                 dna.append(np.array(data["shape_dna"]))
-                for key in data.files:
-                    if key.startswith("hist."):
-                        hists.setdefault(key[5:], {})[row] = np.array(data[key])
+                for kind in kinds:
+                    hists[kind].append(np.array(data[f"hist.{kind}"]))
         width = max((len(d) for d in dna), default=0)
-        table = np.full((len(names), width), np.nan)
-        for row, d in enumerate(dna):
-            table[row, : len(d)] = d
         out = {
-            "shape_dna": table,
+            "shape_dna": np.array(
+                [np.pad(d, (0, width - len(d)), constant_values=np.nan) for d in dna]
+            ).reshape(len(names), width),
             "area": np.array([self.entry(n)["area"] for n in names], dtype=float),
             "n_vertices": np.array([self.entry(n)["n_vertices"] for n in names], dtype=int),
         }
-        for kind, rows in hists.items():
-            shape = next(iter(rows.values())).shape
-            stack = np.full((len(names), *shape), np.nan)
-            for row, h in rows.items():
-                stack[row] = h
-            out[f"histogram.{kind}"] = stack
+        bins = (len(names), HISTOGRAM_SCALES, len(HISTOGRAM_EDGES) - 1)
+        out.update(
+            (f"histogram.{kind}", np.array(rows).reshape(bins)) for kind, rows in hists.items()
+        )
         return out
 
     def name_of(self, mesh_hash: str) -> str | None:

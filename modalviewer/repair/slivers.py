@@ -115,13 +115,9 @@ def _hausdorff(ms, sampled_id: int, target_id: int, n_samples: int) -> float:
     """Largest distance from a vertex of mesh ``sampled_id`` to the surface ``target_id``."""
     import pymeshlab
 
-    res = ms.get_hausdorff_distance(
+    res = ms.get_hausdorff_distance(  # sampling the vertices only: the default
         sampledmesh=sampled_id,
         targetmesh=target_id,
-        samplevert=True,
-        sampleedge=False,
-        samplefauxedge=False,
-        sampleface=False,
         samplenum=n_samples,
         maxdist=pymeshlab.PercentageValue(100.0),
     )
