@@ -79,24 +79,20 @@ class EigenResult:
     residuals: np.ndarray  # (k,) relative residuals (absolute, scaled, for zero modes)
     shift: float
     method: str
+    # seconds per stage: "factorisation", "solves" (the Krylov iteration's),
+    # "orthogonalisation", "ritz" (projected eigenproblems), "restarts" (basis rotations),
+    # "refinement" (the last block of solves), "rayleigh_ritz" (with K itself),
+    # "residuals", "copy" (into the row-major result; a single-precision basis widened
+    # into the modes), "dense"
     stage_seconds: dict[str, float] = field(default_factory=dict)
-    """Where the time went: "factorisation", "solves" (the Krylov iteration's), "orthogonalisation",
-    "ritz" (projected eigenproblems), "restarts" (basis rotations), "refinement" (the last
-    block of solves), "rayleigh_ritz" (with K itself), "residuals", "copy" (into the
-    row-major result; a single-precision basis widened into the modes), "dense"."""
-    operator_columns: int = 0
-    """Columns the shift-invert operator was applied to, refinement included."""
-    null_dim: int = 0
-    """The first ``null_dim`` pairs are the given exact null vectors (eigenvalue 0)."""
-    factor_mb: float | None = None
-    """Memory the factorisation needs in core (PARDISO's analysis), None if unknown."""
+    operator_columns: int = 0  # shift-invert operator applications, refinement included
+    null_dim: int = 0  # the first null_dim pairs are the given exact null vectors (lam 0)
+    factor_mb: float | None = None  # the factor's in-core size (PARDISO's analysis)
+    # the factor did not fit the memory limit beside the Krylov basis: kept in a file
     out_of_core: bool = False
-    """True if the factor did not fit the memory limit beside the Krylov basis and was
-    kept in a file (:mod:`.factor`)."""
+    # even with the factor out of core a double-precision Krylov basis would not fit the
+    # memory limit (:func:`.memory.basis_in_float32`): it was stored in single precision
     basis_float32: bool = False
-    """True if the Krylov basis was stored in single precision because even with the
-    factor out of core a double-precision basis would not fit the memory limit
-    (:func:`.memory.basis_in_float32`)."""
 
 
 def zero_modes(lam: np.ndarray, lam_scale: float = 0.0, null_dim: int = 0) -> np.ndarray:
@@ -183,11 +179,6 @@ def _fix_signs(X: np.ndarray, rows: int = 2048) -> np.ndarray:
     return X
 
 
-def _gershgorin_max(K: sp.csr_matrix, mass_diag: np.ndarray) -> float:
-    row_abs = np.asarray(abs(K).sum(axis=1)).ravel()
-    return float(np.max(row_abs / mass_diag))
-
-
 @single_blas_thread
 def solve_lowest(
     K: sp.spmatrix,
@@ -203,32 +194,19 @@ def solve_lowest(
     memory_limit_mb: float | None = None,
     on_modes: ConvergedFn | None = None,
 ) -> EigenResult:
-    """The k lowest eigenpairs of ``K x = lam diag(mass_diag) x``.
+    """The k lowest eigenpairs (1 <= k <= N) of ``K x = lam diag(mass_diag) x``, K
+    symmetric positive semi-definite: eigenvalues ascending, vectors Mass-orthonormal.
 
-    Parameters
-    ----------
-    K : (N, N) symmetric positive semi-definite sparse matrix.
-    mass_diag : (N,) positive masses.
-    k : number of eigenpairs, 1 <= k <= N.
-    progress : called as ``progress(stage, fraction)``.
-    cancel : polled during the solve; returning True raises :class:`Cancelled`.
-    null_space : (N, d) exact Mass-orthonormal null vectors of K
-        (:func:`.nullspace.null_space`), returned first as eigenvalue 0 and counted in
-        k; the iteration works in their Mass-orthogonal complement, so it neither
-        returns them again nor misses any.  With d >= k no factorisation is made.
-    memory_limit_mb : the memory (MB) the solve plans to stay within (None:
-        :func:`.memory.memory_limit_mb`); beyond it the factor goes out of core, and
-        then the basis to single precision (:func:`.memory.basis_in_float32`).
-    on_modes : called as ``on_modes(eigenvalues, vectors)`` with pairs as they
-        converge, lowest first: (m,) eigenvalues and a new (N, m) array of
-        Mass-orthonormal vectors, the null vectors first, equal to the result's to the
-        solver's tolerance.  Not called by the dense solver nor where the null vectors
-        fill all k.
-
-    Returns
-    -------
-    EigenResult with eigenvalues ascending (the d deflated zeros first) and
-    Mass-orthonormal vectors.
+    ``cancel`` is polled; returning True raises :class:`Cancelled`.  ``null_space``: (N, d)
+    exact Mass-orthonormal null vectors of K (:func:`.nullspace.null_space`), returned
+    first as eigenvalue 0 and counted in k; the iteration works in their Mass-orthogonal
+    complement, so it neither returns them again nor misses any (with d >= k no
+    factorisation is made).  ``memory_limit_mb`` (None: :func:`.memory.memory_limit_mb`):
+    beyond it the factor goes out of core, and then the basis to single precision
+    (:func:`.memory.basis_in_float32`).  ``on_modes(eigenvalues, vectors)`` receives the
+    pairs as they converge, lowest first, (m,) eigenvalues and a new (N, m) array, the
+    null vectors first, equal to the result's to the solver's tolerance; the dense solver
+    does not call it, nor is it called where the null vectors fill all k.
     """
     K, mass_diag = _checked_problem(K, mass_diag, k)
     N = K.shape[0]
@@ -331,7 +309,10 @@ def _complement_pairs(
         return V
 
     if N - d > dense_limit:
-        lam_typical = median_ratio or _gershgorin_max(K, mass_diag)
+        # median_ratio is 0 where half of K's diagonal is: then Gershgorin's bound
+        lam_typical = median_ratio or float(
+            np.max(np.asarray(abs(K).sum(axis=1)).ravel() / mass_diag)
+        )
         args = (K, mass_diag, 1.0 / np.sqrt(mass_diag), k - d, lam_typical, report, tol, block,
                 timer, project, N - d, limit, solver_info, k)  # fmt: skip
         try:
@@ -481,12 +462,6 @@ def factor_below_spectrum(
     )
 
 
-def _scale_rows(Y: np.ndarray, factors: np.ndarray) -> np.ndarray:
-    """``Y`` with row i multiplied by ``factors[i]``, in place; returns Y."""
-    Y *= factors[:, None]
-    return Y
-
-
 FLOAT32_BASIS_TOL = 1e-7
 """Convergence tolerance of the Krylov iteration with a single-precision basis (its
 columns are orthonormal to about that); the final inverse iteration and Rayleigh-Ritz
@@ -549,6 +524,10 @@ def _shift_invert(
         # 1 / |shift|: rounding brings them back in every solve, so each result is projected
         return project(sqrt_m[:, None] * solver.solve(sqrt_m[:, None] * V))
 
+    def relay(theta: np.ndarray, Y: np.ndarray) -> None:
+        Y *= inv_sqrt_m[:, None]  # in place: standard-form vectors to K's
+        on_converged(shift + 1.0 / theta, Y)
+
     # At a restart the basis keeps the working pairs and the best third of the unwanted
     # Ritz vectors next to them, which carry the part of the spectrum the last wanted
     # pairs must be told apart from: fewer operator columns than keeping only the
@@ -565,9 +544,7 @@ def _shift_invert(
         timer=timer,
         project=project,
         basis=Q,
-        on_converged=None
-        if on_converged is None
-        else lambda theta, Y: on_converged(shift + 1.0 / theta, _scale_rows(Y, inv_sqrt_m)),
+        on_converged=None if on_converged is None else relay,
     )
     if float32:
         with timer("copy"):
