@@ -32,7 +32,7 @@ class NotConverged(EigenError):
 
 
 class StageTimer:
-    """Wall-clock seconds spent per stage of a solve (accumulated over calls)."""
+    """Wall-clock seconds per stage of a solve, accumulated over calls."""
 
     def __init__(self) -> None:
         self.seconds: dict[str, float] = {}
@@ -205,8 +205,7 @@ or two pairs at a time, while the basis is small."""
 
 
 def _same_cluster(theta: np.ndarray, i: int) -> bool:
-    """Whether the Ritz values ``theta[i - 1]`` and ``theta[i]`` (descending) lie within
-    :data:`CLUSTER_RTOL` of each other."""
+    """Whether the descending Ritz values ``theta[i - 1:i + 1]`` are one cluster."""
     return theta[i] >= theta[i - 1] * (1.0 - CLUSTER_RTOL)
 
 
@@ -216,7 +215,6 @@ def _whole_clusters(theta: np.ndarray, done: int, handed: int, block: int) -> in
     trailing cluster of ``block`` or more equal values waits too: a block Krylov method
     sees at most ``block`` copies of an eigenvalue before rounding brings in the others,
     so such a cluster may have more members to come."""
-
     ready = min(done, theta.shape[0] - 1)  # the next Ritz value must be there to compare
     while ready > handed and _same_cluster(theta, ready):
         ready -= 1
@@ -262,34 +260,24 @@ def block_krylov_schur(
     basis: np.ndarray | None = None,
     on_converged: ConvergedFn | None = None,
 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """The k largest eigenpairs of a symmetric positive definite operator.
+    """The k largest eigenpairs of the symmetric positive definite operator ``apply_op``
+    (an (N, b) array to OP times it): theta (k,) descending, Y (N, k) orthonormal Ritz
+    vectors (a view into the basis array), and the number of operator columns applied.
 
     The operator is applied to ``block`` vectors at a time (one pass over a factor serves
-    many right-hand sides).  Ritz pairs are checked every 64 new vectors and when the
-    basis is full, which restarts with its ``keep`` best Ritz vectors.
-
-    Parameters
-    ----------
-    apply_op : maps an (N, b) array to OP times it.
-    k : wanted eigenpairs; ``k <= keep``, ``keep + block <= max_basis <= N - block``.
-    tol : a pair counts as converged when ``|OP y - theta y| <= tol * theta``.
-    timer : accumulates the seconds of "solves", "orthogonalisation", "ritz", "restarts".
-    project : removes a known invariant subspace (deflated null vectors) from an (N, b)
-        array in place, applied to the start block and fresh random directions (apply_op
-        projects its results itself).
-    basis : the (N, max_basis + block) float64 or float32 array for the basis (None: a
-        new float64 one).  A float32 basis is orthonormal to about 1e-7 only (products
-        in double, :func:`_basis_t_times`): ``tol`` >= :data:`.eigen.FLOAT32_BASIS_TOL`.
-    on_converged : ``on_converged(theta, Y)`` with newly converged leading pairs, largest
-        first, (m,) values and a new (N, m) array, in pieces of about
-        :data:`HANDOVER_COLUMNS`, a cluster (:data:`CLUSTER_RTOL`) whole, once
-        :data:`HANDOVER_GROWTH` times as many as before are ready.  With it,
-        pairs are checked before the basis has k columns too.
-
-    Returns
-    -------
-    theta (k,) descending, Y (N, k) orthonormal Ritz vectors (a view into the basis
-    array), number of operator columns applied.
+    many right-hand sides); ``k <= keep``, ``keep + block <= max_basis <= N - block``.
+    Ritz pairs are checked every 64 new vectors and when the basis is full, which
+    restarts with its ``keep`` best Ritz vectors; a pair has converged when
+    ``|OP y - theta y| <= tol * theta``.  ``project`` removes a known invariant subspace
+    (deflated null vectors) from an (N, b) array in place, applied to the start block and
+    fresh random directions (apply_op projects its results itself).  ``basis``: the
+    (N, max_basis + block) float64 or float32 array for the basis (None: a new float64
+    one); a float32 basis is orthonormal to about 1e-7 only (products in double,
+    :func:`_basis_t_times`), so ``tol`` >= :data:`.eigen.FLOAT32_BASIS_TOL`.
+    ``on_converged(theta, Y)`` receives newly converged leading pairs, largest first, as
+    (m,) values and a new (N, m) array, in pieces of about :data:`HANDOVER_COLUMNS`, a
+    cluster (:data:`CLUSTER_RTOL`) whole, once :data:`HANDOVER_GROWTH` times as many as
+    before are ready; with it, pairs are checked before the basis has k columns too.
     """
     rng = np.random.default_rng(seed)
     timer = timer or StageTimer()
