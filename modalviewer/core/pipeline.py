@@ -57,13 +57,6 @@ def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
     )
 
 
-ACCURACIES = ("exact",)
-"""The ``accuracy`` values of :func:`compute_spectrum`."""
-
-REMOVED_ACCURACIES = ("preview", "fast preview")
-"""``accuracy`` values :func:`compute_spectrum` refuses with advice: the approximate
-preview spectra are no longer computed."""
-
 PREVIEW_REMOVED = (
     "the preview spectrum was removed: every spectrum is exact. For modes to look at "
     "early, pass on_modes= (a callback that receives the lowest exact modes as they "
@@ -84,36 +77,28 @@ def compute_spectrum(
     accuracy: str = "exact",
     on_modes: Callable[[Spectrum], None] | None = None,
 ) -> Spectrum:
-    """The k lowest eigenpairs of ``operator`` on ``mesh``.
+    """The k lowest eigenpairs of ``operator`` (a name of :data:`.operators.OPERATOR_INFO`
+    or its :class:`.operators.OperatorInfo`) on ``mesh``: a Spectrum with ascending
+    eigenvalues and Mass-orthonormal modes, (n, k) or (n, 3, k), one row per vertex of
+    ``mesh`` (NaN for ``mesh.unused``, a merged duplicate's row that of its vertex).  The
+    operator's exact null vectors (:mod:`.nullspace`) come first as eigenvalue 0, counted
+    in k (``spec.null_space_dimension``).
 
-    Parameters
-    ----------
-    operator : a name of :data:`.operators.OPERATOR_INFO`, or its
-        :class:`.operators.OperatorInfo`.
-    k : number of modes, an integer >= 1 (:mod:`.validate`); capped at the number of
-        unknowns.
-    bending, membrane : Discrete Shells weights (ignored by the scalar energies).
-    progress : ``progress(stage, fraction)`` with fraction in [0, 1].
-    cancel : polled; returning True raises :class:`Cancelled`.
-    accuracy : "exact", the only value; the removed "preview" and "fast preview" raise a
-        ValueError saying what to use instead (:data:`PREVIEW_REMOVED`).
-    on_modes : ``on_modes(spectrum_so_far)`` whenever more modes have converged, in the
-        computing thread: a :class:`.spectrum.Spectrum` of the first j (as
-        :func:`.eigen.solve_lowest` hands them over), ``is_complete`` False, residuals
-        NaN; the last call has the finished spectrum (the only one for small problems).
-
-    Returns
-    -------
-    Spectrum with ascending eigenvalues and Mass-orthonormal modes, (n, k) or (n, 3, k),
-    one row per vertex of ``mesh`` (NaN for ``mesh.unused``, a merged duplicate's row
-    that of its vertex).  The operator's exact null vectors (:mod:`.nullspace`) come
-    first as eigenvalue 0, counted in k (``spec.null_space_dimension``).
+    k is an integer >= 1 (:mod:`.validate`), capped at the number of unknowns; bending
+    and membrane weigh the Discrete Shells energy (the scalar energies ignore them).
+    ``progress(stage, fraction)`` has fraction in [0, 1]; ``cancel`` is polled, and
+    returning True raises :class:`Cancelled`.  ``accuracy`` is "exact", the only value;
+    the removed "preview" and "fast preview" raise a ValueError saying what to use
+    instead (:data:`PREVIEW_REMOVED`).  ``on_modes(spectrum_so_far)`` is called in the
+    computing thread whenever more modes have converged, with a Spectrum of the first j
+    (as :func:`.eigen.solve_lowest` hands them over), ``is_complete`` False, residuals
+    NaN; the last call has the finished spectrum (the only one for small problems).
     """
     operator = operator_info(operator)  # a ValueError naming the known operators
     k = check_count(k, "k")
-    if accuracy in REMOVED_ACCURACIES:
+    if accuracy in ("preview", "fast preview"):  # refused with advice
         raise ValueError(f"accuracy={accuracy!r}: {PREVIEW_REMOVED}")
-    if accuracy not in ACCURACIES:
+    if accuracy != "exact":
         raise ValueError(f"accuracy must be 'exact', got {accuracy!r}")
     if mesh.solver_mesh is not mesh:  # unused or merged vertices: solve on the others
         solved = compute_spectrum(
@@ -151,7 +136,14 @@ def compute_spectrum(
         "k": result.eigenvalues.shape[0],
         "bending": float(bending),
         "membrane": float(membrane),
-        **_solve_parameters(result),
+        "method": result.method,
+        "shift": result.shift,
+        "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
+        "operator_columns": result.operator_columns,
+        "factor_mb": result.factor_mb,
+        "factor_out_of_core": result.out_of_core,
+        "basis_float32": result.basis_float32,
+        "null_space_dimension": result.null_dim,
         "seconds_assembly": pairs.seconds_assembly,
         "seconds_total": time.perf_counter() - started,
         "modes_at_rounding_floor": at_floor,
@@ -199,20 +191,6 @@ def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
             f"trustworthy{_failure_hint(mesh)}"
         )
     return int(above.size), worst_floor
-
-
-def _solve_parameters(result) -> dict:
-    """What the eigensolver's result says about the solve, for ``Spectrum.parameters``."""
-    return {
-        "method": result.method,
-        "shift": result.shift,
-        "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
-        "operator_columns": result.operator_columns,
-        "factor_mb": result.factor_mb,
-        "factor_out_of_core": result.out_of_core,
-        "basis_float32": result.basis_float32,
-        "null_space_dimension": result.null_dim,
-    }
 
 
 class _ModesSoFar:
