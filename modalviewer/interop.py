@@ -8,6 +8,8 @@ import of trimesh, pyvista or meshio: objects are recognised by their type's mod
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -15,7 +17,7 @@ from .core.assembly import operator_matrices as _operator_matrices
 from .core.mesh import Mesh
 from .core.spectrum import Spectrum
 from .extras import extra_needed
-from .io import mesh_from_arrays, meshio_arrays, pyvista_arrays
+from .io import load_mesh, mesh_from_arrays, meshio_arrays, pyvista_arrays
 
 
 def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -37,7 +39,7 @@ def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
     if isinstance(obj, (tuple, list)) and len(obj) == 2:
         return np.asarray(obj[0]), np.asarray(obj[1]), []
     raise TypeError(
-        "as_mesh takes a Mesh, a (vertices, faces) pair of arrays, a trimesh.Trimesh, a "
+        "as_mesh takes a Mesh, a file, a (vertices, faces) pair of arrays, a trimesh.Trimesh, a "
         f"pyvista.PolyData or a meshio.Mesh, not {type(obj).__name__}"
     )
 
@@ -45,7 +47,8 @@ def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
 def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     """A :class:`Mesh` from arrays or another library's mesh object.
 
-    ``obj``: a :class:`Mesh` (returned as it is), ``(vertices (n, 3), faces (m, 3))``, a
+    ``obj``: a :class:`Mesh` (returned as it is), a file (read by
+    :func:`~modalviewer.io.load_mesh`), ``(vertices (n, 3), faces (m, 3))``, a
     ``trimesh.Trimesh``, a ``pyvista.PolyData`` (other data sets: their outer surface;
     polygons triangulated, as ``mesh.report`` says) or a ``meshio.Mesh`` (its triangles;
     quads and polygons triangulated, volume cells skipped).  ``repair`` as in
@@ -55,6 +58,8 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     """
     if isinstance(obj, Mesh):
         return obj
+    if isinstance(obj, (str, os.PathLike)):
+        return load_mesh(obj, repair=repair)
     vertices, faces, notes = arrays_of(obj)
     source = name or ("arrays" if isinstance(obj, (tuple, list)) else type(obj).__name__)
     return mesh_from_arrays(vertices, faces, source, repair=repair, notes=notes)

@@ -199,10 +199,6 @@ def plot(
     as an :class:`~modalviewer.scene.animation.Animation` (a looping GIF; ``screenshot``
     then names a .gif, or a .mp4 where imageio-ffmpeg is installed).
     """
-    if isinstance(mesh, (str, Path)):
-        from .io import load_mesh
-
-        mesh = load_mesh(mesh)
     mesh = as_mesh(mesh)
     viewer = _prepared_viewer(mesh, spectrum, mode, vertex, kind, k)
     try:
@@ -260,10 +256,6 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
     it closes, or at once with ``block=False`` (a notebook with ``%gui qt``, a script
     running the Qt loop).  ``spectrum`` is shown from its first non-zero mode; ``fields``
     (name -> per-vertex array) become the viewer's fields, the first shown."""
-    if isinstance(mesh_or_arrays, (str, Path)):
-        from .io import load_mesh
-
-        mesh_or_arrays = load_mesh(mesh_or_arrays)
     mesh = as_mesh(mesh_or_arrays)
     from .gui.application import ensure_application
     from .gui.main_window import MainWindow

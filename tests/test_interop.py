@@ -45,6 +45,8 @@ def test_arrays_round_trip_keeps_the_numbering(plate):
     np.testing.assert_array_equal(mesh.file_vertices, np.arange(len(v)))
     assert mv.as_mesh(mesh) is mesh
     assert "arrays" in str(mesh.report)
+    for path in (ASSETS / "demo_plate.obj", str(ASSETS / "demo_plate.obj")):  # a file
+        _same(mv.as_mesh(path), plate.vertices, plate.faces)
 
 
 def test_arrays_are_repaired_and_reported(plate):

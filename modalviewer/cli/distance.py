@@ -34,8 +34,6 @@ from .common import (
     wrote,
 )
 
-KINDS = {kind: operator_for_distance(kind) for kind in DISTANCE_KINDS}
-
 
 def add_parsers(sub) -> None:
     d = sub.add_parser(
@@ -51,7 +49,7 @@ def add_parsers(sub) -> None:
     )
     d.add_argument(
         "--kind",
-        choices=tuple(KINDS),
+        choices=tuple(DISTANCE_KINDS),
         default="vibration",
         help="vibration (3D shells), feature (E_D^N), hks (heat kernel of the Laplacian) or "
         "wks (wave kernel signature of the Laplacian, over energies)",
@@ -111,7 +109,7 @@ def distance(args) -> int:
         return _distance_to(args, mesh)
     if args.rescale:
         raise ValueError("--rescale applies to two meshes (with --to)")
-    spec = _cached_spectrum(mesh, KINDS[args.kind], args.k)
+    spec = _cached_spectrum(mesh, operator_for_distance(args.kind), args.k)
     d = mv.multiscale_distance(spec, vertex, kind=signature_kind(args.kind))
     marked = _threshold(args, mesh, d)
     if args.csv:
@@ -205,7 +203,7 @@ def _distance_to(args, mesh_a) -> int:
     mesh_b = mesh_b.solver_mesh  # as mesh_a: the vertices faces use, with the file's numbers
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
-    operator = KINDS[args.kind]
+    operator = operator_for_distance(args.kind)
     spec_a = _cached_spectrum(mesh_a, operator, args.k)
     spec_b = _cached_spectrum(mesh_b, operator, args.k)
     with warnings.catch_warnings(record=True) as caught:
