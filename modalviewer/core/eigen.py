@@ -208,11 +208,18 @@ def solve_lowest(
     null vectors first, equal to the result's to the solver's tolerance; the dense solver
     does not call it, nor is it called where the null vectors fill all k.
     """
-    K, mass_diag = _checked_problem(K, mass_diag, k)
+    K = sp.csr_matrix(K)
     N = K.shape[0]
+    mass_diag = np.asarray(mass_diag, dtype=np.float64)
+    if not (1 <= k <= N):
+        raise ValueError(f"k must be between 1 and {N} (the number of unknowns), got {k}")
+    if np.any(mass_diag <= 0) or not np.all(np.isfinite(mass_diag)):
+        raise EigenError("the mass matrix has non-positive entries (degenerate faces?)")
+    if not np.all(np.isfinite(K.data)):
+        raise EigenError("the operator has NaN or infinite entries")
     report = progress_reporter(progress, cancel)
     median_ratio = typical_eigenvalue(K, mass_diag)
-    Z = _null_vectors(null_space, N, mass_diag)
+    Z = sp.csc_matrix((N, 0)) if null_space is None else _null_vectors(null_space, mass_diag)
     d = Z.shape[1]
     timer = StageTimer()
     columns = 0
@@ -260,21 +267,6 @@ def solve_lowest(
         all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1],
         solver_info["factor_mb"], solver_info["out_of_core"], solver_info["basis_float32"],
     )  # fmt: skip
-
-
-def _checked_problem(K, mass_diag, k: int) -> tuple[sp.csr_matrix, np.ndarray]:
-    """(K as CSR, the masses as float64); errors for a k out of range, non-positive or
-    non-finite masses and non-finite entries of K."""
-    K = sp.csr_matrix(K)
-    N = K.shape[0]
-    mass_diag = np.asarray(mass_diag, dtype=np.float64)
-    if not (1 <= k <= N):
-        raise ValueError(f"k must be between 1 and {N} (the number of unknowns), got {k}")
-    if np.any(mass_diag <= 0) or not np.all(np.isfinite(mass_diag)):
-        raise EigenError("the mass matrix has non-positive entries (degenerate faces?)")
-    if not np.all(np.isfinite(K.data)):
-        raise EigenError("the operator has NaN or infinite entries")
-    return K, mass_diag
 
 
 def progress_reporter(progress: ProgressFn | None, cancel: CancelFn | None) -> ProgressFn:
@@ -383,11 +375,10 @@ class _Handover:
         self.on_modes(lam, X)
 
 
-def _null_vectors(null_space, N: int, mass_diag: np.ndarray) -> sp.csc_matrix:
+def _null_vectors(null_space, mass_diag: np.ndarray) -> sp.csc_matrix:
     """The given null vectors as (N, d) CSC; checks shape and Mass-orthonormality."""
-    if null_space is None:
-        return sp.csc_matrix((N, 0))
     Z = sp.csc_matrix(null_space, dtype=np.float64)
+    N = mass_diag.shape[0]
     if Z.shape[0] != N:
         raise ValueError(f"null_space must have {N} rows (the unknowns), got {Z.shape[0]}")
     gram = (Z.T @ sp.diags(mass_diag) @ Z).toarray()

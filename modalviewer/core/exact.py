@@ -32,24 +32,14 @@ class ModeSink(Protocol):
 
 @dataclass(frozen=True)
 class ExactPairs:
-    """What :func:`exact_pairs` computed.
-
-    Attributes
-    ----------
-    K, mass : the eigenproblem ``K phi = lambda diag(mass) phi``.
-    nulls : the operator's exact null vectors on the mesh (first in ``result``).
-    result : the k lowest pairs (k capped at the number of unknowns).
-    zero_mode_scale : the typical eigenvalue zero modes are measured against.
-    nonzero : (k,) bool, the pairs that are not zero modes (:func:`.eigen.zero_modes`).
-    seconds_assembly : wall-clock seconds of the assembly.
-    """
+    """What :func:`exact_pairs` computed for ``K phi = lambda diag(mass) phi``."""
 
     K: sp.csr_matrix
     mass: np.ndarray
-    nulls: NullSpace
-    result: EigenResult
-    zero_mode_scale: float
-    nonzero: np.ndarray
+    nulls: NullSpace  # the operator's exact null vectors on the mesh (first in result)
+    result: EigenResult  # the k lowest pairs (k capped at the number of unknowns)
+    zero_mode_scale: float  # the typical eigenvalue zero modes are measured against
+    nonzero: np.ndarray  # (k,) bool, the pairs that are not zero modes
     seconds_assembly: float
 
 
