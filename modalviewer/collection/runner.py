@@ -17,12 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from ..core.operators import DISTANCE_KINDS, operator_for_distance, operator_info, signature_kind
-from ..core.spectrum import FORMAT_VERSION as SPECTRUM_FORMAT_VERSION
-from ..core.spectrum import Spectrum
+from ..core.spectrum import SPECTRUM_ARRAYS, Spectrum, spectrum_arrays
 from .store import (
     HISTOGRAM_EDGES,
     HISTOGRAM_SCALES,
-    SPECTRUM_ARRAYS,
     STORE_FORMAT,
     STORE_VERSION,
     entry_key,
@@ -225,12 +223,11 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
             for op in _operators(parameters):
                 spectra[op] = compute_spectrum(mesh, op, parameters["k"], *weights)
             main = spectra[parameters["operator"]]
+            arrays.update(spectrum_arrays(main))  # a spectrum file, and more
             for op, spec in spectra.items():
-                prefix = "" if op == parameters["operator"] else f"{op}."
-                for part in SPECTRUM_ARRAYS:
-                    arrays[prefix + part] = getattr(spec, part)
-                if prefix:
-                    arrays[prefix + "parameters"] = np.array(json.dumps(spec.parameters))
+                if spec is not main:  # a signature's own operator: OP.eigenvalues, ...
+                    arrays.update({f"{op}.{p}": getattr(spec, p) for p in SPECTRUM_ARRAYS})
+                    arrays[f"{op}.parameters"] = np.array(json.dumps(spec.parameters))
             arrays["shape_dna"] = shape_dna(main, area)
             for kind in parameters["signatures"]:
                 spec = spectra[operator_for_distance(kind)]
@@ -238,17 +235,6 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
                 arrays[f"sig.{kind}.times"] = times
                 arrays[f"sig.{kind}.values"] = values
                 arrays[f"hist.{kind}"] = _histogram(spec, area, signature_kind(kind))
-        arrays["meta"] = np.array(
-            json.dumps(
-                {
-                    "format": "modalviewer-spectrum",
-                    "version": SPECTRUM_FORMAT_VERSION,
-                    "operator": main.operator,
-                    "mesh_hash": main.mesh_hash,
-                    "parameters": main.parameters,
-                }
-            )
-        )
         entry = {
             "format": STORE_FORMAT + "-entry",
             "version": STORE_VERSION,
@@ -315,19 +301,16 @@ def run_batch(
     progress: bool = False,
     log: Callable[[str], None] | None = None,
 ) -> BatchSummary:
-    """Compute every mesh of ``sources`` (see :func:`find_meshes`) into ``store``, one task
-    per mesh, on ``client`` (a ``dask.distributed.Client``), else the ``scheduler``
-    (``"tcp://host:8786"``), else a local cluster of ``workers`` single-threaded
-    processes (0: one mesh after another here, without Dask).  Each task asks for its
-    :func:`memory_estimate` of the resource ``memory``, which local workers offer as their
-    ``memory_limit`` (default: the machine's memory over the workers) and a scheduler's
-    if they declare it (``--resources memory=BYTES``), so that two big meshes do not
-    start together on a worker that cannot hold both.  Meshes whose stored key is
-    current are skipped, and recorded failures unless ``retry_failed``; results are
-    written as they arrive, and the index rebuilt at the end (also when interrupted).  A
-    store holds one set of parameters: others raise CollectionError if it holds results.
-    ``progress``: a tqdm bar on stderr (meshes done of all, failures, this run's rate and
-    the time left); ``log(text)`` gets notes."""
+    """Compute every mesh of ``sources`` (:func:`find_meshes`) into ``store``, one task
+    per mesh, on ``client`` (a ``dask.distributed.Client``), else the ``scheduler``, else a
+    local cluster of ``workers`` single-threaded processes (0: in this process, no Dask).
+    Each task asks for its :func:`memory_estimate` of the workers' ``memory`` resource
+    (local workers offer their ``memory_limit``), so that two big meshes do not start
+    together on a worker that cannot hold both.  Current results are skipped, and
+    recorded failures unless ``retry_failed``; results are written as they arrive and the
+    index rebuilt at the end, also when interrupted.  CollectionError if the store holds
+    results of other parameters.  ``progress``: a tqdm bar on stderr; ``log(text)`` gets
+    notes."""
     from tqdm import tqdm
 
     store = Path(store)
@@ -397,11 +380,9 @@ def _done(store: Path, name: str, path: Path, parameters: dict, retry_failed: bo
         if same and entry.get("stat") == stat:
             return "done", None
         return "todo", entry.get("key") if entry.get("parameters") == parameters else None
-    error = store / "errors" / f"{name}.json"
-    if not retry_failed:
-        record = read_json(error) or {}
-        if record.get("parameters") == parameters and record.get("stat") == stat:
-            return "failed", None
+    record = {} if retry_failed else read_json(store / "errors" / f"{name}.json") or {}
+    if record.get("parameters") == parameters and record.get("stat") == stat:
+        return "failed", None
     return "todo", None
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..core.files import atomic_write
-from ..core.spectrum import Spectrum
+from ..core.spectrum import SPECTRUM_ARRAYS, Spectrum
 
 STORE_FORMAT = "modalviewer-collection"
 STORE_VERSION = 1
@@ -29,8 +29,6 @@ HISTOGRAM_SCALES = 8
 """How many of the standard scales (evenly among them) the histograms are taken at."""
 
 
-SPECTRUM_ARRAYS = ("eigenvalues", "modes", "mass", "residuals")
-"""A spectrum's arrays; a second operator's are stored as ``OP.eigenvalues``, ..."""
 STORE_PARAMETERS = ("operator", "k", "bending", "membrane", "signatures")
 """The parameters ``collection.json`` holds: one set per store."""
 

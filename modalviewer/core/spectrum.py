@@ -16,7 +16,7 @@ from .operators import OPERATOR_INFO, OPERATOR_NAMES, OperatorInfo, operator_inf
 
 OPERATORS = OPERATOR_NAMES
 FORMAT_VERSION = 1
-_ARRAYS = ("eigenvalues", "modes", "mass", "residuals")  # a spectrum file's arrays
+SPECTRUM_ARRAYS = ("eigenvalues", "modes", "mass", "residuals")  # a spectrum file's arrays
 
 
 class SpectrumFileError(ValueError):
@@ -115,10 +115,9 @@ class Spectrum:
         return modes**2
 
 
-def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
-    """Write ``spec`` to ``path`` as ``.npz`` (atomically: a half-written file never
-    replaces a good one), with its mesh hash and parameters; an OSError if it cannot
-    be written."""
+def spectrum_arrays(spec: Spectrum) -> dict[str, np.ndarray]:
+    """The arrays of ``spec``'s file: :data:`SPECTRUM_ARRAYS` and ``meta`` (JSON: format,
+    operator, mesh hash, parameters)."""
     meta = {
         "format": "modalviewer-spectrum",
         "version": FORMAT_VERSION,
@@ -126,11 +125,18 @@ def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
         "mesh_hash": spec.mesh_hash,
         "parameters": spec.parameters,
     }
+    arrays = {name: getattr(spec, name) for name in SPECTRUM_ARRAYS}
+    return {**arrays, "meta": np.array(json.dumps(meta))}
+
+
+def save_spectrum(spec: Spectrum, path: str | os.PathLike) -> None:
+    """Write ``spec`` to ``path`` as ``.npz`` (atomically: a half-written file never
+    replaces a good one), with its mesh hash and parameters; an OSError if it cannot
+    be written."""
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as fh:
-            arrays = {name: getattr(spec, name) for name in _ARRAYS}
-            np.savez(fh, **arrays, meta=np.array(json.dumps(meta)))
+            np.savez(fh, **spectrum_arrays(spec))
 
     atomic_write(Path(path), write, suffix=".part")
 
@@ -158,7 +164,7 @@ def load_spectrum(
     try:
         with np.load(path, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
-            arrays = {name: np.array(data[name], dtype=np.float64) for name in _ARRAYS}
+            arrays = {name: np.array(data[name], dtype=np.float64) for name in SPECTRUM_ARRAYS}
             spec = Spectrum(
                 **arrays,
                 operator=meta["operator"],
