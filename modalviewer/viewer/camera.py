@@ -133,13 +133,6 @@ def _up_vector(up) -> np.ndarray:
     return _unit(up)
 
 
-def _bounds(vertices) -> tuple[np.ndarray, float]:
-    """(centre of the bounding box, half its diagonal)."""
-    v = np.asarray(vertices, dtype=np.float64)
-    lo, hi = v.min(axis=0), v.max(axis=0)
-    return 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-12)
-
-
 def principal_axes(vertices, faces=None) -> tuple[np.ndarray, np.ndarray]:
     """(variances (3,) descending, axes as rows (3, 3)): the area-weighted second moments
     of the triangles, or of the vertices without faces."""
@@ -180,10 +173,6 @@ def _face_front(direction: np.ndarray) -> np.ndarray:
     return -direction if d < 0 else direction
 
 
-def _distance(radius: float) -> float:
-    return radius / np.sin(np.radians(0.5 * VIEW_ANGLE))
-
-
 def _rotate(v: np.ndarray, axis: np.ndarray, degrees: float) -> np.ndarray:
     """Rodrigues rotation of ``v`` about the unit ``axis``."""
     t = np.radians(degrees)
@@ -192,12 +181,14 @@ def _rotate(v: np.ndarray, axis: np.ndarray, degrees: float) -> np.ndarray:
 
 def look_from(vertices, direction, up) -> Camera:
     """A camera at ``direction`` from the bounding-box centre, seeing the bounding sphere."""
-    centre, radius = _bounds(vertices)
+    v = np.asarray(vertices, dtype=np.float64)
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    centre, radius = 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-12)
     d = _unit(direction)
     u = np.asarray(up, dtype=np.float64)
     u = u - (u @ d) * d
     u = _unit(u)
-    position = centre + _distance(radius) * d
+    position = centre + radius / np.sin(np.radians(0.5 * VIEW_ANGLE)) * d
     return Camera(tuple(position), tuple(centre), tuple(u))
 
 
@@ -408,12 +399,6 @@ def _flat_base(v: np.ndarray, f: np.ndarray, axis: int) -> float:
     return float(area[base].sum() / total)
 
 
-def _has_boundary(f: np.ndarray) -> bool:
-    e = np.sort(np.vstack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
-    _, counts = np.unique(e, axis=0, return_counts=True)
-    return bool((counts == 1).any())
-
-
 def detect_up(vertices, faces=None) -> str | None:
     """ "+z" when the mesh clearly stands on the XY plane, else None (+Y applies).  No
     claim for a plate (thinner than ``FLAT_ASPECT`` along z) or three feet along y; +Z
@@ -431,8 +416,9 @@ def detect_up(vertices, faces=None) -> str | None:
         return None
     if legs_z >= 3:
         return "+z"
-    if _has_boundary(f):  # an open sheet lying flat in part (a folded plate) has no base
-        return None
+    edges = np.sort(np.vstack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    if (np.unique(edges, axis=0, return_counts=True)[1] == 1).any():
+        return None  # an open sheet lying flat in part (a folded plate) has no base
     base_z, base_y = _flat_base(v, f, 2), _flat_base(v, f, 1)
     if base_z >= BASE_SHARE and base_y < 0.25 * base_z:
         return "+z"

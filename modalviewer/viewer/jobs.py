@@ -156,15 +156,12 @@ class ManualDispatcher:
         count = 0
         try:
             fn = self._queue.get(timeout=timeout) if timeout > 0 else self._queue.get_nowait()
-        except queue.Empty:
-            return 0
-        while True:
-            fn()
-            count += 1
-            try:
+            while True:
+                fn()
+                count += 1
                 fn = self._queue.get_nowait()
-            except queue.Empty:
-                return count
+        except queue.Empty:
+            return count
 
 
 class JobQueue:

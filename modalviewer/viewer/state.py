@@ -159,16 +159,6 @@ class Display:
         return replace(self, kind="none", operator=None, mode=0, field=None)
 
 
-def _scale(t) -> float | None:
-    """A typed signature scale: None, or a positive finite float (ValueError else)."""
-    if t is None:
-        return None
-    t = float(t)
-    if not (np.isfinite(t) and t > 0):
-        raise ValueError("the signature scale t must be positive and finite")
-    return t
-
-
 class ViewerEvents(SignalGroup):
     """The state's events besides its fields' (``camera``, ``up_axis``)."""
 
@@ -437,12 +427,15 @@ class ViewerState:
             if spec is None:
                 raise ValueError(f"no spectrum of {new.operator!r} has been computed")
             new = replace(new, mode=int(np.clip(new.mode, 0, spec.k - 1)))
+        t = None if new.signature_time is None else float(new.signature_time)
+        if t is not None and not (np.isfinite(t) and t > 0):
+            raise ValueError("the signature scale t must be positive and finite")
         new = replace(
             new,
             threshold=float(np.clip(new.threshold, 1e-4, 1.0)),
             threshold_share=float(np.clip(new.threshold_share, 0.0, 1.0)),
             signature_sample=int(np.clip(new.signature_sample, 0, 99)),
-            signature_time=_scale(new.signature_time),
+            signature_time=t,
         )
         if new == self.display:
             return
