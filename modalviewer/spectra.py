@@ -29,31 +29,20 @@ def cached_or_computed(
     child_process: bool = False,
 ) -> Spectrum:
     """``operator``'s ``k`` lowest modes on ``mesh``, read from ``cache`` (default: the
-    user's :class:`.core.cache.SpectrumCache`) or computed (:func:`computed_and_cached`)
-    and stored there.  ``coarse``: the coarse-to-fine approximation (never cached);
-    ``child_process``: exact solves of at least :data:`PROCESS_THRESHOLD` unknowns run
-    in a child process that writes the cache entry itself; ``progress``, ``cancel`` and
-    ``on_modes``: :func:`modalviewer.compute_spectrum`'s."""
+    user's :class:`.core.cache.SpectrumCache`) or computed and stored there.  ``coarse``:
+    the coarse-to-fine approximation (never cached); ``child_process``: exact solves of at
+    least :data:`PROCESS_THRESHOLD` unknowns run in a child process that writes the cache
+    entry itself; ``progress``, ``cancel`` and ``on_modes``:
+    :func:`modalviewer.compute_spectrum`'s."""
     cache = cache if cache is not None else SpectrumCache()
-    key = (operator, k, bending, membrane)
-    spec = None if coarse else cache.get(mesh, *key)
-    if spec is None:
-        spec = computed_and_cached(
-            mesh, key, cache, progress, cancel, on_modes, coarse, child_process
-        )
-    return spec
-
-
-def computed_and_cached(
-    mesh, key, cache, progress=None, cancel=None, on_modes=None, coarse=False, child_process=False
-) -> Spectrum:
-    """The computing half of :func:`cached_or_computed`, ``key`` its ``(operator, k,
-    bending, membrane)``."""
-    operator, k, *weights = key
+    weights = bending, membrane
     if coarse:
         from .coarsen import coarse_to_fine_spectrum
 
         return coarse_to_fine_spectrum(mesh, operator, k, *weights, progress, cancel)
+    spec = cache.get(mesh, operator, k, *weights)
+    if spec is not None:
+        return spec
     if child_process and operator_info(operator).unknowns(mesh.n_vertices) >= PROCESS_THRESHOLD:
         from .viewer.process import compute_in_process
 

@@ -137,7 +137,7 @@ def test_spectra_of_a_come_from_the_main_state_and_the_disk_cache(tmp_path, spot
     def no_compute(*args, **kwargs):
         raise AssertionError("computed instead of read from the cache")
 
-    monkeypatch.setattr("modalviewer.spectra.computed_and_cached", no_compute)
+    monkeypatch.setattr("modalviewer.spectra.compute_spectrum", no_compute)
     again = PairState(model.jobs, model.cache, spot, _moved(spot), k=K)
     jobs = again.request()
     for job in jobs:
@@ -198,7 +198,7 @@ def test_a_cancel_is_not_reported_as_a_failure_and_a_failure_is(tmp_path, spot, 
     def broken(*args, **kwargs):
         raise ValueError("the factorisation broke")
 
-    monkeypatch.setattr("modalviewer.spectra.computed_and_cached", broken)
+    monkeypatch.setattr("modalviewer.spectra.compute_spectrum", broken)
     for job in pair.request():  # asked again: computed again (and failing now)
         pair.jobs.wait(job, timeout=120)
     assert len(messages) == 2 and "could not be computed: the factorisation broke" in messages[0]
