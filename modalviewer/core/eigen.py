@@ -39,9 +39,9 @@ from .memory import basis_in_float32, factor_budget_mb, float32_basis_mb, krylov
 from .memory import memory_limit_mb as default_memory_limit_mb
 from .products import (
     column_block_products,
+    move_columns_in_place,
     single_blas_thread,
     threaded_product,
-    transform_columns_in_place,
 )
 
 ZERO_MODE_RTOL = 1e-8
@@ -248,7 +248,7 @@ def solve_lowest(
             # written over the Krylov basis, which is then shrunk to the modes: no (N, k)
             # array beside the (N, 1.1 k + extra) basis, the largest arrays of a big solve
             del X
-            transform_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
+            move_columns_in_place(basis, lam.shape[0], lead=d_out)  # view not kept
             try:
                 basis.resize((N, k))  # refuses while another reference to it is alive
                 out = basis

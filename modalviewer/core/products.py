@@ -44,10 +44,9 @@ def row_halves(K: sp.csr_matrix) -> list[tuple[slice, sp.csr_matrix]]:
     return [(slice(0, h), csr_rows(K, 0, h)), (slice(h, N), csr_rows(K, h, N))]
 
 
-def threaded_product(K, X, out: np.ndarray | None = None):
+def threaded_product(K, X):
     """K @ X for a CSR matrix K and a dense array or sparse matrix X (a CSR result), the
-    two row halves of K on two threads; dense X's product can be written into ``out``
-    (C-contiguous, not overlapping X), which saves fresh memory."""
+    two row halves of K on two threads."""
     K = sp.csr_matrix(K)
     if sp.issparse(X):
         X = sp.csr_matrix(X)
@@ -55,16 +54,12 @@ def threaded_product(K, X, out: np.ndarray | None = None):
             parts = list(pool.map(lambda part: (part[1] @ X).tocsr(), row_halves(K)))
         return sp.vstack(parts, format="csr")
     X = np.ascontiguousarray(X)
-    if out is None and (X.ndim == 1 or X.shape[1] < 4 or K.shape[0] < 2):
+    if X.ndim == 1 or X.shape[1] < 4 or K.shape[0] < 2:
         return np.asarray(K @ X)
-    if out is None:
-        out = np.empty((K.shape[0],) + X.shape[1:])
-    elif out.shape != (K.shape[0],) + X.shape[1:] or not out.flags.c_contiguous:
-        raise ValueError("out must be a C-contiguous array of the product's shape")
+    out = np.empty((K.shape[0],) + X.shape[1:])
     X2 = X.reshape(X.shape[0], -1)
     out2 = out.reshape(out.shape[0], -1)
-
-    same_type = K.dtype == X2.dtype == out2.dtype == np.float64
+    same_type = K.dtype == X2.dtype == np.float64
 
     def rows(part: tuple[slice, sp.csr_matrix]) -> None:
         s, M = part
@@ -96,20 +91,19 @@ def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[s
         yield cols, threaded_product(K, block) if sp.issparse(K) else np.asarray(K @ block)
 
 
-def transform_columns_in_place(Y: np.ndarray, A, chunk: int = 16384, lead: int = 0) -> np.ndarray:
-    """``Y A`` for a C-contiguous (N, w) Y and a (w, m) A, m <= w (an int m: Y's first m
-    columns), written over Y's buffer (Y is left meaningless) as (N, lead + m), the first
-    ``lead`` columns left for the caller; chunk by chunk, and row i ends at
-    (i + 1)(lead + m) <= (i + 1) w, so writes never reach unread rows."""
+def move_columns_in_place(Y: np.ndarray, m: int, chunk: int = 16384, lead: int = 0):
+    """The first m columns of the C-contiguous (N, w) Y written over Y's buffer (Y is left
+    meaningless) as columns ``lead:`` of an (N, lead + m) array, the first ``lead`` left
+    for the caller; chunk by chunk, and row i ends at (i + 1)(lead + m) <= (i + 1) w, so
+    writes never reach unread rows."""
     n, w = Y.shape
-    m = A if isinstance(A, int) else A.shape[1]
     width = lead + m
     if width > w or not Y.flags.c_contiguous:
-        raise ValueError("Y must be C-contiguous with at least as many columns as A (plus lead)")
+        raise ValueError("Y must be C-contiguous with at least lead + m columns")
     out = Y.reshape(-1)[: n * width].reshape(n, width)
     for start in range(0, n, chunk):
         rows = slice(start, min(start + chunk, n))
-        out[rows, lead:] = Y[rows, :m].copy() if isinstance(A, int) else Y[rows] @ A
+        out[rows, lead:] = Y[rows, :m].copy()
     return out
 
 

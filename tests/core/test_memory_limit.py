@@ -13,7 +13,7 @@ from modalviewer.core import factor as factor_module
 from modalviewer.core.eigen import solve_lowest
 from modalviewer.core.factor import SPDSolver, available_backends
 from modalviewer.core.memory import MEMORY_LIMIT_SHARE, memory_limit_mb, physical_memory_mb
-from modalviewer.core.products import transform_columns_in_place
+from modalviewer.core.products import move_columns_in_place
 
 needs_pardiso = pytest.mark.skipif(
     "pardiso" not in available_backends(), reason="out of core is PARDISO's (the mkl wheel)"
@@ -169,17 +169,17 @@ def test_the_modes_are_written_over_the_krylov_basis_not_beside_it(monkeypatch):
     assert np.abs(gram - np.eye(k)).max() < 1e-12
 
 
-def test_transform_columns_in_place_moves_the_first_columns_behind_a_lead():
+def test_move_columns_in_place_moves_the_first_columns_behind_a_lead():
     rng = np.random.default_rng(3)
     B = rng.standard_normal((1000, 9))
     expected = B[:, :5].copy()
     address = B.__array_interface__["data"][0]
-    out = transform_columns_in_place(B, 5, chunk=7, lead=2)  # several chunks
+    out = move_columns_in_place(B, 5, chunk=7, lead=2)  # several chunks
     assert out.shape == (1000, 7) and out.flags.c_contiguous
     assert out.__array_interface__["data"][0] == address  # B's own memory
     np.testing.assert_array_equal(out[:, 2:], expected)
-    with pytest.raises(ValueError, match="plus lead"):
-        transform_columns_in_place(rng.standard_normal((10, 4)), 3, lead=2)
+    with pytest.raises(ValueError, match=r"lead \+ m columns"):
+        move_columns_in_place(rng.standard_normal((10, 4)), 3, lead=2)
 
 
 def test_the_memory_limit_is_half_the_machine_or_the_setting(monkeypatch):
