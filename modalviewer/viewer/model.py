@@ -162,8 +162,11 @@ class ViewerModel:
             raise ComputeRefused("Open a mesh first.")
         key = state.compute_settings.key(operator, k)
         display_at_request = state.display
-        if state.has_spectrum(key):
-            return self._answered(key, show)
+        if state.has_spectrum(key):  # an ended job; shown unless that operator is on screen
+            job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
+            if show and state.display_operator() != key.operator:
+                self._show_first_mode(key.operator)
+            return job.end_now((state.spectra[key], None))
         refusal = self.refusal(key)
         if refusal:
             raise ComputeRefused(refusal)
@@ -209,17 +212,6 @@ class ViewerModel:
             self._show_if_unchanged(key.operator, before)
 
         return deliver
-
-    def _answered(self, key: SpectrumKey, show: bool) -> SpectrumJob:
-        """An ended job holding ``key``'s spectrum from the state; with ``show`` its first
-        mode is shown unless that operator is on screen already."""
-        state = self.state
-        spec = state.spectra[key]
-        job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
-        job.end_now((spec, None))
-        if show and state.display_operator() != key.operator:
-            self._show_first_mode(key.operator)
-        return job
 
     def computing(self, operator: str) -> bool:
         """Whether a spectrum of ``operator`` is queued or being computed."""
