@@ -22,9 +22,9 @@ from .jobs import CANCELLED, DONE, Job, SpectrumJob
 
 
 def percent_text(fraction: float) -> str:
-    """A relative error as a short percentage: two significant digits below 10 %, whole
-    per cents above, "< 0.01 %" below (more digits would show convergence, not error);
-    no-break spaces keep number and sign together in a wrapped legend."""
+    """A relative error as a short percentage: two significant digits below ten per cent,
+    whole per cents above, "less than" below a hundredth of a per cent (more digits would
+    show convergence, not error); no-break spaces keep number and sign together."""
     value = 100.0 * float(fraction)
     if 0 < value < 0.01:
         return "<\u00a00.01\u00a0%"
