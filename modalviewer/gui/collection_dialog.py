@@ -18,9 +18,8 @@ class CollectionDialog(QtWidgets.QDialog):
     as mesh B of the shape-pair window."""
 
     def __init__(self, main, collection, rows):
-        super().__init__(main)
+        super().__init__(main, windowTitle=f"Collection {collection.path.name}")
         self.main, self.collection, self.rows = main, collection, rows
-        self.setWindowTitle(f"Collection {collection.path.name}")
         layout = QtWidgets.QVBoxLayout(self)
         nearest = main.state.mesh is not None
         what = "nearest to the mesh on screen first" if nearest else "open a mesh to rank them"

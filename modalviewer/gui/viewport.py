@@ -18,6 +18,11 @@ from ..scene.framing import fit_smaller_side
 CLICK_SLOP = 4  # pixels a press may move and still count as a click
 
 
+def _is_click(press, x: float, y: float) -> bool:
+    """Whether a release at (x, y) after a press at ``press`` (None: none) is a click."""
+    return press is not None and max(abs(x - press[0]), abs(y - press[1])) <= CLICK_SLOP
+
+
 def qt_opengl_available() -> bool:
     """True if Qt can create an OpenGL context on this platform."""
     if QtGui.QGuiApplication.platformName() in ("offscreen", "minimal", "vnc", "linuxfb"):
@@ -121,12 +126,8 @@ class OffscreenViewport(QtWidgets.QWidget):
 
     def mouseReleaseEvent(self, event):  # noqa: N802
         pos = event.position()
-        if (
-            self._press_pos is not None
-            and event.button() == QtCore.Qt.MouseButton.LeftButton
-            and abs(pos.x() - self._press_pos[0]) <= CLICK_SLOP
-            and abs(pos.y() - self._press_pos[1]) <= CLICK_SLOP
-        ):
+        left = event.button() == QtCore.Qt.MouseButton.LeftButton
+        if left and _is_click(self._press_pos, pos.x(), pos.y()):
             self.clicked.emit(pos.x(), self.height() - 1 - pos.y())
         self._press_pos = self._last = None
 
@@ -177,10 +178,7 @@ class InteractorViewport(QtCore.QObject):
 
     def _on_release(self, _obj, _event):
         pos = self._event_position()
-        if (
-            self._press is not None
-            and max(abs(pos[0] - self._press[0]), abs(pos[1] - self._press[1])) <= CLICK_SLOP
-        ):
+        if _is_click(self._press, pos[0], pos[1]):
             self.clicked.emit(float(pos[0]), float(pos[1]))
         self._press = None
 

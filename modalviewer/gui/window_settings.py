@@ -65,9 +65,7 @@ def _read(s, key: str, default, kind):
 def restore(win) -> None:
     s = win.settings
     geometry = s.value("window/geometry") if win.remember_settings else None
-    if geometry is not None:
-        win.restoreGeometry(geometry)
-    else:
+    if geometry is None or not win.restoreGeometry(geometry):  # none, or not readable
         win.resize(1280, 820)
     state = s.value("window/state") if win.remember_settings else None
     if state is not None:

@@ -4,12 +4,7 @@ from __future__ import annotations
 
 from qtpy import QtCore, QtGui, QtWidgets
 
-from ...core.operators import (
-    DISTANCE_KINDS,
-    OPERATOR_INFO,
-    operator_for_distance,
-    signature_kind,
-)
+from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ...viewer.state import DISTANCE_DISPLAYS, ViewerState
 from ..plots import LinePlot
 from .common import (
@@ -228,7 +223,7 @@ class DistancesPanel(QtWidgets.QWidget):
 
     def _update_scale_words(self) -> None:
         """A wave kernel's scales are energies E, the others' times t."""
-        wave = signature_kind(self.state.display.distance_kind) == "wks"
+        wave = self.state.derived.wave()
         form = self.layout()
         for edit, word in ((self.t1_edit, "1"), (self.t2_edit, "2"), (self.scale_row, "")):
             label = form.labelForField(edit)
@@ -250,17 +245,13 @@ class DistancesPanel(QtWidgets.QWidget):
 
     def _update_range_placeholders(self) -> None:
         operator = operator_for_distance(self.state.display.distance_kind)
-        if not self.state.derived.has_signatures(operator):
-            self.t1_edit.setPlaceholderText("default")
-            self.t2_edit.setPlaceholderText("default")
-            return
-        table = self.state.derived.kind_table()
-        self.t1_edit.setPlaceholderText(f"default {table.times[0]:.4g}")
-        self.t2_edit.setPlaceholderText(f"default {table.times[-1]:.4g}")
-        if self.state.t_range is None:
-            with quiet(self.t1_edit, self.t2_edit):
-                self.t1_edit.clear()
-                self.t2_edit.clear()
+        shown = self.state.derived.has_signatures(operator)
+        times = self.state.derived.kind_table().times[[0, -1]] if shown else (None, None)
+        for edit, t in zip((self.t1_edit, self.t2_edit), times, strict=True):
+            edit.setPlaceholderText("default" if t is None else f"default {t:.4g}")
+            if shown and self.state.t_range is None:
+                with quiet(edit):
+                    edit.clear()
 
     def _update_signature_plot(self) -> None:
         state = self.state
