@@ -1,17 +1,32 @@
-"""``compute_spectrum``: operator assembly plus eigensolver, with progress and cancel."""
+"""``compute_spectrum``: operator assembly plus eigensolver, with progress and cancel;
+:func:`exact_pairs` finds the pairs, ``compute_spectrum`` checks their residuals and
+wraps them in a :class:`.spectrum.Spectrum`."""
 
 from __future__ import annotations
 
 import time
 import warnings
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
-from .eigen import CancelFn, EigenError, ProgressFn, progress_reporter, rounding_floors
-from .exact import exact_pairs
+from .assembly import operator_matrices
+from .eigen import (
+    CancelFn,
+    EigenError,
+    EigenResult,
+    ProgressFn,
+    progress_reporter,
+    rounding_floors,
+    solve_lowest,
+    typical_eigenvalue,
+    zero_modes,
+)
 from .memory import return_freed_memory
 from .mesh import Mesh
+from .nullspace import NullSpace, null_space
 from .operators import DEFAULT_K, OperatorInfo, OperatorLike, operator_info
 from .spectrum import GrowingSpectrum, Spectrum, in_input_numbering
 from .validate import check_count
@@ -169,6 +184,49 @@ def compute_spectrum(
     return spectrum
 
 
+@dataclass(frozen=True)
+class ExactPairs:
+    """What :func:`exact_pairs` computed for ``K phi = lambda diag(mass) phi``."""
+
+    K: sp.csr_matrix
+    mass: np.ndarray
+    nulls: NullSpace  # the operator's exact null vectors on the mesh (first in result)
+    result: EigenResult  # the k lowest pairs (k capped at the number of unknowns)
+    zero_mode_scale: float  # the typical eigenvalue zero modes are measured against
+    nonzero: np.ndarray  # (k,) bool, the pairs that are not zero modes
+    seconds_assembly: float
+
+
+def exact_pairs(
+    mesh: Mesh,
+    operator: OperatorInfo,
+    k: int,
+    bending: float = 1.0,
+    membrane: float = 1.0,
+    progress: ProgressFn | None = None,
+    cancel: CancelFn | None = None,
+    on_modes: _ModesSoFar | None = None,
+) -> ExactPairs:
+    """The ``min(k, unknowns)`` lowest eigenpairs of ``operator`` on ``mesh``, the exact
+    null vectors first.  ``on_modes`` is told the problem (``start``), then given the
+    pairs as they converge.  Raises what the assembly, the null space and
+    :func:`.eigen.solve_lowest` raise (:class:`.mesh.MeshError`,
+    :class:`.eigen.EigenError`, :class:`.eigen.Cancelled`)."""
+    started = time.perf_counter()
+    K, mass = operator_matrices(mesh, operator, bending, membrane)
+    seconds_assembly = time.perf_counter() - started
+    k = min(int(k), K.shape[0])
+    nulls = null_space(mesh, operator, K, mass)
+    scale = typical_eigenvalue(K, mass)
+    if on_modes is not None:
+        on_modes.start(K, mass, nulls, scale, k)
+    result = solve_lowest(
+        K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors, on_modes=on_modes
+    )
+    nonzero = ~zero_modes(result.eigenvalues, scale, result.null_dim)
+    return ExactPairs(K, mass, nulls, result, scale, nonzero, seconds_assembly)
+
+
 def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
     """(modes accepted at their rounding floor, the rounding floor of the worst mode
     above :data:`WELL_SHAPED_RESIDUAL`); an EigenError where a non-zero mode's residual
@@ -194,9 +252,9 @@ def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
 
 
 class _ModesSoFar:
-    """Collects the pairs handed over during a solve (:class:`.exact.ModeSink`) in a
-    :class:`.spectrum.GrowingSpectrum`, and gives ``on_modes`` a Spectrum of the first j
-    at each step."""
+    """Collects the pairs handed over during a solve (:func:`.eigen.solve_lowest`'s
+    ``on_modes``) in a :class:`.spectrum.GrowingSpectrum`, and gives ``on_modes`` a
+    Spectrum of the first j at each step."""
 
     def __init__(
         self, mesh: Mesh, operator: OperatorInfo, bending: float, membrane: float, on_modes

@@ -241,7 +241,6 @@ def test_rounding_floor_bounds_what_rounding_does(three_spheres):
 
 
 def test_residual_check_accepts_the_rounding_floor_and_rejects_garbage(monkeypatch):
-    import modalviewer.core.exact as exact
     import modalviewer.core.pipeline as pipeline
 
     s = icosphere(2)  # 486 unknowns: the dense solver, residuals at the rounding floor
@@ -249,7 +248,7 @@ def test_residual_check_accepts_the_rounding_floor_and_rejects_garbage(monkeypat
     monkeypatch.setattr(pipeline, "RESIDUAL_LIMIT", 1e-300)  # every mode is "above" it
     spec = mv.compute_spectrum(ellipsoid, "shells", k=30)
     assert spec.parameters["modes_at_rounding_floor"] == 24
-    real = exact.solve_lowest
+    real = pipeline.solve_lowest
 
     def spoiled(*args, **kwargs):
         result = real(*args, **kwargs)
@@ -257,7 +256,7 @@ def test_residual_check_accepts_the_rounding_floor_and_rejects_garbage(monkeypat
         result.residuals[-1] = 1e-3
         return result
 
-    monkeypatch.setattr(exact, "solve_lowest", spoiled)
+    monkeypatch.setattr(pipeline, "solve_lowest", spoiled)
     with pytest.raises(EigenError, match="above the rounding floor"):
         mv.compute_spectrum(ellipsoid, "shells", k=30)
 
