@@ -114,12 +114,6 @@ def _meshio_extensions() -> tuple[str, ...]:
     return tuple(meshio.extension_to_filetypes)
 
 
-def _fan(cells: np.ndarray) -> np.ndarray:
-    """Polygons (m, p) as triangles (m * (p - 2), 3), fanned from each first vertex."""
-    p = cells.shape[1]
-    return np.concatenate([cells[:, [0, i, i + 1]] for i in range(1, p - 1)])
-
-
 def meshio_arrays(m) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """(vertices, triangles, notes) of a ``meshio.Mesh``: its triangle cells, quads and
     polygons fanned into triangles, other cells skipped (the notes say so)."""
@@ -129,7 +123,8 @@ def meshio_arrays(m) -> tuple[np.ndarray, np.ndarray, list[str]]:
         if block.type == "triangle":
             triangles.append(data)
         elif block.type in ("quad", "polygon") or block.type.startswith("polygon"):
-            triangles.append(_fan(data))
+            fan = range(1, data.shape[1] - 1)  # from each polygon's first vertex
+            triangles.append(np.concatenate([data[:, [0, i, i + 1]] for i in fan]))
             notes.append(f"{len(data)} {block.type} cells were triangulated")
         elif block.type not in ("vertex", "line"):
             notes.append(f"{len(data)} {block.type} cells are not surface cells and were skipped")
@@ -184,11 +179,6 @@ def mesh_from_arrays(vertices, faces, source: str, repair: bool = True, notes=()
         if str(exc).startswith(source + ":"):
             raise
         raise MeshError(f"{source}: {exc}") from None
-    for note in notes:
-        mesh.report.add(_sentence(note))
+    for note in notes:  # as a sentence
+        mesh.report.add(note[0].upper() + note[1:] + ("" if note.endswith(".") else "."))
     return mesh
-
-
-def _sentence(note: str) -> str:
-    note = note[0].upper() + note[1:]
-    return note if note.endswith(".") else note + "."

@@ -34,13 +34,20 @@ def add_parsers(sub) -> None:
 def compute(args) -> int:
     import modalviewer as mv
 
-    from ..core.memory import prepare_compute_process
+    from ..coarsen import COARSE_FRACTION
+    from ..core.memory import memory_refusal, prepare_compute_process
+    from ..core.operators import operator_info
     from ..viewer.wording import memory_text, residual_text
 
     make_output_folders(("-o", args.output))
     prepare_compute_process()  # this process exists to compute (see core.memory)
     mesh = load(args.mesh, args.fix_slivers, args.partial)
-    _refuse_if_too_large(mesh, args.operator, args.k)
+    n = mesh.n_vertices  # the viewer's memory check, before the computation starts
+    refusal = memory_refusal(
+        operator_info(args.operator), args.k, n, round(COARSE_FRACTION * n), "on a decimated copy"
+    )
+    if refusal:
+        raise ValueError(refusal)
     bar, on_modes = _counting_modes(progress_bar(), args.k)
     with warnings_printed():
         spec = mv.compute_spectrum(
@@ -90,18 +97,3 @@ def _counting_modes(progress, k: int):
         progress(stage, fraction)
 
     return counted, on_modes
-
-
-def _refuse_if_too_large(mesh, operator: str, k: int) -> None:
-    """The viewer's memory check before an exact computation starts: a ValueError saying
-    what would fit where it would need more than its share of this machine's memory."""
-    from ..coarsen import COARSE_FRACTION
-    from ..core.memory import memory_refusal
-    from ..core.operators import operator_info
-
-    n = mesh.n_vertices
-    refusal = memory_refusal(
-        operator_info(operator), k, n, round(COARSE_FRACTION * n), "on a decimated copy"
-    )
-    if refusal:
-        raise ValueError(refusal)
