@@ -89,12 +89,9 @@ def mesh_names(paths: Sequence[Path]) -> list[str]:
         rel = here.relative_to(root)
         twins = sum(q.with_suffix("") == here.with_suffix("") for q in same)
         names.append("--".join(rel.parts if twins > 1 else rel.with_suffix("").parts))
-    return [_safe(n) for n in names]
-
-
-def _safe(name: str) -> str:
-    keep = "".join(c if c.isalnum() or c in "-_.+" else "_" for c in name)
-    return keep.lstrip(".") or "mesh"
+    # safe file names: letters, digits and -_.+ kept, others "_", no leading dot
+    safe = ["".join(c if c.isalnum() or c in "-_.+" else "_" for c in n) for n in names]
+    return [name.lstrip(".") or "mesh" for name in safe]
 
 
 def _parameters(operator, k, signatures, bending, membrane) -> dict:

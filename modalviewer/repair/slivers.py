@@ -156,8 +156,18 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         slivers_before=int((q0 < SLIVER_QUALITY).sum()),
         worst_quality_before=float(q0.min()),
     )
-    if report.below_min_quality_before == 0:
-        return _unchanged(mesh, report, started)
+    if report.below_min_quality_before == 0:  # the mesh as it is
+        report.triangles_after = mesh.n_faces
+        report.worst_quality_after = report.worst_quality_before
+        report.seconds = time.perf_counter() - started
+        report.add(
+            f"No triangle has quality below {min_quality:g} (worst "
+            f"{report.worst_quality_before:.3g}); nothing was changed."
+        )
+        return Mesh(
+            mesh.vertices, mesh.faces, report=report, file_map=mesh.file_map,
+            merged_into=mesh.merged_into,
+        )  # fmt: skip
     try:
         import pymeshlab
     except ImportError:
@@ -199,23 +209,6 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     )
     report.messages.insert(0, _summary(report, method == "remesh"))
     return result
-
-
-def _unchanged(mesh: Mesh, report: SliverReport, started: float) -> Mesh:
-    """The mesh as it is, with a report that says no triangle is below the quality."""
-    out = Mesh(
-        mesh.vertices, mesh.faces, report=report, file_map=mesh.file_map,
-        merged_into=mesh.merged_into,
-    )  # fmt: skip
-    report.triangles_after = mesh.n_faces
-    report.below_min_quality_after = 0
-    report.worst_quality_after = report.worst_quality_before
-    report.seconds = time.perf_counter() - started
-    report.add(
-        f"No triangle has quality below {report.min_quality:g} (worst "
-        f"{report.worst_quality_before:.3g}); nothing was changed."
-    )
-    return out
 
 
 def _first_repair(mesh: Mesh, report: SliverReport, min_quality: float, progress):
