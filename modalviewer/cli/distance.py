@@ -113,7 +113,7 @@ def distance(args) -> int:
     d = mv.multiscale_distance(spec, vertex, kind=signature_kind(args.kind))
     marked = _threshold(args, mesh, d)
     if args.csv:
-        _write_csv(args.csv, mesh, d, f"{args.kind} distance from vertex {args.vertex}")
+        _write_csv(args, mesh, d)
     if args.output:
         viewer = viewer_of(mesh, args.mesh)
         viewer.add_spectrum(spec)
@@ -131,10 +131,7 @@ def distance(args) -> int:
         + ", ".join(f"{mesh.file_vertex(i)} ({d[i]:.3g})" for i in order)
     )
     if marked is not None:
-        print(
-            f"threshold {marked[0]:.6g} ({marked[0] / d.max():.3g} of the largest distance): "
-            f"{100 * marked[1]:.2f} % of the surface's area is at most that far"
-        )
+        print(f"{_threshold_text(marked, d)} the surface's area is at most that far")
     return 0
 
 
@@ -155,6 +152,12 @@ def _threshold(args, mesh, d: np.ndarray) -> tuple[float, float] | None:
     return value, state.derived.surface_share(d, value)
 
 
+def _threshold_text(marked: tuple[float, float], d: np.ndarray) -> str:
+    value, share = marked
+    fraction = value / d.max()
+    return f"threshold {value:.6g} ({fraction:.3g} of the largest distance): {100 * share:.2f} % of"
+
+
 def _mesh_vertex(mesh, number: int) -> int:
     """The mesh vertex of ``--vertex number`` (the file's numbering)."""
     from ..core.mesh import MeshError
@@ -165,17 +168,19 @@ def _mesh_vertex(mesh, number: int) -> int:
         raise BadArgument(f"--vertex {number}: {exc}") from None
 
 
-def _write_csv(path, mesh, d: np.ndarray, what: str) -> None:
-    """Rows ``vertex,distance``, one per vertex of ``mesh``'s file in the file's numbering;
-    the distance is empty at a file vertex no face uses (merged duplicates share theirs)."""
+def _write_csv(args, mesh, d: np.ndarray, to: str = "") -> None:
+    """``--csv``: rows ``vertex,distance``, one per vertex of ``mesh``'s file in the file's
+    numbering; the distance is empty at a file vertex no face uses (merged duplicates
+    share theirs)."""
     values = mesh.to_file_field(d)
-    with open(path, "w", encoding="utf-8") as fh:
+    with open(args.csv, "w", encoding="utf-8") as fh:
         fh.write("vertex,distance\n")
         for i, x in enumerate(values.tolist()):
             fh.write(f"{i},{x:.10g}\n" if x == x else f"{i},\n")
     unused = int(np.isnan(values).sum())
     note = f", {unused} empty (vertices no face uses)" if unused else ""
-    wrote(path, f"CSV, {len(values)} rows vertex,distance{note}: {what}")
+    what = f"{args.kind} distance from vertex {args.vertex}{to}"
+    wrote(args.csv, f"CSV, {len(values)} rows vertex,distance{note}: {what}")
 
 
 def _cached_spectrum(mesh, operator: str, k: int):
@@ -199,8 +204,9 @@ def _distance_to(args, mesh_a) -> int:
             "--up and --view apply to one mesh's picture; with --to each mesh is shown "
             "from its first view, turned to face the picked vertex and its best match"
         )
-    mesh_b = load(args.to, args.fix_slivers, args.partial)
-    mesh_b = mesh_b.solver_mesh  # as mesh_a: the vertices faces use, with the file's numbers
+    # as mesh_a: the vertices faces use, with the file's numbers
+    mesh_b = load(args.to, args.fix_slivers, args.partial).solver_mesh
+    name_a, name_b = Path(args.mesh).name, Path(args.to).name
     if args.rescale:
         mesh_a, mesh_b = mv.rescale_to_area(mesh_a), mv.rescale_to_area(mesh_b)
     operator = operator_for_distance(args.kind)
@@ -226,27 +232,17 @@ def _distance_to(args, mesh_a) -> int:
     best, back = mesh_b.file_vertex(best_mesh), mesh_a.file_vertex(back_mesh)
     marked = _threshold(args, mesh_b, d)
     if args.csv:
-        _write_csv(
-            args.csv,
-            mesh_b,
-            d,
-            f"{args.kind} distance from vertex {args.vertex} of A to B's vertices",
-        )
+        _write_csv(args, mesh_b, d, " of A to B's vertices")
     if args.output:
         from ..cross_figure import Panel, render_panels
 
         label = distance_word(args.kind)
         display = "continuous" if marked is None else "threshold"
         panels = [
-            Panel(
-                mesh_a,
-                f"{Path(args.mesh).name}: vertex {args.vertex}",
-                vertex,
-                face_marker=True,
-            ),
+            Panel(mesh_a, f"{name_a}: vertex {args.vertex}", vertex, face_marker=True),
             Panel(
                 mesh_b,
-                f"{Path(args.to).name}: {label} distance, best match {best}",
+                f"{name_b}: {label} distance, best match {best}",
                 marker=best_mesh,
                 distances=d,
                 display=display,
@@ -256,14 +252,12 @@ def _distance_to(args, mesh_a) -> int:
             ),
         ]
         render_panels(panels, args.output, (max(16, args.size[0] // 2), args.size[1]))
-        wrote(
-            args.output,
-            f"{picture_text(args.output)}, vertex {args.vertex} of A, {args.kind} distance on B",
-        )
+        what = f"vertex {args.vertex} of A, {args.kind} distance on B"
+        wrote(args.output, f"{picture_text(args.output)}, {what}")
     order = np.argsort(d, kind="stable")[:5]
     print(
-        f"{args.kind} distance from vertex {args.vertex} of {Path(args.mesh).name} to "
-        f"{Path(args.to).name} (scales {tables.times[0]:.4g} .. {tables.times[-1]:.4g}): "
+        f"{args.kind} distance from vertex {args.vertex} of {name_a} to {name_b} (scales "
+        f"{tables.times[0]:.4g} .. {tables.times[-1]:.4g}): "
         f"max {d.max():.6g}; best match {best} ({d[best_mesh]:.3g}), "
         + ("mutual" if back_mesh == vertex else f"not mutual (its best match on A is {back})")
         + "; nearest "
@@ -272,8 +266,7 @@ def _distance_to(args, mesh_a) -> int:
     if marked is not None:
         # between two meshes even the best match is at a distance above zero
         print(
-            f"threshold {marked[0]:.6g} ({marked[0] / d.max():.3g} of the largest distance): "
-            f"{100 * marked[1]:.2f} % of {Path(args.to).name}'s area is at most that far (the "
-            f"best match is at {d[best_mesh] / d.max():.3g} of the largest)"
+            f"{_threshold_text(marked, d)} {name_b}'s area is at most that far (the best "
+            f"match is at {d[best_mesh] / d.max():.3g} of the largest)"
         )
     return 0
