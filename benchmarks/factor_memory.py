@@ -7,7 +7,7 @@ seconds).
 For each operator, ``K - shift M`` (the solver's shift) of the bumpy plate on n x n
 grids (102k, 336k and 1M vertices by default) and of Loop-subdivided bundled meshes
 (:mod:`benchmarks.curved`'s cases) goes through
-:func:`modalviewer.core.factor.factor_memory_mb`.  The plates' sizes are fitted as
+:func:`factor_memory_mb`.  The plates' sizes are fitted as
 power laws of the vertex count (MB at 100k vertices and exponent, in core and out of
 core): the laws the memory check uses for a factor that goes out of core
 (:meth:`modalviewer.core.operators.OperatorInfo.predicted_peak_mb`); the curved rows say
@@ -28,12 +28,27 @@ from benchmarks.growth import fit_growth  # noqa: E402
 from benchmarks.run import save_result  # noqa: E402
 
 
+def factor_memory_mb(A) -> tuple[float, float]:
+    """(in core, out of core): the memory (MB) PARDISO's factorisation of A needs, from
+    its analysis alone (no numerical factorisation)."""
+    import scipy.sparse as sp
+
+    from modalviewer.core.factor import _load_mkl, _Pardiso
+
+    if _load_mkl() is None:
+        raise SystemExit("these sizes come from PARDISO's analysis: install the mkl wheel")
+    analysis = _Pardiso(sp.csr_matrix(A), _load_mkl(), factorise=False)
+    try:
+        return analysis.in_core_mb, analysis.out_of_core_mb
+    finally:
+        analysis.release()
+
+
 def _sizes(mesh, operator: str) -> dict:
     import scipy.sparse as sp
 
     from modalviewer.core.assembly import operator_matrices
     from modalviewer.core.eigen import SHIFT_RTOL, typical_eigenvalue
-    from modalviewer.core.factor import factor_memory_mb
 
     K, mass = operator_matrices(mesh, operator)
     shift = -SHIFT_RTOL * typical_eigenvalue(K, mass)

@@ -150,8 +150,6 @@ class _Pardiso:
     The analysis (phase 11) tells the factor's in-core size (``in_core_mb``); above
     ``memory_budget_mb``, where out of core needs less, phase 22 writes it to a file."""
 
-    MTYPE = 2
-
     def __init__(
         self,
         A: sp.csr_matrix,
@@ -164,10 +162,9 @@ class _Pardiso:
         U.sum_duplicates()
         U.sort_indices()
         self.n = U.shape[0]
-        self.dtype = np.dtype(np.float64)
         self._ia = U.indptr.astype(np.int32)
         self._ja = U.indices.astype(np.int32)
-        self._a = np.ascontiguousarray(U.data, dtype=self.dtype)
+        self._a = np.ascontiguousarray(U.data, dtype=np.float64)
         self._pt = np.zeros(64, dtype=np.int64)
         ip = np.zeros(64, dtype=np.int32)
         ip[0] = 1  # no solver defaults: the values below
@@ -185,7 +182,7 @@ class _Pardiso:
         self._alive = True
         self._folder: str | None = None
         self.out_of_core = False
-        dummy = np.zeros((self.n, 1), dtype=self.dtype, order="F")
+        dummy = np.zeros((self.n, 1), dtype=np.float64, order="F")
         error, _ = self._call(11, dummy)
         if error != 0:
             self.release()
@@ -258,7 +255,7 @@ class _Pardiso:
             ptr(self._pt, ctypes.c_int64),
             ctypes.byref(i32(1)),
             ctypes.byref(i32(1)),
-            ctypes.byref(i32(self.MTYPE)),
+            ctypes.byref(i32(2)),  # mtype 2
             ctypes.byref(i32(phase)),
             ctypes.byref(i32(self.n)),
             ptr(self._a, ctypes.c_double),
@@ -276,7 +273,7 @@ class _Pardiso:
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         one = b.ndim == 1
-        B = np.asfortranarray(b.reshape(self.n, -1), dtype=self.dtype)
+        B = np.asfortranarray(b.reshape(self.n, -1), dtype=np.float64)
         # out of core, PARDISO's parallel substitution reads the factor file many times
         # slower than one thread does (benchmarks/out_of_core_threads.py)
         with _one_mkl_thread(self._lib) if self.out_of_core else nullcontext():
@@ -288,7 +285,7 @@ class _Pardiso:
     def release(self) -> None:
         if self._alive:
             self._alive = False
-            self._call(-1, np.zeros((self.n, 1), dtype=self.dtype, order="F"))
+            self._call(-1, np.zeros((self.n, 1), dtype=np.float64, order="F"))
         if self._folder is not None:
             self._remove_folder()
             self._folder = None
@@ -298,18 +295,6 @@ class _Pardiso:
             self.release()
         except Exception:  # pragma: no cover - interpreter shutdown
             pass
-
-
-def factor_memory_mb(A: sp.spmatrix) -> tuple[float, float] | None:
-    """(in core, out of core): the memory (MB) PARDISO's factorisation of A needs, from
-    its analysis alone (no numerical factorisation); None without PARDISO."""
-    if "pardiso" not in available_backends():
-        return None
-    analysis = _Pardiso(sp.csr_matrix(A), _load_mkl(), factorise=False)
-    try:
-        return analysis.in_core_mb, analysis.out_of_core_mb
-    finally:
-        analysis.release()
 
 
 class SPDSolver:
@@ -327,7 +312,6 @@ class SPDSolver:
         memory_budget_mb: float | None = None,
     ):
         A = sp.csr_matrix(A)
-        self.n = A.shape[0]
         names = available_backends()
         if backend == "auto":
             backend = names[0]
@@ -346,7 +330,7 @@ class SPDSolver:
             coo = A.tocoo()
             try:
                 self._chol = cholespy.CholeskySolverD(
-                    self.n,
+                    A.shape[0],
                     coo.row.astype(np.int32),
                     coo.col.astype(np.int32),
                     np.ascontiguousarray(coo.data, dtype=np.float64),
