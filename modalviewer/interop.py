@@ -1,10 +1,6 @@
-"""Meshes in from other libraries, matrices and point data out.
-
-:func:`as_mesh` (arrays, trimesh, pyvista, meshio objects, repaired and reported as
-:func:`~modalviewer.io.load_mesh` does), :func:`operator_matrices` (an operator's sparse
-``(K, M)``) and :func:`to_pyvista` (modes and fields as point arrays).  No module-level
-import of trimesh, pyvista or meshio: objects are recognised by their type's module.
-"""
+"""Meshes in from other libraries (:func:`as_mesh`), an operator's matrices
+(:func:`operator_matrices`) and point data (:func:`to_pyvista`) out.  trimesh, pyvista
+and meshio objects are recognised by their type's module, without importing them."""
 
 from __future__ import annotations
 

@@ -1,11 +1,7 @@
-"""Reading meshes from files, with repair and a report (OBJ, PLY, STL, OFF, VTK, VTP,
-and whatever meshio reads).
-
-OBJ, PLY, STL and OFF go through the strict :mod:`modalviewer.readers`; VTK and VTP
-through pyvista, imported only then (``import modalviewer`` stays free of VTK); every
-other extension of ``meshio.extension_to_filetypes`` through meshio where it is
-installed (the ``meshio`` extra), triangles kept and quads and polygons triangulated.
-"""
+"""Reading meshes from files, with repair and a report.  OBJ, PLY, STL and OFF go
+through the strict :mod:`modalviewer.readers`; VTK and VTP through pyvista, imported only
+then (``import modalviewer`` stays free of VTK); every other extension meshio reads
+through meshio where it is installed (the ``meshio`` extra)."""
 
 from __future__ import annotations
 

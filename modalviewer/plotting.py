@@ -1,12 +1,7 @@
-"""Pictures in scripts and notebooks: :func:`plot`, :func:`view`, :func:`add_to_plotter`.
-
-:func:`plot` draws what the viewer would show with the renderer of ``modalviewer
-render`` (a :class:`~modalviewer.viewer.Viewer` and its off-screen renderer: same
-colours, isolines, legend, colour bar and first camera) and returns a :class:`Picture`,
-which Jupyter shows inline.  :func:`view` opens the desktop viewer on in-memory data.
-:func:`add_to_plotter` adds a mode or a distance map, in the viewer's colours, to a
-``pyvista.Plotter`` of one's own.  All import pyvista (and :func:`view` Qt) when called.
-"""
+"""Pictures in scripts and notebooks: :func:`plot` (the viewer's picture, drawn off screen
+by ``modalviewer render``'s renderer), :func:`view` (the desktop viewer on in-memory
+data) and :func:`add_to_plotter` (a ``pyvista.Plotter`` of one's own); each imports
+pyvista (and :func:`view` Qt) when called."""
 
 from __future__ import annotations
 

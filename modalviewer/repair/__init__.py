@@ -1,10 +1,6 @@
-"""Mesh repairs: what exists, what each needs, and how to apply one.
-
-The one place the viewer, the command line and the child processes learn which repairs
-there are: :func:`fix_slivers` (needle and cap triangles) and ``largest_component``
-(:mod:`modalviewer.core.components`).  The repairs every file gets on loading are
-:func:`modalviewer.core.cleaning.repair_mesh`'s.
-"""
+"""Mesh repairs: which there are (:data:`REPAIRS`), what each needs and how to apply one,
+for the viewer, the command line and the child processes.  The repairs every file gets
+on loading are :func:`modalviewer.core.cleaning.repair_mesh`'s."""
 
 from __future__ import annotations
 
