@@ -58,17 +58,20 @@ meshes; such spectra are accepted and carry their residuals (the viewer shows th
 largest)."""
 
 
-def sliver_report(mesh: Mesh, threshold: float = 1e-3) -> str:
-    """Words on nearly degenerate triangles (quality 4 sqrt(3) area / sum of squared edge
-    lengths below ``threshold``; 1 is equilateral), or "" if there are none."""
+def sliver_hint(mesh: Mesh, threshold: float = 1e-3) -> str:
+    """What the mesh's nearly degenerate triangles (quality 4 sqrt(3) area / sum of
+    squared edge lengths below ``threshold``; 1 is equilateral) may have to do with a
+    failed solve, or "" if there are none (no advice that may be wrong for the case: the
+    exactly known null vectors are already deflated)."""
     quality = mesh.face_quality
     bad = np.flatnonzero(quality < threshold)
     if bad.size == 0:
         return ""
     worst = int(bad[np.argmin(quality[bad])])
     return (
-        f"{bad.size} nearly degenerate triangles (quality below {threshold:g}; the worst, "
-        f"face {worst}, {quality[worst]:.1e})"
+        f"; the mesh has {bad.size} nearly degenerate triangles (quality below "
+        f"{threshold:g}; the worst, face {worst}, {quality[worst]:.1e}), which make the "
+        "operator ill-conditioned: remesh it (or clean those triangles) and try again"
     )
 
 
@@ -137,7 +140,7 @@ def compute_spectrum(
         )
         pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel, sink)
     except EigenError as exc:
-        raise EigenError(f"{exc}{_failure_hint(mesh)}") from None
+        raise EigenError(f"{exc}{sliver_hint(mesh)}") from None
     result, nulls = pairs.result, pairs.nulls
     if not pairs.nonzero.any():
         warnings.warn(
@@ -246,7 +249,7 @@ def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
         raise EigenError(
             f"the eigensolver's residual {float(residuals[bad].max()):.1e} is above "
             f"{RESIDUAL_LIMIT:.0e} and above the rounding floor; the result is not "
-            f"trustworthy{_failure_hint(mesh)}"
+            f"trustworthy{sliver_hint(mesh)}"
         )
     return int(above.size), worst_floor
 
@@ -338,15 +341,3 @@ def _all_zero_message(k: int, result, nulls, lam_typical: float) -> str:
         head + " The mesh is made of separate pieces or is damaged, or k is not larger than "
         "the null space's dimension." + advice
     )
-
-
-def _failure_hint(mesh: Mesh) -> str:
-    """What the mesh may have to do with a failed solve, or "" (no advice that may be
-    wrong for the case: the exactly known null vectors are already deflated)."""
-    slivers = sliver_report(mesh)
-    if slivers:
-        return (
-            f"; the mesh has {slivers}, which make the operator ill-conditioned: remesh "
-            "it (or clean those triangles) and try again"
-        )
-    return ""

@@ -144,18 +144,18 @@ def test_bad_input_corpus(tmp_path):
 
 
 def test_slivers_are_named_when_they_spoil_a_spectrum():
-    from modalviewer.core.pipeline import sliver_report
+    from modalviewer.core.pipeline import sliver_hint
     from modalviewer.core.primitives import grid_plate
 
     plate = grid_plate(12, 12)
-    assert sliver_report(plate) == ""
+    assert sliver_hint(plate) == ""
     v = plate.vertices.copy()
     # squash one row of vertices onto its neighbour: a strip of needle triangles
     ys = np.unique(np.round(v[:, 1], 12))
     row = np.isclose(v[:, 1], ys[1])
     assert row.sum() >= 12
     v[row, 1] = ys[0] + 1e-9 * (ys[1] - ys[0])
-    text = sliver_report(mv.Mesh(v, plate.faces))
+    text = sliver_hint(mv.Mesh(v, plate.faces))
     assert "nearly degenerate triangles" in text and "face" in text
 
 
