@@ -282,7 +282,13 @@ def block_krylov_schur(
     rng = np.random.default_rng(seed)
     timer = timer or StageTimer()
     b = block
-    Q = _start_basis(N, b, max_basis, rng, project, basis)
+    Q = np.empty((N, max_basis + b)) if basis is None else basis
+    if Q.shape != (N, max_basis + b):
+        raise ValueError(f"the basis array must be ({N}, {max_basis + b}), not {Q.shape}")
+    start = rng.standard_normal((N, b))  # an orthonormal random start block
+    if project is not None:
+        start = project(start)
+    Q[:, :b] = np.linalg.qr(start)[0]
     T = np.zeros((max_basis, max_basis))
     j = 0  # closed columns: OP already applied
     sequence_start = 0  # j of the first block after the last (re)start
@@ -341,22 +347,15 @@ def block_krylov_schur(
                 columns=applied,
             )
         restarts += 1
+        # thick restart: the p best Ritz vectors (T their Ritz values), then the open block
+        p = min(keep, j - b)
         with timer("restarts"):
-            R, j = _thick_restart(Q, T, R, theta, S, j, min(keep, j - b), b)
+            rotate_in_place(Q, j, S[:, :p])
+            Q[:, p : p + b] = Q[:, j : j + b]
+            T[:] = 0.0
+            T[np.arange(p), np.arange(p)] = theta[:p]
+            R, j = R @ S[:, :p], p
         sequence_start = j
-
-
-def _start_basis(N, b, max_basis, rng, project, basis) -> np.ndarray:
-    """The basis array (``basis``, or a new float64 one) with an orthonormal random start
-    block (projected by ``project``) in its first ``b`` columns."""
-    Q = np.empty((N, max_basis + b)) if basis is None else basis
-    if Q.shape != (N, max_basis + b):
-        raise ValueError(f"the basis array must be ({N}, {max_basis + b}), not {Q.shape}")
-    start = rng.standard_normal((N, b))
-    if project is not None:
-        start = project(start)
-    Q[:, :b] = np.linalg.qr(start)[0]
-    return Q
 
 
 def _hand_over(Q, j, theta, S, handed: int, ready: int, timer, on_converged) -> int:
@@ -383,13 +382,3 @@ def _ritz_pairs(T, R, j: int, wanted: int, keep: int, tol: float):
     converged = estimates[:wanted] <= np.maximum(tol * np.abs(theta[:wanted]), floor)
     done = int(np.argmin(converged)) if not converged.all() else wanted
     return theta, S, estimates, done
-
-
-def _thick_restart(Q, T, R, theta, S, j: int, p: int, b: int):
-    """Keep the p best Ritz vectors (rotated into ``Q[:, :p]``, ``T`` their Ritz values)
-    and continue from the open block; returns the new (R, j = p)."""
-    rotate_in_place(Q, j, S[:, :p])
-    Q[:, p : p + b] = Q[:, j : j + b]
-    T[:] = 0.0
-    T[np.arange(p), np.arange(p)] = theta[:p]
-    return R @ S[:, :p], p
