@@ -16,30 +16,6 @@ from .extras import extra_needed
 from .io import load_mesh, mesh_from_arrays, meshio_arrays, pyvista_arrays
 
 
-def arrays_of(obj) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """(vertices, triangles, notes) of any object :func:`as_mesh` accepts."""
-    if isinstance(obj, Mesh):
-        return obj.vertices, obj.faces, []
-    module = type(obj).__module__.split(".")[0]  # recognised without importing the library
-    if module == "trimesh":
-        return np.asarray(obj.vertices, np.float64), np.asarray(obj.faces, np.int64), []
-    if module == "pyvista" or module == "vtkmodules":
-        with extra_needed("as_mesh of a VTK object"):
-            if module == "vtkmodules":
-                import pyvista as pv
-
-                obj = pv.wrap(obj)
-            return pyvista_arrays(obj)
-    if module == "meshio":
-        return meshio_arrays(obj)
-    if isinstance(obj, (tuple, list)) and len(obj) == 2:
-        return np.asarray(obj[0]), np.asarray(obj[1]), []
-    raise TypeError(
-        "as_mesh takes a Mesh, a file, a (vertices, faces) pair of arrays, a trimesh.Trimesh, a "
-        f"pyvista.PolyData or a meshio.Mesh, not {type(obj).__name__}"
-    )
-
-
 def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
     """A :class:`Mesh` from arrays or another library's mesh object.
 
@@ -56,7 +32,24 @@ def as_mesh(obj, repair: bool = True, name: str = "") -> Mesh:
         return obj
     if isinstance(obj, (str, os.PathLike)):
         return load_mesh(obj, repair=repair)
-    vertices, faces, notes = arrays_of(obj)
+    module = type(obj).__module__.split(".")[0]  # recognised without importing the library
+    notes = []
+    if module == "trimesh":
+        vertices, faces = np.asarray(obj.vertices, np.float64), np.asarray(obj.faces, np.int64)
+    elif module in ("pyvista", "vtkmodules"):
+        with extra_needed("as_mesh of a VTK object"):
+            import pyvista as pv
+
+            vertices, faces, notes = pyvista_arrays(pv.wrap(obj))
+    elif module == "meshio":
+        vertices, faces, notes = meshio_arrays(obj)
+    elif isinstance(obj, (tuple, list)) and len(obj) == 2:
+        vertices, faces = np.asarray(obj[0]), np.asarray(obj[1])
+    else:
+        raise TypeError(
+            "as_mesh takes a Mesh, a file, a (vertices, faces) pair of arrays, a "
+            f"trimesh.Trimesh, a pyvista.PolyData or a meshio.Mesh, not {type(obj).__name__}"
+        )
     source = name or ("arrays" if isinstance(obj, (tuple, list)) else type(obj).__name__)
     return mesh_from_arrays(vertices, faces, source, repair=repair, notes=notes)
 

@@ -29,10 +29,6 @@ HISTOGRAM_SCALES = 8
 """How many of the standard scales (evenly among them) the histograms are taken at."""
 
 
-STORE_PARAMETERS = ("operator", "k", "bending", "membrane", "signatures")
-"""The parameters ``collection.json`` holds: one set per store."""
-
-
 class CollectionError(ValueError):
     """A store that cannot be read or written, or a mesh it does not hold."""
 
@@ -141,8 +137,8 @@ def prepare_store(store: Path, parameters: dict) -> None:
     (store / "meshes").mkdir(parents=True, exist_ok=True)
     (store / "errors").mkdir(exist_ok=True)
     header = store / "collection.json"
-    info = {"format": STORE_FORMAT, "version": STORE_VERSION}
-    info.update((key, parameters[key]) for key in STORE_PARAMETERS)
+    info = {"format": STORE_FORMAT, "version": STORE_VERSION}  # one set of parameters
+    info |= {key: parameters[key] for key in ("operator", "k", "bending", "membrane", "signatures")}
     if header.exists():
         old = read_json(header) or {}
         if old.get("format") != STORE_FORMAT:
