@@ -124,8 +124,6 @@ class Viewer(ViewerModel, Pictures):
     def _on_repaired(self, job: Job) -> None:
         if job.status == DONE:
             self._status(str(job.result.report), 20000)
-        elif job.status == FAILED:
-            self.report_error(f"{job.description} failed: {job.error}", "Repair failed")
 
     def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
         """Fix the mesh's slivers and request again the spectrum ``key`` (default: the
@@ -147,7 +145,6 @@ class Viewer(ViewerModel, Pictures):
         retried: list[SpectrumJob] = []
 
         def retry(j: Job) -> None:
-            # a failed repair is reported as any failed job (_on_job_finished)
             if j.status != DONE or self.state.mesh is not j.result:
                 return  # failed, cancelled, or another mesh was opened meanwhile
             self.sliver_failure = None
@@ -332,8 +329,8 @@ class Viewer(ViewerModel, Pictures):
             # every failure's message is logged once below, as the user is told it
             mesh = self.state.mesh
             if isinstance(job, RepairJob):
-                return  # reported by its own callback (_on_repaired)
-            if (
+                self.report_error(f"{job.description} failed: {job.error}", "Repair failed")
+            elif (
                 isinstance(job, SpectrumJob)
                 and mesh is not None
                 and job.owner == mesh.hash

@@ -93,3 +93,26 @@ print(job.status, spec.k)
     )
     assert run.returncode == 0, run.stderr[-1000:]
     assert run.stdout.split() == ["done", "20"]
+
+
+def test_a_failed_sliver_repair_before_a_retry_is_reported(tmp_path, monkeypatch):
+    """The repair fix_slivers_and_retry starts tells the user when it fails, as
+    repair_mesh's does (its failure had reached no message: the job-finished handler
+    leaves repairs to their own callback, which only repair_mesh attached)."""
+    from modalviewer.viewer import Viewer, model
+    from modalviewer.viewer.jobs import FAILED
+    from modalviewer.viewer.state import SpectrumKey
+
+    def broken(name, mesh, progress, cancel):
+        raise RuntimeError("the repair broke")
+
+    monkeypatch.setattr(model, "repair_in_process", broken)
+    viewer = Viewer(cache=SpectrumCache(tmp_path / "cache"))
+    errors = []
+    viewer.events.error.connect(lambda title, text: errors.append((title, text)))
+    viewer.set_mesh(icosphere(2))
+    job = viewer.fix_slivers_and_retry(SpectrumKey("laplacian", 8))
+    viewer.wait_for(job)
+    assert job.status == FAILED
+    assert errors == [("Repair failed", f"{job.description} failed: the repair broke")]
+    assert viewer.state.mesh.hash == icosphere(2).hash and not viewer.jobs.jobs
