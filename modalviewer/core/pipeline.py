@@ -135,10 +135,7 @@ def compute_spectrum(
     started = time.perf_counter()
     progress_reporter(progress, cancel)("assembling", 0.0)
     try:
-        sink = (
-            None if on_modes is None else _ModesSoFar(mesh, operator, bending, membrane, on_modes)
-        )
-        pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel, sink)
+        pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel, on_modes)
     except EigenError as exc:
         raise EigenError(f"{exc}{sliver_hint(mesh)}") from None
     result, nulls = pairs.result, pairs.nulls
@@ -208,11 +205,11 @@ def exact_pairs(
     membrane: float = 1.0,
     progress: ProgressFn | None = None,
     cancel: CancelFn | None = None,
-    on_modes: _ModesSoFar | None = None,
+    on_modes: Callable[[Spectrum], None] | None = None,
 ) -> ExactPairs:
     """The ``min(k, unknowns)`` lowest eigenpairs of ``operator`` on ``mesh``, the exact
-    null vectors first.  ``on_modes`` is told the problem (``start``), then given the
-    pairs as they converge.  Raises what the assembly, the null space and
+    null vectors first; ``on_modes`` as :func:`compute_spectrum`'s, for ``mesh`` itself
+    (no unused or merged vertices).  Raises what the assembly, the null space and
     :func:`.eigen.solve_lowest` raise (:class:`.mesh.MeshError`,
     :class:`.eigen.EigenError`, :class:`.eigen.Cancelled`)."""
     started = time.perf_counter()
@@ -221,10 +218,30 @@ def exact_pairs(
     k = min(int(k), K.shape[0])
     nulls = null_space(mesh, operator, K, mass)
     scale = typical_eigenvalue(K, mass)
+    relay = None
     if on_modes is not None:
-        on_modes.start(K, mass, nulls, scale, k)
+        per_vertex = operator.unknowns_per_vertex
+        modes = GrowingSpectrum(k)
+
+        def relay(eigenvalues: np.ndarray, vectors: np.ndarray) -> None:
+            """Collects the pairs solve_lowest hands over; a Spectrum of the first j."""
+            if per_vertex > 1:  # rows 3i, 3i + 1, 3i + 2 are vertex i's
+                vectors = vectors.reshape(mesh.n_vertices, per_vertex, -1)
+            modes.append(eigenvalues, vectors)
+            parameters = {
+                "k": k,
+                "bending": float(bending),
+                "membrane": float(membrane),
+                "method": "shift-invert block Krylov-Schur, converged Ritz pairs",
+                "null_space_dimension": min(nulls.dimension, modes.count),
+                "zero_mode_scale": scale,
+                "n_components": nulls.n_components,
+                "null_space": nulls.summary(),
+            }
+            on_modes(modes.so_far(operator.name, mass[::per_vertex], mesh.hash, parameters))
+
     result = solve_lowest(
-        K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors, on_modes=on_modes
+        K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors, on_modes=relay
     )
     nonzero = ~zero_modes(result.eigenvalues, scale, result.null_dim)
     return ExactPairs(K, mass, nulls, result, scale, nonzero, seconds_assembly)
@@ -252,45 +269,6 @@ def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
             f"trustworthy{sliver_hint(mesh)}"
         )
     return int(above.size), worst_floor
-
-
-class _ModesSoFar:
-    """Collects the pairs handed over during a solve (:func:`.eigen.solve_lowest`'s
-    ``on_modes``) in a :class:`.spectrum.GrowingSpectrum`, and gives ``on_modes`` a
-    Spectrum of the first j at each step."""
-
-    def __init__(
-        self, mesh: Mesh, operator: OperatorInfo, bending: float, membrane: float, on_modes
-    ):
-        self.mesh, self.operator, self.on_modes = mesh, operator.name, on_modes
-        self.weights = {"bending": float(bending), "membrane": float(membrane)}
-        self.per_vertex = operator.unknowns_per_vertex
-
-    def start(self, K, mass: np.ndarray, nulls, scale: float, k: int) -> None:
-        self.mass, self.nulls, self.scale, self.k = mass, nulls, scale, k
-        self.modes = GrowingSpectrum(k)
-
-    def __call__(self, eigenvalues: np.ndarray, vectors: np.ndarray) -> None:
-        if self.per_vertex > 1:  # rows 3i, 3i + 1, 3i + 2 are vertex i's
-            vectors = vectors.reshape(self.mesh.n_vertices, self.per_vertex, -1)
-        self.modes.append(eigenvalues, vectors)
-        j = self.modes.count
-        self.on_modes(
-            self.modes.so_far(
-                self.operator,
-                self.mass[:: self.per_vertex],
-                self.mesh.hash,
-                {
-                    "k": self.k,
-                    **self.weights,
-                    "method": "shift-invert block Krylov-Schur, converged Ritz pairs",
-                    "null_space_dimension": min(self.nulls.dimension, j),
-                    "zero_mode_scale": self.scale,
-                    "n_components": self.nulls.n_components,
-                    "null_space": self.nulls.summary(),
-                },
-            )
-        )
 
 
 def _returning_freed_memory(progress: ProgressFn | None) -> ProgressFn:
