@@ -478,7 +478,7 @@ class ViewerState:
             self.events.display.emit()
 
     def show_mode(self, index: int, operator: str | None = None) -> None:
-        op = operator or self.display.operator or self._first_computed()
+        op = operator or self.display.operator or next(iter(self.operators_computed()), None)
         self.set_display(kind="mode", operator=op, mode=index)
 
     def first_nonzero_mode(self, operator: str) -> int:
@@ -493,11 +493,7 @@ class ViewerState:
         d = self.display
         if d.operator is not None and self.spectrum(d.operator) is not None:
             return d.operator
-        return self._first_computed()
-
-    def _first_computed(self) -> str | None:
-        ops = self.operators_computed()
-        return ops[0] if ops else None
+        return next(iter(self.operators_computed()), None)
 
     @property
     def picked_file_vertex(self) -> int | None:
