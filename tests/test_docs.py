@@ -145,3 +145,12 @@ def test_docstring_entries_become_napoleon_fields():
     assert (
         docstrings.escape_bars(out)[-1] == ":returns: The spectrum, \\|K u - lambda M u\\| small."
     )
+
+
+def test_the_viewer_guide_lists_the_controls_help_shows():
+    """docs/viewer-guide.md's Controls block is Help > Controls' text, line for line."""
+    from modalviewer.gui.menus import CONTROLS
+
+    guide = (DOCS / "viewer-guide.md").read_text()
+    block = guide.split("## Controls", 1)[1].split("```", 2)[1]
+    assert block.strip("\n") == CONTROLS
