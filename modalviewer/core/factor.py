@@ -208,24 +208,20 @@ class _Pardiso:
                 error, _ = self._call(22, dummy)
             if error not in (0, -4):
                 # out of core failed (buffer too small: -2, file errors: -10, -11): in
-                # core it may still fit, and the caller must not read this as indefinite
-                self._factor_in_core_again()
+                # core it may still fit, and the caller must not read this as indefinite.
+                # A fresh handle (so phase 12); the failed one is not released (PARDISO's
+                # release can crash after error -2): its memory waits for the exit.
+                self._pt = np.zeros(64, dtype=np.int64)
+                ip[59] = 0
+                self.out_of_core = False
+                self._remove_folder()
+                self._folder = None
                 error, _ = self._call(12, dummy)
         if error != 0:
             self.release()
             if error == -4:
                 raise np.linalg.LinAlgError("matrix is not positive definite")
             raise np.linalg.LinAlgError(f"PARDISO factorisation failed (error {error})")
-
-    def _factor_in_core_again(self) -> None:
-        """Drop a failed out-of-core factorisation and its folder for a fresh in-core
-        handle (the next call must be phase 12); the failed one is not released
-        (PARDISO's release can crash after error -2): its memory waits for the exit."""
-        self._pt = np.zeros(64, dtype=np.int64)
-        self._iparm[59] = 0
-        self.out_of_core = False
-        self._remove_folder()
-        self._folder = None
 
     def _out_of_core_folder(self) -> str | None:
         """A new folder for the factor file, or None where it would not fit on the disk."""

@@ -119,16 +119,9 @@ def compute_spectrum(
     if accuracy != "exact":
         raise ValueError(f"accuracy must be 'exact', got {accuracy!r}")
     if mesh.solver_mesh is not mesh:  # unused or merged vertices: solve on the others
+        relay = None if on_modes is None else lambda part: on_modes(in_input_numbering(part, mesh))
         solved = compute_spectrum(
-            mesh.solver_mesh,
-            operator,
-            k,
-            bending,
-            membrane,
-            progress,
-            cancel,
-            accuracy,
-            None if on_modes is None else lambda so_far: on_modes(in_input_numbering(so_far, mesh)),
+            mesh.solver_mesh, operator, k, bending, membrane, progress, cancel, accuracy, relay
         )
         return in_input_numbering(solved, mesh)
     progress = _returning_freed_memory(progress)
