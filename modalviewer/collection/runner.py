@@ -11,6 +11,7 @@ import os
 import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -397,33 +398,34 @@ def import_distributed():
 
 def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, log) -> None:
     distributed = import_distributed()
-    cluster = None
-    own_client = client is None
-    if client is None and scheduler is not None:
-        client = distributed.Client(scheduler)
-    elif client is None:
-        from ..core.memory import physical_memory_mb
+    with ExitStack() as own:  # a client or cluster made here is closed here
+        if client is None and scheduler is not None:
+            client = distributed.Client(scheduler)
+            own.callback(client.close)
+        elif client is None:
+            from ..core.memory import physical_memory_mb
 
-        workers = max(1, int(workers))
-        physical = (physical_memory_mb() or 0.0) * 2**20
-        memory_limit = memory_limit or int(physical / workers) or None
-        threads = str(max(1, (os.cpu_count() or 1) // workers))
-        cluster = distributed.LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            memory_limit=memory_limit,
-            resources={"memory": memory_limit} if memory_limit else None,
-            dashboard_address=":0",
-            env={
-                name: threads
-                for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS")
-            },
-        )
-        client = distributed.Client(cluster)
-        if logging.getLogger("distributed").getEffectiveLevel() >= logging.ERROR:
-            client.run(_quiet_logs)  # the local workers follow this process's quiet log
-    try:
+            workers = max(1, int(workers))
+            physical = (physical_memory_mb() or 0.0) * 2**20
+            memory_limit = memory_limit or int(physical / workers) or None
+            threads = str(max(1, (os.cpu_count() or 1) // workers))
+            cluster = distributed.LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                memory_limit=memory_limit,
+                resources={"memory": memory_limit} if memory_limit else None,
+                dashboard_address=":0",
+                env=dict.fromkeys(
+                    ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS"), threads
+                ),
+            )
+            own.callback(cluster.close)
+            client = distributed.Client(cluster)
+            own.callback(client.close)  # first
+            quiet = logging.getLogger("distributed")
+            if quiet.getEffectiveLevel() >= logging.ERROR:  # so are the local workers' logs
+                client.run(quiet.setLevel, logging.ERROR)  # (on Ctrl+C: cancelled tasks)
         capacity = _memory_resource(client)
         if capacity is None:
             log(
@@ -432,17 +434,13 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
             )
         futures = {}
         for name, path, known in todo:
-            need = (
-                None if capacity is None else memory_estimate(vertex_count_hint(path), parameters)
-            )
+            resources = None  # a task asks for its estimated memory where workers offer it
+            if capacity is not None:
+                need = memory_estimate(vertex_count_hint(path), parameters)
+                resources = {"memory": min(need, capacity)}
+            key = f"modalviewer-mesh-{name}-{os.urandom(4).hex()}"
             future = client.submit(
-                process_mesh,
-                str(path),
-                parameters,
-                known,
-                pure=False,
-                key=f"modalviewer-mesh-{name}-{os.urandom(4).hex()}",
-                resources=None if need is None else {"memory": min(need, capacity)},
+                process_mesh, str(path), parameters, known, pure=False, key=key, resources=resources
             )
             futures[future] = (name, path)
         for future in distributed.as_completed(futures):
@@ -453,16 +451,6 @@ def _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, 
                 result = {"status": "failed", "error": _one_line(exc)}
             future.release()
             take(name, path, result)
-    finally:
-        if own_client:
-            client.close()
-        if cluster is not None:
-            cluster.close()
-
-
-def _quiet_logs() -> None:
-    """Dask's log on errors only (a worker's lines on Ctrl+C: cancelled tasks)."""
-    logging.getLogger("distributed").setLevel(logging.ERROR)
 
 
 def _memory_resource(client) -> int | None:
