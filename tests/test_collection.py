@@ -316,6 +316,24 @@ def test_import_modalviewer_loads_no_dask_and_no_qt():
     assert out.returncode == 0 and out.stdout.strip() == "[]", out.stderr
 
 
+def test_vertex_count_hints_read_the_headers_of_ply_and_off(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    sphere = primitives.icosphere(2)
+    tri = trimesh.Trimesh(sphere.vertices, sphere.faces, process=False)
+    n = sphere.n_vertices
+    for name, encoding in (("a.ply", "ascii"), ("b.ply", "binary")):
+        tri.export(tmp_path / name, encoding=encoding)
+        assert runner.vertex_count_hint(tmp_path / name) == n
+    off = tmp_path / "c.off"
+    tri.export(off)
+    off.write_text("# a comment 7 8 9\n" + off.read_text())
+    assert runner.vertex_count_hint(off) == n
+    tri.export(tmp_path / "d.stl")  # binary: two triangles per vertex on a closed surface
+    assert runner.vertex_count_hint(tmp_path / "d.stl") == len(sphere.faces) // 2
+    (tmp_path / "e.off").write_text("OFF\n")  # no counts: the file size over 40 bytes
+    assert runner.vertex_count_hint(tmp_path / "e.off") == 3
+
+
 def test_an_existing_scheduler_without_memory_resources(sources, tmp_path):
     notes = []
     with distributed.LocalCluster(

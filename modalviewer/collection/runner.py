@@ -8,6 +8,7 @@ import glob
 import json
 import logging
 import os
+import re
 import sys
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -122,32 +123,20 @@ def vertex_count_hint(path: Path) -> int:
     header of PLY and OFF, the ``v`` lines of OBJ, the triangle count of binary STL,
     else the file size over 40 bytes."""
     path = Path(path)
-    size = path.stat().st_size
-    suffix = path.suffix.lower()
+    size, suffix = path.stat().st_size, path.suffix.lower()
     try:
-        if suffix == ".ply":
-            with open(path, "rb") as fh:
-                for _ in range(50):
-                    line = fh.readline()
-                    if line.startswith(b"element vertex"):
-                        return int(line.split()[2])
-                    if line.strip() == b"end_header":
-                        break
-        elif suffix == ".off":
-            with open(path, "rb") as fh:
-                for line in fh:
-                    words = line.split(b"#")[0].split()
-                    if words and words[0].isdigit():
-                        return int(words[0])
-        elif suffix == ".obj":
-            with open(path, "rb") as fh:
-                data = fh.read()
-            return data.count(b"\nv ") + data.startswith(b"v ")
-        elif suffix == ".stl" and size > 84:
-            return max(3, (size - 84) // 50 // 2)
-    except (OSError, ValueError, IndexError):
-        pass
-    return max(3, size // 40)
+        with open(path, "rb") as fh:
+            data = fh.read() if suffix == ".obj" else fh.read(4096)
+    except OSError:
+        data = b""
+    if suffix == ".obj":
+        return data.count(b"\nv ") + data.startswith(b"v ")
+    if suffix == ".stl" and size > 84:
+        return max(3, (size - 84) // 50 // 2)
+    # PLY: its vertex element; OFF: the first line of numbers (comments removed)
+    counts = {".ply": rb"^element vertex (\d+)", ".off": rb"^\s*(\d+)\s"}
+    found = suffix in counts and re.search(counts[suffix], re.sub(rb"#.*", b"", data), re.M)
+    return int(found.group(1)) if found else max(3, size // 40)
 
 
 def memory_estimate(n_vertices: int, parameters: dict) -> int:
