@@ -150,6 +150,8 @@ class _Pardiso:
     The analysis (phase 11) tells the factor's in-core size (``in_core_mb``); above
     ``memory_budget_mb``, where out of core needs less, phase 22 writes it to a file."""
 
+    MTYPE = 2  # a subclass may factor another type (benchmarks/sliced_solver.py: -2)
+
     def __init__(
         self,
         A: sp.csr_matrix,
@@ -251,7 +253,7 @@ class _Pardiso:
             ptr(self._pt, ctypes.c_int64),
             ctypes.byref(i32(1)),
             ctypes.byref(i32(1)),
-            ctypes.byref(i32(2)),  # mtype 2
+            ctypes.byref(i32(self.MTYPE)),
             ctypes.byref(i32(phase)),
             ctypes.byref(i32(self.n)),
             ptr(self._a, ctypes.c_double),
