@@ -82,10 +82,6 @@ class InteractivePicture:
         return f"InteractivePicture({len(self.html) / 2**20:.1f} MB page)"
 
 
-NOTEBOOK_EXTRA = "pip install 'modalviewer[notebook]'"
-"""The command installing what :func:`plot` needs for ``interactive=True``."""
-
-
 def interactive_available() -> bool:
     """Whether the page export (trame-pyvista and trame-vtk) is installed."""
     import importlib.util
@@ -204,7 +200,8 @@ def plot(
             import warnings
 
             warnings.warn(
-                f"an interactive picture needs trame-pyvista and trame-vtk: {NOTEBOOK_EXTRA}; "
+                "an interactive picture needs trame-pyvista and trame-vtk: pip install "
+                "'modalviewer[notebook]'; "
                 "showing an image instead",
                 stacklevel=2,
             )
@@ -218,7 +215,12 @@ def plot(
 
             picture = Animation(viewer.animation_images(frames, fps, size), fps)
         elif interactive:
-            picture = _interactive(viewer, size)
+            # the scene an image is made of (surface, isolines, marker) as a vtk.js page
+            renderer = viewer.renderer(size)
+            renderer.plotter.render()
+            html = renderer.plotter.trame.export_html(None).getvalue()
+            field = viewer.state.derived.field()
+            picture = InteractivePicture(html, field.legend if field is not None else "", size)
         else:
             picture = Picture(viewer.image(transparent=transparent, size=size))
     finally:
@@ -226,22 +228,6 @@ def plot(
     if screenshot is not None:
         picture.save(screenshot)
     return picture
-
-
-def _interactive(viewer, size) -> InteractivePicture:
-    """The off-screen renderer's scene (surface, isolines, marker; the same actors an
-    image is made of) exported as a standalone vtk.js page."""
-    import tempfile
-
-    renderer = viewer.renderer(size)
-    renderer.plotter.render()
-    with tempfile.TemporaryDirectory(prefix="modalviewer-page-") as folder:
-        out = Path(folder) / "scene.html"
-        renderer.plotter.trame.export_html(str(out))
-        html = out.read_text(encoding="utf-8")
-    field = viewer.state.derived.field()
-    legend = field.legend if field is not None else ""
-    return InteractivePicture(html, legend, size)
 
 
 @extra_needed("mv.view (the desktop viewer)")

@@ -163,23 +163,16 @@ def add_mesh_arguments(parser, slivers_note: str = "") -> None:
     )
 
 
-DASH_VALUES = ("--view", "--up")
-"""Options whose values may start with "-" (``--view -x``, ``--view -30,10``, ``--up
--z``): argparse reads such a value as an option unless it is joined with "="."""
-
-
 def joined_dash_values(argv: list[str]) -> list[str]:
-    """``argv`` with ``--view -x`` written ``--view=-x`` (see :data:`DASH_VALUES`)."""
+    """``argv`` with ``--view -x`` written ``--view=-x``: argparse reads a value starting
+    with "-" (``--view -x``, ``--view -30,10``, ``--up -z``) as an option unless it is
+    joined with "="."""
     out: list[str] = []
-    i = 0
-    while i < len(argv):
-        value = argv[i + 1] if i + 1 < len(argv) else ""
-        if argv[i] in DASH_VALUES and value.startswith("-") and not value.startswith("--"):
-            out.append(f"{argv[i]}={argv[i + 1]}")
-            i += 2
-            continue
-        out.append(argv[i])
-        i += 1
+    for arg in argv:
+        if out and out[-1] in ("--view", "--up") and arg[:1] == "-" and arg[:2] != "--":
+            out[-1] += "=" + arg
+        else:
+            out.append(arg)
     return out
 
 

@@ -48,7 +48,15 @@ def compute(args) -> int:
     )
     if refusal:
         raise ValueError(refusal)
-    bar, on_modes = _counting_modes(progress_bar(), args.k)
+    bar, ready = progress_bar(), [0]  # the progress says "solving: 12 of 100 modes ready"
+
+    def on_modes(spec) -> None:
+        ready[0] = spec.k
+
+    def progress(stage: str, fraction: float) -> None:
+        counted = stage == "solving" and ready[0]
+        bar(f"solving: {ready[0]} of {args.k} modes ready" if counted else stage, fraction)
+
     with warnings_printed():
         spec = mv.compute_spectrum(
             mesh,
@@ -56,7 +64,7 @@ def compute(args) -> int:
             args.k,
             args.bending,
             args.membrane,
-            progress=bar,
+            progress=progress,
             on_modes=on_modes,
         )
     mv.save_spectrum(spec, args.output)
@@ -81,19 +89,3 @@ def compute(args) -> int:
             + f" ({spec.parameters['operator_columns']} operator columns)"
         )
     return 0
-
-
-def _counting_modes(progress, k: int):
-    """``(progress, on_modes)`` for :func:`modalviewer.compute_spectrum`: the progress
-    says how many modes have converged ("solving: 12 of 100 modes ready")."""
-    ready = [0]
-
-    def on_modes(spec) -> None:
-        ready[0] = spec.k
-
-    def counted(stage: str, fraction: float) -> None:
-        if stage == "solving" and ready[0]:
-            stage = f"solving: {ready[0]} of {k} modes ready"
-        progress(stage, fraction)
-
-    return counted, on_modes
