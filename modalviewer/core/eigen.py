@@ -219,8 +219,12 @@ def solve_lowest(
         raise EigenError("the operator has NaN or infinite entries")
     report = progress_reporter(progress, cancel)
     median_ratio = typical_eigenvalue(K, mass_diag)
-    Z = sp.csc_matrix((N, 0)) if null_space is None else _null_vectors(null_space, mass_diag)
+    Z = sp.csc_matrix((N, 0) if null_space is None else null_space, dtype=np.float64)
     d = Z.shape[1]
+    if Z.shape[0] != N:
+        raise ValueError(f"null_space must have {N} rows (the unknowns), got {Z.shape[0]}")
+    if d and np.abs((Z.T @ sp.diags(mass_diag) @ Z).toarray() - np.eye(d)).max() > 1e-8:
+        raise ValueError("null_space must be Mass-orthonormal (Z^T M Z = I)")
     timer = StageTimer()
     columns = 0
     method, shift = "null space (no iteration)", 0.0
@@ -373,18 +377,6 @@ class _Handover:
             lam = np.concatenate([np.zeros(Zk.shape[1]), lam])
             X = np.hstack([Zk, X])
         self.on_modes(lam, X)
-
-
-def _null_vectors(null_space, mass_diag: np.ndarray) -> sp.csc_matrix:
-    """The given null vectors as (N, d) CSC; checks shape and Mass-orthonormality."""
-    Z = sp.csc_matrix(null_space, dtype=np.float64)
-    N = mass_diag.shape[0]
-    if Z.shape[0] != N:
-        raise ValueError(f"null_space must have {N} rows (the unknowns), got {Z.shape[0]}")
-    gram = (Z.T @ sp.diags(mass_diag) @ Z).toarray()
-    if Z.shape[1] and np.abs(gram - np.eye(Z.shape[1])).max() > 1e-8:
-        raise ValueError("null_space must be Mass-orthonormal (Z^T M Z = I)")
-    return Z
 
 
 def _fix_column_signs(Z: sp.csc_matrix) -> sp.csc_matrix:
