@@ -293,9 +293,8 @@ def add_to_plotter(
             return scene
         from .viewer.mode_scalar import mode_scalar, smoothed_normals
 
-        if mode is None:
-            nonzero = np.flatnonzero(~spec.zero_mode_mask())
-            mode = int(nonzero[0]) if nonzero.size else 0
+        if mode is None:  # the first non-zero mode (0 if all are zero)
+            mode = int(np.argmax(~spec.zero_mode_mask()))
         values = mode_scalar(
             spec, int(mode), smoothed_normals(solver) if spec.is_vector else normals
         )

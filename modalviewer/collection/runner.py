@@ -341,12 +341,10 @@ def run_batch(
         bar.update()
 
     try:
-        if not todo:
-            pass
-        elif workers == 0 and client is None and scheduler is None:
+        if workers == 0 and client is None and scheduler is None:
             for name, path, known in todo:
                 take(name, path, process_mesh(str(path), parameters, known))
-        else:
+        elif todo:
             _run_dask(todo, parameters, take, workers, scheduler, client, memory_limit, log)
     except KeyboardInterrupt:
         summary.interrupted = True

@@ -349,16 +349,13 @@ class Collection:
         distance 0), before shapes at a distance 0 by rounding.  A mesh the store does not
         hold is ranked by ``spectrum`` where it fits (:meth:`spectrum_fits`), else by a
         spectrum computed with the store's parameters."""
-        from ..core.mesh import Mesh
+        from ..interop import as_mesh
 
         table = self.descriptors["shape_dna"]
         if isinstance(query, str) and query in self:
             stored = query
         else:
-            if not isinstance(query, Mesh):
-                from ..io import load_mesh
-
-                query = load_mesh(query)
+            query = as_mesh(query)
             stored = self.name_of(query.hash)
         if stored is not None:
             dna, own = table[self.names.index(stored)], self.entry(stored)["mesh_hash"]
