@@ -218,9 +218,8 @@ def process_mesh(path: str, parameters: dict, known_key: str | None = None) -> d
             arrays["shape_dna"] = shape_dna(main, area)
             for kind in parameters["signatures"]:
                 spec = spectra[operator_for_distance(kind)]
-                times, values = signature(spec, kind=signature_kind(kind))
-                arrays[f"sig.{kind}.times"] = times
-                arrays[f"sig.{kind}.values"] = values
+                sig = signature(spec, kind=signature_kind(kind))
+                arrays[f"sig.{kind}.times"], arrays[f"sig.{kind}.values"] = sig
                 arrays[f"hist.{kind}"] = _histogram(spec, area, signature_kind(kind))
         entry = {
             "format": STORE_FORMAT + "-entry",
