@@ -118,6 +118,7 @@ def test_store_spectra_equal_compute_spectrum(store, sources):
             else:  # symmetric shapes: the same eigenspaces
                 _same_eigenspaces(stored, direct)
     mesh = mv.load_mesh(sources / "blob.obj")
+    assert set(c.signatures("blob")) == {"hks", "vibration"}
     times, values = c.signatures("blob")["hks"]
     direct_times, direct_values = mv.signature(mv.compute_spectrum(mesh, "laplacian", K))
     np.testing.assert_allclose(times, direct_times, rtol=1e-10)

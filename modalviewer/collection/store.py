@@ -275,13 +275,11 @@ class Collection:
 
     def signatures(self, name: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Kind -> (times (T,), values (n, T)) of ``name``'s stored signatures."""
-        out = {}
         with np.load(self.file(name), allow_pickle=False) as data:
-            for key in data.files:
-                if key.startswith("sig.") and key.endswith(".times"):
-                    kind = key[4:-6]
-                    out[kind] = (np.array(data[key]), np.array(data[f"sig.{kind}.values"]))
-        return out
+            return {
+                kind: (np.array(data[f"sig.{kind}.times"]), np.array(data[f"sig.{kind}.values"]))
+                for kind in self.info.get("signatures", [])  # the store's, of every mesh
+            }
 
     @property
     def descriptors(self) -> dict[str, np.ndarray]:
@@ -317,10 +315,7 @@ class Collection:
 
     def name_of(self, mesh_hash: str) -> str | None:
         """The stored mesh with this geometry hash, or None."""
-        for name in self.names:
-            if self.entry(name).get("mesh_hash") == mesh_hash:
-                return name
-        return None
+        return next((n for n in self.names if self.entry(n).get("mesh_hash") == mesh_hash), None)
 
     def spectrum_fits(self, spectrum: Spectrum | None) -> bool:
         """Whether ``spectrum`` can stand for the store's: its operator and weights, at
