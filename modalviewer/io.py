@@ -68,11 +68,7 @@ def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[s
     except (MeshError, MissingExtraError):
         raise
     except (Exception, SystemExit) as exc:  # a parser may raise anything (meshio even exit)
-        said = (
-            f" (meshio: {exc})"
-            if by_meshio and str(exc) and not isinstance(exc, SystemExit)
-            else ""
-        )
+        said = f" (meshio: {exc})" if by_meshio and isinstance(exc, Exception) and str(exc) else ""
         raise MeshError(
             f"{path.name}: could not be read as a {kind} file{said}; "
             "the file may be damaged, truncated or of another type"
