@@ -361,6 +361,11 @@ BASE_SLICE = 0.01  # the bottom slice a flat base lies in
 BASE_SHARE = 0.02  # share of the area a flat base must hold
 BASE_NORMAL = 0.985  # |n . axis| of a face lying flat
 BASE_SPAN = 0.5  # share of the horizontal extents a base must span
+# a figure on two feet along z stands Z-up when it is at least this many times taller
+# (z) than deep (y): a scanned person or character, whose front or back, lying along y,
+# may touch the bottom slice in several places (hands, nose); a table on two of its legs
+# along z is not that deep
+BIPED_ASPECT = 2.0
 
 
 def _supports(v: np.ndarray, f: np.ndarray, axis: int) -> int:
@@ -402,7 +407,8 @@ def _flat_base(v: np.ndarray, f: np.ndarray, axis: int) -> float:
 def detect_up(vertices, faces=None) -> str | None:
     """ "+z" when the mesh clearly stands on the XY plane, else None (+Y applies).  No
     claim for a plate (thinner than ``FLAT_ASPECT`` along z) or three feet along y; +Z
-    for three feet along z, or (a closed surface) a flat base along z holding
+    for two feet along z under a figure ``BIPED_ASPECT`` times taller than deep, three
+    feet along z, or (a closed surface) a flat base along z holding
     ``BASE_SHARE`` of the area with a base along y under a quarter of that."""
     if faces is None or len(faces) == 0:
         return None
@@ -412,6 +418,8 @@ def detect_up(vertices, faces=None) -> str | None:
     if extent[2] < FLAT_ASPECT * float(extent.max()):
         return None
     legs_z, legs_y = _supports(v, f, 2), _supports(v, f, 1)
+    if legs_z == 2 and extent[2] >= BIPED_ASPECT * extent[1]:
+        return "+z"  # a figure standing on two feet
     if legs_y >= 3:  # it stands on feet along y: Y-up
         return None
     if legs_z >= 3:

@@ -63,6 +63,28 @@ def test_a_z_up_cow_and_table_are_detected_and_their_y_up_originals_not():
     assert detect_up(_z_up(_z_up(_z_up(v))), f) is None  # the same statue, +Y up
 
 
+def _figure_y_up():
+    """A figure standing on two feet, +Y up: two legs under a body, the legs' backs
+    (the bottom slice along z) behind the body's, and two hands and a nose sticking out
+    in front (+z), as a scanned person's front touches a slice in several places."""
+    parts = [
+        _box((-0.2, 0.0, -0.05), (-0.05, 1.0, 0.35)),
+        _box((0.05, 0.0, -0.05), (0.2, 1.0, 0.35)),
+        _box((-0.3, 1.0, 0.0), (0.3, 2.2, 0.3)),
+        _box((-0.28, 1.3, 0.3), (-0.2, 1.4, 0.5)),
+        _box((0.2, 1.3, 0.3), (0.28, 1.4, 0.5)),
+        _box((-0.03, 2.0, 0.3), (0.03, 2.05, 0.5)),
+    ]
+    faces = [f + 8 * i for i, (_, f) in enumerate(parts)]
+    return np.vstack([v for v, _ in parts]), np.vstack(faces)
+
+
+def test_a_figure_on_two_feet_is_detected_z_up_and_its_y_up_original_not():
+    v, f = _figure_y_up()
+    assert detect_up(v, f) is None
+    assert detect_up(_z_up(v), f) == "+z"
+
+
 @pytest.mark.parametrize("name", ["demo_folded_plate", "demo_machined_part", "demo_hand"])
 def test_the_demo_meshes_keep_y_up(name):
     mesh = mv.load_mesh(ASSETS / f"{name}.obj")
