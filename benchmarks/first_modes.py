@@ -187,8 +187,8 @@ def table(data: dict) -> str:
     lines = [
         f"| mesh | vertices | operator | first {data['first']} modes | first {data['first']} "
         f"non-zero | all {data['k']} | share of all | {data['first']}-mode solve | "
-        f"all {data['k']}, baseline | total / baseline | peak / baseline |",
-        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        f"all {data['k']}, baseline | total / baseline | peak / baseline | rounds |",
+        "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for r in data["rows"]:
         lines.append(
@@ -197,7 +197,7 @@ def table(data: dict) -> str:
             f"| {r['seconds_first_nonzero']:.1f} s | {r['seconds_total']:.1f} s | "
             f"{r['seconds_first'] / r['seconds_total']:.2f} | {r['seconds_few']:.1f} s | "
             f"{r['seconds_baseline']:.1f} s | {r['seconds_total'] / r['seconds_baseline']:.2f} | "
-            f"{r['peak_mb'] / r['peak_mb_baseline']:.2f} |"
+            f"{r['peak_mb'] / r['peak_mb_baseline']:.2f} | {r.get('repeats', 1)} |"
         )
     return "\n".join(lines)
 
@@ -210,16 +210,20 @@ def main(argv=None) -> int:
     parser.add_argument("--first", type=int, default=10)
     parser.add_argument("--baseline", default="2420880", help="the commit to compare with")
     parser.add_argument("--repeats", type=int, default=3, help="rounds per row (medians)")
+    from benchmarks.run import add_keep_others, kept_rows, save_result  # imports the package
+
+    add_keep_others(parser, "other cases or operators")
     args = parser.parse_args(argv)
+    now = {(case_name(case), operator) for case in args.cases for operator in args.operators}
+    kept = kept_rows("first_modes", args.keep_others, lambda r: (r["case"], r["operator"]) in now)
     baseline = baseline_tree(args.baseline)
     rows = []
     for case in args.cases:
         for operator in args.operators:
             rows.append(measure(case, operator, args.k, args.first, baseline, args.repeats))
             print(json.dumps(rows[-1]), flush=True)
+    rows = sorted(kept + rows, key=lambda r: (r["case"], r["operator"]))
     data = {"k": args.k, "first": args.first, "baseline": args.baseline, "rows": rows}
-    from benchmarks.run import save_result  # imports the package; the children need not
-
     save_result("first_modes", data)
     print(table(data))
     return 0
