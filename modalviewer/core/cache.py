@@ -13,7 +13,6 @@ import logging
 import os
 import tempfile
 import time
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -150,7 +149,7 @@ class SpectrumCache:
 
     def solves(self) -> list[SolveRecord]:
         """The solves this machine recorded in the cache, most recently used first, read
-        from each file's metadata and mass array header (not its modes); entries that
+        from each file's metadata and mass array (not its modes); entries that
         cannot be read, or carry no time (coarse-to-fine, foreign files), left out."""
         records = (_solve_record(entry.path) for entry in self.entries())
         return [record for record in records if record is not None]
@@ -250,23 +249,15 @@ class SpectrumCache:
 def _solve_record(path: Path) -> SolveRecord | None:
     """The :class:`SolveRecord` of one cache file, or None."""
     try:
-        with zipfile.ZipFile(path) as archive:
-            with archive.open("meta.npy") as fh:
-                meta = json.loads(str(np.lib.format.read_array(fh, allow_pickle=False)))
-            with archive.open("mass.npy") as fh:
-                version = np.lib.format.read_magic(fh)
-                read = (
-                    np.lib.format.read_array_header_1_0
-                    if version == (1, 0)
-                    else np.lib.format.read_array_header_2_0
-                )
-                shape = read(fh)[0]
+        with np.load(path, allow_pickle=False) as data:  # reads these two arrays only
+            meta = json.loads(str(data["meta"]))
+            n_vertices = len(data["mass"])
         params = meta.get("parameters", {})
         seconds = params.get("seconds_total")
         if not isinstance(seconds, (int, float)) or seconds <= 0 or "transferred_from" in params:
             return None
         return SolveRecord(
-            str(meta["operator"]), str(meta.get("mesh_hash", "")), int(shape[0]),
+            str(meta["operator"]), str(meta.get("mesh_hash", "")), n_vertices,
             int(params["k"]), float(seconds),
         )  # fmt: skip
     except Exception:  # damaged or foreign: no record (get() deals with the file)

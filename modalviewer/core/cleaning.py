@@ -84,29 +84,6 @@ def _collapsible(p: int, q: int, v, f, topo, min_area: float) -> bool:
     return True
 
 
-def _flippable(t: int, a: int, b: int, x: int, v, f, topo, min_area: float):
-    """(face across edge ab, its third vertex d) if the zero-area face t = (a, b, x) and
-    that face can trade their edge ab for xd, keeping a manifold with both new faces of
-    area facing the way the old neighbour did; else None."""
-    fi, fp, ni, nptr, on_boundary, adj = topo
-    around_a = fi[fp[a] : fp[a + 1]]
-    across = [int(g) for g in around_a if g != t and b in f[g]]
-    if len(across) != 1:
-        return None
-    g = across[0]
-    k = int(np.flatnonzero(f[g] == b)[0])
-    if f[g][(k + 1) % 3] != a:  # the neighbour must run b -> a
-        return None
-    d = int(f[g][(k + 2) % 3])
-    if d == x or x in ni[nptr[d] : nptr[d + 1]]:
-        return None
-    old = _cross_rows(v[[a]] - v[[b]], v[[d]] - v[[b]])[0]
-    new = _cross_rows(v[[d, b]] - v[[a, d]], v[[x, x]] - v[[a, d]])
-    if np.any(0.5 * np.linalg.norm(new, axis=1) <= min_area) or np.any(new @ old <= 0):
-        return None
-    return g, d
-
-
 def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max_rounds=100):
     """Remove every face of area at most ``min_area`` without opening holes, in rounds
     of non-adjacent changes until none is left or none can be made: flip its longest
@@ -213,15 +190,29 @@ def _lock(locked: np.ndarray, topo, vertices) -> None:
         locked[ni[nptr[w] : nptr[w + 1]]] = True
 
 
-def _flip(face: int, a: int, b: int, x: int, v, f, topo, min_area: float, locked) -> bool:
-    """Flip the edge (a, b) of the zero-area ``face`` (apex x) in place where
-    :func:`_flippable` allows it and the far corner is not locked; whether it did."""
-    flip = _flippable(face, a, b, x, v, f, topo, min_area)
-    if flip is None or locked[flip[1]]:
+def _flip(t: int, a: int, b: int, x: int, v, f, topo, min_area: float, locked) -> bool:
+    """Flip the edge ab of the zero-area face t = (a, b, x) in place, trading it with the
+    face across it for the edge xd (d that face's third vertex), where the far corner is
+    not locked and the surface stays a manifold with both new faces of area facing the
+    way the old neighbour did; whether it did."""
+    fi, fp, ni, nptr = topo[:4]
+    around_a = fi[fp[a] : fp[a + 1]]
+    across = [int(g) for g in around_a if g != t and b in f[g]]
+    if len(across) != 1:
         return False
-    other, d = flip
-    f[face] = (a, d, x)
-    f[other] = (d, b, x)
+    g = across[0]
+    k = int(np.flatnonzero(f[g] == b)[0])
+    if f[g][(k + 1) % 3] != a:  # the neighbour must run b -> a
+        return False
+    d = int(f[g][(k + 2) % 3])
+    if d == x or x in ni[nptr[d] : nptr[d + 1]] or locked[d]:
+        return False
+    old = _cross_rows(v[[a]] - v[[b]], v[[d]] - v[[b]])[0]
+    new = _cross_rows(v[[d, b]] - v[[a, d]], v[[x, x]] - v[[a, d]])
+    if np.any(0.5 * np.linalg.norm(new, axis=1) <= min_area) or np.any(new @ old <= 0):
+        return False
+    f[t] = (a, d, x)
+    f[g] = (d, b, x)
     _lock(locked, topo, (a, b, x, d))
     return True
 

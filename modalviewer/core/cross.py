@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .mesh import Mesh, _unused_words
+from .mesh import Mesh
 from .signatures import SignatureTable, default_energies, default_times, normalised_signatures
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_vertex, check_vertices
@@ -58,14 +58,6 @@ def rescale_to_area(mesh: Mesh, area: float = 1.0) -> Mesh:
         file_map=mesh.file_map,
         merged_into=mesh.merged_into,
     )
-
-
-def _source_row(table: SignatureTable, vertex: int) -> np.ndarray:
-    """The normalised signature of ``vertex``; a ValueError if no face uses it."""
-    row = table.table[check_vertex(vertex, table.table.shape[0])]
-    if np.isnan(row).any():
-        raise ValueError(_unused_words(int(vertex)))
-    return row
 
 
 def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
@@ -138,11 +130,11 @@ class CrossTables:
 
     def a_to_b(self, vertex: int) -> np.ndarray:
         """(n_b,) distance from vertex ``vertex`` of A to every vertex of B."""
-        return self.b.distance_to(_source_row(self.a, vertex))
+        return self.b.distance_to(self.a.row(vertex))
 
     def b_to_a(self, vertex: int) -> np.ndarray:
         """(n_a,) distance from vertex ``vertex`` of B to every vertex of A."""
-        return self.a.distance_to(_source_row(self.b, vertex))
+        return self.a.distance_to(self.b.row(vertex))
 
     def mutual_best_matches(
         self, vertices_a: Vertices, vertices_b: Vertices | None = None

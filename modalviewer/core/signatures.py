@@ -19,18 +19,12 @@ from .mesh import _unused_words
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_times, check_vertex, check_vertices
 
-SIGNATURE_KINDS: dict[str, str] = {
-    "heat": "sum_j exp(-lambda_j t) |phi_j(v)|^2 over scales t",
-    "wks": "the wave kernel signature over energies E (Aubry et al. 2011)",
-}
-"""The signature kinds of :func:`signature` and :class:`SignatureTable`."""
-
 WKS_VARIANCE = 7.0
 """The wave kernel's sigma in units of the log-energy spacing (Aubry et al.'s choice)."""
 
 
 def _check_kind(kind: str) -> str:
-    if kind not in SIGNATURE_KINDS:
+    if kind not in ("heat", "wks"):
         raise ValueError(f"unknown signature kind {kind!r}; choose one of 'heat', 'wks'")
     return kind
 
@@ -184,10 +178,14 @@ class SignatureTable:
         """(n,) distance from ``vertex`` to every vertex: one matrix-vector product by
         ``|F[v] - F[w]|^2 = |F[v]|^2 + |F[w]|^2 - 2 F[v].F[w]``, the entries where that
         cancels recomputed directly, so d(v, v) = 0 exactly."""
+        return self.distance_to(self.row(vertex))
+
+    def row(self, vertex: int) -> np.ndarray:
+        """The normalised signature of ``vertex``; a ValueError if no face uses it."""
         row = self.table[check_vertex(vertex, self.table.shape[0])]
         if np.isnan(row).any():
-            raise ValueError(_unused_words(vertex))
-        return self.distance_to(row)
+            raise ValueError(_unused_words(int(vertex)))
+        return row
 
     def distance_to(self, row: np.ndarray) -> np.ndarray:
         """(n,) distance from a normalised signature ``row`` (T,) sampled at the same
