@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pyvista as pv
 from qtpy import QtCore, QtGui, QtWidgets
+from vtkmodules.vtkInteractionStyle import vtkInteractorStyleTrackballCamera
+from vtkmodules.vtkRenderingUI import vtkGenericRenderWindowInteractor
 
 from ..scene.framing import fit_smaller_side
 
@@ -32,8 +34,9 @@ def qt_opengl_available() -> bool:
 
 
 class OffscreenViewport(QtWidgets.QWidget):
-    """A widget showing frames of an off-screen pyvista plotter, with mouse navigation:
-    left drag rotates, right drag or wheel zooms, middle drag pans, left click picks."""
+    """A widget showing frames of an off-screen pyvista plotter, navigated as the GPU view:
+    VTK's trackball camera (left drag rotates, right drag or wheel zooms, middle drag
+    pans); a left click picks."""
 
     clicked = QtCore.Signal(float, float)
     cameraChanged = QtCore.Signal()
@@ -51,9 +54,16 @@ class OffscreenViewport(QtWidgets.QWidget):
         self._image: QtGui.QImage | None = None
         self._dirty = True
         self._press_pos = None
-        self._last = None
-        self._button = None
         self.render_count = 0
+        # VTK's own trackball camera, fed the widget's mouse events; it renders nothing
+        # itself (the widget paints on request)
+        self._iren = vtkGenericRenderWindowInteractor()
+        self._iren.SetEnableRender(False)
+        self._iren.SetRenderWindow(self.plotter.ren_win)
+        style = vtkInteractorStyleTrackballCamera()
+        self._iren.SetInteractorStyle(style)
+        for event in ("InteractionEvent", "EndInteractionEvent"):  # drags; the wheel
+            style.AddObserver(event, self._on_interaction)
 
     @property
     def widget(self) -> QtWidgets.QWidget:
@@ -95,46 +105,32 @@ class OffscreenViewport(QtWidgets.QWidget):
         super().resizeEvent(event)
 
     # ---------------------------------------------------------------- mouse
-    def mousePressEvent(self, event):  # noqa: N802
+    def _to_vtk(self, event, name: str) -> None:
+        """Hand a Qt mouse event to VTK's interactor as the event ``name``."""
         pos = event.position()
-        self._press_pos = self._last = (pos.x(), pos.y())
-        self._button = event.button()
+        self._iren.SetEventInformationFlipY(int(pos.x()), int(pos.y()))
+        self._iren.InvokeEvent(name)
+
+    def mousePressEvent(self, event):  # noqa: N802
+        self._press_pos = (event.position().x(), event.position().y())
+        self._to_vtk(event, event.button().name + "PressEvent")  # e.g. LeftButtonPressEvent
 
     def mouseMoveEvent(self, event):  # noqa: N802
-        if self._last is None:
-            return
-        pos = event.position()
-        dx, dy = pos.x() - self._last[0], pos.y() - self._last[1]
-        self._last = (pos.x(), pos.y())
-        cam = self.plotter.camera
-        if self._button == QtCore.Qt.MouseButton.LeftButton:
-            cam.Azimuth(-0.4 * dx)
-            cam.Elevation(0.4 * dy)
-            cam.OrthogonalizeViewUp()
-        elif self._button == QtCore.Qt.MouseButton.RightButton:
-            cam.Zoom(1.0 - 0.01 * dy)
-        elif self._button == QtCore.Qt.MouseButton.MiddleButton:
-            fp, pos3 = np.array(cam.GetFocalPoint()), np.array(cam.GetPosition())
-            scale = np.linalg.norm(pos3 - fp) / max(self.height(), 1)
-            right = np.cross(np.array(cam.GetDirectionOfProjection()), cam.GetViewUp())
-            shift = scale * (-dx * right + dy * np.array(cam.GetViewUp()))
-            cam.SetFocalPoint(*(fp + shift))
-            cam.SetPosition(*(pos3 + shift))
-        self.plotter.renderer.ResetCameraClippingRange()
-        self.request_render()
-        self.cameraChanged.emit()
+        self._to_vtk(event, "MouseMoveEvent")
 
     def mouseReleaseEvent(self, event):  # noqa: N802
         pos = event.position()
         left = event.button() == QtCore.Qt.MouseButton.LeftButton
         if left and _is_click(self._press_pos, pos.x(), pos.y()):
             self.clicked.emit(pos.x(), self.height() - 1 - pos.y())
-        self._press_pos = self._last = None
+        self._press_pos = None
+        self._to_vtk(event, event.button().name + "ReleaseEvent")
 
     def wheelEvent(self, event):  # noqa: N802
-        steps = event.angleDelta().y() / 120.0
-        self.plotter.camera.Zoom(1.1**steps)
-        self.plotter.renderer.ResetCameraClippingRange()
+        forward = event.angleDelta().y() > 0
+        self._to_vtk(event, "MouseWheelForwardEvent" if forward else "MouseWheelBackwardEvent")
+
+    def _on_interaction(self, *_args) -> None:
         self.request_render()
         self.cameraChanged.emit()
 
