@@ -69,11 +69,9 @@ class MeshScene:
         self.mesh = mesh
         self.normals = normals
         self.rest_points = np.array(mesh.vertices)
-        self.surface = pv.PolyData.from_regular_faces(self.rest_points.copy(), mesh.faces)
+        self.surface = self._rest_shape()
         self.surface.point_data["field"] = np.zeros(mesh.n_vertices)
         self.surface.point_data["displacement"] = np.zeros((mesh.n_vertices, 3))
-        self.surface.point_data["Normals"] = normals
-        self.surface.GetPointData().SetNormals(self.surface.GetPointData().GetArray("Normals"))
         self.surface.set_active_scalars("field")
         # Our own vertex normals and Phong interpolation instead of pyvista's smooth_shading,
         # which would draw a filtered copy that our in-place updates do not reach.
@@ -138,6 +136,13 @@ class MeshScene:
         self._canonical: tuple | None = None  # (up axis, its canonical camera)
         plotter._modalviewer_scene = self
 
+    def _rest_shape(self) -> pv.PolyData:
+        """A copy of the rest shape with our vertex normals as VTK's normals."""
+        poly = pv.PolyData.from_regular_faces(self.rest_points.copy(), self.mesh.faces)
+        poly.point_data["Normals"] = self.normals
+        poly.GetPointData().SetNormals(poly.GetPointData().GetArray("Normals"))
+        return poly
+
     # ------------------------------------------------------------------ style
     def set_style(self, style: str) -> None:
         """Switch the rendering style: "paper" (white zero, saturated colours, headlight)
@@ -166,13 +171,10 @@ class MeshScene:
         clipped: tuple[bool, bool] = (False, False),
         scale: tuple[np.ndarray, np.ndarray] | None = None,
     ) -> None:
-        """Colour the surface by ``values`` (n,) of ``kind`` "diverging" (symmetric
-        about zero, orange/white/blue), "sequential" (white to red), "threshold" (blue
-        below the middle of ``clim``: :meth:`show_threshold`) or "plain"; ``clipped``
-        (low, high): values lie beyond that end of ``clim``; the zero isoline is bold on a
-        diverging field; the isolines carry ``displacement`` (the animation's shape); a
-        sequential field with a spread ``scale`` (knot values, knot positions) is
-        coloured by ``np.interp(values, *scale)``, its colour bar keeping the values."""
+        """Colour the surface by ``values`` in the colour map of ``kind`` (see ``COLORMAPS``;
+        "threshold": :meth:`show_threshold`), the zero isoline bold on a diverging field;
+        a sequential field's spread ``scale`` (knot values, knot positions) colours
+        ``np.interp(values, *scale)`` while its colour bar keeps the values."""
         values = np.array(values, dtype=np.float64)  # the animation rewrites the copy drawn
         self.scale = None
         if scale is not None and kind == "sequential":
@@ -210,8 +212,7 @@ class MeshScene:
             self.clim = true_range  # what the colour bar says
 
     def set_isolines(self, values: np.ndarray, count: int, emphasise_zero: bool) -> None:
-        """Contour the rest shape (so the lines can follow the animation) at ``count``
-        levels; the line actors are created once and their data replaced in place."""
+        """Contour the rest shape (so the lines can follow the animation) at ``count`` levels."""
         lo, hi = self.clim
         levels = np.linspace(lo, hi, count + 2)[1:-1] if count > 0 else np.zeros(0)
         if emphasise_zero:
@@ -248,8 +249,8 @@ class MeshScene:
     def _show_lines(
         self, lines: pv.PolyData, seg: np.ndarray, disp: np.ndarray, width: float, attr: str
     ):
-        """Replace ``lines`` by the black segments ``seg`` (s, 2, 3) on the rest shape (none:
-        hide the actor); returns (rest points, displacement) of the lines, or (None, None)."""
+        """Draw the black segments ``seg`` (s, 2, 3) in ``lines`` (none: hide the actor);
+        returns their (rest points, displacement), or (None, None)."""
         actor = getattr(self, attr)
         if len(seg) == 0:
             if actor is not None:
@@ -278,8 +279,7 @@ class MeshScene:
         self.set_threshold(threshold)
 
     def set_threshold(self, threshold: float) -> None:
-        """Move the threshold of a map made by :meth:`show_threshold` (its scalar range,
-        centred on the threshold); no render."""
+        """Move a :meth:`show_threshold` map's threshold (its scalar range's centre)."""
         lo, hi = self.clim
         reach = max(threshold - lo, hi - threshold, 1e-300)
         self._mapper.scalar_range = (threshold - reach, threshold + reach)
@@ -301,18 +301,15 @@ class MeshScene:
 
     # ------------------------------------------------------ legend, colour bar
     def set_legend(self, text: str | None) -> None:
-        """Show ``text`` (lines separated by newlines) at the top left of the view, and in
-        exports that ask for the legend; None or "" removes it.  No render."""
+        """Show ``text`` at the top left of the view and in exports; None or "" removes it."""
         self.legend_text = text or None
         self._overlay_changed()
 
     def set_colorbar(
         self, title: str | None, clim: tuple[float, float] | None = None, labels=None
     ) -> None:
-        """Show a colour bar titled ``title`` for the current field (None hides it), on
-        screen and in exports that ask for it.  ``clim`` overrides the field's range.  For
-        a threshold map the bar is a two-swatch legend (blue, white) labelled by
-        ``labels`` (default: ``title`` and "the rest").  No render."""
+        """Show a colour bar titled ``title`` (None hides it), ranged ``clim`` (default the
+        field's); a threshold map's is two swatches labelled ``labels``."""
         self.colorbar_title = title
         self.colorbar_labels = list(labels) if labels is not None else None
         if clim is not None:
@@ -392,10 +389,8 @@ class MeshScene:
 
     # ----------------------------------------------------------------- camera
     def canonical_camera(self) -> cameras.Camera:
-        """The canonical first view of this mesh (see ``modalviewer.viewer.camera``),
-        computed once per up axis: on a large mesh it takes seconds, and R must reset the
-        view at once (the window drew nothing meanwhile, so the view seemed not to
-        reset)."""
+        """The canonical first view, computed once per up axis (seconds on a large mesh,
+        and R must reset the view at once)."""
         up = self.up()
         if self._canonical is None or self._canonical[0] != up:
             camera = cameras.canonical_view(self.mesh.vertices, self.mesh.faces, up=up)
@@ -414,8 +409,7 @@ class MeshScene:
         return self._up[1]
 
     def set_camera(self, camera: cameras.Camera, fit: bool = True) -> None:
-        """Put the camera at ``camera`` (position, focal point, up); with ``fit`` the
-        distance is then adjusted so the whole mesh is in view.  No render."""
+        """Put the camera at ``camera``; ``fit``: then move it so the whole mesh is in view."""
         cam = self.plotter.camera
         cam.SetFocalPoint(*camera.focal_point)
         cam.SetPosition(*camera.position)
@@ -427,8 +421,7 @@ class MeshScene:
         self.plotter.renderer.ResetCameraClippingRange()
 
     def apply_camera_preset(self, name: str) -> cameras.Camera:
-        """Camera preset ``name``: "canonical", "+x", "-x", "+y", "-y", "+z", "-z" (seen
-        from that side) or "isometric"; returns the camera set.  No render."""
+        """Set and return camera preset ``name``: "canonical", "isometric" or a side ("+x")."""
         if name == "canonical":
             camera = self.canonical_camera()
         else:
@@ -453,9 +446,8 @@ class MeshScene:
                 self._move(line, rest, d, s)
 
     def set_color_factor(self, factor: float) -> None:
-        """Colour a diverging field as ``factor`` times its values (1: as shown): a signed
-        mode's colours change sign as it vibrates.  Other fields keep their colours; no
-        render."""
+        """Colour a diverging field as ``factor`` times its values: a signed mode's colours
+        change sign as it vibrates."""
         if self.kind != "diverging" or self._values is None:
             return
         field = self.surface.point_data["field"]  # a view of the VTK array
@@ -463,10 +455,8 @@ class MeshScene:
         self.surface.GetPointData().GetArray("field").Modified()
 
     def motion_points(self, reach: float, both: bool = True, most: int = 20000) -> np.ndarray:
-        """(m, 3) the rest shape and the surface displaced by ``reach`` times its
-        displacement (and by minus that with ``both``): the points a picture of the
-        deformed shape or of a whole vibration must hold.  At most ``most`` vertices of
-        each (every k-th)."""
+        """The rest shape and the surface displaced by ``reach`` (and ``-reach`` with
+        ``both``), at most ``most`` vertices each: what a picture of them must hold."""
         step = max(1, -(-self.mesh.n_vertices // most))
         rest = self.rest_points[::step]
         disp = np.asarray(self.surface.point_data["displacement"])[::step]
@@ -476,16 +466,12 @@ class MeshScene:
         return np.concatenate([rest, *moved])
 
     def set_ghost(self, visible: bool, reach: float = 0.0) -> None:
-        """Show the rest shape as a faint translucent grey copy behind a surface drawn
-        displaced by ``reach`` times its displacement (:meth:`set_displacement_scale`),
-        or hide it; no render.  The ghost fades out where the surface moves less than
-        :data:`GHOST_FADE` of the bounding-box diagonal (:meth:`ghost_opacities`)."""
+        """Show (or hide) the rest shape as a faint grey copy behind the surface displaced
+        by ``reach``, faded where it moves little (:meth:`ghost_opacities`)."""
         if self.ghost_actor is None:
             if not visible:
                 return
-            rest = pv.PolyData.from_regular_faces(self.rest_points.copy(), self.mesh.faces)
-            rest.point_data["Normals"] = self.normals
-            rest.GetPointData().SetNormals(rest.GetPointData().GetArray("Normals"))
+            rest = self._rest_shape()
             rgba = np.zeros((self.mesh.n_vertices, 4), np.uint8)
             rgba[:, :3] = np.round(np.asarray(GHOST_GREY) * 255).astype(np.uint8)
             rest.point_data["ghost_rgba"] = rgba  # the opacities follow the mode shown
@@ -511,10 +497,7 @@ class MeshScene:
         self.ghost_actor.SetVisibility(bool(visible))
 
     def ghost_opacities(self, reach: float) -> np.ndarray:
-        """Per-vertex opacity (n,) of the ghost behind the surface displaced by ``reach``
-        times its displacement: :data:`GHOST_OPACITY` where a vertex moves at least the
-        second share of :data:`GHOST_FADE` of the bounding-box diagonal, 0 below the
-        first, linear between."""
+        """Per-vertex ghost opacity at ``reach``: ramps with the move over :data:`GHOST_FADE`."""
         moved = np.linalg.norm(self.surface.point_data["displacement"], axis=1) * abs(reach)
         low, high = (share * self.mesh.bounding_box_diagonal for share in GHOST_FADE)
         return GHOST_OPACITY * np.clip((moved - low) / (high - low), 0.0, 1.0)
@@ -550,8 +533,7 @@ class MeshScene:
         self._sphere("marker_actor", "marker", vertex, 0.012, (0.9, 0.1, 0.6))
 
     def show_back_marker(self, vertex: int | None) -> None:
-        """A smaller yellow sphere at ``vertex`` (None: none): where the shape pair's best
-        match leads back when that is not the pick.  No render."""
+        """A smaller yellow sphere at ``vertex``: where the shape pair's best match leads back."""
         self._sphere("back_marker_actor", "back_marker", vertex, 0.009, (1.0, 0.75, 0.0))
 
     def _sphere(self, attr: str, name: str, vertex, size: float, color) -> None:
