@@ -1,6 +1,8 @@
 """Numerical core of modalviewer: numpy and scipy only (no Qt, no VTK)."""
+# ruff: noqa: F401 (the imports are the public API: __all__ is made of them below)
 
-from . import components, cross
+from types import ModuleType as _ModuleType
+
 from .cache import SpectrumCache
 from .cleaning import repair_mesh
 from .components import *  # noqa: F403
@@ -23,41 +25,9 @@ from .signatures import (
 from .spectrum import OPERATORS, Spectrum, SpectrumFileError, load_spectrum, save_spectrum
 from .truncation import k_for_truncation, truncation_error
 
+# every public name imported above (the submodules themselves are not exported)
 __all__ = [
-    *components.__all__,
-    *cross.__all__,
-    "Cancelled",
-    "EigenError",
-    "Mesh",
-    "MeshError",
-    "MeshReport",
-    "OPERATORS",
-    "SignatureTable",
-    "Spectrum",
-    "SpectrumFileError",
-    "SpectrumCache",
-    "compute_spectrum",
-    "ZeroModesWarning",
-    "default_energies",
-    "FunctionalMap",
-    "functional_map",
-    "correspondence_errors",
-    "negative_cotan_weights",
-    "robust_laplacian_matrices",
-    "default_times",
-    "load_spectrum",
-    "local_signature",
-    "mass_matrix",
-    "modified_dirichlet_matrix",
-    "multiscale_distance",
-    "normal_shells_hessian",
-    "remove_unused",
-    "repair_mesh",
-    "save_spectrum",
-    "shells_hessian",
-    "signature",
-    "stiffness_matrix",
-    "k_for_truncation",
-    "truncation_error",
-    "vertex_normals",
+    name
+    for name, value in globals().items()
+    if not name.startswith("_") and not isinstance(value, _ModuleType)
 ]
