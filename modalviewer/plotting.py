@@ -105,7 +105,8 @@ def _field_of(field, n: int):
     return str(name), values
 
 
-def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
+def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k, viewer=None):
+    """``viewer`` (default a new one) showing what :func:`plot` draws of ``mesh``."""
     from .core.operators import operator_for_distance
     from .viewer import Viewer
 
@@ -114,7 +115,7 @@ def _prepared_viewer(mesh, spectrum, mode, vertex, kind, k):
             f"mode={mode} is a mode of a spectrum: pass one, e.g. "
             f"plot(mesh, mv.compute_spectrum(mesh, 'laplacian', k), mode={mode})"
         )
-    viewer = Viewer()
+    viewer = viewer or Viewer()
     viewer.set_mesh(mesh)
     if spectrum is not None:
         viewer.add_spectrum(spectrum)
@@ -244,11 +245,8 @@ def view(mesh_or_arrays, spectrum: Spectrum | None = None, fields=None, block: b
 
     app = ensure_application()
     viewer = Viewer()
-    window = MainWindow(viewer=viewer)
-    viewer.set_mesh(mesh)
-    if spectrum is not None:
-        viewer.add_spectrum(spectrum)
-        viewer.show_mode(viewer.state.first_nonzero_mode(spectrum.operator), spectrum.operator)
+    window = MainWindow(viewer=viewer)  # before the mesh: the window draws what follows
+    _prepared_viewer(mesh, spectrum, None, None, None, 0, viewer)
     if fields:
         _field_of(fields, mesh.n_vertices)  # checked as plot checks them
         for name, values in fields.items():
@@ -285,26 +283,27 @@ def add_to_plotter(
     solver = mesh.solver_mesh  # the vertices faces use: what is drawn
     normals = vertex_normals(solver)
     scene = MeshScene(plotter, solver, normals)
-    if isinstance(values_or_spectrum, Spectrum):
+    if not isinstance(values_or_spectrum, Spectrum):
+        values = np.asarray(values_or_spectrum, dtype=np.float64)
+        if values.shape != (mesh.n_vertices,):
+            raise ValueError(f"one value per mesh vertex, ({mesh.n_vertices},); got {values.shape}")
+        if solver is not mesh:
+            values = values[solver.file_vertices]
+        signed = float(values.min()) < 0.0 < float(values.max())
+        kind = "diverging" if signed else "sequential"
+    elif vertex is not None:
         spec = on_solver_mesh(values_or_spectrum, solver)
-        if vertex is not None:
-            values = multiscale_distance(spec, solver.mesh_vertex(int(vertex)))
-            scene.show_field(values, "sequential", isolines=isolines, name=name or "distance")
-            return scene
+        values = multiscale_distance(spec, solver.mesh_vertex(int(vertex)))
+        kind, name = "sequential", name or "distance"
+    else:
         from .viewer.mode_scalar import mode_scalar, smoothed_normals
 
+        spec = on_solver_mesh(values_or_spectrum, solver)
         if mode is None:  # the first non-zero mode (0 if all are zero)
             mode = int(np.argmax(~spec.zero_mode_mask()))
         values = mode_scalar(
             spec, int(mode), smoothed_normals(solver) if spec.is_vector else normals
         )
-        scene.show_field(values, "diverging", isolines=isolines, name=name or f"mode {mode}")
-        return scene
-    values = np.asarray(values_or_spectrum, dtype=np.float64)
-    if values.shape != (mesh.n_vertices,):
-        raise ValueError(f"one value per mesh vertex, ({mesh.n_vertices},); got {values.shape}")
-    if solver is not mesh:
-        values = values[solver.file_vertices]
-    signed = float(values.min()) < 0.0 < float(values.max())
-    scene.show_field(values, "diverging" if signed else "sequential", isolines=isolines, name=name)
+        kind, name = "diverging", name or f"mode {mode}"
+    scene.show_field(values, kind, isolines=isolines, name=name)
     return scene
