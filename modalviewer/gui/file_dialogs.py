@@ -144,17 +144,19 @@ def window_screenshot_dialog(window, name: str, title: str) -> None:
     _save(win, "screenshot", write, say, screenshot_dir=str(Path(path).parent))
 
 
-def field_dialog(win) -> None:
-    if win.scene is None:
-        return
-    path, _ = QtWidgets.QFileDialog.getSaveFileName(
-        win,
-        "Export per-vertex field",
-        str(_mesh_folder(win) / "field.vtp"),
-        "VTK PolyData (*.vtp);;PLY (*.ply)",
-    )
+def _save_as(win, what: str, title: str, start, filters: str, write) -> None:
+    """Ask where to save the ``what`` (starting at ``start``), then :func:`_save` it with
+    ``write(path)``."""
+    path, _ = QtWidgets.QFileDialog.getSaveFileName(win, title, str(start), filters)
     if path:
-        _save(win, "field", lambda: win.export_field(path))
+        _save(win, what, lambda: write(path))
+
+
+def field_dialog(win) -> None:
+    if win.scene is not None:
+        start = _mesh_folder(win) / "field.vtp"
+        filters = "VTK PolyData (*.vtp);;PLY (*.ply)"
+        _save_as(win, "field", "Export per-vertex field", start, filters, win.export_field)
 
 
 def spectrum_dialog(win) -> None:
@@ -163,14 +165,9 @@ def spectrum_dialog(win) -> None:
         win.show_error("Compute a spectrum first.")
         return
     folder = Path(win.state.mesh_path).parent if win.state.mesh_path else Path.cwd()
-    path, _ = QtWidgets.QFileDialog.getSaveFileName(
-        win,
-        f"Export spectrum: {spec.operator_info.label}",
-        str(folder / f"{spec.operator}.npz"),
-        "NumPy (*.npz)",
-    )
-    if path:
-        _save(win, "spectrum", lambda: save_spectrum(spec, path) or path)
+    title = f"Export spectrum: {spec.operator_info.label}"
+    write = lambda path: save_spectrum(spec, path) or path  # noqa: E731
+    _save_as(win, "spectrum", title, folder / f"{spec.operator}.npz", "NumPy (*.npz)", write)
 
 
 def update_cache_label(win) -> None:
@@ -194,14 +191,8 @@ def save_session_dialog(win) -> None:
     if win.state.mesh is None:
         win.show_error("Open a mesh first.")
         return
-    path, _ = QtWidgets.QFileDialog.getSaveFileName(
-        win,
-        "Save session",
-        str(_mesh_folder(win) / f"{Path(win.state.mesh_path or 'mesh').stem}.session.json"),
-        "Session (*.json)",
-    )
-    if path:
-        _save(win, "session", lambda: win.save_session(path))
+    start = _mesh_folder(win) / f"{Path(win.state.mesh_path or 'mesh').stem}.session.json"
+    _save_as(win, "session", "Save session", start, "Session (*.json)", win.save_session)
 
 
 def open_session_dialog(win) -> None:
@@ -239,8 +230,6 @@ def mode_grid_dialog(win) -> None:
     except argparse.ArgumentTypeError as exc:
         win.show_error(str(exc))
         return
-    path, _ = QtWidgets.QFileDialog.getSaveFileName(
-        win, "Export mode grid", str(Path(_picture_folder(win)) / "modes.png"), "PNG (*.png)"
-    )
-    if path:
-        _save(win, "mode grid", lambda: win.viewer.export_mode_grid(path, modes, operator))
+    start = Path(_picture_folder(win)) / "modes.png"
+    write = lambda path: win.viewer.export_mode_grid(path, modes, operator)  # noqa: E731
+    _save_as(win, "mode grid", "Export mode grid", start, "PNG (*.png)", write)

@@ -1,6 +1,6 @@
 """Figures from the real window: the export dialog's width and height, the shape clear of
 the legend whatever the window's size, no pick marker on a mode's picture, File > Export
-animation."""
+animation and the other File exports."""
 
 import numpy as np
 import pytest
@@ -201,3 +201,36 @@ def test_a_session_restores_the_modes_panel_as_it_was(window, spot_path, qtbot, 
         assert second.distances_panel.kind_combo.currentData() == "vibration"
     finally:
         second.close()
+
+
+def test_file_exports_write_the_file_chosen(window, spot_path, tmp_path, monkeypatch):
+    """File > Export field, Export spectrum, Export mode grid and Save session write the
+    file chosen in the save dialog and say so in the status bar."""
+    import pyvista as pv
+
+    from modalviewer.core.spectrum import load_spectrum
+    from modalviewer.gui import file_dialogs
+
+    assert window.open_mesh(spot_path)
+    spec = window.compute("laplacian", k=10, wait=True)
+    window.show_mode(3)
+    chosen = []
+    monkeypatch.setattr(
+        QtWidgets.QFileDialog, "getSaveFileName", lambda *a, **k: (str(chosen[-1]), "")
+    )
+    monkeypatch.setattr(QtWidgets.QInputDialog, "getText", lambda *a, **k: ("1-4", True))
+    for name, dialog in (
+        ("mode.vtp", file_dialogs.field_dialog),
+        ("spec.npz", file_dialogs.spectrum_dialog),
+        ("grid.png", file_dialogs.mode_grid_dialog),
+        ("spot.session.json", file_dialogs.save_session_dialog),
+    ):
+        chosen.append(tmp_path / name)
+        dialog(window)
+        assert chosen[-1].is_file(), name
+        assert f"Saved {chosen[-1]}" in window.statusBar().currentMessage(), name
+    field = pv.read(chosen[0]).point_data
+    np.testing.assert_allclose(field[field.keys()[0]], spec.mode(3), atol=1e-6)
+    np.testing.assert_allclose(load_spectrum(chosen[1]).eigenvalues, spec.eigenvalues)
+    assert Image.open(chosen[2]).size[0] > Image.open(chosen[2]).size[1]  # modes side by side
+    assert window.open_session(chosen[3]) == []
