@@ -54,16 +54,8 @@ def split_components(mesh: Mesh) -> list[tuple[Mesh, np.ndarray]]:
         remap = np.full(mesh.n_vertices, -1, dtype=np.int64)
         remap[vertices] = np.arange(len(vertices))
         faces = remap[mesh.faces[face_label == c]]
-        out.append(
-            (
-                Mesh(
-                    mesh.vertices[vertices],
-                    faces,
-                    file_map=np.where(fm >= 0, remap[np.maximum(fm, 0)], -1),
-                ),
-                vertices,
-            )
-        )
+        file_map = np.where(fm >= 0, remap[np.maximum(fm, 0)], -1)
+        out.append((Mesh(mesh.vertices[vertices], faces, file_map=file_map), vertices))
     return out
 
 

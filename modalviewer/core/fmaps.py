@@ -28,9 +28,6 @@ from .signatures import signature
 from .spectrum import Spectrum
 from .validate import check_count
 
-DESCRIPTORS = ("wks", "hks")
-"""The descriptors :func:`functional_map` computes itself."""
-
 
 @dataclass
 class FunctionalMap:
@@ -56,7 +53,7 @@ def _scalar_basis(spec: Spectrum, k: int, which: str) -> tuple[np.ndarray, np.nd
 
 def _descriptors(spec_a, spec_b, descriptors, samples: int):
     if isinstance(descriptors, str):
-        if descriptors not in DESCRIPTORS:
+        if descriptors not in ("wks", "hks"):
             raise ValueError(
                 f"unknown descriptors {descriptors!r}; choose 'wks', 'hks' or pass a pair of "
                 "arrays (n_a, d), (n_b, d)"
