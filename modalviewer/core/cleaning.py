@@ -84,16 +84,15 @@ def _collapsible(p: int, q: int, v, f, topo, min_area: float) -> bool:
     return True
 
 
-def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max_rounds=100):
+def _repair_zero_area(v, f, min_area: float, diag: float, report: MeshReport, max_rounds=100):
     """Remove every face of area at most ``min_area`` without opening holes, in rounds
     of non-adjacent changes until none is left or none can be made: flip its longest
     edge where the apex lies a tenth to nine tenths along it (a remesh's T-junction: no
     vertex moves); else merge the apex into the nearer end of that edge, or collapse its
     other edges, shortest first, where the surface stays a manifold and no face turns
-    over (:func:`_collapsible`); a face whose longest edge is on the boundary is removed.
-
-    Returns (faces, flipped edges, collapsed edges, faces removed along the boundary,
-    largest move, faces still of zero area, (n,) vertex each vertex was merged into).
+    over (:func:`_collapsible`); a face whose longest edge is on the boundary is removed;
+    one that none of these can remove is dropped.  Says each in ``report``; returns
+    (faces, (n,) vertex each vertex was merged into).
     """
     n = len(v)
     f = f.copy()
@@ -160,7 +159,31 @@ def _collapse_zero_area_faces(v: np.ndarray, f: np.ndarray, min_area: float, max
         f = remap[f[~drop]]
         f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
     left = int((0.5 * _double_areas(v, f) <= min_area).sum()) if len(f) else 0
-    return f, flipped, collapsed, dropped, largest, left, merged_into
+    if flipped:
+        report.add(
+            f"Flipped the longest edge of {_plural(flipped, 'degenerate (zero-area) face')}"
+            " (a vertex lying inside that edge: the two faces on it became two faces "
+            "with area; no vertex moved, no holes opened)."
+        )
+    if collapsed:
+        report.add(
+            f"Collapsed {_plural(collapsed, 'degenerate (zero-area) face')} (merged the "
+            "two vertices of each one's shortest edge, moving none more than "
+            f"{largest / diag:.1e} of the bounding-box diagonal; no holes opened)."
+        )
+    if dropped:
+        report.add(
+            f"Removed {_plural(dropped, 'degenerate (zero-area) face')} lying along the "
+            "boundary (the boundary keeps its shape)."
+        )
+    if left:
+        f = f[0.5 * _double_areas(v, f) > min_area]
+        report.add(
+            f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
+            "flipped or collapsed without tearing or folding the surface (this can "
+            "leave holes)."
+        )
+    return f, merged_into
 
 
 def _topology(f: np.ndarray, n: int):
@@ -321,7 +344,8 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
             f = f[np.sort(keep)]
     min_area = 1e-14 * diag**2
     if len(f) and np.any(0.5 * _double_areas(v, f) <= min_area):
-        f, file_map = _repair_zero_area(v, f, file_map, min_area, diag, report)
+        f, merged_into = _repair_zero_area(v, f, min_area, diag, report)
+        file_map = merged_into[file_map]
     if len(f) == 0:
         raise MeshError("no faces are left after removing degenerate ones: not a surface")
 
@@ -356,37 +380,3 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
     if problem:
         report.add("Shells and E_D^N cannot run: " + problem)
     return mesh
-
-
-def _repair_zero_area(v, f, file_map, min_area: float, diag: float, report: MeshReport):
-    """:func:`_collapse_zero_area_faces`, saying so in ``report``: (faces, file_map with
-    the collapsed vertices merged)."""
-    f, n_flipped, n_collapsed, dropped, largest, left, merged_into = _collapse_zero_area_faces(
-        v, f, min_area
-    )
-    file_map = merged_into[file_map]
-    if n_flipped:
-        report.add(
-            f"Flipped the longest edge of {_plural(n_flipped, 'degenerate (zero-area) face')}"
-            " (a vertex lying inside that edge: the two faces on it became two faces "
-            "with area; no vertex moved, no holes opened)."
-        )
-    if n_collapsed:
-        report.add(
-            f"Collapsed {_plural(n_collapsed, 'degenerate (zero-area) face')} (merged the "
-            "two vertices of each one's shortest edge, moving none more than "
-            f"{largest / diag:.1e} of the bounding-box diagonal; no holes opened)."
-        )
-    if dropped:
-        report.add(
-            f"Removed {_plural(dropped, 'degenerate (zero-area) face')} lying along the "
-            "boundary (the boundary keeps its shape)."
-        )
-    if left:
-        f = f[0.5 * _double_areas(v, f) > min_area]
-        report.add(
-            f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
-            "flipped or collapsed without tearing or folding the surface (this can "
-            "leave holes)."
-        )
-    return f, file_map
