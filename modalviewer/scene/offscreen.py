@@ -52,8 +52,7 @@ class OffscreenRenderer:
             self.drawing.reset_camera()
 
     def set_camera(self, camera: dict | None) -> None:
-        """Look from ``camera`` (position, focal point, view up as plain data, e.g. a
-        window's); None keeps the camera."""
+        """Look from ``camera`` as plain data (a window's); None keeps the camera."""
         if camera is None or self.scene is None:
             return
         from ..viewer.camera import Camera
@@ -63,10 +62,8 @@ class OffscreenRenderer:
     def frame(
         self, reach: float | None = None, both: bool = False, colorbar: bool | None = None
     ) -> None:
-        """Fit the camera, keeping its direction, so that the shape fills the picture
-        clear of the legend and colour bar (:func:`.framing.fit_points`): the rest shape
-        and the surface displaced by ``reach`` times its displacement (default: as the
-        field draws it), and by minus that too with ``both`` (a whole vibration)."""
+        """Fit the camera, keeping its direction, to the shape clear of the legend and colour
+        bar: :meth:`.MeshScene.motion_points` at ``reach`` (default: as drawn)."""
         from .framing import fit_clear_of_overlay
 
         scene = self.scene
@@ -90,8 +87,7 @@ class OffscreenRenderer:
         colorbar: bool | None = None,
         marker: bool = True,
     ):
-        """The picture as an (h, w, 3 or 4) uint8 array, legend and colour bar drawn on
-        (and the pick marker if ``marker``)."""
+        """The picture as an (h, w, 3 or 4) uint8 array, legend and colour bar drawn on."""
         from .export import grab
 
         return grab(self.plotter, self.scene, scale, transparent, colorbar=colorbar, marker=marker)

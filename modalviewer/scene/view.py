@@ -17,14 +17,13 @@ from ..viewer import wording
 from ..viewer.camera import Camera
 from ..viewer.derived import Field
 from ..viewer.state import ViewerState
+from .isolines import line_polydata
 from .mesh_scene import MeshScene, add_actor
 
 
 def draw_field(scene: MeshScene, field: Field | None) -> None:
-    """Colour ``scene``'s surface by ``field`` (None or "plain": the grey surface), drawn
-    displaced by ``field.deformation`` with the rest shape's ghost as the field says; no
-    render.  The one way a :class:`~modalviewer.viewer.derived.Field` becomes a picture,
-    in the main view, the compare views and off screen."""
+    """Colour ``scene``'s surface by ``field`` (None: the grey surface), displaced and with
+    the ghost as it says: the one way a field becomes a picture, in every view."""
     scene.set_displacement_scale(0.0)
     if field is None or field.colormap == "plain":
         scene.show_plain()
@@ -48,10 +47,8 @@ def draw_field(scene: MeshScene, field: Field | None) -> None:
 
 
 def label_field(scene: MeshScene, field: Field | None) -> None:
-    """The colour bar of a picture drawn by :func:`draw_field` without a legend (the
-    compare views): a continuous field's bar titled and ranged as the field; a threshold
-    map's two swatches ("<title> < threshold", "the rest"); none for the plain surface.
-    No render."""
+    """The colour bar of ``field`` drawn without a legend (the compare views); a threshold
+    map's is two swatches ("<title> < threshold", "the rest")."""
     if field is None or field.colormap == "plain":
         scene.set_colorbar(None)
     elif field.colormap == "threshold":
@@ -81,7 +78,6 @@ class StateScene:
             event.connect(slot)
 
     def _connections(self) -> tuple:
-        """(event of the state, slot) of every state change the picture follows."""
         events = self.state.events
         return (
             (events.mesh, self._on_mesh),
@@ -95,15 +91,13 @@ class StateScene:
 
     # -------------------------------------------------------------- mesh
     def sync(self) -> None:
-        """Draw the state as it is now (a scene attached to a state already in use): the
-        mesh in its first view, then the field, the pick and a camera the state sets."""
+        """Draw the state as it is now (a scene attached to a state already in use)."""
         self._on_mesh()
         self.redraw()
         self._on_pick()
         self._apply_camera()
 
     def close(self) -> None:
-        """Stop observing the state and drop the actors."""
         for event, slot in self._connections():
             event.disconnect(slot)
         if self.scene is not None:
@@ -179,8 +173,7 @@ class StateScene:
         self.scene.show_marker(self.state.picked)  # on the surface as drawn
 
     def _show_outline_if_due(self) -> None:
-        """The boundary outline stays at the rest shape: shown on a still rest shape
-        and with the ghost of a deformed one."""
+        """The outline stays at the rest shape: shown with it, or with a deformed one's ghost."""
         if self.outline_actor is None:
             return
         field = self.field
@@ -195,15 +188,12 @@ class StateScene:
         the viewer is as white as the background, so an open mesh (a plate) seen from
         the front had no visible edge.  Hidden while a mode vibrates or is drawn deformed
         (it would stay put), unless the rest shape's ghost is shown."""
-        import pyvista as pv
-
         self.plotter.remove_actor("outline", render=False)
         self.outline_actor = None
         boundary = mesh.edges[mesh.edge_face_counts == 1]
         if len(boundary) == 0:
             return
-        cells = np.column_stack([np.full(len(boundary), 2), boundary]).ravel()
-        lines = pv.PolyData(np.asarray(mesh.vertices, dtype=np.float64), lines=cells)
+        lines = line_polydata(np.asarray(mesh.vertices, dtype=np.float64)[boundary], None)
         self.outline_actor = add_actor(
             self.plotter, lines, "outline", color=(0.45, 0.45, 0.45), line_width=1.5
         )
@@ -215,8 +205,7 @@ class StateScene:
 
     # ------------------------------------------------------------ legend
     def _update_colorbar(self) -> None:
-        """Legend and colour bar as the style asks (both on or both off), titles in
-        words; a threshold map gets a two-swatch legend that follows the threshold."""
+        """Legend and colour bar as the style asks; a threshold map's follows the threshold."""
         scene, field = self.scene, self.field
         if scene is None:
             return
@@ -240,14 +229,12 @@ class StateScene:
 
     # ------------------------------------------------------------ camera
     def reset_camera(self, preset: str = "canonical") -> None:
-        """The mesh's canonical view fitted to the window (R), or a ``preset``: from a
-        side ("+x" ... "-z") or "isometric"."""
+        """The mesh's canonical view (R), or camera ``preset`` ("+x" ... "-z", "isometric")."""
         if self.scene is not None:
             self.scene.apply_camera_preset(preset)
             self.request_render()
 
     def _on_up_axis(self) -> None:
-        """A chosen up axis: the canonical view for it."""
         if self.scene is not None:
             self.scene.up_axis = self.state.derived.up_axis()
             self.reset_camera()
@@ -260,7 +247,6 @@ class StateScene:
         self.request_render()
 
     def current_camera(self) -> dict:
-        """The camera as plain data (for sessions)."""
         cam = self.plotter.camera
         return Camera(cam.position, cam.focal_point, cam.up).as_dict()
 
@@ -281,9 +267,8 @@ class StateScene:
             self.on_animation(playing)
 
     def animation_frame(self, phase: float) -> float:
-        """Move the surface to ``phase`` (radians) of the vibration, ``sin(phase)`` of the
-        amplitude, a signed mode's colours scaled by the same factor (they change sign
-        with the motion); returns the time this took in s."""
+        """Move the surface and scale a signed mode's colours to ``sin(phase)`` of the
+        amplitude; returns the time this took in s."""
         started = time.perf_counter()
         amplitude = self.state.derived.amplitude_length()
         self.scene.set_displacement_scale(amplitude * np.sin(phase))
