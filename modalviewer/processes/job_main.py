@@ -23,6 +23,19 @@ def emit(payload: dict) -> None:
     sys.stdout.flush()
 
 
+def reported(work, short_of_memory: str) -> int:
+    """Run ``work()``; a failure goes to the viewer as ``{"error": ...}`` and exit code 1."""
+    try:
+        work()
+    except MemoryError:
+        emit({"error": short_of_memory})
+        return 1
+    except Exception as exc:  # reported to the viewer as a message
+        emit({"error": str(exc) or type(exc).__name__})
+        return 1
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     job_path, out_path = argv
@@ -32,7 +45,8 @@ def main(argv: list[str] | None = None) -> int:
     from ..core.spectrum import save_spectrum
 
     prepare_compute_process()  # this process exists to compute (see core.memory)
-    try:
+
+    def work() -> None:
         with np.load(job_path, allow_pickle=False) as job:
             vertices, faces = job["vertices"], job["faces"]
             params = json.loads(str(job["params"]))
@@ -49,14 +63,9 @@ def main(argv: list[str] | None = None) -> int:
         )
         emit({"stage": "writing the result", "fraction": 0.97})
         save_spectrum(spec, out_path)
-    except MemoryError:
-        emit({"error": "not enough memory for this computation; try fewer modes"})
-        return 1
-    except Exception as exc:  # reported to the viewer as a message
-        emit({"error": str(exc) or type(exc).__name__})
-        return 1
-    emit({"done": out_path})
-    return 0
+        emit({"done": out_path})
+
+    return reported(work, "not enough memory for this computation; try fewer modes")
 
 
 class _ModesRelay:

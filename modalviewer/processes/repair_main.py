@@ -10,7 +10,7 @@ from __future__ import annotations
 import pickle
 import sys
 
-from .job_main import emit
+from .job_main import emit, reported
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -18,7 +18,7 @@ def main(argv: list[str] | None = None) -> int:
     from ..core.mesh import Mesh
     from ..repair import apply_repair
 
-    try:
+    def work() -> None:
         with open(job_path, "rb") as fh:
             name, vertices, faces, report, file_map, merged_into = pickle.load(fh)
         mesh = Mesh(vertices, faces, report=report, file_map=file_map, merged_into=merged_into)
@@ -27,13 +27,8 @@ def main(argv: list[str] | None = None) -> int:
         )
         with open(out_path, "wb") as fh:
             pickle.dump(repaired, fh)
-    except MemoryError:
-        emit({"error": "not enough memory for this repair"})
-        return 1
-    except Exception as exc:  # reported to the viewer as a message
-        emit({"error": str(exc) or type(exc).__name__})
-        return 1
-    return 0
+
+    return reported(work, "not enough memory for this repair")
 
 
 if __name__ == "__main__":
