@@ -36,15 +36,11 @@ def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
     return mask
 
 
-def _nonzero_eigenvalues(spec: Spectrum) -> np.ndarray:
-    return spec.eigenvalues[_used(spec, False)]
-
-
 def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False) -> np.ndarray:
     """``samples`` log-spaced scales from ``4 ln 10`` over the largest to over the
     smallest non-zero eigenvalue (``include_zero`` does not change the range)."""
     samples = check_count(samples, "samples", 2)
-    lam = _nonzero_eigenvalues(spec)
+    lam = spec.eigenvalues[_used(spec, False)]
     t1 = 4.0 * np.log(10.0) / lam.max()
     t2 = 4.0 * np.log(10.0) / lam.min()
     return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
@@ -68,7 +64,7 @@ def wks_sigma(energies: Sequence[float] | np.ndarray) -> float:
 
 
 def _positive_eigenvalues(spec: Spectrum) -> np.ndarray:
-    lam = _nonzero_eigenvalues(spec)
+    lam = spec.eigenvalues[_used(spec, False)]
     if lam.min() <= 0:
         raise ValueError(
             f"the wave kernel signature needs positive eigenvalues; this spectrum has "
@@ -93,6 +89,8 @@ def signature(
     :func:`default_times`), with or without the zero modes.  ``kind="wks"``: ``W_E(v)``
     at ``energies`` (default :func:`default_energies`) of width ``sigma`` in log-energy
     (default :func:`wks_sigma`) instead (module docstring)."""
+    if vertices is not None:
+        vertices = check_vertices(vertices, spec.n_vertices, allow_empty=True)
     if _check_kind(kind) == "wks":
         if times is not None or include_zero:
             raise ValueError(
@@ -103,8 +101,6 @@ def signature(
         sigma = wks_sigma(energies) if sigma is None else float(sigma)
         if not (np.isfinite(sigma) and sigma > 0):
             raise ValueError(f"sigma must be positive and finite, got {sigma!r}")
-        if vertices is not None:
-            vertices = check_vertices(vertices, spec.n_vertices, allow_empty=True)
         gap = np.log(energies)[None, :] - np.log(_positive_eigenvalues(spec))[:, None]
         weights = np.exp(-(gap**2) / (2.0 * sigma**2))  # (k', T) over the non-zero modes
         squared = spec.squared_modes(vertices)[:, ~spec.zero_mode_mask()]
@@ -114,8 +110,6 @@ def signature(
     mask = _used(spec, include_zero)
     times = default_times(spec, include_zero=include_zero) if times is None else times
     times = check_times(times)
-    if vertices is not None:
-        vertices = check_vertices(vertices, spec.n_vertices, allow_empty=True)
     lam = spec.eigenvalues[mask]
     weights = np.exp(-np.outer(lam, times))  # (k, T)
     values = spec.squared_modes(vertices)[:, mask] @ weights
