@@ -120,19 +120,15 @@ class ScreenshotDialog(_ExportDialog):
             form.addRow(self.marker)
         self._finish()
 
-    def size(self) -> tuple[int, int] | None:
-        if self.width_box is None:
-            return None
-        return self.width_box.value(), self.height_box.value()
-
     def values(self):
-        """(path, scale, transparent, colour bar, (width, height), marker)."""
+        """(path, scale, transparent, colour bar, (width, height) or None, marker)."""
+        size = None if self.width_box is None else (self.width_box.value(), self.height_box.value())
         return (
             self.path_edit.text(),
             self.scale.value(),
             self.transparent.isChecked(),
             self.colorbar.isChecked(),
-            self.size(),
+            size,
             self.marker.isChecked(),
         )
 

@@ -28,12 +28,9 @@ from .viewport import make_viewport
 from .views_window import ViewsWindow
 
 RESCALE_TIP = (
-    "Scale both meshes to unit area before their spectra are computed (the distances are "
-    "shown on the meshes as loaded).\nHeat kernel and feature signatures carry a factor "
-    "1/area, so two copies of one shape of different size differ everywhere; the Discrete "
-    "Shells spectrum is not scale covariant at all (bending, stretching and area terms "
-    "scale by different powers of the size), so a larger copy vibrates differently, not "
-    "just slower. Untick only for meshes known to share one scale."
+    "Scale both meshes to unit area before computing their spectra (distances are shown on "
+    "the meshes as loaded): signatures carry a factor 1/area, and the Discrete Shells "
+    "spectrum is not scale covariant. Untick only for meshes known to share one scale."
 )
 KIND_TIP = (
     "The signature compared: vibration (Discrete Shells), feature (E_D^N), heat kernel or "

@@ -30,9 +30,8 @@ class ComputePanel(QtWidgets.QWidget):
         self.k_spin = spin_box(
             1,
             K_MAX,
-            tip="Number of modes (lowest eigenpairs) to compute. A mesh has as many as it "
-            "has unknowns (vertices, three per vertex for the 3D shells); a request that "
-            "would not fit in memory is refused with what would.",
+            tip="Number of modes (lowest eigenpairs) to compute; a request that would not "
+            "fit in memory is refused with what would.",
         )
         self.bending_spin, self.membrane_spin = (
             QtWidgets.QDoubleSpinBox(decimals=4, maximum=1e6) for _ in range(2)
@@ -45,8 +44,7 @@ class ComputePanel(QtWidgets.QWidget):
         self.coarse_check = QtWidgets.QCheckBox(
             "Coarse-to-fine (default: off)",
             toolTip="Compute on a copy decimated to about a fifth of the vertices and carry "
-            "the modes to this mesh by nearest vertex (paper Section 7): much faster on big "
-            "meshes.",
+            "the modes to this mesh (paper Section 7): much faster on big meshes.",
         )
         compute_tip = "Compute the selected operator's spectrum (Ctrl+R)"
         self.compute_button = QtWidgets.QPushButton("Compute spectrum", toolTip=compute_tip)

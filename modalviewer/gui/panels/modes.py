@@ -47,18 +47,8 @@ class ModesPanel(QtWidgets.QWidget):
         self.color_combo = add_items(
             combo(),
             (
-                (
-                    "Deformed shape",
-                    "deformed",
-                    "The surface displaced by the mode (Amplitude), coloured by the mode's "
-                    "|Phi| per vertex (Mass-normalised, whatever the Amplitude); the rest "
-                    "shape as a grey ghost (G)",
-                ),
-                (
-                    "Normal component on rest shape",
-                    "normal",
-                    "The displacement along smoothed normals, signed, on the rest shape",
-                ),
+                ("Deformed shape", "deformed", "Displaced by the mode, coloured by its |Phi|"),
+                ("Normal component on rest shape", "normal", "Signed, along smoothed normals"),
                 ("Magnitude on rest shape", "magnitude", "|displacement| on the rest shape"),
             ),
         )
