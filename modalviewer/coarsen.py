@@ -34,10 +34,8 @@ def decimated_copy(mesh: Mesh, fraction: float = COARSE_FRACTION) -> Mesh:
 
 
 def transfer_spectrum(coarse_spec: Spectrum, coarse: Mesh, fine: Mesh) -> Spectrum:
-    """Carry a coarse mesh's spectrum to the fine mesh by nearest-vertex lookup: the
-    eigenvalues are kept and each fine vertex takes the modes of the nearest coarse
-    vertex.  The modes are not Mass-orthonormal on the fine mesh; signatures and
-    distances from them approximate the fine ones."""
+    """The coarse spectrum on the fine mesh, each vertex taking its nearest coarse vertex's
+    modes (not Mass-orthonormal there: signatures and distances approximate the fine ones)."""
     _, nearest = cKDTree(coarse.vertices).query(fine.vertices)
     params = dict(coarse_spec.parameters)
     params.update(transferred_from=coarse.hash, coarse_vertices=coarse.n_vertices)
@@ -62,8 +60,7 @@ def coarse_to_fine_spectrum(
     cancel: CancelFn | None = None,
     fraction: float = COARSE_FRACTION,
 ) -> Spectrum:
-    """The ``k`` lowest modes (at most the copy's unknowns) of ``operator`` on a copy of
-    ``mesh`` decimated to ``fraction`` of its vertices, carried to ``mesh``."""
+    """The ``k`` lowest modes of ``operator`` on a decimated copy, carried to ``mesh``."""
     if progress is not None:
         progress("decimating", 0.0)
     coarse = decimated_copy(mesh, fraction)

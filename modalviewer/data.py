@@ -37,8 +37,7 @@ def assets_dir() -> Path:
 
 
 def asset_path(name: str) -> Path:
-    """The path of a bundled file (``spot.obj``, ``demo_hand.obj``, ...), in a checkout
-    or an installed package; a FileNotFoundError listing the bundled files."""
+    """The path of a bundled file (``spot.obj``, ...); a FileNotFoundError lists them."""
     path = assets_dir() / name
     if not path.is_file():
         names = sorted(p.name for p in assets_dir().iterdir() if p.is_file())

@@ -40,8 +40,7 @@ class MissingExtraError(ModuleNotFoundError):
 @contextmanager
 def extra_needed(what: str):
     """Run the block; an optional package it fails to import becomes a
-    :class:`MissingExtraError` saying that ``what`` needs it and how to install it.
-    A missing module that is no optional package's is raised as it is."""
+    :class:`MissingExtraError` saying that ``what`` needs it and how to install it."""
     try:
         yield
     except MissingExtraError:

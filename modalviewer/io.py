@@ -37,8 +37,7 @@ def pyvista_arrays(data) -> tuple[np.ndarray, np.ndarray, list[str]]:
 
 
 def read_file(path, strict: bool = True) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """Raw vertices (n, 3) (every vertex of the file, in its order), triangles (m, 3) and
-    damage notes of a mesh file; ``strict`` as in :func:`load_mesh`."""
+    """Every vertex of a mesh file in its order, the triangles and the damage notes."""
     path = Path(path)
     ext = path.suffix.lower()
     by_meshio = ext not in SUPPORTED_EXTENSIONS and ext in _meshio_extensions()
@@ -87,9 +86,8 @@ AMBIGUOUS_EXTENSIONS = (".dat", ".xml", ".svg", ".node", ".ele", ".wkt", ".txt")
 
 
 def is_mesh_file(path, in_folder: bool = False) -> bool:
-    """Whether ``path``'s name ends in an extension :func:`load_mesh` reads (its own
-    readers', and meshio's where meshio is installed); ``in_folder``: for a folder's
-    search, without :data:`AMBIGUOUS_EXTENSIONS`."""
+    """Whether :func:`load_mesh` reads ``path``'s extension (``in_folder``: a folder's search,
+    without :data:`AMBIGUOUS_EXTENSIONS`)."""
     name = Path(path).name.lower()
     extensions = SUPPORTED_EXTENSIONS + _meshio_extensions()
     if in_folder:
@@ -146,8 +144,7 @@ def load_mesh(path, repair: bool = True, strict: bool = True) -> Mesh:
 
 
 def mesh_from_arrays(vertices, faces, source: str, repair: bool = True, notes=()) -> Mesh:
-    """The :class:`Mesh` of raw arrays read from ``source`` (a name for messages), with
-    the repair and report of :func:`load_mesh`; ``notes`` are added to the report."""
+    """The :class:`Mesh` of raw arrays as :func:`load_mesh` makes it, ``notes`` in its report."""
     vertices = np.asarray(vertices)
     if len(faces) == 0:
         raise MeshError(

@@ -129,9 +129,8 @@ def _mesh_file(vertices, polygons: list, unplaced: list, damage: _Damage, place)
 
 
 def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
-    """(len(rows), width) numbers of text rows that each hold exactly ``width`` of them,
-    parsed by numpy in one go; None where a row holds another count or a word that is
-    not a number (the record-by-record reader then finds and names it)."""
+    """(len(rows), width) numbers of rows of ``width`` numbers each, parsed by numpy in one
+    go; None otherwise (the record-by-record reader then finds and names the problem)."""
     if any(len(row.split()) != width for row in rows):
         return None
     try:
@@ -141,8 +140,7 @@ def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
 
 
 def _triangle_rows(rows: list[str], n_vertices: int) -> np.ndarray | None:
-    """(m, 3) triangles of rows "3 a b c" (OFF, ASCII PLY) naming existing vertices, or
-    None for any other rows."""
+    """(m, 3) triangles of rows "3 a b c" naming existing vertices, or None."""
     table = _numbers(rows, 4, np.int64)
     if table is None or not (table[:, 0] == 3).all():
         return None
@@ -156,9 +154,8 @@ def _triangle_rows(rows: list[str], n_vertices: int) -> np.ndarray | None:
 
 
 def _read_obj_fast(text: str) -> tuple[np.ndarray, np.ndarray] | None:
-    """Vertices and triangles of a well-formed OBJ of triangles (every ``v`` line with
-    the same count of numbers, at least three, every ``f`` line three positive indices);
-    None for any other file, which the line-by-line reader then reads and checks."""
+    """Vertices and triangles of a well-formed OBJ of triangles, or None for any other file
+    (which the line-by-line reader then reads and checks)."""
     lines = text.splitlines()
     if any(line.rstrip() in ("v", "f") for line in lines):  # a bare record: cut there
         return None
@@ -403,9 +400,8 @@ def _ply_ascii(lines, damage, name, count, props, line_index):
 
 
 def _ascii_fast(elements, body: str) -> tuple[np.ndarray, np.ndarray] | None:
-    """Vertices and triangles of a well-formed ASCII body of scalar vertex properties and
-    triangles only, without comments (the counts met exactly), parsed by numpy in one
-    go; None for any other, which the record-by-record reader then reads and checks."""
+    """Vertices and triangles of a well-formed ASCII body of vertices and triangles, or None
+    for any other (which the record-by-record reader then reads and checks)."""
     if [name for name, _, _ in elements] != ["vertex", "face"] or "#" in body:
         return None
     (_, n, vertex_props), (_, m, face_props) = elements
@@ -425,8 +421,7 @@ def _ascii_fast(elements, body: str) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _read_ascii(path: Path, elements, body: str, first: int, damage: _Damage) -> MeshFile:
-    """The elements of an ASCII PLY's or an OFF file's ``body``, whose first line is the
-    file's line ``first``."""
+    """The elements of an ASCII PLY's or OFF's ``body``, starting at the file's line ``first``."""
     _check_last_line(body, damage, "", first)
     fast = _ascii_fast(elements, body)
     if fast is not None:
@@ -597,9 +592,7 @@ READERS = {".obj": _read_obj, ".off": _read_off, ".ply": _read_ply, ".stl": _rea
 
 
 def read_mesh_file(path, strict: bool = True) -> MeshFile:
-    """Vertices, triangles and damage notes of an OBJ, PLY, OFF or STL file.  A
-    :class:`MeshError` where the file is not of its format at all, and with
-    ``strict=True`` at the first damaged or missing record, naming the file, the line or
-    element and what is missing."""
+    """Vertices, triangles and damage notes of an OBJ, PLY, OFF or STL file (see the module
+    docstring for ``strict``)."""
     path = Path(path)
     return READERS[path.suffix.lower()](path, strict)

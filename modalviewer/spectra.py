@@ -28,12 +28,9 @@ def cached_or_computed(
     coarse: bool = False,
     child_process: bool = False,
 ) -> Spectrum:
-    """``operator``'s ``k`` lowest modes on ``mesh``, read from ``cache`` (default: the
-    user's :class:`.core.cache.SpectrumCache`) or computed and stored there.  ``coarse``:
-    the coarse-to-fine approximation (never cached); ``child_process``: exact solves of at
-    least :data:`PROCESS_THRESHOLD` unknowns run in a child process that writes the cache
-    entry itself; ``progress``, ``cancel`` and ``on_modes``:
-    :func:`modalviewer.compute_spectrum`'s."""
+    """``operator``'s ``k`` lowest modes on ``mesh`` from ``cache`` (default the user's), or
+    computed and stored there (by a child process with ``child_process`` from
+    :data:`PROCESS_THRESHOLD` unknowns); ``coarse``: coarse-to-fine, never cached."""
     cache = cache if cache is not None else SpectrumCache()
     weights = bending, membrane
     if coarse:

@@ -96,8 +96,7 @@ class _ModesRelay:
 
 
 def _report(stage: str, fraction: float) -> None:
-    """Progress to the viewer; the computation's own "done" is not the end of the job
-    (the spectrum is still written, read back and prepared), so it stops below 1."""
+    """Progress to the viewer, below 1: the spectrum is still written and read back after."""
     if stage == "done":
         return
     emit({"stage": stage, "fraction": min(float(fraction), 0.96)})

@@ -50,8 +50,7 @@ def frame_phases(frames: int) -> np.ndarray:
 
 
 def animation_path(path) -> Path:
-    """``path`` checked as an animation to write: .gif, or .mp4 where its writer is
-    installed; its folder made.  ValueError otherwise, saying what to do."""
+    """``path`` checked as a .gif or a writable .mp4, its folder made; ValueError otherwise."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in ANIMATION_SUFFIXES:
@@ -101,8 +100,7 @@ def _write_mp4(path, images, fps) -> None:
 
 
 def write_animation(path, images: list[np.ndarray], fps: float = DEFAULT_FPS) -> Path:
-    """Write ``images`` (equal-sized RGB uint8 frames) to ``path`` (.gif or .mp4) playing
-    at ``fps``, atomically; returns the path."""
+    """Write equal-sized RGB frames to ``path`` (.gif or .mp4) atomically; returns the path."""
     if not images:
         raise ValueError("an animation needs at least one frame")
     path = animation_path(path)

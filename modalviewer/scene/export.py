@@ -21,10 +21,8 @@ def grab(
     colorbar: bool | None = None,
     marker: bool = True,
 ) -> np.ndarray:
-    """The plotter's view rendered at ``scale`` times its size, (h, w, 3 or 4) uint8, with
-    the legend (if ``legend``) and colour bar (None: as on screen; a two-swatch legend for
-    threshold maps) drawn at the same scale, also on a transparent background.  ``scene``
-    defaults to the plotter's; without ``marker`` its pick marker is left out."""
+    """The plotter's view at ``scale`` times its size, (h, w, 3 or 4) uint8, with ``scene``'s
+    (default the plotter's) legend and colour bar (None: as on screen) drawn at that scale."""
     from .overlay import draw_overlay
 
     scale = int(max(1, scale))
@@ -101,9 +99,8 @@ def save_png(path, img: np.ndarray) -> Path:
 
 
 def save_field_mesh(path: Path, mesh: Mesh, fields: dict[str, np.ndarray]) -> Path:
-    """Write the mesh with per-vertex ``fields`` as point data to .vtp or .ply, one point
-    per input vertex in its order (NaN at vertices no face uses); a solver mesh of
-    another numbering also gets ``file_vertex``, each point's input vertex number."""
+    """Write the mesh with per-vertex ``fields`` to .vtp or .ply, one point per input vertex
+    (and ``file_vertex``, each point's input number, where the solver renumbered)."""
     from ..interop import to_pyvista
 
     path = Path(path)

@@ -14,10 +14,8 @@ FIT_STEPS = 6
 
 
 def overlay_boxes(width: int, height: int, overlay, scale: float = 1.0):
-    """((legend width, legend height), colour bar height) in pixels: the legend's box at
-    the top left of a ``width`` x ``height`` picture and the rows the colour bar takes at
-    its bottom, as :func:`.overlay.draw_overlay` draws them (measured on a blank image,
-    so any layout of theirs is followed)."""
+    """((legend width, legend height), colour bar height) in pixels, measured on a blank
+    image drawn by :func:`.overlay.draw_overlay` (so any layout of theirs is followed)."""
     from .overlay import Overlay, draw_overlay
 
     legend, bottom = (0, 0), 0
@@ -69,10 +67,8 @@ def fit_clear_of_overlay(renderer, points, size, overlay, scale: float = 1.0) ->
 def fit_points(
     renderer, points: np.ndarray, size, left: int = 0, top: int = 0, right: int = 0, bottom: int = 0
 ) -> None:
-    """Move ``renderer``'s camera, keeping its direction, so that ``points`` fill the
-    free part of a ``size`` (width, height) picture: ``left``, ``top``, ``right`` and
-    ``bottom`` pixels in from its edges, and :data:`MARGIN` more.  Pans and dollies (or scales a
-    parallel projection) in :data:`FIT_STEPS` steps; no render."""
+    """Pan and dolly the camera, keeping its direction, so that ``points`` fill ``size``
+    less the pixels at ``left`` ... ``bottom`` and :data:`MARGIN`."""
     w, h = (int(size[0]), int(size[1]))
     points = np.asarray(points, dtype=np.float64)
     if len(points) == 0 or w < 2 or h < 2:
@@ -144,7 +140,5 @@ def view_angle_on_smaller_side(renderer) -> None:
 
 
 def fit_smaller_side(renderer) -> None:
-    """Before every render, let the camera's view angle apply to the smaller side of the
-    view (:func:`view_angle_on_smaller_side`): the window's views and the off-screen
-    plotter alike."""
+    """Run :func:`view_angle_on_smaller_side` before every render of ``renderer``."""
     renderer.AddObserver("StartEvent", lambda *_: view_angle_on_smaller_side(renderer))

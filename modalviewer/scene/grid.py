@@ -14,8 +14,7 @@ GRID_PANEL = (400, 340)
 
 
 def grid_shape(count: int, grid=None) -> tuple[int, int]:
-    """(columns, rows) of a grid of ``count`` panels: ``grid`` where given (enough
-    cells: ValueError otherwise), else one row up to 4 panels, then rows of 4."""
+    """(columns, rows) for ``count`` panels: ``grid`` if it has room, else rows of up to 4."""
     if grid is not None:
         columns, rows = (int(x) for x in grid)
         if columns < 1 or rows < 1 or columns * rows < count:
@@ -40,8 +39,7 @@ def arrange(images: list[np.ndarray], columns: int, gap: int = 4) -> np.ndarray:
 
 
 def bar_strip(width: int, colorbar, scale: float = 1.0) -> np.ndarray:
-    """A white strip ``width`` pixels wide holding ``colorbar`` as a picture's bottom
-    holds it (:func:`.overlay.draw_overlay`)."""
+    """A white strip ``width`` pixels wide holding ``colorbar`` as a picture's bottom does."""
     from .framing import overlay_boxes
     from .overlay import Overlay, draw_overlay
 
@@ -60,8 +58,7 @@ BAR_PX = 66
 
 
 def panel_size(total, count: int, grid=None, gap: int = 4) -> tuple[int, int]:
-    """The panel size that makes a grid of ``count`` panels, with one-line captions and
-    the colour bar's strip, at most ``total`` (width, height) pixels."""
+    """The panel size of a captioned grid of ``count`` panels fitting in ``total`` pixels."""
     columns, rows = grid_shape(count, grid)
     w = (int(total[0]) - gap * (columns - 1)) // columns
     h = (int(total[1]) - BAR_PX - rows * CAPTION_PX - gap * (rows - 1)) // rows
@@ -71,9 +68,7 @@ def panel_size(total, count: int, grid=None, gap: int = 4) -> tuple[int, int]:
 
 
 def padded(img: np.ndarray, total) -> np.ndarray:
-    """``img`` on a white canvas of ``total`` (width, height) pixels, at its top left
-    (a grid's rounding leaves a few rows or columns); larger images are returned as
-    they are."""
+    """``img`` at the top left of a white canvas of ``total`` pixels (a grid's rounding)."""
     w, h = int(total[0]), int(total[1])
     if img.shape[1] > w or img.shape[0] > h:
         return img
@@ -83,11 +78,8 @@ def padded(img: np.ndarray, total) -> np.ndarray:
 
 
 def mode_grid(viewer, modes, operator: str | None = None, grid=None, size=GRID_PANEL):
-    """The picture (RGB uint8) of ``modes`` of ``operator`` (default: the one shown) of
-    ``viewer``'s mesh: panels of ``size`` pixels in a ``grid`` (columns, rows), each
-    drawn as the viewer draws the mode, from one camera fitted to every panel, captioned
-    "mode j: lambda = ...", coloured over one range (the largest |value| shown) with one
-    colour bar.  The viewer's display is restored after."""
+    """``modes`` of ``operator`` (default the one shown) drawn as the viewer draws them, in
+    ``grid`` panels of ``size``: one camera, one colour range and bar; RGB uint8."""
     from ..core.operators import operator_info
     from .comparison import caption
     from .export import grab

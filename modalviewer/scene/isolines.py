@@ -31,11 +31,10 @@ def line_polydata(seg: np.ndarray, disp: np.ndarray | None) -> pv.PolyData:
 
 
 def segments(points, faces, values, levels, displacement=None):
-    """Isolines of a piecewise-linear field as line segments, one per crossed triangle
-    and level (vectorised; VTK's contour filter is slower): segments (s, 2, 3), their
-    ``displacement`` (s, 2, 3) or None, the level of each (s,), its triangle (s,) and the
-    mesh edges its two ends lie on (s, 2, 2), each edge as (smaller, larger) vertex.  A
-    vertex exactly at a level counts as above it, so each crossing gives one segment."""
+    """Isolines of a piecewise-linear field, one segment per crossed triangle and level
+    (vectorised; VTK's contour filter is slower): segments (s, 2, 3), their
+    ``displacement`` or None, level (s,), triangle (s,) and the mesh edges (s, 2, 2) their
+    ends lie on.  A vertex at a level counts as above it: one segment per crossing."""
     levels = np.sort(np.asarray(levels, dtype=np.float64))
     # levels crossed by each triangle: those in (min, max] of its corner values
     level = np.searchsorted(levels, values, side="right").astype(np.int32)
@@ -80,12 +79,9 @@ def meaningful_zero(
     diagonal: float,
     factor: float = 1.0,
 ) -> np.ndarray:
-    """(len(triangles),) bool: True where the field is meaningfully non-zero near the
-    triangle, so a zero crossing there is a real nodal line: a corner value, or the
-    change along the gradient over ``ZERO_LINE_LENGTH`` times ``diagonal``, reaches
-    ``factor`` times ``ZERO_LINE_FRACTION`` of max |values|.  The gradient term keeps the
-    zero line of low modes on fine meshes (tiny corner values beside it); regions zero
-    up to round-off are dropped."""
+    """Where a zero crossing in ``triangles`` is a real nodal line (see the constants above;
+    ``factor`` scales the fraction).  The gradient term keeps the zero line of low modes
+    on fine meshes, whose corner values beside it are tiny."""
     a = float(np.max(np.abs(values)))
     if triangles.size == 0 or a == 0.0:
         return np.zeros(triangles.size, dtype=bool)
@@ -109,11 +105,9 @@ def meaningful_zero(
 
 
 def meaningful_zero_lines(faces, points, values, triangles, edges, diagonal) -> np.ndarray:
-    """(s,) bool: which zero-line segments (in ``triangles``, ending on mesh ``edges``)
-    to draw, with hysteresis: a segment passing :func:`meaningful_zero` is drawn, and so
-    is every segment connected to one through segments that pass it at a quarter of the
-    fraction, so a line does not break into dashes where the field hovers around the
-    limit.  Segments connect where they end on the same mesh edge."""
+    """Which zero-line segments to draw, with hysteresis: those passing
+    :func:`meaningful_zero`, and those joined to one (through shared mesh ``edges``) by
+    segments passing a quarter of it, so a line does not break into dashes."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 

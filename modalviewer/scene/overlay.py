@@ -57,9 +57,8 @@ def colorbar_label(value: float) -> str:
 
 
 def wrap_text(text: str, measure, width: float) -> str:
-    """``text`` with each line broken at spaces so that ``measure(line) <= width``
-    (a single word wider than that stays on its own line).  No-break spaces hold words
-    together and come out as plain spaces (the default font has no glyph for them)."""
+    """``text`` broken at spaces so that ``measure(line) <= width``.  No-break spaces hold
+    words together and come out as plain spaces (the default font has no glyph for them)."""
     nbsp = "\u00a0"
     out = []
     for line in text.split("\n"):
