@@ -8,7 +8,6 @@ and imported when used).  Public functions accept a name or an :class:`OperatorI
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -119,20 +118,6 @@ class OperatorInfo:
         if self.factor_memory is not None:
             peak += (FILL_MARGIN - 1.0) * self.factor_memory.in_core_mb(n_vertices)
         return peak
-
-    def matrices(self, mesh, bending: float = 1.0, membrane: float = 1.0):
-        """(K, mass (n,) per vertex) on ``mesh``: the function :attr:`assemble`, and the
-        lumped vertex areas unless it returns a mass of its own (:attr:`assembles_mass`)."""
-        assemble = self.assemble
-        if isinstance(assemble, str):
-            module, function = assemble.split(":")
-            assemble = getattr(importlib.import_module(f"modalviewer.core.{module}"), function)
-        result = assemble(mesh, bending, membrane) if self.has_weights else assemble(mesh)
-        if self.assembles_mass:
-            return result
-        from .laplacian import lumped_masses
-
-        return result, lumped_masses(mesh)
 
 
 # exact_growth, factor_memory: the fits of benchmarks/results/growth.json and
