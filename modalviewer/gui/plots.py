@@ -25,6 +25,10 @@ def nice_ticks(lo: float, hi: float, count: int = 5) -> np.ndarray:
     return np.arange(first, hi + 1e-9 * step, step) + 0.0  # + 0.0: no "-0"
 
 
+def _polygon(xs, ys) -> QtGui.QPolygonF:
+    return QtGui.QPolygonF([QtCore.QPointF(x, y) for x, y in zip(xs, ys, strict=True)])
+
+
 TITLE_MARGIN = 6
 """Pixels between the title and the plot's left and right edges."""
 
@@ -86,18 +90,14 @@ class LinePlot(QtWidgets.QWidget):
         # the frame starts below the title's last line
         top = 20 + (max(len(self.title_lines()), 1) - 1) * metrics.lineSpacing()
         rect = self.rect().adjusted(max(46, left), top, -10, -34)
-        if x1 == x0:
-            x1 = x0 + 1
-        if y1 == y0:
-            y1 = y0 + 1
-        px = rect.left() + (x - x0) / (x1 - x0) * rect.width()
-        py = rect.bottom() - (y - y0) / (y1 - y0) * rect.height()
-        self._second_py = (
-            None
-            if self.second is None
-            else rect.bottom() - (self.second - y0) / (y1 - y0) * rect.height()
-        )
-        return rect, px, py, (y0, y1)
+        y1 = y1 if y1 > y0 else y0 + 1  # a flat curve: along the bottom of a unit range
+        px = rect.left() + (x - x0) / ((x1 - x0) or 1) * rect.width()
+
+        def to_py(values):
+            return rect.bottom() - (values - y0) / (y1 - y0) * rect.height()
+
+        self._second_py = None if self.second is None else to_py(self.second)
+        return rect, px, to_py(y), (y0, y1)
 
     def x_ticks(self, rect=None) -> list[tuple[float, float]]:
         """(value, pixel x) of the tick labels along the bottom: round numbers (integers
@@ -158,13 +158,10 @@ class LinePlot(QtWidgets.QWidget):
         )
         self._draw_ylabel(p, rect)
         p.setPen(QtGui.QPen(QtGui.QColor(40, 90, 180), 1.5))
-        p.drawPolyline(QtGui.QPolygonF([QtCore.QPointF(a, b) for a, b in zip(px, py, strict=True)]))
+        p.drawPolyline(_polygon(px, py))
         if self._second_py is not None and len(self._second_py) == len(px):
-            pen = QtGui.QPen(QtGui.QColor(230, 120, 20), 1.5)
-            pen.setStyle(QtCore.Qt.PenStyle.DashLine)
-            p.setPen(pen)
-            points = zip(px, self._second_py, strict=True)
-            p.drawPolyline(QtGui.QPolygonF([QtCore.QPointF(a, b) for a, b in points]))
+            p.setPen(QtGui.QPen(QtGui.QColor(230, 120, 20), 1.5, QtCore.Qt.PenStyle.DashLine))
+            p.drawPolyline(_polygon(px, self._second_py))
             p.drawText(rect.left() + 4, rect.bottom() - 4, self.second_label)
         if self.markers and len(px) <= 400:
             p.setBrush(QtGui.QColor(40, 90, 180))
