@@ -67,34 +67,27 @@ def largest_component(mesh: Mesh) -> Mesh:
         solver = mesh.solver_mesh
         face_label, order = _by_area(solver)
         kept = Mesh(mesh.vertices, mesh.faces[face_label == order[0]], merged_into=mesh.merged_into)
-        report = _largest_report(mesh, kept, solver.n_components)
-        return Mesh(kept.vertices, kept.faces, report=report, merged_into=kept.merged_into)
-    parts = split_components(mesh)
-    kept = parts[0][0]
-    kept.report = _largest_report(mesh, kept, len(parts))
-    return kept
-
-
-def _largest_report(mesh: Mesh, kept: Mesh, n_parts: int) -> MeshReport:
-    """The report of :func:`largest_component` (``kept`` of ``mesh``'s ``n_parts``
-    components); vertex counts are of the vertices faces use."""
+        n_parts = solver.n_components
+    else:
+        parts = split_components(mesh)
+        kept, n_parts = parts[0][0], len(parts)
     # the input's first sentence describes the input: the result's own comes first
     first = shape_summary(mesh)
     messages = [shape_summary(kept)] + [m for m in mesh.report.messages if m != first]
-    report = MeshReport(source=mesh.report.source, messages=messages)
+    kept.report = MeshReport(source=mesh.report.source, messages=messages)
     if n_parts == 1:
-        report.add("The mesh has one connected component; nothing was removed.")
-    else:
+        kept.report.add("The mesh has one connected component; nothing was removed.")
+    else:  # vertex counts are of the vertices faces use
         dropped_v = mesh.solver_mesh.n_vertices - kept.solver_mesh.n_vertices
         dropped_f = mesh.n_faces - kept.n_faces
         share = 100.0 * kept.total_area / mesh.total_area
-        report.add(
+        kept.report.add(
             f"Kept the largest of {n_parts} connected components "
             f"({_plural(kept.solver_mesh.n_vertices, 'vertex')}, {share:.1f} % of the area); "
             f"removed {_plural(n_parts - 1, 'component')} with "
             f"{_plural(dropped_v, 'vertex')} and {_plural(dropped_f, 'face')}."
         )
-    return report
+    return kept
 
 
 @dataclass
