@@ -186,20 +186,13 @@ class MeshScene:
         self.surface.point_data["field"] = values.copy()
         if displacement is not None:
             self.surface.point_data["displacement"] = displacement
-        if kind == "diverging":
-            a = float(np.max(np.abs(values))) or 1.0
-            clim = (-a, a) if clim is None else clim
-            self._mapper.lookup_table = DIVERGING
-        elif kind == "sequential":
-            hi = float(np.max(values)) or 1.0
-            clim = (0.0, hi) if clim is None else clim
-            self._mapper.lookup_table = SEQUENTIAL
-        elif kind == "threshold":
-            clim = clim or (0.0, 1.0)
-            self._mapper.lookup_table = THRESHOLD
-        else:
-            clim = clim or (float(values.min()), float(values.max()) or 1.0)
-            self._mapper.lookup_table = SEQUENTIAL
+        if clim is None:  # the default range of each kind
+            top, a = float(np.max(values)) or 1.0, float(np.max(np.abs(values))) or 1.0
+            ranges = {"diverging": (-a, a), "sequential": (0.0, top), "threshold": (0.0, 1.0)}
+            clim = ranges.get(kind, (float(values.min()), top))
+        self._mapper.lookup_table = {"diverging": DIVERGING, "threshold": THRESHOLD}.get(
+            kind, SEQUENTIAL
+        )
         self._mapper.scalar_range = clim
         self._mapper.ScalarVisibilityOn()
         self.clim = clim
