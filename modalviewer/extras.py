@@ -1,10 +1,5 @@
-"""Optional dependencies: the extra that installs each, and one-line errors naming it.
-
-``import modalviewer`` needs numpy and scipy only.  Where an optional package is
-missing, the call that needs it raises :class:`MissingExtraError` (a
-``ModuleNotFoundError``) saying what needs which package and the ``pip install`` that
-brings it.
-"""
+"""Optional dependencies: ``import modalviewer`` needs numpy and scipy only; a call that
+needs a missing package raises :class:`MissingExtraError` naming the extra to install."""
 
 from __future__ import annotations
 

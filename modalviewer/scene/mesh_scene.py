@@ -1,9 +1,6 @@
-"""What is drawn: the surface with a per-vertex field, isolines, a pick marker, animation.
-
-Only the GUI thread touches these VTK objects.  Updates reuse the ``PolyData`` and
-actors, so switching a mode or a threshold costs one array copy, the isolines and a
-render.  Colours and styles are in :mod:`.colors`.
-"""
+"""The surface with a per-vertex field, isolines, a pick marker, animation.  Updates reuse
+the ``PolyData`` and actors: switching a mode or a threshold costs one array copy, the
+isolines and a render."""
 
 from __future__ import annotations
 
@@ -391,11 +388,8 @@ class MeshScene:
         return self._canonical[1]
 
     def up(self) -> str:
-        """The up axis in effect: :attr:`up_axis` where set (the viewer sets its
-        state's), else the one View > Up axis > Automatic finds
-        (:func:`.viewer.camera.up_axis_of`), so that every picture made of a mesh alone
-        (the two-mesh distance figure, the pair window, notebook plots) stands a Z-up
-        scan upright as the viewer does."""
+        """The up axis in effect: :attr:`up_axis`, else the one detected, so that a picture
+        of a mesh alone (pair window, notebook plots) stands a Z-up scan upright too."""
         if self._up is None or self._up[0] != self.up_axis:
             axis = cameras.up_axis_of(self.mesh.vertices, self.mesh.faces, self.up_axis)
             self._up = (self.up_axis, axis)

@@ -1,7 +1,4 @@
-"""The viewer's picture without a window: a :class:`~.view.StateScene` on an off-screen
-pyvista plotter (EGL where there is no display, no Qt), for exports without a window,
-``modalviewer render``, ``distance -o`` and ``figures``.
-"""
+"""The viewer's picture without a window (EGL where there is no display, no Qt)."""
 
 from __future__ import annotations
 

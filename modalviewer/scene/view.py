@@ -1,10 +1,5 @@
-"""The 3D picture of the viewer state: draws ``state.derived.field()``, the pick, the legend.
-
-:class:`StateScene` observes a :class:`~modalviewer.viewer.state.ViewerState` and keeps
-nothing but VTK objects.  The window's view and the off-screen renderer run the same
-code on their pyvista plotters, so an export from a script shows what the window shows.
-Only the thread that owns the plotter runs it.  No Qt.
-"""
+"""The 3D picture of the viewer state, the same code in the window and off screen, so an
+export from a script shows what the window shows.  Only the plotter's thread runs it."""
 
 from __future__ import annotations
 
