@@ -1,7 +1,4 @@
-"""``operator_matrices``: the (K, mass) of an operator's eigenproblem on a mesh, K from
-the registry's assembly function (:attr:`.operators.OperatorInfo.assemble`), the mass
-the lumped vertex area (or the operator's own) repeated for each unknown of a vertex.
-"""
+"""The (K, mass) of an operator's eigenproblem on a mesh, from the registry."""
 
 from __future__ import annotations
 

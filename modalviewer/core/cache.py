@@ -220,9 +220,7 @@ class SpectrumCache:
         for e in reversed(entries):  # least recently used first
             if total <= self.max_bytes:
                 break
-            if keep is not None and e.path == Path(keep):
-                continue
-            if self._unlink(e.path):
+            if e.path != keep and self._unlink(e.path):
                 total -= e.size
                 evicted.append(e.path)
         if evicted:
