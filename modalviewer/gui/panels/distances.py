@@ -217,8 +217,7 @@ class DistancesPanel(QtWidgets.QWidget):
                 f"Picked vertex {state.picked_file_vertex} at ({x:.4g}, {y:.4g}, {z:.4g})"
             )
         self._update_scale_words()
-        self._update_range_placeholders()
-        self._update_scale_edit()
+        self._update_scale_fields()
         self._update_signature_plot()
 
     def _update_scale_words(self) -> None:
@@ -232,26 +231,20 @@ class DistancesPanel(QtWidgets.QWidget):
         plot = self.signature_plot
         plot.xlabel, plot.ylabel = ("E (log)", "W_E") if wave else ("t (log)", "S_t")
 
-    def _update_scale_edit(self) -> None:
-        """The box shows the scale t the signature is (or would be) shown at."""
-        operator = operator_for_distance(self.state.display.distance_kind)
-        if self.scale_edit.hasFocus():
-            return
-        with quiet(self.scale_edit):
-            if self.state.derived.has_signatures(operator):
-                self.scale_edit.setText(f"{self.state.derived.signature_time():.4g}")
-            else:
-                self.scale_edit.clear()
-
-    def _update_range_placeholders(self) -> None:
-        operator = operator_for_distance(self.state.display.distance_kind)
-        shown = self.state.derived.has_signatures(operator)
-        times = self.state.derived.kind_table().times[[0, -1]] if shown else (None, None)
+    def _update_scale_fields(self) -> None:
+        """t1 and t2 say their defaults (the kind's range), and the scale box the scale t
+        the signature is (or would be) shown at."""
+        derived = self.state.derived
+        shown = derived.has_signatures(operator_for_distance(self.state.display.distance_kind))
+        times = derived.kind_table().times[[0, -1]] if shown else (None, None)
         for edit, t in zip((self.t1_edit, self.t2_edit), times, strict=True):
             edit.setPlaceholderText("default" if t is None else f"default {t:.4g}")
             if shown and self.state.t_range is None:
                 with quiet(edit):
                     edit.clear()
+        if not self.scale_edit.hasFocus():
+            with quiet(self.scale_edit):
+                self.scale_edit.setText(f"{derived.signature_time():.4g}" if shown else "")
 
     def _update_signature_plot(self) -> None:
         state = self.state
