@@ -308,35 +308,29 @@ class MeshScene:
                 self._mapper.scalar_range = self.clim
         self._overlay_changed()
 
-    def colorbar(self) -> ColorBar | None:
-        """The colour bar as drawn (None when hidden or nothing is coloured)."""
-        if self.colorbar_title is None or self.kind == "plain" and not self.field_name:
+    def colorbar(self, title: str | None = None) -> ColorBar | None:
+        """The colour bar as drawn (None when hidden or nothing is coloured), or titled
+        ``title`` when given (shown or not)."""
+        title = title or self.colorbar_title
+        if title is None or self.kind == "plain" and not self.field_name:
             return None
         colors = [np.asarray(c, dtype=float) for c in COLORMAPS.get(self.kind, [WHITE, RED])]
         if self.kind == "threshold":
-            labels = self.colorbar_labels or [self.colorbar_title, "the rest"]
+            labels = self.colorbar_labels or [title, "the rest"]
             return ColorBar("", colors, (0.0, 1.0), "swatches", labels[:2])
         ticks = []
         if self.scale is not None and self.kind == "sequential":
             from ..viewer.color_scale import tick_values
 
             ticks = tick_values(self.scale)
-        return ColorBar(
-            self.colorbar_title, colors, tuple(self.clim), clipped=self.clipped, ticks=ticks
-        )
+        return ColorBar(title, colors, tuple(self.clim), clipped=self.clipped, ticks=ticks)
 
     def overlay(self, legend: bool = True, colorbar: bool | None = None) -> Overlay:
         """Legend and colour bar for an export: the legend if ``legend`` and set; the
         colour bar if shown (``colorbar`` None), or forced on/off."""
-        bar = self.colorbar()
-        if colorbar is False:
-            bar = None
-        elif colorbar is True and bar is None and self.kind != "plain":
-            title = self.field_name or "value"
-            saved = self.colorbar_title
-            self.colorbar_title = title
-            bar = self.colorbar()
-            self.colorbar_title = saved
+        bar = None if colorbar is False else self.colorbar()
+        if colorbar is True and bar is None and self.kind != "plain":
+            bar = self.colorbar(self.field_name or "value")
         return Overlay(self.legend_text if legend else None, bar)
 
     def _overlay_changed(self) -> None:
