@@ -128,13 +128,7 @@ class SpectrumCache:
     def clear(self) -> int:
         """Delete every cached spectrum (and temporary files left by killed writers);
         returns the number of bytes freed."""
-        freed = 0
-        for e in self.entries():
-            try:
-                e.path.unlink()
-                freed += e.size
-            except OSError:
-                pass
+        freed = sum(e.size for e in self.entries() if self._unlink(e.path))
         try:  # and temporary files of killed writers
             parts = list(self.directory.glob("*.part"))
         except OSError:
