@@ -17,6 +17,7 @@ from .mesh import (
     _unique_index_rows,
     checked_arrays,
     shape_summary,
+    triangle_areas,
 )
 
 _LISTED = 10  # vertex numbers a report lists before "and N more"
@@ -44,10 +45,6 @@ def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
     rank[order] = np.arange(len(order))
     kept = first[order]
     return v[kept], rank[inverse][f], len(v) - len(kept), rank[inverse], kept
-
-
-def _double_areas(v: np.ndarray, f: np.ndarray) -> np.ndarray:
-    return np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1)
 
 
 def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -99,7 +96,7 @@ def _repair_zero_area(v, f, min_area: float, diag: float, report: MeshReport, ma
     merged_into = np.arange(n)
     collapsed, flipped, dropped, largest = 0, 0, 0, 0.0
     for _ in range(max_rounds):
-        zero = np.flatnonzero(0.5 * _double_areas(v, f) <= min_area)
+        zero = np.flatnonzero(triangle_areas(v, f) <= min_area)
         if zero.size == 0:
             break
         zf = f[zero]
@@ -158,7 +155,7 @@ def _repair_zero_area(v, f, min_area: float, diag: float, report: MeshReport, ma
         merged_into = remap[merged_into]
         f = remap[f[~drop]]
         f = f[(f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])]
-    left = int((0.5 * _double_areas(v, f) <= min_area).sum()) if len(f) else 0
+    left = int((triangle_areas(v, f) <= min_area).sum()) if len(f) else 0
     if flipped:
         report.add(
             f"Flipped the longest edge of {_plural(flipped, 'degenerate (zero-area) face')}"
@@ -177,7 +174,7 @@ def _repair_zero_area(v, f, min_area: float, diag: float, report: MeshReport, ma
             "boundary (the boundary keeps its shape)."
         )
     if left:
-        f = f[0.5 * _double_areas(v, f) > min_area]
+        f = f[triangle_areas(v, f) > min_area]
         report.add(
             f"Removed {_plural(left, 'degenerate (zero-area) face')} that could not be "
             "flipped or collapsed without tearing or folding the surface (this can "
@@ -343,7 +340,7 @@ def repair_mesh(vertices, faces, source: str = "", merge_tolerance: float = 1e-1
             report.add(f"Removed {_plural(len(f) - len(keep), 'duplicate face')}.")
             f = f[np.sort(keep)]
     min_area = 1e-14 * diag**2
-    if len(f) and np.any(0.5 * _double_areas(v, f) <= min_area):
+    if len(f) and np.any(triangle_areas(v, f) <= min_area):
         f, merged_into = _repair_zero_area(v, f, min_area, diag, report)
         file_map = merged_into[file_map]
     if len(f) == 0:

@@ -58,6 +58,12 @@ def _unused_words(index: int) -> str:
     )
 
 
+def triangle_areas(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m,) triangle areas."""
+    n = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
+    return 0.5 * np.linalg.norm(n, axis=1)
+
+
 def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(m,) quality ``4 sqrt(3) area / (l0^2 + l1^2 + l2^2)`` of each triangle: 1
     equilateral, about 2 h / L for a needle or cap of longest edge L and height h."""

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .laplacian import vertex_normals
-from .mesh import Mesh, MeshError
+from .mesh import Mesh, MeshError, triangle_areas
 from .products import threaded_product
 
 
@@ -89,12 +89,6 @@ def edge_length_gradients(x: np.ndarray, edges: np.ndarray) -> np.ndarray:
     d = x[edges[:, 1]] - x[edges[:, 0]]
     u = d / np.linalg.norm(d, axis=1, keepdims=True)
     return np.stack([-u, u], axis=1)
-
-
-def triangle_areas(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(m,) triangle areas."""
-    n = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
-    return 0.5 * np.linalg.norm(n, axis=1)
 
 
 def triangle_area_gradients(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
