@@ -199,15 +199,16 @@ class PairWindow(ViewsWindow):
         return p.key(), p.picked, p.drawn_mesh("a").hash, p.drawn_mesh("b").hash
 
     def _draw(self, side: str, scene: MeshScene, view: PairView) -> bool:
-        """Bring ``scene`` to ``view``; False if it already showed it."""
-        values_id = None if view.values is None else id(view.values)
-        drawn = self._drawn.get(side)
-        field = (values_id, view.colormap)
+        """Bring ``scene`` to ``view`` from what it shows (``before``); False if it already
+        showed it."""
+        field = (None if view.values is None else id(view.values), view.colormap)
         whole = (field, view.threshold, view.legend, view.marker, view.back_marker)
-        if drawn is not None and drawn[0] == whole and drawn[1] is scene:
+        drawn = self._drawn.get(side)
+        before = drawn[0] if drawn is not None and drawn[1] is scene else None
+        if before == whole:
             return False
-        if drawn is not None and drawn[1] is scene and drawn[0][0] == field:
-            if view.colormap == "threshold" and drawn[0][1] != view.threshold:
+        if before is not None and before[0] == field:
+            if view.colormap == "threshold" and before[1] != view.threshold:
                 scene.set_threshold(view.threshold)
         elif view.values is None:
             scene.show_plain()
@@ -222,9 +223,9 @@ class PairWindow(ViewsWindow):
             scene.set_colorbar(None)
         else:
             scene.set_colorbar(view.colorbar_title, labels=view.colorbar_labels)
-        if drawn is None or drawn[1] is not scene or drawn[0][3] != view.marker:
+        if before is None or before[3] != view.marker:
             scene.show_marker(view.marker)
-        if drawn is None or drawn[1] is not scene or drawn[0][4] != view.back_marker:
+        if before is None or before[4] != view.back_marker:
             scene.show_back_marker(view.back_marker)
         # keep the values alive with the record, so their id cannot be reused
         self._drawn[side] = (whole, scene, view.values)
