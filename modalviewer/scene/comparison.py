@@ -36,9 +36,9 @@ def caption(img: np.ndarray, text: str) -> np.ndarray:
     return np.vstack([rgb, img])
 
 
-def comparison_image(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) -> np.ndarray:
-    """The views of ``comparison`` side by side, each captioned (``camera``: a
-    :class:`~modalviewer.viewer.camera.Camera`, default the mesh's canonical view)."""
+def save_comparison(comparison, path, size=VIEW_SIZE, camera=None, scale: int = 1) -> Path:
+    """Write the views of ``comparison`` side by side, each captioned, to a PNG atomically
+    (``camera``: a :class:`~modalviewer.viewer.camera.Camera`, default the canonical view)."""
     state = comparison.state
     images = []
     for view in comparison.views():
@@ -52,9 +52,4 @@ def comparison_image(comparison, size=VIEW_SIZE, camera=None, scale: int = 1) ->
             images.append(caption(grab(plotter, scene, scale=scale), view.title))
         finally:
             plotter.close()
-    return side_by_side(images, gap=4 * scale)
-
-
-def save_comparison(comparison, path, size=VIEW_SIZE, camera=None, scale: int = 1) -> Path:
-    """Write :func:`comparison_image` to a PNG atomically; returns its path."""
-    return save_png(path, comparison_image(comparison, size, camera, scale))
+    return save_png(path, side_by_side(images, gap=4 * scale))
