@@ -5,8 +5,23 @@ from types import ModuleType as _ModuleType
 
 from .cache import SpectrumCache
 from .cleaning import repair_mesh
-from .components import *  # noqa: F403
-from .cross import *  # noqa: F403
+from .components import (
+    ComponentSpectrum,
+    compute_spectrum_per_component,
+    largest_component,
+    split_components,
+)
+from .cross import (
+    CrossTables,
+    Matches,
+    ScaleWarning,
+    best_match,
+    common_times,
+    cross_distance,
+    distance_ranks,
+    mutual_best_matches,
+    rescale_to_area,
+)
 from .eigen import Cancelled, EigenError
 from .fmaps import FunctionalMap, correspondence_errors, functional_map
 from .laplacian import mass_matrix, modified_dirichlet_matrix, stiffness_matrix, vertex_normals

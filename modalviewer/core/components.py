@@ -18,13 +18,6 @@ from .pipeline import compute_spectrum
 from .spectrum import Spectrum
 from .validate import check_count
 
-__all__ = [
-    "ComponentSpectrum",
-    "compute_spectrum_per_component",
-    "largest_component",
-    "split_components",
-]
-
 
 def _by_area(mesh: Mesh) -> tuple[np.ndarray, list[int]]:
     """Each face's component label, and the components largest area first (then most

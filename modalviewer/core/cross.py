@@ -26,18 +26,6 @@ from .validate import check_count, check_t_range, check_vertex, check_vertices
 TRange = Sequence[float] | np.ndarray | None
 Vertices = int | Sequence[int] | np.ndarray
 
-__all__ = [
-    "CrossTables",
-    "Matches",
-    "ScaleWarning",
-    "best_match",
-    "common_times",
-    "cross_distance",
-    "distance_ranks",
-    "mutual_best_matches",
-    "rescale_to_area",
-]
-
 AREA_TOLERANCE = 0.05  # relative area difference above which a ScaleWarning is issued
 
 
