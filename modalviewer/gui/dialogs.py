@@ -76,13 +76,11 @@ class _ExportDialog(QtWidgets.QDialog):
         self.form.addRow("File", row(self.path_edit, browse))
 
     def _finish(self) -> None:
-        buttons = QtWidgets.QDialogButtonBox(
-            QtWidgets.QDialogButtonBox.StandardButton.Save
-            | QtWidgets.QDialogButtonBox.StandardButton.Cancel
+        standard = QtWidgets.QDialogButtonBox.StandardButton
+        buttons = standard.Save | standard.Cancel
+        self.form.addRow(
+            QtWidgets.QDialogButtonBox(buttons, accepted=self.accept, rejected=self.reject)
         )
-        buttons.accepted.connect(self.accept)
-        buttons.rejected.connect(self.reject)
-        self.form.addRow(buttons)
 
     def _browse(self) -> None:
         path, _ = QtWidgets.QFileDialog.getSaveFileName(
