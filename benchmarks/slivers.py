@@ -2,7 +2,7 @@
 
     python -m benchmarks.slivers [--grid 200] [--meshes assets/spot.obj ...]
 
-Cases (needles and caps from ``core.primitives.add_slivers``):
+Cases (needles and caps from :func:`add_slivers`, which the tests of the repairs use too):
 
 - loader: an icosphere of 40962 vertices with 13000 zero-area caps at mid-edge (flipped)
   and at 2 % of an edge (collapsed), against the same mesh without them;
@@ -31,7 +31,45 @@ sys.path.insert(0, str(ROOT))
 
 import modalviewer as mv  # noqa: E402
 from benchmarks.run import save_result  # noqa: E402
-from modalviewer.core.primitives import add_slivers, icosphere  # noqa: E402
+from modalviewer.core.mesh import Mesh  # noqa: E402
+from modalviewer.core.primitives import icosphere  # noqa: E402
+
+
+def add_slivers(
+    mesh: Mesh, needles: int, caps: int, eps: float, seed: int = 0, at: float = 0.5
+) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of ``mesh`` with nearly degenerate triangles, as remeshers and
+    iso-surfaces make them, for tests of the repairs: ``caps`` random faces (a, b, c)
+    split at x = (1 - at) a + at b moved ``eps`` (relative) towards c, ``needles`` edges
+    split at ``eps`` of their length from one end.  A closed mesh stays closed; the raw
+    arrays hold faces of zero area for eps = 0, which ``repair_mesh`` repairs."""
+    rng = np.random.default_rng(seed)
+    v = [np.asarray(p) for p in mesh.vertices]
+    f = np.array(mesh.faces)
+    picks = iter(rng.permutation(len(f)))
+    for _ in range(caps):
+        t = next(picks)
+        a, b, c = f[t]
+        x = len(v)
+        v.append(((1 - at) * v[a] + at * v[b]) * (1 - eps) + eps * v[c])
+        f[t] = [a, b, x]  # the cap
+        f = np.vstack([f, [[b, c, x], [c, a, x]]])
+    made = 0
+    while made < needles:
+        t = next(picks)
+        a, b, c = f[t]
+        other = np.flatnonzero(((f == b) & (np.roll(f, -1, axis=1) == a)).any(axis=1))
+        if len(other) != 1 or len(set(f[t]) & set(f[other[0]])) != 2:
+            continue  # on the boundary, or not a simple neighbour
+        o = other[0]
+        d = next(int(x) for x in f[o] if x not in (a, b))  # the face across runs (b, a, d)
+        x = len(v)
+        v.append(v[a] * (1 - eps) + eps * v[b])
+        f[t] = [a, x, c]
+        f[o] = [b, x, d]
+        f = np.vstack([f, [[x, b, c], [x, a, d]]])
+        made += 1
+    return np.array(v), f
 
 
 def marching_cubes_surface(n: int) -> mv.Mesh:

@@ -45,7 +45,8 @@ def _error_lines(stderr):
 def sliver_obj(tmp_path_factory):
     """A sphere with 20 needles and 20 caps of quality 1e-8, whose shells Hessian cannot
     be factorised (as in tests/gui/test_sliver_retry.py)."""
-    from modalviewer.core.primitives import add_slivers, icosphere
+    from benchmarks.slivers import add_slivers
+    from modalviewer.core.primitives import icosphere
 
     v, f = add_slivers(icosphere(3), needles=20, caps=20, eps=1e-8, seed=2)
     path = tmp_path_factory.mktemp("slivers") / "slivered.obj"

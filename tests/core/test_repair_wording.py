@@ -1,7 +1,8 @@
 """Counts in the sliver repair's report are grammatical ("1 vertex fewer")."""
 
 import modalviewer as mv
-from modalviewer.core.primitives import add_slivers, icosphere
+from benchmarks.slivers import add_slivers
+from modalviewer.core.primitives import icosphere
 
 
 def test_one_needle_removed_reads_one_vertex_fewer():

@@ -11,9 +11,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 
 import modalviewer as mv
+from benchmarks.slivers import add_slivers
 from modalviewer.core import operators
 from modalviewer.core.assembly import operator_matrices
-from modalviewer.core.primitives import add_slivers, icosphere
+from modalviewer.core.primitives import icosphere
 from modalviewer.core.robust import negative_cotan_weights
 from modalviewer.extras import MissingExtraError
 

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
+from benchmarks.slivers import add_slivers
 from modalviewer.core.mesh import triangle_quality
-from modalviewer.core.primitives import add_slivers, grid_plate, icosphere
+from modalviewer.core.primitives import grid_plate, icosphere
 
 
 def boundary_length(mesh):

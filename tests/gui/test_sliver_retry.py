@@ -7,7 +7,8 @@ import pytest
 from qtpy import QtWidgets
 
 import modalviewer as mv
-from modalviewer.core.primitives import add_slivers, icosphere
+from benchmarks.slivers import add_slivers
+from modalviewer.core.primitives import icosphere
 from modalviewer.repair import repair_for_failure
 
 

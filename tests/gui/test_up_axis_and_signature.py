@@ -114,7 +114,8 @@ def test_the_distances_panel_offers_the_wave_kernel_distance_over_energies(windo
 
 
 def test_the_compute_panel_suggests_the_robust_laplacian_on_slivers(window):
-    from modalviewer.core.primitives import add_slivers, icosphere
+    from benchmarks.slivers import add_slivers
+    from modalviewer.core.primitives import icosphere
 
     pytest.importorskip("robust_laplacian")
     panel = window.compute_panel

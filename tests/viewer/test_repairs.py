@@ -2,9 +2,10 @@
 
 import numpy as np
 
+from benchmarks.slivers import add_slivers
 from modalviewer.core.cache import SpectrumCache
 from modalviewer.core.mesh import Mesh
-from modalviewer.core.primitives import add_slivers, icosphere
+from modalviewer.core.primitives import icosphere
 from modalviewer.viewer import ViewerModel
 from modalviewer.viewer.jobs import DONE
 from modalviewer.viewer.session import restore_session, save_session
@@ -76,7 +77,8 @@ def test_a_process_that_repaired_and_then_computed_exits_cleanly(tmp_path):
 import trimesh
 from pathlib import Path
 from modalviewer.core.cache import SpectrumCache
-from modalviewer.core.primitives import add_slivers, icosphere
+from benchmarks.slivers import add_slivers
+from modalviewer.core.primitives import icosphere
 from modalviewer.viewer import ViewerModel
 tmp = Path({str(tmp_path)!r})
 v, f = add_slivers(icosphere(3), needles=10, caps=10, eps=1e-4, seed=1)

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
-from modalviewer.core.primitives import add_slivers, icosphere
+from benchmarks.slivers import add_slivers
+from modalviewer.core.primitives import icosphere
 from modalviewer.viewer import Viewer, wording
 
 
