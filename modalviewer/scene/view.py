@@ -205,22 +205,19 @@ class StateScene:
         if scene is None:
             return
         if field is None or field.colormap == "plain" or not self.state.style.colorbar:
-            scene.set_legend(None)
-            scene.set_colorbar(None)
+            field = None
+        scene.set_legend(field.legend if field is not None else None)
+        if field is None or field.colormap != "threshold":
+            label_field(scene, field)
             return
-        scene.set_legend(field.legend)
-        if field.colormap == "threshold":
-            d = self.state.display
-            dist = self.state.derived.distance_map()
-            thr = self.state.derived.threshold_value(dist)
-            share = 100.0 * self.state.derived.surface_share(dist, thr)
-            from ..core.operators import DISTANCE_KINDS
+        from ..core.operators import DISTANCE_KINDS
 
-            similar = f"{DISTANCE_KINDS[d.distance_kind].lower()} < {thr:.3g} ({share:.1f} %)"
-            similar += wording.display_mark(self.state)
-            scene.set_colorbar(field.title, labels=[similar, "the rest"])
-        else:
-            scene.set_colorbar(field.title, clim=field.clim)
+        dist = self.state.derived.distance_map()
+        thr = self.state.derived.threshold_value(dist)
+        share = 100.0 * self.state.derived.surface_share(dist, thr)
+        kind = DISTANCE_KINDS[self.state.display.distance_kind].lower()
+        similar = f"{kind} < {thr:.3g} ({share:.1f} %)" + wording.display_mark(self.state)
+        scene.set_colorbar(field.title, labels=[similar, "the rest"])
 
     # ------------------------------------------------------------ camera
     def reset_camera(self, preset: str = "canonical") -> None:
