@@ -339,23 +339,20 @@ def _ply_binary(body, order, damage, name, count, props, offset):
     columns: dict = {p: [] for p, _ in props}
     for i in range(count):
         row_values = {}
-        for prop, types in props:
-            if types[0] == "list":
-                ct = np.dtype(order + _PLY_TYPES[types[1]])
-                it = np.dtype(order + _PLY_TYPES[types[2]])
-                if offset + ct.itemsize > len(body):
-                    break
-                n = int(np.frombuffer(body, ct, 1, offset)[0])
-                if offset + ct.itemsize + it.itemsize * n > len(body):
-                    break
-                row_values[prop] = np.frombuffer(body, it, n, offset + ct.itemsize).astype(np.int64)
-                offset += ct.itemsize + it.itemsize * n
-            else:
-                t = np.dtype(order + _PLY_TYPES[types[0]])
-                if offset + t.itemsize > len(body):
-                    break
-                row_values[prop] = np.frombuffer(body, t, 1, offset)[0]
-                offset += t.itemsize
+        try:  # np.frombuffer raises ValueError where the data end before the value
+            for prop, types in props:
+                if types[0] == "list":
+                    ct, it = (np.dtype(order + _PLY_TYPES[t]) for t in types[1:3])
+                    n = int(np.frombuffer(body, ct, 1, offset)[0])
+                    items = np.frombuffer(body, it, n, offset + ct.itemsize)
+                    row_values[prop] = items.astype(np.int64)
+                    offset += ct.itemsize + it.itemsize * n
+                else:
+                    t = np.dtype(order + _PLY_TYPES[types[0]])
+                    row_values[prop] = np.frombuffer(body, t, 1, offset)[0]
+                    offset += t.itemsize
+        except ValueError:
+            pass
         if len(row_values) < len(props):
             damage(
                 f"element '{name}' {i}",
