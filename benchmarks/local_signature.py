@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import modalviewer as mv
-from modalviewer.core.demo_shapes import machined_part
+from scripts.make_assets import machined_part
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 RESULTS = Path(__file__).resolve().parent / "results" / "local_signature.json"
