@@ -48,7 +48,7 @@ def _merge_duplicate_vertices(v: np.ndarray, f: np.ndarray, tol: float):
 
 
 def _cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross product of (r, 3) arrays (np.cross costs 50 us per call on tiny ones)."""
+    """Row-wise cross product of (r, 3) arrays (np.cross has a large fixed cost per call)."""
     return np.column_stack(
         [
             a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
