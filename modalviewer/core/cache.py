@@ -29,15 +29,6 @@ DEFAULT_LIMIT_MB = 2048  # a dozen shells spectra of mid-sized meshes, or a few 
 _STALE_PART_SECONDS = 3600.0  # a temporary file this old belongs to a killed writer
 
 
-def default_cache_dir() -> Path:
-    """``$MODALVIEWER_CACHE`` or ``$XDG_CACHE_HOME/modalviewer`` (``~/.cache/modalviewer``)."""
-    env = os.environ.get("MODALVIEWER_CACHE")
-    if env:
-        return Path(env)
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "modalviewer"
-
-
 def default_cache_limit() -> int:
     """The size limit in bytes: ``$MODALVIEWER_CACHE_MAX_MB`` megabytes (0 keeps nothing;
     not a number: a warning), else :data:`DEFAULT_LIMIT_MB`."""
@@ -88,7 +79,12 @@ class SpectrumCache:
     nothing): beyond it the least recently used go, never the one just written or read."""
 
     def __init__(self, directory: Path | None = None, max_bytes: int | None = None):
-        self.directory = Path(directory) if directory else default_cache_dir()
+        if not directory:  # $MODALVIEWER_CACHE, else $XDG_CACHE_HOME (~/.cache)/modalviewer
+            directory = os.environ.get("MODALVIEWER_CACHE")
+        if not directory:
+            base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+            directory = Path(base) / "modalviewer"
+        self.directory = Path(directory)
         if max_bytes is not None and max_bytes < 0:
             raise ValueError(f"max_bytes must be at least 0, got {max_bytes}")
         self.max_bytes = int(max_bytes) if max_bytes is not None else default_cache_limit()
