@@ -9,15 +9,15 @@ from pathlib import Path
 import numpy as np
 
 import modalviewer as mv
-from modalviewer.core import demo_shapes
 from modalviewer.core.shells import dihedral_angles, hinges
+from scripts import make_assets
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 
 
 def fold_vertices() -> np.ndarray:
     """Indices of the demo plate's vertices on the fold line."""
-    return np.flatnonzero(np.abs(demo_shapes.plate().vertices[:, 0] - demo_shapes.FOLD_X) < 1e-12)
+    return np.flatnonzero(np.abs(make_assets.plate().vertices[:, 0] - make_assets.FOLD_X) < 1e-12)
 
 
 def sharp_vertices(mesh, angle_degrees: float = 30.0) -> np.ndarray:

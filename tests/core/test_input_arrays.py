@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import modalviewer as mv
-from modalviewer.core.demo_shapes import plate
+from scripts.make_assets import plate
 
 
 @pytest.fixture(scope="module")
