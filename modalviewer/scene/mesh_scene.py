@@ -483,10 +483,6 @@ class MeshScene:
         low, high = (share * self.mesh.bounding_box_diagonal for share in GHOST_FADE)
         return GHOST_OPACITY * np.clip((moved - low) / (high - low), 0.0, 1.0)
 
-    @property
-    def ghost_visible(self) -> bool:
-        return self.ghost_actor is not None and bool(self.ghost_actor.GetVisibility())
-
     @staticmethod
     def _move(poly: pv.PolyData, rest: np.ndarray, disp: np.ndarray, s: float) -> None:
         """In place: points = rest + s * disp, then flag the VTK points as modified."""
