@@ -47,17 +47,14 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
             d = np.asarray(panel.distances, dtype=np.float64)
             if d.shape != (panel.mesh.n_vertices,):
                 raise ValueError("a panel's distances must have one value per vertex")
+            thr = panel.threshold * float(d.max())
             if panel.display == "threshold":
-                thr = panel.threshold * float(d.max())
                 scene.show_threshold(d, thr, name="threshold")
-                if panel.colorbar:
-                    scene.set_colorbar(
-                        panel.colorbar, labels=[f"{panel.colorbar} <= {thr:.3g}", "the rest"]
-                    )
             else:
-                scene.show_field(d, "sequential", isolines=0, name="distance")
-                if panel.colorbar:
-                    scene.set_colorbar(panel.colorbar)
+                scene.show_field(d, "sequential", name="distance")
+            if panel.colorbar:  # the labels name a threshold map's two swatches
+                labels = [f"{panel.colorbar} <= {thr:.3g}", "the rest"]
+                scene.set_colorbar(panel.colorbar, labels=labels)
         scene.show_marker(panel.marker)
         # the viewer's first view of the mesh, turned about its up axis by ``azimuth``
         # (or until the marker faces the camera) and tilted by ``elevation``
