@@ -186,11 +186,7 @@ def paired_ratio(row: dict) -> float:
     """The median over the rounds of the whole run's time over the baseline's: each
     round's two runs are adjacent, so their ratio leaves out the machine's drift between
     rounds (one round's ratio alone varies by about a tenth here)."""
-    return float(
-        np.median(
-            row.get("total_over_baseline_runs", [row["seconds_total"] / row["seconds_baseline"]])
-        )
-    )
+    return float(np.median(row["total_over_baseline_runs"]))
 
 
 def table(data: dict) -> str:
@@ -208,7 +204,7 @@ def table(data: dict) -> str:
             f"| {r['seconds_first_nonzero']:.1f} s | {r['seconds_total']:.1f} s | "
             f"{r['seconds_first'] / r['seconds_total']:.2f} | {r['seconds_few']:.1f} s | "
             f"{r['seconds_baseline']:.1f} s | {paired_ratio(r):.2f} | "
-            f"{r['peak_mb'] / r['peak_mb_baseline']:.2f} | {r.get('repeats', 1)} |"
+            f"{r['peak_mb'] / r['peak_mb_baseline']:.2f} | {r['repeats']} |"
         )
     return "\n".join(lines)
 
