@@ -161,16 +161,13 @@ def _snap(direction: np.ndarray, degrees: float = SNAP_DEGREES) -> np.ndarray:
     """The coordinate axis nearest to ``direction`` if within ``degrees``, else itself."""
     k = int(np.argmax(np.abs(direction)))
     if abs(direction[k]) >= np.cos(np.radians(degrees)):
-        out = np.zeros(3)
-        out[k] = np.sign(direction[k])
-        return out
+        return np.sign(direction[k]) * np.eye(3)[k]
     return direction
 
 
 def _face_front(direction: np.ndarray) -> np.ndarray:
     """``direction`` or its opposite, whichever points to the front side (+Z, +X, +Y)."""
-    d = float(direction @ _FRONT)
-    return -direction if d < 0 else direction
+    return -direction if float(direction @ _FRONT) < 0 else direction
 
 
 def _rotate(v: np.ndarray, axis: np.ndarray, degrees: float) -> np.ndarray:
@@ -186,8 +183,7 @@ def look_from(vertices, direction, up) -> Camera:
     centre, radius = 0.5 * (lo + hi), max(0.5 * float(np.linalg.norm(hi - lo)), 1e-12)
     d = _unit(direction)
     u = np.asarray(up, dtype=np.float64)
-    u = u - (u @ d) * d
-    u = _unit(u)
+    u = _unit(u - (u @ d) * d)
     position = centre + radius / np.sin(np.radians(0.5 * VIEW_ANGLE)) * d
     return Camera(tuple(position), tuple(centre), tuple(u))
 
@@ -200,9 +196,7 @@ def silhouette_area(points, cell: float, directions) -> np.ndarray:
     out = np.zeros(len(directions))
     for i, d in enumerate(np.asarray(directions, dtype=np.float64)):
         d = _unit(d)
-        k = int(np.argmin(np.abs(d)))
-        a = np.zeros(3)
-        a[k] = 1.0
+        a = np.eye(3)[int(np.argmin(np.abs(d)))]
         a = _unit(a - (a @ d) * d)
         b = np.cross(d, a)
         ij = np.floor(np.column_stack([v @ a, v @ b]) / cell).astype(np.int64)
@@ -235,19 +229,16 @@ def _largest_silhouette(vertices, faces, up_vec: np.ndarray) -> np.ndarray:
     if faces is None or len(faces) == 0:
         _, axes = principal_axes(vertices)
         return _snap(axes[2])
-    k = int(np.argmax(np.abs(up_vec)))
-    a = np.zeros(3)
-    a[(k + 1) % 3] = 1.0
+    a = np.eye(3)[(int(np.argmax(np.abs(up_vec))) + 1) % 3]
     a = _unit(a - (a @ up_vec) * up_vec)
     b = np.cross(up_vec, a)
     angles = np.radians(np.arange(0.0, 180.0, 5.0))
     horizontal = np.outer(np.cos(angles), a) + np.outer(np.sin(angles), b)
     axes = [np.array(d) for d in AXES.values() if abs(np.dot(d, up_vec)) < 1e-9]
-    candidates = np.vstack([horizontal, *axes, up_vec]) if axes else np.vstack([horizontal, up_vec])
+    candidates = np.vstack([horizontal, *axes, up_vec])
     area = silhouette_area(*_surface_points(vertices, faces), candidates)
     best_h = int(np.argmax(area[: len(horizontal)]))
-    best = horizontal[best_h]
-    best_area = area[best_h]
+    best, best_area = horizontal[best_h], area[best_h]
     for i, axis in enumerate(axes):
         if area[len(horizontal) + i] >= AXIS_PREFERENCE * best_area:
             best, best_area = axis, area[len(horizontal) + i]
@@ -333,20 +324,14 @@ def preset_view(vertices, name: str, up=None) -> Camera:
     toward the viewer)."""
     up_vec = _up_vector(up)
     key = name.lower()
-    if key == "isometric":
-        k = int(np.argmax(np.abs(up_vec)))
-        a, b = (k + 1) % 3, (k + 2) % 3
-        direction = np.zeros(3)
-        direction[[a, b]] = 1.0
-        direction += up_vec
-        return look_from(vertices, direction, up_vec)
+    k = int(np.argmax(np.abs(up_vec)))
+    if key == "isometric":  # +1 along the two other axes, and up
+        return look_from(vertices, 1.0 - np.eye(3)[k] + up_vec, up_vec)
     if key not in AXES:
         raise ValueError(f"unknown camera preset {name!r}; use one of {', '.join(PRESETS)}")
     direction = np.array(AXES[key])
     if abs(direction @ up_vec) > 0.99:
-        k = int(np.argmax(np.abs(up_vec)))
-        nxt = np.zeros(3)
-        nxt[(k + 1) % 3] = 1.0
+        nxt = np.eye(3)[(k + 1) % 3]
         screen_up = -nxt if direction @ up_vec > 0 else nxt
     else:
         screen_up = up_vec
@@ -446,8 +431,7 @@ def orbit_view(vertices, azimuth: float, elevation: float, up=None) -> Camera:
     from the front: the axis after the up axis (+Z for +Y up).  Azimuth 90: the right."""
     up_vec = _up_vector(up)
     k = int(np.argmax(np.abs(up_vec)))
-    front = np.zeros(3)
-    front[(k + 1) % 3] = 1.0 if up_vec[k] > 0 else -1.0
+    front = np.sign(up_vec[k]) * np.eye(3)[(k + 1) % 3]
     right = np.cross(up_vec, front)
     a, e = np.radians(float(azimuth)), np.radians(float(elevation))
     if abs(abs(float(elevation)) - 90.0) < 1e-9:
