@@ -48,7 +48,7 @@ def _font(size: float):
 
 def _rgba(c) -> tuple[int, int, int, int]:
     c = np.clip(np.asarray(c, dtype=float), 0.0, 1.0)
-    return (int(round(255 * c[0])), int(round(255 * c[1])), int(round(255 * c[2])), 255)
+    return (*(int(round(255 * x)) for x in c[:3]), 255)
 
 
 def colorbar_label(value: float) -> str:
@@ -85,97 +85,68 @@ def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.nd
     canvas = Image.fromarray(np.ascontiguousarray(img), mode)
     draw = ImageDraw.Draw(canvas)
     s = float(scale)
-    margin = MARGIN_PX * s
-    font = _font(FONT_PX * s)
-    black = (0, 0, 0, 255)
-    line_gap = 0.35 * FONT_PX * s
+    h, w = img.shape[:2]
+    margin, em, line_gap = MARGIN_PX * s, FONT_PX * s, 0.35 * FONT_PX * s
+    font = _font(em)
+    black, outline = (0, 0, 0, 255), max(1, round(s))
 
     def measure(text: str) -> float:
         return draw.textlength(text, font=font)
 
+    def write(xy, text: str) -> None:
+        draw.multiline_text(xy, text, fill=black, font=font, spacing=line_gap)
+
     if overlay.legend:
-        width = img.shape[1] - 2 * margin
-        text = wrap_text(overlay.legend, measure, width)
-        draw.multiline_text((margin, margin), text, fill=black, font=font, spacing=line_gap)
+        write((margin, margin), wrap_text(overlay.legend, measure, w - 2 * margin))
     bar = overlay.colorbar
-    if bar is not None:
-        h, w = img.shape[:2]
-        if bar.kind == "swatches":
-            box = FONT_PX * s
-            labels = [
-                wrap_text(label, measure, w - 2 * margin - 1.6 * box)
-                for label in bar.labels[: len(bar.colors)]
-            ]
-            lines = sum(label.count("\n") + 1 for label in labels)
-            y = h - margin - lines * (box + line_gap)
-            if bar.title:
-                title = wrap_text(bar.title, measure, w - 2 * margin)
-                y_title = y - (title.count("\n") + 1) * (box + line_gap)
-                draw.multiline_text(
-                    (margin, y_title), title, fill=black, font=font, spacing=line_gap
-                )
-            for color, label in zip(bar.colors, labels, strict=False):
-                draw.rectangle(
-                    [margin, y, margin + box, y + box],
-                    fill=_rgba(color),
-                    outline=black,
-                    width=max(1, round(s)),
-                )
-                draw.multiline_text(
-                    (margin + 1.6 * box, y), label, fill=black, font=font, spacing=line_gap
-                )
-                y += (label.count("\n") + 1) * (box + line_gap)
-        else:
-            width = min(0.5 * w, 320 * s)
-            height = 0.9 * FONT_PX * s
-            x0 = 0.5 * (w - width)
-            y_labels = h - margin - FONT_PX * s
-            y1 = y_labels - 0.4 * FONT_PX * s
-            y0 = y1 - height
-            n = max(2, int(round(width)))
-            t = np.linspace(0.0, 1.0, n)
-            anchors = np.linspace(0.0, 1.0, len(bar.colors))
-            rgb = np.column_stack(
-                [np.interp(t, anchors, [c[i] for c in bar.colors]) for i in range(3)]
-            )
-            for i in range(n):
-                xa = x0 + width * i / n
-                draw.rectangle(
-                    [xa, y0, x0 + width * (i + 1) / n, y1], fill=_rgba(rgb[i]), outline=None
-                )
-            draw.rectangle([x0, y0, x0 + width, y1], outline=black, width=max(1, round(s)))
-            # arrow heads past clipped ends (matplotlib's "extend"), in the end's colour
-            tip = 0.8 * height
-            for end, x_end, sign in ((0, x0, -1.0), (1, x0 + width, 1.0)):
-                if bar.clipped[end]:
-                    draw.polygon(
-                        [(x_end, y0), (x_end + sign * tip, 0.5 * (y0 + y1)), (x_end, y1)],
-                        fill=_rgba(rgb[-1 if end else 0]),
-                        outline=black,
-                        width=max(1, round(s)),
-                    )
-            lo, hi = bar.clim
-            ticks = [(lo, 0.0), (hi, 1.0)]
-            if lo < 0 < hi:
-                ticks.append((0.0, (0.0 - lo) / (hi - lo)))
-            if bar.ticks:  # a spread scale: its values where they lie on the bar
-                ticks = [(float(v), float(p)) for v, p in bar.ticks]
-                for _, pos in ticks:
-                    x = x0 + pos * width
-                    draw.line([(x, y1), (x, y1 + 0.3 * FONT_PX * s)], fill=black, width=1)
-            for value, pos in ticks:
-                text = colorbar_label(value)
-                if pos in (0.0, 1.0) and bar.clipped[int(pos)]:
-                    text = ("> " if pos else "< ") + text
-                tw = draw.textlength(text, font=font)
-                x = np.clip(x0 + pos * width - 0.5 * tw, 0, w - tw)
-                draw.text((x, y_labels), text, fill=black, font=font)
-            if bar.title:
-                tw = draw.textlength(bar.title, font=font)
-                draw.text(
-                    (max(0.0, 0.5 * (w - tw)), y0 - 1.4 * FONT_PX * s),
-                    bar.title,
-                    fill=black,
-                    font=font,
-                )
+    if bar is None:
+        return np.asarray(canvas)
+    if bar.kind == "swatches":
+        labels = [
+            wrap_text(label, measure, w - 2 * margin - 1.6 * em)
+            for label in bar.labels[: len(bar.colors)]
+        ]
+        lines = sum(label.count("\n") + 1 for label in labels)
+        y = h - margin - lines * (em + line_gap)
+        if bar.title:
+            title = wrap_text(bar.title, measure, w - 2 * margin)
+            write((margin, y - (title.count("\n") + 1) * (em + line_gap)), title)
+        for color, label in zip(bar.colors, labels, strict=False):
+            box = [margin, y, margin + em, y + em]
+            draw.rectangle(box, fill=_rgba(color), outline=black, width=outline)
+            write((margin + 1.6 * em, y), label)
+            y += (label.count("\n") + 1) * (em + line_gap)
+        return np.asarray(canvas)
+    width, height = min(0.5 * w, 320 * s), 0.9 * em
+    x0 = 0.5 * (w - width)
+    y_labels = h - margin - em
+    y1 = y_labels - 0.4 * em
+    y0 = y1 - height
+    n = max(2, int(round(width)))
+    t, anchors = np.linspace(0.0, 1.0, n), np.linspace(0.0, 1.0, len(bar.colors))
+    rgb = np.column_stack([np.interp(t, anchors, [c[i] for c in bar.colors]) for i in range(3)])
+    for i, color in enumerate(rgb):
+        draw.rectangle([x0 + width * i / n, y0, x0 + width * (i + 1) / n, y1], fill=_rgba(color))
+    draw.rectangle([x0, y0, x0 + width, y1], outline=black, width=outline)
+    # arrow heads past clipped ends (matplotlib's "extend"), in the end's colour
+    tip = 0.8 * height
+    for end, x_end, sign in ((0, x0, -1.0), (1, x0 + width, 1.0)):
+        if bar.clipped[end]:
+            head = [(x_end, y0), (x_end + sign * tip, 0.5 * (y0 + y1)), (x_end, y1)]
+            draw.polygon(head, fill=_rgba(rgb[-1 if end else 0]), outline=black, width=outline)
+    lo, hi = bar.clim
+    ticks = [(lo, 0.0), (hi, 1.0)] + ([(0.0, (0.0 - lo) / (hi - lo))] if lo < 0 < hi else [])
+    if bar.ticks:  # a spread scale: its values where they lie on the bar
+        ticks = [(float(v), float(p)) for v, p in bar.ticks]
+        for _, pos in ticks:
+            x = x0 + pos * width
+            draw.line([(x, y1), (x, y1 + 0.3 * em)], fill=black, width=1)
+    for value, pos in ticks:
+        text = colorbar_label(value)
+        if pos in (0.0, 1.0) and bar.clipped[int(pos)]:
+            text = ("> " if pos else "< ") + text
+        tw = measure(text)
+        write((np.clip(x0 + pos * width - 0.5 * tw, 0, w - tw), y_labels), text)
+    if bar.title:
+        write((max(0.0, 0.5 * (w - measure(bar.title))), y0 - 1.4 * em), bar.title)
     return np.asarray(canvas)
