@@ -157,8 +157,7 @@ class PairState:
     # ----------------------------------------------------------- meshes
     def mesh(self, side: str) -> Mesh:
         """Mesh ``side`` as given (the input's numbering)."""
-        _check_side(side)
-        return self.sides[side].mesh.input_mesh
+        return self.drawn_mesh(side).input_mesh
 
     def drawn_mesh(self, side: str) -> Mesh:
         """The surface drawn of ``side``: the vertices faces use (:class:`PairView`'s)."""
@@ -465,7 +464,6 @@ class PairState:
 
     def view(self, side: str) -> PairView:
         """What ``side`` shows: see :class:`PairView`."""
-        _check_side(side)
         drawn = self.drawn_mesh(side)
         head = f"{side.upper()}: {self.name(side)}, {drawn.n_vertices} vertices"
         name = DISTANCE_KINDS[self.kind]
@@ -475,55 +473,29 @@ class PairState:
         matches = self._drawn_matches()
         if matches is None:
             marker = v if from_side == side else None
-            legend = f"{head}\n{name}: {self._missing()}"
-            return PairView(None, "plain", None, marker, None, legend)
+            return PairView(None, "plain", None, marker, None, f"{head}\n{name}: {self._missing()}")
         _, w, dist, back = matches
-        notes = [n for n in (self.note, self.arrival_note()) if n]
-        note = "".join(f"\n{n}" for n in notes)
+        note = "".join(f"\n{n}" for n in (self.note, self.arrival_note()) if n)
         # markers are drawn-mesh vertices, labels the input's numbers
         fv, fw = self.picked[1], self.best_match()[1]
         if from_side == side:
-            mutual = (
-                "mutual"
-                if back == v
-                else f"not mutual: back to vertex {self.back_match()} (yellow)"
-            )
-            return PairView(
-                None,
-                "plain",
-                None,
-                v,
-                None if back == v else back,
-                f"{head}\npicked vertex {fv}\nbest match on {other(side).upper()}: vertex {fw}"
-                f"\n{mutual}{note}",
-            )
+            mutual = f"not mutual: back to vertex {self.back_match()} (yellow)"
+            mutual = "mutual" if back == v else mutual
+            legend = f"{head}\npicked vertex {fv}\nbest match on {other(side).upper()}: vertex {fw}"
+            back_marker = None if back == v else back
+            return PairView(None, "plain", None, v, back_marker, f"{legend}\n{mutual}{note}")
         d = self._drawn_distance(side)
         source = f"from vertex {fv} of {from_side.upper()}"
         if self.distance_display == "threshold":
             thr, share = self.threshold(side)
-            similar = f"{name.lower()} < {thr:.3g} ({100 * share:.1f} %)"
-            return PairView(
-                d,
-                "threshold",
-                thr,
-                w,
-                None,
-                f"{head}\nblue: {name.lower()} < {thr:.3g}, {100 * share:.1f} % of "
-                f"{side.upper()}\n{source}; best match vertex {fw}{note}",
-                f"{name} < {thr:.3g}",
-                [similar, "the rest"],
-            )
-        return PairView(
-            d,
-            "sequential",
-            None,
-            w,
-            None,
-            f"{head}\n{name} {source}: white 0 to red {float(d.max()):.3g}\n"
-            f"best match: vertex {fw} (d = {dist:.3g}){note}",
-            name,
-            scale=self._spread(side, d),
-        )
+            below = f"{name.lower()} < {thr:.3g}"
+            legend = f"{head}\nblue: {below}, {100 * share:.1f} % of {side.upper()}\n{source}"
+            legend += f"; best match vertex {fw}{note}"
+            labels = [f"{below} ({100 * share:.1f} %)", "the rest"]
+            return PairView(d, "threshold", thr, w, None, legend, f"{name} < {thr:.3g}", labels)
+        legend = f"{head}\n{name} {source}: white 0 to red {float(d.max()):.3g}\n"
+        legend += f"best match: vertex {fw} (d = {dist:.3g}){note}"
+        return PairView(d, "sequential", None, w, None, legend, name, scale=self._spread(side, d))
 
 
 def _drawn_vertices(mesh: Mesh, vertices, name: str) -> np.ndarray:
