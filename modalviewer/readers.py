@@ -341,16 +341,14 @@ def _ply_binary(body, order, damage, name, count, props, offset):
         row_values = {}
         try:  # np.frombuffer raises ValueError where the data end before the value
             for prop, types in props:
+                it, n = np.dtype(order + _PLY_TYPES[types[-1]]), 1
                 if types[0] == "list":
-                    ct, it = (np.dtype(order + _PLY_TYPES[t]) for t in types[1:3])
+                    ct = np.dtype(order + _PLY_TYPES[types[1]])
                     n = int(np.frombuffer(body, ct, 1, offset)[0])
-                    items = np.frombuffer(body, it, n, offset + ct.itemsize)
-                    row_values[prop] = items.astype(np.int64)
-                    offset += ct.itemsize + it.itemsize * n
-                else:
-                    t = np.dtype(order + _PLY_TYPES[types[0]])
-                    row_values[prop] = np.frombuffer(body, t, 1, offset)[0]
-                    offset += t.itemsize
+                    offset += ct.itemsize
+                items = np.frombuffer(body, it, n, offset)
+                row_values[prop] = items.astype(np.int64) if types[0] == "list" else items[0]
+                offset += it.itemsize * n
         except ValueError:
             pass
         if len(row_values) < len(props):
@@ -473,16 +471,10 @@ def _read_elements(path: Path, elements, read, damage: _Damage) -> MeshFile:
             break  # the data ended: no later element can be read
     if vertices is None:
         raise MeshError(f"{path.name}: the PLY file has no vertex element")
-    n = len(vertices)
-    if isinstance(polygons, np.ndarray):
-        bad = np.flatnonzero(np.any((polygons < 0) | (polygons >= n), axis=1))
-        for i in bad[:1] if damage.strict else bad:
-            damage(
-                f"face {i}",
-                f"the face names vertex {polygons[i][(polygons[i] < 0) | (polygons[i] >= n)][0]}"
-                f" but the file has only {count_text(n, 'vertex', 'vertices')} (numbered from 0)",
-            )
-        return MeshFile(vertices, np.delete(polygons, bad, axis=0), damage.notes)
+    if isinstance(polygons, np.ndarray):  # the binary fast path's (m, 3) triangles
+        if len(polygons) == 0 or (polygons.min() >= 0 and polygons.max() < len(vertices)):
+            return MeshFile(vertices, polygons, damage.notes)
+        polygons = polygons.tolist()  # _mesh_file names each face naming no vertex
     return _mesh_file(vertices, polygons, unplaced, damage, lambda i: f"face {i}")
 
 
@@ -545,21 +537,16 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
 def _stl_vertices(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(vertices, triangles) of an STL file's triangle corners (3 m, 3): STL names a
     vertex by its position only, so its vertices are the distinct corner positions in
-    the order they first appear (vertex i is the i-th distinct one).  One stable sort
-    of the coordinates' bits finds them (``np.unique(axis=0)`` compares rows element by
-    element, slower)."""
-    if len(corners) == 0:
-        return corners, np.zeros((0, 3), dtype=np.int64)
-    bits = np.ascontiguousarray(corners + 0.0).view(np.uint64)  # + 0.0: -0.0 is 0.0
-    order = np.lexsort(bits.T[::-1])  # stable: each position's first corner comes first
-    new = np.ones(len(order), dtype=bool)
-    new[1:] = (np.diff(bits[order], axis=0) != 0).any(axis=1)
-    first = order[new]  # the first corner of each distinct position, sorted by position
+    the order they first appear (vertex i is the i-th distinct one), found by one stable
+    sort of the positions' bytes."""
+    bits = np.ascontiguousarray(corners + 0.0, dtype=np.float64)  # + 0.0: -0.0 is 0.0
+    _, first, group = np.unique(
+        bits.view(np.dtype((np.void, 24))).ravel(), return_index=True, return_inverse=True
+    )
+    order = np.argsort(first)  # the distinct positions in the order they first appear
     rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    group = np.empty(len(order), dtype=np.int64)
-    group[order] = np.cumsum(new) - 1
-    return corners[np.sort(first)], rank[group].reshape(-1, 3)
+    rank[order] = np.arange(len(first))
+    return corners[first[order]], rank[group.reshape(-1)].reshape(-1, 3)
 
 
 STL_COORDINATE_LIMIT = 1e30
