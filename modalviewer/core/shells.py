@@ -103,7 +103,7 @@ def triangle_area_gradients(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 # --------------------------------------------------------------- the energy
 def _terms(mesh: Mesh, bending: float, membrane: float):
-    """Yield (stencil (e, L), f(x) callable, grad callable, weights at rest (e,))."""
+    """Per term: (stencil (e, L), f(x) callable, grad callable, weights at rest (e,))."""
     rest = mesh.vertices
     hinge = hinges(mesh)
     edges = mesh.edges
@@ -117,36 +117,6 @@ def _terms(mesh: Mesh, bending: float, membrane: float):
         yield mesh.faces, triangle_areas, triangle_area_gradients, membrane / mesh.face_areas
 
 
-def _check_weights(bending: float, membrane: float) -> None:
-    for name, value in (("bending", bending), ("membrane", membrane)):
-        if not np.isfinite(value) or value < 0:
-            raise ValueError(f"{name} weight must be a finite number >= 0, got {value}")
-    if bending == 0 and membrane == 0:
-        raise ValueError("bending and membrane weights cannot both be zero")
-
-
-def shells_energy(mesh: Mesh, x, bending: float = 1.0, membrane: float = 1.0) -> float:
-    """Discrete Shells energy of deformed positions ``x`` (n, 3) relative to the mesh."""
-    _check_weights(bending, membrane)
-    x = np.asarray(x, dtype=np.float64).reshape(-1, 3)
-    total = 0.0
-    for stencil, f, _, w in _terms(mesh, bending, membrane):
-        diff = f(x, stencil) - f(mesh.vertices, stencil)
-        total += 0.5 * float(np.sum(w * diff**2))
-    return total
-
-
-def shells_gradient(mesh: Mesh, x, bending: float = 1.0, membrane: float = 1.0) -> np.ndarray:
-    """(3n,) gradient of :func:`shells_energy` at ``x``, vertex-major."""
-    _check_weights(bending, membrane)
-    x = np.asarray(x, dtype=np.float64).reshape(-1, 3)
-    grad = np.zeros((mesh.n_vertices, 3))
-    for stencil, f, df, w in _terms(mesh, bending, membrane):
-        coef = w * (f(x, stencil) - f(mesh.vertices, stencil))
-        np.add.at(grad, stencil.ravel(), (coef[:, None, None] * df(x, stencil)).reshape(-1, 3))
-    return grad.ravel()
-
-
 def weighted_gradient_matrix(
     mesh: Mesh,
     bending: float = 1.0,
@@ -157,7 +127,11 @@ def weighted_gradient_matrix(
     edges, edges, faces, in that order), so that the Hessian at rest is ``G^T G``
     (Lemma 1).  Columns: the 3n vertex-major dofs, or with ``normals`` (n, 3) the n
     normal variations, which gives ``H_N = G_N^T G_N`` without the 3n Hessian."""
-    _check_weights(bending, membrane)
+    for name, value in (("bending", bending), ("membrane", membrane)):
+        if not np.isfinite(value) or value < 0:
+            raise ValueError(f"{name} weight must be a finite number >= 0, got {value}")
+    if bending == 0 and membrane == 0:
+        raise ValueError("bending and membrane weights cannot both be zero")
     n = mesh.n_vertices if normals is not None else 3 * mesh.n_vertices
     blocks = []
     for stencil, _, df, w in _terms(mesh, bending, membrane):
