@@ -93,15 +93,6 @@ class ComponentSpectrum:
     vertices: np.ndarray
     spectrum: Spectrum
 
-    def mode_on_original(self, j: int, n_vertices: int, fill: float = np.nan) -> np.ndarray:
-        """Mode j as a field on the original mesh: (n,) or (n, 3), ``fill`` on the
-        vertices of other components (NaN: no value there).  With ``fill=0`` it is an
-        eigenvector of the whole mesh's operator too, which is block diagonal."""
-        mode = self.spectrum.mode(j)
-        out = np.full((n_vertices, *mode.shape[1:]), fill)
-        out[self.vertices] = mode
-        return out
-
 
 def compute_spectrum_per_component(
     mesh: Mesh,
