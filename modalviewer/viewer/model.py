@@ -165,7 +165,7 @@ class ViewerModel:
         if state.has_spectrum(key):  # an ended job; shown unless that operator is on screen
             job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)
             if show and state.display_operator() != key.operator:
-                self._show_first_mode(key.operator)
+                state.show_mode(state.first_nonzero_mode(key.operator), key.operator)
             return job.end_now((state.spectra[key], None))
         refusal = self.refusal(key)
         if refusal:
@@ -235,13 +235,9 @@ class ViewerModel:
         first non-zero mode."""
         if self.state.display not in (before, before.blank()):
             return
-        if before.kind == "mode" and before.operator == operator:
-            self.state.show_mode(before.mode, operator)
-        else:
-            self._show_first_mode(operator)
-
-    def _show_first_mode(self, operator: str) -> None:
-        self.state.show_mode(self.state.first_nonzero_mode(operator), operator)
+        same = before.kind == "mode" and before.operator == operator
+        mode = before.mode if same else self.state.first_nonzero_mode(operator)
+        self.state.show_mode(mode, operator)
 
     def _work(self, key: SpectrumKey, on_modes=None):
         """The function a job runs for ``key``: the spectrum, then its signature table."""

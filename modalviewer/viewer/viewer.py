@@ -112,18 +112,10 @@ class Viewer(ViewerModel, Pictures):
         """Apply repair ``name`` ("fix_slivers", "largest_component") in the background;
         the repaired mesh replaces the loaded one.  With ``wait`` returns it (ComputeError
         if the repair failed)."""
-        job = self.repair(name)
-        job.then(self._on_repaired)
-        if not wait:
-            return None
-        self.wait_for(job)
-        if job.status != DONE:
-            raise ComputeError(job.error or job.status)
-        return job.result
-
-    def _on_repaired(self, job: Job) -> None:
-        if job.status == DONE:
-            self._status(str(job.result.report), 20000)
+        job = self.repair(name).then(
+            lambda j: self._status(str(j.result.report), 20000) if j.status == DONE else None
+        )
+        return self._waited(job).result if wait else None
 
     def fix_slivers_and_retry(self, key: SpectrumKey | None = None, wait: bool = False):
         """Fix the mesh's slivers and request again the spectrum ``key`` (default: the
@@ -255,12 +247,14 @@ class Viewer(ViewerModel, Pictures):
             return None
         if then is not None:
             job.then(lambda j: then(self._public(j.result[0])) if j.status == DONE else None)
-        if not wait:
-            return None
+        return self._public(self._waited(job).result[0]) if wait else None
+
+    def _waited(self, job: Job) -> Job:
+        """``job`` once it has ended; ComputeError if it failed or was cancelled."""
         self.wait_for(job)
         if job.status != DONE:
             raise ComputeError(job.error or job.status)
-        return self._public(job.result[0])
+        return job
 
     def long_wait_note(self, job: SpectrumJob) -> str:
         """ "this will take about ..." for a request expected (from this machine's solves)
@@ -475,11 +469,8 @@ class Viewer(ViewerModel, Pictures):
         """Colour by the signature at scale sample ``sample`` of the distance kind."""
         operator = operator_for_distance(self.state.display.distance_kind)
         if not self.state.derived.has_signatures(operator):
-            self._status(
-                f"Compute the {OPERATOR_INFO[operator].label} spectrum first (with non-zero "
-                "modes).",
-                5000,
-            )
+            label = OPERATOR_INFO[operator].label
+            self._status(f"Compute the {label} spectrum first (with non-zero modes).", 5000)
             return
         self.state.set_display(kind="signature", signature_sample=int(sample))
 
@@ -564,11 +555,7 @@ class Viewer(ViewerModel, Pictures):
                 raise ComputeRefused(self.last_error or "the computation was refused")
             return None
         if wait:
-            for job in jobs:
-                self.wait_for(job)
-                if job.status != DONE:
-                    raise ComputeError(job.error or job.status)
-            return jobs
+            return [self._waited(job) for job in jobs]
         called = []
 
         def ready(_job=None) -> None:  # once, when the last job is in (never if one failed)

@@ -229,10 +229,6 @@ def seconds_text(seconds: float) -> str:
     return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
 
 
-def worst_residual(spec: Spectrum) -> float:
-    return float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
-
-
 # what the status line and ``modalviewer compute`` say of a solve that saved memory
 OUT_OF_CORE_WORDS = "factor kept on disk"
 FLOAT32_BASIS_WORDS = "Krylov basis in single precision"
@@ -289,7 +285,7 @@ def residual_text(spec: Spectrum) -> str:
     """'largest relative residual 1.3e-05' and, where it is high, the mode's rounding
     floor: the residual rounding the mode to double precision alone causes (an
     estimate: no solver goes much below it)."""
-    worst = worst_residual(spec)
+    worst = float(np.max(spec.residuals[~spec.zero_mode_mask()], initial=0.0))
     text = f"largest relative residual {worst:.1e}"
     floor = float(spec.parameters.get("worst_residual_rounding_floor", 0.0))
     if floor > 0.0 and worst <= 1.5 * floor:
