@@ -210,23 +210,13 @@ class MeshScene:
         want_zero = count > 0 and emphasise_zero and lo < 0 < hi
         # one pass over the triangles for all levels, the zero line split off after
         everything = list(levels) + ([0.0] if want_zero else [])
-        seg, disp, level, tri, edges = segments(
-            self.rest_points,
-            self.mesh.faces,
-            values,
-            everything,
-            self.surface.point_data["displacement"],
-        )
+        faces, rest = self.mesh.faces, self.rest_points
+        moves = self.surface.point_data["displacement"]
+        seg, disp, level, tri, edges = segments(rest, faces, values, everything, moves)
         zero = level == 0.0 if want_zero else np.zeros(len(level), dtype=bool)
         if want_zero:
-            keep = meaningful_zero_lines(
-                self.mesh.faces,
-                self.rest_points,
-                values,
-                tri[zero],
-                edges[zero],
-                self.mesh.bounding_box_diagonal,
-            )
+            diagonal = self.mesh.bounding_box_diagonal
+            keep = meaningful_zero_lines(faces, rest, values, tri[zero], edges[zero], diagonal)
             drop = np.flatnonzero(zero)[~keep]
             seg, disp, zero = (np.delete(x, drop, axis=0) for x in (seg, disp, zero))
         self._iso_rest, self._iso_disp = self._show_lines(
@@ -401,18 +391,15 @@ class MeshScene:
             self.plotter.renderer.ResetCamera(*self.surface.bounds)
         self.plotter.renderer.ResetCameraClippingRange()
 
-    def apply_camera_preset(self, name: str) -> cameras.Camera:
-        """Set and return camera preset ``name``: "canonical", "isometric" or a side ("+x")."""
-        if name == "canonical":
+    def reset_camera(self, preset: str = "canonical") -> cameras.Camera:
+        """Set and return camera ``preset``: the canonical first view (R), "isometric" or a
+        side ("+x")."""
+        if preset == "canonical":
             camera = self.canonical_camera()
         else:
-            camera = cameras.preset_view(self.mesh.vertices, name, up=self.up())
+            camera = cameras.preset_view(self.mesh.vertices, preset, up=self.up())
         self.set_camera(camera)
         return camera
-
-    def reset_camera(self) -> cameras.Camera:
-        """Back to the canonical first view."""
-        return self.apply_camera_preset("canonical")
 
     # -------------------------------------------------------------- animation
     def set_displacement_scale(self, s: float) -> None:

@@ -223,7 +223,7 @@ class StateScene:
     def reset_camera(self, preset: str = "canonical") -> None:
         """The mesh's canonical view (R), or camera ``preset`` ("+x" ... "-z", "isometric")."""
         if self.scene is not None:
-            self.scene.apply_camera_preset(preset)
+            self.scene.reset_camera(preset)
             self.request_render()
 
     def _on_up_axis(self) -> None:

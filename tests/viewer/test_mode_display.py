@@ -303,7 +303,7 @@ def test_the_ghost_fades_where_the_surface_moved_slightly_behind_it():
     plotter = offscreen_plotter((400, 300))
     try:
         scene = MeshScene(plotter, mesh, vertex_normals(mesh))
-        scene.apply_camera_preset("+z")
+        scene.reset_camera("+z")
         pictures = []
         for ghost in (True, False):
             field.ghost = ghost
