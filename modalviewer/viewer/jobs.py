@@ -27,6 +27,7 @@ _ids = itertools.count(1)
 # failures whose message says it all: their jobs keep no traceback for the log
 EXPECTED_FAILURES: tuple[type[Exception], ...] = (MeshError, EigenError, ChildError)
 PROGRESS_INTERVAL = 0.05  # seconds between reports of one stage (each crosses threads)
+NO_MEMORY = "Not enough memory for this computation; compute fewer modes or use Coarse-to-fine."
 
 QUEUED, RUNNING, DONE, FAILED, CANCELLED = "queued", "running", "done", "failed", "cancelled"
 
@@ -91,14 +92,7 @@ class Job:
 class SpectrumJob(Job):
     """A job computing the spectrum ``spectrum_key``; result ``(Spectrum, table or None)``."""
 
-    def __init__(
-        self,
-        fn: Callable | None,
-        key: Hashable,
-        description: str,
-        owner: Hashable,
-        spectrum_key,
-    ):
+    def __init__(self, fn, key, description, owner, spectrum_key) -> None:
         super().__init__(fn, key, description, owner)
         self.spectrum_key = spectrum_key
 
@@ -270,22 +264,14 @@ class JobQueue:
         except Cancelled as exc:  # a reason given by the work itself is kept
             outcome = (CANCELLED, None, job.error or str(exc) or "cancelled", "")
         except MemoryError:
-            outcome = (
-                FAILED,
-                None,
-                "Not enough memory for this computation; compute fewer modes or use "
-                "Coarse-to-fine.",
-                traceback.format_exc(),
-            )
+            outcome = (FAILED, None, NO_MEMORY, traceback.format_exc())
         except EXPECTED_FAILURES as exc:  # the message says it all: no traceback
             outcome = (FAILED, None, str(exc) or type(exc).__name__, "")
         except Exception as exc:  # reported to the user, never raised into the event loop
             outcome = (FAILED, None, str(exc) or type(exc).__name__, traceback.format_exc())
         else:
-            if job._cancel.is_set():
-                outcome = (CANCELLED, None, job.error or "cancelled", "")
-            else:
-                outcome = (DONE, result, None, "")
+            cancelled = (CANCELLED, None, job.error or "cancelled", "")
+            outcome = cancelled if job._cancel.is_set() else (DONE, result, None, "")
         job.seconds = time.perf_counter() - job._started
         job._done.set()
         self.dispatch(lambda: self._finish(job, *outcome))
