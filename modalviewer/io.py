@@ -148,11 +148,9 @@ def mesh_from_arrays(vertices, faces, source: str, repair: bool = True, notes=()
     vertices = np.asarray(vertices)
     if len(faces) == 0:
         raise MeshError(
-            f"{source}: the file contains "
-            f"{count_text(len(vertices), 'vertex', 'vertices')} but "
-            "no faces: a point "
-            "cloud is not a surface (reconstruct a surface from it first), or the file is "
-            "truncated before its faces"
+            f"{source}: the file contains {count_text(len(vertices), 'vertex', 'vertices')} "
+            "but no faces: a point cloud is not a surface (reconstruct a surface from it "
+            "first), or the file is truncated before its faces"
         )
     try:
         if repair:

@@ -202,8 +202,7 @@ def plot(
 
             warnings.warn(
                 "an interactive picture needs trame-pyvista and trame-vtk: pip install "
-                "'modalviewer[notebook]'; "
-                "showing an image instead",
+                "'modalviewer[notebook]'; showing an image instead",
                 stacklevel=2,
             )
             interactive = False

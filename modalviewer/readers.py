@@ -117,9 +117,8 @@ def _mesh_file(vertices, polygons: list, unplaced: list, damage: _Damage, place)
         else:
             outside = np.zeros(3)
         vertices[unplaced] = outside + np.arange(len(unplaced))[:, None]
-        used = np.zeros(n, dtype=bool)
-        used[unplaced] = True
-        whole = [p for p in kept if not used[p].any()]
+        incomplete = set(unplaced)
+        whole = [p for p in kept if incomplete.isdisjoint(p)]
         if len(whole) < len(kept):
             dropped = count_text(len(kept) - len(whole), "face", "faces")
             damage.note("faces", f"{dropped} using a vertex whose record was incomplete dropped")
@@ -188,9 +187,7 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
     _check_last_line(text, damage, ("v", "f"))
     fast = _read_obj_fast(text)
     result = _obj_records(text, damage) if fast is None else MeshFile(*fast, damage.notes)
-    used = np.zeros(len(result.vertices), dtype=bool)
-    used[result.faces.ravel()] = True
-    unused = int((~used).sum())
+    unused = int((np.bincount(result.faces.ravel(), minlength=len(result.vertices)) == 0).sum())
     # a file cut between two face records ends in a face record and leaves vertices no
     # face uses; one that ends in a comment ("# End of File") or another record does not
     tail = [line.strip() for line in text[-4096:].splitlines() if line.strip()]

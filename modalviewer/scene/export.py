@@ -120,8 +120,7 @@ def _write_ply(path: Path, mesh: Mesh, arrays: dict[str, np.ndarray]) -> None:
     """Binary little-endian PLY of ``mesh`` with each of ``arrays`` (n,) or (n, c) as
     vertex properties (``name``, or ``name_0 .. name_c-1``; doubles, integers as int),
     which VTK's PLY writer would drop (it keeps only colours and texture coordinates)."""
-    columns = [("x", "<f8", mesh.vertices[:, 0]), ("y", "<f8", mesh.vertices[:, 1])]
-    columns.append(("z", "<f8", mesh.vertices[:, 2]))
+    columns = [(c, "<f8", mesh.vertices[:, i]) for i, c in enumerate("xyz")]
     for name, values in arrays.items():
         kind = "<i4" if np.issubdtype(values.dtype, np.integer) else "<f8"
         if values.ndim == 1:

@@ -75,7 +75,7 @@ def fit_points(
         return
     view_angle_on_smaller_side(renderer)
     camera = renderer.GetActiveCamera()
-    aspect = w / h
+    aspect, angle = w / h, camera.GetViewAngle()
     # the free box in normalised device coordinates
     x0 = -1.0 + 2.0 * (left / w + MARGIN)
     x1 = 1.0 - 2.0 * (right / w + MARGIN)
@@ -102,15 +102,12 @@ def fit_points(
         # the world lengths of half the picture at the focal point
         focal, position = np.array(camera.GetFocalPoint()), np.array(camera.GetPosition())
         d = float(np.linalg.norm(focal - position))
-        if camera.GetParallelProjection():
-            half = camera.GetParallelScale()
-            half_h, half_w = half, half * aspect
+        parallel = camera.GetParallelProjection()
+        half = camera.GetParallelScale() if parallel else d * np.tan(np.radians(angle) / 2.0)
+        if not parallel and camera.GetUseHorizontalViewAngle():
+            half_w, half_h = half, half / aspect
         else:
-            half = d * np.tan(np.radians(camera.GetViewAngle()) / 2.0)
-            if camera.GetUseHorizontalViewAngle():
-                half_w, half_h = half, half / aspect
-            else:
-                half_h, half_w = half, half * aspect
+            half_h, half_w = half, half * aspect
         up = np.array(camera.GetViewUp())
         forward = (focal - position) / d
         right = np.cross(forward, up)
@@ -119,7 +116,7 @@ def fit_points(
         shift = -dx * half_w * right - dy * half_h * up
         camera.SetFocalPoint(*(focal + shift))
         camera.SetPosition(*(position + shift))
-        if camera.GetParallelProjection():
+        if parallel:
             camera.SetParallelScale(half * k)
         else:
             camera.Dolly(1.0 / k)
