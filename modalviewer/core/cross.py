@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .mesh import Mesh
-from .signatures import SignatureTable, default_energies, default_times, normalised_signatures
+from .signatures import SignatureTable, default_scales, log_spaced, normalised_signatures
 from .spectrum import Spectrum
 from .validate import check_count, check_t_range, check_vertex, check_vertices
 
@@ -81,8 +81,7 @@ def common_times(
     ValueError if those do not overlap (the meshes differ too much in size)."""
     samples = check_count(samples, "samples", 2)
     if t_range is None:
-        ends = default_energies if kind == "wks" else default_times
-        ta, tb = ends(spec_a, 2), ends(spec_b, 2)
+        ta, tb = default_scales(spec_a, 2, kind), default_scales(spec_b, 2, kind)
         t1, t2 = max(ta[0], tb[0]), min(ta[-1], tb[-1])
         if not t1 < t2:
             raise ValueError(
@@ -92,7 +91,7 @@ def common_times(
             )
     else:
         t1, t2 = check_t_range(t_range)
-    return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
+    return log_spaced(t1, t2, samples)
 
 
 class CrossTables:

@@ -36,14 +36,18 @@ def _used(spec: Spectrum, include_zero: bool) -> np.ndarray:
     return mask
 
 
-def default_times(spec: Spectrum, samples: int = 100, include_zero: bool = False) -> np.ndarray:
+def log_spaced(start: float, stop: float, samples: int) -> np.ndarray:
+    """``samples`` values log-spaced from ``start`` to ``stop``: every scale range's grid
+    (np.geomspace differs in the last digits)."""
+    return np.exp(np.linspace(np.log(start), np.log(stop), samples))
+
+
+def default_times(spec: Spectrum, samples: int = 100) -> np.ndarray:
     """``samples`` log-spaced scales from ``4 ln 10`` over the largest to over the
-    smallest non-zero eigenvalue (``include_zero`` does not change the range)."""
+    smallest non-zero eigenvalue (with or without the zero modes in the signature)."""
     samples = check_count(samples, "samples", 2)
     lam = spec.eigenvalues[_used(spec, False)]
-    t1 = 4.0 * np.log(10.0) / lam.max()
-    t2 = 4.0 * np.log(10.0) / lam.min()
-    return np.exp(np.linspace(np.log(t1), np.log(t2), samples))
+    return log_spaced(4.0 * np.log(10.0) / lam.max(), 4.0 * np.log(10.0) / lam.min(), samples)
 
 
 def default_energies(spec: Spectrum, samples: int = 100) -> np.ndarray:
@@ -51,7 +55,12 @@ def default_energies(spec: Spectrum, samples: int = 100) -> np.ndarray:
     the largest non-zero eigenvalue (Aubry et al.'s band)."""
     samples = check_count(samples, "samples", 2)
     lam = _positive_eigenvalues(spec)
-    return np.exp(np.linspace(np.log(lam.min()), np.log(lam.max()), samples))
+    return log_spaced(lam.min(), lam.max(), samples)
+
+
+def default_scales(spec: Spectrum, samples: int = 100, kind: str = "heat") -> np.ndarray:
+    """:func:`default_energies` for ``kind="wks"``, else :func:`default_times`."""
+    return (default_energies if kind == "wks" else default_times)(spec, samples)
 
 
 def wks_sigma(energies: Sequence[float] | np.ndarray) -> float:
@@ -108,8 +117,7 @@ def signature(
     if energies is not None or sigma is not None:
         raise ValueError('energies= and sigma= belong to kind="wks"')
     mask = _used(spec, include_zero)
-    times = default_times(spec, include_zero=include_zero) if times is None else times
-    times = check_times(times)
+    times = check_times(default_times(spec) if times is None else times)
     lam = spec.eigenvalues[mask]
     weights = np.exp(-np.outer(lam, times))  # (k, T)
     values = spec.squared_modes(vertices)[:, mask] @ weights
@@ -150,14 +158,10 @@ class SignatureTable:
             raise ValueError("the wave kernel signature leaves the zero modes out")
         self.t_range = None if t_range is None else check_t_range(t_range)
         if self.t_range is not None:
-            t1, t2 = self.t_range
-            times = np.exp(np.linspace(np.log(t1), np.log(t2), samples))
-        elif kind == "wks":
-            times = default_energies(spec, samples)
+            self.times = log_spaced(*self.t_range, samples)
         else:
-            times = default_times(spec, samples, include_zero)
-        self.times = times
-        self.table = normalised_signatures(spec, times, include_zero, kind=kind)
+            self.times = default_scales(spec, samples, kind)
+        self.table = normalised_signatures(spec, self.times, include_zero, kind=kind)
 
     @property
     def table(self) -> np.ndarray:
