@@ -131,19 +131,13 @@ def compute_spectrum(
         pairs = exact_pairs(mesh, operator, k, bending, membrane, progress, cancel, on_modes)
     except EigenError as exc:
         raise EigenError(f"{exc}{sliver_hint(mesh)}") from None
-    result, nulls = pairs.result, pairs.nulls
+    result = pairs.result
     if not pairs.nonzero.any():
-        warnings.warn(
-            _all_zero_message(result.eigenvalues.shape[0], result, nulls, pairs.zero_mode_scale),
-            ZeroModesWarning,
-            stacklevel=2,
-        )
+        warnings.warn(_all_zero_message(pairs), ZeroModesWarning, stacklevel=2)
     at_floor, worst_floor = _checked_residuals(pairs, mesh)
     progress("done", 1.0)
     parameters = {
-        "k": result.eigenvalues.shape[0],
-        "bending": float(bending),
-        "membrane": float(membrane),
+        **pairs.parameters,
         "method": result.method,
         "shift": result.shift,
         "seconds_by_stage": {s: round(t, 4) for s, t in result.stage_seconds.items()},
@@ -156,9 +150,6 @@ def compute_spectrum(
         "seconds_total": time.perf_counter() - started,
         "modes_at_rounding_floor": at_floor,
         "worst_residual_rounding_floor": worst_floor,
-        "zero_mode_scale": pairs.zero_mode_scale,
-        "n_components": nulls.n_components,
-        "null_space": nulls.summary(),
     }
     per_vertex = operator.unknowns_per_vertex
     spectrum = Spectrum(
@@ -185,9 +176,9 @@ class ExactPairs:
     mass: np.ndarray
     nulls: NullSpace  # the operator's exact null vectors on the mesh (first in result)
     result: EigenResult  # the k lowest pairs (k capped at the number of unknowns)
-    zero_mode_scale: float  # the typical eigenvalue zero modes are measured against
     nonzero: np.ndarray  # (k,) bool, the pairs that are not zero modes
     seconds_assembly: float
+    parameters: dict  # the spectrum's parameters every partial and whole one has
 
 
 def exact_pairs(
@@ -211,6 +202,14 @@ def exact_pairs(
     k = min(int(k), K.shape[0])
     nulls = null_space(mesh, operator, K, mass)
     scale = typical_eigenvalue(K, mass)
+    parameters = {
+        "k": k,
+        "bending": float(bending),
+        "membrane": float(membrane),
+        "zero_mode_scale": scale,
+        "n_components": nulls.n_components,
+        "null_space": nulls.summary(),
+    }
     relay = None
     if on_modes is not None:
         per_vertex = operator.unknowns_per_vertex
@@ -221,23 +220,18 @@ def exact_pairs(
             if per_vertex > 1:  # rows 3i, 3i + 1, 3i + 2 are vertex i's
                 vectors = vectors.reshape(mesh.n_vertices, per_vertex, -1)
             modes.append(eigenvalues, vectors)
-            parameters = {
-                "k": k,
-                "bending": float(bending),
-                "membrane": float(membrane),
+            so_far = {
+                **parameters,
                 "method": "shift-invert block Krylov-Schur, converged Ritz pairs",
                 "null_space_dimension": min(nulls.dimension, modes.count),
-                "zero_mode_scale": scale,
-                "n_components": nulls.n_components,
-                "null_space": nulls.summary(),
             }
-            on_modes(modes.so_far(operator.name, mass[::per_vertex], mesh.hash, parameters))
+            on_modes(modes.so_far(operator.name, mass[::per_vertex], mesh.hash, so_far))
 
     result = solve_lowest(
         K, mass, k, progress=progress, cancel=cancel, null_space=nulls.vectors, on_modes=relay
     )
     nonzero = ~zero_modes(result.eigenvalues, scale, result.null_dim)
-    return ExactPairs(K, mass, nulls, result, scale, nonzero, seconds_assembly)
+    return ExactPairs(K, mass, nulls, result, nonzero, seconds_assembly, parameters)
 
 
 def _checked_residuals(pairs, mesh: Mesh) -> tuple[int, float]:
@@ -280,8 +274,10 @@ def _returning_freed_memory(progress: ProgressFn | None) -> ProgressFn:
     return report
 
 
-def _all_zero_message(k: int, result, nulls, lam_typical: float) -> str:
+def _all_zero_message(pairs: ExactPairs) -> str:
     """Why a spectrum holds only zero modes (see :class:`ZeroModesWarning`)."""
+    result, nulls, lam_typical = pairs.result, pairs.nulls, pairs.parameters["zero_mode_scale"]
+    k = result.eigenvalues.shape[0]
     if result.null_dim >= k:
         what = (
             "the only mode is an exact zero mode"
