@@ -190,12 +190,6 @@ class DerivedValues:
         """(n,) total curvature sqrt(k1^2 + k2^2) of the mesh."""
         return self._mesh_value("curvature", total_curvature)
 
-    def negative_cotan_weights(self) -> int:
-        """:func:`~modalviewer.core.robust.negative_cotan_weights` of the mesh."""
-        from ..core.robust import negative_cotan_weights
-
-        return negative_cotan_weights(self.state.mesh)
-
     def vertex_areas(self) -> np.ndarray:
         """(n,) lumped vertex areas: shares "of the surface" are of its area, not vertices."""
         return self._mesh_value("vertex_areas", lumped_masses)

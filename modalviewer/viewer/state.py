@@ -37,6 +37,7 @@ from ..core.operators import (
 )
 from ..core.spectrum import Spectrum, on_solver_mesh
 from ..spectra import cached_or_computed
+from .camera import AXES
 from .derived import DerivedValues
 
 DISPLAY_KINDS = ("none", "mode", "distance", "signature", "curvature", "field")
@@ -241,8 +242,6 @@ class ViewerState:
 
     def __setattr__(self, name: str, value) -> None:
         if name == "up_axis":
-            from .camera import AXES
-
             value = None if value in (None, "auto") else str(value).lower()
             if value is not None and value not in AXES:
                 raise ValueError(f"up axis must be auto or one of {', '.join(AXES)}")
@@ -355,8 +354,7 @@ class ViewerState:
 
     def spectrum(self, operator: str | None) -> Spectrum | None:
         """The most recent spectrum of ``operator``, or None."""
-        key = self._latest.get(operator) if operator else None
-        return self.spectra.get(key) if key is not None else None
+        return self.spectra.get(self._latest.get(operator))
 
     def spectrum_key(self, operator: str) -> SpectrumKey | None:
         return self._latest.get(operator)
@@ -536,7 +534,7 @@ class ViewerState:
 
     def is_coarse(self, operator: str | None) -> bool:
         """Whether ``operator``'s spectrum was computed coarse-to-fine (approximate)."""
-        key = self._latest.get(operator) if operator else None
+        key = self._latest.get(operator)
         return key is not None and key.coarse and key in self.spectra
 
     def _match_threshold(self, fraction_set: bool = False, share_set: bool = False) -> None:

@@ -21,7 +21,7 @@ import numpy as np
 from psygnal import Signal, SignalGroup
 
 from ..core.cache import SpectrumCache
-from ..core.mesh import Mesh
+from ..core.mesh import Mesh, _plural
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ..core.spectrum import Spectrum, in_input_numbering
 from ..repair import repair_for_failure, repair_unavailable
@@ -284,12 +284,8 @@ class Viewer(ViewerModel, Pictures):
             for job in self.jobs.jobs
             if not job.done and not job.cancel_requested
         }
-        plural = "s" if len(left) > 1 else ""
-        self._cancel_note = (
-            f"Cancelled; {len(left)} more request{plural} queued (Ctrl+Shift+Esc cancels all)"
-            if left
-            else ""
-        )
+        more = _plural(len(left), "more request")
+        self._cancel_note = f"Cancelled; {more} queued (Ctrl+Shift+Esc cancels all)" if left else ""
         self._status(self._cancel_note or "Cancelling...", 5000)
 
     def clear_cache(self) -> int:

@@ -16,6 +16,7 @@ from ..core.operators import (
     operator_info,
 )
 from ..core.pipeline import FLOOR_FACTOR
+from ..core.robust import negative_cotan_weights
 from ..core.spectrum import Spectrum
 from .color_scale import ROBUST_PERCENTILE
 from .jobs import CANCELLED, DONE, Job, SpectrumJob
@@ -183,7 +184,7 @@ def negative_weights_note(state) -> str:
     robust = next((info for info in OPERATOR_INFO.values() if info.nonnegative_weights), None)
     if state.mesh is None or robust is None:
         return ""
-    count = state.derived.negative_cotan_weights()
+    count = negative_cotan_weights(state.mesh)
     if count == 0:
         return ""
     return (
