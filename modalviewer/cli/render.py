@@ -102,11 +102,10 @@ def _check(args) -> None:
                 f"{len(args.modes)} modes"
             )
     if args.animate:
-        from ..scene.animation import animation_path, check_size
+        from ..scene.animation import animation_path
 
         try:
-            check_size(args.output, args.size or (2, 2))
-            animation_path(args.output)
+            animation_path(args.output, args.size)
         except ValueError as exc:
             raise BadArgument(f"-o {args.output}: {exc}") from None
     elif args.frames is not None:

@@ -170,10 +170,8 @@ def shape_dna_distance(a: np.ndarray, b: np.ndarray) -> float:
 
 
 class Collection:
-    """A store written by :func:`run_batch`, read with numpy (module docstring):
-    ``names`` lists the stored meshes, ``spectrum(name)`` and ``signatures(name)`` read
-    one, ``descriptors`` holds the per-shape arrays of all in the order of ``names``, and
-    ``errors`` the meshes that failed, with their errors."""
+    """A store written by :func:`run_batch` (its files: the module docstring), read with
+    numpy alone."""
 
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)

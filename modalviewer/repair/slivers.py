@@ -144,6 +144,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     """
     if not 0.0 < min_quality < 1.0:
         raise ValueError(f"min_quality must be between 0 and 1, got {min_quality}")
+    progress = progress or (lambda stage, fraction: None)
     started = time.perf_counter()
     v0, f0 = mesh.vertices, mesh.faces
     q0 = mesh.face_quality
@@ -181,8 +182,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
     origin = np.where(whole, np.rint(tags), 0).astype(np.int64)
     moved = np.linalg.norm(result.vertices - v0[origin], axis=1)
     unchanged = _unchanged_triangles(mesh, result, origin, whole & (moved == 0))
-    if progress is not None:
-        progress("measuring the change", 0.9)
+    progress("measuring the change", 0.9)
     out_id = ms.current_mesh_id()
     ms.add_mesh(pymeshlab.Mesh(v0, f0.astype(np.int32)))
     in_id = ms.current_mesh_id()
@@ -201,8 +201,7 @@ def fix_slivers(mesh: Mesh, min_quality: float = 0.05, progress=None) -> Mesh:
         report.max_vertex_shift = float(moved[whole].max(initial=0.0)) / diag
     report.max_deviation = max(to_new, to_old) / diag
     report.seconds = time.perf_counter() - started
-    if progress is not None:
-        progress("done", 1.0)
+    progress("done", 1.0)
     report.add(
         "The repair numbers the vertices anew: vertex numbers (picks, --vertex, CSV rows, "
         "sessions) are now the repaired mesh's, not the file's."
@@ -221,8 +220,7 @@ def _first_repair(mesh: Mesh, report: SliverReport, min_quality: float, progress
     before = _topology(mesh)
     refused = []
     for number, method in enumerate(_METHODS):
-        if progress is not None:
-            progress(f"fixing slivers: {_METHODS[method].split(' (')[0]}", 0.8 * number / 3)
+        progress(f"fixing slivers: {_METHODS[method].split(' (')[0]}", 0.8 * number / 3)
         try:
             v, f, tags, ms = _run_meshlab(
                 mesh.vertices, mesh.faces, mesh.face_quality, method, min_quality

@@ -49,8 +49,9 @@ def frame_phases(frames: int) -> np.ndarray:
     return start + 2.0 * np.pi * np.arange(n) / n
 
 
-def animation_path(path) -> Path:
-    """``path`` checked as a .gif or a writable .mp4, its folder made; ValueError otherwise."""
+def animation_path(path, size=None) -> Path:
+    """``path`` checked as a .gif or a writable .mp4 of an even ``size`` (if given: MP4's
+    H.264 4:2:0 needs an even width and height), its folder made; ValueError otherwise."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in ANIMATION_SUFFIXES:
@@ -60,14 +61,10 @@ def animation_path(path) -> Path:
             f"{path.name}: writing MP4 needs imageio and imageio-ffmpeg ({VIDEO_EXTRA}); "
             "or write a .gif"
         )
+    if suffix == ".mp4" and size is not None and (int(size[0]) % 2 or int(size[1]) % 2):
+        raise ValueError(f"an MP4's width and height must be even, got {size[0]}x{size[1]}")
     make_folder_for(path)
     return path
-
-
-def check_size(path, size) -> None:
-    """MP4 (H.264, 4:2:0) needs an even width and height: ValueError otherwise."""
-    if Path(path).suffix.lower() == ".mp4" and (int(size[0]) % 2 or int(size[1]) % 2):
-        raise ValueError(f"an MP4's width and height must be even, got {size[0]}x{size[1]}")
 
 
 def _write_gif(target, images, fps) -> None:
@@ -103,8 +100,7 @@ def write_animation(path, images: list[np.ndarray], fps: float = DEFAULT_FPS) ->
     """Write equal-sized RGB frames to ``path`` (.gif or .mp4) atomically; returns the path."""
     if not images:
         raise ValueError("an animation needs at least one frame")
-    path = animation_path(path)
-    check_size(path, (images[0].shape[1], images[0].shape[0]))
+    path = animation_path(path, (images[0].shape[1], images[0].shape[0]))
     if path.suffix.lower() == ".gif":
         return atomic_write(path, lambda tmp: _write_gif(tmp, images, fps))
     return atomic_write(path, lambda tmp: _write_mp4(tmp, images, fps))

@@ -1,6 +1,4 @@
-"""A comparison (:class:`~modalviewer.viewer.comparison.Comparison`) drawn off screen:
-its views side by side in one image, each captioned with its title, all seen by the
-same camera (the mesh's canonical first view unless one is given)."""
+"""A comparison (:class:`~modalviewer.viewer.comparison.Comparison`) drawn off screen."""
 
 from __future__ import annotations
 
@@ -37,8 +35,8 @@ def caption(img: np.ndarray, text: str) -> np.ndarray:
 
 
 def save_comparison(comparison, path, size=VIEW_SIZE, camera=None, scale: int = 1) -> Path:
-    """Write the views of ``comparison`` side by side, each captioned, to a PNG atomically
-    (``camera``: a :class:`~modalviewer.viewer.camera.Camera`, default the canonical view)."""
+    """Write the views of ``comparison`` side by side, each captioned with its title, to a
+    PNG atomically, all seen by ``camera`` (default the mesh's canonical first view)."""
     state = comparison.state
     images = []
     for view in comparison.views():

@@ -1,6 +1,4 @@
-"""Several modes side by side in one picture (the paper's rows of modes): one shared
-camera fitted to all of them, each panel captioned with its mode number and eigenvalue,
-one colour bar for the shared colour range.  No Qt."""
+"""Several modes side by side in one picture (the paper's rows of modes).  No Qt."""
 
 from __future__ import annotations
 
@@ -79,7 +77,8 @@ def padded(img: np.ndarray, total) -> np.ndarray:
 
 def mode_grid(viewer, modes, operator: str | None = None, grid=None, size=GRID_PANEL):
     """``modes`` of ``operator`` (default the one shown) drawn as the viewer draws them, in
-    ``grid`` panels of ``size``: one camera, one colour range and bar; RGB uint8."""
+    ``grid`` panels of ``size`` captioned with mode number and eigenvalue: one camera
+    fitted to all of them, one colour range and bar; RGB uint8."""
     from ..core.operators import operator_info
     from .comparison import caption
     from .export import grab

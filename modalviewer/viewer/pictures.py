@@ -181,12 +181,10 @@ class Pictures:
             ANIMATION_SIZE,
             DEFAULT_FPS,
             animation_path,
-            check_size,
             write_animation,
         )
 
-        path = animation_path(path)  # a wrong name is refused before any drawing
-        check_size(path, size or ANIMATION_SIZE)
+        path = animation_path(path, size or ANIMATION_SIZE)  # checked before any drawing
         images = self.animation_images(frames, fps, size, marker)
         return write_animation(path, images, DEFAULT_FPS if fps is None else fps)
 
