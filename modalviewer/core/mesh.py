@@ -67,14 +67,9 @@ def triangle_areas(x: np.ndarray, faces: np.ndarray) -> np.ndarray:
 def triangle_quality(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(m,) quality ``4 sqrt(3) area / (l0^2 + l1^2 + l2^2)`` of each triangle: 1
     equilateral, about 2 h / L for a needle or cap of longest edge L and height h."""
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces)
-    e0 = v[f[:, 1]] - v[f[:, 0]]
-    e1 = v[f[:, 2]] - v[f[:, 1]]
-    e2 = v[f[:, 0]] - v[f[:, 2]]
-    double_area = np.linalg.norm(np.cross(e0, -e2), axis=1)
-    sq = (e0 * e0).sum(axis=1) + (e1 * e1).sum(axis=1) + (e2 * e2).sum(axis=1)
-    return 2.0 * np.sqrt(3.0) * double_area / np.maximum(sq, np.finfo(float).tiny)
+    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
+    sq = sum(((v[f[:, (c + 1) % 3]] - v[f[:, c]]) ** 2).sum(axis=1) for c in range(3))
+    return 4.0 * np.sqrt(3.0) * triangle_areas(v, f) / np.maximum(sq, np.finfo(float).tiny)
 
 
 def checked_arrays(vertices, faces, polygons: bool = False):
@@ -101,11 +96,9 @@ def checked_arrays(vertices, faces, polygons: bool = False):
         )
     if f.ndim != 2:
         raise MeshError(f"faces must be an (m, 3) array of vertex indices; got shape {f.shape}")
-    if f.dtype == bool or not (
-        np.issubdtype(f.dtype, np.integer) or np.issubdtype(f.dtype, np.floating)
-    ):
+    if f.dtype.kind not in "iuf":  # not bool, complex or object
         raise MeshError(f"face indices must be integers; got an array of {f.dtype}")
-    if np.issubdtype(f.dtype, np.floating):
+    if f.dtype.kind == "f":
         whole = np.isfinite(f) & (f == np.round(f))
         if not whole.all():
             face = int(np.flatnonzero(~whole.all(axis=1))[0])
