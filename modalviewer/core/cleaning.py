@@ -244,7 +244,6 @@ def _collapse(tries, v, f, topo, min_area: float, locked, remap) -> float | None
         if locked[p] or locked[q] or not _collapsible(p, q, v, f, topo, min_area):
             continue
         remap[p] = q
-        locked[p] = locked[q] = True
         _lock(locked, topo, (p, q))
         return float(np.linalg.norm(v[p] - v[q]))
     return None

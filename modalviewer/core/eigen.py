@@ -39,6 +39,7 @@ from .memory import basis_in_float32, factor_budget_mb, float32_basis_mb, krylov
 from .memory import memory_limit_mb as default_memory_limit_mb
 from .products import (
     column_block_products,
+    column_norms,
     move_columns_in_place,
     single_blas_thread,
     threaded_product,
@@ -268,9 +269,8 @@ def solve_lowest(
         out[coo.row, coo.col] = coo.data
     res = np.concatenate([res_null, res_rest])
     return EigenResult(
-        all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1],
-        solver_info["factor_mb"], solver_info["out_of_core"], solver_info["basis_float32"],
-    )  # fmt: skip
+        all_lam, out, res, shift, method, timer.seconds, columns, Zk.shape[1], **solver_info
+    )
 
 
 def progress_reporter(progress: ProgressFn | None, cancel: CancelFn | None) -> ProgressFn:
@@ -395,11 +395,7 @@ def _null_residuals(K, mass_diag, Z: sp.csc_matrix, lam_max: float) -> np.ndarra
         return np.zeros(0)
     KZ = sp.csc_matrix(K @ Z)
     MZ = sp.csc_matrix(sp.diags(mass_diag) @ Z)
-
-    def norms(A):
-        return np.sqrt(np.asarray(A.multiply(A).sum(axis=0)).ravel())
-
-    return norms(KZ) / (lam_max * norms(MZ))
+    return column_norms(KZ) / (lam_max * column_norms(MZ))
 
 
 def _dense_complement(K, mass_diag, Y0: sp.csr_matrix, k: int):

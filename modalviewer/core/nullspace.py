@@ -20,6 +20,7 @@ import scipy.sparse as sp
 from .laplacian import vertex_normals
 from .mesh import Mesh
 from .operators import OperatorInfo, OperatorLike, operator_info
+from .products import column_norms
 
 NULL_RTOL = 1e-10
 """A candidate null vector z is accepted if ``|K z| <= NULL_RTOL * | |K| |z| |``: exact
@@ -148,12 +149,8 @@ def null_space(
         K = sp.csr_matrix(K)
         KZ = (K @ Z).tocsc()
         bound = (abs(K) @ abs(Z)).tocsc()
-        exact = _column_norms(KZ) <= NULL_RTOL * _column_norms(bound)
+        exact = column_norms(KZ) <= NULL_RTOL * column_norms(bound)
         Z = Z[:, np.flatnonzero(exact)]
         component = np.asarray(component)[exact]
     per_component = np.bincount(np.asarray(component, dtype=np.int64), minlength=n_components)
     return NullSpace(sp.csc_matrix(Z), info, n_components, per_component)
-
-
-def _column_norms(A: sp.csc_matrix) -> np.ndarray:
-    return np.sqrt(np.asarray(A.multiply(A).sum(axis=0)).ravel())

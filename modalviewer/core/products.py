@@ -91,6 +91,11 @@ def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[s
         yield cols, threaded_product(K, block) if sp.issparse(K) else np.asarray(K @ block)
 
 
+def column_norms(A: sp.spmatrix) -> np.ndarray:
+    """The Euclidean norm of each column of a sparse matrix."""
+    return np.sqrt(np.asarray(A.multiply(A).sum(axis=0)).ravel())
+
+
 def move_columns_in_place(Y: np.ndarray, m: int, chunk: int = 16384, lead: int = 0):
     """The first m columns of the C-contiguous (N, w) Y written over Y's buffer (Y is left
     meaningless) as columns ``lead:`` of an (N, lead + m) array, the first ``lead`` left
