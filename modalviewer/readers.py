@@ -138,17 +138,6 @@ def _numbers(rows: list[str], width: int, dtype) -> np.ndarray | None:
         return None
 
 
-def _triangle_rows(rows: list[str], n_vertices: int) -> np.ndarray | None:
-    """(m, 3) triangles of rows "3 a b c" naming existing vertices, or None."""
-    table = _numbers(rows, 4, np.int64)
-    if table is None or not (table[:, 0] == 3).all():
-        return None
-    faces = table[:, 1:]
-    if len(faces) and (faces.min() < 0 or faces.max() >= n_vertices):
-        return None
-    return faces
-
-
 # --------------------------------------------------------------------------- OBJ
 
 
@@ -406,8 +395,11 @@ def _ascii_fast(elements, body: str) -> tuple[np.ndarray, np.ndarray] | None:
     if len(rows) != n + m:
         return None
     table = _numbers(rows[:n], len(names), np.float64)
-    faces = None if table is None else _triangle_rows(rows[n:], n)
-    if faces is None:
+    faces = _numbers(rows[n:], 4, np.int64)  # rows "3 a b c" of triangles
+    if table is None or faces is None or not (faces[:, 0] == 3).all():
+        return None
+    faces = faces[:, 1:]
+    if len(faces) and (faces.min() < 0 or faces.max() >= n):
         return None
     return np.ascontiguousarray(table[:, [names.index(c) for c in "xyz"]]), faces
 
