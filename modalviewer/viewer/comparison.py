@@ -127,20 +127,17 @@ class Comparison:
                 continue
             op = operator_for_distance(item)
             mark = approximation_mark(state.spectrum(op), state.is_coarse(op))
+            title = f"{item_label(item)}{mark} from vertex {shown}"
             if display.distance_display == "threshold":
-                if share is None:
-                    thr = display.threshold * float(d.max())
-                else:
-                    thr = derived.threshold_for_share(share, d) * float(d.max())
-                marked = 100.0 * derived.surface_share(d, thr)
-                field = Field(d, "threshold", title=item_label(item), threshold=thr)
-                field.share_similar = marked / 100.0
-                title = (
-                    f"{item_label(item)}{mark} from vertex {shown}: blue < {thr:.3g} "
-                    f"({marked:.1f} %)"
+                fraction = (
+                    display.threshold if share is None else derived.threshold_for_share(share, d)
                 )
+                thr = fraction * float(d.max())
+                similar = derived.surface_share(d, thr)
+                field = Field(d, "threshold", title=item_label(item), threshold=thr)
+                field.share_similar = similar
+                title += f": blue < {thr:.3g} ({100.0 * similar:.1f} %)"
             else:
                 field = derived.scaled(Field(d, "sequential", title=item_label(item)))
-                title = f"{item_label(item)}{mark} from vertex {shown}"
             views.append(ComparisonView(item, title, field, vertex))
         return views

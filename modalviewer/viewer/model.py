@@ -56,11 +56,8 @@ def estimated_seconds(
         return b / ESTIMATE_RANGE <= a <= ESTIMATE_RANGE * b
 
     mesh = [r for r in same if mesh_hash and r.mesh_hash == mesh_hash]
-    for r in mesh:
-        if r.k == k:
-            return r.seconds
     modes = [r for r in mesh if within(r.k, k)]
-    if modes:
+    if modes:  # the most recent of the nearest k: of k itself if recorded
         best = min(modes, key=lambda r: abs(np.log(r.k / k)))
         return best.seconds * (k / best.k) ** MODES_EXPONENT
     sizes = [r for r in same if r.k == k and within(r.n_vertices, n)]
@@ -206,7 +203,7 @@ class ViewerModel:
             shown = state.spectra.get(key)  # spec, or spec in the solver's numbering
             if before is None or shown is None or shown.k != spec.k:
                 return  # not shown (yet): the spectrum on screen has more modes
-            if not (~spec.zero_mode_mask()).any():
+            if spec.zero_mode_mask().all():
                 return
             wanted[0] = None
             self._show_if_unchanged(key.operator, before)
