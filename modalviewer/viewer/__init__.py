@@ -1,8 +1,5 @@
-"""The viewer without a window: :class:`Viewer`, one object (a :class:`ViewerModel`: the
-evented state, the job queue and the spectrum cache, with the scripting API and pictures)
-that the windows, the command line and notebooks share; sessions.  No Qt and no VTK here:
-pictures are drawn by ``modalviewer.scene``, windows in ``modalviewer.gui`` observe the
-state."""
+"""The viewer without a window (no Qt, no VTK): :class:`Viewer` (:mod:`.viewer` says what
+it is), its state, jobs and sessions."""
 
 from .jobs import Job, JobQueue, ManualDispatcher, RepairJob, SpectrumJob
 from .model import ComputeRefused, ViewerModel

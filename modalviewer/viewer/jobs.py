@@ -53,7 +53,6 @@ class Job:
         self._fn = fn
         self._cancel = threading.Event()
         self._done = threading.Event()
-        self._thread: threading.Thread | None = None
 
     def __repr__(self) -> str:
         return f"<Job {self.id} {self.description!r} {self.status}>"
@@ -238,16 +237,13 @@ class JobQueue:
 
     # ------------------------------------------------------------ internal
     def _start_next(self) -> None:
-        if self.running is not None:
-            return
         job = next((j for j in self.jobs if j.status == QUEUED), None)
-        if job is None:
+        if job is None or self.running is not None:
             return
         job.status, job.stage = RUNNING, "starting"
-        job._thread = threading.Thread(target=self._run, args=(job,), daemon=True)
         job._started = time.perf_counter()
         self.events.changed.emit(job)
-        job._thread.start()
+        threading.Thread(target=self._run, args=(job,), daemon=True).start()
 
     def _run(self, job: Job) -> None:
         last = {"stage": None, "time": 0.0}
