@@ -106,7 +106,7 @@ def distance(args) -> int:
     mesh = load(args.mesh, args.fix_slivers, args.partial).solver_mesh
     vertex = _mesh_vertex(mesh, args.vertex)
     if args.to is not None:
-        return _distance_to(args, mesh)
+        return _distance_to(args, mesh, vertex)
     if args.rescale:
         raise ValueError("--rescale applies to two meshes (with --to)")
     spec = _cached_spectrum(mesh, operator_for_distance(args.kind), args.k)
@@ -192,7 +192,7 @@ def _cached_spectrum(mesh, operator: str, k: int):
         return cached_or_computed(mesh, operator, k, progress=progress_bar())
 
 
-def _distance_to(args, mesh_a) -> int:
+def _distance_to(args, mesh_a, vertex: int) -> int:
     """``distance A --vertex V --to B``: from vertex V of A to every vertex of B."""
     import warnings
 
@@ -225,8 +225,7 @@ def _distance_to(args, mesh_a) -> int:
             ) from None
     for warning in caught:
         sys.stderr.write(f"modalviewer: warning: {warning.message} (or pass --rescale)\n")
-    vertex = _mesh_vertex(mesh_a, args.vertex)  # the file's numbers in, and out below
-    d = tables.a_to_b(vertex)
+    d = tables.a_to_b(vertex)  # vertex: mesh_a's number of --vertex (rescaling keeps them)
     best_mesh = int(np.argmin(d))
     back_mesh = int(np.argmin(tables.b_to_a(best_mesh)))
     best, back = mesh_b.file_vertex(best_mesh), mesh_a.file_vertex(back_mesh)

@@ -90,10 +90,8 @@ def _run_meshlab(vertices, faces, quality, method: str, min_quality: float):
         near = np.zeros(len(vertices), dtype=bool)
         near[faces[bad].ravel()] = True
         region = faces[near[faces].any(axis=1)]
-        edges = np.concatenate([region[:, [0, 1]], region[:, [1, 2]], region[:, [2, 0]]])
-        target = float(
-            np.median(np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]], axis=1))
-        )
+        edges = vertices[region] - vertices[np.roll(region, -1, axis=1)]  # (r, 3, 3)
+        target = float(np.median(np.linalg.norm(edges, axis=-1)))
         ms.compute_selection_by_condition_per_face(condselect=f"fq < {min_quality!r}")
         ms.apply_selection_dilatation()
         ms.meshing_isotropic_explicit_remeshing(

@@ -22,16 +22,15 @@ def overlay_boxes(width: int, height: int, overlay, scale: float = 1.0):
     if overlay is None:
         return legend, bottom
     blank = np.zeros((int(height), int(width), 4), np.uint8)
-    if overlay.legend:
-        alpha = draw_overlay(blank, Overlay(overlay.legend, None), scale)[..., 3]
-        rows, cols = np.flatnonzero(alpha.any(1)), np.flatnonzero(alpha.any(0))
-        if rows.size:
-            legend = (int(cols.max()) + 1, int(rows.max()) + 1)
-    if overlay.colorbar is not None:
-        alpha = draw_overlay(blank, Overlay(None, overlay.colorbar), scale)[..., 3]
-        rows = np.flatnonzero(alpha.any(1))
-        if rows.size:
-            bottom = int(height) - int(rows.min())
+    # each drawn alone on a blank image (one without a legend or bar stays blank)
+    alpha = draw_overlay(blank, Overlay(overlay.legend, None), scale)[..., 3]
+    rows, cols = np.flatnonzero(alpha.any(1)), np.flatnonzero(alpha.any(0))
+    if rows.size:
+        legend = (int(cols.max()) + 1, int(rows.max()) + 1)
+    alpha = draw_overlay(blank, Overlay(None, overlay.colorbar), scale)[..., 3]
+    rows = np.flatnonzero(alpha.any(1))
+    if rows.size:
+        bottom = int(height) - int(rows.min())
     return legend, bottom
 
 
