@@ -148,16 +148,16 @@ class ViewerModel:
         return memory_refusal(info, key.k, n, copy, "with Coarse-to-fine (a decimated copy)")
 
     def request_spectrum(
-        self, operator: str | None = None, k: int | None = None, show: bool = False
+        self, operator: str | None = None, k: int | None = None, show: bool = False, key=None
     ) -> SpectrumJob:
         """A job computing (or loading from the cache) ``operator``'s spectrum, the compute
-        settings for what is not given (an ended one if the state has it); ``show``: show
-        its first non-zero mode when it arrives, unless the display changed meanwhile.
-        ComputeRefused if too large for this machine."""
+        settings for what is not given (an ended one if the state has it), or the spectrum
+        ``key``; ``show``: show its first non-zero mode when it arrives, unless the display
+        changed meanwhile.  ComputeRefused if too large for this machine."""
         state = self.state
         if state.mesh is None:
             raise ComputeRefused("Open a mesh first.")
-        key = state.compute_settings.key(operator, k)
+        key = key or state.compute_settings.key(operator, k)
         display_at_request = state.display
         if state.has_spectrum(key):  # an ended job; shown unless that operator is on screen
             job = SpectrumJob(None, key, key.describe(), state.mesh.hash, key)

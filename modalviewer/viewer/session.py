@@ -173,13 +173,10 @@ def restore_session(model, path) -> Restored:
     display = Display(**_known(Display, saved_display))
     for raw in data.get("spectra") or []:
         key = SpectrumKey(**_known(SpectrumKey, raw))
-        saved = asdict(state.compute_settings)
-        _update(state.compute_settings, asdict(key), ("bending", "membrane", "rescale", "coarse"))
-        try:
-            out.jobs.append(model.request_spectrum(key.operator, key.k))
+        try:  # the key as the compute settings make it (validated, weights where used)
+            out.jobs.append(model.request_spectrum(key=ComputeSettings(**asdict(key)).key()))
         except ValueError as exc:
             out.notes.append(f"{key.describe()}: {exc}")
-        _update(state.compute_settings, saved)
     camera = data.get("camera")
 
     def apply_display(_job=None) -> None:

@@ -142,3 +142,30 @@ def test_a_session_naming_the_removed_preview_options_opens_without_them(tmp_pat
     settings = second.state.compute_settings
     assert (settings.operator, settings.k, settings.coarse) == ("laplacian", 25, True)
     assert not hasattr(settings, "preview")
+
+
+def test_restored_spectra_keep_their_keys_and_the_compute_settings_stay_as_saved(tmp_path):
+    """Each saved spectrum is requested under its own key (Discrete Shells weights, unit
+    area), whatever the saved compute settings say; those come back unchanged."""
+    mesh_path = tmp_path / "spot.obj"
+    shutil.copy(ASSETS / "spot.obj", mesh_path)
+    first = _model(tmp_path)
+    first.open_mesh(mesh_path)
+    settings = first.state.compute_settings
+    settings.bending, settings.membrane, settings.rescale = 2.0, 0.5, True
+    first.jobs.wait(first.request_spectrum("shells", k=8))
+    settings.bending, settings.membrane, settings.rescale = 1.0, 1.0, False
+    first.jobs.wait(first.request_spectrum("laplacian", k=10))
+    settings.operator, settings.k, settings.coarse = "modified_dirichlet", 30, True
+    path = save_session(first.state, tmp_path / "keys.json")
+
+    second = _model(tmp_path)
+    restored = restore_session(second, path)
+    _wait_all(second, restored)
+    assert restored.notes == []
+    assert set(second.state.spectra) == set(first.state.spectra)
+    shells = second.state.spectrum_key("shells")
+    assert (shells.k, shells.bending, shells.membrane, shells.rescale) == (8, 2.0, 0.5, True)
+    restored_settings = second.state.compute_settings
+    assert restored_settings == first.state.compute_settings
+    assert restored_settings.coarse and restored_settings.k == 30
