@@ -141,12 +141,10 @@ def distance_kind_of(spectrum: Spectrum | None, kind: str | None) -> str:
     without a spectrum."""
     if kind is not None:
         return kind
-    if spectrum is None:
-        return "vibration"
-    from .core.operators import DISTANCE_KINDS
-
-    own = spectrum.operator_info.distance_kind
+    own = "vibration" if spectrum is None else spectrum.operator_info.distance_kind
     if own is None:
+        from .core.operators import DISTANCE_KINDS
+
         raise ValueError(
             f"a {spectrum.operator} spectrum defines no distance; pass kind= (one of "
             f"{', '.join(DISTANCE_KINDS)})"

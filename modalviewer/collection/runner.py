@@ -155,12 +155,9 @@ def memory_estimate(n_vertices: int, parameters: dict) -> int:
 
 
 def _operators(parameters: dict) -> list[str]:
-    ops = [parameters["operator"]]
-    for kind in parameters["signatures"]:
-        op = operator_for_distance(kind)
-        if op not in ops:
-            ops.append(op)
-    return ops
+    """The batch's operator, then those its signatures need, each once."""
+    kinds = parameters["signatures"]
+    return list(dict.fromkeys([parameters["operator"], *map(operator_for_distance, kinds)]))
 
 
 def _histogram(spec: Spectrum, area: float, kind: str = "heat") -> np.ndarray:
