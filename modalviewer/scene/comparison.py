@@ -26,12 +26,10 @@ def caption(img: np.ndarray, text: str) -> np.ndarray:
     font = _font(FONT_PX)
     text = wrap_text(text, lambda t: probe.textlength(t, font=font), width - 16)
     lines = text.count("\n") + 1
-    band = Image.new("RGB", (width, int(lines * FONT_PX * 1.35 + 12)), "white")
+    mode = "RGBA" if img.shape[2] == 4 else "RGB"  # opaque white either way
+    band = Image.new(mode, (width, int(lines * FONT_PX * 1.35 + 12)), "white")
     ImageDraw.Draw(band).multiline_text((8, 6), text, fill="black", font=font)
-    rgb = np.asarray(band)
-    if img.shape[2] == 4:
-        rgb = np.dstack([rgb, np.full(rgb.shape[:2], 255, np.uint8)])
-    return np.vstack([rgb, img])
+    return np.vstack([np.asarray(band), img])
 
 
 def save_comparison(comparison, path, size=VIEW_SIZE, camera=None, scale: int = 1) -> Path:

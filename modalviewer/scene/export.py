@@ -26,8 +26,7 @@ def grab(
     from .overlay import draw_overlay
 
     scale = int(max(1, scale))
-    if scene is None:
-        scene = getattr(plotter, "_modalviewer_scene", None)
+    scene = scene or getattr(plotter, "_modalviewer_scene", None)
     overlay = scene.overlay(legend=legend, colorbar=colorbar) if scene is not None else None
     # the scene's own overlay is replaced by the overlay drawn at the export's scale
     hidden = [] if scene is None else [scene.overlay_actor, None if marker else scene.marker_actor]
@@ -56,9 +55,7 @@ def side_by_side(images: list[np.ndarray], gap: int = 0, transparent: bool = Fal
     channels = 4 if transparent else 3
     height = max(img.shape[0] for img in images)
     width = sum(img.shape[1] for img in images) + gap * (len(images) - 1)
-    canvas = np.zeros((height, width, channels), np.uint8)
-    if not transparent:
-        canvas[:] = 255
+    canvas = np.full((height, width, channels), 0 if transparent else 255, np.uint8)
     x = 0
     for img in images:
         if img.shape[2] < channels:
