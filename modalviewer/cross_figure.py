@@ -32,7 +32,6 @@ class Panel:
 
 def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
     """(h, w, 3) image of one panel, captioned."""
-    from .core.laplacian import vertex_normals
     from .scene.comparison import caption
     from .scene.export import grab
     from .scene.mesh_scene import MeshScene
@@ -41,8 +40,7 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
 
     plotter = offscreen_plotter(size)
     try:
-        normals = vertex_normals(panel.mesh)
-        scene = MeshScene(plotter, panel.mesh, normals)
+        scene = MeshScene(plotter, panel.mesh)  # its own vertex normals
         if panel.distances is not None:
             d = np.asarray(panel.distances, dtype=np.float64)
             if d.shape != (panel.mesh.n_vertices,):
@@ -65,7 +63,7 @@ def render_panel(panel: Panel, size=(640, 560)) -> np.ndarray:
         if panel.face_marker and panel.marker is not None:
             to_camera = np.asarray(first.direction)
             up = np.asarray(first.up)
-            n = normals[panel.marker] - np.dot(normals[panel.marker], up) * up
+            n = scene.normals[panel.marker] - np.dot(scene.normals[panel.marker], up) * up
             if np.linalg.norm(n) > 0.3:
                 side = np.cross(up, to_camera)
                 azimuth = float(np.degrees(np.arctan2(np.dot(n, side), np.dot(n, to_camera))))
