@@ -18,9 +18,7 @@ from .wording import approximation_mark
 
 def item_label(item: str) -> str:
     """A comparison item (an operator or a distance kind) in a few words."""
-    if item in DISTANCE_KINDS:
-        return DISTANCE_KINDS[item]
-    return OPERATOR_INFO[item].short_label
+    return DISTANCE_KINDS[item] if item in DISTANCE_KINDS else OPERATOR_INFO[item].short_label
 
 
 @dataclass

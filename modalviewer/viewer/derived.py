@@ -361,9 +361,7 @@ class DerivedValues:
     def threshold_value(self, d: np.ndarray | None = None) -> float | None:
         """The absolute threshold of the display's distance (fraction x largest)."""
         d = self.distance_map() if d is None else d
-        if d is None:
-            return None
-        return self.state.display.threshold * float(d.max())
+        return None if d is None else self.state.display.threshold * float(d.max())
 
     def map_fraction(self, d: np.ndarray) -> float:
         """The threshold fraction for ``d``: the display's, or with ``keep_share`` while no

@@ -90,9 +90,7 @@ class ViewerModel:
         """Wait until ``job`` has ended (its callbacks have run)."""
         if job.done:
             return job
-        if self._waiter is not None:
-            return self._waiter(job)
-        return self.jobs.wait(job, timeout)
+        return self._waiter(job) if self._waiter is not None else self.jobs.wait(job, timeout)
 
     # -------------------------------------------------------------- mesh
     def set_mesh(self, mesh: Mesh, path=None, repairs: list[str] | None = None) -> None:

@@ -114,9 +114,7 @@ class Pictures:
     def marker_shown(self, marker: bool | None = None) -> bool:
         """``marker`` where given, else True on distance maps only (a mode's picture does
         not depend on the pick)."""
-        if marker is not None:
-            return bool(marker)
-        return self.state.display.kind == "distance"
+        return bool(marker) if marker is not None else self.state.display.kind == "distance"
 
     def _offscreen_at(self, size):
         """(renderer at ``size``, whether to close it): this viewer's own, or with a
@@ -155,13 +153,11 @@ class Pictures:
         renderer = OffscreenRenderer(state, size)
         try:
             renderer.set_camera(camera)
-            reach = state.derived.amplitude_length()
-            renderer.frame(reach=reach, both=True)
-            marker = bool(marker)
+            renderer.frame(reach=state.derived.amplitude_length(), both=True)
             images = []
             for phase in frame_phases(n):
                 renderer.drawing.animation_frame(phase)
-                images.append(renderer.image(marker=marker)[..., :3])
+                images.append(renderer.image(marker=bool(marker))[..., :3])
         finally:
             renderer.close()
         return images

@@ -104,9 +104,8 @@ def legend(state) -> str:
         if spec is None:
             return ""
         j = int(np.clip(d.mode, 0, spec.k - 1))
-        lam = float(spec.eigenvalues[j])
         zero = spec.zero_mode_mask()[j]
-        value = "0 (zero mode)" if zero else f"{lam:.4g}"
+        value = "0 (zero mode)" if zero else f"{float(spec.eigenvalues[j]):.4g}"
         if state.is_coarse(d.operator):
             value += " (coarse-to-fine: approximate)"
         colours = "blue +, white 0, orange -"
