@@ -304,47 +304,44 @@ def _complement_pairs(
             V -= Y0 @ (Y0t @ V)
         return V
 
-    if N - d > dense_limit:
+    # A few more pairs than requested: the last requested pairs then converge as fast as
+    # the others (the gap to the unwanted part of the spectrum is larger).
+    sizes = krylov_sizes(k - d, N - d, block)  # working pairs, block, basis, kept
+    if N - d > dense_limit and sizes[2] + sizes[1] <= N - d:  # else the basis does not fit
         # median_ratio is 0 where half of K's diagonal is: then Gershgorin's bound
         lam_typical = median_ratio or float(
             np.max(np.asarray(abs(K).sum(axis=1)).ravel() / mass_diag)
         )
-        args = (K, mass_diag, 1.0 / np.sqrt(mass_diag), k - d, lam_typical, report, tol, block,
-                timer, project, N - d, limit, solver_info, k)  # fmt: skip
+        args = (K, mass_diag, 1.0 / np.sqrt(mass_diag), k - d, lam_typical, report, tol, sizes,
+                timer, project, limit, solver_info, k)  # fmt: skip
+
+        def attempt(shift_rtol: float):
+            return _shift_invert(*args, shift_rtol, handover.attempt())
+
         try:
-            lam, basis, shift, backend, columns = _shift_invert_retrying(args, d, report, handover)
-        except _TooSmall:
-            pass
-        else:
-            method = f"shift-invert block Krylov-Schur ({backend})"
-            if solver_info["out_of_core"]:
-                method += ", factor out of core"
-            if solver_info["basis_float32"]:
-                method += ", single-precision Krylov basis"
-            if d:
-                method += f", {d} null vectors deflated"
-            return lam, basis[:, : lam.shape[0]], basis, shift, method, columns
+            lam, basis, shift, backend, columns = attempt(DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL)
+        except NotConverged as failed:
+            # the tiny deflated shift leaves K - shift M so close to singular that the
+            # solves' rounding floor can sit above the tolerance (residuals stuck near
+            # 1e-8): again with the larger SHIFT_RTOL, at the cost of a compressed spectrum
+            if not d:
+                raise
+            report("retrying with a larger shift", 0.05)
+            lam, basis, shift, backend, columns = attempt(SHIFT_RTOL)
+            columns += failed.columns  # the failed attempt's count too
+        method = f"shift-invert block Krylov-Schur ({backend})"
+        if solver_info["out_of_core"]:
+            method += ", factor out of core"
+        if solver_info["basis_float32"]:
+            method += ", single-precision Krylov basis"
+        if d:
+            method += f", {d} null vectors deflated"
+        return lam, basis[:, : lam.shape[0]], basis, shift, method, columns
     report("solving (dense)", 0.1)
     with timer("dense"):
         lam, X = _dense_complement(K, mass_diag, Y0, k - d)
     method = "dense" + (f", {d} null vectors deflated" if d else "")
     return lam, X, None, 0.0, method, 0
-
-
-def _shift_invert_retrying(args, d: int, report, handover):
-    """:func:`_shift_invert` with the deflated shift where null vectors are deflated,
-    again with the larger :data:`SHIFT_RTOL` if that does not converge: the tiny shift
-    leaves K - shift M so close to singular that the solves' rounding floor can sit
-    above the tolerance (residuals stuck near 1e-8), at the cost of a compressed
-    spectrum.  The columns counted include the failed attempt's."""
-    try:
-        return _shift_invert(*args, DEFLATED_SHIFT_RTOL if d else SHIFT_RTOL, handover.attempt())
-    except NotConverged as failed:
-        if not d:
-            raise
-        report("retrying with a larger shift", 0.05)
-        lam, basis, shift, backend, columns = _shift_invert(*args, SHIFT_RTOL, handover.attempt())
-        return lam, basis, shift, backend, columns + failed.columns
 
 
 class _Handover:
@@ -464,24 +461,20 @@ def _widen_in_place(buffer: np.ndarray, n: int, width: int, count: int, out_widt
 
 
 def _shift_invert(
-    K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, block, timer, project, n_free,
-    limit_mb, solver_info, out_columns, shift_rtol, on_converged=None,
+    K, mass_diag, inv_sqrt_m, k, lam_typical, report, tol, sizes, timer, project, limit_mb,
+    solver_info, out_columns, shift_rtol, on_converged=None,
 ):  # fmt: skip
     """Lowest k pairs by block Krylov-Schur on ``M^1/2 (K - shift M)^-1 M^1/2`` in the
-    complement (dimension ``n_free``) of the deflated null vectors that ``project``
-    removes: (eigenvalues, (N, w) array whose first k columns are the Mass-orthonormal
-    modes, shift, backend name, operator columns).  The factor and basis keep within
-    ``limit_mb`` (:func:`.memory.factor_budget_mb`, :func:`.memory.basis_in_float32`; with
-    a single-precision basis w is exactly ``out_columns``); ``solver_info`` receives
-    "factor_mb", "out_of_core" and "basis_float32"; ``on_converged`` the pairs of K as
-    they converge."""
+    complement of the deflated null vectors that ``project`` removes, with the
+    :func:`.memory.krylov_sizes` ``sizes``: (eigenvalues, (N, w) array whose first k
+    columns are the Mass-orthonormal modes, shift, backend name, operator columns).  The
+    factor and basis keep within ``limit_mb`` (:func:`.memory.factor_budget_mb`,
+    :func:`.memory.basis_in_float32`; with a single-precision basis w is exactly
+    ``out_columns``); ``solver_info`` receives "factor_mb", "out_of_core" and
+    "basis_float32"; ``on_converged`` the pairs of K as they converge."""
     N = K.shape[0]
     sqrt_m = np.sqrt(mass_diag)
-    # A few more pairs than requested: the last requested pairs then converge as fast
-    # as the others (the gap to the unwanted part of the spectrum is larger).
-    k_work, block, max_basis, keep = krylov_sizes(k, n_free, block)
-    if max_basis + block > n_free:
-        raise _TooSmall()  # the basis would not fit: the dense solver is the right tool
+    _, block, max_basis, keep = sizes
     budget = factor_budget_mb(limit_mb, N, max_basis + block, block)
     solver, shift = factor_below_spectrum(
         K, mass_diag, lam_typical, report, timer, shift_rtol, budget
@@ -580,7 +573,3 @@ def _rayleigh_ritz_in_place(K, inv_sqrt_m: np.ndarray, Y: np.ndarray) -> np.ndar
     lam, W = la.eigh(0.5 * (G + G.T), 0.5 * (B + B.T))
     rotate_in_place(Y, Y.shape[1], d[:, None] * W)
     return lam
-
-
-class _TooSmall(Exception):
-    """The Krylov basis would not fit: solve densely instead."""
