@@ -7,6 +7,7 @@ asked (``show=True``) and the display has not changed since the request.
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -109,14 +110,8 @@ class ViewerModel:
         if name not in REPAIRS:
             raise ValueError(f"unknown repair {name!r}; choose one of {', '.join(REPAIRS)}")
         mesh, path, done = state.mesh, state.mesh_path, list(state.mesh_repairs)
-        job = self.jobs.add(
-            RepairJob(
-                lambda progress, cancel: repair_in_process(name, mesh, progress, cancel),
-                ("repair", mesh.hash, name),
-                REPAIRS[name],
-                mesh.hash,
-            )
-        )
+        work = partial(repair_in_process, name, mesh)  # work(progress, cancel)
+        job = self.jobs.add(RepairJob(work, ("repair", mesh.hash, name), REPAIRS[name], mesh.hash))
 
         def replace_mesh(j: Job) -> None:
             if j.status == DONE and self.state.mesh is mesh:

@@ -83,13 +83,9 @@ class PairEvents(SignalGroup):
 class _Side:
     def __init__(self, mesh: Mesh, path) -> None:
         self.mesh = mesh.solver_mesh  # the vertices faces use; its map gives the input's numbers
-        self.path = Path(path) if path is not None else None
+        self.name = Path(path).name if path is not None else "mesh"
         self.masses = lumped_masses(self.mesh)
         self.unit_mesh: Mesh | None = None
-
-    @property
-    def name(self) -> str:
-        return self.path.name if self.path is not None else "mesh"
 
 
 @dataclass(eq=False)
