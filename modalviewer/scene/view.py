@@ -137,13 +137,11 @@ class StateScene:
         if self.scene is None:
             return
         signature = self._signature()
-        d = self.state.display
         if self.scene.style != self.state.style.render:
             self.scene.set_style(self.state.style.render)
+        # a threshold map drawn for this display (all of it but the threshold): recoloured
         if (
             self._drawn == signature
-            and d.kind == "distance"
-            and d.distance_display == "threshold"
             and self.field is not None
             and self.field.colormap == "threshold"
             and self.state.derived.distance_map() is not None
