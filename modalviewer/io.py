@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 
 from .core.cleaning import repair_mesh
-from .core.mesh import Mesh, MeshError, MeshReport, shape_summary
+from .core.mesh import Mesh, MeshError, MeshReport, _plural, shape_summary
 from .extras import MissingExtraError, extra_needed
-from .readers import count_text, read_mesh_file
+from .readers import read_mesh_file
 
 SUPPORTED_EXTENSIONS = (".obj", ".ply", ".stl", ".off", ".vtk", ".vtp")
 
@@ -148,7 +148,7 @@ def mesh_from_arrays(vertices, faces, source: str, repair: bool = True, notes=()
     vertices = np.asarray(vertices)
     if len(faces) == 0:
         raise MeshError(
-            f"{source}: the file contains {count_text(len(vertices), 'vertex', 'vertices')} "
+            f"{source}: the file contains {_plural(len(vertices), 'vertex')} "
             "but no faces: a point cloud is not a surface (reconstruct a surface from it "
             "first), or the file is truncated before its faces"
         )

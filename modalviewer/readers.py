@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.mesh import MeshError
+from .core.mesh import MeshError, _plural
 
 
 class DamagedFileError(MeshError):
@@ -69,10 +69,6 @@ class _Damage:
         self.notes.append(f"{where}: {what}")
 
 
-def count_text(count: int, singular: str, plural: str) -> str:
-    return f"{count} {singular if count == 1 else plural}"
-
-
 def _check_last_line(text: str, damage: _Damage, record, first: int = 1) -> None:
     """A text whose last record has no line break may have been cut inside it (``first``:
     the file's number of the text's first line)."""
@@ -105,7 +101,7 @@ def _mesh_file(vertices, polygons: list, unplaced: list, damage: _Damage, place)
             damage(
                 place(i),
                 f"the face names vertex {bad[0]} but the file has only "
-                f"{count_text(n, 'vertex', 'vertices')} (numbered from 0)",
+                f"{_plural(n, 'vertex')} (numbered from 0)",
             )
         else:
             kept.append(face)
@@ -120,7 +116,7 @@ def _mesh_file(vertices, polygons: list, unplaced: list, damage: _Damage, place)
         incomplete = set(unplaced)
         whole = [p for p in kept if incomplete.isdisjoint(p)]
         if len(whole) < len(kept):
-            dropped = count_text(len(kept) - len(whole), "face", "faces")
+            dropped = _plural(len(kept) - len(whole), "face")
             damage.note("faces", f"{dropped} using a vertex whose record was incomplete dropped")
         kept = whole
     triangles = [(p[0], p[i], p[i + 1]) for p in kept for i in range(1, len(p) - 1)]  # fanned
@@ -182,7 +178,7 @@ def _read_obj(path: Path, strict: bool) -> MeshFile:
     tail = [line.strip() for line in text[-4096:].splitlines() if line.strip()]
     if unused and len(result.faces) and tail[-1].startswith(("f ", "f\t")):
         result.notes.append(
-            f"the file ends with a face record and {count_text(unused, 'vertex', 'vertices')} "
+            f"the file ends with a face record and {_plural(unused, 'vertex')} "
             f"of it {'is' if unused == 1 else 'are'} used by no face: it may be truncated (a "
             "file cut between two face records leaves such vertices)"
         )
@@ -484,8 +480,7 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
         if len(data) != 84 + 50 * binary_count:
             _refuse_implausible_stl(path.name, arr, binary_count, len(data))
         if rows < binary_count:
-            announced = count_text(binary_count, "triangle", "triangles")
-            damage.ends_early(f"triangle {rows}", rows, announced)
+            damage.ends_early(f"triangle {rows}", rows, _plural(binary_count, "triangle"))
         corners = arr["v"].reshape(-1, 3).astype(np.float64)
         return MeshFile(*_stl_vertices(corners), damage.notes)
     corners, triangles, current, facet_line = [], [], [], 0
@@ -555,7 +550,7 @@ def _refuse_implausible_stl(name: str, arr: np.ndarray, announced: int, size: in
     first = int(np.flatnonzero(bad)[0])
     raise MeshError(
         f"{name}: not an STL file: its header announces "
-        f"{count_text(announced, 'triangle', 'triangles')} where {size} bytes hold "
+        f"{_plural(announced, 'triangle')} where {size} bytes hold "
         f"{len(arr)}, and triangle {first + 1} has a coordinate that is not a number or "
         f"beyond {STL_COORDINATE_LIMIT:.0e}; check that this is the file you meant"
     )
