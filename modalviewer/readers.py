@@ -483,7 +483,7 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
             damage.ends_early(f"triangle {rows}", rows, _plural(binary_count, "triangle"))
         corners = arr["v"].reshape(-1, 3).astype(np.float64)
         return MeshFile(*_stl_vertices(corners), damage.notes)
-    corners, triangles, current, facet_line = [], [], [], 0
+    corners, current, facet_line = [], [], 0  # three corners a facet, in the file's order
     lines = data.decode("ascii", "replace").splitlines()
     ended = False
     for number, line in enumerate(lines, start=1):
@@ -505,9 +505,7 @@ def _read_stl(path: Path, strict: bool) -> MeshFile:
             if len(current) != 3 or any(c is None for c in current):
                 damage(f"line {facet_line}", "the facet does not have three whole vertices")
             else:
-                base = len(corners)
                 corners += current
-                triangles.append([base, base + 1, base + 2])
             current = []
         elif key == "endsolid":
             ended = True

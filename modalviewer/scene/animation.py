@@ -101,9 +101,8 @@ def write_animation(path, images: list[np.ndarray], fps: float = DEFAULT_FPS) ->
     if not images:
         raise ValueError("an animation needs at least one frame")
     path = animation_path(path, (images[0].shape[1], images[0].shape[0]))
-    if path.suffix.lower() == ".gif":
-        return atomic_write(path, lambda tmp: _write_gif(tmp, images, fps))
-    return atomic_write(path, lambda tmp: _write_mp4(tmp, images, fps))
+    write = _write_gif if path.suffix.lower() == ".gif" else _write_mp4
+    return atomic_write(path, lambda tmp: write(tmp, images, fps))
 
 
 class Animation:
