@@ -448,15 +448,12 @@ def parse_view(text: str) -> str | tuple[float, float]:
         return key
     if key == "iso":
         return "isometric"
-    parts = key.split(",")
-    if len(parts) == 2:
-        try:
-            az, el = (float(p) for p in parts)
-        except ValueError:
-            pass
-        else:
-            if np.isfinite(az) and np.isfinite(el) and -90.0 <= el <= 90.0:
-                return az, el
+    try:
+        az, el = (float(p) for p in key.split(","))
+    except ValueError:  # not two numbers
+        az = el = np.nan
+    if np.isfinite(az) and np.isfinite(el) and -90.0 <= el <= 90.0:
+        return az, el
     raise ValueError(
         f"unknown view {text!r}: use canonical, {', '.join(AXES)}, iso or AZ,EL in degrees "
         "(elevation -90 .. 90)"

@@ -28,8 +28,10 @@ from ..core.signatures import (
     wks_sigma,
 )
 from ..core.spectrum import Spectrum
+from ..core.truncation import TRUNCATION_LEVEL, k_for_truncation, truncation_error
 from . import wording
-from .color_scale import robust_limit
+from .camera import DEFAULT_UP, detect_up
+from .color_scale import SPREAD_SHARE, crowded_share, robust_limit, spread_knots
 from .mode_scalar import smoothed_normals, vector_mode_scalar
 
 TIE_TOLERANCE = 1e-7  # distances this close (share of the largest) are marked together
@@ -133,8 +135,6 @@ class DerivedValues:
         under ``style.color_range``; "auto" is symmetric for modes, else robust, or
         "spread" where a tenth of the robust scale would cover more than
         :data:`.color_scale.SPREAD_SHARE` of the surface."""
-        from .color_scale import SPREAD_SHARE, crowded_share
-
         style, values = self.state.style, np.asarray(values, dtype=np.float64)
         rule = style.color_range
         automatic = rule == "auto"
@@ -170,8 +170,6 @@ class DerivedValues:
 
     def scaled(self, field: Field) -> Field:
         """``field`` with its colour range and, on a spread range, its knots."""
-        from .color_scale import spread_knots
-
         field.clim, field.clipped, field.color_range = self.color_range(
             field.values, field.colormap
         )
@@ -254,8 +252,6 @@ class DerivedValues:
         """(estimated truncation error, k suggested) of ``operator``'s signature at ``t``
         (defaults: the display's; :mod:`modalviewer.core.truncation`).  None without
         signatures, and for the wave kernel (the estimate is the heat kernel's)."""
-        from ..core.truncation import TRUNCATION_LEVEL, k_for_truncation, truncation_error
-
         if operator is None:
             if self.wave():
                 return None
@@ -315,8 +311,6 @@ class DerivedValues:
 
     def up_axis(self) -> str:
         """The chosen up axis, else :func:`.camera.detect_up`'s, else +Y."""
-        from .camera import DEFAULT_UP, detect_up
-
         if self.state.up_axis is not None:
             return self.state.up_axis
         if self.state.mesh is None:

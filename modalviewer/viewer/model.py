@@ -15,6 +15,7 @@ import numpy as np
 from ..coarsen import COARSE_FRACTION
 from ..core.cache import SolveRecord, SpectrumCache
 from ..core.eigen import Cancelled
+from ..core.local_signature import local_signature
 from ..core.memory import memory_refusal
 from ..core.mesh import Mesh
 from ..core.operators import operator_info
@@ -255,8 +256,6 @@ class ViewerModel:
         :meth:`.derived.DerivedValues.exact_curve`, announced by
         ``state.events.signature_curve``.  None without a curve, for a coarse-to-fine
         spectrum, or if it is in already."""
-        from ..core.local_signature import local_signature
-
         state, derived = self.state, self.state.derived
         key = derived.curve_key()
         if key is None or derived.exact_curve() is not None:

@@ -37,6 +37,7 @@ from ..core.spectrum import Spectrum
 from ..core.validate import check_vertices
 from .color_scale import auto_spread
 from .jobs import CANCELLED, DONE, Job, JobQueue
+from .model import expected_seconds
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
     DISTANCE_DISPLAYS,
@@ -276,8 +277,6 @@ class PairState:
     def estimated_seconds(self) -> float | None:
         """Seconds the missing spectra are expected to take; None if none is missing or
         one has no estimate."""
-        from .model import expected_seconds
-
         key = self.key()
         missing = [side for side in SIDES if self.spectrum(side) is None]
         seconds = [expected_seconds(key, self.compute_mesh(s, key), self.cache) for s in missing]

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..extras import extra_needed
+from .camera import Camera, parse_view, view_camera
 
 
 class Pictures:
@@ -212,8 +213,6 @@ class Pictures:
         """Turn the camera to ``view``: "canonical", a preset ("+x" ... "-z", "iso") or
         (azimuth, elevation) in degrees about the up axis (or "AZ,EL"), after choosing
         the ``up`` axis if given.  Returns the camera set, None without a mesh."""
-        from .camera import parse_view, view_camera
-
         view = parse_view(view) if isinstance(view, str) else tuple(float(x) for x in view)
         if up is not None:
             self.state.up_axis = up
@@ -238,7 +237,6 @@ class Pictures:
         """Write the views of ``comparison`` (a :meth:`comparison` or its items) side by
         side to a PNG from this viewer's camera, each ``scale`` times ``size``."""
         from ..scene.comparison import VIEW_SIZE, save_comparison
-        from .camera import Camera
 
         if not hasattr(comparison, "views"):
             comparison = self.comparison(comparison)

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..core.files import atomic_write
 from .jobs import Job
+from .process import repair_in_process
 from .state import ComputeSettings, Display, SpectrumKey, ViewerState
 
 FORMAT = "modalviewer-session"
@@ -132,8 +133,6 @@ def restore_session(model, path) -> Restored:
     if repairs:
         # re-applied here, in order, each in a child process (see .process); a sliver
         # repair of a big scan takes seconds
-        from .process import repair_in_process
-
         for name in repairs:
             mesh = repair_in_process(name, mesh, lambda *_: None, lambda: False)
         model.set_mesh(mesh, mesh_path, repairs)

@@ -25,9 +25,12 @@ from ..core.mesh import Mesh, _plural
 from ..core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
 from ..core.spectrum import Spectrum, in_input_numbering
 from ..repair import repair_for_failure, repair_unavailable
+from .comparison import Comparison
 from .jobs import CANCELLED, DONE, FAILED, Job, ManualDispatcher, RepairJob, SpectrumJob
 from .model import ComputeRefused, ViewerModel
+from .pair import PairState
 from .pictures import Pictures
+from .session import restore_session, save_session
 from .state import SpectrumKey
 from .wording import ended_text, finished_text, memory_text, residual_text, seconds_text
 
@@ -507,8 +510,6 @@ class Viewer(ViewerModel, Pictures):
     # ============================================================ sessions
     def save_session(self, path) -> Path:
         """Write the session (mesh, spectra, display, pick, camera) to a JSON file."""
-        from .session import save_session
-
         camera = self.current_camera()
         if camera is not None:
             with self.state.events.camera.blocked():  # what the picture shows already
@@ -518,8 +519,6 @@ class Viewer(ViewerModel, Pictures):
     def open_session(self, path, wait: bool = True) -> list[str]:
         """Restore a session (with ``wait``, its spectra too); returns notes on what could
         not be restored as saved.  SessionError, MeshError or OSError for a bad file."""
-        from .session import restore_session
-
         restored = restore_session(self, path)
         if wait:
             for job in restored.jobs:
@@ -568,8 +567,6 @@ class Viewer(ViewerModel, Pictures):
     def comparison(self, items: list[str], wait: bool = True):
         """A :class:`~.comparison.Comparison` of two or three operators or distance kinds;
         missing spectra are computed first (the display is not changed)."""
-        from .comparison import Comparison
-
         if self.state.mesh is None:
             raise ComputeError("Open a mesh first.")
         comparison = Comparison(self.state, items)
@@ -586,7 +583,6 @@ class Viewer(ViewerModel, Pictures):
         :meth:`open_mesh`.  ComputeError if no mesh is open, or (with ``wait``, which
         waits for both spectra) a spectrum could not be computed."""
         from ..io import load_mesh
-        from .pair import PairState
 
         state = self.state
         if state.mesh is None:

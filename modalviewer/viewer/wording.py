@@ -18,6 +18,7 @@ from ..core.operators import (
 from ..core.pipeline import FLOOR_FACTOR
 from ..core.robust import negative_cotan_weights
 from ..core.spectrum import Spectrum
+from ..core.truncation import TRUNCATION_LEVEL
 from .color_scale import ROBUST_PERCENTILE
 from .jobs import CANCELLED, DONE, Job, SpectrumJob
 
@@ -195,8 +196,6 @@ def negative_weights_note(state) -> str:
 def truncation_note(truncation: tuple[float, int] | None, k: int) -> str:
     """The share of a signature of ``k`` modes truncation misses and the k bringing it
     below :data:`~modalviewer.core.truncation.TRUNCATION_LEVEL`, when above it; else ""."""
-    from ..core.truncation import TRUNCATION_LEVEL
-
     if truncation is None or truncation[0] <= TRUNCATION_LEVEL:
         return ""
     error, needed = truncation
