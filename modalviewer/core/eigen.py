@@ -226,6 +226,7 @@ def solve_lowest(
         raise ValueError(f"null_space must have {N} rows (the unknowns), got {Z.shape[0]}")
     if d and np.abs((Z.T @ sp.diags(mass_diag) @ Z).toarray() - np.eye(d)).max() > 1e-8:
         raise ValueError("null_space must be Mass-orthonormal (Z^T M Z = I)")
+    Zk = _fix_column_signs(Z[:, : min(d, k)])  # the first modes, signs as the others'
     timer = StageTimer()
     columns = 0
     method, shift = "null space (no iteration)", 0.0
@@ -236,14 +237,13 @@ def solve_lowest(
         limit = default_memory_limit_mb() if memory_limit_mb is None else float(memory_limit_mb)
         lam, X, basis, shift, method, columns = _complement_pairs(
             K, mass_diag, Z, k, median_ratio, report, timer, dense_limit, tol, block, limit,
-            solver_info, _Handover(on_modes, Z, k),
+            solver_info, _Handover(on_modes, Zk),
         )  # fmt: skip
     all_lam = np.concatenate([np.zeros(min(d, k)), lam])
     report("checking residuals", 0.97)
     with timer("residuals"):
         X = _fix_signs(X)
         res_rest = relative_residuals(K, mass_diag, lam, X, lam_scale=median_ratio)
-        Zk = _fix_column_signs(Z[:, : min(d, k)])
         res_null = _null_residuals(K, mass_diag, Zk, zero_mode_size(all_lam, median_ratio))
     if not np.all(np.isfinite(lam)) or not np.all(np.isfinite(X)):
         raise EigenError("the eigensolver produced NaN values")
@@ -350,9 +350,9 @@ class _Handover:
     first pairs again: those already relayed are skipped), signs fixed as in the
     result."""
 
-    def __init__(self, on_modes: ConvergedFn | None, Z: sp.csc_matrix, k: int) -> None:
+    def __init__(self, on_modes: ConvergedFn | None, Zk: sp.csc_matrix) -> None:
         self.on_modes = on_modes
-        self.Z = Z[:, : min(Z.shape[1], k)]
+        self.Zk = Zk  # the null vectors among the first k modes
         self.relayed = 0  # iteration pairs relayed
         self.seen = 0  # pairs the current attempt has handed over
 
@@ -369,10 +369,9 @@ class _Handover:
             return
         first = self.relayed == 0
         self.relayed += lam.shape[0]
-        if first and self.Z.shape[1]:
-            Zk = _fix_column_signs(self.Z).toarray()
-            lam = np.concatenate([np.zeros(Zk.shape[1]), lam])
-            X = np.hstack([Zk, X])
+        if first and self.Zk.shape[1]:
+            lam = np.concatenate([np.zeros(self.Zk.shape[1]), lam])
+            X = np.hstack([self.Zk.toarray(), X])
         self.on_modes(lam, X)
 
 
