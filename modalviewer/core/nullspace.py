@@ -115,20 +115,13 @@ def _candidates(mesh: Mesh, info: OperatorInfo, mass: np.ndarray, normals):
             yield verts, _mass_orthonormal(along @ Vt[ok].T, m)
 
 
-def null_space(
-    mesh: Mesh,
-    operator: OperatorLike,
-    K: sp.spmatrix,
-    mass: np.ndarray,
-    normals: np.ndarray | None = None,
-) -> NullSpace:
+def null_space(mesh: Mesh, operator: OperatorLike, K: sp.spmatrix, mass: np.ndarray) -> NullSpace:
     """The exactly known null vectors of ``operator`` on ``mesh``, checked against its
-    matrix ``K`` (mass: its diagonal mass); ``normals``: the vertex normals it was built
-    with (default: the area-weighted ones the operators use)."""
+    matrix ``K`` (mass: its diagonal mass)."""
     info = operator_info(operator)  # a ValueError naming the known operators
     mass = np.asarray(mass, dtype=np.float64)
-    if info.null_space_rule.startswith("normal") and normals is None:  # E_D^N, normal shells
-        normals = vertex_normals(mesh)
+    # E_D^N and the normal shells are built with the area-weighted vertex normals
+    normals = vertex_normals(mesh) if info.null_space_rule.startswith("normal") else None
     rows, cols, vals = [], [], []
     component = []
     for c, (comp_rows, Z) in enumerate(_candidates(mesh, info, mass, normals)):
