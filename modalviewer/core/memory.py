@@ -3,14 +3,7 @@ the viewer, the desktop and the file cache that holds an out-of-core factor), ho
 this process holds, the allocator settings for processes that compute, the exact
 solver's plan (the Krylov basis's size, the factor's budget, a single-precision basis)
 and the predictions from the mesh's size alone (the memory check that refuses what
-would not fit).
-
-A computation allocates and frees many arrays of hundreds of megabytes, and first
-touches of fresh pages cost more than much of the arithmetic:
-:func:`prepare_compute_process` reuses heap memory, stops numpy's huge-page advice
-(compaction slows page faults) and gives all threads one malloc arena ("Memory" in
-docs/how-it-works.md).
-"""
+would not fit)."""
 
 from __future__ import annotations
 
@@ -101,9 +94,12 @@ HEAP_ARRAY_MAX_BYTES = 32 * 2**20
 
 def prepare_compute_process() -> bool:
     """The allocator settings for a process that exists to compute, called when it starts
-    (True if all took effect): glibc serves arrays up to :data:`HEAP_ARRAY_MAX_BYTES` from
-    the heap, keeps freed heap memory and serves every thread from one arena (memory freed
-    on one thread is reused on any other); numpy stops advising huge pages."""
+    (True if all took effect).  A computation allocates and frees many large arrays, and
+    first touches of fresh pages cost more than much of the arithmetic, so glibc serves
+    arrays up to :data:`HEAP_ARRAY_MAX_BYTES` from the heap, keeps freed heap memory and
+    serves every thread from one arena (memory freed on one thread is reused on any
+    other); numpy stops advising huge pages (compaction slows page faults).  "Memory" in
+    docs/how-it-works.md."""
     mallopt = getattr(glibc(), "mallopt", None)
     settings = [
         (-3, HEAP_ARRAY_MAX_BYTES),  # M_MMAP_THRESHOLD

@@ -184,11 +184,7 @@ def load_spectrum(
     if spec.modes.shape != expected or spec.residuals.shape != (k,):
         raise SpectrumFileError(f"{path} has inconsistent array shapes")
     valued = spec.mass > 0  # vertices no face uses have mass 0 and NaN modes
-    if not (
-        np.all(np.isfinite(spec.eigenvalues))
-        and np.all(np.isfinite(spec.modes[valued]))
-        and np.all(np.isfinite(spec.mass))
-    ):
+    if not all(np.isfinite(a).all() for a in (spec.eigenvalues, spec.modes[valued], spec.mass)):
         raise SpectrumFileError(f"{path} contains NaN or infinite values")
     if mesh_hash is not None and spec.mesh_hash != mesh_hash:
         raise SpectrumFileError(f"{path} belongs to another mesh")
