@@ -23,11 +23,6 @@ def current_umask() -> int:
     return mask
 
 
-def new_file_mode() -> int:
-    """The mode a newly created regular file gets: 0666 minus the umask."""
-    return 0o666 & ~current_umask()
-
-
 def make_folder_for(path: Path) -> Path:
     """Make ``path``'s folder (and its parents) and check that it can be written in;
     returns the folder.  An OSError saying which folder and why otherwise."""
@@ -53,7 +48,7 @@ def atomic_write(path: Path, write, suffix: str | None = None) -> Path:
     )
     tmp = Path(name)
     try:
-        os.fchmod(fd, new_file_mode())
+        os.fchmod(fd, 0o666 & ~current_umask())  # what a new file of open() gets
     finally:
         os.close(fd)
     try:

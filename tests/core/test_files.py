@@ -4,7 +4,7 @@ import os
 
 import pytest
 
-from modalviewer.core.files import atomic_write, current_umask, new_file_mode
+from modalviewer.core.files import atomic_write, current_umask
 
 
 @pytest.mark.parametrize("umask", [0o022, 0o077, 0o002])
@@ -12,7 +12,6 @@ def test_atomic_write_uses_the_umask(tmp_path, umask):
     old = os.umask(umask)
     try:
         assert current_umask() == umask
-        assert new_file_mode() == 0o666 & ~umask
         path = atomic_write(tmp_path / "a.txt", lambda tmp: tmp.write_text("x"))
         plain = tmp_path / "plain.txt"
         plain.write_text("x")  # what open() gives, for comparison
