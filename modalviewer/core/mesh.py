@@ -94,7 +94,7 @@ def checked_arrays(vertices, faces, polygons: bool = False):
             f"the mesh has {_plural(len(v), 'vertex')} but no faces: a point cloud is not "
             "a surface (reconstruct a surface from it first)"
         )
-    if f.ndim != 2:
+    if f.ndim != 2 or f.shape[1] < 3:
         raise MeshError(f"faces must be an (m, 3) array of vertex indices; got shape {f.shape}")
     if f.dtype.kind not in "iuf":  # not bool, complex or object
         raise MeshError(f"face indices must be integers; got an array of {f.dtype}")
@@ -111,8 +111,6 @@ def checked_arrays(vertices, faces, polygons: bool = False):
                 f"faces have shape {f.shape}: three rows of {f.shape[1]} indices, one "
                 "column per face; faces are one row per face, (m, 3): pass faces.T"
             )
-        if f.shape[1] < 3:
-            raise MeshError(f"faces must be an (m, 3) array of vertex indices; got {f.shape}")
         if not polygons:
             raise MeshError(
                 f"faces have shape {f.shape}: polygons of {f.shape[1]} vertices; a Mesh "
