@@ -81,11 +81,11 @@ class ViewerModel:
     """The state, the job queue, the spectrum cache and the requests that fill the state
     (:class:`.viewer.Viewer` adds messages and the scripting API)."""
 
-    def __init__(self, cache: SpectrumCache | None = None, dispatch=None):
+    def __init__(self, cache: SpectrumCache | None = None, dispatch=None, waiter=None):
         self.state = ViewerState()
         self.jobs = JobQueue(dispatch)
         self.cache = cache or SpectrumCache()
-        self._waiter = None  # how a window waits (Viewer.use_event_loop)
+        self._waiter = waiter  # how a window waits (Viewer.use_event_loop)
         self.jobs.events.finished.connect(self._store_result)
 
     def wait_for(self, job: Job, timeout: float | None = None) -> Job:

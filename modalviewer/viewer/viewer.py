@@ -58,11 +58,10 @@ class Viewer(ViewerModel, Pictures):
     :meth:`use_event_loop` (the defaults suit scripts)."""
 
     def __init__(self, cache: SpectrumCache | None = None, dispatch=None, waiter=None):
-        super().__init__(cache=cache, dispatch=dispatch or ManualDispatcher())
+        super().__init__(cache, dispatch or ManualDispatcher(), waiter)
         self.events = ViewerMessages()
         self.last_error: str | None = None
         self.sliver_failure: SpectrumKey | None = None  # failed on slivers, to retry
-        self._waiter = waiter
         self._cancel_note = ""  # what a cancel left queued, said when the next job starts
         self._renderer = None  # the off-screen picture, made on the first export
         self._picture = None  # a window's picture source (see attach_picture)
