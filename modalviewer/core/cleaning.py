@@ -105,12 +105,7 @@ def _repair_zero_area(v, f, min_area: float, diag: float, report: MeshReport, ma
             axis=1,
         )  # edge c runs from corner c to corner c + 1
         rows = np.arange(len(zf))
-        shortest = np.argmin(lengths, axis=1)
-        apex = zf[rows, (np.argmax(lengths, axis=1) + 2) % 3]
-        a, b = zf[rows, shortest], zf[rows, (shortest + 1) % 3]
-        moved = np.where(b == apex, b, a)
-        kept = np.where(b == apex, a, b)
-        order = np.argsort(lengths[rows, shortest], kind="stable")
+        order = np.argsort(lengths.min(axis=1), kind="stable")  # shortest edge first
 
         topo = _topology(f, n)
 
@@ -138,12 +133,12 @@ def _repair_zero_area(v, f, min_area: float, diag: float, report: MeshReport, ma
             if 0.1 <= t <= 0.9 and _flip(zero[i], a_, b_, x_, v, f, topo, min_area, locked):
                 flipped += 1
                 continue
-            # else collapse: the apex into the nearer end first; then the other ways of
-            # collapsing an edge of this face, shortest edge first
-            tries = [(int(moved[i]), int(kept[i]))]
+            # else collapse an edge of this face, shortest first, either way round; on
+            # the shortest, the apex into the nearer end first
+            tries = []
             for e in np.argsort(lengths[i], kind="stable"):
                 u, w = int(corners[e]), int(corners[(e + 1) % 3])
-                tries += [(u, w), (w, u)]
+                tries += [(w, u), (u, w)] if w == x_ and not tries else [(u, w), (w, u)]
             move = _collapse(tries, v, f, topo, min_area, locked, remap)
             if move is not None:
                 largest = max(largest, move)
