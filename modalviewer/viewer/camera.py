@@ -123,8 +123,7 @@ def _unit(v) -> np.ndarray:
 
 
 def _up_vector(up) -> np.ndarray:
-    if up is None:
-        up = DEFAULT_UP
+    up = DEFAULT_UP if up is None else up
     if isinstance(up, str):
         key = up.lower() if up[0] in "+-" else "+" + up.lower()
         if key not in AXES:

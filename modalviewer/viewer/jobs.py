@@ -144,17 +144,15 @@ class ManualDispatcher:
     def __call__(self, fn: Callable[[], None]) -> None:
         self._queue.put(fn)
 
-    def process(self, timeout: float = 0.0) -> int:
+    def process(self, timeout: float = 0.0) -> None:
         """Run the pending functions (waiting up to ``timeout`` s for the first)."""
-        count = 0
         try:
             fn = self._queue.get(timeout=timeout) if timeout > 0 else self._queue.get_nowait()
             while True:
                 fn()
-                count += 1
                 fn = self._queue.get_nowait()
         except queue.Empty:
-            return count
+            pass
 
 
 class JobQueue:
