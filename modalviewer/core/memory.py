@@ -16,8 +16,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .factor import available_backends
-
 MEMORY_LIMIT_SHARE = 0.5  # the share of this machine's memory a computation plans for
 
 MB = 2**20
@@ -313,16 +311,3 @@ FILL_MARGIN = 1.26
 the curved meshes PARDISO analysed (closed curved surfaces fill in more than the plates
 the laws come from; ``factor_memory.json``'s curved rows, checked by
 tests/core/test_cost.py)."""
-
-
-def factor_goes_out_of_core(
-    in_core_peak_mb: float, factor: FactorLaw | None, n_vertices: int, limit_mb: float | None
-) -> bool:
-    """Whether the exact solver will keep its factor in a file: the in-core peak above
-    ``limit_mb``, out of core needing less, and PARDISO (the only backend with that mode)
-    there."""
-    if factor is None or limit_mb is None or in_core_peak_mb <= limit_mb:
-        return False
-    if factor.out_of_core_mb(n_vertices) >= factor.in_core_mb(n_vertices):
-        return False
-    return "pardiso" in available_backends()

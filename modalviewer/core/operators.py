@@ -11,12 +11,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from .factor import available_backends
 from .memory import (
     FILL_MARGIN,
     FactorLaw,
     GrowthLaw,
     exact_peak_mb,
-    factor_goes_out_of_core,
     float32_basis_saving_mb,
     memory_limit_mb,
 )
@@ -104,11 +104,16 @@ class OperatorInfo:
         self, n_vertices: int, k: int = DEFAULT_K, limit_mb: float | None = None
     ) -> bool:
         """Whether the exact solve of ``k`` modes on ``n_vertices`` is predicted to keep
-        its factor in a file (:func:`.memory.factor_goes_out_of_core`; ``limit_mb`` None:
-        this machine's :func:`.memory.memory_limit_mb`)."""
+        its factor in a file: the in-core peak above ``limit_mb`` (None: this machine's
+        :func:`.memory.memory_limit_mb`), out of core needing less, and PARDISO (the only
+        backend with that mode) there."""
         limit_mb = memory_limit_mb() if limit_mb is None else limit_mb
-        peak = self._in_core_peak_mb(n_vertices, k)
-        return factor_goes_out_of_core(peak, self.factor_memory, n_vertices, limit_mb)
+        peak, factor = self._in_core_peak_mb(n_vertices, k), self.factor_memory
+        if factor is None or limit_mb is None or peak <= limit_mb:
+            return False
+        if factor.out_of_core_mb(n_vertices) >= factor.in_core_mb(n_vertices):
+            return False
+        return "pardiso" in available_backends()
 
     def _in_core_peak_mb(self, n_vertices: int, k: int) -> float:
         """The predicted peak with the factor in core: the law with the arrays that grow
