@@ -44,8 +44,7 @@ def spread_knots(values: np.ndarray, weights: np.ndarray, n: int = KNOTS):
     if len(unique) < 2:  # one value everywhere
         return np.array([unique[0], unique[0] + 1.0]), np.array([0.0, 1.0])
     pos = positions[first]
-    pos[-1] = 1.0
-    pos[0] = 0.0
+    pos[[0, -1]] = 0.0, 1.0
     return unique, pos
 
 

@@ -161,8 +161,7 @@ def repair_in_process(name: str, mesh: Mesh, progress, cancel) -> Mesh:
         _run_child(
             ["modalviewer.processes.repair_main", job_path, out_path], progress, cancel, "repair"
         )
-        with open(out_path, "rb") as fh:
-            return pickle.load(fh)  # written by our own child process just now
+        return pickle.loads(Path(out_path).read_bytes())  # written by our own child just now
     finally:
         Path(job_path).unlink(missing_ok=True)
         Path(out_path).unlink(missing_ok=True)
