@@ -120,17 +120,12 @@ MEMORY_SHARE = 0.75
 before they start."""
 
 
-def memory_needed(operator, k: int, n_vertices: int) -> float:
-    """Bytes an exact solve of ``k`` modes of ``operator`` (an
-    :class:`~.operators.OperatorInfo`) on ``n_vertices`` is predicted to need at its peak."""
-    return operator.predicted_peak_mb(n_vertices, k) * MB
-
-
 def largest_k_that_fits(operator, k: int, n_vertices: int, available: float) -> int:
-    """The most modes, up to ``k``, whose expected memory stays within
-    :data:`MEMORY_SHARE` of ``available`` bytes; 0 if not even one does."""
+    """The most modes, up to ``k``, whose predicted peak memory
+    (:meth:`.operators.OperatorInfo.predicted_peak_mb`) stays within :data:`MEMORY_SHARE`
+    of ``available`` bytes; 0 if not even one does."""
     ks, limit = range(1, max(1, k) + 1), MEMORY_SHARE * available  # memory grows with k
-    return bisect_right(ks, limit, key=lambda j: memory_needed(operator, j, n_vertices))
+    return bisect_right(ks, limit, key=lambda j: operator.predicted_peak_mb(n_vertices, j) * MB)
 
 
 def what_fits(
@@ -146,7 +141,7 @@ def what_fits(
     if (
         copy_vertices is not None
         and k <= operator.unknowns(copy_vertices)
-        and memory_needed(operator, k, copy_vertices) <= MEMORY_SHARE * available
+        and operator.predicted_peak_mb(copy_vertices, k) * MB <= MEMORY_SHARE * available
     ):
         options.append(f"{k} modes {coarse} fit")
     if not options:
@@ -162,7 +157,7 @@ def memory_refusal(
     need more than :data:`MEMORY_SHARE` of this machine's memory, saying what would fit
     (:func:`what_fits`); else None.  The viewer's refusals and ``modalviewer compute``
     say the same."""
-    needed = memory_needed(operator, k, n_vertices)
+    needed = operator.predicted_peak_mb(n_vertices, k) * MB  # bytes
     available = (physical_memory_mb() or 0.0) * MB  # bytes; 0 if unknown
     if not available or needed <= MEMORY_SHARE * available:
         return None

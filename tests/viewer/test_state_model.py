@@ -466,7 +466,7 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     n, shells = m.state.mesh.n_vertices, operator_info("shells")
 
     # memory for about 150 of the 300 modes asked for
-    needed = memory.memory_needed(shells, 150, n)
+    needed = shells.predicted_peak_mb(n, 150) * memory.MB
     available = int(needed / memory.MEMORY_SHARE)
     # the solver's choices (out of core, float32 basis) stay those of this machine
     monkeypatch.setenv("MODALVIEWER_MEMORY_LIMIT_MB", str(memory.memory_limit_mb()))
@@ -475,8 +475,8 @@ def test_a_refusal_says_what_would_fit(monkeypatch):
     k = memory.largest_k_that_fits(shells, 300, n, available)
     assert 1 <= k < 300 and f"at most {k} modes fit" in message.lower()
     limit = memory.MEMORY_SHARE * available
-    assert memory.memory_needed(shells, k, n) <= limit
-    assert memory.memory_needed(shells, k + 1, n) > limit
+    assert shells.predicted_peak_mb(n, k) * memory.MB <= limit
+    assert shells.predicted_peak_mb(n, k + 1) * memory.MB > limit
     assert "Coarse-to-fine" in message
     # it names the limit it applies, not only the machine's memory (above which a
     # refused request's need can lie)
@@ -506,12 +506,12 @@ def test_a_refusal_offers_no_option_that_cannot_give_the_modes_asked_for(monkeyp
     # enough memory for the copy's solve and for 300 modes, not for the request
     available = int(
         max(
-            memory.memory_needed(shells, too_many, copy),
-            memory.memory_needed(shells, 300, n),
+            shells.predicted_peak_mb(copy, too_many) * memory.MB,
+            shells.predicted_peak_mb(n, 300) * memory.MB,
         )
         / memory.MEMORY_SHARE
     )
-    assert memory.memory_needed(shells, too_many, n) > memory.MEMORY_SHARE * available
+    assert shells.predicted_peak_mb(n, too_many) * memory.MB > memory.MEMORY_SHARE * available
     monkeypatch.setenv("MODALVIEWER_MEMORY_LIMIT_MB", str(memory.memory_limit_mb()))
     monkeypatch.setattr(memory, "physical_memory_mb", lambda: available / 2**20)
     message = m.refusal(m.state.compute_settings.key("shells", too_many))
