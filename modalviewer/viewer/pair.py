@@ -41,6 +41,7 @@ from .model import expected_seconds
 from .state import (
     DEFAULT_THRESHOLD_SHARE,
     DISTANCE_DISPLAYS,
+    ComputeSettings,
     SpectrumKey,
     ViewerState,
     unit_area,
@@ -185,10 +186,8 @@ class PairState:
         return operator_for_distance(self.kind)
 
     def key(self) -> SpectrumKey:
-        """The spectrum key both meshes need now."""
-        weights = operator_info(self.operator).has_weights
-        bending, membrane = self.weights if weights else (1.0, 1.0)
-        return SpectrumKey(self.operator, self.k, bending, membrane, rescale=self.rescale)
+        """The spectrum key both meshes need now, made as the compute settings make one."""
+        return ComputeSettings(self.operator, self.k, *self.weights, self.rescale).key()
 
     def set_display(self, display: str, share: float | None = None) -> None:
         """Set ``distance_display`` and, if given, ``share``."""

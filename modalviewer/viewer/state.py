@@ -336,9 +336,8 @@ class ViewerState:
             self.derived.keep_table(spec, table)
         self._match_threshold()
         self.events.spectra.emit(key.operator)
-        if self.display.kind in ("mode", "distance", "signature"):
-            if self.display_operator() == key.operator:
-                self.events.display.emit()
+        if self.display_operator() == key.operator:  # None unless a mode, map or signature
+            self.events.display.emit()
 
     def set_computing(self, key: SpectrumKey, computing: bool) -> None:
         """Mark the spectrum of ``key`` as computed or queued (or not)."""
