@@ -46,6 +46,7 @@ from .state import (
     ViewerState,
     unit_area,
 )
+from .wording import arrival_text
 
 SIDES = ("a", "b")
 
@@ -302,13 +303,8 @@ class PairState:
 
     def arrival_note(self) -> str:
         """ "from the first 20 of 100 modes of B" while a spectrum is incomplete, else ""."""
-        parts = []
-        for side in SIDES:
-            spec = self.spectrum(side)
-            if spec is not None and not spec.is_complete:
-                parts.append(
-                    f"the first {spec.k} of {spec.modes_requested} modes of {side.upper()}"
-                )
+        arriving = {side: arrival_text(self.spectrum(side)) for side in SIDES}
+        parts = [f"the {text} of {side.upper()}" for side, text in arriving.items() if text]
         return f"from {' and '.join(parts)}" if parts else ""
 
     def _on_job(self, slot, job: Job | None, spec: Spectrum | None = None) -> None:
