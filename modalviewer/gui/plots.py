@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from matplotlib.backends.backend_qtagg import FigureCanvasQTAgg
 from matplotlib.figure import Figure
@@ -11,6 +13,9 @@ from qtpy import QtCore
 FONT_SIZE = 8
 """Points, for every text of the plot: a dock is at most 340 pixels wide."""
 LINE, SECOND, HIGHLIGHT = "#285ab4", "#e67814", "#dc2828"
+
+# a plot squeezed below the size of its labels (a dock dragged small) keeps its last layout
+warnings.filterwarnings("ignore", "constrained_layout not applied", UserWarning)
 
 
 class LinePlot(FigureCanvasQTAgg):
