@@ -157,6 +157,7 @@ class MainWindow(QtWidgets.QMainWindow):
             lambda: self.show_signature(self.state.display.signature_sample)
         )
         self.distances_panel.exactCurveRequested.connect(self.viewer.request_exact_curve)
+        self.distances_panel.signatureAtRequested.connect(self.viewer.show_signature_at)
         build_docks(self)
         menus.build_menus(self)
         jobs = self.viewer.jobs

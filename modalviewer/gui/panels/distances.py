@@ -27,11 +27,12 @@ class DistancesPanel(QtWidgets.QWidget):
     threshold slider moves by default through the share of the surface marked similar (a
     quantile), so its whole travel is useful whatever the distribution; "by value" makes
     it linear in the fraction of the largest distance.  Actions needing a spectrum go to
-    the window through ``showDistanceRequested``."""
+    the window through its signals."""
 
     showDistanceRequested = QtCore.Signal()
     showSignatureRequested = QtCore.Signal()
     exactCurveRequested = QtCore.Signal()
+    signatureAtRequested = QtCore.Signal(float)
 
     def __init__(self, state: ViewerState, parent=None):
         super().__init__(parent)
@@ -165,15 +166,10 @@ class DistancesPanel(QtWidgets.QWidget):
             t = float(self.scale_edit.text())
         except ValueError:
             return
-        operator = operator_for_distance(self.state.display.distance_kind)
-        if t <= 0 or not self.state.derived.has_signatures(operator):
-            self.showSignatureRequested.emit()  # says what is missing
-            return
-        self.state.set_display(
-            kind="signature",
-            signature_sample=self.state.derived.nearest_sample(t),
-            signature_time=t,
-        )
+        if t > 0:
+            self.signatureAtRequested.emit(t)
+        else:
+            self.showSignatureRequested.emit()
 
     # ------------------------------------------------------------ output
     def update_from_state(self, *_args) -> None:

@@ -34,17 +34,14 @@ class JobsPanel(QtWidgets.QWidget):
         self.last.clear()
         self.last.hide()
 
-    def _of_another_mesh(self, job: Job) -> bool:
-        mesh = self.state.mesh
-        return job.owner is not None and mesh is not None and job.owner != mesh.hash
-
     def _on_changed(self, job: Job) -> None:
         row = self.rows.get(job.id)
         if job.done:
             if row is not None:
                 row[0].deleteLater()
                 del self.rows[job.id]
-                if not self._of_another_mesh(job):
+                mesh = self.state.mesh  # a job of another mesh says nothing of this one
+                if job.owner is None or mesh is None or job.owner == mesh.hash:
                     self.last.setText(f"Last: {ended_text(job)}")
                     self.last.show()
         else:

@@ -70,14 +70,6 @@ class ModesPanel(QtWidgets.QWidget):
         self.update_from_state()
         self._update_style()
 
-    def _operator(self) -> str | None:
-        """The spectrum the panel shows: the mode's on screen, or the one last shown
-        (a distance map on screen, a restored session), else the first computed."""
-        d = self.state.display
-        if d.kind == "mode":
-            return d.operator
-        return self.state.current_operator()
-
     def _on_spectrum_chosen(self, _index: int) -> None:
         """Show the chosen spectrum's modes: the mode last shown of it, or its first
         non-zero mode; choosing the spectrum on screen again changes nothing."""
@@ -92,16 +84,14 @@ class ModesPanel(QtWidgets.QWidget):
         self.state.show_mode(self.state.first_nonzero_mode(op), op)
 
     def _on_mode_input(self, index: int) -> None:
-        op = self._operator()
+        op = self.state.current_operator()  # the mode's shown or last shown, else the first
         if op is not None and self.state.spectrum(op) is not None:
             self.state.show_mode(int(index), op)
 
     def update_from_state(self, *_args) -> None:
         state = self.state
         computed = state.operators_computed()
-        op = self._operator()
-        if op not in computed:
-            op = computed[0] if computed else None
+        op = state.current_operator()
         with quiet(self.spectrum_combo, self.mode_slider, self.mode_spin):
             self.spectrum_combo.clear()
             for name in computed:
