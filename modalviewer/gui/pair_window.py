@@ -84,8 +84,8 @@ class PairWindow(ViewsWindow):
         self.share_slider = slider(1, 500, SHARE_TIP)  # tenths of a percent of the other's area
         self.share_slider.valueChanged.connect(lambda v: p.set_display("threshold", v / 1000))
         self.share_label = QtWidgets.QLabel(minimumWidth=150)
-        self.k_spin = spin_box(2, 1000, tip="Modes computed on each mesh (the same on both)")
-        self.k_spin.setPrefix("k = ")
+        k_tip = "Modes computed on each mesh (the same on both)"
+        self.k_spin = spin_box(2, 1000, tip=k_tip, prefix="k = ")
         self.k_spin.editingFinished.connect(lambda: setattr(p, "k", self.k_spin.value()))
         rescale = "Rescale both to the same area before computing"
         self.rescale_check = QtWidgets.QCheckBox(rescale, toolTip=RESCALE_TIP)
@@ -118,9 +118,9 @@ class PairWindow(ViewsWindow):
         layout.addLayout(views, 1)
         self.status = QtWidgets.QLabel(wordWrap=True)
         self.job_progress = JobProgress((240, 320), "Cancel this window's work", p.cancel)
-        self.progress = self.job_progress.bar
-        layout.addLayout(row((self.status, 1), self.progress, self.job_progress.cancel_button))
-        self.scenes: dict[str, MeshScene | None] = {"a": None, "b": None}
+        progress = self.job_progress
+        layout.addLayout(row((self.status, 1), progress.bar, progress.cancel_button))
+        self.scenes: dict[str, MeshScene] = {}  # both from the window's first _on_meshes
         self._drawn: dict[str, tuple] = {}  # side -> (what is drawn, scene, values)
         self.install_keys(
             [("Escape", self._escape), ("Ctrl+W", self.close), ("R", self.reset_cameras)]
@@ -138,7 +138,7 @@ class PairWindow(ViewsWindow):
     def _on_meshes(self) -> None:
         for side in SIDES:
             mesh = self.pair.drawn_mesh(side)
-            scene = self.scenes[side]
+            scene = self.scenes.get(side)
             if scene is not None and scene.mesh is mesh:
                 continue
             if scene is not None:
@@ -186,10 +186,7 @@ class PairWindow(ViewsWindow):
         if self._wanted() != self._requested:
             self.request()
         for side in SIDES:
-            scene = self.scenes[side]
-            if scene is None:
-                continue
-            if self._draw(side, scene, self.pair.view(side)):
+            if self._draw(side, self.scenes[side], self.pair.view(side)):
                 self.viewports[side].request_render()
         self._sync_controls()
         self._update_status()
@@ -233,10 +230,8 @@ class PairWindow(ViewsWindow):
 
     def _update_status(self) -> None:
         p = self.pair
-        if p.distance_display == "threshold":
-            self.share_label.setText(f"{100 * p.share:.1f} % of the other mesh")
-        else:
-            self.share_label.setText("")
+        threshold = p.distance_display == "threshold"
+        self.share_label.setText(f"{100 * p.share:.1f} % of the other mesh" if threshold else "")
         match = p.best_match()
         if match is not None:
             side, w, dist = match
@@ -269,13 +264,8 @@ class PairWindow(ViewsWindow):
         same to the other.  Free cameras: turn B by hand to line it up with A (a rotated
         copy), then link."""
         self._sync_controls()
-        self._link = self._make_link() if on else None
-
-    def _make_link(self) -> CameraLink | None:
-        """The link that carries A's camera to B's as they are now."""
-        if self.scenes["a"] is None or self.scenes["b"] is None:
-            return None
-        return CameraLink.between(*(_camera(self.viewports[s].plotter.camera) for s in SIDES))
+        cameras = (_camera(self.viewports[side].plotter.camera) for side in SIDES)
+        self._link = CameraLink.between(*cameras) if on else None  # A's to B's as they are
 
     def _on_camera(self, side: str) -> None:
         if self.pair.linked and not self._syncing:
@@ -310,22 +300,15 @@ class PairWindow(ViewsWindow):
 
     def reset_cameras(self) -> None:
         """Back to the first views (R): see :meth:`_start_views`."""
-        if self.scenes["a"] is not None and self.scenes["b"] is not None:
-            self._start_views()
+        self._start_views()
         self.render_all()
 
     # ====================================================== interaction
     def _on_click(self, side: str, x: float, y: float) -> None:
-        scene = self.scenes[side]
-        vertex = scene.vertex_at_display(x, y) if scene is not None else None
-        if vertex is not None:
-            self._pick(side, vertex)
-
-    def _pick(self, side: str, vertex: int) -> None:
-        """Pick drawn vertex ``vertex`` of ``side`` (a click); a spectrum missing or
-        cancelled before is computed."""
-        self.pair.pick(side, self.pair.drawn_mesh(side).file_vertex(vertex))
-        self.request()
+        vertex = self.scenes[side].vertex_at_display(x, y)
+        if vertex is not None:  # a spectrum missing or cancelled before is computed
+            self.pair.pick(side, self.pair.drawn_mesh(side).file_vertex(vertex))
+            self.request()
 
     def request(self) -> list:
         """Start the computations the current kind needs (the status says how long they

@@ -210,7 +210,7 @@ def test_the_pairs_progress_text_fits_its_bar(window, spot_path, moved_spot, qtb
     seen = []
 
     def text_fits():
-        bar = pair.progress
+        bar = pair.job_progress.bar
         if bar.isVisible() and "%" in bar.text():
             seen.append((bar.text(), bar.fontMetrics().horizontalAdvance(bar.text()), bar.width()))
         return bool(seen)

@@ -75,14 +75,12 @@ class WrappingLabel(QtWidgets.QLabel):
 
 
 def slider(low: int, high: int, tip: str = "") -> QtWidgets.QSlider:
-    """A horizontal slider over ``low`` .. ``high`` with the tooltip ``tip``."""
     horizontal = QtCore.Qt.Orientation.Horizontal
     return QtWidgets.QSlider(horizontal, minimum=low, maximum=high, toolTip=tip)
 
 
-def spin_box(low, high, value=None, tip: str = "", suffix: str = "") -> QtWidgets.QSpinBox:
-    """A whole-number box over ``low`` .. ``high`` set to ``value`` (if given)."""
-    box = QtWidgets.QSpinBox(minimum=low, maximum=high, toolTip=tip, suffix=suffix)
+def spin_box(low, high, value=None, tip: str = "", **props) -> QtWidgets.QSpinBox:
+    box = QtWidgets.QSpinBox(minimum=low, maximum=high, toolTip=tip, **props)
     if value is not None:
         box.setValue(int(value))
     return box
