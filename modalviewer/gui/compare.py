@@ -29,12 +29,11 @@ class CompareWindow(ViewsWindow):
         self.main = main
         self.state = main.state
         self.comparison = Comparison(self.state, items)
-        self.items = self.comparison.items
         self.setWindowTitle("modalviewer - " + self.comparison.title)
         layout = QtWidgets.QHBoxLayout(self)
         self.viewports, self.scenes, self.titles = [], [], []
         camera = None
-        for item in self.items:
+        for item in self.comparison.items:
             column = QtWidgets.QVBoxLayout()
             title = QtWidgets.QLabel(item_label(item))
             column.addWidget(title)

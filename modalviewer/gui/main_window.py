@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import os
 import time
+from concurrent.futures import ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
 from contextlib import contextmanager
 from functools import partial
@@ -76,11 +77,8 @@ VIEWS = {
     "cache": "viewer.cache",
     "plotter": "viewport.plotter",
     "status_line": "status_widgets.status_line",
-    "cancel_button": "status_widgets.cancel_button",
     "mesh": "state.mesh",
     "scene": "scene_view.scene",
-    "display": "state.display.kind",
-    "frame_times": "scene_view.frame_times",
     "running_job": "viewer.jobs.running",
     "busy": "viewer.jobs.busy",
     "cancel_all": "viewer.jobs.cancel_all",
@@ -307,8 +305,6 @@ class MainWindow(QtWidgets.QMainWindow):
         dropped), or raises what ``load_mesh`` raises.  Shortcuts are off meanwhile
         (:func:`_shortcuts_off`), so no key applies to the old mesh or queues for the
         new one."""
-        from concurrent.futures import ThreadPoolExecutor
-
         from ..core.robust import negative_cotan_weights
         from ..io import load_mesh
 
@@ -471,7 +467,3 @@ class MainWindow(QtWidgets.QMainWindow):
         if notes:  # in a box of their own: the status bar's line is soon another's
             self._show_info_box("Session restored with changes", "\n".join(notes))
         return notes
-
-    @property
-    def current_operator(self) -> str | None:
-        return self.state.current_operator()

@@ -17,15 +17,14 @@ class SceneView(QtCore.QObject):
     def __init__(self, state: ViewerState, viewport, parent=None):
         super().__init__(parent)
         self.state = state
-        self.viewport = viewport
-        self.plotter = viewport.plotter
+        self.plotter = viewport.plotter  # plotter and scene: what the viewer's pictures use
         self._phase = 0.0
         self._last_tick: float | None = None
         self.frame_times: list[float] = []
         self.timer = QtCore.QTimer(self, interval=16)
         self.timer.timeout.connect(self._animate_step)
         self.drawing = StateScene(
-            state, self.plotter, viewport.request_render, on_animation=self._on_animation
+            state, viewport.plotter, viewport.request_render, on_animation=self._on_animation
         )
         state.events.display.connect(self._restart_phase)
 

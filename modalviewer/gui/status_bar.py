@@ -98,9 +98,8 @@ class StatusBarWidgets:
         bar.addPermanentWidget(self.status_line)
         cancel_tip = "Cancel the running computation (Esc)"
         self.progress = JobProgress((260, 260), cancel_tip, cancel, named=False)
-        self.cancel_button = self.progress.cancel_button
         bar.addPermanentWidget(self.progress.bar)
-        bar.addPermanentWidget(self.cancel_button)
+        bar.addPermanentWidget(self.progress.cancel_button)
         # the message shares the bar with the status line: while one is shown the status
         # line (elided, whole in its tooltip) gives it room; whole message on hover
         bar.messageChanged.connect(self._on_message)

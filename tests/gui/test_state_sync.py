@@ -32,7 +32,7 @@ def test_2_the_modes_panel_does_not_name_a_mode_that_is_not_shown(window, spot_p
     assert window.modes_panel.eigen_label.text().startswith("lambda_31 = ")
     window.pick_vertex(700)
     window.show_distance("vibration", display="threshold", share=0.3)
-    qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
+    qtbot.waitUntil(lambda: window.state.display.kind == "distance", timeout=120000)
     label = window.modes_panel.eigen_label.text()
     assert "lambda_31" not in label and label.startswith("Not shown")
     assert "vibration distance" in label
@@ -615,7 +615,7 @@ def test_a_typed_t1_alone_takes_the_default_t2_and_a_reversed_range_is_said(
     window.compute("laplacian", k=30, wait=True)
     window.pick_vertex(700)
     window.show_distance("hks")
-    qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
+    qtbot.waitUntil(lambda: window.state.display.kind == "distance", timeout=120000)
     panel = window.distances_panel
     from modalviewer.core.signatures import default_times
 

@@ -40,7 +40,7 @@ def test_mode_colours_and_isolines(window, spot_path):
     assert window.open_mesh(spot_path)
     window.state.style.colorbar = False  # the legend's black text would count as lines
     spec = window.compute("laplacian", k=20, wait=True)
-    assert spec.k == 20 and window.current_operator == "laplacian"
+    assert spec.k == 20 and window.state.current_operator() == "laplacian"
     window.show_mode(6)
     counts = _both_sides(window)
     assert counts["blue"] > 2000, counts
@@ -89,11 +89,11 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     before = window.viewport.render_now()
     window.animation_panel.play_button.click()
     # frames arrive every 16 ms on an idle machine; allow for a loaded one
-    qtbot.waitUntil(lambda: len(window.frame_times) > 3, timeout=5000)
+    qtbot.waitUntil(lambda: len(window.scene_view.frame_times) > 3, timeout=5000)
     assert window.scene_view.timer.isActive()
     moved = np.array(window.scene.surface.points)
     assert np.abs(moved - rest).max() > 1e-3 * window.mesh.bounding_box_diagonal
-    assert max(window.frame_times) < 0.05
+    assert max(window.scene_view.frame_times) < 0.05
     window.animation_frame(np.pi / 2)  # peak displacement
     after = window.viewport.render_now()
     assert np.mean(np.any(before != after, axis=2)) > 0.002
@@ -128,7 +128,7 @@ def test_click_picks_the_vertex_under_the_mouse(window, spot_path, qtbot, displa
     )
     assert window.picked == target
     # the vibration distance needs the shells spectrum: computed in the worker
-    qtbot.waitUntil(lambda: window.display == "distance", timeout=120000)
+    qtbot.waitUntil(lambda: window.state.display.kind == "distance", timeout=120000)
     d = window.distance_map()
     assert d.shape == (window.mesh.n_vertices,) and d[target] == 0.0 and d.max() > 0
     img = window.viewport.render_now()
@@ -177,13 +177,13 @@ def test_cancel_a_running_computation(window, tmp_path, qtbot):
     window.open_mesh(_big_mesh_file(tmp_path))
     window.compute("shells", k=200, wait=False)
     job = window.running_job
-    assert job is not None and window.cancel_button.isVisible()
+    assert job is not None and window.status_widgets.progress.cancel_button.isVisible()
     qtbot.wait(1500)
-    window.cancel_button.click()
+    window.status_widgets.progress.cancel_button.click()
     qtbot.waitUntil(lambda: job.done, timeout=30000)
     assert job.status == "cancelled" and not window.busy
     assert "shells" not in window.spectra
-    assert not window.cancel_button.isVisible()
+    assert not window.status_widgets.progress.cancel_button.isVisible()
 
 
 def test_loading_a_mesh_during_a_computation_drops_the_old_result(
@@ -345,7 +345,7 @@ def test_linked_comparison_of_three_operators(window, spot_path, tmp_path, qtbot
     cameras = {id(vp.plotter.renderer.GetActiveCamera()) for vp in compare.viewports}
     assert len(cameras) == 1  # one shared camera
     compare.comparison.show_mode(7)
-    for op, scene in zip(compare.items, compare.scenes, strict=True):
+    for op, scene in zip(compare.comparison.items, compare.scenes, strict=True):
         np.testing.assert_allclose(
             scene.surface.point_data["field"], window.spectra[op].mode(7), rtol=0, atol=0
         )
