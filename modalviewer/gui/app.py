@@ -103,6 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         window.resize(1500, 900)
     window.show()
     app.processEvents()
+    out = Path(args.screenshot) if args.screenshot else SCREENSHOTS / "headless_run.png"
     if args.session:
         notes = window.open_session(args.session, wait=headless)
         if window.state.mesh is None:
@@ -111,57 +112,49 @@ def main(argv: list[str] | None = None) -> int:
                 return 1
         if not headless:
             return app.exec()
-        for note in notes:
-            print(f"note: {note}")
-        out = Path(args.screenshot) if args.screenshot else SCREENSHOTS / "headless_run.png"
-        app.processEvents()
-        window.export_screenshot(out)
-        print(f"session {args.session}: screenshot {out}")
-        window.close()
-        window = None
-        gc.collect()
-        return 0
-    path = Path(args.mesh) if args.mesh else DEFAULT_MESH
-    opened = window.open_mesh(path, strict=not args.partial)
-    if not headless:
-        if opened and args.operator:
-            window.compute(
-                args.operator, k=args.k, wait=False, then=lambda s: _show_mode(window, s, args.mode)
+        said = [f"note: {note}" for note in notes] + [f"session {args.session}: screenshot {out}"]
+    else:
+        path = Path(args.mesh) if args.mesh else DEFAULT_MESH
+        opened = window.open_mesh(path, strict=not args.partial)
+        if not headless:
+            if opened and args.operator:
+                then = lambda s: _show_mode(window, s, args.mode)  # noqa: E731
+                window.compute(args.operator, k=args.k, wait=False, then=then)
+            return app.exec()
+        if not opened:
+            print(f"modalviewer: error: {window.last_error}", file=sys.stderr)
+            if str(window.last_error).endswith(DAMAGED_WORDS):
+                print(
+                    "modalviewer: note: --partial opens the file's whole records", file=sys.stderr
+                )
+            return 1
+        if args.partial:  # what was dropped
+            print(window.mesh.report)
+        operator = args.operator or "modified_dirichlet"
+        if args.screenshot is None:
+            print(
+                "No display found: running the viewer off-screen on "
+                f"{path.name} and saving a screenshot instead."
             )
-        return app.exec()
-
-    if not opened:
-        print(f"modalviewer: error: {window.last_error}", file=sys.stderr)
-        if str(window.last_error).endswith(DAMAGED_WORDS):
-            print("modalviewer: note: --partial opens the file's whole records", file=sys.stderr)
-        return 1
-    if args.partial:  # what was dropped
-        print(window.mesh.report)
-    operator = args.operator or "modified_dirichlet"
-    out = Path(args.screenshot) if args.screenshot else SCREENSHOTS / "headless_run.png"
-    if args.screenshot is None:
-        print(
-            "No display found: running the viewer off-screen on "
-            f"{path.name} and saving a screenshot instead."
-        )
-    try:
-        spec = window.compute(operator, k=args.k, wait=True)
-    except Exception as exc:  # ComputeError carries the user message
-        print(f"modalviewer: error: {exc}", file=sys.stderr)
-        return 1
-    if args.mode is not None and args.mode >= spec.k:  # as argparse's own errors
-        print(f"modalviewer: error: --mode must be between 0 and {spec.k - 1}", file=sys.stderr)
-        return 2
-    if args.mode is not None:
-        window.show_mode(args.mode)
+        try:
+            spec = window.compute(operator, k=args.k, wait=True)
+        except Exception as exc:  # ComputeError carries the user message
+            print(f"modalviewer: error: {exc}", file=sys.stderr)
+            return 1
+        if args.mode is not None and args.mode >= spec.k:  # as argparse's own errors
+            print(f"modalviewer: error: --mode must be between 0 and {spec.k - 1}", file=sys.stderr)
+            return 2
+        if args.mode is not None:
+            window.show_mode(args.mode)
+        nonzero = spec.eigenvalues[~spec.zero_mode_mask()][:6]
+        said = [
+            f"{path.name}: {window.mesh.n_vertices} vertices; {operator}: {spec.k} modes; "
+            f"lowest non-zero eigenvalues {', '.join(f'{x:.5g}' for x in nonzero)}",
+            f"screenshot: {out}",
+        ]
     app.processEvents()
     window.export_screenshot(out)
-    nonzero = spec.eigenvalues[~spec.zero_mode_mask()][:6]
-    print(
-        f"{path.name}: {window.mesh.n_vertices} vertices; {operator}: {spec.k} modes; "
-        f"lowest non-zero eigenvalues {', '.join(f'{x:.5g}' for x in nonzero)}"
-    )
-    print(f"screenshot: {out}")
+    print("\n".join(said))
     window.close()
     window = None  # drop the last reference before collecting
     gc.collect()  # release VTK objects before the interpreter shuts down
