@@ -12,7 +12,7 @@ from qtpy import QtCore, QtGui
 
 from ..core.operators import OPERATOR_INFO
 from ..viewer.camera import AXES
-from ..viewer.state import COLOR_RANGES, RENDER_STYLES, SHELL_COLORINGS
+from ..viewer.state import RENDER_STYLES, SHELL_COLORINGS
 from .docks import fit_modes_dock
 
 PREFERENCES = (
@@ -82,16 +82,13 @@ def restore(win) -> None:
 def _restore_color_range(st, s) -> None:
     """The colour range rule and typed limits as saved; a damaged entry gives the default
     (the automatic range), never an error at start-up."""
-    rule = str(s.value("view/color_range", "auto"))
     try:
         low, high = (float(x) for x in str(s.value("view/color_limits", "")).split())
         limits = (low, high)
     except ValueError:
         limits = None
-    if rule not in COLOR_RANGES or (rule == "limits" and limits is None):
-        rule = "auto"
-    try:
-        st.set_color_range(rule, limits)
+    try:  # refused: a rule not offered, limits not low < high, "limits" without them
+        st.set_color_range(str(s.value("view/color_range", "auto")), limits)
     except ValueError:
         st.set_color_range("auto")
 

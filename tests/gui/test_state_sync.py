@@ -667,3 +667,30 @@ def test_a_session_restored_with_changes_says_so_in_a_box(
     assert box.windowTitle() == "Session restored with changes"
     assert "704" in box.text()
     box.close()
+
+
+@pytest.mark.parametrize(
+    "rule, limits, expected",
+    [
+        ("robust", "not numbers", ("robust", None)),
+        ("limits", "-1 3", ("limits", (-1.0, 3.0))),
+        ("limits", "", ("auto", None)),  # the limits rule without its limits
+        ("limits", "3 -1", ("auto", None)),  # not low < high
+        ("brightest", "", ("auto", None)),  # a rule not offered
+    ],
+)
+def test_a_damaged_colour_range_setting_starts_with_the_automatic_range(
+    qtbot, rule, limits, expected
+):
+    from modalviewer.gui import MainWindow
+    from modalviewer.gui.window_settings import settings
+
+    saved = settings()
+    saved.setValue("view/color_range", rule)
+    saved.setValue("view/color_limits", limits)
+    saved.sync()
+    window = MainWindow()
+    qtbot.addWidget(window)
+    style = window.state.style
+    assert (style.color_range, style.color_limits) == expected
+    assert window.color_range_actions[expected[0]].isChecked()
