@@ -147,9 +147,8 @@ class AnimationDialog(_ExportDialog):
         form.addRow("Frames in one period", self.frames)
         form.addRow("Frames per second", self.fps)
         if not mp4_available():
-            note = QtWidgets.QLabel("MP4 needs imageio-ffmpeg: pip install 'modalviewer[video]'")
-            note.setWordWrap(True)
-            form.addRow(note)
+            note = "MP4 needs imageio-ffmpeg: pip install 'modalviewer[video]'"
+            form.addRow(QtWidgets.QLabel(note, wordWrap=True))
         self._finish()
 
     def values(self):

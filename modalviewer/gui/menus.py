@@ -19,31 +19,25 @@ def _action(win, menu, text, slot, shortcut=None, tip=None) -> QtGui.QAction:
     return action
 
 
-class _ShortcutsThroughNumberFields(QtCore.QObject):
-    """Lets the shortcuts of some actions (Ctrl+Left/Right: previous / next mode) reach
-    them from a number field (a spin box), which would otherwise take the keys to move
-    its cursor by words: the override request is left unaccepted, so the window's
-    shortcut runs."""
+class ShortcutsThroughNumberFields(QtCore.QObject):
+    """Lets the shortcuts of ``actions`` (Ctrl+Left/Right: previous / next mode) reach
+    them from every number field (spin box) of ``win``, which would otherwise take the
+    keys to move its cursor by words: the override request is left unaccepted, so the
+    window's shortcut runs."""
 
-    def __init__(self, actions, parent):
-        super().__init__(parent)
+    def __init__(self, actions, win):
+        super().__init__(win)
         self.keys = {action.shortcut().toString() for action in actions}
+        for box in win.findChildren(QtWidgets.QAbstractSpinBox):
+            box.installEventFilter(self)
+            if box.lineEdit() is not None:
+                box.lineEdit().installEventFilter(self)
 
     def eventFilter(self, obj, event) -> bool:  # noqa: N802 (Qt override)
         return (
             event.type() == QtCore.QEvent.Type.ShortcutOverride
             and QtGui.QKeySequence(event.keyCombination()).toString() in self.keys
         )
-
-
-def let_shortcuts_through(win, actions) -> None:
-    """Install :class:`_ShortcutsThroughNumberFields` for ``actions`` on every spin box
-    of ``win``."""
-    keys = _ShortcutsThroughNumberFields(actions, win)
-    for box in win.findChildren(QtWidgets.QAbstractSpinBox):
-        box.installEventFilter(keys)
-        if box.lineEdit() is not None:
-            box.lineEdit().installEventFilter(keys)
 
 
 def build_menus(win) -> None:
@@ -137,7 +131,7 @@ def _view_menu(win, m) -> None:
         _action(win, m, "&Next mode", lambda: win.step_mode(+1), "Ctrl+Right"),
         _action(win, m, "&Previous mode", lambda: win.step_mode(-1), "Ctrl+Left"),
     ]
-    let_shortcuts_through(win, steps)
+    ShortcutsThroughNumberFields(steps, win)
     _action(win, m, "Play / pause animation", win.toggle_animation, "P")
     _action(win, m, "Show &mode", win.viewer.show_current_mode, "M")
     _action(win, m, "Show &distance", lambda: win.show_distance(), "D")
@@ -271,10 +265,7 @@ def _up_axis_menu(win, menu) -> None:
         actions[None].setText(f"&Automatic ({detected.upper()})" if shown else "&Automatic")
         actions[state.up_axis].setChecked(True)
 
-    def on_mesh() -> None:
-        window_settings.restore_up_axis(win)
-        update()
-
-    state.events.mesh.connect(on_mesh)
+    state.events.mesh.connect(lambda: window_settings.restore_up_axis(win))
+    state.events.mesh.connect(update)  # after the restore: the new mesh's detected axis
     state.events.up_axis.connect(update)
     update()
