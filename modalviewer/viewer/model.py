@@ -31,15 +31,10 @@ class ComputeRefused(ValueError):
     """A computation was refused before it started; the message says why and what to do."""
 
 
-ESTIMATE_RANGE = 2.0
-"""An estimate scales a recorded solve whose vertex count, or number of modes, is within
-this factor of the request's (:func:`estimated_seconds`)."""
-
-SIZE_EXPONENT = 1.2
-"""Seconds grow as the vertex count to this power in :func:`estimated_seconds`."""
-
-MODES_EXPONENT = 0.6
-"""Seconds grow as the number of modes to this power in :func:`estimated_seconds`."""
+# how :func:`estimated_seconds` scales a recorded solve (its docstring says when)
+ESTIMATE_RANGE = 2.0  # recorded vertex counts and numbers of modes within this factor
+SIZE_EXPONENT = 1.2  # seconds grow as the vertex count to this power
+MODES_EXPONENT = 0.6  # seconds grow as the number of modes to this power
 
 
 def estimated_seconds(

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+from contextlib import suppress
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
@@ -43,10 +44,8 @@ def session_dict(state: ViewerState, base: Path | None = None) -> dict:
     path = Path(state.mesh_path).resolve() if state.mesh_path else None
     relative = None
     if path is not None and base is not None:
-        try:
+        with suppress(ValueError):  # none from another drive (Windows)
             relative = os.path.relpath(path, base)
-        except ValueError:
-            relative = None
     return {
         "format": FORMAT,
         "version": VERSION,
@@ -188,9 +187,8 @@ def restore_session(model, path) -> Restored:
         if camera:
             state.camera = camera
 
-    if out.jobs:
-        for job in out.jobs:
-            job.then(apply_display)
-    else:
+    for job in out.jobs:
+        job.then(apply_display)
+    if not out.jobs:
         apply_display()
     return out
