@@ -162,15 +162,7 @@ class SignatureTable:
         else:
             self.times = default_scales(spec, samples, kind)
         self.table = normalised_signatures(spec, self.times, include_zero, kind=kind)
-
-    @property
-    def table(self) -> np.ndarray:
-        return self._table
-
-    @table.setter
-    def table(self, value: np.ndarray) -> None:
-        self._table = value
-        self._norms2 = np.einsum("ij,ij->i", value, value)  # (n,) squared row norms
+        self._norms2 = np.einsum("ij,ij->i", self.table, self.table)  # (n,) squared row norms
 
     def distance_from(self, vertex: int) -> np.ndarray:
         """(n,) distance from ``vertex`` to every vertex: one matrix-vector product by
