@@ -58,9 +58,7 @@ def check_vertices(
     values: object, n: int, name: str = "vertices", allow_empty: bool = False
 ) -> np.ndarray:
     """(p,) int64 indices from one index or a sequence of them, each in ``0..n-1``."""
-    if isinstance(values, (str, bytes)):
-        raise TypeError(f"{name} must be integer vertex indices, got {_shown(values)}")
-    idx = np.atleast_1d(np.asarray(values))
+    idx = np.atleast_1d(np.asarray(values))  # a string: one element of kind "U" or "S"
     if idx.ndim != 1 or (idx.size == 0 and not allow_empty):
         raise ValueError(f"{name} must be one vertex index or a non-empty list of them")
     if idx.size and idx.dtype.kind not in "iu":
