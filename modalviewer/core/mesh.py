@@ -35,9 +35,7 @@ class MeshReport:
 
     def __str__(self) -> str:
         head = f"{self.source}: " if self.source else ""
-        if not self.messages:
-            return head + "no problems found."
-        return head + " ".join(self.messages)
+        return head + (" ".join(self.messages) or "no problems found.")
 
     def __bool__(self) -> bool:  # a report is always worth showing
         return True
