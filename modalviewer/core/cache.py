@@ -1,9 +1,7 @@
-"""On-disk cache of computed spectra, keyed by mesh hash, operator and parameters.
-
-A folder of ``.npz`` files, one per spectrum, the least recently used (by modification
-time) going first.  Every entry is checked when read; a damaged or foreign one is
-deleted with a warning in the ``modalviewer.cache`` log and counts as a miss.
-"""
+"""On-disk cache of computed spectra (:class:`SpectrumCache`), keyed by mesh hash,
+operator and parameters; an entry's last use is its file's modification time.  Every
+entry is checked when read; a damaged or foreign one is deleted with a warning in the
+``modalviewer.cache`` log and counts as a miss."""
 
 from __future__ import annotations
 
