@@ -60,9 +60,8 @@ def _descriptors(spec_a, spec_b, descriptors, samples: int):
             )
         kind = "wks" if descriptors == "wks" else "heat"
         scales = common_times(spec_a, spec_b, samples=samples, kind=kind)
-        if kind == "wks":
-            return tuple(signature(s, kind="wks", energies=scales)[1] for s in (spec_a, spec_b))
-        return signature(spec_a, scales)[1], signature(spec_b, scales)[1]
+        at = {"kind": "wks", "energies": scales} if kind == "wks" else {"times": scales}
+        return tuple(signature(s, **at)[1] for s in (spec_a, spec_b))
     fa, fb = (np.asarray(f, dtype=np.float64) for f in descriptors)
     if fa.ndim == 1:
         fa, fb = fa[:, None], fb[:, None]
