@@ -51,7 +51,6 @@ class PairWindow(ViewsWindow):
 
     def __init__(self, main, mesh_b: Mesh, path_b=None, k: int | None = None, force_offscreen=None):
         super().__init__(main, QtCore.Qt.WindowType.Window)
-        self.setAttribute(QtCore.Qt.WidgetAttribute.WA_DeleteOnClose, False)
         self.setAcceptDrops(True)
         self.main = main
         state_a = main.state

@@ -51,11 +51,8 @@ class DistancesPanel(QtWidgets.QWidget):
         self.threshold_label = WrappingLabel("-")
         self.threshold_slider.setSingleStep(5)  # 0.5 % of the surface per arrow key
         self.threshold_slider.setPageStep(50)
-        self.t1_edit = QtWidgets.QLineEdit()
-        self.t2_edit = QtWidgets.QLineEdit()
-        for edit in (self.t1_edit, self.t2_edit):
-            edit.setPlaceholderText("default")
-            edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
+        self.t1_edit = QtWidgets.QLineEdit(placeholderText="default")
+        self.t2_edit = QtWidgets.QLineEdit(placeholderText="default")
         self.pick_label = WrappingLabel("Click the surface to pick a vertex.")
         self.distance_button = QtWidgets.QPushButton(
             "Show distance", toolTip="Distance from the picked vertex (D)"
@@ -77,7 +74,8 @@ class DistancesPanel(QtWidgets.QWidget):
             toolTip="Type a scale t: the signature is summed at t itself (the slider shows "
             "the nearest sample)"
         )
-        self.scale_edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
+        for edit in (self.t1_edit, self.t2_edit, self.scale_edit):  # scales t (or energies E)
+            edit.setValidator(QtGui.QDoubleValidator(0.0, 1e30, 12))
         log_tip = "Colour the signature by log10(S / smallest S)"
         self.log_check = QtWidgets.QCheckBox("Log colours", toolTip=log_tip)
         self.scale_row = row((self.scale_edit, 1), self.log_check)
