@@ -143,8 +143,7 @@ def principal_axes(vertices, faces=None) -> tuple[np.ndarray, np.ndarray]:
         f = np.asarray(faces)
         x0, x1, x2 = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
         area = 0.5 * np.linalg.norm(np.cross(x1 - x0, x2 - x0), axis=1)
-        total = float(area.sum()) or 1.0
-        w = area / total
+        w = area / (float(area.sum()) or 1.0)
         centroid = (x0 + x1 + x2) / 3.0
         mean = w @ centroid
         # exact second moment of a uniform triangle: (sum_i x_i x_i^T + s s^T) / 12 with

@@ -403,14 +403,12 @@ class DerivedValues:
     def mode_fields(self, spec: Spectrum, j: int) -> tuple[np.ndarray, np.ndarray]:
         """(scalar (n,), displacement (n, 3) of peak 1) of mode j."""
         phi = spec.mode(j)
-        if spec.is_vector:
+        if not spec.is_vector:  # a scalar mode displaces the surface along its normals
+            scalar, disp = phi, phi[:, None] * self.normals
+        else:
             coloring = self.vector_coloring()
             normals = self.smoothed_normals() if coloring == "normal" else None
-            scalar = vector_mode_scalar(phi, normals, coloring)
-            disp = phi
-        else:
-            scalar = phi
-            disp = phi[:, None] * self.normals
+            scalar, disp = vector_mode_scalar(phi, normals, coloring), phi
         peak = float(np.max(np.linalg.norm(disp, axis=1))) or 1.0
         return scalar, disp / peak
 

@@ -201,9 +201,8 @@ class ViewerModel:
 
     def computing(self, operator: str) -> bool:
         """Whether a spectrum of ``operator`` is queued or being computed."""
-        return any(
+        return any(  # the queue holds only jobs that have not ended
             isinstance(job, SpectrumJob)
-            and not job.done
             and not job.cancel_requested
             and job.spectrum_key.operator == operator
             for job in self.jobs.jobs

@@ -261,9 +261,7 @@ class Viewer(ViewerModel, Pictures):
     def long_wait_note(self, job: SpectrumJob) -> str:
         """ "this will take about ..." for a request expected (from this machine's solves)
         to take longer than :data:`LONG_WAIT_SECONDS`; else ""."""
-        if job.done:
-            return ""
-        seconds = self.estimated_seconds(job.spectrum_key)
+        seconds = None if job.done else self.estimated_seconds(job.spectrum_key)
         if seconds is None or seconds <= LONG_WAIT_SECONDS:
             return ""
         about = seconds_text(seconds)

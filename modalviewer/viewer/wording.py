@@ -70,12 +70,9 @@ def display_mark(state) -> str:
 def approximation_note(spec: Spectrum | None, coarse: bool) -> str:
     """ " (coarse-to-fine spectrum)", " (from the first 20 of 100 modes)" or "" for a map
     or signature made of ``spec``."""
-    arriving = arrival_text(spec)
-    notes = [
-        "coarse-to-fine spectrum" if coarse else "",
-        f"from the {arriving}" if arriving else "",
-    ]
-    notes = [n for n in notes if n and spec is not None]
+    arriving = arrival_text(spec)  # "" without a spectrum
+    notes = ["coarse-to-fine spectrum"] if coarse and spec is not None else []
+    notes += [f"from the {arriving}"] if arriving else []
     return f" ({'; '.join(notes)})" if notes else ""
 
 
