@@ -122,17 +122,13 @@ def zero_mode_size(lam: np.ndarray, lam_scale: float) -> float:
 
 
 def relative_residuals(
-    K,
-    mass_diag: np.ndarray,
-    lam: np.ndarray,
-    X: np.ndarray,
-    lam_scale: float = 0.0,
-    null_dim: int = 0,
+    K, mass_diag: np.ndarray, lam: np.ndarray, X: np.ndarray, lam_scale: float = 0.0
 ) -> np.ndarray:
     """|K x - lam M x| / |lam M x| per column; |K x| / (lam_max |M x|) for the zero modes
-    of :func:`zero_modes` (``lam_scale`` and ``null_dim`` are passed on)."""
+    of :func:`zero_modes` (``lam_scale`` is passed on; the exact null vectors have their
+    own residuals, :func:`_null_residuals`)."""
     scale = np.abs(lam).copy()
-    scale[zero_modes(lam, lam_scale, null_dim)] = zero_mode_size(lam, lam_scale)
+    scale[zero_modes(lam, lam_scale)] = zero_mode_size(lam, lam_scale)
     out = np.empty(X.shape[1])
     for cols, KX in column_block_products(K, X):  # (N, 32) temporaries, not three (N, k) ones
         MX = mass_diag[:, None] * X[:, cols]
