@@ -187,9 +187,7 @@ class Mesh:
             fm = np.array(file_map, dtype=np.int64, copy=True).reshape(-1)
             if fm.size and (fm.min() < -1 or fm.max() >= n):
                 raise MeshError("file_map refers to vertices the mesh does not have")
-            hit = np.zeros(n, dtype=bool)
-            hit[fm[fm >= 0]] = True
-            if not hit.all():
+            if not np.bincount(fm[fm >= 0], minlength=n).all():
                 raise MeshError("file_map leaves a mesh vertex without a vertex of the file")
             if not (len(fm) == n and np.array_equal(fm, np.arange(n))):
                 fm.setflags(write=False)

@@ -82,11 +82,8 @@ class Spectrum:
 
     def zero_mode_mask(self) -> np.ndarray:
         """(k,) True for the zero modes (the rule of :func:`.eigen.zero_modes`)."""
-        return zero_modes(
-            self.eigenvalues,
-            float(self.parameters.get("zero_mode_scale", 0.0)),
-            self.null_space_dimension,
-        )
+        scale = float(self.parameters.get("zero_mode_scale", 0.0))
+        return zero_modes(self.eigenvalues, scale, self.null_space_dimension)
 
     def mode(self, j: int) -> np.ndarray:
         """Mode j: (n,) for scalar operators, (n, 3) for ``"shells"``."""
@@ -179,8 +176,7 @@ def load_spectrum(
         raise SpectrumFileError(f"{path} is not a modalviewer spectrum file")
     k = spec.eigenvalues.shape[0]
     n = spec.mass.shape[0]
-    per_vertex = operator_info(spec.operator).unknowns_per_vertex
-    expected = (n, 3, k) if per_vertex == 3 else (n, k)
+    expected = (n, 3, k) if spec.operator_info.unknowns_per_vertex == 3 else (n, k)
     if spec.modes.shape != expected or spec.residuals.shape != (k,):
         raise SpectrumFileError(f"{path} has inconsistent array shapes")
     valued = spec.mass > 0  # vertices no face uses have mass 0 and NaN modes
