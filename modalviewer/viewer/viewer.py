@@ -395,15 +395,12 @@ class Viewer(ViewerModel, Pictures):
             raise ValueError(f"share is a share of the surface's area, in (0, 1]: {share}")
         if threshold is not None and not 0.0 <= float(threshold) < np.inf:
             raise ValueError(f"threshold is a distance, at least 0: {threshold}")
-        changes = {}
-        if kind is not None:
-            if kind not in DISTANCE_KINDS:
-                raise ValueError(f"unknown distance {kind!r}; choose one of {list(DISTANCE_KINDS)}")
-            changes["distance_kind"] = kind
-        if display is not None:
-            changes["distance_display"] = display
-        if share is not None or threshold is not None:
-            changes.setdefault("distance_display", "threshold")
+        if kind is not None and kind not in DISTANCE_KINDS:
+            raise ValueError(f"unknown distance {kind!r}; choose one of {list(DISTANCE_KINDS)}")
+        if display is None and (share is not None or threshold is not None):
+            display = "threshold"
+        changes = {"distance_kind": kind, "distance_display": display}
+        changes = {name: value for name, value in changes.items() if value is not None}
         if changes:
             self.state.set_display(**changes)
         if self.state.mesh is None:
