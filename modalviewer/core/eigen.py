@@ -382,9 +382,7 @@ def _fix_column_signs(Z: sp.csc_matrix) -> sp.csc_matrix:
 
 
 def _null_residuals(K, mass_diag, Z: sp.csc_matrix, lam_max: float) -> np.ndarray:
-    """|K z| / (lam_max |M z|) per column of the sparse null vectors."""
-    if Z.shape[1] == 0:
-        return np.zeros(0)
+    """|K z| / (lam_max |M z|) per column of the sparse null vectors (none: empty)."""
     KZ = sp.csc_matrix(K @ Z)
     MZ = sp.csc_matrix(sp.diags(mass_diag) @ Z)
     return column_norms(KZ) / (lam_max * column_norms(MZ))
