@@ -81,14 +81,12 @@ def threaded_product(K, X):
 
 
 def column_block_products(K, Y: np.ndarray, width: int = 32) -> Iterator[tuple[slice, np.ndarray]]:
-    """``(cols, K @ Y[:, cols])`` for consecutive blocks of ``width`` columns: passes over
-    ``K Y`` with (N, width) temporaries instead of an (N, k) one."""
-    if sp.issparse(K):
-        K = sp.csr_matrix(K)
+    """``(cols, K @ Y[:, cols])`` for consecutive blocks of ``width`` columns of a sparse K:
+    passes over ``K Y`` with (N, width) temporaries instead of an (N, k) one."""
+    K = sp.csr_matrix(K)
     for start in range(0, Y.shape[1], width):
         cols = slice(start, start + width)
-        block = Y[:, cols]
-        yield cols, threaded_product(K, block) if sp.issparse(K) else np.asarray(K @ block)
+        yield cols, threaded_product(K, Y[:, cols])
 
 
 def column_norms(A: sp.spmatrix) -> np.ndarray:
