@@ -54,10 +54,9 @@ def _check_pair(spec_a: Spectrum, spec_b: Spectrum) -> None:
             f"both spectra must come from the same operator, got {spec_a.operator!r} "
             f"and {spec_b.operator!r} (signatures of different operators are not comparable)"
         )
-    for name in ("bending", "membrane"):
+    for name in ("bending", "membrane") if spec_a.operator_info.has_weights else ():
         a, b = spec_a.parameters.get(name), spec_b.parameters.get(name)
-        weighted = spec_a.operator_info.has_weights
-        if weighted and a is not None and b is not None and a != b:
+        if a is not None and b is not None and a != b:
             raise ValueError(f"the two shells spectra use different {name} weights ({a} and {b})")
     area_a, area_b = float(spec_a.mass.sum()), float(spec_b.mass.sum())
     if abs(area_a - area_b) > AREA_TOLERANCE * max(area_a, area_b):

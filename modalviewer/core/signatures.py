@@ -120,8 +120,7 @@ def signature(
     times = check_times(default_times(spec) if times is None else times)
     lam = spec.eigenvalues[mask]
     weights = np.exp(-np.outer(lam, times))  # (k, T)
-    values = spec.squared_modes(vertices)[:, mask] @ weights
-    return times, values
+    return times, spec.squared_modes(vertices)[:, mask] @ weights
 
 
 def normalised_signatures(
