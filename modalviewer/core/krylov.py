@@ -43,8 +43,7 @@ class StageTimer:
         try:
             yield
         finally:
-            elapsed = time.perf_counter() - start
-            self.seconds[stage] = self.seconds.get(stage, 0.0) + elapsed
+            self.seconds[stage] = self.seconds.get(stage, 0.0) + (time.perf_counter() - start)
 
 
 def _gram_cholesky(W: np.ndarray) -> np.ndarray | None:
