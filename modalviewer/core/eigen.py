@@ -300,6 +300,7 @@ def _complement_pairs(
             V -= Y0 @ (Y0t @ V)
         return V
 
+    deflated = f", {d} null vectors deflated" if d else ""
     # A few more pairs than requested: the last requested pairs then converge as fast as
     # the others (the gap to the unwanted part of the spectrum is larger).
     sizes = krylov_sizes(k - d, N - d, block)  # working pairs, block, basis, kept
@@ -330,14 +331,11 @@ def _complement_pairs(
             method += ", factor out of core"
         if solver_info["basis_float32"]:
             method += ", single-precision Krylov basis"
-        if d:
-            method += f", {d} null vectors deflated"
-        return lam, basis[:, : lam.shape[0]], basis, shift, method, columns
+        return lam, basis[:, : lam.shape[0]], basis, shift, method + deflated, columns
     report("solving (dense)", 0.1)
     with timer("dense"):
         lam, X = _dense_complement(K, mass_diag, Y0, k - d)
-    method = "dense" + (f", {d} null vectors deflated" if d else "")
-    return lam, X, None, 0.0, method, 0
+    return lam, X, None, 0.0, "dense" + deflated, 0
 
 
 class _Handover:
