@@ -132,7 +132,7 @@ def render(args) -> int:
     viewer.show_mode(asked[0])
     viewer.set_view(args.view, up=args.up)
     if args.modes is not None:
-        from ..scene.export import png_path, save_png
+        from ..scene.export import save_png
 
         shape = args.size or (1024, 768)
         grid = args.grid or grid_shape(len(args.modes))
@@ -141,7 +141,7 @@ def render(args) -> int:
         except ValueError as exc:
             raise BadArgument(f"--size {shape[0]}x{shape[1]}: {exc}") from None
         img = viewer.mode_grid(args.modes, grid=grid, size=panel)
-        written = save_png(png_path(args.output), padded(img, shape))
+        written = save_png(args.output, padded(img, shape))
         viewer.close()
         shown = ", ".join(f"{j}: {spec.eigenvalues[j]:.6g}" for j in args.modes)
         print(f"modes of {args.operator}: lambda {shown}")
