@@ -44,9 +44,7 @@ def grab(
         if hidden:
             plotter.render()
     img = np.ascontiguousarray(img)
-    if overlay:
-        img = draw_overlay(img, overlay, scale * getattr(scene, "overlay_scale", 1.0))
-    return img
+    return draw_overlay(img, overlay, scale * getattr(scene, "overlay_scale", 1.0))
 
 
 def side_by_side(images: list[np.ndarray], gap: int = 0, transparent: bool = False):

@@ -351,9 +351,7 @@ class MeshScene:
         if key == self._overlay_key or w < 2 or h < 2:
             return
         self._overlay_key = key
-        rgba = np.zeros((h, w, 4), np.uint8)
-        if overlay:
-            rgba = draw_overlay(rgba, overlay, self.overlay_scale)
+        rgba = draw_overlay(np.zeros((h, w, 4), np.uint8), overlay, self.overlay_scale)
         image = vtkImageData()
         image.SetDimensions(w, h, 1)
         scalars = numpy_to_vtk(rgba[::-1].reshape(-1, 4).copy(), deep=True)

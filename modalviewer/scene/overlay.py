@@ -74,9 +74,10 @@ def wrap_text(text: str, measure, width: float) -> str:
     return "\n".join(out).replace(nbsp, " ")
 
 
-def draw_overlay(img: np.ndarray, overlay: Overlay, scale: float = 1.0) -> np.ndarray:
+def draw_overlay(img: np.ndarray, overlay: Overlay | None, scale: float = 1.0) -> np.ndarray:
     """``img`` (h, w, 3 or 4) uint8 with the legend at the top left and the colour bar at
-    the bottom drawn on it; a copy.  Sizes are ``scale`` times the on-screen ones."""
+    the bottom drawn on it, a copy (``img`` itself where ``overlay`` is empty or None).
+    Sizes are ``scale`` times the on-screen ones."""
     from PIL import Image, ImageDraw
 
     if not overlay:
