@@ -562,3 +562,35 @@ def test_compute_says_how_many_modes_are_ready(tmp_path):
     counts = [int(n) for n in re.findall(r"solving: (\d+) of 60 modes ready", r.stderr)]
     assert len(counts) >= 2 and counts == sorted(counts) and counts[-1] < 60
     assert counts[0] >= 6  # the six rigid motions come with the first modes
+
+
+def test_a_distance_csv_interrupted_while_written_leaves_the_old_file_whole(
+    tmp_path, monkeypatch, capsys
+):
+    """``distance --csv`` writes beside the target and renames: a run that stops while the
+    rows are written (here a full disk after ten rows) is one error line and leaves the
+    file it would have replaced as it was, and no temporary file behind."""
+    from modalviewer import cli
+    from modalviewer.core.mesh import Mesh
+
+    monkeypatch.setenv("MODALVIEWER_CACHE", str(tmp_path / "cache"))
+    csv = tmp_path / "d.csv"
+    csv.write_text("vertex,distance\n0,1\n")
+
+    class RowsThenError(np.ndarray):
+        def tolist(self):
+            rows = super().tolist()
+            for i, x in enumerate(rows):
+                if i == 10:
+                    raise OSError("no space left on device")
+                yield x
+
+    def file_field(self, values):
+        return np.asarray(values, dtype=float).view(RowsThenError)
+
+    monkeypatch.setattr(Mesh, "to_file_field", file_field)
+    args = ["distance", str(ASSETS / "spot.obj"), "--vertex", "0", "--kind", "hks", "-k", "8"]
+    assert cli.main([*args, "--csv", str(csv)]) == 1
+    assert "modalviewer: error: no space left on device" in capsys.readouterr().err
+    assert csv.read_text() == "vertex,distance\n0,1\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cache", "d.csv"]

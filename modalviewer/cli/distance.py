@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.files import atomic_write
 from ..core.operators import (
     DEFAULT_K,
     DISTANCE_KINDS,
@@ -171,12 +172,17 @@ def _mesh_vertex(mesh, number: int) -> int:
 def _write_csv(args, mesh, d: np.ndarray, to: str = "") -> None:
     """``--csv``: rows ``vertex,distance``, one per vertex of ``mesh``'s file in the file's
     numbering; the distance is empty at a file vertex no face uses (merged duplicates
-    share theirs)."""
+    share theirs).  Written beside the target and renamed, so a failed run leaves no
+    partial file."""
     values = mesh.to_file_field(d)
-    with open(args.csv, "w", encoding="utf-8") as fh:
-        fh.write("vertex,distance\n")
-        for i, x in enumerate(values.tolist()):
-            fh.write(f"{i},{x:.10g}\n" if x == x else f"{i},\n")
+
+    def write(tmp: Path) -> None:
+        with open(tmp, "w", encoding="utf-8") as fh:
+            fh.write("vertex,distance\n")
+            for i, x in enumerate(values.tolist()):
+                fh.write(f"{i},{x:.10g}\n" if x == x else f"{i},\n")
+
+    atomic_write(Path(args.csv), write)
     unused = int(np.isnan(values).sum())
     note = f", {unused} empty (vertices no face uses)" if unused else ""
     what = f"{args.kind} distance from vertex {args.vertex}{to}"
