@@ -31,6 +31,7 @@ class LinePlot(FigureCanvasQTAgg):
         self.setMinimumHeight(140)
         self.title, self.xlabel, self.ylabel = title, xlabel, ylabel
         self.ax = self.figure.add_subplot()
+        self._shown = None  # what the axes were last built and laid out for (see draw)
         self.mpl_connect("button_press_event", self._on_press)
         self.set_data([], [])
 
@@ -41,26 +42,45 @@ class LinePlot(FigureCanvasQTAgg):
         self.second, self.second_label = None, ""
         if title is not None:
             self.title = title
-        self._draw_plot()
+        self.draw_idle()
 
     def set_second(self, y, label: str = "") -> None:
         """A second curve over the same x, drawn dashed in orange and named ``label`` in
         the legend (bottom left); None removes it."""
         self.second = None if y is None else np.asarray(y, dtype=float)
         self.second_label = label if y is not None else ""
-        self._draw_plot()
+        self.draw_idle()
 
-    def _draw_plot(self) -> None:
-        """Draw the data on a cleared axes.  A long title wraps between words; a short
-        y label ("λ", "S_t") stands upright, a longer one reads upwards."""
+    def draw(self) -> None:
+        """Draw the data, once for all changes since the last draw (Qt draws when idle).
+        A change of the highlight alone (a step to the next mode) draws its dot on the
+        picture kept from the last full drawing; anything else rebuilds and lays out the
+        axes.  A long title wraps between words; a short y label ("λ", "S_t") stands
+        upright, a longer one reads upwards."""
+        second = None if self.second is None else self.second.tobytes()
+        shown = (self.title, self.xlabel, self.ylabel, self.logx, self.markers, self.x.tobytes())
+        shown += (self.y.tobytes(), second, self.second_label, *self.figure.bbox.size)
+        if shown != self._shown:
+            self._shown = shown
+            self._plot()
+            super().draw()
+            self._background = self.copy_from_bbox(self.figure.bbox)
+        else:
+            self.restore_region(self._background)
+        if self.highlight is not None and 0 <= self.highlight < self.x.size:
+            self._dot.set_data([self.x[self.highlight]], [self.y[self.highlight]])
+            self.ax.draw_artist(self._dot)
+        self.update()
+
+    def _plot(self) -> None:
         ax = self.ax
         ax.clear()
         ax.set_title(self.title, fontsize=FONT_SIZE, wrap=True)
         ax.set_axis_on()
+        self._dot = ax.plot([], [], "o", color=HIGHLIGHT, ms=7)[0]  # placed by draw()
         if self.x.size == 0:
             ax.set_axis_off()
             ax.text(0.5, 0.5, "no data", ha="center", va="center", transform=ax.transAxes)
-            self.draw_idle()
             return
         ax.set_xscale("log" if self.logx else "linear")
         marker = "o" if self.markers and self.x.size <= 400 else None
@@ -68,8 +88,6 @@ class LinePlot(FigureCanvasQTAgg):
         if self.second is not None and self.second.shape == self.x.shape:
             ax.plot(self.x, self.second, "--", color=SECOND, lw=1.5, label=self.second_label)
             ax.legend(loc="lower left", fontsize=FONT_SIZE, frameon=False)
-        if self.highlight is not None and 0 <= self.highlight < self.x.size:
-            ax.plot(self.x[self.highlight], self.y[self.highlight], "o", color=HIGHLIGHT, ms=7)
         if self.logx:  # labels at powers of ten only: a narrow dock has no room for more
             ax.xaxis.set_minor_formatter(NullFormatter())
         elif np.allclose(self.x, np.round(self.x)):  # mode indices
@@ -79,7 +97,6 @@ class LinePlot(FigureCanvasQTAgg):
         ax.set_xlabel(self.xlabel, fontsize=FONT_SIZE, loc="right")
         upright = len(self.ylabel) <= 3
         ax.set_ylabel(self.ylabel, fontsize=FONT_SIZE, rotation=0 if upright else 90)
-        self.draw_idle()
 
     def _on_press(self, event) -> None:
         if self.x.size:

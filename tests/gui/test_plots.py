@@ -64,10 +64,17 @@ def test_the_spectrum_is_drawn_where_the_eigenvalues_are_with_the_mode_shown_mar
     ]
     x4, y4 = _pixel(plot, 4, LAM[4])
     assert len(red) > 10 and all(abs(x - x4) < 6 and abs(y - y4) < 6 for x, y in red)
+    # the next mode (the highlight alone changes): the dot moves, the old place is blue
+    plot.set_data(np.arange(LAM.size), LAM, highlight=7)
+    image = plot.grab().toImage()
+    for i, red in ((7, True), (4, False)):
+        x, y = _pixel(plot, i, LAM[i])
+        assert (image.pixelColor(round(x), round(y)).red() > 180) == red, i
     plot.set_data(np.arange(LAM.size), LAM)  # no mode shown: no mark
     image = plot.grab().toImage()
-    x, y = _pixel(plot, 4, LAM[4])
-    assert image.pixelColor(round(x), round(y)).red() < 110
+    for i in (4, 7):
+        x, y = _pixel(plot, i, LAM[i])
+        assert image.pixelColor(round(x), round(y)).red() < 110, i
 
 
 def test_zero_modes_read_0_and_the_mode_indices_are_whole_numbers(qtbot):
