@@ -144,23 +144,15 @@ class MainWindow(QtWidgets.QMainWindow):
         self.scene_view = SceneView(self.state, self.viewport, self)
         self.viewer.attach_picture(self.scene_view)
 
-        self.compute_panel = ComputePanel(self.state)
-        self.compute_panel.computeRequested.connect(lambda: self.compute(wait=False))
+        self.compute_panel = ComputePanel(self.viewer)
         self.jobs_panel = JobsPanel(self.viewer.jobs, self.state)
         self.modes_panel = ModesPanel(self.state)
         self.animation_panel = AnimationPanel(self.state)
-        self.distances_panel = DistancesPanel(self.state)
-        self.distances_panel.showDistanceRequested.connect(lambda: self.show_distance())
-        self.distances_panel.showSignatureRequested.connect(
-            lambda: self.show_signature(self.state.display.signature_sample)
-        )
-        self.distances_panel.exactCurveRequested.connect(self.viewer.request_exact_curve)
-        self.distances_panel.signatureAtRequested.connect(self.viewer.show_signature_at)
+        self.distances_panel = DistancesPanel(self.viewer)
         build_docks(self)
         menus.build_menus(self)
-        jobs = self.viewer.jobs
         self.status_widgets = StatusBarWidgets(
-            self.statusBar(), self.state, jobs, self.cancel_computation
+            self.statusBar(), self.state, self.viewer.jobs, self.cancel_computation
         )
 
         self.state.events.mesh.connect(self._on_mesh)

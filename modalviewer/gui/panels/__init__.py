@@ -1,1 +1,2 @@
-"""Dock panels: each observes the viewer state and sets it on input, nothing else."""
+"""Dock panels: each observes the viewer state and sets it on input; what needs a
+computation it asks of the viewer."""

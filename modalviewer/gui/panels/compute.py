@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from qtpy import QtCore, QtWidgets
+from qtpy import QtWidgets
 
 from ...core.operators import OPERATOR_INFO
 from ...viewer import wording
-from ...viewer.state import ViewerState
+from ...viewer.viewer import Viewer
 from .common import WrappingLabel, add_items, bind, combo, follow, show_values, spin_box
 
 K_MAX = 1_000_000
@@ -14,13 +14,11 @@ K_MAX = 1_000_000
 
 
 class ComputePanel(QtWidgets.QWidget):
-    """Sets ``state.compute_settings``; the button asks the window to compute."""
+    """Sets ``state.compute_settings``; the button asks the viewer to compute."""
 
-    computeRequested = QtCore.Signal()
-
-    def __init__(self, state: ViewerState, parent=None):
+    def __init__(self, viewer: Viewer, parent=None):
         super().__init__(parent)
-        self.state = state
+        self.state = state = viewer.state
         form = QtWidgets.QFormLayout(self)
         operators = ((info.label, info.name) for info in OPERATOR_INFO.values())
         self.operator_combo = add_items(combo(), operators)
@@ -68,7 +66,7 @@ class ComputePanel(QtWidgets.QWidget):
         }
         for name, widget in self.fields.items():
             bind(widget, lambda value, n=name: setattr(state.compute_settings, n, value))
-        self.compute_button.clicked.connect(self.computeRequested)
+        self.compute_button.clicked.connect(lambda: viewer.compute(wait=False))
         follow(state, self.update_from_state, "compute_settings", "mesh")
         self.update_from_state()
 

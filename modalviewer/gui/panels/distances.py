@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
-from qtpy import QtCore, QtGui, QtWidgets
+from qtpy import QtGui, QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO, operator_for_distance
-from ...viewer.state import DISTANCE_DISPLAYS, ViewerState
+from ...viewer.state import DISTANCE_DISPLAYS
+from ...viewer.viewer import Viewer
 from ..plots import LinePlot
 from .common import (
     WrappingLabel,
@@ -27,16 +28,12 @@ class DistancesPanel(QtWidgets.QWidget):
     threshold slider moves by default through the share of the surface marked similar (a
     quantile), so its whole travel is useful whatever the distribution; "by value" makes
     it linear in the fraction of the largest distance.  Actions needing a spectrum go to
-    the window through its signals."""
+    the viewer."""
 
-    showDistanceRequested = QtCore.Signal()
-    showSignatureRequested = QtCore.Signal()
-    exactCurveRequested = QtCore.Signal()
-    signatureAtRequested = QtCore.Signal(float)
-
-    def __init__(self, state: ViewerState, parent=None):
+    def __init__(self, viewer: Viewer, parent=None):
         super().__init__(parent)
-        self.state = state
+        self.viewer = viewer
+        self.state = state = viewer.state
         form = QtWidgets.QFormLayout(self)
         self.kind_combo = add_items(combo(), ((v, k) for k, v in DISTANCE_KINDS.items()))
         displays = ("Continuous (white to red)", "Threshold (blue = similar)")
@@ -89,7 +86,7 @@ class DistancesPanel(QtWidgets.QWidget):
         bind(self.by_share_check, lambda on: self.state.set_display(keep_share=on))
         self.t1_edit.editingFinished.connect(self._on_range)
         self.t2_edit.editingFinished.connect(self._on_range)
-        self.distance_button.clicked.connect(self.showDistanceRequested)
+        self.distance_button.clicked.connect(lambda: viewer.show_distance())
         self.scale_slider.valueChanged.connect(self._on_scale)
         self.scale_edit.editingFinished.connect(self._on_scale_typed)
         bind(self.log_check, lambda on: setattr(self.state.style, "log_signature", on))
@@ -111,9 +108,9 @@ class DistancesPanel(QtWidgets.QWidget):
         ):
             # with a vertex picked the new kind's map is shown (also after a map that
             # failed, which left the mode on screen)
-            self.showDistanceRequested.emit()
+            self.viewer.show_distance()
         elif self.state.display.kind == "signature":
-            self.showSignatureRequested.emit()
+            self.viewer.show_signature(self.state.display.signature_sample)
 
     def _on_slider(self, value: int) -> None:
         position = value / SLIDER_STEPS
@@ -155,8 +152,8 @@ class DistancesPanel(QtWidgets.QWidget):
         self.range_label.setText("")
 
     def _on_scale(self, value: int) -> None:
-        self.state.set_display(signature_sample=value)
-        self.showSignatureRequested.emit()
+        self.state.set_display(signature_sample=value)  # kept while signatures are missing
+        self.viewer.show_signature(value)
 
     def _on_scale_typed(self) -> None:
         """A typed scale t: the signature at t itself (not the nearest sample)."""
@@ -165,9 +162,9 @@ class DistancesPanel(QtWidgets.QWidget):
         except ValueError:
             return
         if t > 0:
-            self.signatureAtRequested.emit(t)
+            self.viewer.show_signature_at(t)
         else:
-            self.showSignatureRequested.emit()
+            self.viewer.show_signature(self.state.display.signature_sample)
 
     # ------------------------------------------------------------ output
     def update_from_state(self, *_args) -> None:
@@ -271,6 +268,6 @@ class DistancesPanel(QtWidgets.QWidget):
             return
         exact = derived.exact_curve()
         if exact is None:
-            self.exactCurveRequested.emit()
+            self.viewer.request_exact_curve()
             return
         self.signature_plot.set_second(exact, "dashed: all modes")
