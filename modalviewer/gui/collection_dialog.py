@@ -72,10 +72,8 @@ def open_collection_window(main, path) -> CollectionDialog | None:
         return None
     mesh = main.state.mesh
     spectrum = main.state.spectrum(collection.operator)
-    weights = operator_info(collection.operator).has_weights and (
-        collection.info["bending"],
-        collection.info["membrane"],
-    ) != (1.0, 1.0)
+    stored = (collection.info["bending"], collection.info["membrane"])
+    weights = operator_info(collection.operator).has_weights and stored != (1.0, 1.0)
     if mesh is not None and collection.needs_spectrum(mesh, spectrum) and not weights:
         # the viewer computes it in the background (and caches it); the list follows
         main.statusBar().showMessage(

@@ -26,14 +26,11 @@ class SceneView(QtCore.QObject):
         self.drawing = StateScene(
             state, viewport.plotter, viewport.request_render, on_animation=self._on_animation
         )
-        state.events.display.connect(self._restart_phase)
+        state.events.display.connect(lambda: setattr(self, "_phase", 0.0))  # from rest
 
     @property
     def scene(self):
         return self.drawing.scene
-
-    def _restart_phase(self) -> None:
-        self._phase = 0.0
 
     def _on_animation(self, playing: bool) -> None:
         if playing:
