@@ -93,7 +93,6 @@ def test_animation_moves_the_surface(window, spot_path, qtbot):
     assert window.scene_view.timer.isActive()
     moved = np.array(window.scene.surface.points)
     assert np.abs(moved - rest).max() > 1e-3 * window.mesh.bounding_box_diagonal
-    assert max(window.scene_view.frame_times) < 0.05
     window.animation_frame(np.pi / 2)  # peak displacement
     after = window.viewport.render_now()
     assert np.mean(np.any(before != after, axis=2)) > 0.002
