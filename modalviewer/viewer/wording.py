@@ -163,12 +163,10 @@ def range_note(rule: str, clim: tuple[float, float], clipped: tuple[bool, bool])
     lo, hi = clim
     if rule == "spread":
         return "colours spread by area: each tenth of the bar covers a tenth of the surface"
-    if rule == "robust":
-        text = f"robust range: {ROBUST_PERCENTILE:g}th percentile of |value| by area"
-    elif rule == "limits":
-        text = f"range: limits {lo:.3g} .. {hi:.3g}"
-    else:
-        text = "range: the largest |value|"
+    text = {
+        "robust": f"robust range: {ROBUST_PERCENTILE:g}th percentile of |value| by area",
+        "limits": f"range: limits {lo:.3g} .. {hi:.3g}",
+    }.get(rule, "range: the largest |value|")
     ends = [f"< {lo:.3g}"] * clipped[0] + [f"> {hi:.3g}"] * clipped[1]
     if ends:
         text += f" ({' and '.join(ends)} clipped)"
