@@ -144,10 +144,13 @@ def restore_session(model, path) -> Restored:
     _update(state.style, style, STYLE)
     state.set_color_range(str(style.get("color_range", "auto")), style.get("color_limits"))
     _update(state.animation, data.get("animation"))
-    _update(
-        state.compute_settings,
-        asdict(ComputeSettings(**_known(ComputeSettings, data.get("compute_settings")))),
-    )
+    settings = ComputeSettings()  # the saved fields that are valid, the defaults elsewhere
+    for name, value in _known(ComputeSettings, data.get("compute_settings")).items():
+        try:
+            setattr(settings, name, value)
+        except (TypeError, ValueError) as exc:
+            out.notes.append(f"the compute setting {name} = {value!r}: {exc}; default used")
+    _update(state.compute_settings, asdict(settings))
     if data.get("t_range"):
         state.set_scale_range(tuple(data["t_range"]))
     try:
@@ -170,11 +173,15 @@ def restore_session(model, path) -> Restored:
         saved_display.setdefault("keep_share", saved_display.pop("threshold_by_share"))
     display = Display(**_known(Display, saved_display))
     for raw in data.get("spectra") or []:
-        key = SpectrumKey(**_known(SpectrumKey, raw))
+        if "operator" not in raw or "k" not in raw:
+            out.notes.append(f"a saved spectrum names no operator or k ({raw}); not computed")
+            continue
         try:  # the key as the compute settings make it (validated, weights where used)
-            out.jobs.append(model.request_spectrum(key=ComputeSettings(**asdict(key)).key()))
-        except ValueError as exc:
-            out.notes.append(f"{key.describe()}: {exc}")
+            key = ComputeSettings(**asdict(SpectrumKey(**_known(SpectrumKey, raw)))).key()
+            out.jobs.append(model.request_spectrum(key=key))
+        except (TypeError, ValueError) as exc:
+            what = f"{raw['operator']}, k = {raw['k']}"
+            out.notes.append(f"the saved spectrum {what} is not computed: {exc}")
     camera = data.get("camera")
 
     def apply_display(_job=None) -> None:

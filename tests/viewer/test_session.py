@@ -169,3 +169,30 @@ def test_restored_spectra_keep_their_keys_and_the_compute_settings_stay_as_saved
     restored_settings = second.state.compute_settings
     assert restored_settings == first.state.compute_settings
     assert restored_settings.coarse and restored_settings.k == 30
+
+
+def test_a_session_naming_an_unknown_operator_opens_what_it_can_and_says_what_not(tmp_path):
+    """A session from a version with another operator (or edited by hand): the mesh and
+    the other spectra open; each spectrum that cannot be asked for is a note naming it,
+    and compute settings naming no known operator fall back to the defaults with a note."""
+    mesh_path = tmp_path / "spot.obj"
+    shutil.copy(ASSETS / "spot.obj", mesh_path)
+    first = _model(tmp_path)
+    first.open_mesh(mesh_path)
+    first.jobs.wait(first.request_spectrum("laplacian", k=10))
+    path = save_session(first.state, tmp_path / "s.json")
+    data = json.loads(path.read_text())
+    data["spectra"] += [{"operator": "biharmonic_2030", "k": 12}, {"k": 12}]
+    data["compute_settings"]["operator"] = "biharmonic_2030"
+    path.write_text(json.dumps(data))
+
+    second = _model(tmp_path)
+    restored = restore_session(second, path)
+    _wait_all(second, restored)
+    assert [key.operator for key in second.state.spectra] == ["laplacian"]
+    unknown = [note for note in restored.notes if "biharmonic_2030" in note]
+    assert len(unknown) == 2, restored.notes  # the spectrum and the compute settings
+    assert any("names no operator" in note for note in restored.notes)
+    assert second.state.compute_settings.operator == "modified_dirichlet"  # the default
+    assert second.state.compute_settings.k == first.state.compute_settings.k  # kept
+    assert len(restored.notes) == 3, restored.notes
