@@ -146,7 +146,7 @@ class MainWindow(QtWidgets.QMainWindow):
 
         self.compute_panel = ComputePanel(self.viewer)
         self.jobs_panel = JobsPanel(self.viewer.jobs, self.state)
-        self.modes_panel = ModesPanel(self.state)
+        self.modes_panel = ModesPanel(self.viewer)
         self.animation_panel = AnimationPanel(self.state)
         self.distances_panel = DistancesPanel(self.viewer)
         build_docks(self)

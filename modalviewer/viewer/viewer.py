@@ -351,10 +351,11 @@ class Viewer(ViewerModel, Pictures):
             return
         self.state.show_mode((d.mode if d.kind == "mode" and d.operator == op else 0) + step, op)
 
-    def show_current_mode(self) -> None:
-        """Back to the mode last shown, or the current spectrum's first non-zero mode."""
+    def show_current_mode(self, operator: str | None = None) -> None:
+        """Back to the mode last shown of ``operator`` (default: the current spectrum's),
+        or its first non-zero mode."""
         d = self.state.display
-        op = self.state.current_operator()
+        op = operator or self.state.current_operator()
         if op is not None:
             mode = d.mode if op == d.operator else self.state.first_nonzero_mode(op)
             self.show_mode(mode, op)

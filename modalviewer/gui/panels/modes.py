@@ -7,6 +7,7 @@ from qtpy import QtWidgets
 
 from ...core.operators import DISTANCE_KINDS, OPERATOR_INFO
 from ...viewer.state import ViewerState
+from ...viewer.viewer import Viewer
 from ...viewer.wording import approximation_mark, arrival_note
 from ..plots import LinePlot
 from .common import (
@@ -29,9 +30,9 @@ class ModesPanel(QtWidgets.QWidget):
     """Shows and sets ``state.display`` for modes and ``state.style``; while the surface
     shows something else, it says so instead of naming a mode not on screen."""
 
-    def __init__(self, state: ViewerState, parent=None):
+    def __init__(self, viewer: Viewer, parent=None):
         super().__init__(parent)
-        self.state = state
+        self.state = state = viewer.state
         lay = QtWidgets.QVBoxLayout(self)
         self.spectrum_combo = combo()
         describe(self.spectrum_combo, "The computed spectrum whose modes are shown")
@@ -58,10 +59,16 @@ class ModesPanel(QtWidgets.QWidget):
         form.addRow("Isolines", self.iso_spin)
         lay.addLayout(form)
 
-        self.spectrum_combo.activated.connect(self._on_spectrum_chosen)
-        self.mode_slider.valueChanged.connect(self._on_mode_input)
-        self.mode_spin.valueChanged.connect(self._on_mode_input)
-        self.spectrum_plot.sampleClicked.connect(self._on_mode_input)
+        # the chosen spectrum's mode last shown, or its first non-zero mode
+        self.spectrum_combo.activated.connect(
+            lambda _: viewer.show_current_mode(self.spectrum_combo.currentData())
+        )
+        for signal in (
+            self.mode_slider.valueChanged,
+            self.mode_spin.valueChanged,
+            self.spectrum_plot.sampleClicked,
+        ):
+            signal.connect(viewer.show_mode)
         self.style_fields = {"shell_coloring": self.color_combo, "isolines": self.iso_spin}
         for name, widget in self.style_fields.items():
             bind(widget, lambda value, n=name: setattr(state.style, n, value))
@@ -69,24 +76,6 @@ class ModesPanel(QtWidgets.QWidget):
         state.events.style.connect(self._update_style)
         self.update_from_state()
         self._update_style()
-
-    def _on_spectrum_chosen(self, _index: int) -> None:
-        """Show the chosen spectrum's modes: the mode last shown of it, or its first
-        non-zero mode; choosing the spectrum on screen again changes nothing."""
-        op = self.spectrum_combo.currentData()
-        if op is None:
-            return
-        d = self.state.display
-        if d.operator == op:
-            if d.kind != "mode":
-                self.state.show_mode(d.mode, op)
-            return
-        self.state.show_mode(self.state.first_nonzero_mode(op), op)
-
-    def _on_mode_input(self, index: int) -> None:
-        op = self.state.current_operator()  # the mode's shown or last shown, else the first
-        if op is not None and self.state.spectrum(op) is not None:
-            self.state.show_mode(int(index), op)
 
     def update_from_state(self, *_args) -> None:
         state = self.state
