@@ -436,7 +436,10 @@ def _read_elements(path: Path, elements, read, damage: _Damage) -> MeshFile:
             missing = [c for c in "xyz" if c not in columns]
             if missing:
                 raise MeshError(f"{path.name}: the PLY vertices have no '{missing[0]}' property")
-            unplaced = [i for i, x in enumerate(columns["x"]) if x is None]
+            xs = columns["x"]  # None marks an incomplete ASCII record; arrays are whole
+            unplaced = (
+                [] if isinstance(xs, np.ndarray) else [i for i, x in enumerate(xs) if x is None]
+            )
             vertices = np.column_stack(
                 [np.array(columns[c], dtype=np.float64).reshape(-1) for c in "xyz"]
             )
