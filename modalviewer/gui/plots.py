@@ -95,8 +95,9 @@ class LinePlot(FigureCanvasQTAgg):
         ax.yaxis.set_major_locator(MaxNLocator(nbins=4))
         ax.tick_params(labelsize=FONT_SIZE)
         ax.set_xlabel(self.xlabel, fontsize=FONT_SIZE, loc="right")
-        upright = len(self.ylabel) <= 3
-        ax.set_ylabel(self.ylabel, fontsize=FONT_SIZE, rotation=0 if upright else 90)
+        upright = len(self.ylabel) <= 3  # then it ends left of the tick labels, not centred
+        align = {"rotation": 0, "ha": "right", "va": "center"} if upright else {}
+        ax.set_ylabel(self.ylabel, fontsize=FONT_SIZE, **align)
 
     def _on_press(self, event) -> None:
         if self.x.size:

@@ -132,10 +132,11 @@ def test_a_title_wider_than_the_plot_wraps_whole(qtbot):
     assert rows[306][-1] - rows[306][0] > 1.8 * (rows[600][-1] - rows[600][0])
 
 
-@pytest.mark.parametrize("name", ["eigenvalue", "S_t", ""])
+@pytest.mark.parametrize("name", ["eigenvalue", "S_t", "W_E", ""])
 def test_the_y_axis_is_named_in_the_left_margin(qtbot, name):
     """Left of the y tick labels, over the frame's height: a long name ("eigenvalue")
-    reads upwards, a short one ("S_t", "λ") stands as it is; without one no ink."""
+    reads upwards, a short one ("S_t", "λ") stands as it is, clear of the tick labels;
+    without one no ink."""
     plot = _plot(qtbot, (360, 220), "Spectrum", "mode index", name, x=np.arange(9), y=LAM[1:])
     ax = plot.ax
     labels = [_box(plot, t) for _, t in _shown_ticks(ax.yaxis, ax.get_ylim())]
@@ -147,6 +148,8 @@ def test_the_y_axis_is_named_in_the_left_margin(qtbot, name):
         return
     width = max(x for x, _ in ink) - min(x for x, _ in ink)
     height = max(y for _, y in ink) - min(y for _, y in ink)
+    name_right = _box(plot, ax.yaxis.label)[2]  # the name keeps clear of the tick labels
+    assert name_right < min(b[0] for b in labels) - 1, (name_right, labels)
     if name == "eigenvalue":
         assert height > 3 * width, (width, height)
     else:
