@@ -5,9 +5,10 @@ Canonical view: up is the caller's axis or +Y (most OBJ/PLY/OFF models).  The vi
 looks along the horizontal direction (every 5 degrees) with the largest silhouette,
 preferring a coordinate axis within ``AXIS_PREFERENCE`` of the best, or from above when
 that shows ``TOP_VIEW_RATIO`` times more (a plate); then it turns by a small azimuth and
-elevation to show depth, from the +Z (then +X, +Y) side most models face.  A CAD-like
-part (mostly coplanar neighbours, sharp feature edges) is turned instead to the view
-that shows its sharp edges best.  Without faces the axis of least spread stands in.
+elevation to show depth, from the side most models face (+Z for +Y up, -Y for +Z up).
+A CAD-like part (mostly coplanar neighbours, sharp feature edges) is turned instead to
+the view that shows its sharp edges best.  Without faces the axis of least spread
+stands in.
 """
 
 from __future__ import annotations
@@ -163,9 +164,17 @@ def _snap(direction: np.ndarray, degrees: float = SNAP_DEGREES) -> np.ndarray:
     return direction
 
 
-def _face_front(direction: np.ndarray) -> np.ndarray:
-    """``direction`` or its opposite, whichever points to the front side (+Z, +X, +Y)."""
-    return -direction if float(direction @ _FRONT) < 0 else direction
+def _for_up(v: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """``v``, a direction for +Y up, turned as +Y is turned to ``up``: the front side, +Z
+    for +Y up, is -Y for +Z up, where a quarter turn about X puts a Y-up model's front
+    (and Z-up tools put theirs)."""
+    turn = np.cross([0.0, 1.0, 0.0], up) if abs(up[1]) < 1.0 - 1e-9 else np.eye(3)[0]
+    return _rotate(v, _unit(turn), np.degrees(np.arccos(np.clip(up[1], -1.0, 1.0))))
+
+
+def _face_front(direction: np.ndarray, front: np.ndarray) -> np.ndarray:
+    """``direction`` or its opposite, whichever points to the ``front`` side."""
+    return -direction if float(direction @ front) < 0 else direction
 
 
 def _rotate(v: np.ndarray, axis: np.ndarray, degrees: float) -> np.ndarray:
@@ -277,6 +286,7 @@ def canonical_view(
     ``azimuth``/``elevation`` (degrees) turn from the front view (default
     :data:`DEFAULT_TURN`, for a CAD-like part the best of :data:`CAD_TURNS`)."""
     up_vec = _up_vector(up)
+    front, toward = (_for_up(v, up_vec) for v in (_FRONT, _TURN_TOWARD))
     view = _largest_silhouette(vertices, faces, up_vec)
     if abs(view @ up_vec) > np.cos(np.radians(30.0)):
         # flat across the up axis: from above, the longest axis left to right
@@ -286,9 +296,9 @@ def canonical_view(
         screen_up = middle - (middle @ view) * view
         if np.linalg.norm(screen_up) < 1e-6:
             screen_up = _snap(axes[2]) - (_snap(axes[2]) @ view) * view
-        screen_up = -_face_front(_unit(screen_up))  # the front side at the bottom
+        screen_up = -_face_front(_unit(screen_up), front)  # the front side at the bottom
     else:
-        view = _face_front(view)
+        view = _face_front(view, front)
         screen_up = _unit(up_vec - (up_vec @ view) * view)
     edges = None
     if azimuth is None and elevation is None and faces is not None and len(faces):
@@ -296,21 +306,21 @@ def canonical_view(
     if edges is None:
         az = DEFAULT_TURN[0] if azimuth is None else azimuth
         el = DEFAULT_TURN[1] if elevation is None else elevation
-        direction = _turned(view, screen_up, az, el)
+        direction = _turned(view, screen_up, az, el, toward)
     else:
         # the turn showing the creases best: their lengths weighted by the cosine of the
         # less visible face (a crease shows where both faces are seen)
         lengths, normals = np.linalg.norm(edges[0], axis=1), edges[1]
-        turns = [_turned(view, screen_up, a, e) for a, e in CAD_TURNS]
+        turns = [_turned(view, screen_up, a, e, toward) for a, e in CAD_TURNS]
         direction = max(turns, key=lambda d: lengths @ np.clip((normals @ d).min(1), 0, None))
     return look_from(vertices, direction, screen_up)
 
 
-def _turned(view, screen_up, azimuth: float, elevation: float) -> np.ndarray:
-    """``view`` turned by ``azimuth`` about ``screen_up`` toward the front, then by
-    ``elevation`` toward up."""
+def _turned(view, screen_up, azimuth: float, elevation: float, toward) -> np.ndarray:
+    """``view`` turned by ``azimuth`` about ``screen_up`` to the side of ``toward``, then
+    by ``elevation`` toward up."""
     turns = [_rotate(view, screen_up, a) for a in (azimuth, -azimuth)]
-    direction = max(turns, key=lambda d: float(d @ _TURN_TOWARD))
+    direction = max(turns, key=lambda d: float(d @ toward))
     right = _unit(np.cross(screen_up, direction))
     return _rotate(direction, right, -elevation)
 

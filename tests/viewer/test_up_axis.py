@@ -147,3 +147,16 @@ def test_the_canonical_view_uses_the_up_axis_given():
     cow = mv.load_mesh(ASSETS / "spot.obj")
     cam = canonical_view(_z_up(cow.vertices), cow.faces, up="+z")
     assert cam.up[2] > 0.9
+
+
+@pytest.mark.parametrize("name", ["spot.obj", "demo_hand.obj"])
+def test_a_model_turned_to_z_up_is_seen_from_the_same_side(name):
+    """Turning a Y-up model a quarter about X (y -> z, z -> -y: its front, +Z, goes to -Y,
+    where Z-up tools put the front) turns its canonical view with it: the Z-up copy is
+    seen from its front, not from behind."""
+    mesh = mv.load_mesh(ASSETS / name)
+    y_up = canonical_view(mesh.vertices, mesh.faces, up="+y")
+    z_up = canonical_view(_z_up(mesh.vertices), mesh.faces, up="+z")
+    turned = _z_up(np.array([y_up.direction, y_up.up]))
+    np.testing.assert_allclose(z_up.direction, turned[0], atol=1e-6)
+    np.testing.assert_allclose(z_up.up, turned[1], atol=1e-6)
