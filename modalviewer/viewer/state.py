@@ -498,9 +498,7 @@ class ViewerState:
 
     def set_pick_file_vertex(self, file_index: int | None) -> None:
         """Pick vertex ``file_index`` of the file (a ValueError for one no face uses)."""
-        if file_index is not None:
-            if self.mesh is None:
-                raise ValueError("no mesh is loaded")
+        if file_index is not None and self.mesh is not None:  # else set_pick says no mesh
             file_index = self.mesh.mesh_vertex(file_index)
         self.set_pick(file_index)
 
