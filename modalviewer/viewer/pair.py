@@ -446,7 +446,8 @@ class PairState:
         failure = self.failure()
         if failure:
             return failure
-        waiting = [s.upper() for s in SIDES if self.spectrum(s) is None]
+        spectra = [(s.upper(), self.spectrum(s)) for s in SIDES]  # first modes: still computing
+        waiting = [s for s, spec in spectra if spec is None or not spec.is_complete]
         if waiting:
             label = operator_info(self.operator).label
             return f"computing the {label} spectrum of {' and '.join(waiting)}"

@@ -340,3 +340,22 @@ def test_the_pair_estimates_the_time_of_its_missing_spectra(tmp_path, spot):
     assert pair.estimated_seconds() == pytest.approx(8.0)
     _wait(pair)
     assert pair.estimated_seconds() is None  # nothing is missing
+
+
+def test_while_a_sides_first_modes_are_in_the_legend_says_both_sides_are_computing(
+    tmp_path, spot
+):
+    """A's first modes arrive (its job still running) and B has none: both are being
+    computed, and the legend names A and B, not B alone."""
+    import dataclasses
+
+    pair = _pair(tmp_path, spot, _moved(spot), k=K, kind="feature")
+    key = pair.key()
+    whole = mv.compute_spectrum(spot, key.operator, k=K)
+    first = dataclasses.replace(whole, parameters={**whole.parameters, "modes_requested": 40})
+    assert not first.is_complete
+    pair._on_job(("a", spot.hash, key), None, first)  # as the job hands its first modes over
+    assert pair.spectrum("a") is first and pair.spectrum("b") is None
+    pair.pick("a", 3)
+    label = "Modified Dirichlet energy E_D^N"
+    assert f"computing the {label} spectrum of A and B" in pair.view("b").legend
