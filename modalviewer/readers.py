@@ -436,10 +436,8 @@ def _read_elements(path: Path, elements, read, damage: _Damage) -> MeshFile:
             missing = [c for c in "xyz" if c not in columns]
             if missing:
                 raise MeshError(f"{path.name}: the PLY vertices have no '{missing[0]}' property")
-            xs = columns["x"]  # None marks an incomplete ASCII record; arrays are whole
-            unplaced = (
-                [] if isinstance(xs, np.ndarray) else [i for i, x in enumerate(xs) if x is None]
-            )
+            xs = columns["x"]  # an array is whole; None marks an incomplete ASCII record
+            unplaced = [i for i, x in enumerate(xs) if x is None] if isinstance(xs, list) else []
             vertices = np.column_stack(
                 [np.array(columns[c], dtype=np.float64).reshape(-1) for c in "xyz"]
             )

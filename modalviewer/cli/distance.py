@@ -175,14 +175,11 @@ def _write_csv(args, mesh, d: np.ndarray, to: str = "") -> None:
     share theirs).  Written beside the target and renamed, so a failed run leaves no
     partial file."""
     values = mesh.to_file_field(d)
-
-    def write(tmp: Path) -> None:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write("vertex,distance\n")
-            for i, x in enumerate(values.tolist()):
-                fh.write(f"{i},{x:.10g}\n" if x == x else f"{i},\n")
-
-    atomic_write(Path(args.csv), write)
+    rows = (f"{i},{x:.10g}\n" if x == x else f"{i},\n" for i, x in enumerate(values.tolist()))
+    atomic_write(
+        Path(args.csv),
+        lambda tmp: Path(tmp).write_text("vertex,distance\n" + "".join(rows), encoding="utf-8"),
+    )
     unused = int(np.isnan(values).sum())
     note = f", {unused} empty (vertices no face uses)" if unused else ""
     what = f"{args.kind} distance from vertex {args.vertex}{to}"

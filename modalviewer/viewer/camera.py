@@ -165,9 +165,8 @@ def _snap(direction: np.ndarray, degrees: float = SNAP_DEGREES) -> np.ndarray:
 
 
 def _for_up(v: np.ndarray, up: np.ndarray) -> np.ndarray:
-    """``v``, a direction for +Y up, turned as +Y is turned to ``up``: the front side, +Z
-    for +Y up, is -Y for +Z up, where a quarter turn about X puts a Y-up model's front
-    (and Z-up tools put theirs)."""
+    """``v``, a direction for +Y up, turned as +Y is turned to ``up``: +Z to -Y for +Z up,
+    where a quarter turn about X puts a Y-up model's front (and Z-up tools put theirs)."""
     turn = np.cross([0.0, 1.0, 0.0], up) if abs(up[1]) < 1.0 - 1e-9 else np.eye(3)[0]
     return _rotate(v, _unit(turn), np.degrees(np.arccos(np.clip(up[1], -1.0, 1.0))))
 

@@ -173,15 +173,11 @@ def restore_session(model, path) -> Restored:
         saved_display.setdefault("keep_share", saved_display.pop("threshold_by_share"))
     display = Display(**_known(Display, saved_display))
     for raw in data.get("spectra") or []:
-        if "operator" not in raw or "k" not in raw:
-            out.notes.append(f"a saved spectrum names no operator or k ({raw}); not computed")
-            continue
         try:  # the key as the compute settings make it (validated, weights where used)
             key = ComputeSettings(**asdict(SpectrumKey(**_known(SpectrumKey, raw)))).key()
             out.jobs.append(model.request_spectrum(key=key))
-        except (TypeError, ValueError) as exc:
-            what = f"{raw['operator']}, k = {raw['k']}"
-            out.notes.append(f"the saved spectrum {what} is not computed: {exc}")
+        except (TypeError, ValueError) as exc:  # a TypeError names a missing field
+            out.notes.append(f"the saved spectrum {raw} is not computed: {exc}")
     camera = data.get("camera")
 
     def apply_display(_job=None) -> None:
