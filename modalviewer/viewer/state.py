@@ -483,10 +483,11 @@ class ViewerState:
         return int(np.argmax(nonzero)) if nonzero.any() else 0
 
     def current_operator(self) -> str | None:
-        """The operator of the mode shown or last shown, else the first one computed."""
-        d = self.display
-        if d.operator is not None and self.spectrum(d.operator) is not None:
-            return d.operator
+        """The operator of the mode shown or last shown, else the one the display is made
+        of (a distance's), else the first one computed."""
+        for op in (self.display.operator, self.display_operator()):
+            if op is not None and self.spectrum(op) is not None:
+                return op
         return next(iter(self.operators_computed()), None)
 
     @property

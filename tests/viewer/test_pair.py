@@ -342,9 +342,7 @@ def test_the_pair_estimates_the_time_of_its_missing_spectra(tmp_path, spot):
     assert pair.estimated_seconds() is None  # nothing is missing
 
 
-def test_while_a_sides_first_modes_are_in_the_legend_says_both_sides_are_computing(
-    tmp_path, spot
-):
+def test_while_a_sides_first_modes_are_in_the_legend_says_both_sides_are_computing(tmp_path, spot):
     """A's first modes arrive (its job still running) and B has none: both are being
     computed, and the legend names A and B, not B alone."""
     import dataclasses

@@ -125,6 +125,22 @@ def test_a_comparison_never_changes_the_display(viewer, spot_path, tmp_path):
         viewer.comparison(["laplacian", "hks"])
 
 
+def test_a_comparison_leaves_the_spectrum_of_a_distance_shown_current(viewer, spot_path):
+    """A distance shown before any mode (its spectrum computed for it): a comparison that
+    computes another spectrum leaves the current spectrum (the Modes panel's, the
+    exported one) the distance's, not the first operator computed."""
+    viewer.open_mesh(spot_path)
+    viewer.pick_vertex(50, show=False)
+    viewer.show_distance("feature", display="threshold", share=0.1)
+    viewer.wait_for_modes(viewer.state.compute_settings.k, "modified_dirichlet")
+    assert viewer.state.display.operator is None  # no mode shown yet
+    assert viewer.state.current_operator() == "modified_dirichlet"
+    viewer.comparison(["feature", "hks"])  # computes the Laplacian's spectrum
+    assert set(viewer.spectra) >= {"laplacian", "modified_dirichlet"}
+    assert viewer.state.current_operator() == "modified_dirichlet"
+    assert viewer.spectrum_shown().operator == "modified_dirichlet"
+
+
 def test_a_session_restores_the_same_picture(tmp_path, spot_path):
     cache = mv.core.cache.SpectrumCache(tmp_path / "cache")
     first = Viewer(cache=cache)
