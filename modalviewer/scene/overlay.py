@@ -51,9 +51,10 @@ def _rgba(c) -> tuple[int, int, int, int]:
     return (*(int(round(255 * x)) for x in c[:3]), 255)
 
 
-def colorbar_label(value: float) -> str:
-    """A colour-bar tick label: 3 significant digits, exact zero as "0"."""
-    return "0" if value == 0 else f"{value:.3g}"
+def colorbar_label(value: float, scale: float = 0.0) -> str:
+    """A colour-bar tick label: 3 significant digits; "0" for zero and for round-off
+    (at most 1e-9 of ``scale``, the bar's largest |value|)."""
+    return "0" if abs(value) <= 1e-9 * scale else f"{value:.3g}"
 
 
 def wrap_text(text: str, measure, width: float) -> str:
@@ -143,7 +144,7 @@ def draw_overlay(img: np.ndarray, overlay: Overlay | None, scale: float = 1.0) -
             x = x0 + pos * width
             draw.line([(x, y1), (x, y1 + 0.3 * em)], fill=black, width=1)
     for value, pos in ticks:
-        text = colorbar_label(value)
+        text = colorbar_label(value, max(abs(lo), abs(hi)))
         if pos in (0.0, 1.0) and bar.clipped[int(pos)]:
             text = ("> " if pos else "< ") + text
         tw = measure(text)

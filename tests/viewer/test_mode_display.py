@@ -208,6 +208,19 @@ def test_the_colour_bar_marks_clipped_ends():
     assert red.sum() > 10  # the arrow head in the end's colour
 
 
+def test_round_off_at_a_colour_bar_end_reads_0():
+    """A range from 2.02e-16 (round-off of a magnitude that is 0 somewhere) to 2.19 is
+    labelled as the range from 0: the same picture; a real small end keeps its digits."""
+    blank = np.full((120, 400, 3), 255, np.uint8)
+    colors = [np.array([1.0, 1.0, 1.0]), np.array([0.78, 0.08, 0.08])]
+
+    def drawn(lo):
+        return draw_overlay(blank, Overlay(None, ColorBar("d", colors, (lo, 2.19))))
+
+    assert np.array_equal(drawn(2.02e-16), drawn(0.0))
+    assert not np.array_equal(drawn(0.00581), drawn(0.0))
+
+
 def test_typed_colour_limits(spot):
     state = spot.state
     d = state.derived.distance_map()
