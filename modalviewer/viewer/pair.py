@@ -484,7 +484,8 @@ class PairState:
             legend += f"; best match vertex {fw}{note}"
             labels = [f"{below} ({100 * share:.1f} %)", "the rest"]
             return PairView(d, "threshold", thr, w, None, legend, f"{name} < {thr:.3g}", labels)
-        legend = f"{head}\n{name} {source}: white 0 to red {float(d.max()):.3g}\n"
+        span = f"white {float(np.nanmin(d)):.3g} to red {float(np.nanmax(d)):.3g}"  # the bar's
+        legend = f"{head}\n{name} {source}: {span}\n"
         legend += f"best match: vertex {fw} (d = {dist:.3g}){note}"
         return PairView(d, "sequential", None, w, None, legend, name, scale=self._spread(side, d))
 

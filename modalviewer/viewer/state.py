@@ -483,8 +483,7 @@ class ViewerState:
         return int(np.argmax(nonzero)) if nonzero.any() else 0
 
     def current_operator(self) -> str | None:
-        """The operator of the mode shown or last shown, else the one the display is made
-        of (a distance's), else the first one computed."""
+        """The operator of the mode (last) shown, else the display's, else the first computed."""
         for op in (self.display.operator, self.display_operator()):
             if op is not None and self.spectrum(op) is not None:
                 return op

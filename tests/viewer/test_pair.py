@@ -357,3 +357,16 @@ def test_while_a_sides_first_modes_are_in_the_legend_says_both_sides_are_computi
     pair.pick("a", 3)
     label = "Modified Dirichlet energy E_D^N"
     assert f"computing the {label} spectrum of A and B" in pair.view("b").legend
+
+
+def test_the_legend_of_a_continuous_map_on_the_other_mesh_names_its_range(tmp_path, spot):
+    """On B, the distance from A's vertex is nowhere 0 (B is a noisy copy): the legend
+    names the range the colours span, from the best match's distance, not from 0."""
+    noise = 0.004 * np.random.default_rng(5).normal(size=spot.vertices.shape)
+    pair = _pair(tmp_path, spot, mv.Mesh(_moved(spot).vertices + noise, spot.faces), k=K)
+    _wait(pair)
+    pair.pick("a", 700)
+    view = pair.view("b")
+    lo, hi = float(np.nanmin(view.values)), float(np.nanmax(view.values))
+    assert lo > 1e-3 * hi  # no vertex of B has distance 0
+    assert f"white {lo:.3g} to red {hi:.3g}" in view.legend, view.legend
