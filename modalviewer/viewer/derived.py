@@ -132,14 +132,14 @@ class DerivedValues:
 
     def color_range(self, values: np.ndarray, colormap: str) -> tuple[tuple, tuple, str]:
         """(clim, clipped (low, high), rule applied) of ``values`` drawn with ``colormap``
-        under ``style.color_range``; "auto" is symmetric for modes, else robust, or
-        "spread" where a tenth of the robust scale would cover more than
+        under ``style.color_range``; "auto" is symmetric for modes (every mode), else
+        robust, or "spread" where a tenth of the robust scale would cover more than
         :data:`.color_scale.SPREAD_SHARE` of the surface."""
         style, values = self.state.style, np.asarray(values, dtype=np.float64)
         rule = style.color_range
-        automatic = rule == "auto"
-        if automatic:
-            rule = "symmetric" if self.state.display.kind == "mode" else "robust"
+        may_spread = rule == "auto" and self.state.display.kind != "mode"  # modes: one rule
+        if rule == "auto":
+            rule = "robust" if may_spread else "symmetric"
         if rule == "spread":
             if colormap == "sequential" and values.size:
                 return (float(values.min()), float(values.max())), (False, False), rule
@@ -155,7 +155,7 @@ class DerivedValues:
             a = a or 1.0
             lo, hi = (-a, a) if colormap == "diverging" else (0.0, a)
         if (
-            automatic
+            may_spread
             and colormap == "sequential"
             and values.size
             and crowded_share(values, self.vertex_areas(), (lo, hi)) > SPREAD_SHARE

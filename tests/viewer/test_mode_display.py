@@ -159,6 +159,22 @@ def spot():
     v.close()
 
 
+def test_automatic_colours_of_3d_modes_keep_one_rule_from_mode_to_mode(machined):
+    """Stepping through 3D modes drawn as deformed shapes (|Phi|, white to red), the
+    automatic range is the largest |value| for every mode, so a colour means the same
+    share of a mode's largest displacement on each (not spread by area on some)."""
+    state = machined.state
+    assert state.style.color_range == "auto"
+    rules = []
+    for mode in range(6, 16):
+        machined.show_mode(mode)
+        field = state.derived.field()
+        assert field.colormap == "sequential"
+        rules.append(field.color_range)
+        assert field.clim == (0.0, pytest.approx(float(np.max(np.abs(field.values)))))
+    assert set(rules) == {"symmetric"}, rules
+
+
 def test_the_robust_range_clips_at_the_99th_area_weighted_percentile(spot):
     state = spot.state
     assert state.style.color_range == "auto"
