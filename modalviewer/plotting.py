@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .core.operators import DISTANCE_KINDS
 from .core.spectrum import Spectrum
 from .extras import extra_needed
 from .interop import as_mesh
@@ -143,8 +144,6 @@ def distance_kind_of(spectrum: Spectrum | None, kind: str | None) -> str:
         return kind
     own = "vibration" if spectrum is None else spectrum.operator_info.distance_kind
     if own is None:
-        from .core.operators import DISTANCE_KINDS
-
         raise ValueError(
             f"a {spectrum.operator} spectrum defines no distance; pass kind= (one of "
             f"{', '.join(DISTANCE_KINDS)})"

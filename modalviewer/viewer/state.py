@@ -343,7 +343,7 @@ class ViewerState:
         """Mark the spectrum of ``key`` as computed or queued (or not)."""
         if computing == (key in self.computing):
             return
-        self.computing.symmetric_difference_update({key})  # in if computing, out if not
+        (self.computing.add if computing else self.computing.discard)(key)
         self.events.spectra.emit(key.operator)
         if self.display_operator() == key.operator:
             self.events.display.emit()
